@@ -1,0 +1,48 @@
+//! Index sets.
+
+use crate::{Comm, Int, Result};
+use petsc_sys as sys;
+
+/// An owned index set, destroyed on drop.
+pub struct IndexSet {
+    raw: sys::IS,
+}
+
+impl Drop for IndexSet {
+    fn drop(&mut self) {
+        // SAFETY: owned handle, destroyed once.
+        unsafe { sys::ISDestroy(&mut self.raw) };
+    }
+}
+
+impl IndexSet {
+    /// An index set holding a copy of `idx` (global indices owned by this rank).
+    pub fn new_general(comm: Comm, idx: &[Int]) -> Result<IndexSet> {
+        let mut raw = std::ptr::null_mut();
+        call!(ISCreateGeneral(comm.raw(), idx.len() as Int, idx.as_ptr(), sys::PetscCopyMode::PETSC_COPY_VALUES, &mut raw))?;
+        Ok(IndexSet { raw })
+    }
+
+    /// Number of indices on this rank.
+    pub fn local_len(&self) -> Result<usize> {
+        let mut n: Int = 0;
+        call!(ISGetLocalSize(self.raw, &mut n))?;
+        Ok(n as usize)
+    }
+
+    /// The indices on this rank.
+    pub fn indices(&self) -> Result<Vec<Int>> {
+        let n = self.local_len()?;
+        let mut p: *const Int = std::ptr::null();
+        call!(ISGetIndices(self.raw, &mut p))?;
+        // SAFETY: ISGetIndices returned `n` indices, valid until ISRestoreIndices.
+        let v = if n == 0 { Vec::new() } else { unsafe { std::slice::from_raw_parts(p, n) }.to_vec() };
+        call!(ISRestoreIndices(self.raw, &mut p))?;
+        Ok(v)
+    }
+
+    #[allow(dead_code)]
+    pub(crate) fn raw(&self) -> sys::IS {
+        self.raw
+    }
+}

@@ -1,0 +1,276 @@
+//! Nonlinear solvers (SNES) with residual and Jacobian callbacks written in Rust.
+//!
+//! The callbacks are the two methods of a [`NonlinearProblem`], borrowed only for the duration of
+//! one [`Snes::solve`]; outside a solve the SNES holds no pointer to Rust data. Panics inside the
+//! callbacks are caught at the FFI boundary and become errors; a [`CallbackError::Domain`] marks the
+//! trial state as inadmissible (`SNESSetFunctionDomainError`), which makes the solve end as diverged
+//! instead of failing, so the caller can cut the step.
+
+use crate::ksp::KspRef;
+use crate::mat::{Mat, MatRef};
+use crate::vector::{VecOps, VecRef, Vector};
+use crate::{cstring, error, Comm, Int, Real, Result};
+use petsc_sys as sys;
+use std::ffi::{c_char, c_void, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Why a callback could not produce its result.
+#[derive(Debug, Clone)]
+pub enum CallbackError {
+    /// The trial state is outside the domain of the problem (e.g. a particle's volume became
+    /// negative): the solve stops as diverged and the caller may retry with a smaller step.
+    Domain(String),
+    /// Anything else: the solve fails with this message.
+    Fatal(String),
+}
+
+/// The residual and Jacobian of a nonlinear system `F(x) = 0`.
+pub trait NonlinearProblem {
+    /// Evaluates `f = F(x)`.
+    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> std::result::Result<(), CallbackError>;
+    /// Assembles the Jacobian `J = dF/dx` at `x` into `j` (the matrix given to [`Snes::solve`]).
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> std::result::Result<(), CallbackError>;
+}
+
+/// What one [`Snes::solve`] did.
+#[derive(Debug, Clone)]
+pub struct SolveOutcome {
+    /// Whether SNES reports convergence.
+    pub converged: bool,
+    /// PETSc's `SNESConvergedReason` (positive: converged).
+    pub reason: i32,
+    /// PETSc's name for the reason (`CONVERGED_FNORM_RELATIVE`, `DIVERGED_LINE_SEARCH`, ...).
+    pub reason_text: String,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Krylov iterations summed over the Newton iterations.
+    pub linear_iterations: usize,
+    /// Residual 2-norm before the first and after every Newton iteration.
+    pub residual_history: Vec<Real>,
+    /// The message of a [`CallbackError::Domain`] raised during the solve, if any.
+    pub domain_error: Option<String>,
+}
+
+/// An owned SNES, destroyed on drop.
+pub struct Snes {
+    raw: sys::SNES,
+    history: Box<[Real]>,
+    history_its: Box<[Int]>,
+}
+
+impl Drop for Snes {
+    fn drop(&mut self) {
+        // SAFETY: owned handle, destroyed once; the history buffers outlive it.
+        unsafe { sys::SNESDestroy(&mut self.raw) };
+    }
+}
+
+struct Context<'a> {
+    problem: &'a mut dyn NonlinearProblem,
+    domain_error: Option<String>,
+}
+
+fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+/// Maps a callback's outcome to a PETSc error code (0 = success or domain error already flagged).
+fn finish(
+    outcome: std::thread::Result<std::result::Result<(), CallbackError>>,
+    what: &str,
+    ctx: &mut Context,
+    flag_domain: impl FnOnce(),
+) -> sys::PetscErrorCode {
+    match outcome {
+        Ok(Ok(())) => 0,
+        Ok(Err(CallbackError::Domain(msg))) => {
+            if ctx.domain_error.is_none() {
+                ctx.domain_error = Some(msg);
+            }
+            flag_domain();
+            0
+        }
+        Ok(Err(CallbackError::Fatal(msg))) => {
+            error::set_pending(format!("{what}: {msg}"));
+            sys::PETSC_ERR_USER as sys::PetscErrorCode
+        }
+        Err(p) => {
+            error::set_pending(format!("{what} panicked: {}", panic_text(p)));
+            sys::PETSC_ERR_USER as sys::PetscErrorCode
+        }
+    }
+}
+
+unsafe extern "C" fn residual_trampoline(snes: sys::SNES, x: sys::Vec, f: sys::Vec, ctx: *mut c_void) -> sys::PetscErrorCode {
+    if ctx.is_null() {
+        error::set_pending("SNES residual evaluated outside Snes::solve".into());
+        return sys::PETSC_ERR_ORDER as sys::PetscErrorCode;
+    }
+    // SAFETY: `ctx` points to the Context living on the stack of `Snes::solve` during the solve.
+    let ctx = unsafe { &mut *(ctx as *mut Context) };
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.residual(&VecRef::new(x), &mut VecRef::new(f))));
+    finish(outcome, "residual evaluation", ctx, || {
+        // SAFETY: valid SNES handle passed by PETSc.
+        unsafe { sys::SNESSetFunctionDomainError(snes) };
+    })
+}
+
+unsafe extern "C" fn jacobian_trampoline(
+    snes: sys::SNES,
+    x: sys::Vec,
+    a: sys::Mat,
+    _p: sys::Mat,
+    ctx: *mut c_void,
+) -> sys::PetscErrorCode {
+    if ctx.is_null() {
+        error::set_pending("SNES Jacobian evaluated outside Snes::solve".into());
+        return sys::PETSC_ERR_ORDER as sys::PetscErrorCode;
+    }
+    // SAFETY: as in `residual_trampoline`.
+    let ctx = unsafe { &mut *(ctx as *mut Context) };
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a))));
+    finish(outcome, "Jacobian assembly", ctx, || {
+        // SAFETY: valid SNES handle passed by PETSc.
+        unsafe { sys::SNESSetJacobianDomainError(snes) };
+    })
+}
+
+impl Snes {
+    /// A new nonlinear solver on `comm`.
+    pub fn new(comm: Comm) -> Result<Snes> {
+        let mut raw = std::ptr::null_mut();
+        call!(SNESCreate(comm.raw(), &mut raw))?;
+        let mut s = Snes { raw, history: vec![0.0; 1000].into_boxed_slice(), history_its: vec![0; 1000].into_boxed_slice() };
+        call!(SNESSetConvergenceHistory(
+            s.raw,
+            s.history.as_mut_ptr(),
+            s.history_its.as_mut_ptr(),
+            s.history.len() as Int,
+            sys::PetscBool::PETSC_TRUE
+        ))?;
+        Ok(s)
+    }
+
+    /// Attaches a DM (its field names drive `-pc_fieldsplit_*_fields`).
+    pub fn set_dm(&mut self, dm: &crate::DmDa) -> Result<()> {
+        call!(SNESSetDM(self.raw, dm.raw()))
+    }
+
+    /// Sets the SNES method by PETSc name (`"newtonls"`, ...).
+    pub fn set_type(&mut self, name: &str) -> Result<()> {
+        let c = cstring(name)?;
+        call!(SNESSetType(self.raw, c.as_ptr()))
+    }
+
+    /// Absolute, relative and step tolerances and the iteration limit (`None` keeps PETSc's).
+    pub fn set_tolerances(&mut self, atol: Option<Real>, rtol: Option<Real>, stol: Option<Real>, max_it: Option<usize>) -> Result<()> {
+        let d = sys::PETSC_DEFAULT as Real;
+        call!(SNESSetTolerances(
+            self.raw,
+            atol.unwrap_or(d),
+            rtol.unwrap_or(d),
+            stol.unwrap_or(d),
+            max_it.map_or(sys::PETSC_DEFAULT as Int, |m| m as Int),
+            sys::PETSC_DEFAULT as Int
+        ))
+    }
+
+    /// Current (atol, rtol, stol, max_it).
+    pub fn tolerances(&self) -> Result<(Real, Real, Real, usize)> {
+        let (mut a, mut r, mut s) = (0.0, 0.0, 0.0);
+        let (mut it, mut mf): (Int, Int) = (0, 0);
+        call!(SNESGetTolerances(self.raw, &mut a, &mut r, &mut s, &mut it, &mut mf))?;
+        Ok((a, r, s, it as usize))
+    }
+
+    /// Rebuild the Jacobian every `lag` iterations within a solve (-1: never, -2: once more).
+    pub fn set_lag_jacobian(&mut self, lag: i32) -> Result<()> {
+        call!(SNESSetLagJacobian(self.raw, lag))
+    }
+
+    /// The current Jacobian lag.
+    pub fn lag_jacobian(&self) -> Result<i32> {
+        let mut l: Int = 0;
+        call!(SNESGetLagJacobian(self.raw, &mut l))?;
+        Ok(l)
+    }
+
+    /// Sets the options prefix.
+    pub fn set_prefix(&mut self, prefix: &str) -> Result<()> {
+        crate::set_object_prefix(self.raw as sys::PetscObject, prefix)
+    }
+
+    /// Reads `-snes_*`, `-ksp_*`, `-pc_*` options (call after the defaults set in code).
+    pub fn set_from_options(&mut self) -> Result<()> {
+        call!(SNESSetFromOptions(self.raw))
+    }
+
+    /// The linear solver inside the SNES.
+    pub fn ksp(&mut self) -> Result<KspRef<'_>> {
+        let mut k = std::ptr::null_mut();
+        call!(SNESGetKSP(self.raw, &mut k))?;
+        Ok(KspRef::new(k))
+    }
+
+    /// The SNES method's PETSc name.
+    pub fn type_name(&self) -> Result<String> {
+        let mut t: sys::SNESType = std::ptr::null();
+        call!(SNESGetType(self.raw, &mut t))?;
+        // SAFETY: PETSc returns a NUL-terminated static string.
+        Ok(if t.is_null() { String::new() } else { unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned() })
+    }
+
+    /// Prints the solver configuration (what `-snes_view` prints).
+    pub fn view(&self, viewer: &crate::Viewer) -> Result<()> {
+        call!(SNESView(self.raw, viewer.raw()))
+    }
+
+    /// Solves `F(x) = 0` starting from `x`, with `jac` as Jacobian (and preconditioning) matrix.
+    ///
+    /// Solver failures that PETSc reports as divergence (line search, iteration limit, domain
+    /// error) come back as `Ok` with `converged == false`; only genuine errors are `Err`.
+    pub fn solve(&mut self, x: &mut Vector, jac: &mut Mat, problem: &mut dyn NonlinearProblem) -> Result<SolveOutcome> {
+        let mut ctx = Context { problem, domain_error: None };
+        let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
+        call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), ctx_ptr))?;
+        call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), ctx_ptr))?;
+        let solved = call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()));
+        // Never leave a pointer to this stack frame inside the SNES.
+        let unset_f = call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), std::ptr::null_mut()));
+        let unset_j = call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), std::ptr::null_mut()));
+        solved?;
+        unset_f?;
+        unset_j?;
+
+        let mut reason = sys::SNESConvergedReason(0);
+        call!(SNESGetConvergedReason(self.raw, &mut reason))?;
+        let mut text: *const c_char = std::ptr::null();
+        call!(SNESGetConvergedReasonString(self.raw, &mut text))?;
+        // SAFETY: PETSc returns a NUL-terminated static string.
+        let reason_text = if text.is_null() { String::new() } else { unsafe { CStr::from_ptr(text) }.to_string_lossy().into_owned() };
+        let mut its: Int = 0;
+        call!(SNESGetIterationNumber(self.raw, &mut its))?;
+        let mut lits: Int = 0;
+        call!(SNESGetLinearSolveIterations(self.raw, &mut lits))?;
+        let mut hist: *mut Real = std::ptr::null_mut();
+        let mut hist_its: *mut Int = std::ptr::null_mut();
+        let mut nhist: Int = 0;
+        call!(SNESGetConvergenceHistory(self.raw, &mut hist, &mut hist_its, &mut nhist))?;
+        let n = (nhist.max(0) as usize).min(self.history.len());
+        Ok(SolveOutcome {
+            converged: reason.0 > 0,
+            reason: reason.0,
+            reason_text,
+            iterations: its as usize,
+            linear_iterations: lits as usize,
+            residual_history: self.history[..n].to_vec(),
+            domain_error: ctx.domain_error,
+        })
+    }
+}

@@ -1,0 +1,375 @@
+//! PETSc smoke tests of the safe layer, run in one process (PETSc and MPI can be initialised only
+//! once per process, so this file is its own harness).
+//!
+//! * every `.opts` file in `petsc_options/` assembles and solves a small symmetric indefinite
+//!   five-field system on a DMDA (same layout as the u-p-U problem) through SNES, and the solution
+//!   matches the manufactured one;
+//! * SNES solves a small nonlinear system with a hand-coded tangent that agrees with a
+//!   finite-difference Jacobian, and converges quadratically;
+//! * errors from PETSc, from callbacks and from panics in callbacks come back as `Err` with a message;
+//!   a domain error ends the solve as diverged; unused options are reported.
+
+use petsc::ksp::KspOps;
+use petsc::mat::MatOps;
+use petsc::snes::NonlinearProblem;
+use petsc::{CallbackError, Comm, DmDa, Mat, MatRef, Options, Petsc, Snes, VecOps, VecRef, Vector};
+use std::path::{Path, PathBuf};
+
+type TestResult = Result<(), String>;
+
+fn e<T: std::fmt::Display>(x: T) -> String {
+    x.to_string()
+}
+
+/// A linear five-field system `A x = b` on a DMDA: Laplacian + identity on the fields 0,1,3,4,
+/// minus a small mass on field 2, coupled symmetrically to field 0. Symmetric indefinite.
+struct SaddleSystem<'a> {
+    dm: &'a DmDa,
+    rhs: Vec<f64>,
+}
+
+impl SaddleSystem<'_> {
+    fn assemble(&self, a: &mut dyn MatOps) -> Result<(), petsc::Error> {
+        let info = *self.dm.info();
+        let g = info.ghosted;
+        let [nx, ny] = info.nodes;
+        for j in info.owned_start[1]..info.owned_start[1] + info.owned_count[1] {
+            for i in info.owned_start[0]..info.owned_start[0] + info.owned_count[0] {
+                let row_node = g.node(i, j).unwrap();
+                for f in 0..5 {
+                    let r = (row_node * 5 + f) as i32;
+                    if f == 2 {
+                        a.set_values_local(&[r], &[r], &[-0.05], true)?;
+                        let c = (row_node * 5) as i32;
+                        a.set_values_local(&[r], &[c], &[0.3], true)?;
+                        a.set_values_local(&[c], &[r], &[0.3], true)?;
+                        continue;
+                    }
+                    a.set_values_local(&[r], &[r], &[5.0], true)?;
+                    let nbrs = [(i.wrapping_sub(1), j), (i + 1, j), (i, j.wrapping_sub(1)), (i, j + 1)];
+                    for (ni, nj) in nbrs {
+                        if ni < nx && nj < ny {
+                            let c = (g.node(ni, nj).unwrap() * 5 + f) as i32;
+                            a.set_values_local(&[r], &[c], &[-1.0], true)?;
+                        }
+                    }
+                }
+            }
+        }
+        a.assemble()
+    }
+}
+
+impl NonlinearProblem for SaddleSystem<'_> {
+    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
+        // F(x) = A x - b, with A applied through a freshly assembled matrix (keeps the test simple).
+        let mut a = self.dm.create_matrix().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        self.assemble(&mut a).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        a.mult(x, f).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let mut fa = f.write().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        for (fi, bi) in fa.iter_mut().zip(&self.rhs) {
+            *fi -= bi;
+        }
+        Ok(())
+    }
+
+    fn jacobian(&mut self, _x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+        j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        self.assemble(j).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        Ok(())
+    }
+}
+
+fn solve_with_options_file(path: &Path) -> TestResult {
+    let comm = Comm::world();
+    let mut opts = Options::new().map_err(e)?;
+    opts.insert_file(comm, path).map_err(e)?;
+    opts.push().map_err(e)?;
+    let dm = DmDa::new_2d(comm, [6, 5], 1, &["ux", "uy", "p", "Ux", "Uy"]).map_err(e)?;
+    // Manufactured solution and right-hand side b = A x*.
+    let mut a = dm.create_matrix().map_err(e)?;
+    let sys0 = SaddleSystem { dm: &dm, rhs: Vec::new() };
+    sys0.assemble(&mut a).map_err(e)?;
+    let mut xstar = dm.create_global_vector().map_err(e)?;
+    {
+        let (lo, _) = xstar.ownership_range().map_err(e)?;
+        let mut w = xstar.write().map_err(e)?;
+        for (k, v) in w.iter_mut().enumerate() {
+            *v = ((lo + k) as f64 * 0.37).sin() + 0.1;
+        }
+    }
+    let mut b = dm.create_global_vector().map_err(e)?;
+    a.mult(&xstar, &mut b).map_err(e)?;
+    let rhs = b.read().map_err(e)?.to_vec();
+    let mut problem = SaddleSystem { dm: &dm, rhs };
+
+    let mut snes = Snes::new(comm).map_err(e)?;
+    snes.set_dm(&dm).map_err(e)?;
+    // Defaults in code (as the application does), then the options file on top.
+    {
+        let mut ksp = snes.ksp().map_err(e)?;
+        ksp.set_type("preonly").map_err(e)?;
+        ksp.pc().map_err(e)?.set_type("lu").map_err(e)?;
+    }
+    snes.set_tolerances(None, Some(1e-10), None, Some(50)).map_err(e)?;
+    snes.set_from_options().map_err(e)?;
+    let mut x = dm.create_global_vector().map_err(e)?;
+    x.set_all(0.0).map_err(e)?;
+    let mut jac = dm.create_matrix().map_err(e)?;
+    let out = snes.solve(&mut x, &mut jac, &mut problem).map_err(e)?;
+    if !out.converged {
+        return Err(format!("SNES did not converge: {}", out.reason_text));
+    }
+    x.axpy(-1.0, &xstar).map_err(e)?;
+    let err = x.norm2().map_err(e)? / xstar.norm2().map_err(e)?;
+    if err > 1e-7 {
+        return Err(format!("solution error {err:.3e} > 1e-7"));
+    }
+    let unused = opts.unused().map_err(e)?;
+    drop(snes);
+    opts.pop().map_err(e)?;
+    if !unused.is_empty() {
+        return Err(format!("options not used: {}", unused.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(" ")));
+    }
+    println!("    {}: rel. error {err:.2e}, {} Newton, {} Krylov iterations", path.display(), out.iterations, out.linear_iterations);
+    Ok(())
+}
+
+fn every_options_file_solves_the_saddle_system() -> TestResult {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("petsc_options");
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(&dir).map_err(e)?.flatten().map(|d| d.path()).filter(|p| p.extension().is_some_and(|x| x == "opts")).collect();
+    files.sort();
+    if files.len() < 5 {
+        return Err(format!("expected at least five .opts files in {}, found {}", dir.display(), files.len()));
+    }
+    for f in files {
+        solve_with_options_file(&f).map_err(|m| format!("{}: {m}", f.display()))?;
+    }
+    Ok(())
+}
+
+/// F_i(x) = x_i^3 + (L x)_i - b_i with L the 1D Laplacian: a small nonlinear system.
+struct Cubic {
+    n: usize,
+    b: Vec<f64>,
+    calls: usize,
+    mode: Mode,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    Normal,
+    Fatal,
+    Panic,
+    Domain,
+}
+
+impl Cubic {
+    fn eval(&self, x: &[f64]) -> Vec<f64> {
+        (0..self.n)
+            .map(|i| {
+                let mut lx = 2.0 * x[i];
+                if i > 0 {
+                    lx -= x[i - 1];
+                }
+                if i + 1 < self.n {
+                    lx -= x[i + 1];
+                }
+                x[i].powi(3) + lx - self.b[i]
+            })
+            .collect()
+    }
+
+    fn tangent(&self, x: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut j = vec![0.0; n * n];
+        for i in 0..n {
+            j[i * n + i] = 3.0 * x[i] * x[i] + 2.0;
+            if i > 0 {
+                j[i * n + i - 1] = -1.0;
+            }
+            if i + 1 < n {
+                j[i * n + i + 1] = -1.0;
+            }
+        }
+        j
+    }
+}
+
+impl NonlinearProblem for Cubic {
+    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
+        self.calls += 1;
+        match self.mode {
+            Mode::Fatal => return Err(CallbackError::Fatal("the residual refuses".into())),
+            Mode::Panic => panic!("deliberate panic in a residual callback"),
+            Mode::Domain => return Err(CallbackError::Domain("volume became negative".into())),
+            Mode::Normal => {}
+        }
+        let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
+        let r = self.eval(&xv);
+        f.write().map_err(|e| CallbackError::Fatal(e.to_string()))?.copy_from_slice(&r);
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+        let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
+        let t = self.tangent(&xv);
+        let idx: Vec<i32> = (0..self.n as i32).collect();
+        j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        j.set_values(&idx, &idx, &t, false).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        j.assemble().map_err(|e| CallbackError::Fatal(e.to_string()))
+    }
+}
+
+fn dense_matrix(n: usize) -> Result<Mat, petsc::Error> {
+    let nnz = vec![n as i32; n];
+    Mat::new_aij(Comm::self_(), n, n, &nnz, &vec![0; n])
+}
+
+fn snes_self(problem: &mut Cubic) -> Result<petsc::SolveOutcome, petsc::Error> {
+    let mut snes = Snes::new(Comm::self_())?;
+    snes.set_prefix("cubic_")?;
+    {
+        let mut ksp = snes.ksp()?;
+        ksp.set_type("preonly")?;
+        ksp.pc()?.set_type("lu")?;
+    }
+    snes.set_tolerances(Some(1e-14), Some(1e-12), Some(0.0), Some(30))?;
+    snes.set_from_options()?;
+    let mut x = Vector::from_slice(&vec![0.5; problem.n])?;
+    let mut j = dense_matrix(problem.n)?;
+    snes.solve(&mut x, &mut j, problem)
+}
+
+fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResult {
+    let n = 8;
+    let mut p = Cubic { n, b: (0..n).map(|i| 1.0 + 0.3 * i as f64).collect(), calls: 0, mode: Mode::Normal };
+    // Central finite differences of the residual at a generic point, column by column.
+    let x0: Vec<f64> = (0..n).map(|i| 0.2 + 0.1 * (i as f64).cos()).collect();
+    let t = p.tangent(&x0);
+    let h = 1e-6;
+    let mut max_err: f64 = 0.0;
+    for c in 0..n {
+        let (mut xp, mut xm) = (x0.clone(), x0.clone());
+        xp[c] += h;
+        xm[c] -= h;
+        let (fp, fm) = (p.eval(&xp), p.eval(&xm));
+        for r in 0..n {
+            let fd = (fp[r] - fm[r]) / (2.0 * h);
+            max_err = max_err.max((fd - t[r * n + c]).abs());
+        }
+    }
+    if max_err > 1e-7 {
+        return Err(format!("tangent differs from finite differences by {max_err:.3e}"));
+    }
+    let out = snes_self(&mut p).map_err(e)?;
+    if !out.converged {
+        return Err(format!("Newton did not converge: {}", out.reason_text));
+    }
+    let h = &out.residual_history;
+    // Quadratic convergence: in the last iterations log(r_{k+1}) ~ 2 log(r_k) (ratio r_{k+1}/r_k^2 bounded).
+    let k = h.len();
+    if k < 4 {
+        return Err(format!("expected several Newton iterations, history {h:?}"));
+    }
+    let rate = (h[k - 2] / h[k - 3]).ln() / (h[k - 3] / h[k - 4]).ln();
+    if rate < 1.8 {
+        return Err(format!("Newton convergence order {rate:.2} < 1.8 (history {h:?})"));
+    }
+    println!("    FD tangent error {max_err:.1e}; Newton history {:?}; observed order {rate:.2}", h);
+    Ok(())
+}
+
+fn callback_errors_panics_and_domain_errors_are_reported() -> TestResult {
+    let n = 4;
+    let mk = |mode| Cubic { n, b: vec![1.0; n], calls: 0, mode };
+    match snes_self(&mut mk(Mode::Fatal)) {
+        Err(err) if err.message.contains("the residual refuses") => {}
+        other => return Err(format!("fatal callback error not reported: {:?}", other.map(|o| o.reason_text))),
+    }
+    // Silence the default hook's message for the deliberate panic.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let r = snes_self(&mut mk(Mode::Panic));
+    std::panic::set_hook(hook);
+    match r {
+        Err(err) if err.message.contains("panicked") && err.message.contains("deliberate panic") => {}
+        other => return Err(format!("panic in callback not reported: {:?}", other.map(|o| o.reason_text))),
+    }
+    match snes_self(&mut mk(Mode::Domain)) {
+        Ok(out) if !out.converged && out.domain_error.as_deref() == Some("volume became negative") => {}
+        other => return Err(format!("domain error not reported as divergence: {:?}", other.map(|o| (o.converged, o.reason_text)))),
+    }
+    Ok(())
+}
+
+fn petsc_errors_carry_petsc_messages() -> TestResult {
+    // Inserting outside the preallocated pattern of a matrix that forbids new nonzeros fails.
+    let mut m = dense_matrix(3).map_err(e)?;
+    let r = m.set_values(&[7], &[0], &[1.0], false);
+    match r {
+        Err(err) if err.message.contains("MatSetValues") || err.message.to_lowercase().contains("out of range") => {
+            println!("    PETSc error reported as: {}", err.message);
+            Ok(())
+        }
+        Err(err) => Err(format!("unexpected message: {}", err.message)),
+        Ok(()) => Err("out-of-range insertion was accepted".into()),
+    }
+}
+
+fn unused_options_are_reported() -> TestResult {
+    let mut opts = Options::new().map_err(e)?;
+    opts.insert_string("-snes_rtol 1e-9 -this_option_does_not_exist 3").map_err(e)?;
+    opts.push().map_err(e)?;
+    let mut p = Cubic { n: 3, b: vec![1.0; 3], calls: 0, mode: Mode::Normal };
+    let mut snes = Snes::new(Comm::self_()).map_err(e)?;
+    snes.set_from_options().map_err(e)?;
+    let mut x = Vector::from_slice(&[0.0; 3]).map_err(e)?;
+    let mut j = dense_matrix(3).map_err(e)?;
+    snes.solve(&mut x, &mut j, &mut p).map_err(e)?;
+    let unused = opts.unused().map_err(e)?;
+    drop(snes);
+    opts.pop().map_err(e)?;
+    let names: Vec<String> = unused.iter().map(|o| o.name.clone()).collect();
+    if names != ["this_option_does_not_exist"] {
+        return Err(format!("unused options reported as {names:?}"));
+    }
+    Ok(())
+}
+
+fn main() {
+    let petsc = match Petsc::initialize(&[], None, "porompm PETSc smoke tests") {
+        Ok(p) => p,
+        Err(err) => {
+            eprintln!("cannot initialise PETSc: {err}");
+            std::process::exit(1);
+        }
+    };
+    let tests: &[(&str, fn() -> TestResult)] = &[
+        ("every_options_file_solves_the_saddle_system", every_options_file_solves_the_saddle_system),
+        ("hand_tangent_matches_finite_differences_and_newton_is_quadratic", hand_tangent_matches_finite_differences_and_newton_is_quadratic),
+        ("callback_errors_panics_and_domain_errors_are_reported", callback_errors_panics_and_domain_errors_are_reported),
+        ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
+        ("unused_options_are_reported", unused_options_are_reported),
+    ];
+    let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
+    let mut failed = 0;
+    let mut ran = 0;
+    for (name, t) in tests {
+        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        ran += 1;
+        match t() {
+            Ok(()) => println!("test {name} ... ok"),
+            Err(msg) => {
+                failed += 1;
+                println!("test {name} ... FAILED\n    {msg}");
+            }
+        }
+    }
+    drop(petsc);
+    println!("\npetsc_smoke: {} passed; {failed} failed", ran - failed);
+    std::process::exit(if failed == 0 { 0 } else { 1 });
+}
