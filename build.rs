@@ -1,5 +1,5 @@
-//! Embeds the git revision and the PETSc version and packages (from `petsc-sys`'s build metadata)
-//! so that `porompm --version` can print them.
+//! Embeds the git revision and the PETSc version and packages (from `petsc-sys`'s `links`
+//! metadata) so that `porompm --version` prints them.
 
 use std::process::Command;
 
@@ -15,8 +15,14 @@ fn main() {
     println!("cargo:rustc-env=POROMPM_GIT_REV={rev}");
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/index");
-    // petsc-sys declares `links = "petsc"`, so its metadata reaches us only through the `petsc`
-    // crate; read it from petsc-sys's environment if forwarded, else leave it to run time.
-    let version = std::env::var("DEP_PETSC_VERSION").unwrap_or_default();
-    println!("cargo:rustc-env=POROMPM_PETSC_HEADERS={version}");
+    let version = std::env::var("DEP_PETSC_VERSION").unwrap_or_else(|_| "unknown".into());
+    let packages: Vec<&str> = ["mumps", "hypre", "superlu_dist", "suitesparse", "hdf5"]
+        .into_iter()
+        .filter(|p| std::env::var(format!("DEP_PETSC_{}", p.to_uppercase())).as_deref() == Ok("1"))
+        .collect();
+    println!("cargo:rustc-env=POROMPM_PETSC_VERSION={version}");
+    println!(
+        "cargo:rustc-env=POROMPM_PETSC_PACKAGES={}",
+        packages.join(", ")
+    );
 }

@@ -1,1 +1,280 @@
-fn main() {}
+//! The `porompm` command line. The only place that initialises MPI and PETSc.
+//!
+//! Exit codes: 0 success; 1 a run failed (e.g. a step did not converge); 2 bad input (case file,
+//! override, options file, unused PETSc option). Every error is one line on standard error.
+
+use clap::{Parser, Subcommand};
+use porompm::case::{self, Override};
+use porompm::driver::{self, RunError, RunRequest};
+use porompm::io::{self, RunOutput};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "porompm", version = porompm::VERSION_LONG, about = "Implicit u–p–U GIMP material point method for saturated soils, on PETSc")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case: writes summary.json and history.csv into DIR.
+    Run {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// PETSc options file(s), applied in order after the case's own and before the command line's.
+        #[arg(long = "options-file", value_name = "FILE")]
+        options_file: Vec<PathBuf>,
+        /// Override a case value by its dotted path, e.g. `--set stages[0].dt=5e-4`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress messages.
+        #[arg(long)]
+        quiet: bool,
+        /// PETSc options, after `--` (they reach PETSc's options database unchanged).
+        #[arg(last = true, value_name = "PETSC_OPTIONS")]
+        petsc: Vec<String>,
+    },
+    /// Parse and validate a case and print what it will build.
+    Check {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Override a case value by its dotted path.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// Compare the assembled tangent with finite differences of the residual, block by block, after
+    /// a few steps of a (small) case; exits with 1 if a block differs by more than the tolerance.
+    TestJacobian {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Steps to run before the check (so that particles carry stress, velocity, pressure).
+        #[arg(long, default_value_t = 3)]
+        steps: usize,
+        /// Largest accepted relative difference per block.
+        #[arg(long, default_value_t = 1e-6)]
+        tolerance: f64,
+        /// Override a case value by its dotted path.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// PETSc options, after `--`.
+        #[arg(last = true)]
+        petsc: Vec<String>,
+    },
+    /// Print the MPI and PETSc environment and check a collective operation.
+    Info {
+        /// PETSc options, after `--`.
+        #[arg(last = true)]
+        petsc: Vec<String>,
+    },
+}
+
+/// A failure of the command, with its exit code.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn input(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
+    let overrides: Vec<Override> = sets
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<_, _>>()
+        .map_err(|e| input(e.to_string()))?;
+    let text = io::read_text(path).map_err(input)?;
+    case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
+}
+
+fn run(
+    case_path: &Path,
+    out: &Path,
+    options_files: &[PathBuf],
+    sets: &[String],
+    quiet: bool,
+    petsc_args: &[String],
+) -> Result<(), Failure> {
+    let c = load_case(case_path, sets)?;
+    // Options files: the case's own (relative to the case file), then the command line's.
+    let mut files: Vec<PathBuf> = Vec::new();
+    if let Some(f) = &c.solver.options_file {
+        let base = case_path.parent().unwrap_or(Path::new("."));
+        files.push(base.join(f));
+    }
+    files.extend(options_files.iter().cloned());
+    for f in &files {
+        if !f.is_file() {
+            return Err(input(format!(
+                "PETSc options file {} does not exist",
+                f.display()
+            )));
+        }
+    }
+    let mut args: Vec<String> = Vec::new();
+    for f in &files {
+        args.push("-options_file".into());
+        args.push(f.display().to_string());
+    }
+    args.extend(petsc_args.iter().cloned());
+    let petsc = petsc::Petsc::initialize(&args, None, "porompm")
+        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    let comm = petsc.world();
+    let mut output = RunOutput::create(out, comm.rank() == 0).map_err(input)?;
+    let req = RunRequest {
+        case: &c,
+        case_label: case_path.display().to_string(),
+        overrides: sets.to_vec(),
+        out_dir: out.to_path_buf(),
+        quiet,
+        comm,
+    };
+    let (summary, err) = driver::run(&req, &mut output);
+    drop(output);
+    if comm.rank() == 0 && !quiet {
+        for (name, m) in &summary.verification {
+            eprintln!(
+                "{name} = {:.4e} (tolerance {:.1e}) {}  [{}]",
+                m.value,
+                m.tolerance,
+                if m.pass { "pass" } else { "FAIL" },
+                m.detail
+            );
+        }
+        eprintln!(
+            "{}: {} steps, {} Newton and {} Krylov iterations, {} unknowns, {} material points, {:.2} s wall time",
+            summary.status, summary.steps, summary.snes_iterations, summary.ksp_iterations, summary.dofs, summary.particles, summary.wall_time_s
+        );
+    }
+    drop(petsc);
+    match err {
+        None => Ok(()),
+        Some(RunError::Input(m)) => Err(input(m)),
+        Some(RunError::Failed(m)) => Err(Failure {
+            code: 1,
+            message: m,
+        }),
+    }
+}
+
+fn test_jacobian(
+    case_path: &Path,
+    steps: usize,
+    tolerance: f64,
+    sets: &[String],
+    petsc_args: &[String],
+) -> Result<(), Failure> {
+    let c = load_case(case_path, sets)?;
+    let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
+        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    let req = RunRequest {
+        case: &c,
+        case_label: case_path.display().to_string(),
+        overrides: sets.to_vec(),
+        out_dir: PathBuf::from("."),
+        quiet: true,
+        comm: petsc.world(),
+    };
+    let result = driver::test_jacobian(&req, steps);
+    drop(petsc);
+    let blocks = result.map_err(|e| Failure {
+        code: 1,
+        message: e.message().to_string(),
+    })?;
+    println!(
+        "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps)",
+        "row", "col", "max|J-Jfd|", "max|J|", "relative"
+    );
+    let mut worst: f64 = 0.0;
+    for b in &blocks {
+        println!(
+            "{:>4} {:>4} {:>14.4e} {:>14.4e} {:>12.3e}",
+            b.row, b.col, b.max_abs_error, b.max_abs_entry, b.relative_error
+        );
+        worst = worst.max(b.relative_error);
+    }
+    if worst > tolerance {
+        return Err(Failure {
+            code: 1,
+            message: format!(
+                "the tangent differs from finite differences by {worst:.3e} > {tolerance:.1e}"
+            ),
+        });
+    }
+    println!("all blocks agree within {tolerance:.1e} (worst {worst:.3e})");
+    Ok(())
+}
+
+fn info(petsc_args: &[String]) -> Result<(), Failure> {
+    let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
+        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    let comm = petsc.world();
+    let coll = porompm::assembly::Collective::new(comm);
+    let total = coll.sum(&[1.0]).map_err(|e| Failure {
+        code: 1,
+        message: e,
+    })?[0];
+    let ranks = coll.gather(&[comm.rank() as f64]).map_err(|e| Failure {
+        code: 1,
+        message: e,
+    })?;
+    if comm.rank() == 0 {
+        let b = petsc::PetscBuild::get();
+        println!("porompm {}", porompm::VERSION);
+        println!("PETSc {} with {}", b.version, b.packages.join(", "));
+        println!("ranks: {}", comm.size());
+        println!("collective sum over ranks: {total} (ranks reporting: {ranks:?})");
+    }
+    drop(petsc);
+    if total as usize != ranks.len() {
+        return Err(Failure {
+            code: 1,
+            message: "the collective sum does not match the number of ranks".into(),
+        });
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Run {
+            case,
+            out,
+            options_file,
+            set,
+            quiet,
+            petsc,
+        } => run(case, out, options_file, set, *quiet, petsc),
+        Command::Check { case, set } => load_case(case, set).map(|c| {
+            print!(
+                "{}",
+                porompm::describe::describe(&c, &case.display().to_string())
+            )
+        }),
+        Command::TestJacobian {
+            case,
+            steps,
+            tolerance,
+            set,
+            petsc,
+        } => test_jacobian(case, *steps, *tolerance, set, petsc),
+        Command::Info { petsc } => info(petsc),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}

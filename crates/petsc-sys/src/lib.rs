@@ -4,10 +4,16 @@
 //! MPI handle types (`MPI_Comm`, `MPI_Datatype`, ...) are re-used from rsmpi's `mpi-sys`, so a
 //! communicator obtained from the `mpi` crate can be handed to PETSc directly.
 //!
-//! The cfg flags `petsc_have_mumps`, `petsc_have_hypre`, `petsc_have_superlu_dist` and
-//! `petsc_have_hdf5` are set by the build script from `petscconf.h`; [`EXTERNAL_PACKAGES`] lists
+//! The cfg flags `petsc_have_mumps`, `petsc_have_hypre`, `petsc_have_superlu_dist`,
+//! `petsc_have_suitesparse` and `petsc_have_hdf5` are set by the build script from `petscconf.h`; [`EXTERNAL_PACKAGES`] lists
 //! the same information at run time.
-#![allow(non_upper_case_globals, non_camel_case_types, non_snake_case, dead_code, improper_ctypes)]
+#![allow(
+    non_upper_case_globals,
+    non_camel_case_types,
+    non_snake_case,
+    dead_code,
+    improper_ctypes
+)]
 #![allow(clippy::all)]
 
 include!(concat!(env!("OUT_DIR"), "/bindings.rs"));
@@ -17,5 +23,6 @@ pub const EXTERNAL_PACKAGES: &[(&str, bool)] = &[
     ("mumps", cfg!(petsc_have_mumps)),
     ("hypre", cfg!(petsc_have_hypre)),
     ("superlu_dist", cfg!(petsc_have_superlu_dist)),
+    ("suitesparse", cfg!(petsc_have_suitesparse)),
     ("hdf5", cfg!(petsc_have_hdf5)),
 ];

@@ -19,7 +19,13 @@ impl IndexSet {
     /// An index set holding a copy of `idx` (global indices owned by this rank).
     pub fn new_general(comm: Comm, idx: &[Int]) -> Result<IndexSet> {
         let mut raw = std::ptr::null_mut();
-        call!(ISCreateGeneral(comm.raw(), idx.len() as Int, idx.as_ptr(), sys::PetscCopyMode::PETSC_COPY_VALUES, &mut raw))?;
+        call!(ISCreateGeneral(
+            comm.raw(),
+            idx.len() as Int,
+            idx.as_ptr(),
+            sys::PetscCopyMode::PETSC_COPY_VALUES,
+            &mut raw
+        ))?;
         Ok(IndexSet { raw })
     }
 
@@ -36,7 +42,11 @@ impl IndexSet {
         let mut p: *const Int = std::ptr::null();
         call!(ISGetIndices(self.raw, &mut p))?;
         // SAFETY: ISGetIndices returned `n` indices, valid until ISRestoreIndices.
-        let v = if n == 0 { Vec::new() } else { unsafe { std::slice::from_raw_parts(p, n) }.to_vec() };
+        let v = if n == 0 {
+            Vec::new()
+        } else {
+            unsafe { std::slice::from_raw_parts(p, n) }.to_vec()
+        };
         call!(ISRestoreIndices(self.raw, &mut p))?;
         Ok(v)
     }

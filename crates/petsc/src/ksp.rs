@@ -68,7 +68,12 @@ pub trait KspOps {
     }
 
     /// Relative, absolute and divergence tolerances and the iteration limit (`None` keeps PETSc's).
-    fn set_tolerances(&mut self, rtol: Option<Real>, atol: Option<Real>, max_it: Option<usize>) -> Result<()> {
+    fn set_tolerances(
+        &mut self,
+        rtol: Option<Real>,
+        atol: Option<Real>,
+        max_it: Option<usize>,
+    ) -> Result<()> {
         let d = sys::PETSC_DEFAULT as Real;
         call!(KSPSetTolerances(
             self.raw(),
@@ -93,7 +98,10 @@ pub trait KspOps {
     fn pc(&mut self) -> Result<PcRef<'_>> {
         let mut pc = std::ptr::null_mut();
         call!(KSPGetPC(self.raw(), &mut pc))?;
-        Ok(PcRef { raw: pc, _life: PhantomData })
+        Ok(PcRef {
+            raw: pc,
+            _life: PhantomData,
+        })
     }
 
     /// Solves `A x = b`.
@@ -110,7 +118,11 @@ pub trait KspOps {
         call!(KSPGetIterationNumber(self.raw(), &mut its))?;
         let mut text: *const c_char = std::ptr::null();
         call!(KSPGetConvergedReasonString(self.raw(), &mut text))?;
-        Ok(LinearSolve { reason: reason.0, reason_text: c_str(text), iterations: its as usize })
+        Ok(LinearSolve {
+            reason: reason.0,
+            reason_text: c_str(text),
+            iterations: its as usize,
+        })
     }
 }
 
@@ -144,7 +156,10 @@ impl Ksp {
 
 impl KspRef<'_> {
     pub(crate) fn new(raw: sys::KSP) -> Self {
-        KspRef { raw, _life: PhantomData }
+        KspRef {
+            raw,
+            _life: PhantomData,
+        }
     }
 }
 
@@ -160,6 +175,12 @@ impl PcRef<'_> {
         let mut t: sys::PCType = std::ptr::null();
         call!(PCGetType(self.raw, &mut t))?;
         Ok(c_str(t))
+    }
+
+    /// For factorisation preconditioners: which package factorises (`"mumps"`, `"petsc"`, ...).
+    pub fn set_factor_solver_type(&mut self, name: &str) -> Result<()> {
+        let c = cstring(name)?;
+        call!(PCFactorSetMatSolverType(self.raw, c.as_ptr()))
     }
 
     /// For factorisation preconditioners: the package doing it (`"mumps"`, `"petsc"`, ...).

@@ -1,0 +1,940 @@
+//! The global system: the only application module that talks to PETSc.
+//!
+//! A DMDA holds the background grid (dofs ux, uy, p, Ux, Uy interlaced, or ux, uy), so that the
+//! distribution of nodes over ranks, ghost nodes and matrix preallocation come from PETSc. Every
+//! step ([`GridSystem::prepare_step`]):
+//! 1. each particle's stencil (nodes, S, ∇S) is computed once on the configuration x_n;
+//! 2. masses, momenta and mass-weighted accelerations are mapped to the nodes ([003] Eq. 19) and
+//!    summed over ranks; they give the Newmark predictors of every nodal dof;
+//! 3. a node is active when the weights of the particles reaching it sum to more than
+//!    [`ACTIVE_WEIGHT`]; dofs of inactive nodes and the components fixed by active boundaries are
+//!    constrained (residual x − 0, identity row and zero column in the tangent);
+//! 4. the external tractions at t_{n+1} are assembled; a fresh matrix is created when the
+//!    particle–node connectivity or the constraints changed (its structure follows the particles),
+//!    otherwise the previous one is reused, so PETSc keeps the symbolic factorisation and only
+//!    refactorises numerically.
+//!
+//! [`GridSystem::solve`] then runs PETSc SNES with residual and Jacobian callbacks that loop over
+//! particles, call the pure kernels of [`crate::kernels`] and scatter the small dense blocks with
+//! local (ghosted) indices; PETSc sums contributions to nodes owned by other ranks.
+
+use crate::case::Side;
+use crate::kernels::{self, NodeBasis, NodeState, StepResult, MAX_LOCAL, MAX_NODES};
+use crate::model::loads::LoadTarget;
+use crate::model::shape::{self, Stencil};
+use crate::model::{Active, Model};
+use petsc::ksp::KspOps;
+use petsc::mat::MatOps;
+use petsc::snes::NonlinearProblem;
+use petsc::{
+    CallbackError, Comm, DmDa, GhostedRange, LogStage, Mat, MatRef, Options, Snes, StageGuard,
+    VecOps, VecRef, Vector,
+};
+use std::time::Instant;
+
+/// A node takes part in the solve when the GIMP/MPM weights reaching it sum to more than this.
+pub const ACTIVE_WEIGHT: f64 = 1e-9;
+
+/// Errors of the global system.
+pub type Error = petsc::Error;
+
+/// The stencils of all particles for one step, in this rank's ghosted node numbering, stored
+/// flat: particle k uses entries `offsets[k]..offsets[k + 1]` of `nodes` and `basis`.
+#[derive(Debug, Clone, Default)]
+struct Stencils {
+    offsets: Vec<usize>,
+    nodes: Vec<u32>,
+    basis: Vec<NodeBasis>,
+}
+
+impl Stencils {
+    fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    fn nodes(&self, k: usize) -> &[u32] {
+        &self.nodes[self.offsets[k]..self.offsets[k + 1]]
+    }
+
+    fn get(&self, k: usize) -> (&[u32], &[NodeBasis]) {
+        let r = self.offsets[k]..self.offsets[k + 1];
+        (&self.nodes[r.clone()], &self.basis[r])
+    }
+
+    /// Whether every particle couples only nodes it coupled in `old`.
+    fn within(&self, old: &Stencils) -> bool {
+        self.len() == old.len()
+            && (0..self.len()).all(|k| self.nodes(k).iter().all(|x| old.nodes(k).contains(x)))
+    }
+}
+
+/// Per-step data shared by the callbacks.
+#[derive(Debug, Default)]
+struct StepData {
+    nm: Option<kernels::Newmark>,
+    body_acc: [f64; 2],
+    stencils: Stencils,
+    /// Newmark predictors ã_n, ṽ_n per ghosted dof.
+    pred_a: Vec<f64>,
+    pred_v: Vec<f64>,
+    /// External nodal forces at t_{n+1} (tractions) per ghosted dof.
+    fext: Vec<f64>,
+    /// Constrained flag per ghosted dof.
+    constrained: Vec<bool>,
+    /// Offsets of constrained dofs in the owned part of global vectors.
+    owned_constrained: Vec<usize>,
+    /// Global index of the first owned dof.
+    global_start: usize,
+    /// Δd at convergence, per ghosted dof.
+    solution: Vec<f64>,
+    /// Unknowns solved for (unconstrained dofs), summed over ranks.
+    free_dofs: usize,
+}
+
+/// Outcome of one nonlinear step solve.
+#[derive(Debug, Clone)]
+pub struct StepSolve {
+    /// Whether SNES converged.
+    pub converged: bool,
+    /// PETSc's reason (`CONVERGED_FNORM_RELATIVE`, `DIVERGED_LINE_SEARCH`, ...).
+    pub reason: String,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Krylov iterations.
+    pub linear_iterations: usize,
+    /// Residual norms, initial and after each iteration.
+    pub residual_history: Vec<f64>,
+    /// A domain error raised by the callbacks.
+    pub domain_error: Option<String>,
+    /// Wall time spent in the residual and Jacobian callbacks [s].
+    pub assembly_seconds: f64,
+    /// Wall time of the whole SNES solve [s].
+    pub solve_seconds: f64,
+}
+
+/// The PETSc log stages of a run (shown by `-log_view`).
+struct Stages {
+    setup: LogStage,
+    solve: LogStage,
+    assembly: LogStage,
+    update: LogStage,
+    output: LogStage,
+}
+
+/// The phases of a step, for log stages.
+#[derive(Debug, Clone, Copy)]
+pub enum Phase {
+    /// Mapping to the grid, constraints, loads.
+    StepSetup,
+    /// The Newton solve (assembly and linear solves).
+    NewtonSolve,
+    /// Particle update.
+    ParticleUpdate,
+    /// Writing results.
+    Output,
+}
+
+/// The DMDA grid, the solver and the per-step state of the global system.
+pub struct GridSystem {
+    comm: Comm,
+    dm: DmDa,
+    ndof: usize,
+    two_phase: bool,
+    ghost: GhostedRange,
+    owned_start: [usize; 2],
+    owned_count: [usize; 2],
+    x: Vector,
+    x_local: Vector,
+    f_local: Vector,
+    work_local: Vector,
+    work_global: Vector,
+    snes: Snes,
+    jac: Option<Mat>,
+    /// Stencil nodes of each particle and the free dofs when the matrix was created.
+    pattern: Option<(Stencils, Vec<bool>)>,
+    /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
+    pub reused_patterns: usize,
+    step: StepData,
+    stages: Stages,
+}
+
+/// Ghost width in nodes: a GIMP particle of a cell reaches at most one cell beyond it, so the
+/// nodes of a rank's cells plus two rows cover every node its particles touch.
+const STENCIL_WIDTH: usize = 2;
+
+impl GridSystem {
+    /// Creates the DMDA for the grid and dof layout, and the SNES with porompm's defaults, then
+    /// lets the PETSc options database override them. Defaults: Newton with full steps, relative
+    /// residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on one rank (the
+    /// fastest of the measured strategies on the verification cases, see docs/solvers.md) and by
+    /// MUMPS on several ranks (UMFPACK is sequential).
+    pub fn new(
+        comm: Comm,
+        grid: &crate::model::grid::Grid,
+        two_phase: bool,
+    ) -> Result<GridSystem, Error> {
+        let dm = DmDa::new_2d(
+            comm,
+            grid.nodes(),
+            STENCIL_WIDTH,
+            crate::model::field_names(two_phase),
+        )?;
+        let info = *dm.info();
+        let x = dm.create_global_vector()?;
+        let x_local = dm.create_local_vector()?;
+        let f_local = dm.create_local_vector()?;
+        let work_local = dm.create_local_vector()?;
+        let work_global = dm.create_global_vector()?;
+        let mut snes = Snes::new(comm)?;
+        snes.set_dm(&dm)?;
+        snes.set_type("newtonls")?;
+        snes.set_line_search("basic")?;
+        snes.set_tolerances(Some(1e-50), Some(1e-6), Some(1e-12), Some(30))?;
+        {
+            let mut ksp = snes.ksp()?;
+            ksp.set_type("preonly")?;
+            let mut pc = ksp.pc()?;
+            pc.set_type("lu")?;
+            pc.set_factor_solver_type(default_factor_package(comm))?;
+        }
+        snes.set_from_options()?;
+        let stages = Stages {
+            setup: LogStage::register("porompm: step setup")?,
+            solve: LogStage::register("porompm: Newton solve")?,
+            assembly: LogStage::register("porompm: assembly")?,
+            update: LogStage::register("porompm: particle update")?,
+            output: LogStage::register("porompm: output")?,
+        };
+        Ok(GridSystem {
+            comm,
+            dm,
+            ndof: if two_phase { 5 } else { 2 },
+            two_phase,
+            ghost: info.ghosted,
+            owned_start: info.owned_start,
+            owned_count: info.owned_count,
+            x,
+            x_local,
+            f_local,
+            work_local,
+            work_global,
+            snes,
+            jac: None,
+            pattern: None,
+            reused_patterns: 0,
+            step: StepData::default(),
+            stages,
+        })
+    }
+
+    /// Whether this rank owns cell (i, j): the cell's lower-left node is owned.
+    pub fn owns_cell(&self, i: usize, j: usize) -> bool {
+        i >= self.owned_start[0]
+            && i < self.owned_start[0] + self.owned_count[0]
+            && j >= self.owned_start[1]
+            && j < self.owned_start[1] + self.owned_count[1]
+    }
+
+    /// Enters a log stage until the guard is dropped.
+    pub fn phase(&self, p: Phase) -> Result<StageGuard, Error> {
+        match p {
+            Phase::StepSetup => self.stages.setup.push(),
+            Phase::NewtonSolve => self.stages.solve.push(),
+            Phase::ParticleUpdate => self.stages.update.push(),
+            Phase::Output => self.stages.output.push(),
+        }
+    }
+
+    /// Unknowns of the last prepared step (unconstrained dofs over all ranks).
+    pub fn free_dofs(&self) -> usize {
+        self.step.free_dofs
+    }
+
+    /// Total dofs of the grid (all nodes × dofs per node).
+    pub fn total_dofs(&self) -> usize {
+        let [nx, ny] = self.dm.info().nodes;
+        nx * ny * self.ndof
+    }
+
+    /// The communicator.
+    pub fn comm(&self) -> Comm {
+        self.comm
+    }
+
+    /// Sums a ghosted per-dof array over ranks: afterwards every ghost holds the global total.
+    fn sum_over_ranks(&mut self, data: &mut [f64]) -> Result<(), Error> {
+        self.work_local.write()?.copy_from_slice(data);
+        self.work_global.set_all(0.0)?;
+        self.dm
+            .local_to_global_add(&self.work_local, &mut self.work_global)?;
+        self.dm
+            .global_to_local(&self.work_global, &mut self.work_local)?;
+        data.copy_from_slice(&self.work_local.read()?);
+        Ok(())
+    }
+
+    fn local_node(&self, i: u32, j: u32) -> Option<u32> {
+        self.ghost.node(i as usize, j as usize).map(|n| n as u32)
+    }
+
+    /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
+    /// boundaries (see the module documentation).
+    pub fn prepare_step(
+        &mut self,
+        model: &Model,
+        active: &Active,
+        t_new: f64,
+        dt: f64,
+    ) -> Result<(), String> {
+        let nd = self.ndof;
+        let ng = self.ghost.len() * nd;
+        let ps = &model.particles;
+        let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
+
+        // 1. Stencils on x_n.
+        let mut stencils = Stencils {
+            offsets: Vec::with_capacity(ps.len() + 1),
+            ..Default::default()
+        };
+        stencils.offsets.push(0);
+        for k in 0..ps.len() {
+            let st: Stencil = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+            if st.iter().all(|(_, w, _)| w == 0.0) {
+                return Err(format!(
+                    "material point {} at ({:.4}, {:.4}) m has left the grid",
+                    ps.id[k], ps.x[k][0], ps.x[k][1]
+                ));
+            }
+            for &(i, j) in &st.nodes[..st.len] {
+                stencils.nodes.push(self.local_node(i, j).ok_or_else(|| {
+                    format!(
+                        "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \
+                         (particle migration between ranks is not implemented yet)",
+                        ps.id[k], ps.x[k][0], ps.x[k][1]
+                    )
+                })?);
+            }
+            kernels::plain_basis(&st, &mut stencils.basis);
+            stencils.offsets.push(stencils.nodes.len());
+        }
+
+        // 2. Nodal masses, momenta, mass-weighted accelerations and weight sums ([003] Eq. 19).
+        let (mut mass, mut mom, mut acc, mut weight) =
+            (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
+        for k in 0..stencils.len() {
+            let (nodes, basis) = stencils.get(k);
+            let mw = if self.two_phase {
+                ps.porosity[k]
+                    * model.materials[ps.material[k] as usize].water_density
+                    * ps.volume[k]
+            } else {
+                0.0
+            };
+            for (&node, nb) in nodes.iter().zip(basis) {
+                let b = node as usize * nd;
+                let s = nb.s;
+                weight[b] += s;
+                for c in 0..2 {
+                    mass[b + c] += s * ps.mass[k];
+                    mom[b + c] += s * ps.mass[k] * ps.vel[k][c];
+                    acc[b + c] += s * ps.mass[k] * ps.acc[k][c];
+                    if self.two_phase {
+                        mass[b + 3 + c] += s * mw;
+                        mom[b + 3 + c] += s * mw * ps.vel_w[k][c];
+                        acc[b + 3 + c] += s * mw * ps.acc_w[k][c];
+                    }
+                }
+            }
+        }
+        for v in [&mut mass, &mut mom, &mut acc, &mut weight] {
+            self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+        }
+
+        // 3. Constraints: inactive nodes, and components fixed by the active boundaries.
+        let mut constrained = vec![false; ng];
+        for l in 0..self.ghost.len() {
+            let (i, j) = self.ghost.ij(l);
+            let inactive = weight[l * nd] <= ACTIVE_WEIGHT;
+            for c in 0..nd {
+                constrained[l * nd + c] = inactive;
+            }
+            let fixed = model.fixed_components(active, i, j);
+            for c in 0..nd {
+                constrained[l * nd + c] |= fixed[c];
+            }
+        }
+        let mut owned_constrained = Vec::new();
+        let mut free = 0usize;
+        for jj in 0..self.owned_count[1] {
+            for ii in 0..self.owned_count[0] {
+                let l = self
+                    .ghost
+                    .node(self.owned_start[0] + ii, self.owned_start[1] + jj)
+                    .expect("owned nodes are ghosted");
+                for c in 0..nd {
+                    let o = (jj * self.owned_count[0] + ii) * nd + c;
+                    if constrained[l * nd + c] {
+                        owned_constrained.push(o);
+                    } else {
+                        free += 1;
+                    }
+                }
+            }
+        }
+        let free_dofs = self.comm.sum_usize(free).map_err(|e| e.to_string())?;
+
+        // Newmark predictors ([003] Eq. 21) from v_n = momentum/mass, a_n = (mass-weighted a)/mass.
+        let (beta, gamma) = (model.beta, model.gamma);
+        let mut pred_a = vec![0.0; ng];
+        let mut pred_v = vec![0.0; ng];
+        for q in 0..ng {
+            let c = q % nd;
+            if constrained[q] || c == 2 && self.two_phase || mass[q] <= 0.0 {
+                continue;
+            }
+            let v = mom[q] / mass[q];
+            let a = acc[q] / mass[q];
+            pred_a[q] = -v / (beta * dt) - (0.5 / beta - 1.0) * a;
+            pred_v[q] = -(gamma / beta - 1.0) * v - (0.5 * gamma / beta - 1.0) * dt * a;
+        }
+
+        // 4. Tractions at t_{n+1}.
+        let mut fext = vec![0.0; ng];
+        for &li in &active.loads {
+            let load = &model.loads[li];
+            let f = load.time_fn.eval(t_new);
+            match &load.target {
+                LoadTarget::ParticleTraction {
+                    particles,
+                    face,
+                    traction,
+                } => {
+                    for &k in particles {
+                        let (x, lp) = (ps.x[k], ps.lp[k]);
+                        let (point, length) = match face {
+                            Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
+                            Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
+                            Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
+                            Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
+                        };
+                        let w = shape::point_weights(&model.grid, point);
+                        for ((i, j), s, _) in w.iter() {
+                            let l = self
+                                .local_node(i, j)
+                                .ok_or("a traction point lies outside this rank's ghost region")?
+                                as usize;
+                            for c in 0..2 {
+                                fext[l * nd + c] += s * traction[c] * f * length;
+                            }
+                        }
+                    }
+                }
+                LoadTarget::NodalTraction { nodes, traction } => {
+                    for &(i, j, trib) in nodes {
+                        let owned = (self.owned_start[0]
+                            ..self.owned_start[0] + self.owned_count[0])
+                            .contains(&i)
+                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1])
+                                .contains(&j);
+                        if owned {
+                            let l = self.ghost.node(i, j).expect("owned") * nd;
+                            for c in 0..2 {
+                                fext[l + c] += traction[c] * f * trib;
+                            }
+                        }
+                    }
+                }
+                LoadTarget::BodyForce { .. } => {}
+            }
+        }
+
+        let global_start = self.x.ownership_range().map_err(|e| e.to_string())?.0;
+        self.step = StepData {
+            nm: Some(nm),
+            body_acc: model.body_acceleration(active, t_new),
+            stencils,
+            pred_a,
+            pred_v,
+            fext,
+            constrained,
+            owned_constrained,
+            global_start,
+            solution: Vec::new(),
+            free_dofs,
+        };
+        // The matrix structure is the union of the particles' node couplings over the free dofs.
+        // It can be kept while every particle couples a subset of the nodes it coupled when the
+        // matrix was created and no constrained dof became free: PETSc then keeps the stored
+        // pattern (unused entries stay zero) and refactorises numerically only.
+        let reusable = match &self.pattern {
+            Some((old, free)) => {
+                self.step.stencils.within(old)
+                    && free
+                        .iter()
+                        .zip(&self.step.constrained)
+                        .all(|(&was_free, &c)| was_free || c)
+            }
+            None => false,
+        };
+        if reusable && self.jac.is_some() {
+            self.reused_patterns += 1;
+        } else {
+            self.jac = Some(self.dm.create_matrix().map_err(|e| e.to_string())?);
+            let nodes_only = Stencils {
+                offsets: self.step.stencils.offsets.clone(),
+                nodes: self.step.stencils.nodes.clone(),
+                basis: Vec::new(),
+            };
+            self.pattern = Some((
+                nodes_only,
+                self.step.constrained.iter().map(|c| !c).collect(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Solves the prepared step by Newton's method from Δd = 0.
+    pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
+        let _stage = self.stages.solve.push()?;
+        self.x.set_all(0.0)?;
+        let mut assembly_seconds = 0.0;
+        let t0 = Instant::now();
+        let out = {
+            let GridSystem {
+                dm,
+                x,
+                x_local,
+                f_local,
+                snes,
+                jac,
+                step,
+                ndof,
+                two_phase,
+                stages,
+                ..
+            } = self;
+            let jac = jac
+                .as_mut()
+                .ok_or_else(|| petsc::Error::new("solve called before prepare_step"))?;
+            let mut asm = Assembler {
+                dm,
+                model,
+                step,
+                x_local,
+                f_local,
+                nd: *ndof,
+                two_phase: *two_phase,
+                seconds: &mut assembly_seconds,
+                stage: &stages.assembly,
+            };
+            snes.solve(x, jac, &mut asm)?
+        };
+        let solve_seconds = t0.elapsed().as_secs_f64();
+        self.dm.global_to_local(&self.x, &mut self.x_local)?;
+        self.step.solution = self.x_local.read()?.to_vec();
+        Ok(StepSolve {
+            converged: out.converged,
+            reason: out.reason_text,
+            newton_iterations: out.iterations,
+            linear_iterations: out.linear_iterations,
+            residual_history: out.residual_history,
+            domain_error: out.domain_error,
+            assembly_seconds,
+            solve_seconds,
+        })
+    }
+
+    /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.
+    pub fn step_result(&self, k: usize) -> StepResult {
+        let (nodes, basis) = self.step.stencils.get(k);
+        let states = node_states(nodes, &self.step.solution, &self.step, self.ndof);
+        kernels::step_result(basis, &states[..nodes.len()], self.two_phase)
+    }
+}
+
+/// Nodal states of a particle's stencil from the increments `xl` and the step's predictors.
+#[inline]
+fn node_states(nodes: &[u32], xl: &[f64], step: &StepData, nd: usize) -> [NodeState; MAX_NODES] {
+    let nm = step.nm.expect("prepared");
+    let mut out = [NodeState::default(); MAX_NODES];
+    for (n, &node) in nodes.iter().enumerate() {
+        let b = node as usize * nd;
+        for c in 0..nd {
+            let d = xl[b + c];
+            out[n].d[c] = d;
+            out[n].a[c] = nm.a0 * d + step.pred_a[b + c];
+            out[n].v[c] = nm.a1 * d + step.pred_v[b + c];
+        }
+    }
+    out
+}
+
+/// The residual and Jacobian callbacks of one step.
+struct Assembler<'a> {
+    dm: &'a DmDa,
+    model: &'a Model,
+    step: &'a StepData,
+    x_local: &'a mut Vector,
+    f_local: &'a mut Vector,
+    nd: usize,
+    two_phase: bool,
+    seconds: &'a mut f64,
+    stage: &'a LogStage,
+}
+
+fn fatal(e: petsc::Error) -> CallbackError {
+    CallbackError::Fatal(e.to_string())
+}
+
+impl Assembler<'_> {
+    fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
+        self.dm.global_to_local(x, self.x_local).map_err(fatal)?;
+        Ok(self.x_local.read().map_err(fatal)?.to_vec())
+    }
+}
+
+impl NonlinearProblem for Assembler<'_> {
+    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
+        let _stage = self.stage.push().map_err(fatal)?;
+        let t0 = Instant::now();
+        let xl = self.gather(x)?;
+        let nd = self.nd;
+        {
+            let mut fl = self.f_local.write().map_err(fatal)?;
+            for (q, v) in fl.iter_mut().enumerate() {
+                *v = -self.step.fext[q];
+            }
+            let mut buf = [0.0; MAX_LOCAL];
+            for k in 0..self.step.stencils.len() {
+                let (nodes, basis) = self.step.stencils.get(k);
+                let states = node_states(nodes, &xl, self.step, nd);
+                let input = self.model.particle_input(k, self.step.body_acc);
+                let mat = &self.model.materials[self.model.particles.material[k] as usize];
+                let m = nodes.len() * nd;
+                kernels::residual(
+                    basis,
+                    &states[..nodes.len()],
+                    &input,
+                    &mat.model,
+                    self.two_phase,
+                    &mut buf[..m],
+                );
+                for (n, &node) in nodes.iter().enumerate() {
+                    let b = node as usize * nd;
+                    for c in 0..nd {
+                        fl[b + c] += buf[n * nd + c];
+                    }
+                }
+            }
+        }
+        f.set_all(0.0).map_err(fatal)?;
+        self.dm
+            .local_to_global_add(self.f_local, f)
+            .map_err(fatal)?;
+        {
+            // Constrained dofs: residual x − 0 (Dirichlet value zero).
+            let xo = x.read().map_err(fatal)?;
+            let mut fo = f.write().map_err(fatal)?;
+            for &o in &self.step.owned_constrained {
+                fo[o] = xo[o];
+            }
+        }
+        *self.seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+        let _stage = self.stage.push().map_err(fatal)?;
+        let t0 = Instant::now();
+        let xl = self.gather(x)?;
+        let nd = self.nd;
+        let nm = self.step.nm.expect("prepared");
+        j.zero_entries().map_err(fatal)?;
+        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
+        let mut idx = [0i32; MAX_LOCAL];
+        for k in 0..self.step.stencils.len() {
+            let (nodes, basis) = self.step.stencils.get(k);
+            let input = self.model.particle_input(k, self.step.body_acc);
+            let mat = &self.model.materials[self.model.particles.material[k] as usize];
+            let m = nodes.len() * nd;
+            // The soil tangent at the current iterate.
+            let states = node_states(nodes, &xl, self.step, nd);
+            let kin = kernels::interpolate(basis, &states[..nodes.len()], self.two_phase);
+            let dsig = mat.model.update(&input.stress, &kin.deps).tangent;
+            kernels::tangent(
+                basis,
+                &input,
+                &dsig,
+                nm,
+                self.two_phase,
+                &mut block[..m * m],
+            );
+            for (n, &node) in nodes.iter().enumerate() {
+                let b = node as usize * nd;
+                for c in 0..nd {
+                    idx[n * nd + c] = if self.step.constrained[b + c] {
+                        -1
+                    } else {
+                        (b + c) as i32
+                    };
+                }
+            }
+            j.set_values_local(&idx[..m], &idx[..m], &block[..m * m], true)
+                .map_err(fatal)?;
+        }
+        for &o in &self.step.owned_constrained {
+            let g = (self.step.global_start + o) as i32;
+            j.set_values(&[g], &[g], &[1.0], true).map_err(fatal)?;
+        }
+        j.assemble().map_err(fatal)?;
+        *self.seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+}
+
+/// The factorisation package of the default solver: UMFPACK on one rank, MUMPS otherwise.
+pub fn default_factor_package(comm: Comm) -> &'static str {
+    if comm.size() == 1 && petsc::PetscBuild::get().packages.contains(&"suitesparse") {
+        "umfpack"
+    } else {
+        "mumps"
+    }
+}
+
+/// PETSc options that were given but not used by any solver object so far.
+pub fn unused_petsc_options() -> Result<Vec<String>, Error> {
+    Ok(Options::global()
+        .unused()?
+        .iter()
+        .map(|o| o.to_string())
+        .collect())
+}
+
+/// Every option in PETSc's database, as `-name value` strings.
+pub fn petsc_options() -> Result<Vec<String>, Error> {
+    Ok(Options::global()
+        .all()?
+        .iter()
+        .map(|o| o.to_string())
+        .collect())
+}
+
+/// The solver configuration (KSP and PC types and the factorisation package), for the summary.
+pub fn describe_solver(sys: &mut GridSystem) -> Result<String, Error> {
+    let snes_type = sys.snes.type_name()?;
+    let lag = sys.snes.lag_jacobian()?;
+    let mut ksp = sys.snes.ksp()?;
+    let ksp_type = ksp.type_name()?;
+    let pc = ksp.pc()?;
+    let pc_type = pc.type_name()?;
+    let factor = if pc_type == "lu" || pc_type == "cholesky" {
+        pc.factor_solver_type()?
+            .map(|s| format!(" ({s})"))
+            .unwrap_or_default()
+    } else {
+        String::new()
+    };
+    let newton = if lag > 1 || lag == -1 || lag == -2 {
+        "modified Newton (lagged Jacobian)"
+    } else {
+        "Newton"
+    };
+    Ok(format!(
+        "{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"
+    ))
+}
+
+/// Reductions over ranks for code outside this module (observers, probes, summaries).
+#[derive(Clone, Copy)]
+pub struct Collective {
+    comm: Comm,
+}
+
+impl Collective {
+    /// Over the run's communicator.
+    pub fn new(comm: Comm) -> Collective {
+        Collective { comm }
+    }
+
+    /// This rank.
+    pub fn rank(&self) -> usize {
+        self.comm.rank()
+    }
+
+    /// Number of ranks.
+    pub fn size(&self) -> usize {
+        self.comm.size()
+    }
+
+    /// Element-wise sum over ranks.
+    pub fn sum(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        let mut d = v.to_vec();
+        self.comm.sum_f64(&mut d).map_err(|e| e.to_string())?;
+        Ok(d)
+    }
+
+    /// Element-wise maximum over ranks.
+    pub fn max(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        let mut d = v.to_vec();
+        self.comm.max_f64(&mut d).map_err(|e| e.to_string())?;
+        Ok(d)
+    }
+
+    /// Every rank's values concatenated in rank order, on every rank.
+    pub fn gather(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        self.comm.all_gather_f64(v).map_err(|e| e.to_string())
+    }
+
+    /// Whether any rank reports `flag`.
+    pub fn any(&self, flag: bool) -> Result<bool, String> {
+        Ok(self.max(&[if flag { 1.0 } else { 0.0 }])?[0] > 0.5)
+    }
+}
+
+/// Whether component `c` of a node is the pore pressure.
+fn self_two_phase_p(two_phase: bool, c: usize) -> bool {
+    two_phase && c == kernels::dof::P
+}
+
+/// Agreement of one field-pair block of the assembled tangent with finite differences.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BlockCheck {
+    /// Row field (`ux`, `uy`, `p`, `Ux`, `Uy`).
+    pub row: &'static str,
+    /// Column field.
+    pub col: &'static str,
+    /// max |J − J_fd| over the block.
+    pub max_abs_error: f64,
+    /// max |J| over the block.
+    pub max_abs_entry: f64,
+    /// max |J − J_fd| / max |J| of the block (of the block's rows if the block is zero).
+    pub relative_error: f64,
+}
+
+impl GridSystem {
+    /// Compares the assembled tangent of the prepared step with central finite differences of the
+    /// assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
+    /// converged increment of this step). One rank only (it builds the dense FD Jacobian: small
+    /// cases only).
+    pub fn jacobian_check(
+        &mut self,
+        model: &Model,
+        fraction: f64,
+    ) -> Result<Vec<BlockCheck>, Error> {
+        if self.comm.size() != 1 {
+            return Err(petsc::Error::new(
+                "the finite-difference Jacobian check runs on one rank",
+            ));
+        }
+        let nd = self.ndof;
+        let names = crate::model::field_names(self.two_phase);
+        // A realistic iterate: part of this step's converged increment.
+        self.solve(model)?;
+        let mut x = self.x.duplicate()?;
+        self.x.copy_to(&mut x)?;
+        x.scale(fraction)?;
+        let n = x.local_size()?;
+        let free: Vec<usize> = (0..n)
+            .filter(|o| !self.step.owned_constrained.contains(o))
+            .collect();
+        let GridSystem {
+            dm,
+            x_local,
+            f_local,
+            jac,
+            step,
+            stages,
+            two_phase,
+            ..
+        } = self;
+        let jac = jac
+            .as_mut()
+            .ok_or_else(|| petsc::Error::new("jacobian_check called before prepare_step"))?;
+        let mut seconds = 0.0;
+        let mut asm = Assembler {
+            dm,
+            model,
+            step,
+            x_local,
+            f_local,
+            nd,
+            two_phase: *two_phase,
+            seconds: &mut seconds,
+            stage: &stages.assembly,
+        };
+        asm.jacobian(&x.as_ref(), &mut jac.as_ref())
+            .map_err(|e| petsc::Error::new(format!("{e:?}")))?;
+        let (_, dense) = jac.local_rows_dense()?;
+        let xv = x.read()?.to_vec();
+        // The finite-difference step of a dof follows the typical size of its kind of unknown:
+        // displacements (ux, uy, Ux, Uy share one scale) or pore pressure, with floors of 1e-6 of a
+        // cell (m) and 1 Pa when a kind is identically zero.
+        let is_p = |o: usize| self_two_phase_p(*two_phase, o % nd);
+        let (mut typ_u, mut typ_p) = (0.0f64, 0.0f64);
+        for &o in &free {
+            if is_p(o) {
+                typ_p = typ_p.max(xv[o].abs());
+            } else {
+                typ_u = typ_u.max(xv[o].abs());
+            }
+        }
+        let h_cell = model.grid.h[0].min(model.grid.h[1]);
+        let typical: Vec<f64> = (0..nd)
+            .map(|c| {
+                if is_p(c) {
+                    typ_p.max(1.0)
+                } else {
+                    typ_u.max(1e-6 * h_cell)
+                }
+            })
+            .collect();
+        let mut fd = vec![0.0; n * n];
+        let (mut xp, mut fp, mut fm) = (x.duplicate()?, x.duplicate()?, x.duplicate()?);
+        for &c in &free {
+            let h = 1e-6 * (xv[c].abs() + typical[c % nd]);
+            for (sign, out) in [(1.0, &mut fp), (-1.0, &mut fm)] {
+                {
+                    let mut w = xp.write()?;
+                    w.copy_from_slice(&xv);
+                    w[c] += sign * h;
+                }
+                asm.residual(&xp.as_ref(), &mut out.as_ref())
+                    .map_err(|e| petsc::Error::new(format!("{e:?}")))?;
+            }
+            let (a, b) = (fp.read()?, fm.read()?);
+            for &r in &free {
+                fd[r * n + c] = (a[r] - b[r]) / (2.0 * h);
+            }
+        }
+        // A block is measured against the largest entry of its rows, so that blocks that are zero
+        // (e.g. ux–Uy) are judged by their finite-difference noise relative to that scale.
+        let row_scale: Vec<f64> = (0..nd)
+            .map(|rf| {
+                free.iter()
+                    .filter(|&&r| r % nd == rf)
+                    .flat_map(|&r| free.iter().map(move |&c| (r, c)))
+                    .fold(0.0f64, |m, (r, c)| m.max(dense[r * n + c].abs()))
+            })
+            .collect();
+        let mut out = Vec::new();
+        for rf in 0..nd {
+            for cf in 0..nd {
+                let (mut err, mut big) = (0.0f64, 0.0f64);
+                for &r in free.iter().filter(|&&r| r % nd == rf) {
+                    for &c in free.iter().filter(|&&c| c % nd == cf) {
+                        err = err.max((dense[r * n + c] - fd[r * n + c]).abs());
+                        big = big.max(dense[r * n + c].abs());
+                    }
+                }
+                out.push(BlockCheck {
+                    row: names[rf],
+                    col: names[cf],
+                    max_abs_error: err,
+                    max_abs_entry: big,
+                    relative_error: err / big.max(row_scale[rf]).max(f64::MIN_POSITIVE),
+                });
+            }
+        }
+        Ok(out)
+    }
+}

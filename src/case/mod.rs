@@ -1,0 +1,279 @@
+//! Case files: typed TOML with `deny_unknown_fields`, `--set` overrides, range checks.
+//!
+//! [`parse`] turns the text of a case file plus the command line's overrides into a validated
+//! [`Case`]; every error names the file, the key and what is wrong, in one line.
+
+pub mod overrides;
+pub mod schema;
+mod validate;
+
+pub use overrides::Override;
+pub use schema::*;
+
+use std::fmt;
+
+/// A problem with a case file or an override, as one line of text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseError(String);
+
+impl CaseError {
+    /// An error with the given message.
+    pub fn new(msg: impl Into<String>) -> Self {
+        CaseError(msg.into())
+    }
+}
+
+impl fmt::Display for CaseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for CaseError {}
+
+/// Line (1-based) of a byte offset in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// Parses and validates a case. `origin` names the file in messages.
+pub fn parse(text: &str, origin: &str, overrides: &[Override]) -> Result<Case, CaseError> {
+    let mut doc: toml::Value = toml::from_str(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| format!(" (line {})", line_of(text, s.start)))
+            .unwrap_or_default();
+        CaseError::new(format!("{origin}{line}: {}", e.message().trim()))
+    })?;
+    let mut set_paths = Vec::new();
+    for ov in overrides {
+        let path =
+            overrides::apply(&mut doc, ov).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
+        set_paths.push((path, ov.key.clone()));
+    }
+    let case: Case = serde_path_to_error::deserialize(doc).map_err(|e| {
+        let path = e.path().to_string();
+        let msg = e.inner().message().trim().to_string();
+        let from_set = set_paths.iter().find(|(p, _)| {
+            path == *p || path.starts_with(&format!("{p}.")) || path.starts_with(&format!("{p}["))
+        });
+        match from_set {
+            Some((_, key)) => CaseError::new(format!("{origin}: --set {key}: {msg}")),
+            None if path == "." || path.is_empty() => CaseError::new(format!("{origin}: {msg}")),
+            None => CaseError::new(format!("{origin}: key `{path}`: {msg}")),
+        }
+    })?;
+    validate::validate(&case).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
+    Ok(case)
+}
+
+impl Case {
+    /// The material called `name`.
+    pub fn material(&self, name: &str) -> Option<&Material> {
+        self.materials.iter().find(|m| m.name == name)
+    }
+
+    /// Index of the material called `name`.
+    pub fn material_index(&self, name: &str) -> Option<usize> {
+        self.materials.iter().position(|m| m.name == name)
+    }
+
+    /// The body called `name`.
+    pub fn body(&self, name: &str) -> Option<&Body> {
+        self.bodies.iter().find(|b| b.name == name)
+    }
+
+    /// The load called `name`.
+    pub fn load(&self, name: &str) -> Option<&Load> {
+        self.loads.iter().find(|l| l.name() == name)
+    }
+
+    /// The time function called `name`.
+    pub fn time_function(&self, name: &str) -> Option<&TimeFunction> {
+        self.time_functions.iter().find(|f| f.name() == name)
+    }
+
+    /// Total analysis time [s].
+    pub fn end_time(&self) -> f64 {
+        self.stages.iter().map(|s| s.duration).sum()
+    }
+
+    /// Cell size in x and y [m].
+    pub fn cell_size(&self) -> [f64; 2] {
+        [
+            self.grid.size[0] / self.grid.cells[0] as f64,
+            self.grid.size[1] / self.grid.cells[1] as f64,
+        ]
+    }
+}
+
+impl Shape {
+    /// Bounding box (min, max) [m].
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        match self {
+            Shape::Rectangle { min, max } => (*min, *max),
+            Shape::Polygon { vertices } => {
+                let mut lo = [f64::INFINITY; 2];
+                let mut hi = [f64::NEG_INFINITY; 2];
+                for v in vertices {
+                    for d in 0..2 {
+                        lo[d] = lo[d].min(v[d]);
+                        hi[d] = hi[d].max(v[d]);
+                    }
+                }
+                (lo, hi)
+            }
+        }
+    }
+
+    /// Whether point `p` lies inside (boundary points of a rectangle count as inside; polygons use
+    /// the even–odd rule).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        match self {
+            Shape::Rectangle { min, max } => {
+                p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1]
+            }
+            Shape::Polygon { vertices } => {
+                let mut inside = false;
+                let n = vertices.len();
+                let mut j = n - 1;
+                for i in 0..n {
+                    let (a, b) = (vertices[i], vertices[j]);
+                    if (a[1] > p[1]) != (b[1] > p[1])
+                        && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+                    {
+                        inside = !inside;
+                    }
+                    j = i;
+                }
+                inside
+            }
+        }
+    }
+}
+
+impl Region {
+    /// Whether point `p` lies in the box (boundary included, with a tolerance of 1e-9 of the box's
+    /// size and coordinates, so that points on a grid line are not lost to round-off, also when the
+    /// box is a line).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        (0..2).all(|d| {
+            let tol = 1e-9
+                * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs())
+                + 1e-15;
+            p[d] >= self.min[d] - tol && p[d] <= self.max[d] + tol
+        })
+    }
+}
+
+/// Case texts shared by unit tests.
+#[cfg(test)]
+pub(crate) mod tests_support {
+    /// A small valid two-phase column.
+    pub const MINIMAL: &str = r#"
+        [analysis]
+        formulation = "two_phase"
+        [grid]
+        size = [0.1, 1.0]
+        cells = [1, 10]
+        [[materials]]
+        name = "soil"
+        porosity = 0.3
+        solid_density = 2650.0
+        water_bulk_modulus = 2.2e9
+        solid_bulk_modulus = inf
+        hydraulic_conductivity = 1e-3
+        [materials.model]
+        type = "linear_elastic"
+        young_modulus = 1e7
+        poisson_ratio = 0.0
+        [[bodies]]
+        name = "column"
+        material = "soil"
+        shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }
+        [[stages]]
+        name = "load"
+        duration = 0.1
+        dt = 1e-3
+    "#;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tests_support::MINIMAL;
+    use super::*;
+
+    #[test]
+    fn a_minimal_case_parses_with_defaults() {
+        let c = parse(MINIMAL, "t.toml", &[]).unwrap();
+        assert_eq!(c.analysis.shape_functions, ShapeFunctions::Gimp);
+        assert_eq!(c.time_integration.beta, 0.25);
+        assert_eq!(c.cell_size(), [0.1, 0.1]);
+        assert!(c.materials[0].solid_bulk_modulus.unwrap().is_infinite());
+    }
+
+    #[test]
+    fn unknown_keys_and_wrong_types_name_the_key() {
+        let e = parse(
+            &MINIMAL.replace("porosity = 0.3", "porosity = 0.3\nporosty = 1"),
+            "t.toml",
+            &[],
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("materials[0]") && e.to_string().contains("porosty"),
+            "{e}"
+        );
+        let e = parse(
+            &MINIMAL.replace("cells = [1, 10]", "cells = [1, \"ten\"]"),
+            "t.toml",
+            &[],
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("grid.cells"), "{e}");
+        let e = parse(
+            MINIMAL,
+            "t.toml",
+            &[Override::parse("grid.cels=[2,20]").unwrap()],
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("--set grid.cels") && e.to_string().contains("unknown field"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn overrides_change_values() {
+        let c = parse(
+            MINIMAL,
+            "t.toml",
+            &[
+                Override::parse("grid.cells=[2,20]").unwrap(),
+                Override::parse("stages[0].dt=5e-4").unwrap(),
+            ],
+        )
+        .unwrap();
+        assert_eq!(c.grid.cells, [2, 20]);
+        assert_eq!(c.stages[0].dt, 5e-4);
+    }
+
+    #[test]
+    fn shapes_contain_points() {
+        let poly = Shape::Polygon {
+            vertices: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]],
+        };
+        assert!(poly.contains([0.5, 0.5]));
+        assert!(!poly.contains([1.5, 1.5]));
+        let r = Region {
+            min: [0.0, 1.0],
+            max: [1.0, 1.0],
+        };
+        assert!(r.contains([0.5, 1.0 + 1e-12]));
+        assert!(!r.contains([0.5, 1.01]));
+    }
+}

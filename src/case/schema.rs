@@ -1,0 +1,560 @@
+//! The case-file schema: every table and key a case may contain, with units.
+//!
+//! All structs deny unknown fields, so a misspelt key is an error naming it. Ranges are checked
+//! in [`super::validate`]. SI units throughout: m, s, kg, Pa, m/s.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole case: what is simulated, how, and what it is checked against.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Physics switches that shape the discrete system.
+    pub analysis: Analysis,
+    /// The background grid.
+    pub grid: Grid,
+    /// Materials, referred to by name from bodies.
+    pub materials: Vec<Material>,
+    /// Bodies filled with material points at t = 0.
+    pub bodies: Vec<Body>,
+    /// Named time functions that scale loads.
+    #[serde(default)]
+    pub time_functions: Vec<TimeFunction>,
+    /// Dirichlet conditions on grid nodes.
+    #[serde(default)]
+    pub boundaries: Vec<Boundary>,
+    /// Loads (tractions, body forces).
+    #[serde(default)]
+    pub loads: Vec<Load>,
+    /// The analysis stages, run in order.
+    pub stages: Vec<Stage>,
+    /// Newmark parameters.
+    #[serde(default)]
+    pub time_integration: TimeIntegration,
+    /// Solver strategy (PETSc options file).
+    #[serde(default)]
+    pub solver: Solver,
+    /// Output control.
+    #[serde(default)]
+    pub output: Output,
+    /// Material points whose history is recorded.
+    #[serde(default)]
+    pub probes: Vec<Probe>,
+    /// The analytical solution the run is checked against, if any.
+    #[serde(default)]
+    pub verification: Option<Verification>,
+}
+
+/// Physics switches.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Analysis {
+    /// `two_phase`: the u–p–U system (5 dofs per node); `one_phase`: total-stress u system (2 dofs).
+    pub formulation: Formulation,
+    /// Basis functions: `gimp` (uGIMP, [003] Eqs. 13–15) or `linear` (standard MPM).
+    #[serde(default = "default_shape")]
+    pub shape_functions: ShapeFunctions,
+    /// Gravitational acceleration g [m/s²] used in Darcy's law (γ_w = ρ_w g). It is a material
+    /// constant here; gravity as a load is a `body_force` load.
+    #[serde(default = "default_g")]
+    pub g: f64,
+}
+
+fn default_shape() -> ShapeFunctions {
+    ShapeFunctions::Gimp
+}
+fn default_g() -> f64 {
+    9.81
+}
+
+/// The discrete system to build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    /// Solid displacement, pore pressure, water displacement per node (u–p–U).
+    TwoPhase,
+    /// Solid displacement only (total stress, or dry material).
+    OnePhase,
+}
+
+/// Material-point basis functions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeFunctions {
+    /// Undeformed GIMP: particle domain of half-width l_p = h / (2 × particles per cell).
+    Gimp,
+    /// Standard MPM: bilinear hat functions evaluated at the particle.
+    Linear,
+}
+
+/// A uniform structured background grid.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Grid {
+    /// Lower-left corner [m].
+    #[serde(default)]
+    pub origin: [f64; 2],
+    /// Extent in x and y [m].
+    pub size: [f64; 2],
+    /// Number of cells in x and y.
+    pub cells: [usize; 2],
+}
+
+/// A material: phase densities, porosity, the water and grain compressibility, the permeability,
+/// and the constitutive model of the skeleton.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Name used by bodies.
+    pub name: String,
+    /// Initial porosity n [-].
+    pub porosity: f64,
+    /// Density of the solid grains ρ_s [kg/m³].
+    pub solid_density: f64,
+    /// Density of the pore water ρ_w [kg/m³].
+    #[serde(default = "default_rho_w")]
+    pub water_density: f64,
+    /// Bulk modulus of the pore water K_w [Pa] (two-phase).
+    #[serde(default)]
+    pub water_bulk_modulus: Option<f64>,
+    /// Bulk modulus of the solid grains K_s [Pa]; `inf` for incompressible grains (two-phase).
+    #[serde(default)]
+    pub solid_bulk_modulus: Option<f64>,
+    /// Hydraulic conductivity k [m/s] (two-phase).
+    #[serde(default)]
+    pub hydraulic_conductivity: Option<f64>,
+    /// The constitutive model of the solid skeleton.
+    pub model: SoilModel,
+}
+
+fn default_rho_w() -> f64 {
+    1000.0
+}
+
+/// Constitutive model of the skeleton (effective stress in two-phase analyses, total stress in
+/// one-phase analyses).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SoilModel {
+    /// Isotropic linear elasticity, plane strain.
+    LinearElastic {
+        /// Young's modulus E [Pa].
+        young_modulus: f64,
+        /// Poisson's ratio ν [-].
+        poisson_ratio: f64,
+    },
+}
+
+/// A body filled with material points.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Name used by probes and verification.
+    pub name: String,
+    /// Name of its material.
+    pub material: String,
+    /// Material points per cell and direction (2 gives 2×2 per cell).
+    #[serde(default = "default_ppc")]
+    pub particles_per_cell: usize,
+    /// The region it occupies at t = 0.
+    pub shape: Shape,
+}
+
+fn default_ppc() -> usize {
+    2
+}
+
+/// A planar region.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Shape {
+    /// Axis-aligned rectangle.
+    Rectangle {
+        /// Lower-left corner [m].
+        min: [f64; 2],
+        /// Upper-right corner [m].
+        max: [f64; 2],
+    },
+    /// Simple polygon, vertices in order [m].
+    Polygon {
+        /// Vertices.
+        vertices: Vec<[f64; 2]>,
+    },
+}
+
+/// An axis-aligned box [m] used to select nodes or particles.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    /// Lower-left corner [m].
+    pub min: [f64; 2],
+    /// Upper-right corner [m].
+    pub max: [f64; 2],
+}
+
+/// A side of the background grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// x = origin_x.
+    XMin,
+    /// x = origin_x + size_x.
+    XMax,
+    /// y = origin_y.
+    YMin,
+    /// y = origin_y + size_y.
+    YMax,
+}
+
+/// A nodal degree of freedom.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum Dof {
+    /// Solid displacement, x.
+    #[serde(rename = "ux")]
+    Ux,
+    /// Solid displacement, y.
+    #[serde(rename = "uy")]
+    Uy,
+    /// Pore pressure.
+    #[serde(rename = "p")]
+    P,
+    /// Water displacement, x.
+    #[serde(rename = "Ux")]
+    WUx,
+    /// Water displacement, y.
+    #[serde(rename = "Uy")]
+    WUy,
+}
+
+impl std::fmt::Display for Dof {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Dof::Ux => "ux",
+            Dof::Uy => "uy",
+            Dof::P => "p",
+            Dof::WUx => "Ux",
+            Dof::WUy => "Uy",
+        })
+    }
+}
+
+/// Homogeneous Dirichlet conditions (fixed displacement components, drained p = 0) on the grid
+/// nodes of a side or of a box.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Boundary {
+    /// Name used by stages.
+    pub name: String,
+    /// A side of the grid (give `side` or `region`).
+    #[serde(default)]
+    pub side: Option<Side>,
+    /// Nodes inside this box (give `side` or `region`).
+    #[serde(default)]
+    pub region: Option<Region>,
+    /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained).
+    pub fix: Vec<Dof>,
+}
+
+/// A load, scaled in time by a named time function (default: constant 1).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Load {
+    /// A traction [Pa] on one face of the particle domains whose centres lie in `region` at t = 0
+    /// and whose face is on the surface of the material (the point just beyond it is outside every
+    /// body), applied at the face centre (force = traction × face length, per metre of thickness).
+    ParticleTraction {
+        /// Name used by stages and verification.
+        name: String,
+        /// Particles carrying it.
+        region: Region,
+        /// Which face of each particle domain carries it.
+        face: Side,
+        /// Traction vector [Pa].
+        traction: [f64; 2],
+        /// Name of the time function scaling it.
+        #[serde(default)]
+        time_function: Option<String>,
+    },
+    /// A traction [Pa] along the line of grid nodes inside `region`, each node taking its
+    /// tributary length of the line.
+    NodalTraction {
+        /// Name used by stages and verification.
+        name: String,
+        /// Nodes carrying it (a row or column of nodes).
+        region: Region,
+        /// Traction vector [Pa].
+        traction: [f64; 2],
+        /// Name of the time function scaling it.
+        #[serde(default)]
+        time_function: Option<String>,
+    },
+    /// A body acceleration [m/s²] on every particle (gravity: [0, -9.81]), acting on both phases.
+    BodyForce {
+        /// Name used by stages.
+        name: String,
+        /// Acceleration vector [m/s²].
+        acceleration: [f64; 2],
+        /// Name of the time function scaling it.
+        #[serde(default)]
+        time_function: Option<String>,
+    },
+}
+
+impl Load {
+    /// The load's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Load::ParticleTraction { name, .. }
+            | Load::NodalTraction { name, .. }
+            | Load::BodyForce { name, .. } => name,
+        }
+    }
+
+    /// The name of its time function, if any.
+    pub fn time_function(&self) -> Option<&str> {
+        match self {
+            Load::ParticleTraction { time_function, .. }
+            | Load::NodalTraction { time_function, .. }
+            | Load::BodyForce { time_function, .. } => time_function.as_deref(),
+        }
+    }
+}
+
+/// A scalar function of the analysis time t [s] multiplying a load.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TimeFunction {
+    /// f = value.
+    Constant {
+        /// Name used by loads.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// f rises linearly from 0 at `start` to 1 at `start + duration` [s], then stays 1.
+    Ramp {
+        /// Name used by loads.
+        name: String,
+        /// Start [s].
+        #[serde(default)]
+        start: f64,
+        /// Duration [s].
+        duration: f64,
+    },
+    /// As `ramp` but with the C² smoothstep 6s⁵ − 15s⁴ + 10s³ (no jump in rate or acceleration).
+    SmoothRamp {
+        /// Name used by loads.
+        name: String,
+        /// Start [s].
+        #[serde(default)]
+        start: f64,
+        /// Duration [s].
+        duration: f64,
+    },
+    /// f = cos(ω t + φ), multiplied by a smooth ramp over `ramp_duration` [s] if it is positive.
+    Harmonic {
+        /// Name used by loads.
+        name: String,
+        /// ω [rad/s].
+        angular_frequency: f64,
+        /// φ [rad].
+        #[serde(default)]
+        phase: f64,
+        /// Duration of the smooth start [s].
+        #[serde(default)]
+        ramp_duration: f64,
+    },
+    /// Piecewise linear through (times[i], values[i]); constant outside.
+    Table {
+        /// Name used by loads.
+        name: String,
+        /// Increasing times [s].
+        times: Vec<f64>,
+        /// Values.
+        values: Vec<f64>,
+    },
+}
+
+impl TimeFunction {
+    /// The function's name.
+    pub fn name(&self) -> &str {
+        match self {
+            TimeFunction::Constant { name, .. }
+            | TimeFunction::Ramp { name, .. }
+            | TimeFunction::SmoothRamp { name, .. }
+            | TimeFunction::Harmonic { name, .. }
+            | TimeFunction::Table { name, .. } => name,
+        }
+    }
+}
+
+/// One analysis stage.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stage {
+    /// Name shown in progress and history.
+    pub name: String,
+    /// Duration [s].
+    pub duration: f64,
+    /// Time step [s].
+    pub dt: f64,
+    /// Boundaries active in this stage (default: all).
+    #[serde(default)]
+    pub boundaries: Option<Vec<String>>,
+    /// Loads active in this stage (default: all).
+    #[serde(default)]
+    pub loads: Option<Vec<String>>,
+    /// How many times in a row a step may be cut before the run fails.
+    #[serde(default = "default_cuts")]
+    pub max_step_cuts: usize,
+    /// Factor applied to Δt at each cut.
+    #[serde(default = "default_cut_factor")]
+    pub cut_factor: f64,
+}
+
+fn default_cuts() -> usize {
+    4
+}
+fn default_cut_factor() -> f64 {
+    0.5
+}
+
+/// Newmark parameters ([003] Eqs. 20–22).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeIntegration {
+    /// β [-] (1/4: average acceleration).
+    #[serde(default = "default_beta")]
+    pub beta: f64,
+    /// γ [-] (1/2: no numerical damping).
+    #[serde(default = "default_gamma")]
+    pub gamma: f64,
+}
+
+fn default_beta() -> f64 {
+    0.25
+}
+fn default_gamma() -> f64 {
+    0.5
+}
+
+impl Default for TimeIntegration {
+    fn default() -> Self {
+        TimeIntegration {
+            beta: default_beta(),
+            gamma: default_gamma(),
+        }
+    }
+}
+
+/// Solver strategy.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Solver {
+    /// A PETSc options file applied before the command line's, relative to the case file.
+    #[serde(default)]
+    pub options_file: Option<String>,
+}
+
+/// Output control.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Write a history row every this many steps (the last step of a stage is always written).
+    #[serde(default = "default_every")]
+    pub history_every: usize,
+}
+
+fn default_every() -> usize {
+    1
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Output { history_every: 1 }
+    }
+}
+
+/// A probe: follows the material point nearest to `point` at t = 0.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    /// Column prefix in history.csv.
+    pub name: String,
+    /// Position at t = 0 [m].
+    pub point: [f64; 2],
+}
+
+/// The analytical reference of a case.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Verification {
+    /// One-dimensional consolidation ([003] §4.1.1, Eqs. 31–33).
+    Terzaghi {
+        /// The consolidating body (its height is the drainage length; drained at its top).
+        body: String,
+        /// The surface load (its final magnitude is q).
+        load: String,
+        /// Time factors T_v at which e_p is evaluated (the last one also gives the RMS and settlement errors).
+        #[serde(default = "default_tv")]
+        time_factors: Vec<f64>,
+        /// Pass threshold for e_p ([003] Eq. 33).
+        #[serde(default = "default_ep_tol")]
+        e_p_tolerance: f64,
+        /// Pass threshold for the plain RMS of the normalised pressure error.
+        #[serde(default = "default_rms_tol")]
+        p_rms_tolerance: f64,
+        /// Pass threshold for the relative settlement error.
+        #[serde(default = "default_settle_tol")]
+        settlement_tolerance: f64,
+    },
+    /// Steady-state harmonic column (Zienkiewicz, Chang & Bettess 1980; [003] §4.1.2).
+    HarmonicColumn {
+        /// The column body.
+        body: String,
+        /// The harmonic surface load.
+        load: String,
+        /// Number of final load periods over which the amplitude is measured.
+        #[serde(default = "default_periods")]
+        measure_periods: usize,
+        /// Pass threshold for the maximum amplitude error relative to the peak amplitude.
+        tolerance: f64,
+    },
+    /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
+    ShockWave {
+        /// The column body.
+        body: String,
+        /// The step surface load.
+        load: String,
+        /// Depth of the observation point below the initial surface [m].
+        probe_depth: f64,
+        /// Pass threshold for the fast (undrained) wave arrival error.
+        #[serde(default = "default_fast_tol")]
+        fast_tolerance: f64,
+        /// Pass threshold for the slow (damped) wave arrival error.
+        #[serde(default = "default_slow_tol")]
+        slow_tolerance: f64,
+    },
+}
+
+fn default_tv() -> Vec<f64> {
+    vec![0.1, 0.5]
+}
+fn default_ep_tol() -> f64 {
+    1e-2
+}
+fn default_rms_tol() -> f64 {
+    5e-2
+}
+fn default_settle_tol() -> f64 {
+    5e-2
+}
+fn default_periods() -> usize {
+    3
+}
+fn default_fast_tol() -> f64 {
+    0.02
+}
+fn default_slow_tol() -> f64 {
+    0.05
+}

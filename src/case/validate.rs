@@ -1,0 +1,405 @@
+//! Range and consistency checks of a typed case. Messages name the key (`materials[0].porosity`)
+//! and say what is wrong and what was found.
+
+use super::schema::*;
+use std::collections::HashSet;
+
+type R = Result<(), String>;
+
+fn positive(key: &str, v: f64) -> R {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be a positive number, got {v}"))
+    }
+}
+
+fn positive_or_inf(key: &str, v: f64) -> R {
+    if v > 0.0 && !v.is_nan() {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be positive (or inf), got {v}"))
+    }
+}
+
+fn in_open(key: &str, v: f64, lo: f64, hi: f64) -> R {
+    if v > lo && v < hi {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be in ({lo}, {hi}), got {v}"))
+    }
+}
+
+fn finite2(key: &str, v: [f64; 2]) -> R {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be finite, got {v:?}"))
+    }
+}
+
+fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> R {
+    let mut seen = HashSet::new();
+    for n in names {
+        if n.is_empty() {
+            return Err(format!("{what}: names must not be empty"));
+        }
+        if !seen.insert(n) {
+            return Err(format!("{what}: the name `{n}` is used twice"));
+        }
+    }
+    Ok(())
+}
+
+/// Checks every range and reference of the case.
+pub fn validate(c: &Case) -> R {
+    let two_phase = c.analysis.formulation == Formulation::TwoPhase;
+    positive("analysis.g", c.analysis.g)?;
+
+    // Grid.
+    finite2("grid.origin", c.grid.origin)?;
+    positive("grid.size[0]", c.grid.size[0])?;
+    positive("grid.size[1]", c.grid.size[1])?;
+    for d in 0..2 {
+        if c.grid.cells[d] == 0 || c.grid.cells[d] > 100_000 {
+            return Err(format!(
+                "key `grid.cells[{d}]`: must be between 1 and 100000, got {}",
+                c.grid.cells[d]
+            ));
+        }
+    }
+    let lo = c.grid.origin;
+    let hi = [lo[0] + c.grid.size[0], lo[1] + c.grid.size[1]];
+    let h = c.cell_size();
+    let tol = [1e-9 * h[0], 1e-9 * h[1]];
+    let inside_grid =
+        |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] - tol[d] && p[d] <= hi[d] + tol[d]);
+
+    // Materials.
+    if c.materials.is_empty() {
+        return Err("at least one [[materials]] table is needed".into());
+    }
+    unique("materials", c.materials.iter().map(|m| m.name.as_str()))?;
+    for (i, m) in c.materials.iter().enumerate() {
+        let k = |f: &str| format!("materials[{i}].{f}");
+        in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+        positive(&k("solid_density"), m.solid_density)?;
+        positive(&k("water_density"), m.water_density)?;
+        match &m.model {
+            SoilModel::LinearElastic {
+                young_modulus,
+                poisson_ratio,
+            } => {
+                positive(&k("model.young_modulus"), *young_modulus)?;
+                in_open(&k("model.poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
+            }
+        }
+        if two_phase {
+            for (f, v) in [
+                ("water_bulk_modulus", m.water_bulk_modulus),
+                ("hydraulic_conductivity", m.hydraulic_conductivity),
+            ] {
+                match v {
+                    Some(v) => positive(&k(f), v)?,
+                    None => {
+                        return Err(format!("key `{}`: required in a two_phase analysis", k(f)))
+                    }
+                }
+            }
+            match m.solid_bulk_modulus {
+                Some(v) => positive_or_inf(&k("solid_bulk_modulus"), v)?,
+                None => {
+                    return Err(format!(
+                    "key `{}`: required in a two_phase analysis (inf for incompressible grains)",
+                    k("solid_bulk_modulus")
+                ))
+                }
+            }
+        }
+    }
+
+    // Bodies.
+    if c.bodies.is_empty() {
+        return Err("at least one [[bodies]] table is needed".into());
+    }
+    unique("bodies", c.bodies.iter().map(|b| b.name.as_str()))?;
+    for (i, b) in c.bodies.iter().enumerate() {
+        if c.material(&b.material).is_none() {
+            return Err(format!(
+                "key `bodies[{i}].material`: no material named `{}`",
+                b.material
+            ));
+        }
+        if b.particles_per_cell == 0 || b.particles_per_cell > 8 {
+            return Err(format!(
+                "key `bodies[{i}].particles_per_cell`: must be between 1 and 8, got {}",
+                b.particles_per_cell
+            ));
+        }
+        match &b.shape {
+            Shape::Rectangle { min, max } => {
+                finite2(&format!("bodies[{i}].shape.rectangle.min"), *min)?;
+                finite2(&format!("bodies[{i}].shape.rectangle.max"), *max)?;
+                if !(max[0] > min[0] && max[1] > min[1]) {
+                    return Err(format!("key `bodies[{i}].shape.rectangle`: max must exceed min in x and y, got {min:?} .. {max:?}"));
+                }
+            }
+            Shape::Polygon { vertices } => {
+                if vertices.len() < 3 {
+                    return Err(format!("key `bodies[{i}].shape.polygon.vertices`: a polygon needs at least 3 vertices"));
+                }
+                for (j, v) in vertices.iter().enumerate() {
+                    finite2(&format!("bodies[{i}].shape.polygon.vertices[{j}]"), *v)?;
+                }
+            }
+        }
+        let (bmin, bmax) = b.shape.bounds();
+        if !inside_grid(bmin) || !inside_grid(bmax) {
+            return Err(format!(
+                "key `bodies[{i}].shape`: body `{}` ({bmin:?} .. {bmax:?}) reaches outside the grid ({lo:?} .. {hi:?}); particles outside the grid are not allowed",
+                b.name
+            ));
+        }
+    }
+
+    // Time functions.
+    unique("time_functions", c.time_functions.iter().map(|f| f.name()))?;
+    for (i, f) in c.time_functions.iter().enumerate() {
+        let k = |x: &str| format!("time_functions[{i}].{x}");
+        match f {
+            TimeFunction::Constant { value, .. } => {
+                if !value.is_finite() {
+                    return Err(format!("key `{}`: must be finite", k("value")));
+                }
+            }
+            TimeFunction::Ramp {
+                start, duration, ..
+            }
+            | TimeFunction::SmoothRamp {
+                start, duration, ..
+            } => {
+                positive(&k("duration"), *duration)?;
+                if !start.is_finite() || *start < 0.0 {
+                    return Err(format!("key `{}`: must be ≥ 0, got {start}", k("start")));
+                }
+            }
+            TimeFunction::Harmonic {
+                angular_frequency,
+                phase,
+                ramp_duration,
+                ..
+            } => {
+                positive(&k("angular_frequency"), *angular_frequency)?;
+                if !phase.is_finite() {
+                    return Err(format!("key `{}`: must be finite", k("phase")));
+                }
+                if !ramp_duration.is_finite() || *ramp_duration < 0.0 {
+                    return Err(format!(
+                        "key `{}`: must be ≥ 0, got {ramp_duration}",
+                        k("ramp_duration")
+                    ));
+                }
+            }
+            TimeFunction::Table { times, values, .. } => {
+                if times.is_empty() || times.len() != values.len() {
+                    return Err(format!(
+                        "key `{}`: times and values must be non-empty and of equal length",
+                        k("times")
+                    ));
+                }
+                if times.windows(2).any(|w| w[1] <= w[0])
+                    || times.iter().chain(values).any(|v| !v.is_finite())
+                {
+                    return Err(format!(
+                        "key `{}`: times must be finite and strictly increasing",
+                        k("times")
+                    ));
+                }
+            }
+        }
+    }
+
+    // Boundaries.
+    unique("boundaries", c.boundaries.iter().map(|b| b.name.as_str()))?;
+    for (i, b) in c.boundaries.iter().enumerate() {
+        if b.side.is_some() == b.region.is_some() {
+            return Err(format!(
+                "key `boundaries[{i}]`: give exactly one of `side` and `region`"
+            ));
+        }
+        if b.fix.is_empty() {
+            return Err(format!(
+                "key `boundaries[{i}].fix`: list at least one component"
+            ));
+        }
+        if !two_phase {
+            if let Some(d) = b.fix.iter().find(|d| !matches!(d, Dof::Ux | Dof::Uy)) {
+                return Err(format!("key `boundaries[{i}].fix`: `{d:?}` exists only in a two_phase analysis (one_phase nodes carry ux, uy)"));
+            }
+        }
+    }
+
+    // Loads.
+    unique("loads", c.loads.iter().map(|l| l.name()))?;
+    for (i, l) in c.loads.iter().enumerate() {
+        if let Some(tf) = l.time_function() {
+            if c.time_function(tf).is_none() {
+                return Err(format!(
+                    "key `loads[{i}].time_function`: no time function named `{tf}`"
+                ));
+            }
+        }
+        match l {
+            Load::ParticleTraction {
+                region, traction, ..
+            }
+            | Load::NodalTraction {
+                region, traction, ..
+            } => {
+                finite2(&format!("loads[{i}].traction"), *traction)?;
+                finite2(&format!("loads[{i}].region.min"), region.min)?;
+                finite2(&format!("loads[{i}].region.max"), region.max)?;
+                if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
+                    return Err(format!(
+                        "key `loads[{i}].region`: max must not be below min"
+                    ));
+                }
+            }
+            Load::BodyForce { acceleration, .. } => {
+                finite2(&format!("loads[{i}].acceleration"), *acceleration)?
+            }
+        }
+    }
+
+    // Stages.
+    if c.stages.is_empty() {
+        return Err("at least one [[stages]] table is needed".into());
+    }
+    for (i, s) in c.stages.iter().enumerate() {
+        let k = |x: &str| format!("stages[{i}].{x}");
+        positive(&k("duration"), s.duration)?;
+        positive(&k("dt"), s.dt)?;
+        if s.dt > s.duration * (1.0 + 1e-12) {
+            return Err(format!(
+                "key `{}`: Δt = {} exceeds the stage duration {}",
+                k("dt"),
+                s.dt,
+                s.duration
+            ));
+        }
+        if s.duration / s.dt > 1e8 {
+            return Err(format!(
+                "key `{}`: more than 1e8 steps in the stage",
+                k("dt")
+            ));
+        }
+        in_open(&k("cut_factor"), s.cut_factor, 0.0, 1.0)?;
+        if s.max_step_cuts > 30 {
+            return Err(format!(
+                "key `{}`: at most 30, got {}",
+                k("max_step_cuts"),
+                s.max_step_cuts
+            ));
+        }
+        for n in s.boundaries.iter().flatten() {
+            if !c.boundaries.iter().any(|b| &b.name == n) {
+                return Err(format!(
+                    "key `{}`: no boundary named `{n}`",
+                    k("boundaries")
+                ));
+            }
+        }
+        for n in s.loads.iter().flatten() {
+            if c.load(n).is_none() {
+                return Err(format!("key `{}`: no load named `{n}`", k("loads")));
+            }
+        }
+    }
+
+    // Newmark: unconditional stability of the average-acceleration family needs 2β ≥ γ ≥ 1/2.
+    let (beta, gamma) = (c.time_integration.beta, c.time_integration.gamma);
+    if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta <= 1.0) {
+        return Err(format!(
+            "key `time_integration`: β = {beta}, γ = {gamma} is not unconditionally stable; use 2β ≥ γ ≥ 1/2 (default β = 1/4, γ = 1/2)"
+        ));
+    }
+    if c.output.history_every == 0 {
+        return Err("key `output.history_every`: must be at least 1".into());
+    }
+
+    // Probes.
+    unique("probes", c.probes.iter().map(|p| p.name.as_str()))?;
+    for (i, p) in c.probes.iter().enumerate() {
+        finite2(&format!("probes[{i}].point"), p.point)?;
+        if !inside_grid(p.point) {
+            return Err(format!(
+                "key `probes[{i}].point`: {:?} is outside the grid",
+                p.point
+            ));
+        }
+    }
+
+    // Verification references.
+    if let Some(v) = &c.verification {
+        let (body, load) = match v {
+            Verification::Terzaghi {
+                body,
+                load,
+                time_factors,
+                e_p_tolerance,
+                p_rms_tolerance,
+                settlement_tolerance,
+            } => {
+                if time_factors.is_empty()
+                    || time_factors.iter().any(|t| !(*t > 0.0 && t.is_finite()))
+                {
+                    return Err(
+                        "key `verification.time_factors`: give positive time factors".into(),
+                    );
+                }
+                for (k, t) in [
+                    ("e_p_tolerance", e_p_tolerance),
+                    ("p_rms_tolerance", p_rms_tolerance),
+                    ("settlement_tolerance", settlement_tolerance),
+                ] {
+                    positive(&format!("verification.{k}"), *t)?;
+                }
+                (body, load)
+            }
+            Verification::HarmonicColumn {
+                body,
+                load,
+                measure_periods,
+                tolerance,
+            } => {
+                positive("verification.tolerance", *tolerance)?;
+                if *measure_periods == 0 {
+                    return Err("key `verification.measure_periods`: must be at least 1".into());
+                }
+                (body, load)
+            }
+            Verification::ShockWave {
+                body,
+                load,
+                probe_depth,
+                fast_tolerance,
+                slow_tolerance,
+            } => {
+                positive("verification.probe_depth", *probe_depth)?;
+                positive("verification.fast_tolerance", *fast_tolerance)?;
+                positive("verification.slow_tolerance", *slow_tolerance)?;
+                (body, load)
+            }
+        };
+        if c.body(body).is_none() {
+            return Err(format!("key `verification.body`: no body named `{body}`"));
+        }
+        if c.load(load).is_none() {
+            return Err(format!("key `verification.load`: no load named `{load}`"));
+        }
+        if !two_phase {
+            return Err("key `verification`: the consolidation and wave references need a two_phase analysis".into());
+        }
+    }
+    Ok(())
+}

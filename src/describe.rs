@@ -1,0 +1,176 @@
+//! `porompm check`: what a case will build, computed without PETSc (one process).
+
+use crate::assembly::ACTIVE_WEIGHT;
+use crate::case::{Case, Load, SoilModel};
+use crate::model::{shape, Model};
+use std::fmt::Write;
+
+/// A plain-text description of the discrete problem a case defines.
+pub fn describe(case: &Case, label: &str) -> String {
+    let model = Model::build(case, |_, _| true);
+    let g = &model.grid;
+    let nd = model.ndof();
+    let mut s = String::new();
+    let _ = writeln!(s, "case: {label}");
+    let _ = writeln!(
+        s,
+        "formulation: {} ({} dofs per node: {})",
+        if model.two_phase {
+            "two_phase, u–p–U"
+        } else {
+            "one_phase, u"
+        },
+        nd,
+        model.field_names().join(", ")
+    );
+    let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
+    let _ = writeln!(
+        s,
+        "grid: {} × {} cells of {:.4} × {:.4} m from ({}, {}); {} nodes, {} grid dofs",
+        g.cells[0],
+        g.cells[1],
+        g.h[0],
+        g.h[1],
+        g.origin[0],
+        g.origin[1],
+        g.node_count(),
+        g.node_count() * nd
+    );
+    for m in &case.materials {
+        let model_txt = match &m.model {
+            SoilModel::LinearElastic {
+                young_modulus,
+                poisson_ratio,
+            } => format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}"),
+        };
+        let _ = writeln!(
+            s,
+            "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³",
+            m.name, m.porosity, m.solid_density
+        );
+    }
+    for (b, body) in case.bodies.iter().enumerate() {
+        let count = model
+            .particles
+            .body
+            .iter()
+            .filter(|&&x| x as usize == b)
+            .count();
+        let n = body.particles_per_cell;
+        let _ = writeln!(
+            s,
+            "body `{}`: {count} material points ({n}×{n} per cell), material `{}`",
+            body.name, body.material
+        );
+    }
+    let _ = writeln!(s, "material points: {}", model.particles.len());
+
+    // Active nodes and unknowns of the first step.
+    let mut weight = vec![0.0; g.node_count()];
+    for k in 0..model.particles.len() {
+        let st = shape::stencil(model.basis, g, model.particles.x[k], model.particles.lp[k]);
+        for ((i, j), w, _) in st.iter() {
+            weight[j as usize * g.nodes()[0] + i as usize] += w;
+        }
+    }
+    let active_nodes = weight.iter().filter(|&&w| w > ACTIVE_WEIGHT).count();
+    let first = model.active(&case.stages[0]);
+    let mut unknowns = 0;
+    for j in 0..g.nodes()[1] {
+        for i in 0..g.nodes()[0] {
+            if weight[j * g.nodes()[0] + i] > ACTIVE_WEIGHT {
+                let fixed = model.fixed_components(&first, i, j);
+                unknowns += (0..nd).filter(|&c| !fixed[c]).count();
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}"
+    );
+
+    for l in &model.loads {
+        let kind = match case.load(&l.name) {
+            Some(Load::ParticleTraction { .. }) => {
+                format!("particle traction on {} material points", l.size())
+            }
+            Some(Load::NodalTraction { .. }) => format!("nodal traction on {} nodes", l.size()),
+            Some(Load::BodyForce { acceleration, .. }) => {
+                format!("body force {acceleration:?} m/s²")
+            }
+            None => String::new(),
+        };
+        let _ = writeln!(s, "load `{}`: {kind}", l.name);
+    }
+    for b in &model.boundaries {
+        let count = (0..g.nodes()[1])
+            .flat_map(|j| (0..g.nodes()[0]).map(move |i| (i, j)))
+            .filter(|&(i, j)| b.contains(g, i, j))
+            .count();
+        let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
+        let _ = writeln!(
+            s,
+            "boundary `{}`: {} fixed on {count} nodes",
+            b.name,
+            fix.join(", ")
+        );
+    }
+    for st in &case.stages {
+        let a = model.active(st);
+        let _ = writeln!(
+            s,
+            "stage `{}`: {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]",
+            st.name,
+            st.duration,
+            st.dt,
+            (st.duration / st.dt).ceil() as usize,
+            a.loads
+                .iter()
+                .map(|&i| model.loads[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            a.boundaries
+                .iter()
+                .map(|&i| model.boundaries[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let gravity = case
+        .loads
+        .iter()
+        .any(|l| matches!(l, Load::BodyForce { .. }));
+    let _ = writeln!(
+        s,
+        "features: gravity {}; return mapping {}; B-bar off; patch recovery off",
+        if gravity { "on" } else { "off" },
+        if model.materials.iter().all(|m| m.model.is_linear()) {
+            "never called (elastic)"
+        } else {
+            "on"
+        }
+    );
+    let _ = writeln!(
+        s,
+        "Newmark: β = {}, γ = {}",
+        case.time_integration.beta, case.time_integration.gamma
+    );
+    let _ = writeln!(
+        s,
+        "solver: {}",
+        case.solver.options_file.as_deref().map_or(
+            "built-in default (Newton; sparse LU by UMFPACK on one rank, MUMPS on several)"
+                .to_string(),
+            |f| format!("options file {f}")
+        )
+    );
+    match &case.verification {
+        Some(v) => {
+            let _ = writeln!(s, "verification: {}", crate::verification::describe(v));
+        }
+        None => {
+            let _ = writeln!(s, "verification: none");
+        }
+    }
+    s
+}

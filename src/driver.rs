@@ -1,0 +1,699 @@
+//! The algorithm on one page.
+//!
+//! ```text
+//! run
+//! ├── set up: grid system (DMDA, SNES), material points, verification check, probes, output
+//! ├── for each stage:                                   run_stage
+//! │   └── until the stage ends:                         (time-step loop)
+//! │       ├── Δt ← min(stage Δt after cuts, time to the next event / stage end)
+//! │       ├── newton_solve: map to grid, constraints, loads; SNES on the Newmark residual
+//! │       ├── if converged: update_particles ([003] Eq. 24, [000] Eq. 11) unless inadmissible
+//! │       ├── if not: cut Δt (stage.cut_factor), retry; fail after stage.max_step_cuts cuts in a row
+//! │       └── record_step: probes, check, history.csv
+//! └── finish: verification metrics, summary.json
+//! ```
+
+use crate::assembly::{self, Collective, GridSystem, Phase};
+use crate::case::{Case, Stage};
+use crate::io::RunOutput;
+use crate::kernels::StepResult;
+use crate::model::Model;
+use crate::verification::{self, Check, Metric};
+use petsc::Comm;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What a run is asked to do.
+pub struct RunRequest<'a> {
+    /// The validated case.
+    pub case: &'a Case,
+    /// How the case was named on the command line.
+    pub case_label: String,
+    /// The `--set` overrides, as given.
+    pub overrides: Vec<String>,
+    /// Output directory.
+    pub out_dir: PathBuf,
+    /// No progress lines.
+    pub quiet: bool,
+    /// The run's communicator.
+    pub comm: Comm,
+}
+
+/// Why a run stopped early.
+#[derive(Debug, Clone)]
+pub enum RunError {
+    /// Bad input discovered while setting up or on the first solve (e.g. an unused PETSc option).
+    Input(String),
+    /// The run could not continue (e.g. a step that does not converge after the allowed cuts).
+    Failed(String),
+}
+
+impl RunError {
+    /// The message.
+    pub fn message(&self) -> &str {
+        match self {
+            RunError::Input(m) | RunError::Failed(m) => m,
+        }
+    }
+}
+
+/// Wall time per phase [s].
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Timings {
+    /// Setting up (grid, particles, solver).
+    pub setup_s: f64,
+    /// Mapping to the grid, constraints, loads, matrix creation, every step.
+    pub step_setup_s: f64,
+    /// Residual and Jacobian assembly (inside the Newton solves).
+    pub assembly_s: f64,
+    /// Linear solves and the rest of SNES (Newton solve time minus assembly).
+    pub linear_solve_s: f64,
+    /// Particle updates.
+    pub particle_update_s: f64,
+    /// Writing results.
+    pub output_s: f64,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// "running", "completed" or "failed".
+    pub status: String,
+    /// Why the run failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// The case file.
+    pub case: String,
+    /// `--set` overrides.
+    pub overrides: Vec<String>,
+    /// porompm version and git revision.
+    pub porompm_version: String,
+    /// Wall time of the run [s].
+    pub wall_time_s: f64,
+    /// Simulated time reached [s].
+    pub time_s: f64,
+    /// Simulated time asked for [s].
+    pub end_time_s: f64,
+    /// Converged steps.
+    pub steps: usize,
+    /// Step cuts (retries with smaller Δt).
+    pub step_cuts: usize,
+    /// Newton iterations over the run.
+    pub snes_iterations: usize,
+    /// Krylov iterations over the run.
+    pub ksp_iterations: usize,
+    /// Steps whose matrix kept the previous step's nonzero structure (so the symbolic
+    /// factorisation was reused).
+    pub matrix_structure_reuses: usize,
+    /// Unknowns of the last step (unconstrained dofs).
+    pub dofs: usize,
+    /// Dofs of the whole grid.
+    pub grid_dofs: usize,
+    /// Material points.
+    pub particles: usize,
+    /// MPI ranks.
+    pub ranks: usize,
+    /// The solver actually used.
+    pub solver: String,
+    /// PETSc's options database.
+    pub petsc_options: Vec<String>,
+    /// Wall time per phase.
+    pub timings: Timings,
+    /// Metrics against the case's analytical reference.
+    pub verification: BTreeMap<String, Metric>,
+    /// Whether every metric passed (absent without verification).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification_passed: Option<bool>,
+}
+
+/// A probe: the particle nearest to a point at t = 0.
+struct Probe {
+    name: String,
+    id: u64,
+}
+
+struct Simulation<'a> {
+    case: &'a Case,
+    model: Model,
+    system: GridSystem,
+    check: Option<Box<dyn Check>>,
+    probes: Vec<Probe>,
+    out: &'a mut RunOutput,
+    coll: Collective,
+    quiet: bool,
+    t: f64,
+    step: usize,
+    summary: &'a mut Summary,
+    options_checked: bool,
+    last_newton: (usize, usize),
+}
+
+/// Runs a case and returns its summary (also written to `summary.json`).
+pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
+    let start = Instant::now();
+    let mut summary = Summary::new(req);
+    let result = out
+        .write_summary(&summary)
+        .map_err(RunError::Input)
+        .and_then(|_| {
+            let mut sim = Simulation::set_up(req, out, &mut summary)?;
+            for stage in &req.case.stages {
+                sim.run_stage(stage)?;
+            }
+            sim.finish()
+        });
+    summary.wall_time_s = start.elapsed().as_secs_f64();
+    summary.petsc_options = assembly::petsc_options().unwrap_or_default();
+    let err = result.err();
+    match &err {
+        None => summary.status = "completed".into(),
+        Some(e) => {
+            summary.status = "failed".into();
+            summary.error = Some(e.message().to_string());
+        }
+    }
+    let written = out.write_summary(&summary);
+    match (err, written) {
+        (Some(e), _) => (summary, Some(e)),
+        (None, Err(w)) => (summary, Some(RunError::Failed(w))),
+        (None, Ok(())) => (summary, None),
+    }
+}
+
+impl Summary {
+    fn new(req: &RunRequest) -> Summary {
+        Summary {
+            status: "running".into(),
+            error: None,
+            case: req.case_label.clone(),
+            overrides: req.overrides.clone(),
+            porompm_version: crate::VERSION.into(),
+            wall_time_s: 0.0,
+            time_s: 0.0,
+            end_time_s: req.case.end_time(),
+            steps: 0,
+            step_cuts: 0,
+            snes_iterations: 0,
+            ksp_iterations: 0,
+            matrix_structure_reuses: 0,
+            dofs: 0,
+            grid_dofs: 0,
+            particles: 0,
+            ranks: req.comm.size(),
+            solver: String::new(),
+            petsc_options: assembly::petsc_options().unwrap_or_default(),
+            timings: Timings::default(),
+            verification: BTreeMap::new(),
+            verification_passed: None,
+        }
+    }
+}
+
+/// Runs `steps` steps of the first stage, prepares the next one and compares its assembled tangent
+/// with central finite differences of the assembled residual, block by block (one rank, small
+/// cases). Nothing is written.
+pub fn test_jacobian(
+    req: &RunRequest,
+    steps: usize,
+) -> Result<Vec<assembly::BlockCheck>, RunError> {
+    let mut summary = Summary::new(req);
+    let mut out = RunOutput::create(&req.out_dir, false).map_err(RunError::Input)?;
+    let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
+    let stage = &req.case.stages[0];
+    let active = sim.model.active(stage);
+    for _ in 0..steps {
+        sim.newton_solve(&active, stage.dt)?
+            .map_err(RunError::Failed)?;
+        sim.update_particles(stage.dt)?.map_err(RunError::Failed)?;
+        sim.t += stage.dt;
+    }
+    sim.system
+        .prepare_step(&sim.model, &active, sim.t + stage.dt, stage.dt)
+        .map_err(RunError::Failed)?;
+    sim.system
+        .jacobian_check(&sim.model, 0.7)
+        .map_err(|e| RunError::Failed(e.to_string()))
+}
+
+impl<'a> Simulation<'a> {
+    fn set_up(
+        req: &RunRequest<'a>,
+        out: &'a mut RunOutput,
+        summary: &'a mut Summary,
+    ) -> Result<Simulation<'a>, RunError> {
+        let t0 = Instant::now();
+        let case = req.case;
+        let coll = Collective::new(req.comm);
+        let input = |e: String| RunError::Input(e);
+        let two_phase = case.analysis.formulation == crate::case::Formulation::TwoPhase;
+        let system = GridSystem::new(req.comm, &crate::model::grid_of(case), two_phase)
+            .map_err(|e| input(e.to_string()))?;
+        let model = Model::build(case, |i, j| system.owns_cell(i, j));
+        let check = verification::for_case(case, &model, &coll)
+            .map_err(|e| input(format!("verification: {e}")))?;
+        let probes = find_probes(case, &model, &coll).map_err(input)?;
+        summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
+        summary.grid_dofs = system.total_dofs();
+        let mut columns: Vec<String> = [
+            "time",
+            "step",
+            "dt",
+            "newton_iterations",
+            "linear_iterations",
+        ]
+        .map(String::from)
+        .to_vec();
+        for p in &probes {
+            columns.extend(
+                probe_fields(model.two_phase)
+                    .iter()
+                    .map(|f| format!("{}.{f}", p.name)),
+            );
+        }
+        if let Some(c) = &check {
+            columns.extend(c.columns());
+        }
+        out.start_history(&columns).map_err(input)?;
+        summary.timings.setup_s = t0.elapsed().as_secs_f64();
+        let mut sim = Simulation {
+            case,
+            model,
+            system,
+            check,
+            probes,
+            out,
+            coll,
+            quiet: req.quiet,
+            t: 0.0,
+            step: 0,
+            summary,
+            options_checked: false,
+            last_newton: (0, 0),
+        };
+        sim.record_step(0.0)?;
+        Ok(sim)
+    }
+
+    /// The time-step loop of one stage.
+    fn run_stage(&mut self, stage: &Stage) -> Result<(), RunError> {
+        let active = self.model.active(stage);
+        let mut control = StepControl::new(stage, self.stage_end(stage));
+        self.progress(&format!(
+            "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
+            stage.name, self.t, control.t_end, stage.dt
+        ));
+        let mut next_report = self.t + stage.duration / 10.0;
+        while !control.finished(self.t) {
+            let events = self
+                .check
+                .as_ref()
+                .map(|c| c.event_times())
+                .unwrap_or_default();
+            let dt = control.next(self.t, &events);
+            let outcome = self.newton_solve(&active, dt)?;
+            let admitted = match outcome {
+                Ok(()) => self.update_particles(dt)?,
+                Err(why) => Err(why),
+            };
+            match admitted {
+                Ok(()) => {
+                    self.t = control.advance(self.t, dt);
+                    control.accepted();
+                    self.step += 1;
+                    self.summary.steps = self.step;
+                    self.summary.time_s = self.t;
+                    if self.step.is_multiple_of(self.case.output.history_every)
+                        || control.finished(self.t)
+                    {
+                        self.record_step(dt)?;
+                    } else {
+                        self.observe_only(dt)?;
+                    }
+                    if self.t >= next_report - 1e-9 * stage.dt {
+                        self.progress(&format!("  t = {:.6e} s, step {}", self.t, self.step));
+                        next_report += stage.duration / 10.0;
+                    }
+                }
+                Err(why) => {
+                    self.summary.step_cuts += 1;
+                    if control.rejected(dt).is_err() {
+                        return Err(RunError::Failed(format!(
+                            "stage `{}`: the step from t = {:.6e} s did not converge after {} cuts of Δt (last Δt = {:.3e} s): {why}",
+                            stage.name, self.t, stage.max_step_cuts, dt
+                        )));
+                    }
+                    self.progress(&format!(
+                        "  step from t = {:.6e} s cut to Δt = {:.3e} s: {why}",
+                        self.t, control.dt
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One Newton solve of the step t → t + dt. `Ok(Err(reason))` means it did not converge.
+    fn newton_solve(
+        &mut self,
+        active: &crate::model::Active,
+        dt: f64,
+    ) -> Result<Result<(), String>, RunError> {
+        let t0 = Instant::now();
+        {
+            let _stage = self
+                .system
+                .phase(Phase::StepSetup)
+                .map_err(|e| RunError::Failed(e.to_string()))?;
+            let prepared = self
+                .system
+                .prepare_step(&self.model, active, self.t + dt, dt);
+            let failed = self.coll.any(prepared.is_err()).map_err(RunError::Failed)?;
+            if let Err(e) = prepared {
+                return Err(RunError::Failed(e));
+            } else if failed {
+                return Err(RunError::Failed(
+                    "another rank could not prepare the step".into(),
+                ));
+            }
+        }
+        self.summary.timings.step_setup_s += t0.elapsed().as_secs_f64();
+        self.summary.dofs = self.system.free_dofs();
+        self.summary.matrix_structure_reuses = self.system.reused_patterns;
+        let solve = self
+            .system
+            .solve(&self.model)
+            .map_err(|e| RunError::Failed(format!("Newton solve at t = {:.6e} s: {e}", self.t)))?;
+        self.summary.timings.assembly_s += solve.assembly_seconds;
+        self.summary.timings.linear_solve_s += solve.solve_seconds - solve.assembly_seconds;
+        self.summary.snes_iterations += solve.newton_iterations;
+        self.summary.ksp_iterations += solve.linear_iterations;
+        self.last_newton = (solve.newton_iterations, solve.linear_iterations);
+        if !self.options_checked {
+            self.options_checked = true;
+            self.summary.solver = assembly::describe_solver(&mut self.system).unwrap_or_default();
+            let unused =
+                assembly::unused_petsc_options().map_err(|e| RunError::Failed(e.to_string()))?;
+            if !unused.is_empty() {
+                return Err(RunError::Input(format!(
+                    "PETSc option(s) not used by any solver object: {} (misspelt, or not applicable to this solver)",
+                    unused.join(", ")
+                )));
+            }
+        }
+        if solve.converged {
+            Ok(Ok(()))
+        } else {
+            let why = match solve.domain_error {
+                Some(d) => format!("{} ({d})", solve.reason),
+                None => solve.reason,
+            };
+            Ok(Err(why))
+        }
+    }
+
+    /// The particle update of a converged step; `Ok(Err(..))` if a particle would become
+    /// inadmissible (the step is then cut), in which case no particle is changed.
+    fn update_particles(&mut self, dt: f64) -> Result<Result<(), String>, RunError> {
+        let t0 = Instant::now();
+        let _stage = self
+            .system
+            .phase(Phase::ParticleUpdate)
+            .map_err(|e| RunError::Failed(e.to_string()))?;
+        let n = self.model.particles.len();
+        let results: Vec<StepResult> = (0..n).map(|k| self.system.step_result(k)).collect();
+        let bad = results
+            .iter()
+            .enumerate()
+            .find_map(|(k, r)| self.model.check_step(k, r).err());
+        if self.coll.any(bad.is_some()).map_err(RunError::Failed)? {
+            return Ok(Err(bad.map(|e| e.0).unwrap_or_else(|| {
+                "a material point on another rank became inadmissible".into()
+            })));
+        }
+        for (k, r) in results.iter().enumerate() {
+            self.model
+                .update_particle(k, r, r.kin.dp, dt)
+                .map_err(|e| RunError::Failed(e.0))?;
+        }
+        self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
+        Ok(Ok(()))
+    }
+
+    /// Probes, check and one row of history.csv.
+    fn record_step(&mut self, dt: f64) -> Result<(), RunError> {
+        let t0 = Instant::now();
+        let _stage = self
+            .system
+            .phase(Phase::Output)
+            .map_err(|e| RunError::Failed(e.to_string()))?;
+        let mut row = vec![
+            self.t,
+            self.step as f64,
+            dt,
+            self.last_newton.0 as f64,
+            self.last_newton.1 as f64,
+        ];
+        row.extend(probe_values(&self.model, &self.probes, &self.coll).map_err(RunError::Failed)?);
+        if let Some(c) = self.check.as_mut() {
+            row.extend(
+                c.observe(self.t, dt, &self.model, &self.coll)
+                    .map_err(RunError::Failed)?,
+            );
+        }
+        self.out.history_row(&row).map_err(RunError::Failed)?;
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The check's observation on steps without a history row.
+    fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
+        if let Some(c) = self.check.as_mut() {
+            c.observe(self.t, dt, &self.model, &self.coll)
+                .map_err(RunError::Failed)?;
+        }
+        Ok(())
+    }
+
+    /// Metrics and tables of the check.
+    fn finish(mut self) -> Result<(), RunError> {
+        if let Some(c) = self.check.as_mut() {
+            let (metrics, tables) = c
+                .finish(&self.model, &self.coll)
+                .map_err(RunError::Failed)?;
+            self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
+            for t in &tables {
+                self.out
+                    .write_table(&t.name, &t.header, &t.rows)
+                    .map_err(RunError::Failed)?;
+            }
+            self.summary.verification = metrics.into_iter().collect();
+        }
+        Ok(())
+    }
+
+    fn stage_end(&self, stage: &Stage) -> f64 {
+        let mut end = 0.0;
+        for s in &self.case.stages {
+            end += s.duration;
+            if std::ptr::eq(s, stage) {
+                break;
+            }
+        }
+        end
+    }
+
+    fn progress(&self, msg: &str) {
+        if !self.quiet && self.coll.rank() == 0 {
+            eprintln!("{msg}");
+        }
+    }
+}
+
+/// Time-step control within a stage: the Δt of the next try, cuts after a failed try, regrowth
+/// after successes, and landing exactly on event times (e.g. the times a verification needs) and
+/// on the stage end.
+#[derive(Debug, Clone)]
+struct StepControl {
+    stage_dt: f64,
+    dt: f64,
+    cuts: usize,
+    max_cuts: usize,
+    factor: f64,
+    t_end: f64,
+}
+
+impl StepControl {
+    fn new(stage: &Stage, t_end: f64) -> StepControl {
+        StepControl {
+            stage_dt: stage.dt,
+            dt: stage.dt,
+            cuts: 0,
+            max_cuts: stage.max_step_cuts,
+            factor: stage.cut_factor,
+            t_end,
+        }
+    }
+
+    /// Round-off allowance on times.
+    fn tiny(&self) -> f64 {
+        1e-9 * self.stage_dt
+    }
+
+    /// Whether the stage is done at time `t`.
+    fn finished(&self, t: f64) -> bool {
+        t >= self.t_end - self.tiny()
+    }
+
+    /// Δt of the next try from `t`: the current Δt, shortened to land on the first event time
+    /// inside the step and on the stage end.
+    fn next(&self, t: f64, events: &[f64]) -> f64 {
+        let mut next = t + self.dt;
+        for &e in events {
+            if e > t + self.tiny() && e < next {
+                next = e;
+            }
+        }
+        // Do not leave a sliver of less than a millionth of a step before the end.
+        if next > self.t_end - 1e-6 * self.dt {
+            next = self.t_end;
+        }
+        next - t
+    }
+
+    /// The time after an accepted step (exactly the stage end when it lands there).
+    fn advance(&self, t: f64, dt: f64) -> f64 {
+        if (self.t_end - (t + dt)).abs() <= self.tiny() {
+            self.t_end
+        } else {
+            t + dt
+        }
+    }
+
+    /// After an accepted step: reset the cut count and let Δt grow back towards the stage's.
+    fn accepted(&mut self) {
+        self.cuts = 0;
+        self.dt = (self.dt / self.factor).min(self.stage_dt);
+    }
+
+    /// After a failed try of length `dt_tried`: cut, or `Err` if the cuts are exhausted.
+    fn rejected(&mut self, dt_tried: f64) -> Result<(), ()> {
+        self.cuts += 1;
+        if self.cuts > self.max_cuts {
+            return Err(());
+        }
+        self.dt = dt_tried * self.factor;
+        Ok(())
+    }
+}
+
+fn probe_fields(two_phase: bool) -> &'static [&'static str] {
+    if two_phase {
+        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "p"]
+    } else {
+        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy"]
+    }
+}
+
+fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Probe>, String> {
+    let ps = &model.particles;
+    let mut out = Vec::new();
+    for p in &case.probes {
+        let local: Vec<f64> = (0..ps.len())
+            .flat_map(|k| {
+                [
+                    ((ps.x0[k][0] - p.point[0]).powi(2) + (ps.x0[k][1] - p.point[1]).powi(2))
+                        .sqrt(),
+                    ps.id[k] as f64,
+                ]
+            })
+            .collect();
+        let all = coll.gather(&local)?;
+        let best = all
+            .chunks(2)
+            .min_by(|a, b| {
+                a[0].partial_cmp(&b[0])
+                    .unwrap()
+                    .then(a[1].partial_cmp(&b[1]).unwrap())
+            })
+            .ok_or(format!("probe `{}`: there are no material points", p.name))?;
+        out.push(Probe {
+            name: p.name.clone(),
+            id: best[1] as u64,
+        });
+    }
+    Ok(out)
+}
+
+fn probe_values(model: &Model, probes: &[Probe], coll: &Collective) -> Result<Vec<f64>, String> {
+    let ps = &model.particles;
+    let nf = probe_fields(model.two_phase).len();
+    let mut local = vec![0.0; probes.len() * nf];
+    for (i, pr) in probes.iter().enumerate() {
+        if let Some(k) = (0..ps.len()).find(|&k| ps.id[k] == pr.id) {
+            let s = ps.stress[k];
+            let v = [
+                ps.x[k][0],
+                ps.x[k][1],
+                ps.disp[k][0],
+                ps.disp[k][1],
+                ps.vel[k][0],
+                ps.vel[k][1],
+                s[0],
+                s[1],
+                s[2],
+                ps.p[k],
+            ];
+            local[i * nf..(i + 1) * nf].copy_from_slice(&v[..nf]);
+        }
+    }
+    coll.sum(&local)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stage(dt: f64, cuts: usize) -> Stage {
+        Stage {
+            name: "s".into(),
+            duration: 1.0,
+            dt,
+            boundaries: None,
+            loads: None,
+            max_step_cuts: cuts,
+            cut_factor: 0.5,
+        }
+    }
+
+    #[test]
+    fn steps_land_on_events_and_on_the_stage_end() {
+        let c = StepControl::new(&stage(0.3, 2), 1.0);
+        assert_eq!(c.next(0.0, &[]), 0.3);
+        assert!((c.next(0.0, &[0.1, 0.5]) - 0.1).abs() < 1e-15);
+        // An event at the current time is not a target.
+        assert!((c.next(0.1, &[0.1]) - 0.3).abs() < 1e-15);
+        // The last step is shortened to end exactly at the stage end.
+        assert!((c.next(0.9, &[]) - 0.1).abs() < 1e-15);
+        assert_eq!(c.advance(0.9, 0.1), 1.0);
+        assert!(c.finished(1.0 - 1e-12) && !c.finished(0.99));
+    }
+
+    #[test]
+    fn failed_steps_are_cut_then_grow_back_and_the_cuts_are_limited() {
+        let mut c = StepControl::new(&stage(0.2, 2), 1.0);
+        assert!(c.rejected(0.2).is_ok());
+        assert!((c.next(0.0, &[]) - 0.1).abs() < 1e-15);
+        assert!(c.rejected(0.1).is_ok());
+        assert!((c.next(0.0, &[]) - 0.05).abs() < 1e-15);
+        // A third failure in a row exceeds max_step_cuts = 2.
+        assert!(c.clone().rejected(0.05).is_err());
+        // Success resets the count and doubles Δt back, never above the stage's.
+        c.accepted();
+        assert!((c.dt - 0.1).abs() < 1e-15 && c.cuts == 0);
+        c.accepted();
+        c.accepted();
+        assert_eq!(c.dt, 0.2);
+    }
+}

@@ -1,0 +1,156 @@
+//! Files: reading case files, and writing a run's results (`summary.json`, `history.csv`, extra
+//! CSV tables). The only application module that touches the file system. Under MPI only rank 0
+//! writes; the other ranks hold a [`RunOutput`] that does nothing.
+//!
+//! A run first writes `summary.json` with `"status": "running"` and rewrites it at the end with
+//! `"completed"` or `"failed"`; a run that dies in between never looks complete.
+//! `history.csv` is flushed row by row, so it stays readable whatever happens.
+
+use serde::Serialize;
+use std::fs::{self, File};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Reads a whole text file, with the path in the error message.
+pub fn read_text(path: &Path) -> Result<String, String> {
+    fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+}
+
+/// The output directory of a run.
+pub struct RunOutput {
+    dir: Option<PathBuf>,
+    history: Option<BufWriter<File>>,
+}
+
+/// Writes `content` to `path` atomically (write a temporary file, then rename).
+fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
+    let tmp = path.with_extension("tmp");
+    let mut f = File::create(&tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
+    f.write_all(content)
+        .and_then(|_| f.sync_all())
+        .map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
+    fs::rename(&tmp, path)
+        .map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
+}
+
+impl RunOutput {
+    /// Prepares `dir` (created if needed) on the writing rank; a no-op on the others. Results of
+    /// an earlier run in the same directory are removed first so that they cannot be mistaken
+    /// for this run's.
+    pub fn create(dir: &Path, writer: bool) -> Result<RunOutput, String> {
+        if !writer {
+            return Ok(RunOutput {
+                dir: None,
+                history: None,
+            });
+        }
+        fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+        for old in ["summary.json", "history.csv", "amplitude_profile.csv"] {
+            let p = dir.join(old);
+            if p.exists() {
+                fs::remove_file(&p)
+                    .map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
+            }
+        }
+        Ok(RunOutput {
+            dir: Some(dir.to_path_buf()),
+            history: None,
+        })
+    }
+
+    /// Whether this rank writes.
+    pub fn is_writer(&self) -> bool {
+        self.dir.is_some()
+    }
+
+    /// Writes (replaces) `summary.json`.
+    pub fn write_summary<T: Serialize>(&self, summary: &T) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        let text = serde_json::to_string_pretty(summary)
+            .map_err(|e| format!("cannot serialise the summary: {e}"))?;
+        write_atomic(&dir.join("summary.json"), text.as_bytes())
+    }
+
+    /// Starts `history.csv` with the given column names.
+    pub fn start_history(&mut self, columns: &[String]) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        let path = dir.join("history.csv");
+        let f =
+            File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+        let mut w = BufWriter::new(f);
+        writeln!(w, "{}", columns.join(","))
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        w.flush().map_err(|e| e.to_string())?;
+        self.history = Some(w);
+        Ok(())
+    }
+
+    /// Appends one row to `history.csv` and flushes it.
+    pub fn history_row(&mut self, values: &[f64]) -> Result<(), String> {
+        let Some(w) = self.history.as_mut() else {
+            return Ok(());
+        };
+        let line: Vec<String> = values.iter().map(|v| format!("{v:.10e}")).collect();
+        writeln!(w, "{}", line.join(","))
+            .and_then(|_| w.flush())
+            .map_err(|e| format!("cannot write history.csv: {e}"))
+    }
+
+    /// Writes a CSV table `name` (header, rows) atomically.
+    pub fn write_table(
+        &self,
+        name: &str,
+        header: &[&str],
+        rows: &[Vec<f64>],
+    ) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        let mut text = header.join(",");
+        text.push('\n');
+        for r in rows {
+            text.push_str(
+                &r.iter()
+                    .map(|v| format!("{v:.10e}"))
+                    .collect::<Vec<_>>()
+                    .join(","),
+            );
+            text.push('\n');
+        }
+        write_atomic(&dir.join(name), text.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_are_written_and_old_results_removed() {
+        let dir = std::env::temp_dir().join(format!("porompm-io-test-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("summary.json"), "{\"status\": \"completed\"}").unwrap();
+        let mut out = RunOutput::create(&dir, true).unwrap();
+        assert!(
+            !dir.join("summary.json").exists(),
+            "a stale summary must not survive"
+        );
+        out.write_summary(&serde_json::json!({"status": "running"}))
+            .unwrap();
+        out.start_history(&["time".into(), "p".into()]).unwrap();
+        out.history_row(&[0.5, 1.25]).unwrap();
+        out.write_table("t.csv", &["a", "b"], &[vec![1.0, 2.0]])
+            .unwrap();
+        let h = fs::read_to_string(dir.join("history.csv")).unwrap();
+        assert!(h.starts_with("time,p\n5.0000000000e-1,1.2500000000e0"));
+        assert!(fs::read_to_string(dir.join("summary.json"))
+            .unwrap()
+            .contains("running"));
+        assert!(fs::read_to_string(dir.join("t.csv"))
+            .unwrap()
+            .starts_with("a,b\n"));
+        let silent = RunOutput::create(&dir.join("never"), false).unwrap();
+        silent.write_summary(&serde_json::json!({})).unwrap();
+        assert!(!dir.join("never").exists());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}

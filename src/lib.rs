@@ -1,0 +1,34 @@
+//! porompm: the implicit three-field (u–p–U) GIMP material point method for large-deformation
+//! saturated soils, on PETSc. See ARCHITECTURE.md for the map of the code.
+//!
+//! Local and global stay apart: [`kernels`] and [`model`] are pure Rust (one material point, one
+//! small dense block at a time); [`assembly`] is the only module that talks to PETSc; [`io`] is the
+//! only module that touches files; [`driver`] is the algorithm on one page.
+
+pub mod assembly;
+pub mod case;
+pub mod describe;
+pub mod driver;
+pub mod io;
+pub mod kernels;
+pub mod model;
+pub mod verification;
+
+/// porompm's version and git revision.
+pub const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (git ",
+    env!("POROMPM_GIT_REV"),
+    ")"
+);
+
+/// What `porompm --version` prints after the program name.
+pub const VERSION_LONG: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (git ",
+    env!("POROMPM_GIT_REV"),
+    ")\nPETSc ",
+    env!("POROMPM_PETSC_VERSION"),
+    " with ",
+    env!("POROMPM_PETSC_PACKAGES")
+);

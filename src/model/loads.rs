@@ -1,0 +1,333 @@
+//! Time functions, loads and Dirichlet conditions, resolved against the grid and the particles.
+
+use super::grid::Grid;
+use super::particles::Particles;
+use crate::case::{self, Dof, Region, Side, TimeFunction};
+
+/// A scalar function of time.
+#[derive(Debug, Clone)]
+pub enum TimeFn {
+    /// f = value.
+    Constant(f64),
+    /// Linear from 0 at `start` to 1 at `start + duration`.
+    Ramp { start: f64, duration: f64 },
+    /// C² smoothstep from 0 at `start` to 1 at `start + duration`.
+    SmoothRamp { start: f64, duration: f64 },
+    /// cos(ωt + φ) times a smooth start over `ramp`.
+    Harmonic { omega: f64, phase: f64, ramp: f64 },
+    /// Piecewise linear.
+    Table { t: Vec<f64>, v: Vec<f64> },
+}
+
+/// The smoothstep 6s⁵ − 15s⁴ + 10s³ clamped to [0, 1].
+pub fn smoothstep(s: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+}
+
+impl TimeFn {
+    /// From the case's definition.
+    pub fn from_case(f: &TimeFunction) -> TimeFn {
+        match f {
+            TimeFunction::Constant { value, .. } => TimeFn::Constant(*value),
+            TimeFunction::Ramp {
+                start, duration, ..
+            } => TimeFn::Ramp {
+                start: *start,
+                duration: *duration,
+            },
+            TimeFunction::SmoothRamp {
+                start, duration, ..
+            } => TimeFn::SmoothRamp {
+                start: *start,
+                duration: *duration,
+            },
+            TimeFunction::Harmonic {
+                angular_frequency,
+                phase,
+                ramp_duration,
+                ..
+            } => TimeFn::Harmonic {
+                omega: *angular_frequency,
+                phase: *phase,
+                ramp: *ramp_duration,
+            },
+            TimeFunction::Table { times, values, .. } => TimeFn::Table {
+                t: times.clone(),
+                v: values.clone(),
+            },
+        }
+    }
+
+    /// f(t).
+    pub fn eval(&self, t: f64) -> f64 {
+        match self {
+            TimeFn::Constant(v) => *v,
+            TimeFn::Ramp { start, duration } => ((t - start) / duration).clamp(0.0, 1.0),
+            TimeFn::SmoothRamp { start, duration } => smoothstep((t - start) / duration),
+            TimeFn::Harmonic { omega, phase, ramp } => {
+                let env = if *ramp > 0.0 {
+                    smoothstep(t / ramp)
+                } else {
+                    1.0
+                };
+                env * (omega * t + phase).cos()
+            }
+            TimeFn::Table { t: ts, v } => {
+                if t <= ts[0] {
+                    return v[0];
+                }
+                for k in 1..ts.len() {
+                    if t <= ts[k] {
+                        let s = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+                        return v[k - 1] + s * (v[k] - v[k - 1]);
+                    }
+                }
+                *v.last().unwrap()
+            }
+        }
+    }
+}
+
+/// A load ready to be applied.
+#[derive(Debug, Clone)]
+pub struct LoadDef {
+    /// Name from the case.
+    pub name: String,
+    /// Its time function (constant 1 if none).
+    pub time_fn: TimeFn,
+    /// What it acts on.
+    pub target: LoadTarget,
+}
+
+/// What a load acts on.
+#[derive(Debug, Clone)]
+pub enum LoadTarget {
+    /// Face tractions on the listed particles (local indices), applied at the face centre.
+    ParticleTraction {
+        particles: Vec<usize>,
+        face: Side,
+        traction: [f64; 2],
+    },
+    /// Forces on grid nodes (i, j, tributary length [m]).
+    NodalTraction {
+        nodes: Vec<(usize, usize, f64)>,
+        traction: [f64; 2],
+    },
+    /// Body acceleration on all particles.
+    BodyForce { acceleration: [f64; 2] },
+}
+
+impl LoadDef {
+    /// Resolves a case load on this rank's particles and the grid.
+    pub fn from_case(
+        l: &case::Load,
+        c: &case::Case,
+        grid: &Grid,
+        particles: &Particles,
+    ) -> LoadDef {
+        let time_fn = l
+            .time_function()
+            .and_then(|n| c.time_function(n))
+            .map(TimeFn::from_case)
+            .unwrap_or(TimeFn::Constant(1.0));
+        let target = match l {
+            case::Load::ParticleTraction {
+                region,
+                face,
+                traction,
+                ..
+            } => LoadTarget::ParticleTraction {
+                particles: (0..particles.len())
+                    .filter(|&k| {
+                        region.contains(particles.x0[k])
+                            && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
+                    })
+                    .collect(),
+                face: *face,
+                traction: *traction,
+            },
+            case::Load::NodalTraction {
+                region, traction, ..
+            } => LoadTarget::NodalTraction {
+                nodes: tributary_nodes(grid, region),
+                traction: *traction,
+            },
+            case::Load::BodyForce { acceleration, .. } => LoadTarget::BodyForce {
+                acceleration: *acceleration,
+            },
+        };
+        LoadDef {
+            name: l.name().to_string(),
+            time_fn,
+            target,
+        }
+    }
+
+    /// Number of particles or nodes it acts on (for `check`).
+    pub fn size(&self) -> usize {
+        match &self.target {
+            LoadTarget::ParticleTraction { particles, .. } => particles.len(),
+            LoadTarget::NodalTraction { nodes, .. } => nodes.len(),
+            LoadTarget::BodyForce { .. } => 0,
+        }
+    }
+}
+
+/// Whether the `face` of a particle domain centred at `x` lies on the surface of the material:
+/// the point just beyond the face centre is outside every body. This selects the outer row of
+/// particles whatever the particle spacing, so a traction region need not be adjusted when the
+/// grid is refined.
+pub fn face_is_exposed(c: &case::Case, x: [f64; 2], lp: [f64; 2], face: Side) -> bool {
+    let e = 1.0 + 1e-6;
+    let p = match face {
+        Side::XMin => [x[0] - e * lp[0], x[1]],
+        Side::XMax => [x[0] + e * lp[0], x[1]],
+        Side::YMin => [x[0], x[1] - e * lp[1]],
+        Side::YMax => [x[0], x[1] + e * lp[1]],
+    };
+    !c.bodies.iter().any(|b| b.shape.contains(p))
+}
+
+/// Grid nodes inside `region`, with the length of line each stands for: half the distance to its
+/// neighbours along the line (the line is along the direction in which the nodes spread most).
+pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)> {
+    let [nx, ny] = grid.nodes();
+    let mut sel: Vec<(usize, usize)> = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            if region.contains(grid.node_position(i, j)) {
+                sel.push((i, j));
+            }
+        }
+    }
+    if sel.is_empty() {
+        return Vec::new();
+    }
+    let spread = |d: usize| {
+        let v: Vec<f64> = sel
+            .iter()
+            .map(|&(i, j)| grid.node_position(i, j)[d])
+            .collect();
+        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - v.iter().cloned().fold(f64::INFINITY, f64::min)
+    };
+    let dir = if spread(0) >= spread(1) { 0 } else { 1 };
+    let coord = |n: &(usize, usize)| grid.node_position(n.0, n.1)[dir];
+    sel.sort_by(|a, b| coord(a).partial_cmp(&coord(b)).unwrap());
+    let m = sel.len();
+    (0..m)
+        .map(|k| {
+            let left = if k > 0 {
+                (coord(&sel[k]) - coord(&sel[k - 1])) / 2.0
+            } else {
+                0.0
+            };
+            let right = if k + 1 < m {
+                (coord(&sel[k + 1]) - coord(&sel[k])) / 2.0
+            } else {
+                0.0
+            };
+            (sel[k].0, sel[k].1, left + right)
+        })
+        .collect()
+}
+
+/// A set of homogeneous Dirichlet conditions.
+#[derive(Debug, Clone)]
+pub struct BoundaryDef {
+    /// Name from the case.
+    pub name: String,
+    /// Where.
+    pub side: Option<Side>,
+    /// Or which box of nodes.
+    pub region: Option<Region>,
+    /// Components fixed to zero.
+    pub fix: Vec<Dof>,
+}
+
+impl BoundaryDef {
+    /// From the case.
+    pub fn from_case(b: &case::Boundary) -> BoundaryDef {
+        BoundaryDef {
+            name: b.name.clone(),
+            side: b.side,
+            region: b.region,
+            fix: b.fix.clone(),
+        }
+    }
+
+    /// Whether node (i, j) belongs to it.
+    pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
+        if let Some(side) = self.side {
+            return match side {
+                Side::XMin => i == 0,
+                Side::XMax => i == grid.cells[0],
+                Side::YMin => j == 0,
+                Side::YMax => j == grid.cells[1],
+            };
+        }
+        self.region
+            .is_some_and(|r| r.contains(grid.node_position(i, j)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_functions_take_their_values() {
+        assert_eq!(TimeFn::Constant(2.0).eval(5.0), 2.0);
+        let r = TimeFn::Ramp {
+            start: 1.0,
+            duration: 2.0,
+        };
+        assert_eq!((r.eval(0.0), r.eval(2.0), r.eval(9.0)), (0.0, 0.5, 1.0));
+        let s = TimeFn::SmoothRamp {
+            start: 0.0,
+            duration: 1.0,
+        };
+        assert!((s.eval(0.5) - 0.5).abs() < 1e-15 && s.eval(-1.0) == 0.0 && s.eval(2.0) == 1.0);
+        // The smoothstep has zero slope at both ends.
+        assert!((s.eval(1e-4) / 1e-4) < 1e-6);
+        let h = TimeFn::Harmonic {
+            omega: 2.0,
+            phase: 0.0,
+            ramp: 0.0,
+        };
+        assert!((h.eval(0.3) - (0.6f64).cos()).abs() < 1e-15);
+        let hr = TimeFn::Harmonic {
+            omega: 2.0,
+            phase: 0.0,
+            ramp: 1.0,
+        };
+        assert_eq!(hr.eval(0.0), 0.0);
+        assert!((hr.eval(3.0) - (6.0f64).cos()).abs() < 1e-15);
+        let t = TimeFn::Table {
+            t: vec![0.0, 1.0, 3.0],
+            v: vec![0.0, 2.0, 0.0],
+        };
+        assert_eq!(
+            (t.eval(-1.0), t.eval(0.5), t.eval(2.0), t.eval(5.0)),
+            (0.0, 1.0, 1.0, 0.0)
+        );
+    }
+
+    #[test]
+    fn tributary_lengths_sum_to_the_loaded_line() {
+        let g = Grid::new([0.0, 0.0], [0.25, 0.25], [8, 4]);
+        let nodes = tributary_nodes(
+            &g,
+            &Region {
+                min: [0.0, 1.0],
+                max: [0.5, 1.0],
+            },
+        );
+        assert_eq!(nodes.len(), 3);
+        let total: f64 = nodes.iter().map(|n| n.2).sum();
+        assert!((total - 0.5).abs() < 1e-12);
+        assert_eq!(nodes[0].2, 0.125);
+        assert_eq!(nodes[1].2, 0.25);
+    }
+}

@@ -1,0 +1,250 @@
+//! The physical model of a run: grid geometry, materials, material points, loads and Dirichlet
+//! conditions, and the particle update after a converged step. Pure Rust; the global system lives in
+//! [`crate::assembly`].
+
+pub mod grid;
+pub mod loads;
+pub mod material;
+pub mod particles;
+pub mod shape;
+
+use crate::case::{Case, Formulation, ShapeFunctions};
+use crate::kernels::{ParticleInput, StepResult};
+use grid::Grid;
+use loads::{BoundaryDef, LoadDef, LoadTarget};
+use material::Material;
+use particles::Particles;
+use shape::Basis;
+
+/// Everything that describes the continuum and its discretisation on this rank.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// u–p–U (true) or u only.
+    pub two_phase: bool,
+    /// Basis functions.
+    pub basis: Basis,
+    /// Background grid.
+    pub grid: Grid,
+    /// Materials, indexed by `particles.material`.
+    pub materials: Vec<Material>,
+    /// This rank's material points.
+    pub particles: Particles,
+    /// Loads, in case order.
+    pub loads: Vec<LoadDef>,
+    /// Dirichlet conditions, in case order.
+    pub boundaries: Vec<BoundaryDef>,
+    /// g in Darcy's law [m/s²].
+    pub g: f64,
+    /// Newmark β.
+    pub beta: f64,
+    /// Newmark γ.
+    pub gamma: f64,
+}
+
+/// Names of the nodal fields, in dof order: ux, uy, p, Ux, Uy (two-phase) or ux, uy.
+pub fn field_names(two_phase: bool) -> &'static [&'static str] {
+    if two_phase {
+        &["ux", "uy", "p", "Ux", "Uy"]
+    } else {
+        &["ux", "uy"]
+    }
+}
+
+/// The background grid of a case.
+pub fn grid_of(case: &Case) -> Grid {
+    Grid::new(case.grid.origin, case.cell_size(), case.grid.cells)
+}
+
+/// Which loads and boundaries a stage switches on.
+#[derive(Debug, Clone)]
+pub struct Active {
+    /// Indices into `Model::loads`.
+    pub loads: Vec<usize>,
+    /// Indices into `Model::boundaries`.
+    pub boundaries: Vec<usize>,
+}
+
+/// Why a particle update was refused.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InadmissibleStep(pub String);
+
+impl Model {
+    /// Builds the model of `case`, generating particles only in the cells `owned(i, j)`.
+    pub fn build(case: &Case, owned: impl Fn(usize, usize) -> bool) -> Model {
+        let grid = grid_of(case);
+        let particles = Particles::generate(case, &grid, owned);
+        let loads = case
+            .loads
+            .iter()
+            .map(|l| LoadDef::from_case(l, case, &grid, &particles))
+            .collect();
+        Model {
+            two_phase: case.analysis.formulation == Formulation::TwoPhase,
+            basis: match case.analysis.shape_functions {
+                ShapeFunctions::Gimp => Basis::Gimp,
+                ShapeFunctions::Linear => Basis::Linear,
+            },
+            grid,
+            materials: case
+                .materials
+                .iter()
+                .map(|m| Material::from_case(m, case.analysis.formulation))
+                .collect(),
+            particles,
+            loads,
+            boundaries: case.boundaries.iter().map(BoundaryDef::from_case).collect(),
+            g: case.analysis.g,
+            beta: case.time_integration.beta,
+            gamma: case.time_integration.gamma,
+        }
+    }
+
+    /// Dofs per node.
+    pub fn ndof(&self) -> usize {
+        if self.two_phase {
+            5
+        } else {
+            2
+        }
+    }
+
+    /// Names of the nodal fields, in dof order.
+    pub fn field_names(&self) -> &'static [&'static str] {
+        field_names(self.two_phase)
+    }
+
+    /// Loads and boundaries active in a stage (all when the stage does not list them).
+    pub fn active(&self, stage: &crate::case::Stage) -> Active {
+        let pick = |names: &Option<Vec<String>>, all: Vec<&str>| -> Vec<usize> {
+            match names {
+                None => (0..all.len()).collect(),
+                Some(ns) => (0..all.len())
+                    .filter(|&i| ns.iter().any(|n| n == all[i]))
+                    .collect(),
+            }
+        };
+        Active {
+            loads: pick(
+                &stage.loads,
+                self.loads.iter().map(|l| l.name.as_str()).collect(),
+            ),
+            boundaries: pick(
+                &stage.boundaries,
+                self.boundaries.iter().map(|b| b.name.as_str()).collect(),
+            ),
+        }
+    }
+
+    /// Which dof components (ux, uy, p, Ux, Uy) the active boundaries fix at node (i, j).
+    pub fn fixed_components(&self, active: &Active, i: usize, j: usize) -> [bool; 5] {
+        let mut fixed = [false; 5];
+        for &bi in &active.boundaries {
+            let b = &self.boundaries[bi];
+            if b.contains(&self.grid, i, j) {
+                for d in &b.fix {
+                    fixed[match d {
+                        crate::case::Dof::Ux => 0,
+                        crate::case::Dof::Uy => 1,
+                        crate::case::Dof::P => 2,
+                        crate::case::Dof::WUx => 3,
+                        crate::case::Dof::WUy => 4,
+                    }] = true;
+                }
+            }
+        }
+        fixed
+    }
+
+    /// Body acceleration at time `t` from the active body-force loads [m/s²].
+    pub fn body_acceleration(&self, active: &Active, t: f64) -> [f64; 2] {
+        let mut b = [0.0; 2];
+        for &i in &active.loads {
+            if let LoadTarget::BodyForce { acceleration } = &self.loads[i].target {
+                let f = self.loads[i].time_fn.eval(t);
+                b[0] += acceleration[0] * f;
+                b[1] += acceleration[1] * f;
+            }
+        }
+        b
+    }
+
+    /// The kernel input of particle `k` at the start of the step.
+    #[inline]
+    pub fn particle_input(&self, k: usize, body_acc: [f64; 2]) -> ParticleInput {
+        let ps = &self.particles;
+        let mat = &self.materials[ps.material[k] as usize];
+        let (v, n) = (ps.volume[k], ps.porosity[k]);
+        let (water_mass, drag, inv_q) = if self.two_phase {
+            let gw = mat.water_density * self.g;
+            (
+                n * mat.water_density * v,
+                n * n * gw * v / mat.conductivity,
+                mat.inv_q_at(n),
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        ParticleInput {
+            volume: v,
+            porosity: n,
+            mass: ps.mass[k],
+            water_mass,
+            drag,
+            inv_q,
+            stress: ps.stress[k],
+            p: ps.p[k],
+            body_acc,
+        }
+    }
+
+    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and the
+    /// porosity it implies, n = 1 − (1 − n₀)/J, inside (0, 1).
+    pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
+        let j = step.jacobian;
+        let ps = &self.particles;
+        let n_new = 1.0 - (1.0 - ps.porosity[k]) / j;
+        if j.is_nan() || j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
+            return Err(InadmissibleStep(format!(
+                "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
+                ps.id[k], ps.x[k][0], ps.x[k][1]
+            )));
+        }
+        Ok(())
+    }
+
+    /// Updates particle `k` with the converged step ([003] Eq. 24, [000] Eq. 11): accelerations from
+    /// the nodal Newmark accelerations, velocities by the Newmark (trapezoidal for γ = 1/2) rule,
+    /// stress by the soil model, pore pressure by `dp` (the interpolated or recovered increment),
+    /// position and displacement by the interpolated solid increment, volume by J = det(I + ∇Δu),
+    /// porosity by conservation of solid mass: (1 − n_{n+1}) V_{n+1} = (1 − n_n) V_n.
+    pub fn update_particle(
+        &mut self,
+        k: usize,
+        step: &StepResult,
+        dp: f64,
+        dt: f64,
+    ) -> Result<(), InadmissibleStep> {
+        self.check_step(k, step)?;
+        let j = step.jacobian;
+        let ps = &mut self.particles;
+        let n_new = 1.0 - (1.0 - ps.porosity[k]) / j;
+        let g = self.gamma;
+        let kin = &step.kin;
+        for c in 0..2 {
+            ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * kin.a_u[c]);
+            ps.acc[k][c] = kin.a_u[c];
+            if self.two_phase {
+                ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * kin.a_w[c]);
+                ps.acc_w[k][c] = kin.a_w[c];
+            }
+            ps.x[k][c] += kin.du[c];
+            ps.disp[k][c] += kin.du[c];
+        }
+        let mat = &self.materials[ps.material[k] as usize];
+        ps.stress[k] = mat.model.update(&ps.stress[k], &kin.deps).stress;
+        ps.p[k] += dp;
+        ps.volume[k] *= j;
+        ps.porosity[k] = n_new;
+        Ok(())
+    }
+}

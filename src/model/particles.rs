@@ -1,0 +1,152 @@
+//! Material points in struct-of-arrays storage, and their generation from the case geometry.
+//!
+//! One set of points carries both phases ([003] §3, single-layer MPM): it moves with the solid;
+//! the water is described by its velocity, acceleration and mass n ρ_w V on the same points.
+
+use super::grid::Grid;
+use crate::case::{Case, Formulation};
+
+/// All material points held by this rank.
+#[derive(Debug, Clone, Default)]
+pub struct Particles {
+    /// Global identifier (stable over the run, unique across ranks).
+    pub id: Vec<u64>,
+    /// Index of the body it was generated in.
+    pub body: Vec<u16>,
+    /// Index of its material.
+    pub material: Vec<u16>,
+    /// Position [m].
+    pub x: Vec<[f64; 2]>,
+    /// Position at t = 0 [m].
+    pub x0: Vec<[f64; 2]>,
+    /// Total solid displacement [m].
+    pub disp: Vec<[f64; 2]>,
+    /// Half-widths of the (undeformed) GIMP domain l_p [m].
+    pub lp: Vec<[f64; 2]>,
+    /// Volume per metre of thickness [m²·1 m].
+    pub volume: Vec<f64>,
+    /// Porosity [-].
+    pub porosity: Vec<f64>,
+    /// Mass carried by the solid-displacement equation [kg]: the grains' (1 − n)ρ_s V in two-phase
+    /// analyses (constant: solid mass is conserved), the mixture's ρV in one-phase analyses.
+    pub mass: Vec<f64>,
+    /// Solid velocity [m/s].
+    pub vel: Vec<[f64; 2]>,
+    /// Solid acceleration [m/s²].
+    pub acc: Vec<[f64; 2]>,
+    /// Water velocity [m/s] (two-phase).
+    pub vel_w: Vec<[f64; 2]>,
+    /// Water acceleration [m/s²] (two-phase).
+    pub acc_w: Vec<[f64; 2]>,
+    /// Effective stress [xx, yy, xy, zz] (total stress in one-phase analyses) [Pa].
+    pub stress: Vec<[f64; 4]>,
+    /// Pore pressure (compression positive) [Pa].
+    pub p: Vec<f64>,
+    /// Deviatoric plastic strain ε_p^d = sqrt(2/3 e_p : e_p) [-].
+    pub eps_pd: Vec<f64>,
+}
+
+impl Particles {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Fills the bodies of the case with `n × n` points per cell, keeping those whose cell
+    /// satisfies `owned(cell_i, cell_j)` (the cells of this rank). Points are placed at the centres
+    /// of the n × n sub-cells; a point belongs to the first body that contains it.
+    pub fn generate(case: &Case, grid: &Grid, owned: impl Fn(usize, usize) -> bool) -> Particles {
+        let mut ps = Particles::default();
+        let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+        for (b, body) in case.bodies.iter().enumerate() {
+            let mat_index = case.material_index(&body.material).expect("validated");
+            let mat = &case.materials[mat_index];
+            let n = body.particles_per_cell;
+            let (lo, hi) = body.shape.bounds();
+            let c0 = grid.cell_of(lo).unwrap_or((0, 0));
+            let c1 = grid
+                .cell_of(hi)
+                .unwrap_or((grid.cells[0] - 1, grid.cells[1] - 1));
+            let lp = [grid.h[0] / (2.0 * n as f64), grid.h[1] / (2.0 * n as f64)];
+            let vol = grid.h[0] * grid.h[1] / (n * n) as f64;
+            for cj in c0.1..=c1.1 {
+                for ci in c0.0..=c1.0 {
+                    for sj in 0..n {
+                        for si in 0..n {
+                            // Global id from the body and the sub-cell position: unique and independent
+                            // of how cells are distributed over ranks.
+                            let gi = (ci * n + si) as u64;
+                            let gj = (cj * n + sj) as u64;
+                            let id = ((b as u64) << 48) | (gj * (grid.cells[0] * 8) as u64 + gi);
+                            let x = [
+                                grid.origin[0]
+                                    + (ci as f64 + (si as f64 + 0.5) / n as f64) * grid.h[0],
+                                grid.origin[1]
+                                    + (cj as f64 + (sj as f64 + 0.5) / n as f64) * grid.h[1],
+                            ];
+                            let earlier = case.bodies[..b].iter().any(|o| o.shape.contains(x));
+                            if !body.shape.contains(x) || earlier || !owned(ci, cj) {
+                                continue;
+                            }
+                            let mass = if two_phase {
+                                (1.0 - mat.porosity) * mat.solid_density * vol
+                            } else {
+                                ((1.0 - mat.porosity) * mat.solid_density
+                                    + mat.porosity * mat.water_density)
+                                    * vol
+                            };
+                            ps.id.push(id);
+                            ps.body.push(b as u16);
+                            ps.material.push(mat_index as u16);
+                            ps.x.push(x);
+                            ps.x0.push(x);
+                            ps.disp.push([0.0; 2]);
+                            ps.lp.push(lp);
+                            ps.volume.push(vol);
+                            ps.porosity.push(mat.porosity);
+                            ps.mass.push(mass);
+                            ps.vel.push([0.0; 2]);
+                            ps.acc.push([0.0; 2]);
+                            ps.vel_w.push([0.0; 2]);
+                            ps.acc_w.push([0.0; 2]);
+                            ps.stress.push([0.0; 4]);
+                            ps.p.push(0.0);
+                            ps.eps_pd.push(0.0);
+                        }
+                    }
+                }
+            }
+        }
+        ps
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case;
+
+    #[test]
+    fn a_column_is_filled_with_two_by_two_points_per_cell_of_the_right_volume() {
+        let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.grid.cells);
+        let ps = Particles::generate(&c, &g, |_, _| true);
+        assert_eq!(ps.len(), 40);
+        let v: f64 = ps.volume.iter().sum();
+        assert!((v - 0.1).abs() < 1e-12);
+        assert!((ps.lp[0][0] - 0.025).abs() < 1e-15);
+        let mut ids = ps.id.clone();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), 40, "ids are unique");
+        // Only the cells a rank owns.
+        let half = Particles::generate(&c, &g, |_, j| j < 5);
+        assert_eq!(half.len(), 20);
+        assert!(half.x.iter().all(|x| x[1] < 0.5));
+    }
+}

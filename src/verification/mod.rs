@@ -1,0 +1,597 @@
+//! Verification: analytical references and the checks that compare a run with them.
+//!
+//! A [`Check`] watches the run after every converged step and computes its metrics from the run's
+//! own particles at the end; nothing is copied from a table. The analytical solutions live in
+//! [`terzaghi`], [`biot_harmonic`] and [`waves`], each with its own unit tests.
+//!
+//! * Terzaghi ([003] §4.1.1): `e_p_Tv<T>` is [003] Eq. 33, sqrt(Σ (P*−P)²)/N over the particles of
+//!   the column (note: divided by N, not √N), with P = p/q; `p_rms_error_Tv<T>` is the plain RMS
+//!   sqrt(Σ (P*−P)²/N); `settlement_rel_error_Tv<T>` compares the settlement with Terzaghi's. The
+//!   settlement of the laterally confined column is its loss of volume per unit width,
+//!   (Σ V₀ − Σ V)/w, which follows every particle's J. The analytical P* is evaluated at each
+//!   particle's initial depth below the drained top, at the time the run reaches T_v (the time
+//!   stepping lands on it exactly).
+//! * Harmonic column ([003] §4.1.2): over the last `measure_periods` whole load periods each
+//!   particle's pressure is projected on cos ωt and sin ωt with a Hann window w(t) = sin²(π(t−t₀)/T_w),
+//!   A = 2 |∫ w p e^{-iωt} dt| / ∫ w dt. For a pure tone at ω over whole periods this is exact; free
+//!   vibrations at other frequencies ω' leak into it only like 1/((ω'−ω)T_w)³ (a rectangular window
+//!   leaks like 1/((ω'−ω)T_w)). `p_amplitude_max_rel_error` is max_z |A − A*| / max_z A* over the
+//!   depth profile (particles at the same depth averaged).
+//! * Shock wave ([003] §4.1.3): see [`shock`] for how arrival times are picked.
+
+pub mod biot_harmonic;
+pub mod shock;
+pub mod terzaghi;
+pub mod waves;
+
+use crate::assembly::Collective;
+use crate::case::{self, Case, Load, TimeFunction, Verification};
+use crate::model::Model;
+use serde::Serialize;
+
+/// One verification metric as written to `summary.json`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Metric {
+    /// The value computed from the run.
+    pub value: f64,
+    /// What it is compared with (0 for error measures).
+    pub reference: f64,
+    /// Largest accepted |value − reference|.
+    pub tolerance: f64,
+    /// Whether |value − reference| ≤ tolerance.
+    pub pass: bool,
+    /// What was measured, in words and numbers.
+    pub detail: String,
+}
+
+impl Metric {
+    /// An error measure (reference 0).
+    pub fn error(value: f64, tolerance: f64, detail: String) -> Metric {
+        Metric {
+            value,
+            reference: 0.0,
+            tolerance,
+            pass: value.is_finite() && value.abs() <= tolerance,
+            detail,
+        }
+    }
+}
+
+/// A table a check writes next to the summary (e.g. `amplitude_profile.csv`).
+#[derive(Debug, Clone)]
+pub struct Table {
+    /// File name.
+    pub name: String,
+    /// Column names.
+    pub header: Vec<&'static str>,
+    /// Rows.
+    pub rows: Vec<Vec<f64>>,
+}
+
+/// What a check reports at the end: named metrics, and tables to write.
+pub type Findings = (Vec<(String, Metric)>, Vec<Table>);
+
+/// A comparison of a run with an analytical solution.
+pub trait Check {
+    /// Extra `history.csv` columns this check fills after every step.
+    fn columns(&self) -> Vec<String>;
+    /// Times the time stepping must land on exactly.
+    fn event_times(&self) -> Vec<f64>;
+    /// Called after every converged step at time `t`; returns the values of [`Check::columns`].
+    fn observe(
+        &mut self,
+        t: f64,
+        dt: f64,
+        model: &Model,
+        coll: &Collective,
+    ) -> Result<Vec<f64>, String>;
+    /// The metrics (name, metric) and tables at the end of the run.
+    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String>;
+}
+
+/// Geometry and soil of a loaded one-dimensional column, taken from the case.
+#[derive(Debug, Clone)]
+pub(crate) struct Column {
+    pub body: u16,
+    pub top: f64,
+    pub height: f64,
+    pub width: f64,
+    pub x_centre: f64,
+    pub load: f64,
+    pub constrained_modulus: f64,
+    pub inv_q: f64,
+    pub porosity: f64,
+    pub solid_density: f64,
+    pub water_density: f64,
+    pub water_bulk_modulus: f64,
+    pub conductivity: f64,
+    pub g: f64,
+}
+
+impl Column {
+    fn from_case(c: &Case, model: &Model, body: &str, load: &str) -> Result<Column, String> {
+        let bi = c
+            .bodies
+            .iter()
+            .position(|b| b.name == body)
+            .ok_or(format!("no body `{body}`"))?;
+        let b = &c.bodies[bi];
+        let (lo, hi) = b.shape.bounds();
+        let traction = match c.load(load) {
+            Some(Load::ParticleTraction { traction, .. })
+            | Some(Load::NodalTraction { traction, .. }) => *traction,
+            _ => {
+                return Err(format!(
+                    "verification load `{load}` must be a particle_traction or nodal_traction"
+                ))
+            }
+        };
+        let mi = c.material_index(&b.material).expect("validated");
+        let mat = &model.materials[mi];
+        Ok(Column {
+            body: bi as u16,
+            top: hi[1],
+            height: hi[1] - lo[1],
+            width: hi[0] - lo[0],
+            x_centre: 0.5 * (lo[0] + hi[0]),
+            load: traction[1].abs(),
+            constrained_modulus: mat.model.elastic().constrained_modulus(),
+            inv_q: mat.inv_q,
+            porosity: mat.porosity,
+            solid_density: mat.solid_density,
+            water_density: mat.water_density,
+            water_bulk_modulus: mat.water_bulk_modulus,
+            conductivity: mat.conductivity,
+            g: model.g,
+        })
+    }
+
+    /// Local indices of the column's particles.
+    fn particles<'a>(&'a self, model: &'a Model) -> impl Iterator<Item = usize> + 'a {
+        (0..model.particles.len()).filter(move |&k| model.particles.body[k] == self.body)
+    }
+}
+
+/// The check the case asks for, if any.
+pub fn for_case(
+    c: &Case,
+    model: &Model,
+    coll: &Collective,
+) -> Result<Option<Box<dyn Check>>, String> {
+    let Some(v) = &c.verification else {
+        return Ok(None);
+    };
+    let end = c.end_time();
+    Ok(Some(match v {
+        Verification::Terzaghi {
+            body,
+            load,
+            time_factors,
+            e_p_tolerance,
+            p_rms_tolerance,
+            settlement_tolerance,
+        } => {
+            let col = Column::from_case(c, model, body, load)?;
+            let f_end = c
+                .load(load)
+                .and_then(|l| l.time_function())
+                .and_then(|n| c.time_function(n))
+                .map(crate::model::loads::TimeFn::from_case);
+            let scale = f_end.map_or(1.0, |f| f.eval(end));
+            Box::new(TerzaghiCheck::new(
+                col,
+                scale,
+                time_factors,
+                *e_p_tolerance,
+                *p_rms_tolerance,
+                *settlement_tolerance,
+                model,
+                coll,
+            )?)
+        }
+        Verification::HarmonicColumn {
+            body,
+            load,
+            measure_periods,
+            tolerance,
+        } => {
+            let col = Column::from_case(c, model, body, load)?;
+            let omega = match c
+                .load(load)
+                .and_then(|l| l.time_function())
+                .and_then(|n| c.time_function(n))
+            {
+                Some(TimeFunction::Harmonic {
+                    angular_frequency, ..
+                }) => *angular_frequency,
+                _ => {
+                    return Err(format!(
+                        "verification load `{load}` must have a harmonic time function"
+                    ))
+                }
+            };
+            Box::new(HarmonicCheck::new(
+                col,
+                omega,
+                end,
+                *measure_periods,
+                *tolerance,
+            )?)
+        }
+        Verification::ShockWave {
+            body,
+            load,
+            probe_depth,
+            fast_tolerance,
+            slow_tolerance,
+        } => {
+            let col = Column::from_case(c, model, body, load)?;
+            Box::new(shock::ShockCheck::new(
+                col,
+                *probe_depth,
+                *fast_tolerance,
+                *slow_tolerance,
+                model,
+                coll,
+            )?)
+        }
+    }))
+}
+
+/// Format of a time factor in metric names (`0.1`, `0.5`).
+fn tv_name(tv: f64) -> String {
+    format!("{tv}")
+}
+
+/// Terzaghi consolidation check.
+pub struct TerzaghiCheck {
+    col: Column,
+    theory: terzaghi::Terzaghi,
+    targets: Vec<(f64, f64)>,
+    tolerances: (f64, f64, f64),
+    volume0: f64,
+    results: Vec<(f64, f64, f64, f64, f64)>,
+}
+
+impl TerzaghiCheck {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        col: Column,
+        load_scale: f64,
+        tvs: &[f64],
+        ep_tol: f64,
+        rms_tol: f64,
+        settle_tol: f64,
+        model: &Model,
+        coll: &Collective,
+    ) -> Result<TerzaghiCheck, String> {
+        let theory = terzaghi::Terzaghi::new(
+            col.load * load_scale.abs(),
+            col.height,
+            col.constrained_modulus,
+            col.inv_q,
+            col.conductivity,
+            col.water_density * col.g,
+        );
+        theory.validate()?;
+        let targets = tvs.iter().map(|&tv| (tv, theory.time_for(tv))).collect();
+        let v0: f64 = col
+            .particles(model)
+            .map(|k| model.particles.volume[k])
+            .sum();
+        let volume0 = coll.sum(&[v0])?[0];
+        Ok(TerzaghiCheck {
+            col,
+            theory,
+            targets,
+            tolerances: (ep_tol, rms_tol, settle_tol),
+            volume0,
+            results: Vec::new(),
+        })
+    }
+
+    fn settlement(&self, model: &Model, coll: &Collective) -> Result<f64, String> {
+        let v: f64 = self
+            .col
+            .particles(model)
+            .map(|k| model.particles.volume[k])
+            .sum();
+        Ok((self.volume0 - coll.sum(&[v])?[0]) / self.col.width)
+    }
+}
+
+impl Check for TerzaghiCheck {
+    fn columns(&self) -> Vec<String> {
+        [
+            "terzaghi.Tv",
+            "terzaghi.settlement",
+            "terzaghi.settlement_analytical",
+            "terzaghi.U_analytical",
+        ]
+        .map(String::from)
+        .to_vec()
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        self.targets.iter().map(|t| t.1).collect()
+    }
+
+    fn observe(
+        &mut self,
+        t: f64,
+        _dt: f64,
+        model: &Model,
+        coll: &Collective,
+    ) -> Result<Vec<f64>, String> {
+        let s = self.settlement(model, coll)?;
+        let q = self.theory.load;
+        for &(tv, tt) in &self.targets {
+            if (t - tt).abs() <= 1e-9 * tt {
+                let local: Vec<f64> = self
+                    .col
+                    .particles(model)
+                    .flat_map(|k| {
+                        [
+                            self.col.top - model.particles.x0[k][1],
+                            model.particles.p[k],
+                        ]
+                    })
+                    .collect();
+                let all = coll.gather(&local)?;
+                let n = all.len() / 2;
+                let sq: f64 = all
+                    .chunks(2)
+                    .map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2))
+                    .sum();
+                let e_p = sq.sqrt() / n as f64;
+                let rms = (sq / n as f64).sqrt();
+                let s_ana = self.theory.settlement(t);
+                self.results
+                    .push((tv, e_p, rms, (s - s_ana).abs() / s_ana.abs(), s));
+            }
+        }
+        Ok(vec![
+            self.theory.time_factor(t),
+            s,
+            self.theory.settlement(t),
+            self.theory.degree_of_consolidation(t),
+        ])
+    }
+
+    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+        let (ep_tol, rms_tol, s_tol) = self.tolerances;
+        let mut out = Vec::new();
+        for (i, &(tv, tt)) in self.targets.iter().enumerate() {
+            let last = i + 1 == self.targets.len();
+            let r = self.results.iter().find(|r| r.0 == tv);
+            let name = tv_name(tv);
+            let missing = format!("T_v = {tv} (t = {tt:.6e} s) was not reached by the run");
+            match r {
+                Some(&(_, e_p, rms, se, s)) => {
+                    out.push((
+                        format!("e_p_Tv{name}"),
+                        Metric::error(
+                            e_p,
+                            ep_tol,
+                            format!("[003] Eq. 33 over the column's particles at t = {tt:.6e} s"),
+                        ),
+                    ));
+                    if last {
+                        out.push((
+                            format!("p_rms_error_Tv{name}"),
+                            Metric::error(
+                                rms,
+                                rms_tol,
+                                "RMS of (P* - P) over particles, P = p/q".into(),
+                            ),
+                        ));
+                        out.push((
+                            format!("settlement_rel_error_Tv{name}"),
+                            Metric::error(
+                                se,
+                                s_tol,
+                                format!(
+                                    "settlement {s:.6e} m vs Terzaghi {:.6e} m",
+                                    self.theory.settlement(tt)
+                                ),
+                            ),
+                        ));
+                    }
+                }
+                None => {
+                    out.push((
+                        format!("e_p_Tv{name}"),
+                        Metric::error(f64::NAN, ep_tol, missing.clone()),
+                    ));
+                    if last {
+                        out.push((
+                            format!("p_rms_error_Tv{name}"),
+                            Metric::error(f64::NAN, rms_tol, missing.clone()),
+                        ));
+                        out.push((
+                            format!("settlement_rel_error_Tv{name}"),
+                            Metric::error(f64::NAN, s_tol, missing),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok((out, Vec::new()))
+    }
+}
+
+/// Steady-state harmonic column check.
+pub struct HarmonicCheck {
+    col: Column,
+    omega: f64,
+    window: (f64, f64),
+    tolerance: f64,
+    theory: biot_harmonic::BiotSolution,
+    /// Per local particle: (∫ w p cos ωt, ∫ w p sin ωt) over the window.
+    sums: Vec<(f64, f64)>,
+    /// ∫ w dt.
+    weight: f64,
+}
+
+impl HarmonicCheck {
+    fn new(
+        col: Column,
+        omega: f64,
+        end: f64,
+        periods: usize,
+        tolerance: f64,
+    ) -> Result<HarmonicCheck, String> {
+        if col.inv_q <= 0.0 {
+            return Err(
+                "the harmonic column needs a compressible pore fluid (finite water_bulk_modulus)"
+                    .into(),
+            );
+        }
+        let period = 2.0 * std::f64::consts::PI / omega;
+        let start = end - periods as f64 * period;
+        if start <= 0.0 {
+            return Err(format!("the run ({end} s) is shorter than the {periods} measured load periods ({period:.4e} s each)"));
+        }
+        let theory = biot_harmonic::BiotColumn {
+            height: col.height,
+            constrained_modulus: col.constrained_modulus,
+            q_modulus: 1.0 / col.inv_q,
+            porosity: col.porosity,
+            solid_density: col.solid_density,
+            water_density: col.water_density,
+            conductivity: col.conductivity,
+            gravity: col.g,
+            omega,
+            load_amplitude: col.load,
+        }
+        .solve()?;
+        Ok(HarmonicCheck {
+            col,
+            omega,
+            window: (start, end),
+            tolerance,
+            theory,
+            sums: Vec::new(),
+            weight: 0.0,
+        })
+    }
+}
+
+impl Check for HarmonicCheck {
+    fn columns(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        vec![self.window.0]
+    }
+
+    fn observe(
+        &mut self,
+        t: f64,
+        dt: f64,
+        model: &Model,
+        _coll: &Collective,
+    ) -> Result<Vec<f64>, String> {
+        if self.sums.len() != model.particles.len() {
+            self.sums = vec![(0.0, 0.0); model.particles.len()];
+        }
+        // Right-endpoint sums (the window vanishes at both ends, so this is the trapezoidal rule).
+        if t > self.window.0 + 1e-9 * dt && t <= self.window.1 + 1e-9 * dt {
+            let tw = self.window.1 - self.window.0;
+            let w = (std::f64::consts::PI * (t - self.window.0) / tw)
+                .sin()
+                .powi(2);
+            self.weight += w * dt;
+            let (c, s) = ((self.omega * t).cos(), (self.omega * t).sin());
+            for k in self.col.particles(model) {
+                self.sums[k].0 += w * model.particles.p[k] * c * dt;
+                self.sums[k].1 += w * model.particles.p[k] * s * dt;
+            }
+        }
+        Ok(Vec::new())
+    }
+
+    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
+        if self.weight <= 0.0 {
+            return Err("the measurement window of the harmonic column was never reached".into());
+        }
+        let norm = 2.0 / self.weight;
+        let local: Vec<f64> = self
+            .col
+            .particles(model)
+            .flat_map(|k| {
+                let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
+                [
+                    self.col.top - model.particles.x0[k][1],
+                    norm * (c * c + s * s).sqrt(),
+                ]
+            })
+            .collect();
+        let all = coll.gather(&local)?;
+        // Average the particles at the same depth.
+        let mut rows: Vec<(f64, f64, usize)> = Vec::new();
+        for d in all.chunks(2) {
+            match rows
+                .iter_mut()
+                .find(|r| (r.0 - d[0]).abs() < 1e-9 * self.col.height)
+            {
+                Some(r) => {
+                    r.1 += d[1];
+                    r.2 += 1;
+                }
+                None => rows.push((d[0], d[1], 1)),
+            }
+        }
+        rows.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+        let q = self.col.load;
+        let table: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|r| {
+                vec![
+                    r.0,
+                    r.1 / r.2 as f64 / q,
+                    self.theory.pressure_amplitude(r.0) / q,
+                ]
+            })
+            .collect();
+        let peak = table.iter().map(|r| r[2]).fold(0.0, f64::max);
+        let (worst, at) = table
+            .iter()
+            .map(|r| ((r[1] - r[2]).abs(), r[0]))
+            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+        let err = worst / peak;
+        let metric = Metric::error(
+            err,
+            self.tolerance,
+            format!("largest |A - A*| = {worst:.4e} q at depth {at:.3} m; peak A* = {peak:.4e} q; ω = {:.4e} rad/s", self.omega),
+        );
+        Ok((
+            vec![("p_amplitude_max_rel_error".into(), metric)],
+            vec![Table {
+                name: "amplitude_profile.csv".into(),
+                header: vec![
+                    "depth_m",
+                    "computed_p_amplitude_over_q",
+                    "analytical_p_amplitude_over_q",
+                ],
+                rows: table,
+            }],
+        ))
+    }
+}
+
+/// The case's verification kind, for `check`.
+pub fn describe(v: &case::Verification) -> String {
+    match v {
+        Verification::Terzaghi { time_factors, .. } => {
+            format!("Terzaghi consolidation at T_v = {time_factors:?}")
+        }
+        Verification::HarmonicColumn {
+            measure_periods, ..
+        } => format!("harmonic column (Zienkiewicz et al. 1980), last {measure_periods} periods"),
+        Verification::ShockWave { probe_depth, .. } => {
+            format!("shock-wave arrival at {probe_depth} m depth")
+        }
+    }
+}
