@@ -21,8 +21,5 @@ fn main() {
         .filter(|p| std::env::var(format!("DEP_PETSC_{}", p.to_uppercase())).as_deref() == Ok("1"))
         .collect();
     println!("cargo:rustc-env=POROMPM_PETSC_VERSION={version}");
-    println!(
-        "cargo:rustc-env=POROMPM_PETSC_PACKAGES={}",
-        packages.join(", ")
-    );
+    println!("cargo:rustc-env=POROMPM_PETSC_PACKAGES={}", packages.join(", "));
 }

@@ -15,11 +15,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     let _ = writeln!(
         s,
         "formulation: {} ({} dofs per node: {})",
-        if model.two_phase {
-            "two_phase, u–p–U"
-        } else {
-            "one_phase, u"
-        },
+        if model.two_phase { "two_phase, u–p–U" } else { "one_phase, u" },
         nd,
         model.field_names().join(", ")
     );
@@ -38,24 +34,14 @@ pub fn describe(case: &Case, label: &str) -> String {
     );
     for m in &case.materials {
         let model_txt = match &m.model {
-            SoilModel::LinearElastic {
-                young_modulus,
-                poisson_ratio,
-            } => format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}"),
+            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+                format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
+            }
         };
-        let _ = writeln!(
-            s,
-            "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³",
-            m.name, m.porosity, m.solid_density
-        );
+        let _ = writeln!(s, "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³", m.name, m.porosity, m.solid_density);
     }
     for (b, body) in case.bodies.iter().enumerate() {
-        let count = model
-            .particles
-            .body
-            .iter()
-            .filter(|&&x| x as usize == b)
-            .count();
+        let count = model.particles.body.iter().filter(|&&x| x as usize == b).count();
         let n = body.particles_per_cell;
         let _ = writeln!(
             s,
@@ -84,10 +70,7 @@ pub fn describe(case: &Case, label: &str) -> String {
             }
         }
     }
-    let _ = writeln!(
-        s,
-        "active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}"
-    );
+    let _ = writeln!(s, "active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}");
 
     for l in &model.loads {
         let kind = match case.load(&l.name) {
@@ -108,12 +91,7 @@ pub fn describe(case: &Case, label: &str) -> String {
             .filter(|&(i, j)| b.contains(g, i, j))
             .count();
         let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
-        let _ = writeln!(
-            s,
-            "boundary `{}`: {} fixed on {count} nodes",
-            b.name,
-            fix.join(", ")
-        );
+        let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
     }
     for st in &case.stages {
         let a = model.active(st);
@@ -124,43 +102,23 @@ pub fn describe(case: &Case, label: &str) -> String {
             st.duration,
             st.dt,
             (st.duration / st.dt).ceil() as usize,
-            a.loads
-                .iter()
-                .map(|&i| model.loads[i].name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            a.boundaries
-                .iter()
-                .map(|&i| model.boundaries[i].name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+            a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
+            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", ")
         );
     }
-    let gravity = case
-        .loads
-        .iter()
-        .any(|l| matches!(l, Load::BodyForce { .. }));
+    let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
     let _ = writeln!(
         s,
         "features: gravity {}; return mapping {}; B-bar off; patch recovery off",
         if gravity { "on" } else { "off" },
-        if model.materials.iter().all(|m| m.model.is_linear()) {
-            "never called (elastic)"
-        } else {
-            "on"
-        }
+        if model.materials.iter().all(|m| m.model.is_linear()) { "never called (elastic)" } else { "on" }
     );
-    let _ = writeln!(
-        s,
-        "Newmark: β = {}, γ = {}",
-        case.time_integration.beta, case.time_integration.gamma
-    );
+    let _ = writeln!(s, "Newmark: β = {}, γ = {}", case.time_integration.beta, case.time_integration.gamma);
     let _ = writeln!(
         s,
         "solver: {}",
         case.solver.options_file.as_deref().map_or(
-            "built-in default (Newton; sparse LU by UMFPACK on one rank, MUMPS on several)"
-                .to_string(),
+            "built-in default (Newton; sparse LU by UMFPACK on one rank, MUMPS on several)".to_string(),
             |f| format!("options file {f}")
         )
     );

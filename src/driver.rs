@@ -154,16 +154,13 @@ struct Simulation<'a> {
 pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
     let start = Instant::now();
     let mut summary = Summary::new(req);
-    let result = out
-        .write_summary(&summary)
-        .map_err(RunError::Input)
-        .and_then(|_| {
-            let mut sim = Simulation::set_up(req, out, &mut summary)?;
-            for stage in &req.case.stages {
-                sim.run_stage(stage)?;
-            }
-            sim.finish()
-        });
+    let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| {
+        let mut sim = Simulation::set_up(req, out, &mut summary)?;
+        for stage in &req.case.stages {
+            sim.run_stage(stage)?;
+        }
+        sim.finish()
+    });
     summary.wall_time_s = start.elapsed().as_secs_f64();
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
     let err = result.err();
@@ -214,27 +211,19 @@ impl Summary {
 /// Runs `steps` steps of the first stage, prepares the next one and compares its assembled tangent
 /// with central finite differences of the assembled residual, block by block (one rank, small
 /// cases). Nothing is written.
-pub fn test_jacobian(
-    req: &RunRequest,
-    steps: usize,
-) -> Result<Vec<assembly::BlockCheck>, RunError> {
+pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<Vec<assembly::BlockCheck>, RunError> {
     let mut summary = Summary::new(req);
     let mut out = RunOutput::create(&req.out_dir, false).map_err(RunError::Input)?;
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
     for _ in 0..steps {
-        sim.newton_solve(&active, stage.dt)?
-            .map_err(RunError::Failed)?;
+        sim.newton_solve(&active, stage.dt)?.map_err(RunError::Failed)?;
         sim.update_particles(stage.dt)?.map_err(RunError::Failed)?;
         sim.t += stage.dt;
     }
-    sim.system
-        .prepare_step(&sim.model, &active, sim.t + stage.dt, stage.dt)
-        .map_err(RunError::Failed)?;
-    sim.system
-        .jacobian_check(&sim.model, 0.7)
-        .map_err(|e| RunError::Failed(e.to_string()))
+    sim.system.prepare_step(&sim.model, &active, sim.t + stage.dt, stage.dt).map_err(RunError::Failed)?;
+    sim.system.jacobian_check(&sim.model, 0.7).map_err(|e| RunError::Failed(e.to_string()))
 }
 
 impl<'a> Simulation<'a> {
@@ -248,29 +237,17 @@ impl<'a> Simulation<'a> {
         let coll = Collective::new(req.comm);
         let input = |e: String| RunError::Input(e);
         let two_phase = case.analysis.formulation == crate::case::Formulation::TwoPhase;
-        let system = GridSystem::new(req.comm, &crate::model::grid_of(case), two_phase)
-            .map_err(|e| input(e.to_string()))?;
+        let system =
+            GridSystem::new(req.comm, &crate::model::grid_of(case), two_phase).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
-        let check = verification::for_case(case, &model, &coll)
-            .map_err(|e| input(format!("verification: {e}")))?;
+        let check = verification::for_case(case, &model, &coll).map_err(|e| input(format!("verification: {e}")))?;
         let probes = find_probes(case, &model, &coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
         summary.grid_dofs = system.total_dofs();
-        let mut columns: Vec<String> = [
-            "time",
-            "step",
-            "dt",
-            "newton_iterations",
-            "linear_iterations",
-        ]
-        .map(String::from)
-        .to_vec();
+        let mut columns: Vec<String> =
+            ["time", "step", "dt", "newton_iterations", "linear_iterations"].map(String::from).to_vec();
         for p in &probes {
-            columns.extend(
-                probe_fields(model.two_phase)
-                    .iter()
-                    .map(|f| format!("{}.{f}", p.name)),
-            );
+            columns.extend(probe_fields(model.two_phase).iter().map(|f| format!("{}.{f}", p.name)));
         }
         if let Some(c) = &check {
             columns.extend(c.columns());
@@ -306,11 +283,7 @@ impl<'a> Simulation<'a> {
         ));
         let mut next_report = self.t + stage.duration / 10.0;
         while !control.finished(self.t) {
-            let events = self
-                .check
-                .as_ref()
-                .map(|c| c.event_times())
-                .unwrap_or_default();
+            let events = self.check.as_ref().map(|c| c.event_times()).unwrap_or_default();
             let dt = control.next(self.t, &events);
             let outcome = self.newton_solve(&active, dt)?;
             let admitted = match outcome {
@@ -324,9 +297,7 @@ impl<'a> Simulation<'a> {
                     self.step += 1;
                     self.summary.steps = self.step;
                     self.summary.time_s = self.t;
-                    if self.step.is_multiple_of(self.case.output.history_every)
-                        || control.finished(self.t)
-                    {
+                    if self.step.is_multiple_of(self.case.output.history_every) || control.finished(self.t) {
                         self.record_step(dt)?;
                     } else {
                         self.observe_only(dt)?;
@@ -344,10 +315,7 @@ impl<'a> Simulation<'a> {
                             stage.name, self.t, stage.max_step_cuts, dt
                         )));
                     }
-                    self.progress(&format!(
-                        "  step from t = {:.6e} s cut to Δt = {:.3e} s: {why}",
-                        self.t, control.dt
-                    ));
+                    self.progress(&format!("  step from t = {:.6e} s cut to Δt = {:.3e} s: {why}", self.t, control.dt));
                 }
             }
         }
@@ -355,27 +323,16 @@ impl<'a> Simulation<'a> {
     }
 
     /// One Newton solve of the step t → t + dt. `Ok(Err(reason))` means it did not converge.
-    fn newton_solve(
-        &mut self,
-        active: &crate::model::Active,
-        dt: f64,
-    ) -> Result<Result<(), String>, RunError> {
+    fn newton_solve(&mut self, active: &crate::model::Active, dt: f64) -> Result<Result<(), String>, RunError> {
         let t0 = Instant::now();
         {
-            let _stage = self
-                .system
-                .phase(Phase::StepSetup)
-                .map_err(|e| RunError::Failed(e.to_string()))?;
-            let prepared = self
-                .system
-                .prepare_step(&self.model, active, self.t + dt, dt);
+            let _stage = self.system.phase(Phase::StepSetup).map_err(|e| RunError::Failed(e.to_string()))?;
+            let prepared = self.system.prepare_step(&self.model, active, self.t + dt, dt);
             let failed = self.coll.any(prepared.is_err()).map_err(RunError::Failed)?;
             if let Err(e) = prepared {
                 return Err(RunError::Failed(e));
             } else if failed {
-                return Err(RunError::Failed(
-                    "another rank could not prepare the step".into(),
-                ));
+                return Err(RunError::Failed("another rank could not prepare the step".into()));
             }
         }
         self.summary.timings.step_setup_s += t0.elapsed().as_secs_f64();
@@ -393,8 +350,7 @@ impl<'a> Simulation<'a> {
         if !self.options_checked {
             self.options_checked = true;
             self.summary.solver = assembly::describe_solver(&mut self.system).unwrap_or_default();
-            let unused =
-                assembly::unused_petsc_options().map_err(|e| RunError::Failed(e.to_string()))?;
+            let unused = assembly::unused_petsc_options().map_err(|e| RunError::Failed(e.to_string()))?;
             if !unused.is_empty() {
                 return Err(RunError::Input(format!(
                     "PETSc option(s) not used by any solver object: {} (misspelt, or not applicable to this solver)",
@@ -417,25 +373,17 @@ impl<'a> Simulation<'a> {
     /// inadmissible (the step is then cut), in which case no particle is changed.
     fn update_particles(&mut self, dt: f64) -> Result<Result<(), String>, RunError> {
         let t0 = Instant::now();
-        let _stage = self
-            .system
-            .phase(Phase::ParticleUpdate)
-            .map_err(|e| RunError::Failed(e.to_string()))?;
+        let _stage = self.system.phase(Phase::ParticleUpdate).map_err(|e| RunError::Failed(e.to_string()))?;
         let n = self.model.particles.len();
         let results: Vec<StepResult> = (0..n).map(|k| self.system.step_result(k)).collect();
-        let bad = results
-            .iter()
-            .enumerate()
-            .find_map(|(k, r)| self.model.check_step(k, r).err());
+        let bad = results.iter().enumerate().find_map(|(k, r)| self.model.check_step(k, r).err());
         if self.coll.any(bad.is_some()).map_err(RunError::Failed)? {
-            return Ok(Err(bad.map(|e| e.0).unwrap_or_else(|| {
-                "a material point on another rank became inadmissible".into()
-            })));
+            return Ok(Err(bad
+                .map(|e| e.0)
+                .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
         for (k, r) in results.iter().enumerate() {
-            self.model
-                .update_particle(k, r, r.kin.dp, dt)
-                .map_err(|e| RunError::Failed(e.0))?;
+            self.model.update_particle(k, r, r.kin.dp, dt).map_err(|e| RunError::Failed(e.0))?;
         }
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(Ok(()))
@@ -444,23 +392,11 @@ impl<'a> Simulation<'a> {
     /// Probes, check and one row of history.csv.
     fn record_step(&mut self, dt: f64) -> Result<(), RunError> {
         let t0 = Instant::now();
-        let _stage = self
-            .system
-            .phase(Phase::Output)
-            .map_err(|e| RunError::Failed(e.to_string()))?;
-        let mut row = vec![
-            self.t,
-            self.step as f64,
-            dt,
-            self.last_newton.0 as f64,
-            self.last_newton.1 as f64,
-        ];
+        let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
+        let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
         row.extend(probe_values(&self.model, &self.probes, &self.coll).map_err(RunError::Failed)?);
         if let Some(c) = self.check.as_mut() {
-            row.extend(
-                c.observe(self.t, dt, &self.model, &self.coll)
-                    .map_err(RunError::Failed)?,
-            );
+            row.extend(c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?);
         }
         self.out.history_row(&row).map_err(RunError::Failed)?;
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
@@ -470,8 +406,7 @@ impl<'a> Simulation<'a> {
     /// The check's observation on steps without a history row.
     fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
         if let Some(c) = self.check.as_mut() {
-            c.observe(self.t, dt, &self.model, &self.coll)
-                .map_err(RunError::Failed)?;
+            c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?;
         }
         Ok(())
     }
@@ -479,14 +414,10 @@ impl<'a> Simulation<'a> {
     /// Metrics and tables of the check.
     fn finish(mut self) -> Result<(), RunError> {
         if let Some(c) = self.check.as_mut() {
-            let (metrics, tables) = c
-                .finish(&self.model, &self.coll)
-                .map_err(RunError::Failed)?;
+            let (metrics, tables) = c.finish(&self.model, &self.coll).map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
             for t in &tables {
-                self.out
-                    .write_table(&t.name, &t.header, &t.rows)
-                    .map_err(RunError::Failed)?;
+                self.out.write_table(&t.name, &t.header, &t.rows).map_err(RunError::Failed)?;
             }
             self.summary.verification = metrics.into_iter().collect();
         }
@@ -602,26 +533,15 @@ fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Prob
     for p in &case.probes {
         let local: Vec<f64> = (0..ps.len())
             .flat_map(|k| {
-                [
-                    ((ps.x0[k][0] - p.point[0]).powi(2) + (ps.x0[k][1] - p.point[1]).powi(2))
-                        .sqrt(),
-                    ps.id[k] as f64,
-                ]
+                [((ps.x0[k][0] - p.point[0]).powi(2) + (ps.x0[k][1] - p.point[1]).powi(2)).sqrt(), ps.id[k] as f64]
             })
             .collect();
         let all = coll.gather(&local)?;
         let best = all
             .chunks(2)
-            .min_by(|a, b| {
-                a[0].partial_cmp(&b[0])
-                    .unwrap()
-                    .then(a[1].partial_cmp(&b[1]).unwrap())
-            })
+            .min_by(|a, b| a[0].partial_cmp(&b[0]).unwrap().then(a[1].partial_cmp(&b[1]).unwrap()))
             .ok_or(format!("probe `{}`: there are no material points", p.name))?;
-        out.push(Probe {
-            name: p.name.clone(),
-            id: best[1] as u64,
-        });
+        out.push(Probe { name: p.name.clone(), id: best[1] as u64 });
     }
     Ok(out)
 }

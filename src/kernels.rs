@@ -61,11 +61,7 @@ pub struct NodeBasis {
 
 /// The basis of a whole stencil without B̄, appended to `out`.
 pub fn plain_basis(st: &Stencil, out: &mut Vec<NodeBasis>) {
-    out.extend((0..st.len).map(|k| NodeBasis {
-        s: st.w[k],
-        g: st.dw[k],
-        gv: st.dw[k],
-    }));
+    out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k] }));
 }
 
 /// Nodal values seen by a particle: the increment Δd, and a, v at t_{n+1} (u and U components).
@@ -114,10 +110,7 @@ pub struct Newmark {
 impl Newmark {
     /// Factors for step `dt`.
     pub fn new(beta: f64, gamma: f64, dt: f64) -> Newmark {
-        Newmark {
-            a0: 1.0 / (beta * dt * dt),
-            a1: gamma / (beta * dt),
-        }
+        Newmark { a0: 1.0 / (beta * dt * dt), a1: gamma / (beta * dt) }
     }
 }
 
@@ -207,11 +200,7 @@ pub fn residual(
         let o = k * nd;
         for c in 0..2 {
             let inertia = part.mass * (kin.a_u[c] - part.body_acc[c]);
-            let drag = if two_phase {
-                part.drag * (kin.v_u[c] - kin.v_w[c])
-            } else {
-                0.0
-            };
+            let drag = if two_phase { part.drag * (kin.v_u[c] - kin.v_w[c]) } else { 0.0 };
             let internal: f64 = (0..4).map(|r| bb[r][c] * s[r]).sum::<f64>() * v;
             out[o + c] = b.s * (inertia + drag) + internal;
         }
@@ -230,14 +219,7 @@ pub fn residual(
 /// Tangent block of one particle: d(residual)/d(Δd), row-major `(nn·ndof)²`, for the soil tangent
 /// `dsig` (the `tangent` of the stress update at the current iterate). Every entry of `out` is
 /// written (the zero couplings too), so the buffer may be reused from particle to particle.
-pub fn tangent(
-    basis: &[NodeBasis],
-    part: &ParticleInput,
-    dsig: &Mat4,
-    nm: Newmark,
-    two_phase: bool,
-    out: &mut [f64],
-) {
+pub fn tangent(basis: &[NodeBasis], part: &ParticleInput, dsig: &Mat4, nm: Newmark, two_phase: bool, out: &mut [f64]) {
     let nd = if two_phase { 5 } else { 2 };
     let m = basis.len() * nd;
     out[..m * m].fill(0.0);
@@ -310,10 +292,7 @@ pub fn step_result(basis: &[NodeBasis], states: &[NodeState], two_phase: bool) -
             }
         }
     }
-    StepResult {
-        kin,
-        jacobian: f[0][0] * f[1][1] - f[0][1] * f[1][0],
-    }
+    StepResult { kin, jacobian: f[0][0] * f[1][1] - f[0][1] * f[1][0] }
 }
 
 #[cfg(test)]
@@ -377,14 +356,7 @@ mod tests {
             let pv: Vec<f64> = (0..m).map(|i| 0.01 * ((i as f64) * 0.3).cos()).collect();
             let p = part();
             let mut r0 = vec![0.0; m];
-            let upd = residual(
-                &basis,
-                &states(&d0, nd, nm, &pa, &pv),
-                &p,
-                &model,
-                two_phase,
-                &mut r0,
-            );
+            let upd = residual(&basis, &states(&d0, nd, nm, &pa, &pv), &p, &model, two_phase, &mut r0);
             // A dirty buffer: the kernel must write every entry (the assembly reuses its buffer).
             let mut t = vec![f64::NAN; m * m];
             tangent(&basis, &p, &upd.tangent, nm, two_phase, &mut t);
@@ -397,22 +369,8 @@ mod tests {
                 dp[c] += h;
                 dm[c] -= h;
                 let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
-                residual(
-                    &basis,
-                    &states(&dp, nd, nm, &pa, &pv),
-                    &p,
-                    &model,
-                    two_phase,
-                    &mut rp,
-                );
-                residual(
-                    &basis,
-                    &states(&dm, nd, nm, &pa, &pv),
-                    &p,
-                    &model,
-                    two_phase,
-                    &mut rm,
-                );
+                residual(&basis, &states(&dp, nd, nm, &pa, &pv), &p, &model, two_phase, &mut rp);
+                residual(&basis, &states(&dm, nd, nm, &pa, &pv), &p, &model, two_phase, &mut rm);
                 for r in 0..m {
                     let fd = (rp[r] - rm[r]) / (2.0 * h);
                     let e = worst.entry((r % nd, c % nd)).or_insert(0.0);
@@ -430,10 +388,7 @@ mod tests {
             // Symmetric for a symmetric soil tangent.
             for r in 0..m {
                 for c in 0..m {
-                    assert!(
-                        (t[r * m + c] - t[c * m + r]).abs() <= 1e-12 * scale,
-                        "asymmetric at ({r},{c})"
-                    );
+                    assert!((t[r * m + c] - t[c * m + r]).abs() <= 1e-12 * scale, "asymmetric at ({r},{c})");
                 }
             }
         }
@@ -453,14 +408,7 @@ mod tests {
         p.p = 0.0;
         let st = vec![NodeState::default(); 4];
         let mut r = vec![0.0; 20];
-        residual(
-            &basis,
-            &st,
-            &p,
-            &Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)),
-            true,
-            &mut r,
-        );
+        residual(&basis, &st, &p, &Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)), true, &mut r);
         let fy: f64 = (0..4).map(|k| r[k * 5 + 1] + r[k * 5 + 4]).sum();
         assert!((fy - (p.mass + p.water_mass) * 9.81).abs() < 1e-12);
         assert!((0..4).all(|k| r[k * 5 + 2] == 0.0));
@@ -478,11 +426,7 @@ mod tests {
                 let sy = if y == 0.0 { 1.0 - py } else { py };
                 let gx = if x == 0.0 { -1.0 } else { 1.0 };
                 let gy = if y == 0.0 { -1.0 } else { 1.0 };
-                NodeBasis {
-                    s: sx * sy,
-                    g: [gx * sy, sx * gy],
-                    gv: [gx * sy, sx * gy],
-                }
+                NodeBasis { s: sx * sy, g: [gx * sy, sx * gy], gv: [gx * sy, sx * gy] }
             })
             .collect();
         let st: Vec<NodeState> = pts

@@ -15,12 +15,7 @@ pub mod model;
 pub mod verification;
 
 /// porompm's version and git revision.
-pub const VERSION: &str = concat!(
-    env!("CARGO_PKG_VERSION"),
-    " (git ",
-    env!("POROMPM_GIT_REV"),
-    ")"
-);
+pub const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (git ", env!("POROMPM_GIT_REV"), ")");
 
 /// What `porompm --version` prints after the program name.
 pub const VERSION_LONG: &str = concat!(

@@ -80,18 +80,12 @@ struct Failure {
 }
 
 fn input(message: impl Into<String>) -> Failure {
-    Failure {
-        code: 2,
-        message: message.into(),
-    }
+    Failure { code: 2, message: message.into() }
 }
 
 fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
-    let overrides: Vec<Override> = sets
-        .iter()
-        .map(|s| Override::parse(s))
-        .collect::<Result<_, _>>()
-        .map_err(|e| input(e.to_string()))?;
+    let overrides: Vec<Override> =
+        sets.iter().map(|s| Override::parse(s)).collect::<Result<_, _>>().map_err(|e| input(e.to_string()))?;
     let text = io::read_text(path).map_err(input)?;
     case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
@@ -114,10 +108,7 @@ fn run(
     files.extend(options_files.iter().cloned());
     for f in &files {
         if !f.is_file() {
-            return Err(input(format!(
-                "PETSc options file {} does not exist",
-                f.display()
-            )));
+            return Err(input(format!("PETSc options file {} does not exist", f.display())));
         }
     }
     let mut args: Vec<String> = Vec::new();
@@ -126,8 +117,8 @@ fn run(
         args.push(f.display().to_string());
     }
     args.extend(petsc_args.iter().cloned());
-    let petsc = petsc::Petsc::initialize(&args, None, "porompm")
-        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    let petsc =
+        petsc::Petsc::initialize(&args, None, "porompm").map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
     let comm = petsc.world();
     let mut output = RunOutput::create(out, comm.rank() == 0).map_err(input)?;
     let req = RunRequest {
@@ -152,17 +143,20 @@ fn run(
         }
         eprintln!(
             "{}: {} steps, {} Newton and {} Krylov iterations, {} unknowns, {} material points, {:.2} s wall time",
-            summary.status, summary.steps, summary.snes_iterations, summary.ksp_iterations, summary.dofs, summary.particles, summary.wall_time_s
+            summary.status,
+            summary.steps,
+            summary.snes_iterations,
+            summary.ksp_iterations,
+            summary.dofs,
+            summary.particles,
+            summary.wall_time_s
         );
     }
     drop(petsc);
     match err {
         None => Ok(()),
         Some(RunError::Input(m)) => Err(input(m)),
-        Some(RunError::Failed(m)) => Err(Failure {
-            code: 1,
-            message: m,
-        }),
+        Some(RunError::Failed(m)) => Err(Failure { code: 1, message: m }),
     }
 }
 
@@ -186,10 +180,7 @@ fn test_jacobian(
     };
     let result = driver::test_jacobian(&req, steps);
     drop(petsc);
-    let blocks = result.map_err(|e| Failure {
-        code: 1,
-        message: e.message().to_string(),
-    })?;
+    let blocks = result.map_err(|e| Failure { code: 1, message: e.message().to_string() })?;
     println!(
         "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps)",
         "row", "col", "max|J-Jfd|", "max|J|", "relative"
@@ -205,9 +196,7 @@ fn test_jacobian(
     if worst > tolerance {
         return Err(Failure {
             code: 1,
-            message: format!(
-                "the tangent differs from finite differences by {worst:.3e} > {tolerance:.1e}"
-            ),
+            message: format!("the tangent differs from finite differences by {worst:.3e} > {tolerance:.1e}"),
         });
     }
     println!("all blocks agree within {tolerance:.1e} (worst {worst:.3e})");
@@ -219,14 +208,8 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
         .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
     let comm = petsc.world();
     let coll = porompm::assembly::Collective::new(comm);
-    let total = coll.sum(&[1.0]).map_err(|e| Failure {
-        code: 1,
-        message: e,
-    })?[0];
-    let ranks = coll.gather(&[comm.rank() as f64]).map_err(|e| Failure {
-        code: 1,
-        message: e,
-    })?;
+    let total = coll.sum(&[1.0]).map_err(|e| Failure { code: 1, message: e })?[0];
+    let ranks = coll.gather(&[comm.rank() as f64]).map_err(|e| Failure { code: 1, message: e })?;
     if comm.rank() == 0 {
         let b = petsc::PetscBuild::get();
         println!("porompm {}", porompm::VERSION);
@@ -236,10 +219,7 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
     }
     drop(petsc);
     if total as usize != ranks.len() {
-        return Err(Failure {
-            code: 1,
-            message: "the collective sum does not match the number of ranks".into(),
-        });
+        return Err(Failure { code: 1, message: "the collective sum does not match the number of ranks".into() });
     }
     Ok(())
 }
@@ -247,27 +227,13 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run {
-            case,
-            out,
-            options_file,
-            set,
-            quiet,
-            petsc,
-        } => run(case, out, options_file, set, *quiet, petsc),
-        Command::Check { case, set } => load_case(case, set).map(|c| {
-            print!(
-                "{}",
-                porompm::describe::describe(&c, &case.display().to_string())
-            )
-        }),
-        Command::TestJacobian {
-            case,
-            steps,
-            tolerance,
-            set,
-            petsc,
-        } => test_jacobian(case, *steps, *tolerance, set, petsc),
+        Command::Run { case, out, options_file, set, quiet, petsc } => run(case, out, options_file, set, *quiet, petsc),
+        Command::Check { case, set } => {
+            load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
+        }
+        Command::TestJacobian { case, steps, tolerance, set, petsc } => {
+            test_jacobian(case, *steps, *tolerance, set, petsc)
+        }
         Command::Info { petsc } => info(petsc),
     };
     match result {

@@ -47,12 +47,7 @@ impl SaddleSystem<'_> {
                         continue;
                     }
                     a.set_values_local(&[r], &[r], &[5.0], true)?;
-                    let nbrs = [
-                        (i.wrapping_sub(1), j),
-                        (i + 1, j),
-                        (i, j.wrapping_sub(1)),
-                        (i, j + 1),
-                    ];
+                    let nbrs = [(i.wrapping_sub(1), j), (i + 1, j), (i, j.wrapping_sub(1)), (i, j + 1)];
                     for (ni, nj) in nbrs {
                         if ni < nx && nj < ny {
                             let c = (g.node(ni, nj).unwrap() * 5 + f) as i32;
@@ -69,14 +64,9 @@ impl SaddleSystem<'_> {
 impl NonlinearProblem for SaddleSystem<'_> {
     fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
         // F(x) = A x - b, with A applied through a freshly assembled matrix (keeps the test simple).
-        let mut a = self
-            .dm
-            .create_matrix()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        self.assemble(&mut a)
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        a.mult(x, f)
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let mut a = self.dm.create_matrix().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        self.assemble(&mut a).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        a.mult(x, f).map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let mut fa = f.write().map_err(|e| CallbackError::Fatal(e.to_string()))?;
         for (fi, bi) in fa.iter_mut().zip(&self.rhs) {
             *fi -= bi;
@@ -85,10 +75,8 @@ impl NonlinearProblem for SaddleSystem<'_> {
     }
 
     fn jacobian(&mut self, _x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
-        j.zero_entries()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        self.assemble(j)
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        self.assemble(j).map_err(|e| CallbackError::Fatal(e.to_string()))?;
         Ok(())
     }
 }
@@ -101,10 +89,7 @@ fn solve_with_options_file(path: &Path) -> TestResult {
     let dm = DmDa::new_2d(comm, [6, 5], 1, &["ux", "uy", "p", "Ux", "Uy"]).map_err(e)?;
     // Manufactured solution and right-hand side b = A x*.
     let mut a = dm.create_matrix().map_err(e)?;
-    let sys0 = SaddleSystem {
-        dm: &dm,
-        rhs: Vec::new(),
-    };
+    let sys0 = SaddleSystem { dm: &dm, rhs: Vec::new() };
     sys0.assemble(&mut a).map_err(e)?;
     let mut xstar = dm.create_global_vector().map_err(e)?;
     {
@@ -127,8 +112,7 @@ fn solve_with_options_file(path: &Path) -> TestResult {
         ksp.set_type("preonly").map_err(e)?;
         ksp.pc().map_err(e)?.set_type("lu").map_err(e)?;
     }
-    snes.set_tolerances(None, Some(1e-10), None, Some(50))
-        .map_err(e)?;
+    snes.set_tolerances(None, Some(1e-10), None, Some(50)).map_err(e)?;
     snes.set_from_options().map_err(e)?;
     let mut x = dm.create_global_vector().map_err(e)?;
     x.set_all(0.0).map_err(e)?;
@@ -148,11 +132,7 @@ fn solve_with_options_file(path: &Path) -> TestResult {
     if !unused.is_empty() {
         return Err(format!(
             "options not used: {}",
-            unused
-                .iter()
-                .map(|o| o.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
+            unused.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(" ")
         ));
     }
     println!(
@@ -174,11 +154,7 @@ fn every_options_file_solves_the_saddle_system() -> TestResult {
         .collect();
     files.sort();
     if files.len() < 5 {
-        return Err(format!(
-            "expected at least five .opts files in {}, found {}",
-            dir.display(),
-            files.len()
-        ));
+        return Err(format!("expected at least five .opts files in {}, found {}", dir.display(), files.len()));
     }
     for f in files {
         solve_with_options_file(&f).map_err(|m| format!("{}: {m}", f.display()))?;
@@ -243,30 +219,19 @@ impl NonlinearProblem for Cubic {
             Mode::Domain => return Err(CallbackError::Domain("volume became negative".into())),
             Mode::Normal => {}
         }
-        let xv = x
-            .read()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?
-            .to_vec();
+        let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
         let r = self.eval(&xv);
-        f.write()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?
-            .copy_from_slice(&r);
+        f.write().map_err(|e| CallbackError::Fatal(e.to_string()))?.copy_from_slice(&r);
         Ok(())
     }
 
     fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
-        let xv = x
-            .read()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?
-            .to_vec();
+        let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
         let t = self.tangent(&xv);
         let idx: Vec<i32> = (0..self.n as i32).collect();
-        j.zero_entries()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        j.set_values(&idx, &idx, &t, false)
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        j.assemble()
-            .map_err(|e| CallbackError::Fatal(e.to_string()))
+        j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        j.set_values(&idx, &idx, &t, false).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        j.assemble().map_err(|e| CallbackError::Fatal(e.to_string()))
     }
 }
 
@@ -292,12 +257,7 @@ fn snes_self(problem: &mut Cubic) -> Result<petsc::SolveOutcome, petsc::Error> {
 
 fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResult {
     let n = 8;
-    let mut p = Cubic {
-        n,
-        b: (0..n).map(|i| 1.0 + 0.3 * i as f64).collect(),
-        calls: 0,
-        mode: Mode::Normal,
-    };
+    let mut p = Cubic { n, b: (0..n).map(|i| 1.0 + 0.3 * i as f64).collect(), calls: 0, mode: Mode::Normal };
     // Central finite differences of the residual at a generic point, column by column.
     let x0: Vec<f64> = (0..n).map(|i| 0.2 + 0.1 * (i as f64).cos()).collect();
     let t = p.tangent(&x0);
@@ -314,9 +274,7 @@ fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResu
         }
     }
     if max_err > 1e-7 {
-        return Err(format!(
-            "tangent differs from finite differences by {max_err:.3e}"
-        ));
+        return Err(format!("tangent differs from finite differences by {max_err:.3e}"));
     }
     let out = snes_self(&mut p).map_err(e)?;
     if !out.converged {
@@ -330,33 +288,18 @@ fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResu
     }
     let rate = (h[k - 2] / h[k - 3]).ln() / (h[k - 3] / h[k - 4]).ln();
     if rate < 1.8 {
-        return Err(format!(
-            "Newton convergence order {rate:.2} < 1.8 (history {h:?})"
-        ));
+        return Err(format!("Newton convergence order {rate:.2} < 1.8 (history {h:?})"));
     }
-    println!(
-        "    FD tangent error {max_err:.1e}; Newton history {:?}; observed order {rate:.2}",
-        h
-    );
+    println!("    FD tangent error {max_err:.1e}; Newton history {:?}; observed order {rate:.2}", h);
     Ok(())
 }
 
 fn callback_errors_panics_and_domain_errors_are_reported() -> TestResult {
     let n = 4;
-    let mk = |mode| Cubic {
-        n,
-        b: vec![1.0; n],
-        calls: 0,
-        mode,
-    };
+    let mk = |mode| Cubic { n, b: vec![1.0; n], calls: 0, mode };
     match snes_self(&mut mk(Mode::Fatal)) {
         Err(err) if err.message.contains("the residual refuses") => {}
-        other => {
-            return Err(format!(
-                "fatal callback error not reported: {:?}",
-                other.map(|o| o.reason_text)
-            ))
-        }
+        other => return Err(format!("fatal callback error not reported: {:?}", other.map(|o| o.reason_text))),
     }
     // Silence the default hook's message for the deliberate panic.
     let hook = std::panic::take_hook();
@@ -364,18 +307,11 @@ fn callback_errors_panics_and_domain_errors_are_reported() -> TestResult {
     let r = snes_self(&mut mk(Mode::Panic));
     std::panic::set_hook(hook);
     match r {
-        Err(err)
-            if err.message.contains("panicked") && err.message.contains("deliberate panic") => {}
-        other => {
-            return Err(format!(
-                "panic in callback not reported: {:?}",
-                other.map(|o| o.reason_text)
-            ))
-        }
+        Err(err) if err.message.contains("panicked") && err.message.contains("deliberate panic") => {}
+        other => return Err(format!("panic in callback not reported: {:?}", other.map(|o| o.reason_text))),
     }
     match snes_self(&mut mk(Mode::Domain)) {
-        Ok(out)
-            if !out.converged && out.domain_error.as_deref() == Some("volume became negative") => {}
+        Ok(out) if !out.converged && out.domain_error.as_deref() == Some("volume became negative") => {}
         other => {
             return Err(format!(
                 "domain error not reported as divergence: {:?}",
@@ -391,10 +327,7 @@ fn petsc_errors_carry_petsc_messages() -> TestResult {
     let mut m = dense_matrix(3).map_err(e)?;
     let r = m.set_values(&[7], &[0], &[1.0], false);
     match r {
-        Err(err)
-            if err.message.contains("MatSetValues")
-                || err.message.to_lowercase().contains("out of range") =>
-        {
+        Err(err) if err.message.contains("MatSetValues") || err.message.to_lowercase().contains("out of range") => {
             println!("    PETSc error reported as: {}", err.message);
             Ok(())
         }
@@ -405,15 +338,9 @@ fn petsc_errors_carry_petsc_messages() -> TestResult {
 
 fn unused_options_are_reported() -> TestResult {
     let mut opts = Options::new().map_err(e)?;
-    opts.insert_string("-snes_rtol 1e-9 -this_option_does_not_exist 3")
-        .map_err(e)?;
+    opts.insert_string("-snes_rtol 1e-9 -this_option_does_not_exist 3").map_err(e)?;
     opts.push().map_err(e)?;
-    let mut p = Cubic {
-        n: 3,
-        b: vec![1.0; 3],
-        calls: 0,
-        mode: Mode::Normal,
-    };
+    let mut p = Cubic { n: 3, b: vec![1.0; 3], calls: 0, mode: Mode::Normal };
     let mut snes = Snes::new(Comm::self_()).map_err(e)?;
     snes.set_from_options().map_err(e)?;
     let mut x = Vector::from_slice(&[0.0; 3]).map_err(e)?;
@@ -438,10 +365,7 @@ fn main() {
         }
     };
     let tests: &[(&str, TestFn)] = &[
-        (
-            "every_options_file_solves_the_saddle_system",
-            every_options_file_solves_the_saddle_system,
-        ),
+        ("every_options_file_solves_the_saddle_system", every_options_file_solves_the_saddle_system),
         (
             "hand_tangent_matches_finite_differences_and_newton_is_quadratic",
             hand_tangent_matches_finite_differences_and_newton_is_quadratic,
@@ -450,16 +374,10 @@ fn main() {
             "callback_errors_panics_and_domain_errors_are_reported",
             callback_errors_panics_and_domain_errors_are_reported,
         ),
-        (
-            "petsc_errors_carry_petsc_messages",
-            petsc_errors_carry_petsc_messages,
-        ),
+        ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
         ("unused_options_are_reported", unused_options_are_reported),
     ];
-    let filter: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with('-'))
-        .collect();
+    let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = 0;
     let mut ran = 0;
     for (name, t) in tests {

@@ -32,11 +32,7 @@ fn pkg_config(args: &[&str]) -> Option<String> {
 }
 
 fn have_pkg_config() -> bool {
-    Command::new("pkg-config")
-        .arg("--version")
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
+    Command::new("pkg-config").arg("--version").output().map(|o| o.status.success()).unwrap_or(false)
 }
 
 /// bindgen loads libclang at run time; look where Debian's `libclang-dev` and `libclang1-*` put it.
@@ -46,10 +42,7 @@ fn have_libclang() -> bool {
             return true;
         }
     }
-    let mut dirs: Vec<PathBuf> = vec![
-        PathBuf::from("/usr/lib/x86_64-linux-gnu"),
-        PathBuf::from("/usr/lib"),
-    ];
+    let mut dirs: Vec<PathBuf> = vec![PathBuf::from("/usr/lib/x86_64-linux-gnu"), PathBuf::from("/usr/lib")];
     if let Ok(rd) = std::fs::read_dir("/usr/lib") {
         for e in rd.flatten() {
             let name = e.file_name().to_string_lossy().to_string();
@@ -60,33 +53,22 @@ fn have_libclang() -> bool {
     }
     dirs.iter().any(|d| {
         std::fs::read_dir(d)
-            .map(|rd| {
-                rd.flatten()
-                    .any(|e| e.file_name().to_string_lossy().starts_with("libclang"))
-            })
+            .map(|rd| rd.flatten().any(|e| e.file_name().to_string_lossy().starts_with("libclang")))
             .unwrap_or(false)
     })
 }
 
 fn include_dirs(cflags: &str) -> Vec<PathBuf> {
-    cflags
-        .split_whitespace()
-        .filter_map(|f| f.strip_prefix("-I"))
-        .map(PathBuf::from)
-        .collect()
+    cflags.split_whitespace().filter_map(|f| f.strip_prefix("-I")).map(PathBuf::from).collect()
 }
 
 fn main() {
     println!("cargo:rerun-if-changed=wrapper.h");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG_PATH");
-    for flag in [
-        "petsc_have_mumps",
-        "petsc_have_hypre",
-        "petsc_have_superlu_dist",
-        "petsc_have_suitesparse",
-        "petsc_have_hdf5",
-    ] {
+    for flag in
+        ["petsc_have_mumps", "petsc_have_hypre", "petsc_have_superlu_dist", "petsc_have_suitesparse", "petsc_have_hdf5"]
+    {
         println!("cargo:rustc-check-cfg=cfg({flag})");
     }
 
@@ -94,60 +76,29 @@ fn main() {
     let mut missing = Vec::new();
     let has_pc = have_pkg_config();
     if !has_pc {
-        missing.push(Missing {
-            what: "pkg-config (used to find PETSc and MPI)",
-            package: "pkg-config",
-        });
+        missing.push(Missing { what: "pkg-config (used to find PETSc and MPI)", package: "pkg-config" });
     }
-    let petsc_cflags = if has_pc {
-        pkg_config(&["--cflags", "PETSc"])
-    } else {
-        None
-    };
-    let petsc_libs = if has_pc {
-        pkg_config(&["--libs", "PETSc"])
-    } else {
-        None
-    };
+    let petsc_cflags = if has_pc { pkg_config(&["--cflags", "PETSc"]) } else { None };
+    let petsc_libs = if has_pc { pkg_config(&["--libs", "PETSc"]) } else { None };
     if has_pc && (petsc_cflags.is_none() || petsc_libs.is_none()) {
-        missing.push(Missing {
-            what: "PETSc 3.18 development files (pkg-config module `PETSc`)",
-            package: "petsc-dev",
-        });
+        missing
+            .push(Missing { what: "PETSc 3.18 development files (pkg-config module `PETSc`)", package: "petsc-dev" });
     }
-    let mpi_cflags = if has_pc {
-        pkg_config(&["--cflags", "ompi-c"])
-    } else {
-        None
-    };
+    let mpi_cflags = if has_pc { pkg_config(&["--cflags", "ompi-c"]) } else { None };
     if has_pc && mpi_cflags.is_none() {
-        missing.push(Missing {
-            what: "OpenMPI headers (pkg-config module `ompi-c`)",
-            package: "libopenmpi-dev",
-        });
+        missing.push(Missing { what: "OpenMPI headers (pkg-config module `ompi-c`)", package: "libopenmpi-dev" });
     }
     if !have_libclang() {
-        missing.push(Missing {
-            what: "libclang (bindgen parses the PETSc headers with it)",
-            package: "libclang-dev",
-        });
+        missing.push(Missing { what: "libclang (bindgen parses the PETSc headers with it)", package: "libclang-dev" });
     }
     if !missing.is_empty() {
         let mut msg = String::from("\n\npetsc-sys cannot be built; missing:\n");
         for m in &missing {
-            msg.push_str(&format!(
-                "  - {}  -> Debian package `{}`\n",
-                m.what, m.package
-            ));
+            msg.push_str(&format!("  - {}  -> Debian package `{}`\n", m.what, m.package));
         }
         let pkgs: Vec<&str> = missing.iter().map(|m| m.package).collect();
-        msg.push_str(&format!(
-            "Install them with:  apt-get install -y {}\n",
-            pkgs.join(" ")
-        ));
-        msg.push_str(
-            "(or run `make setup`, which installs every system dependency of porompm)\n\n",
-        );
+        msg.push_str(&format!("Install them with:  apt-get install -y {}\n", pkgs.join(" ")));
+        msg.push_str("(or run `make setup`, which installs every system dependency of porompm)\n\n");
         eprintln!("{msg}");
         println!("cargo:warning={}", msg.replace('\n', " "));
         std::process::exit(1);
@@ -162,18 +113,10 @@ fn main() {
         .iter()
         .map(|d| d.join("petscconf.h"))
         .find(|p| p.exists())
-        .unwrap_or_else(|| {
-            fail(&format!(
-                "petscconf.h not found in the PETSc include directories {incs:?}"
-            ))
-        });
-    let conf_text = std::fs::read_to_string(&conf)
-        .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", conf.display())));
-    let defined = |name: &str| {
-        conf_text
-            .lines()
-            .any(|l| l.split_whitespace().take(2).eq(["#define", name]))
-    };
+        .unwrap_or_else(|| fail(&format!("petscconf.h not found in the PETSc include directories {incs:?}")));
+    let conf_text =
+        std::fs::read_to_string(&conf).unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", conf.display())));
+    let defined = |name: &str| conf_text.lines().any(|l| l.split_whitespace().take(2).eq(["#define", name]));
     if defined("PETSC_USE_64BIT_INDICES") {
         fail("this PETSc uses 64-bit PetscInt; porompm's bindings expect the 32-bit build of Debian's petsc-dev");
     }
@@ -183,10 +126,7 @@ fn main() {
     if defined("PETSC_USE_COMPLEX") {
         fail("this PETSc uses complex PetscScalar; porompm needs the real build (-lpetsc_real)");
     }
-    let version_h = incs
-        .iter()
-        .map(|d| d.join("petscversion.h"))
-        .find(|p| p.exists());
+    let version_h = incs.iter().map(|d| d.join("petscversion.h")).find(|p| p.exists());
     let version = version_h
         .and_then(|p| std::fs::read_to_string(p).ok())
         .map(|t| {
@@ -199,35 +139,16 @@ fn main() {
                     })
                     .unwrap_or_else(|| "?".into())
             };
-            format!(
-                "{}.{}.{}",
-                get("PETSC_VERSION_MAJOR"),
-                get("PETSC_VERSION_MINOR"),
-                get("PETSC_VERSION_SUBMINOR")
-            )
+            format!("{}.{}.{}", get("PETSC_VERSION_MAJOR"), get("PETSC_VERSION_MINOR"), get("PETSC_VERSION_SUBMINOR"))
         })
         .unwrap_or_else(|| "unknown".into());
     println!("cargo:version={version}");
-    println!(
-        "cargo:include={}",
-        incs.iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(":")
-    );
+    println!("cargo:include={}", incs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(":"));
     for (macro_name, key, cfg) in [
         ("PETSC_HAVE_MUMPS", "mumps", "petsc_have_mumps"),
         ("PETSC_HAVE_HYPRE", "hypre", "petsc_have_hypre"),
-        (
-            "PETSC_HAVE_SUPERLU_DIST",
-            "superlu_dist",
-            "petsc_have_superlu_dist",
-        ),
-        (
-            "PETSC_HAVE_SUITESPARSE",
-            "suitesparse",
-            "petsc_have_suitesparse",
-        ),
+        ("PETSC_HAVE_SUPERLU_DIST", "superlu_dist", "petsc_have_superlu_dist"),
+        ("PETSC_HAVE_SUITESPARSE", "suitesparse", "petsc_have_suitesparse"),
         ("PETSC_HAVE_HDF5", "hdf5", "petsc_have_hdf5"),
     ] {
         let have = defined(macro_name);
@@ -249,13 +170,9 @@ fn main() {
     // ---- 4. bindings ----
     let mut builder = bindgen::Builder::default()
         .header("wrapper.h")
-        .allowlist_function(
-            "(Petsc|Vec|Mat|KSP|PC|SNES|DM|DMDA|IS|ISLocalToGlobalMapping)[A-Za-z0-9_]*",
-        )
+        .allowlist_function("(Petsc|Vec|Mat|KSP|PC|SNES|DM|DMDA|IS|ISLocalToGlobalMapping)[A-Za-z0-9_]*")
         .allowlist_function("PETSC_VIEWER_STDOUT_")
-        .allowlist_type(
-            "(Petsc|Vec|Mat|KSP|PC|SNES|DM|DMDA|IS|InsertMode|ScatterMode|NormType)[A-Za-z0-9_]*",
-        )
+        .allowlist_type("(Petsc|Vec|Mat|KSP|PC|SNES|DM|DMDA|IS|InsertMode|ScatterMode|NormType)[A-Za-z0-9_]*")
         .allowlist_var("(PETSC|Petsc|KSP|PC|SNES|MAT|VEC|DM)[A-Za-z0-9_]*")
         .blocklist_type("MPI_.*")
         .blocklist_type("ompi_.*")
@@ -263,33 +180,20 @@ fn main() {
         .blocklist_function("MPI_.*|PMPI_.*")
         .raw_line("#[allow(unused_imports)] pub use mpi_sys::*;")
         // Newtype enums: a value PETSc writes back can never be an invalid Rust enum.
-        .default_enum_style(bindgen::EnumVariation::NewType {
-            is_bitfield: false,
-            is_global: false,
-        })
+        .default_enum_style(bindgen::EnumVariation::NewType { is_bitfield: false, is_global: false })
         .derive_default(true)
         .layout_tests(false)
         .generate_comments(false)
         .parse_callbacks(Box::new(bindgen::CargoCallbacks::new()));
-    for d in include_dirs(&petsc_cflags)
-        .iter()
-        .chain(include_dirs(&mpi_cflags).iter())
-    {
+    for d in include_dirs(&petsc_cflags).iter().chain(include_dirs(&mpi_cflags).iter()) {
         builder = builder.clang_arg(format!("-I{}", d.display()));
     }
-    for f in petsc_cflags
-        .split_whitespace()
-        .filter(|f| f.starts_with("-D"))
-    {
+    for f in petsc_cflags.split_whitespace().filter(|f| f.starts_with("-D")) {
         builder = builder.clang_arg(f);
     }
-    let bindings = builder
-        .generate()
-        .unwrap_or_else(|e| fail(&format!("bindgen failed on the PETSc headers: {e}")));
+    let bindings = builder.generate().unwrap_or_else(|e| fail(&format!("bindgen failed on the PETSc headers: {e}")));
     let out = PathBuf::from(env::var("OUT_DIR").unwrap()).join("bindings.rs");
-    bindings
-        .write_to_file(&out)
-        .unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", out.display())));
+    bindings.write_to_file(&out).unwrap_or_else(|e| fail(&format!("cannot write {}: {e}", out.display())));
 }
 
 fn fail(msg: &str) -> ! {

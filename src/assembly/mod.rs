@@ -27,8 +27,7 @@ use petsc::ksp::KspOps;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
 use petsc::{
-    CallbackError, Comm, DmDa, GhostedRange, LogStage, Mat, MatRef, Options, Snes, StageGuard,
-    VecOps, VecRef, Vector,
+    CallbackError, Comm, DmDa, GhostedRange, LogStage, Mat, MatRef, Options, Snes, StageGuard, VecOps, VecRef, Vector,
 };
 use std::time::Instant;
 
@@ -63,8 +62,7 @@ impl Stencils {
 
     /// Whether every particle couples only nodes it coupled in `old`.
     fn within(&self, old: &Stencils) -> bool {
-        self.len() == old.len()
-            && (0..self.len()).all(|k| self.nodes(k).iter().all(|x| old.nodes(k).contains(x)))
+        self.len() == old.len() && (0..self.len()).all(|k| self.nodes(k).iter().all(|x| old.nodes(k).contains(x)))
     }
 }
 
@@ -168,17 +166,8 @@ impl GridSystem {
     /// residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on one rank (the
     /// fastest of the measured strategies on the verification cases, see docs/solvers.md) and by
     /// MUMPS on several ranks (UMFPACK is sequential).
-    pub fn new(
-        comm: Comm,
-        grid: &crate::model::grid::Grid,
-        two_phase: bool,
-    ) -> Result<GridSystem, Error> {
-        let dm = DmDa::new_2d(
-            comm,
-            grid.nodes(),
-            STENCIL_WIDTH,
-            crate::model::field_names(two_phase),
-        )?;
+    pub fn new(comm: Comm, grid: &crate::model::grid::Grid, two_phase: bool) -> Result<GridSystem, Error> {
+        let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, crate::model::field_names(two_phase))?;
         let info = *dm.info();
         let x = dm.create_global_vector()?;
         let x_local = dm.create_local_vector()?;
@@ -265,10 +254,8 @@ impl GridSystem {
     fn sum_over_ranks(&mut self, data: &mut [f64]) -> Result<(), Error> {
         self.work_local.write()?.copy_from_slice(data);
         self.work_global.set_all(0.0)?;
-        self.dm
-            .local_to_global_add(&self.work_local, &mut self.work_global)?;
-        self.dm
-            .global_to_local(&self.work_global, &mut self.work_local)?;
+        self.dm.local_to_global_add(&self.work_local, &mut self.work_global)?;
+        self.dm.global_to_local(&self.work_global, &mut self.work_local)?;
         data.copy_from_slice(&self.work_local.read()?);
         Ok(())
     }
@@ -279,23 +266,14 @@ impl GridSystem {
 
     /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
     /// boundaries (see the module documentation).
-    pub fn prepare_step(
-        &mut self,
-        model: &Model,
-        active: &Active,
-        t_new: f64,
-        dt: f64,
-    ) -> Result<(), String> {
+    pub fn prepare_step(&mut self, model: &Model, active: &Active, t_new: f64, dt: f64) -> Result<(), String> {
         let nd = self.ndof;
         let ng = self.ghost.len() * nd;
         let ps = &model.particles;
         let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
 
         // 1. Stencils on x_n.
-        let mut stencils = Stencils {
-            offsets: Vec::with_capacity(ps.len() + 1),
-            ..Default::default()
-        };
+        let mut stencils = Stencils { offsets: Vec::with_capacity(ps.len() + 1), ..Default::default() };
         stencils.offsets.push(0);
         for k in 0..ps.len() {
             let st: Stencil = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
@@ -319,14 +297,11 @@ impl GridSystem {
         }
 
         // 2. Nodal masses, momenta, mass-weighted accelerations and weight sums ([003] Eq. 19).
-        let (mut mass, mut mom, mut acc, mut weight) =
-            (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
+        let (mut mass, mut mom, mut acc, mut weight) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         for k in 0..stencils.len() {
             let (nodes, basis) = stencils.get(k);
             let mw = if self.two_phase {
-                ps.porosity[k]
-                    * model.materials[ps.material[k] as usize].water_density
-                    * ps.volume[k]
+                ps.porosity[k] * model.materials[ps.material[k] as usize].water_density * ps.volume[k]
             } else {
                 0.0
             };
@@ -404,11 +379,7 @@ impl GridSystem {
             let load = &model.loads[li];
             let f = load.time_fn.eval(t_new);
             match &load.target {
-                LoadTarget::ParticleTraction {
-                    particles,
-                    face,
-                    traction,
-                } => {
+                LoadTarget::ParticleTraction { particles, face, traction } => {
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
                         let (point, length) = match face {
@@ -419,10 +390,9 @@ impl GridSystem {
                         };
                         let w = shape::point_weights(&model.grid, point);
                         for ((i, j), s, _) in w.iter() {
-                            let l = self
-                                .local_node(i, j)
-                                .ok_or("a traction point lies outside this rank's ghost region")?
-                                as usize;
+                            let l =
+                                self.local_node(i, j).ok_or("a traction point lies outside this rank's ghost region")?
+                                    as usize;
                             for c in 0..2 {
                                 fext[l * nd + c] += s * traction[c] * f * length;
                             }
@@ -431,11 +401,8 @@ impl GridSystem {
                 }
                 LoadTarget::NodalTraction { nodes, traction } => {
                     for &(i, j, trib) in nodes {
-                        let owned = (self.owned_start[0]
-                            ..self.owned_start[0] + self.owned_count[0])
-                            .contains(&i)
-                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1])
-                                .contains(&j);
+                        let owned = (self.owned_start[0]..self.owned_start[0] + self.owned_count[0]).contains(&i)
+                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1]).contains(&j);
                         if owned {
                             let l = self.ghost.node(i, j).expect("owned") * nd;
                             for c in 0..2 {
@@ -469,10 +436,7 @@ impl GridSystem {
         let reusable = match &self.pattern {
             Some((old, free)) => {
                 self.step.stencils.within(old)
-                    && free
-                        .iter()
-                        .zip(&self.step.constrained)
-                        .all(|(&was_free, &c)| was_free || c)
+                    && free.iter().zip(&self.step.constrained).all(|(&was_free, &c)| was_free || c)
             }
             None => false,
         };
@@ -485,10 +449,7 @@ impl GridSystem {
                 nodes: self.step.stencils.nodes.clone(),
                 basis: Vec::new(),
             };
-            self.pattern = Some((
-                nodes_only,
-                self.step.constrained.iter().map(|c| !c).collect(),
-            ));
+            self.pattern = Some((nodes_only, self.step.constrained.iter().map(|c| !c).collect()));
         }
         Ok(())
     }
@@ -500,22 +461,8 @@ impl GridSystem {
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
         let out = {
-            let GridSystem {
-                dm,
-                x,
-                x_local,
-                f_local,
-                snes,
-                jac,
-                step,
-                ndof,
-                two_phase,
-                stages,
-                ..
-            } = self;
-            let jac = jac
-                .as_mut()
-                .ok_or_else(|| petsc::Error::new("solve called before prepare_step"))?;
+            let GridSystem { dm, x, x_local, f_local, snes, jac, step, ndof, two_phase, stages, .. } = self;
+            let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("solve called before prepare_step"))?;
             let mut asm = Assembler {
                 dm,
                 model,
@@ -611,14 +558,7 @@ impl NonlinearProblem for Assembler<'_> {
                 let input = self.model.particle_input(k, self.step.body_acc);
                 let mat = &self.model.materials[self.model.particles.material[k] as usize];
                 let m = nodes.len() * nd;
-                kernels::residual(
-                    basis,
-                    &states[..nodes.len()],
-                    &input,
-                    &mat.model,
-                    self.two_phase,
-                    &mut buf[..m],
-                );
+                kernels::residual(basis, &states[..nodes.len()], &input, &mat.model, self.two_phase, &mut buf[..m]);
                 for (n, &node) in nodes.iter().enumerate() {
                     let b = node as usize * nd;
                     for c in 0..nd {
@@ -628,9 +568,7 @@ impl NonlinearProblem for Assembler<'_> {
             }
         }
         f.set_all(0.0).map_err(fatal)?;
-        self.dm
-            .local_to_global_add(self.f_local, f)
-            .map_err(fatal)?;
+        self.dm.local_to_global_add(self.f_local, f).map_err(fatal)?;
         {
             // Constrained dofs: residual x − 0 (Dirichlet value zero).
             let xo = x.read().map_err(fatal)?;
@@ -661,26 +599,14 @@ impl NonlinearProblem for Assembler<'_> {
             let states = node_states(nodes, &xl, self.step, nd);
             let kin = kernels::interpolate(basis, &states[..nodes.len()], self.two_phase);
             let dsig = mat.model.update(&input.stress, &kin.deps).tangent;
-            kernels::tangent(
-                basis,
-                &input,
-                &dsig,
-                nm,
-                self.two_phase,
-                &mut block[..m * m],
-            );
+            kernels::tangent(basis, &input, &dsig, nm, self.two_phase, &mut block[..m * m]);
             for (n, &node) in nodes.iter().enumerate() {
                 let b = node as usize * nd;
                 for c in 0..nd {
-                    idx[n * nd + c] = if self.step.constrained[b + c] {
-                        -1
-                    } else {
-                        (b + c) as i32
-                    };
+                    idx[n * nd + c] = if self.step.constrained[b + c] { -1 } else { (b + c) as i32 };
                 }
             }
-            j.set_values_local(&idx[..m], &idx[..m], &block[..m * m], true)
-                .map_err(fatal)?;
+            j.set_values_local(&idx[..m], &idx[..m], &block[..m * m], true).map_err(fatal)?;
         }
         for &o in &self.step.owned_constrained {
             let g = (self.step.global_start + o) as i32;
@@ -703,20 +629,12 @@ pub fn default_factor_package(comm: Comm) -> &'static str {
 
 /// PETSc options that were given but not used by any solver object so far.
 pub fn unused_petsc_options() -> Result<Vec<String>, Error> {
-    Ok(Options::global()
-        .unused()?
-        .iter()
-        .map(|o| o.to_string())
-        .collect())
+    Ok(Options::global().unused()?.iter().map(|o| o.to_string()).collect())
 }
 
 /// Every option in PETSc's database, as `-name value` strings.
 pub fn petsc_options() -> Result<Vec<String>, Error> {
-    Ok(Options::global()
-        .all()?
-        .iter()
-        .map(|o| o.to_string())
-        .collect())
+    Ok(Options::global().all()?.iter().map(|o| o.to_string()).collect())
 }
 
 /// The solver configuration (KSP and PC types and the factorisation package), for the summary.
@@ -728,20 +646,12 @@ pub fn describe_solver(sys: &mut GridSystem) -> Result<String, Error> {
     let pc = ksp.pc()?;
     let pc_type = pc.type_name()?;
     let factor = if pc_type == "lu" || pc_type == "cholesky" {
-        pc.factor_solver_type()?
-            .map(|s| format!(" ({s})"))
-            .unwrap_or_default()
+        pc.factor_solver_type()?.map(|s| format!(" ({s})")).unwrap_or_default()
     } else {
         String::new()
     };
-    let newton = if lag > 1 || lag == -1 || lag == -2 {
-        "modified Newton (lagged Jacobian)"
-    } else {
-        "Newton"
-    };
-    Ok(format!(
-        "{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"
-    ))
+    let newton = if lag > 1 || lag == -1 || lag == -2 { "modified Newton (lagged Jacobian)" } else { "Newton" };
+    Ok(format!("{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"))
 }
 
 /// Reductions over ranks for code outside this module (observers, probes, summaries).
@@ -816,15 +726,9 @@ impl GridSystem {
     /// assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
     /// converged increment of this step). One rank only (it builds the dense FD Jacobian: small
     /// cases only).
-    pub fn jacobian_check(
-        &mut self,
-        model: &Model,
-        fraction: f64,
-    ) -> Result<Vec<BlockCheck>, Error> {
+    pub fn jacobian_check(&mut self, model: &Model, fraction: f64) -> Result<Vec<BlockCheck>, Error> {
         if self.comm.size() != 1 {
-            return Err(petsc::Error::new(
-                "the finite-difference Jacobian check runs on one rank",
-            ));
+            return Err(petsc::Error::new("the finite-difference Jacobian check runs on one rank"));
         }
         let nd = self.ndof;
         let names = crate::model::field_names(self.two_phase);
@@ -834,22 +738,9 @@ impl GridSystem {
         self.x.copy_to(&mut x)?;
         x.scale(fraction)?;
         let n = x.local_size()?;
-        let free: Vec<usize> = (0..n)
-            .filter(|o| !self.step.owned_constrained.contains(o))
-            .collect();
-        let GridSystem {
-            dm,
-            x_local,
-            f_local,
-            jac,
-            step,
-            stages,
-            two_phase,
-            ..
-        } = self;
-        let jac = jac
-            .as_mut()
-            .ok_or_else(|| petsc::Error::new("jacobian_check called before prepare_step"))?;
+        let free: Vec<usize> = (0..n).filter(|o| !self.step.owned_constrained.contains(o)).collect();
+        let GridSystem { dm, x_local, f_local, jac, step, stages, two_phase, .. } = self;
+        let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("jacobian_check called before prepare_step"))?;
         let mut seconds = 0.0;
         let mut asm = Assembler {
             dm,
@@ -862,8 +753,7 @@ impl GridSystem {
             seconds: &mut seconds,
             stage: &stages.assembly,
         };
-        asm.jacobian(&x.as_ref(), &mut jac.as_ref())
-            .map_err(|e| petsc::Error::new(format!("{e:?}")))?;
+        asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
         let (_, dense) = jac.local_rows_dense()?;
         let xv = x.read()?.to_vec();
         // The finite-difference step of a dof follows the typical size of its kind of unknown:
@@ -879,15 +769,8 @@ impl GridSystem {
             }
         }
         let h_cell = model.grid.h[0].min(model.grid.h[1]);
-        let typical: Vec<f64> = (0..nd)
-            .map(|c| {
-                if is_p(c) {
-                    typ_p.max(1.0)
-                } else {
-                    typ_u.max(1e-6 * h_cell)
-                }
-            })
-            .collect();
+        let typical: Vec<f64> =
+            (0..nd).map(|c| if is_p(c) { typ_p.max(1.0) } else { typ_u.max(1e-6 * h_cell) }).collect();
         let mut fd = vec![0.0; n * n];
         let (mut xp, mut fp, mut fm) = (x.duplicate()?, x.duplicate()?, x.duplicate()?);
         for &c in &free {
@@ -898,8 +781,7 @@ impl GridSystem {
                     w.copy_from_slice(&xv);
                     w[c] += sign * h;
                 }
-                asm.residual(&xp.as_ref(), &mut out.as_ref())
-                    .map_err(|e| petsc::Error::new(format!("{e:?}")))?;
+                asm.residual(&xp.as_ref(), &mut out.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
             }
             let (a, b) = (fp.read()?, fm.read()?);
             for &r in &free {

@@ -33,34 +33,26 @@ impl std::error::Error for CaseError {}
 
 /// Line (1-based) of a byte offset in `text`.
 fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())]
-        .bytes()
-        .filter(|&b| b == b'\n')
-        .count()
-        + 1
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
 /// Parses and validates a case. `origin` names the file in messages.
 pub fn parse(text: &str, origin: &str, overrides: &[Override]) -> Result<Case, CaseError> {
     let mut doc: toml::Value = toml::from_str(text).map_err(|e| {
-        let line = e
-            .span()
-            .map(|s| format!(" (line {})", line_of(text, s.start)))
-            .unwrap_or_default();
+        let line = e.span().map(|s| format!(" (line {})", line_of(text, s.start))).unwrap_or_default();
         CaseError::new(format!("{origin}{line}: {}", e.message().trim()))
     })?;
     let mut set_paths = Vec::new();
     for ov in overrides {
-        let path =
-            overrides::apply(&mut doc, ov).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
+        let path = overrides::apply(&mut doc, ov).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
         set_paths.push((path, ov.key.clone()));
     }
     let case: Case = serde_path_to_error::deserialize(doc).map_err(|e| {
         let path = e.path().to_string();
         let msg = e.inner().message().trim().to_string();
-        let from_set = set_paths.iter().find(|(p, _)| {
-            path == *p || path.starts_with(&format!("{p}.")) || path.starts_with(&format!("{p}["))
-        });
+        let from_set = set_paths
+            .iter()
+            .find(|(p, _)| path == *p || path.starts_with(&format!("{p}.")) || path.starts_with(&format!("{p}[")));
         match from_set {
             Some((_, key)) => CaseError::new(format!("{origin}: --set {key}: {msg}")),
             None if path == "." || path.is_empty() => CaseError::new(format!("{origin}: {msg}")),
@@ -104,10 +96,7 @@ impl Case {
 
     /// Cell size in x and y [m].
     pub fn cell_size(&self) -> [f64; 2] {
-        [
-            self.grid.size[0] / self.grid.cells[0] as f64,
-            self.grid.size[1] / self.grid.cells[1] as f64,
-        ]
+        [self.grid.size[0] / self.grid.cells[0] as f64, self.grid.size[1] / self.grid.cells[1] as f64]
     }
 }
 
@@ -134,18 +123,14 @@ impl Shape {
     /// the even–odd rule).
     pub fn contains(&self, p: [f64; 2]) -> bool {
         match self {
-            Shape::Rectangle { min, max } => {
-                p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1]
-            }
+            Shape::Rectangle { min, max } => p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1],
             Shape::Polygon { vertices } => {
                 let mut inside = false;
                 let n = vertices.len();
                 let mut j = n - 1;
                 for i in 0..n {
                     let (a, b) = (vertices[i], vertices[j]);
-                    if (a[1] > p[1]) != (b[1] > p[1])
-                        && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
-                    {
+                    if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0] {
                         inside = !inside;
                     }
                     j = i;
@@ -162,9 +147,7 @@ impl Region {
     /// box is a line).
     pub fn contains(&self, p: [f64; 2]) -> bool {
         (0..2).all(|d| {
-            let tol = 1e-9
-                * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs())
-                + 1e-15;
+            let tol = 1e-9 * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs()) + 1e-15;
             p[d] >= self.min[d] - tol && p[d] <= self.max[d] + tol
         })
     }
@@ -218,33 +201,12 @@ mod tests {
 
     #[test]
     fn unknown_keys_and_wrong_types_name_the_key() {
-        let e = parse(
-            &MINIMAL.replace("porosity = 0.3", "porosity = 0.3\nporosty = 1"),
-            "t.toml",
-            &[],
-        )
-        .unwrap_err();
-        assert!(
-            e.to_string().contains("materials[0]") && e.to_string().contains("porosty"),
-            "{e}"
-        );
-        let e = parse(
-            &MINIMAL.replace("cells = [1, 10]", "cells = [1, \"ten\"]"),
-            "t.toml",
-            &[],
-        )
-        .unwrap_err();
+        let e = parse(&MINIMAL.replace("porosity = 0.3", "porosity = 0.3\nporosty = 1"), "t.toml", &[]).unwrap_err();
+        assert!(e.to_string().contains("materials[0]") && e.to_string().contains("porosty"), "{e}");
+        let e = parse(&MINIMAL.replace("cells = [1, 10]", "cells = [1, \"ten\"]"), "t.toml", &[]).unwrap_err();
         assert!(e.to_string().contains("grid.cells"), "{e}");
-        let e = parse(
-            MINIMAL,
-            "t.toml",
-            &[Override::parse("grid.cels=[2,20]").unwrap()],
-        )
-        .unwrap_err();
-        assert!(
-            e.to_string().contains("--set grid.cels") && e.to_string().contains("unknown field"),
-            "{e}"
-        );
+        let e = parse(MINIMAL, "t.toml", &[Override::parse("grid.cels=[2,20]").unwrap()]).unwrap_err();
+        assert!(e.to_string().contains("--set grid.cels") && e.to_string().contains("unknown field"), "{e}");
     }
 
     #[test]
@@ -252,10 +214,7 @@ mod tests {
         let c = parse(
             MINIMAL,
             "t.toml",
-            &[
-                Override::parse("grid.cells=[2,20]").unwrap(),
-                Override::parse("stages[0].dt=5e-4").unwrap(),
-            ],
+            &[Override::parse("grid.cells=[2,20]").unwrap(), Override::parse("stages[0].dt=5e-4").unwrap()],
         )
         .unwrap();
         assert_eq!(c.grid.cells, [2, 20]);
@@ -264,15 +223,10 @@ mod tests {
 
     #[test]
     fn shapes_contain_points() {
-        let poly = Shape::Polygon {
-            vertices: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]],
-        };
+        let poly = Shape::Polygon { vertices: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]] };
         assert!(poly.contains([0.5, 0.5]));
         assert!(!poly.contains([1.5, 1.5]));
-        let r = Region {
-            min: [0.0, 1.0],
-            max: [1.0, 1.0],
-        };
+        let r = Region { min: [0.0, 1.0], max: [1.0, 1.0] };
         assert!(r.contains([0.5, 1.0 + 1e-12]));
         assert!(!r.contains([0.5, 1.01]));
     }

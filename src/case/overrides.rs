@@ -19,9 +19,7 @@ pub struct Override {
 impl Override {
     /// Parses `KEY=VALUE`.
     pub fn parse(s: &str) -> Result<Override, CaseError> {
-        let (k, v) = s
-            .split_once('=')
-            .ok_or_else(|| CaseError::new(format!("--set {s}: expected KEY=VALUE")))?;
+        let (k, v) = s.split_once('=').ok_or_else(|| CaseError::new(format!("--set {s}: expected KEY=VALUE")))?;
         let key = k.trim();
         if key.is_empty() {
             return Err(CaseError::new(format!("--set {s}: empty key")));
@@ -31,10 +29,7 @@ impl Override {
             Ok(mut t) => t.remove("v").unwrap_or(Value::String(raw.to_string())),
             Err(_) => Value::String(raw.to_string()),
         };
-        Ok(Override {
-            key: key.to_string(),
-            value,
-        })
+        Ok(Override { key: key.to_string(), value })
     }
 }
 
@@ -58,9 +53,8 @@ fn segments(key: &str) -> Result<Vec<Segment>, String> {
             rest = &rest[b..];
             while let Some(stripped) = rest.strip_prefix('[') {
                 let close = stripped.find(']').ok_or("unclosed `[`")?;
-                let idx: usize = stripped[..close]
-                    .parse()
-                    .map_err(|_| format!("bad index `{}`", &stripped[..close]))?;
+                let idx: usize =
+                    stripped[..close].parse().map_err(|_| format!("bad index `{}`", &stripped[..close]))?;
                 out.push(Segment::Index(idx));
                 rest = &stripped[close + 1..];
             }
@@ -97,17 +91,13 @@ pub fn apply(doc: &mut Value, ov: &Override) -> Result<String, CaseError> {
                             t.insert(name.clone(), ov.value.clone());
                             return Ok(path);
                         }
-                        cur = t
-                            .entry(name.clone())
-                            .or_insert_with(|| Value::Table(toml::Table::new()));
+                        cur = t.entry(name.clone()).or_insert_with(|| Value::Table(toml::Table::new()));
                     }
                     Value::Array(a) => {
                         // Select an element of an array of tables by its `name`.
                         let idx = a
                             .iter()
-                            .position(|e| {
-                                e.get("name").and_then(|n| n.as_str()) == Some(name.as_str())
-                            })
+                            .position(|e| e.get("name").and_then(|n| n.as_str()) == Some(name.as_str()))
                             .ok_or_else(|| err(format!("no element named `{name}` in `{path}`")))?;
                         path.push_str(&format!("[{idx}]"));
                         if last {
@@ -122,10 +112,7 @@ pub fn apply(doc: &mut Value, ov: &Override) -> Result<String, CaseError> {
             Segment::Index(i) => match cur {
                 Value::Array(a) => {
                     if *i >= a.len() {
-                        return Err(err(format!(
-                            "index {i} out of range: `{path}` has {} elements",
-                            a.len()
-                        )));
+                        return Err(err(format!("index {i} out of range: `{path}` has {} elements", a.len())));
                     }
                     path.push_str(&format!("[{i}]"));
                     if last {
@@ -163,20 +150,12 @@ mod tests {
 
     #[test]
     fn values_parse_as_toml_or_fall_back_to_strings() {
-        assert_eq!(
-            Override::parse("time.dt=5e-4").unwrap().value,
-            Value::Float(5e-4)
-        );
+        assert_eq!(Override::parse("time.dt=5e-4").unwrap().value, Value::Float(5e-4));
         assert_eq!(
             Override::parse("grid.cells=[20,1]").unwrap().value,
             Value::Array(vec![Value::Integer(20), Value::Integer(1)])
         );
-        assert_eq!(
-            Override::parse("analysis.shape_functions=linear")
-                .unwrap()
-                .value,
-            Value::String("linear".into())
-        );
+        assert_eq!(Override::parse("analysis.shape_functions=linear").unwrap().value, Value::String("linear".into()));
         assert!(Override::parse("no_equals_sign").is_err());
     }
 
@@ -186,43 +165,23 @@ mod tests {
         let p = apply(&mut d, &Override::parse("grid.cells=[2,20]").unwrap()).unwrap();
         assert_eq!(p, "grid.cells");
         assert_eq!(d["grid"]["cells"][1].as_integer(), Some(20));
-        let p = apply(
-            &mut d,
-            &Override::parse("materials[1].porosity=0.2").unwrap(),
-        )
-        .unwrap();
+        let p = apply(&mut d, &Override::parse("materials[1].porosity=0.2").unwrap()).unwrap();
         assert_eq!(p, "materials[1].porosity");
         assert_eq!(d["materials"][1]["porosity"].as_float(), Some(0.2));
-        let p = apply(
-            &mut d,
-            &Override::parse("materials.soil.porosity=0.4").unwrap(),
-        )
-        .unwrap();
+        let p = apply(&mut d, &Override::parse("materials.soil.porosity=0.4").unwrap()).unwrap();
         assert_eq!(p, "materials[0].porosity");
         assert_eq!(d["materials"][0]["porosity"].as_float(), Some(0.4));
         // A missing table is created (its key may be optional in the schema).
-        let p = apply(
-            &mut d,
-            &Override::parse("time_integration.beta=0.3").unwrap(),
-        )
-        .unwrap();
+        let p = apply(&mut d, &Override::parse("time_integration.beta=0.3").unwrap()).unwrap();
         assert_eq!(p, "time_integration.beta");
     }
 
     #[test]
     fn bad_paths_name_the_key() {
         let mut d = doc();
-        let e = apply(
-            &mut d,
-            &Override::parse("materials.clay.porosity=0.4").unwrap(),
-        )
-        .unwrap_err();
+        let e = apply(&mut d, &Override::parse("materials.clay.porosity=0.4").unwrap()).unwrap_err();
         assert!(e.to_string().contains("no element named `clay`"), "{e}");
-        let e = apply(
-            &mut d,
-            &Override::parse("materials[5].porosity=0.4").unwrap(),
-        )
-        .unwrap_err();
+        let e = apply(&mut d, &Override::parse("materials[5].porosity=0.4").unwrap()).unwrap_err();
         assert!(e.to_string().contains("out of range"), "{e}");
         let e = apply(&mut d, &Override::parse("grid.cells.x=3").unwrap()).unwrap_err();
         assert!(e.to_string().starts_with("--set grid.cells.x"), "{e}");

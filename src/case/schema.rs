@@ -276,7 +276,10 @@ pub enum Load {
         time_function: Option<String>,
     },
     /// A traction [Pa] along the line of grid nodes inside `region`, each node taking its
-    /// tributary length of the line.
+    /// tributary length of the line. The load stays on that grid line: when the loaded surface moves
+    /// off it by δ, the stress of the particles in the cell below is too large by about h/(h − δ)
+    /// (the force passes through a partly filled cell). Use a `particle_traction`, which follows the
+    /// surface, when the surface moves by more than a small fraction of a cell.
     NodalTraction {
         /// Name used by stages and verification.
         name: String,
@@ -304,9 +307,9 @@ impl Load {
     /// The load's name.
     pub fn name(&self) -> &str {
         match self {
-            Load::ParticleTraction { name, .. }
-            | Load::NodalTraction { name, .. }
-            | Load::BodyForce { name, .. } => name,
+            Load::ParticleTraction { name, .. } | Load::NodalTraction { name, .. } | Load::BodyForce { name, .. } => {
+                name
+            }
         }
     }
 
@@ -440,10 +443,7 @@ fn default_gamma() -> f64 {
 
 impl Default for TimeIntegration {
     fn default() -> Self {
-        TimeIntegration {
-            beta: default_beta(),
-            gamma: default_gamma(),
-        }
+        TimeIntegration { beta: default_beta(), gamma: default_gamma() }
     }
 }
 
@@ -520,6 +520,23 @@ pub enum Verification {
         /// Pass threshold for the maximum amplitude error relative to the peak amplitude.
         tolerance: f64,
     },
+    /// Elastic column under its self-weight and a surcharge, at rest at the end of the run: the
+    /// vertical stress is −(ρ g d + q) at depth d and the settlement ρ g H²/(2 E_c) + q H/E_c.
+    ElasticColumn {
+        /// The column body (laterally confined, fixed base).
+        body: String,
+        /// The body-force load carrying gravity.
+        gravity: String,
+        /// The surface load (particle or nodal traction), if any.
+        #[serde(default)]
+        surcharge: Option<String>,
+        /// Pass threshold for max |σ_yy − σ*| / max |σ*| over the column.
+        #[serde(default = "default_column_tol")]
+        stress_tolerance: f64,
+        /// Pass threshold for the relative settlement error.
+        #[serde(default = "default_column_tol")]
+        settlement_tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -551,6 +568,9 @@ fn default_settle_tol() -> f64 {
 }
 fn default_periods() -> usize {
     3
+}
+fn default_column_tol() -> f64 {
+    0.01
 }
 fn default_fast_tol() -> f64 {
     0.02

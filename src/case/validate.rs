@@ -62,18 +62,14 @@ pub fn validate(c: &Case) -> R {
     positive("grid.size[1]", c.grid.size[1])?;
     for d in 0..2 {
         if c.grid.cells[d] == 0 || c.grid.cells[d] > 100_000 {
-            return Err(format!(
-                "key `grid.cells[{d}]`: must be between 1 and 100000, got {}",
-                c.grid.cells[d]
-            ));
+            return Err(format!("key `grid.cells[{d}]`: must be between 1 and 100000, got {}", c.grid.cells[d]));
         }
     }
     let lo = c.grid.origin;
     let hi = [lo[0] + c.grid.size[0], lo[1] + c.grid.size[1]];
     let h = c.cell_size();
     let tol = [1e-9 * h[0], 1e-9 * h[1]];
-    let inside_grid =
-        |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] - tol[d] && p[d] <= hi[d] + tol[d]);
+    let inside_grid = |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] - tol[d] && p[d] <= hi[d] + tol[d]);
 
     // Materials.
     if c.materials.is_empty() {
@@ -86,33 +82,27 @@ pub fn validate(c: &Case) -> R {
         positive(&k("solid_density"), m.solid_density)?;
         positive(&k("water_density"), m.water_density)?;
         match &m.model {
-            SoilModel::LinearElastic {
-                young_modulus,
-                poisson_ratio,
-            } => {
+            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
                 positive(&k("model.young_modulus"), *young_modulus)?;
                 in_open(&k("model.poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
             }
         }
         if two_phase {
-            for (f, v) in [
-                ("water_bulk_modulus", m.water_bulk_modulus),
-                ("hydraulic_conductivity", m.hydraulic_conductivity),
-            ] {
+            for (f, v) in
+                [("water_bulk_modulus", m.water_bulk_modulus), ("hydraulic_conductivity", m.hydraulic_conductivity)]
+            {
                 match v {
                     Some(v) => positive(&k(f), v)?,
-                    None => {
-                        return Err(format!("key `{}`: required in a two_phase analysis", k(f)))
-                    }
+                    None => return Err(format!("key `{}`: required in a two_phase analysis", k(f))),
                 }
             }
             match m.solid_bulk_modulus {
                 Some(v) => positive_or_inf(&k("solid_bulk_modulus"), v)?,
                 None => {
                     return Err(format!(
-                    "key `{}`: required in a two_phase analysis (inf for incompressible grains)",
-                    k("solid_bulk_modulus")
-                ))
+                        "key `{}`: required in a two_phase analysis (inf for incompressible grains)",
+                        k("solid_bulk_modulus")
+                    ))
                 }
             }
         }
@@ -125,10 +115,7 @@ pub fn validate(c: &Case) -> R {
     unique("bodies", c.bodies.iter().map(|b| b.name.as_str()))?;
     for (i, b) in c.bodies.iter().enumerate() {
         if c.material(&b.material).is_none() {
-            return Err(format!(
-                "key `bodies[{i}].material`: no material named `{}`",
-                b.material
-            ));
+            return Err(format!("key `bodies[{i}].material`: no material named `{}`", b.material));
         }
         if b.particles_per_cell == 0 || b.particles_per_cell > 8 {
             return Err(format!(
@@ -141,12 +128,16 @@ pub fn validate(c: &Case) -> R {
                 finite2(&format!("bodies[{i}].shape.rectangle.min"), *min)?;
                 finite2(&format!("bodies[{i}].shape.rectangle.max"), *max)?;
                 if !(max[0] > min[0] && max[1] > min[1]) {
-                    return Err(format!("key `bodies[{i}].shape.rectangle`: max must exceed min in x and y, got {min:?} .. {max:?}"));
+                    return Err(format!(
+                        "key `bodies[{i}].shape.rectangle`: max must exceed min in x and y, got {min:?} .. {max:?}"
+                    ));
                 }
             }
             Shape::Polygon { vertices } => {
                 if vertices.len() < 3 {
-                    return Err(format!("key `bodies[{i}].shape.polygon.vertices`: a polygon needs at least 3 vertices"));
+                    return Err(format!(
+                        "key `bodies[{i}].shape.polygon.vertices`: a polygon needs at least 3 vertices"
+                    ));
                 }
                 for (j, v) in vertices.iter().enumerate() {
                     finite2(&format!("bodies[{i}].shape.polygon.vertices[{j}]"), *v)?;
@@ -172,32 +163,19 @@ pub fn validate(c: &Case) -> R {
                     return Err(format!("key `{}`: must be finite", k("value")));
                 }
             }
-            TimeFunction::Ramp {
-                start, duration, ..
-            }
-            | TimeFunction::SmoothRamp {
-                start, duration, ..
-            } => {
+            TimeFunction::Ramp { start, duration, .. } | TimeFunction::SmoothRamp { start, duration, .. } => {
                 positive(&k("duration"), *duration)?;
                 if !start.is_finite() || *start < 0.0 {
                     return Err(format!("key `{}`: must be ≥ 0, got {start}", k("start")));
                 }
             }
-            TimeFunction::Harmonic {
-                angular_frequency,
-                phase,
-                ramp_duration,
-                ..
-            } => {
+            TimeFunction::Harmonic { angular_frequency, phase, ramp_duration, .. } => {
                 positive(&k("angular_frequency"), *angular_frequency)?;
                 if !phase.is_finite() {
                     return Err(format!("key `{}`: must be finite", k("phase")));
                 }
                 if !ramp_duration.is_finite() || *ramp_duration < 0.0 {
-                    return Err(format!(
-                        "key `{}`: must be ≥ 0, got {ramp_duration}",
-                        k("ramp_duration")
-                    ));
+                    return Err(format!("key `{}`: must be ≥ 0, got {ramp_duration}", k("ramp_duration")));
                 }
             }
             TimeFunction::Table { times, values, .. } => {
@@ -207,13 +185,8 @@ pub fn validate(c: &Case) -> R {
                         k("times")
                     ));
                 }
-                if times.windows(2).any(|w| w[1] <= w[0])
-                    || times.iter().chain(values).any(|v| !v.is_finite())
-                {
-                    return Err(format!(
-                        "key `{}`: times must be finite and strictly increasing",
-                        k("times")
-                    ));
+                if times.windows(2).any(|w| w[1] <= w[0]) || times.iter().chain(values).any(|v| !v.is_finite()) {
+                    return Err(format!("key `{}`: times must be finite and strictly increasing", k("times")));
                 }
             }
         }
@@ -223,14 +196,10 @@ pub fn validate(c: &Case) -> R {
     unique("boundaries", c.boundaries.iter().map(|b| b.name.as_str()))?;
     for (i, b) in c.boundaries.iter().enumerate() {
         if b.side.is_some() == b.region.is_some() {
-            return Err(format!(
-                "key `boundaries[{i}]`: give exactly one of `side` and `region`"
-            ));
+            return Err(format!("key `boundaries[{i}]`: give exactly one of `side` and `region`"));
         }
         if b.fix.is_empty() {
-            return Err(format!(
-                "key `boundaries[{i}].fix`: list at least one component"
-            ));
+            return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
         }
         if !two_phase {
             if let Some(d) = b.fix.iter().find(|d| !matches!(d, Dof::Ux | Dof::Uy)) {
@@ -244,30 +213,19 @@ pub fn validate(c: &Case) -> R {
     for (i, l) in c.loads.iter().enumerate() {
         if let Some(tf) = l.time_function() {
             if c.time_function(tf).is_none() {
-                return Err(format!(
-                    "key `loads[{i}].time_function`: no time function named `{tf}`"
-                ));
+                return Err(format!("key `loads[{i}].time_function`: no time function named `{tf}`"));
             }
         }
         match l {
-            Load::ParticleTraction {
-                region, traction, ..
-            }
-            | Load::NodalTraction {
-                region, traction, ..
-            } => {
+            Load::ParticleTraction { region, traction, .. } | Load::NodalTraction { region, traction, .. } => {
                 finite2(&format!("loads[{i}].traction"), *traction)?;
                 finite2(&format!("loads[{i}].region.min"), region.min)?;
                 finite2(&format!("loads[{i}].region.max"), region.max)?;
                 if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
-                    return Err(format!(
-                        "key `loads[{i}].region`: max must not be below min"
-                    ));
+                    return Err(format!("key `loads[{i}].region`: max must not be below min"));
                 }
             }
-            Load::BodyForce { acceleration, .. } => {
-                finite2(&format!("loads[{i}].acceleration"), *acceleration)?
-            }
+            Load::BodyForce { acceleration, .. } => finite2(&format!("loads[{i}].acceleration"), *acceleration)?,
         }
     }
 
@@ -280,33 +238,18 @@ pub fn validate(c: &Case) -> R {
         positive(&k("duration"), s.duration)?;
         positive(&k("dt"), s.dt)?;
         if s.dt > s.duration * (1.0 + 1e-12) {
-            return Err(format!(
-                "key `{}`: Δt = {} exceeds the stage duration {}",
-                k("dt"),
-                s.dt,
-                s.duration
-            ));
+            return Err(format!("key `{}`: Δt = {} exceeds the stage duration {}", k("dt"), s.dt, s.duration));
         }
         if s.duration / s.dt > 1e8 {
-            return Err(format!(
-                "key `{}`: more than 1e8 steps in the stage",
-                k("dt")
-            ));
+            return Err(format!("key `{}`: more than 1e8 steps in the stage", k("dt")));
         }
         in_open(&k("cut_factor"), s.cut_factor, 0.0, 1.0)?;
         if s.max_step_cuts > 30 {
-            return Err(format!(
-                "key `{}`: at most 30, got {}",
-                k("max_step_cuts"),
-                s.max_step_cuts
-            ));
+            return Err(format!("key `{}`: at most 30, got {}", k("max_step_cuts"), s.max_step_cuts));
         }
         for n in s.boundaries.iter().flatten() {
             if !c.boundaries.iter().any(|b| &b.name == n) {
-                return Err(format!(
-                    "key `{}`: no boundary named `{n}`",
-                    k("boundaries")
-                ));
+                return Err(format!("key `{}`: no boundary named `{n}`", k("boundaries")));
             }
         }
         for n in s.loads.iter().flatten() {
@@ -332,10 +275,7 @@ pub fn validate(c: &Case) -> R {
     for (i, p) in c.probes.iter().enumerate() {
         finite2(&format!("probes[{i}].point"), p.point)?;
         if !inside_grid(p.point) {
-            return Err(format!(
-                "key `probes[{i}].point`: {:?} is outside the grid",
-                p.point
-            ));
+            return Err(format!("key `probes[{i}].point`: {:?} is outside the grid", p.point));
         }
     }
 
@@ -350,12 +290,8 @@ pub fn validate(c: &Case) -> R {
                 p_rms_tolerance,
                 settlement_tolerance,
             } => {
-                if time_factors.is_empty()
-                    || time_factors.iter().any(|t| !(*t > 0.0 && t.is_finite()))
-                {
-                    return Err(
-                        "key `verification.time_factors`: give positive time factors".into(),
-                    );
+                if time_factors.is_empty() || time_factors.iter().any(|t| !(*t > 0.0 && t.is_finite())) {
+                    return Err("key `verification.time_factors`: give positive time factors".into());
                 }
                 for (k, t) in [
                     ("e_p_tolerance", e_p_tolerance),
@@ -366,25 +302,19 @@ pub fn validate(c: &Case) -> R {
                 }
                 (body, load)
             }
-            Verification::HarmonicColumn {
-                body,
-                load,
-                measure_periods,
-                tolerance,
-            } => {
+            Verification::HarmonicColumn { body, load, measure_periods, tolerance } => {
                 positive("verification.tolerance", *tolerance)?;
                 if *measure_periods == 0 {
                     return Err("key `verification.measure_periods`: must be at least 1".into());
                 }
                 (body, load)
             }
-            Verification::ShockWave {
-                body,
-                load,
-                probe_depth,
-                fast_tolerance,
-                slow_tolerance,
-            } => {
+            Verification::ElasticColumn { body, gravity, stress_tolerance, settlement_tolerance, .. } => {
+                positive("verification.stress_tolerance", *stress_tolerance)?;
+                positive("verification.settlement_tolerance", *settlement_tolerance)?;
+                (body, gravity)
+            }
+            Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
                 positive("verification.probe_depth", *probe_depth)?;
                 positive("verification.fast_tolerance", *fast_tolerance)?;
                 positive("verification.slow_tolerance", *slow_tolerance)?;
@@ -395,10 +325,32 @@ pub fn validate(c: &Case) -> R {
             return Err(format!("key `verification.body`: no body named `{body}`"));
         }
         if c.load(load).is_none() {
-            return Err(format!("key `verification.load`: no load named `{load}`"));
+            return Err(format!(
+                "key `verification.{}`: no load named `{load}`",
+                if matches!(v, Verification::ElasticColumn { .. }) { "gravity" } else { "load" }
+            ));
         }
-        if !two_phase {
-            return Err("key `verification`: the consolidation and wave references need a two_phase analysis".into());
+        match v {
+            Verification::ElasticColumn { surcharge, .. } => {
+                if !matches!(c.load(load), Some(Load::BodyForce { .. })) {
+                    return Err(format!("key `verification.gravity`: `{load}` must be a body_force load"));
+                }
+                if let Some(sname) = surcharge {
+                    if !matches!(c.load(sname), Some(Load::ParticleTraction { .. } | Load::NodalTraction { .. })) {
+                        return Err(format!("key `verification.surcharge`: no traction load named `{sname}`"));
+                    }
+                }
+                if two_phase {
+                    return Err("key `verification`: the elastic column reference is for a one_phase analysis".into());
+                }
+            }
+            _ => {
+                if !two_phase {
+                    return Err(
+                        "key `verification`: the consolidation and wave references need a two_phase analysis".into()
+                    );
+                }
+            }
         }
     }
     Ok(())

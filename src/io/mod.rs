@@ -26,11 +26,8 @@ pub struct RunOutput {
 fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
     let tmp = path.with_extension("tmp");
     let mut f = File::create(&tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
-    f.write_all(content)
-        .and_then(|_| f.sync_all())
-        .map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
-    fs::rename(&tmp, path)
-        .map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
+    f.write_all(content).and_then(|_| f.sync_all()).map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
+    fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
 }
 
 impl RunOutput {
@@ -39,24 +36,16 @@ impl RunOutput {
     /// for this run's.
     pub fn create(dir: &Path, writer: bool) -> Result<RunOutput, String> {
         if !writer {
-            return Ok(RunOutput {
-                dir: None,
-                history: None,
-            });
+            return Ok(RunOutput { dir: None, history: None });
         }
-        fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+        fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
         for old in ["summary.json", "history.csv", "amplitude_profile.csv"] {
             let p = dir.join(old);
             if p.exists() {
-                fs::remove_file(&p)
-                    .map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
+                fs::remove_file(&p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
             }
         }
-        Ok(RunOutput {
-            dir: Some(dir.to_path_buf()),
-            history: None,
-        })
+        Ok(RunOutput { dir: Some(dir.to_path_buf()), history: None })
     }
 
     /// Whether this rank writes.
@@ -67,8 +56,7 @@ impl RunOutput {
     /// Writes (replaces) `summary.json`.
     pub fn write_summary<T: Serialize>(&self, summary: &T) -> Result<(), String> {
         let Some(dir) = &self.dir else { return Ok(()) };
-        let text = serde_json::to_string_pretty(summary)
-            .map_err(|e| format!("cannot serialise the summary: {e}"))?;
+        let text = serde_json::to_string_pretty(summary).map_err(|e| format!("cannot serialise the summary: {e}"))?;
         write_atomic(&dir.join("summary.json"), text.as_bytes())
     }
 
@@ -76,11 +64,9 @@ impl RunOutput {
     pub fn start_history(&mut self, columns: &[String]) -> Result<(), String> {
         let Some(dir) = &self.dir else { return Ok(()) };
         let path = dir.join("history.csv");
-        let f =
-            File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+        let f = File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
         let mut w = BufWriter::new(f);
-        writeln!(w, "{}", columns.join(","))
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        writeln!(w, "{}", columns.join(",")).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         w.flush().map_err(|e| e.to_string())?;
         self.history = Some(w);
         Ok(())
@@ -92,28 +78,16 @@ impl RunOutput {
             return Ok(());
         };
         let line: Vec<String> = values.iter().map(|v| format!("{v:.10e}")).collect();
-        writeln!(w, "{}", line.join(","))
-            .and_then(|_| w.flush())
-            .map_err(|e| format!("cannot write history.csv: {e}"))
+        writeln!(w, "{}", line.join(",")).and_then(|_| w.flush()).map_err(|e| format!("cannot write history.csv: {e}"))
     }
 
     /// Writes a CSV table `name` (header, rows) atomically.
-    pub fn write_table(
-        &self,
-        name: &str,
-        header: &[&str],
-        rows: &[Vec<f64>],
-    ) -> Result<(), String> {
+    pub fn write_table(&self, name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<(), String> {
         let Some(dir) = &self.dir else { return Ok(()) };
         let mut text = header.join(",");
         text.push('\n');
         for r in rows {
-            text.push_str(
-                &r.iter()
-                    .map(|v| format!("{v:.10e}"))
-                    .collect::<Vec<_>>()
-                    .join(","),
-            );
+            text.push_str(&r.iter().map(|v| format!("{v:.10e}")).collect::<Vec<_>>().join(","));
             text.push('\n');
         }
         write_atomic(&dir.join(name), text.as_bytes())
@@ -130,24 +104,15 @@ mod tests {
         fs::create_dir_all(&dir).unwrap();
         fs::write(dir.join("summary.json"), "{\"status\": \"completed\"}").unwrap();
         let mut out = RunOutput::create(&dir, true).unwrap();
-        assert!(
-            !dir.join("summary.json").exists(),
-            "a stale summary must not survive"
-        );
-        out.write_summary(&serde_json::json!({"status": "running"}))
-            .unwrap();
+        assert!(!dir.join("summary.json").exists(), "a stale summary must not survive");
+        out.write_summary(&serde_json::json!({"status": "running"})).unwrap();
         out.start_history(&["time".into(), "p".into()]).unwrap();
         out.history_row(&[0.5, 1.25]).unwrap();
-        out.write_table("t.csv", &["a", "b"], &[vec![1.0, 2.0]])
-            .unwrap();
+        out.write_table("t.csv", &["a", "b"], &[vec![1.0, 2.0]]).unwrap();
         let h = fs::read_to_string(dir.join("history.csv")).unwrap();
         assert!(h.starts_with("time,p\n5.0000000000e-1,1.2500000000e0"));
-        assert!(fs::read_to_string(dir.join("summary.json"))
-            .unwrap()
-            .contains("running"));
-        assert!(fs::read_to_string(dir.join("t.csv"))
-            .unwrap()
-            .starts_with("a,b\n"));
+        assert!(fs::read_to_string(dir.join("summary.json")).unwrap().contains("running"));
+        assert!(fs::read_to_string(dir.join("t.csv")).unwrap().starts_with("a,b\n"));
         let silent = RunOutput::create(&dir.join("never"), false).unwrap();
         silent.write_summary(&serde_json::json!({})).unwrap();
         assert!(!dir.join("never").exists());

@@ -29,10 +29,7 @@ impl Grid {
 
     /// Position of node (i, j) [m].
     pub fn node_position(&self, i: usize, j: usize) -> [f64; 2] {
-        [
-            self.origin[0] + i as f64 * self.h[0],
-            self.origin[1] + j as f64 * self.h[1],
-        ]
+        [self.origin[0] + i as f64 * self.h[0], self.origin[1] + j as f64 * self.h[1]]
     }
 
     /// The cell (i, j) containing `x`, or `None` outside the grid (points on the upper boundary
@@ -51,17 +48,11 @@ impl Grid {
 
     /// Centre of cell (i, j) [m].
     pub fn cell_centre(&self, i: usize, j: usize) -> [f64; 2] {
-        [
-            self.origin[0] + (i as f64 + 0.5) * self.h[0],
-            self.origin[1] + (j as f64 + 0.5) * self.h[1],
-        ]
+        [self.origin[0] + (i as f64 + 0.5) * self.h[0], self.origin[1] + (j as f64 + 0.5) * self.h[1]]
     }
 
     /// Upper-right corner [m].
     pub fn extent_max(&self) -> [f64; 2] {
-        [
-            self.origin[0] + self.cells[0] as f64 * self.h[0],
-            self.origin[1] + self.cells[1] as f64 * self.h[1],
-        ]
+        [self.origin[0] + self.cells[0] as f64 * self.h[0], self.origin[1] + self.cells[1] as f64 * self.h[1]]
     }
 }

@@ -30,32 +30,14 @@ impl TimeFn {
     pub fn from_case(f: &TimeFunction) -> TimeFn {
         match f {
             TimeFunction::Constant { value, .. } => TimeFn::Constant(*value),
-            TimeFunction::Ramp {
-                start, duration, ..
-            } => TimeFn::Ramp {
-                start: *start,
-                duration: *duration,
-            },
-            TimeFunction::SmoothRamp {
-                start, duration, ..
-            } => TimeFn::SmoothRamp {
-                start: *start,
-                duration: *duration,
-            },
-            TimeFunction::Harmonic {
-                angular_frequency,
-                phase,
-                ramp_duration,
-                ..
-            } => TimeFn::Harmonic {
-                omega: *angular_frequency,
-                phase: *phase,
-                ramp: *ramp_duration,
-            },
-            TimeFunction::Table { times, values, .. } => TimeFn::Table {
-                t: times.clone(),
-                v: values.clone(),
-            },
+            TimeFunction::Ramp { start, duration, .. } => TimeFn::Ramp { start: *start, duration: *duration },
+            TimeFunction::SmoothRamp { start, duration, .. } => {
+                TimeFn::SmoothRamp { start: *start, duration: *duration }
+            }
+            TimeFunction::Harmonic { angular_frequency, phase, ramp_duration, .. } => {
+                TimeFn::Harmonic { omega: *angular_frequency, phase: *phase, ramp: *ramp_duration }
+            }
+            TimeFunction::Table { times, values, .. } => TimeFn::Table { t: times.clone(), v: values.clone() },
         }
     }
 
@@ -66,11 +48,7 @@ impl TimeFn {
             TimeFn::Ramp { start, duration } => ((t - start) / duration).clamp(0.0, 1.0),
             TimeFn::SmoothRamp { start, duration } => smoothstep((t - start) / duration),
             TimeFn::Harmonic { omega, phase, ramp } => {
-                let env = if *ramp > 0.0 {
-                    smoothstep(t / ramp)
-                } else {
-                    1.0
-                };
+                let env = if *ramp > 0.0 { smoothstep(t / ramp) } else { 1.0 };
                 env * (omega * t + phase).cos()
             }
             TimeFn::Table { t: ts, v } => {
@@ -104,64 +82,34 @@ pub struct LoadDef {
 #[derive(Debug, Clone)]
 pub enum LoadTarget {
     /// Face tractions on the listed particles (local indices), applied at the face centre.
-    ParticleTraction {
-        particles: Vec<usize>,
-        face: Side,
-        traction: [f64; 2],
-    },
+    ParticleTraction { particles: Vec<usize>, face: Side, traction: [f64; 2] },
     /// Forces on grid nodes (i, j, tributary length [m]).
-    NodalTraction {
-        nodes: Vec<(usize, usize, f64)>,
-        traction: [f64; 2],
-    },
+    NodalTraction { nodes: Vec<(usize, usize, f64)>, traction: [f64; 2] },
     /// Body acceleration on all particles.
     BodyForce { acceleration: [f64; 2] },
 }
 
 impl LoadDef {
     /// Resolves a case load on this rank's particles and the grid.
-    pub fn from_case(
-        l: &case::Load,
-        c: &case::Case,
-        grid: &Grid,
-        particles: &Particles,
-    ) -> LoadDef {
-        let time_fn = l
-            .time_function()
-            .and_then(|n| c.time_function(n))
-            .map(TimeFn::from_case)
-            .unwrap_or(TimeFn::Constant(1.0));
+    pub fn from_case(l: &case::Load, c: &case::Case, grid: &Grid, particles: &Particles) -> LoadDef {
+        let time_fn =
+            l.time_function().and_then(|n| c.time_function(n)).map(TimeFn::from_case).unwrap_or(TimeFn::Constant(1.0));
         let target = match l {
-            case::Load::ParticleTraction {
-                region,
-                face,
-                traction,
-                ..
-            } => LoadTarget::ParticleTraction {
+            case::Load::ParticleTraction { region, face, traction, .. } => LoadTarget::ParticleTraction {
                 particles: (0..particles.len())
                     .filter(|&k| {
-                        region.contains(particles.x0[k])
-                            && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
+                        region.contains(particles.x0[k]) && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
                     })
                     .collect(),
                 face: *face,
                 traction: *traction,
             },
-            case::Load::NodalTraction {
-                region, traction, ..
-            } => LoadTarget::NodalTraction {
-                nodes: tributary_nodes(grid, region),
-                traction: *traction,
-            },
-            case::Load::BodyForce { acceleration, .. } => LoadTarget::BodyForce {
-                acceleration: *acceleration,
-            },
+            case::Load::NodalTraction { region, traction, .. } => {
+                LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: *traction }
+            }
+            case::Load::BodyForce { acceleration, .. } => LoadTarget::BodyForce { acceleration: *acceleration },
         };
-        LoadDef {
-            name: l.name().to_string(),
-            time_fn,
-            target,
-        }
+        LoadDef { name: l.name().to_string(), time_fn, target }
     }
 
     /// Number of particles or nodes it acts on (for `check`).
@@ -205,12 +153,8 @@ pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)>
         return Vec::new();
     }
     let spread = |d: usize| {
-        let v: Vec<f64> = sel
-            .iter()
-            .map(|&(i, j)| grid.node_position(i, j)[d])
-            .collect();
-        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-            - v.iter().cloned().fold(f64::INFINITY, f64::min)
+        let v: Vec<f64> = sel.iter().map(|&(i, j)| grid.node_position(i, j)[d]).collect();
+        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min)
     };
     let dir = if spread(0) >= spread(1) { 0 } else { 1 };
     let coord = |n: &(usize, usize)| grid.node_position(n.0, n.1)[dir];
@@ -218,16 +162,8 @@ pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)>
     let m = sel.len();
     (0..m)
         .map(|k| {
-            let left = if k > 0 {
-                (coord(&sel[k]) - coord(&sel[k - 1])) / 2.0
-            } else {
-                0.0
-            };
-            let right = if k + 1 < m {
-                (coord(&sel[k + 1]) - coord(&sel[k])) / 2.0
-            } else {
-                0.0
-            };
+            let left = if k > 0 { (coord(&sel[k]) - coord(&sel[k - 1])) / 2.0 } else { 0.0 };
+            let right = if k + 1 < m { (coord(&sel[k + 1]) - coord(&sel[k])) / 2.0 } else { 0.0 };
             (sel[k].0, sel[k].1, left + right)
         })
         .collect()
@@ -249,12 +185,7 @@ pub struct BoundaryDef {
 impl BoundaryDef {
     /// From the case.
     pub fn from_case(b: &case::Boundary) -> BoundaryDef {
-        BoundaryDef {
-            name: b.name.clone(),
-            side: b.side,
-            region: b.region,
-            fix: b.fix.clone(),
-        }
+        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, fix: b.fix.clone() }
     }
 
     /// Whether node (i, j) belongs to it.
@@ -267,8 +198,7 @@ impl BoundaryDef {
                 Side::YMax => j == grid.cells[1],
             };
         }
-        self.region
-            .is_some_and(|r| r.contains(grid.node_position(i, j)))
+        self.region.is_some_and(|r| r.contains(grid.node_position(i, j)))
     }
 }
 
@@ -279,51 +209,25 @@ mod tests {
     #[test]
     fn time_functions_take_their_values() {
         assert_eq!(TimeFn::Constant(2.0).eval(5.0), 2.0);
-        let r = TimeFn::Ramp {
-            start: 1.0,
-            duration: 2.0,
-        };
+        let r = TimeFn::Ramp { start: 1.0, duration: 2.0 };
         assert_eq!((r.eval(0.0), r.eval(2.0), r.eval(9.0)), (0.0, 0.5, 1.0));
-        let s = TimeFn::SmoothRamp {
-            start: 0.0,
-            duration: 1.0,
-        };
+        let s = TimeFn::SmoothRamp { start: 0.0, duration: 1.0 };
         assert!((s.eval(0.5) - 0.5).abs() < 1e-15 && s.eval(-1.0) == 0.0 && s.eval(2.0) == 1.0);
         // The smoothstep has zero slope at both ends.
         assert!((s.eval(1e-4) / 1e-4) < 1e-6);
-        let h = TimeFn::Harmonic {
-            omega: 2.0,
-            phase: 0.0,
-            ramp: 0.0,
-        };
+        let h = TimeFn::Harmonic { omega: 2.0, phase: 0.0, ramp: 0.0 };
         assert!((h.eval(0.3) - (0.6f64).cos()).abs() < 1e-15);
-        let hr = TimeFn::Harmonic {
-            omega: 2.0,
-            phase: 0.0,
-            ramp: 1.0,
-        };
+        let hr = TimeFn::Harmonic { omega: 2.0, phase: 0.0, ramp: 1.0 };
         assert_eq!(hr.eval(0.0), 0.0);
         assert!((hr.eval(3.0) - (6.0f64).cos()).abs() < 1e-15);
-        let t = TimeFn::Table {
-            t: vec![0.0, 1.0, 3.0],
-            v: vec![0.0, 2.0, 0.0],
-        };
-        assert_eq!(
-            (t.eval(-1.0), t.eval(0.5), t.eval(2.0), t.eval(5.0)),
-            (0.0, 1.0, 1.0, 0.0)
-        );
+        let t = TimeFn::Table { t: vec![0.0, 1.0, 3.0], v: vec![0.0, 2.0, 0.0] };
+        assert_eq!((t.eval(-1.0), t.eval(0.5), t.eval(2.0), t.eval(5.0)), (0.0, 1.0, 1.0, 0.0));
     }
 
     #[test]
     fn tributary_lengths_sum_to_the_loaded_line() {
         let g = Grid::new([0.0, 0.0], [0.25, 0.25], [8, 4]);
-        let nodes = tributary_nodes(
-            &g,
-            &Region {
-                min: [0.0, 1.0],
-                max: [0.5, 1.0],
-            },
-        );
+        let nodes = tributary_nodes(&g, &Region { min: [0.0, 1.0], max: [0.5, 1.0] });
         assert_eq!(nodes.len(), 3);
         let total: f64 = nodes.iter().map(|n| n.2).sum();
         assert!((total - 0.5).abs() < 1e-12);

@@ -35,17 +35,8 @@ impl LinearElastic {
         let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
         let mu = e / (2.0 * (1.0 + nu));
         let a = lam + 2.0 * mu;
-        let d = [
-            [a, lam, 0.0, lam],
-            [lam, a, 0.0, lam],
-            [0.0, 0.0, mu, 0.0],
-            [lam, lam, 0.0, a],
-        ];
-        LinearElastic {
-            young: e,
-            poisson: nu,
-            d,
-        }
+        let d = [[a, lam, 0.0, lam], [lam, a, 0.0, lam], [0.0, 0.0, mu, 0.0], [lam, lam, 0.0, a]];
+        LinearElastic { young: e, poisson: nu, d }
     }
 
     /// Constrained (oedometric) modulus E_c = E(1 − ν)/((1 + ν)(1 − 2ν)) [Pa].
@@ -77,10 +68,7 @@ impl Constitutive {
                 for (r, sr) in s.iter_mut().enumerate() {
                     *sr += (0..4).map(|c| el.d[r][c] * deps[c]).sum::<f64>();
                 }
-                StressUpdate {
-                    stress: s,
-                    tangent: el.d,
-                }
+                StressUpdate { stress: s, tangent: el.d }
             }
         }
     }
@@ -125,17 +113,12 @@ impl Material {
     /// Builds the solver's material from the case's.
     pub fn from_case(m: &case::Material, formulation: Formulation) -> Material {
         let model = match m.model {
-            SoilModel::LinearElastic {
-                young_modulus,
-                poisson_ratio,
-            } => Constitutive::LinearElastic(LinearElastic::new(young_modulus, poisson_ratio)),
+            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+                Constitutive::LinearElastic(LinearElastic::new(young_modulus, poisson_ratio))
+            }
         };
         let two = formulation == Formulation::TwoPhase;
-        let kw = if two {
-            m.water_bulk_modulus.unwrap_or(f64::INFINITY)
-        } else {
-            f64::INFINITY
-        };
+        let kw = if two { m.water_bulk_modulus.unwrap_or(f64::INFINITY) } else { f64::INFINITY };
         let ks = m.solid_bulk_modulus.unwrap_or(f64::INFINITY);
         Material {
             name: m.name.clone(),
@@ -145,11 +128,7 @@ impl Material {
             inv_q: if two { inv_q(m.porosity, kw, ks) } else { 0.0 },
             water_bulk_modulus: kw,
             solid_bulk_modulus: ks,
-            conductivity: if two {
-                m.hydraulic_conductivity.unwrap_or(f64::INFINITY)
-            } else {
-                f64::INFINITY
-            },
+            conductivity: if two { m.hydraulic_conductivity.unwrap_or(f64::INFINITY) } else { f64::INFINITY },
             model,
         }
     }

@@ -73,11 +73,7 @@ impl Model {
     pub fn build(case: &Case, owned: impl Fn(usize, usize) -> bool) -> Model {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
-        let loads = case
-            .loads
-            .iter()
-            .map(|l| LoadDef::from_case(l, case, &grid, &particles))
-            .collect();
+        let loads = case.loads.iter().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
         Model {
             two_phase: case.analysis.formulation == Formulation::TwoPhase,
             basis: match case.analysis.shape_functions {
@@ -85,11 +81,7 @@ impl Model {
                 ShapeFunctions::Linear => Basis::Linear,
             },
             grid,
-            materials: case
-                .materials
-                .iter()
-                .map(|m| Material::from_case(m, case.analysis.formulation))
-                .collect(),
+            materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
             particles,
             loads,
             boundaries: case.boundaries.iter().map(BoundaryDef::from_case).collect(),
@@ -118,20 +110,12 @@ impl Model {
         let pick = |names: &Option<Vec<String>>, all: Vec<&str>| -> Vec<usize> {
             match names {
                 None => (0..all.len()).collect(),
-                Some(ns) => (0..all.len())
-                    .filter(|&i| ns.iter().any(|n| n == all[i]))
-                    .collect(),
+                Some(ns) => (0..all.len()).filter(|&i| ns.iter().any(|n| n == all[i])).collect(),
             }
         };
         Active {
-            loads: pick(
-                &stage.loads,
-                self.loads.iter().map(|l| l.name.as_str()).collect(),
-            ),
-            boundaries: pick(
-                &stage.boundaries,
-                self.boundaries.iter().map(|b| b.name.as_str()).collect(),
-            ),
+            loads: pick(&stage.loads, self.loads.iter().map(|l| l.name.as_str()).collect()),
+            boundaries: pick(&stage.boundaries, self.boundaries.iter().map(|b| b.name.as_str()).collect()),
         }
     }
 
@@ -176,11 +160,7 @@ impl Model {
         let (v, n) = (ps.volume[k], ps.porosity[k]);
         let (water_mass, drag, inv_q) = if self.two_phase {
             let gw = mat.water_density * self.g;
-            (
-                n * mat.water_density * v,
-                n * n * gw * v / mat.conductivity,
-                mat.inv_q_at(n),
-            )
+            (n * mat.water_density * v, n * n * gw * v / mat.conductivity, mat.inv_q_at(n))
         } else {
             (0.0, 0.0, 0.0)
         };
@@ -217,13 +197,7 @@ impl Model {
     /// stress by the soil model, pore pressure by `dp` (the interpolated or recovered increment),
     /// position and displacement by the interpolated solid increment, volume by J = det(I + ∇Δu),
     /// porosity by conservation of solid mass: (1 − n_{n+1}) V_{n+1} = (1 − n_n) V_n.
-    pub fn update_particle(
-        &mut self,
-        k: usize,
-        step: &StepResult,
-        dp: f64,
-        dt: f64,
-    ) -> Result<(), InadmissibleStep> {
+    pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
         self.check_step(k, step)?;
         let j = step.jacobian;
         let ps = &mut self.particles;

@@ -69,9 +69,7 @@ impl Particles {
             let n = body.particles_per_cell;
             let (lo, hi) = body.shape.bounds();
             let c0 = grid.cell_of(lo).unwrap_or((0, 0));
-            let c1 = grid
-                .cell_of(hi)
-                .unwrap_or((grid.cells[0] - 1, grid.cells[1] - 1));
+            let c1 = grid.cell_of(hi).unwrap_or((grid.cells[0] - 1, grid.cells[1] - 1));
             let lp = [grid.h[0] / (2.0 * n as f64), grid.h[1] / (2.0 * n as f64)];
             let vol = grid.h[0] * grid.h[1] / (n * n) as f64;
             for cj in c0.1..=c1.1 {
@@ -84,10 +82,8 @@ impl Particles {
                             let gj = (cj * n + sj) as u64;
                             let id = ((b as u64) << 48) | (gj * (grid.cells[0] * 8) as u64 + gi);
                             let x = [
-                                grid.origin[0]
-                                    + (ci as f64 + (si as f64 + 0.5) / n as f64) * grid.h[0],
-                                grid.origin[1]
-                                    + (cj as f64 + (sj as f64 + 0.5) / n as f64) * grid.h[1],
+                                grid.origin[0] + (ci as f64 + (si as f64 + 0.5) / n as f64) * grid.h[0],
+                                grid.origin[1] + (cj as f64 + (sj as f64 + 0.5) / n as f64) * grid.h[1],
                             ];
                             let earlier = case.bodies[..b].iter().any(|o| o.shape.contains(x));
                             if !body.shape.contains(x) || earlier || !owned(ci, cj) {
@@ -96,9 +92,7 @@ impl Particles {
                             let mass = if two_phase {
                                 (1.0 - mat.porosity) * mat.solid_density * vol
                             } else {
-                                ((1.0 - mat.porosity) * mat.solid_density
-                                    + mat.porosity * mat.water_density)
-                                    * vol
+                                ((1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density) * vol
                             };
                             ps.id.push(id);
                             ps.body.push(b as u16);
@@ -148,5 +142,32 @@ mod tests {
         let half = Particles::generate(&c, &g, |_, j| j < 5);
         assert_eq!(half.len(), 20);
         assert!(half.x.iter().all(|x| x[1] < 0.5));
+    }
+
+    #[test]
+    fn polygons_and_several_bodies_are_filled_without_overlap() {
+        let text = crate::case::tests_support::MINIMAL
+            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [1.0, 1.0]\n        cells = [10, 10]")
+            .replace(
+                "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+                "shape = { polygon = { vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] } }\n        [[bodies]]\n        name = \"block\"\n        material = \"soil\"\n        particles_per_cell = 1\n        shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }",
+            );
+        let c = case::parse(&text, "t", &[]).unwrap();
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.grid.cells);
+        let ps = Particles::generate(&c, &g, |_, _| true);
+        let tri: f64 = (0..ps.len()).filter(|&k| ps.body[k] == 0).map(|k| ps.volume[k]).sum();
+        // The 2×2 points of the triangle cover half the square up to the staircase along the hypotenuse.
+        assert!((tri - 0.5).abs() < 0.05, "triangle area {tri}");
+        // The block takes only the points the triangle left (one per cell, where the cell centre is
+        // not in the triangle): the 45 cells above the diagonal, and those whose centre lies on it
+        // if the even-odd rule leaves them out of the triangle.
+        let block: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == 1).collect();
+        assert!((45..=55).contains(&block.len()), "{} block points", block.len());
+        assert!(block.iter().all(|&k| !c.bodies[0].shape.contains(ps.x[k])));
+        assert!((0..ps.len()).filter(|&k| ps.body[k] == 0).all(|k| c.bodies[0].shape.contains(ps.x[k])));
+        let mut ids = ps.id.clone();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), ps.len());
     }
 }

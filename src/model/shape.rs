@@ -64,12 +64,7 @@ pub struct Stencil {
 
 impl Default for Stencil {
     fn default() -> Self {
-        Stencil {
-            len: 0,
-            nodes: [(0, 0); MAX_STENCIL],
-            w: [0.0; MAX_STENCIL],
-            dw: [[0.0; 2]; MAX_STENCIL],
-        }
+        Stencil { len: 0, nodes: [(0, 0); MAX_STENCIL], w: [0.0; MAX_STENCIL], dw: [[0.0; 2]; MAX_STENCIL] }
     }
 }
 
@@ -81,14 +76,7 @@ impl Stencil {
 }
 
 /// Weights of a particle at `x` along one direction: up to 4 (node, S, dS).
-fn weights_1d(
-    basis: Basis,
-    x: f64,
-    lp: f64,
-    origin: f64,
-    h: f64,
-    ncells: usize,
-) -> ([(u32, f64, f64); 4], usize) {
+fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize) -> ([(u32, f64, f64); 4], usize) {
     let mut out = [(0u32, 0.0, 0.0); 4];
     let mut n = 0;
     match basis {
@@ -180,10 +168,7 @@ mod tests {
             if a >= h + lp {
                 (0.0, 0.0)
             } else if a >= h - lp {
-                (
-                    (h + lp - a).powi(2) / (4.0 * h * lp),
-                    -sg * (h + lp - a) / (2.0 * h * lp),
-                )
+                ((h + lp - a).powi(2) / (4.0 * h * lp), -sg * (h + lp - a) / (2.0 * h * lp))
             } else if a >= lp {
                 (1.0 - a / h, -sg / h)
             } else {
@@ -194,10 +179,7 @@ mod tests {
             let r = k as f64 * 0.01 + 0.0031;
             let (w, g) = gimp_1d(r, lp, h);
             let (wc, gc) = closed(r);
-            assert!(
-                (w - wc).abs() < 1e-12 && (g - gc).abs() < 1e-12,
-                "r = {r}: ({w}, {g}) vs ({wc}, {gc})"
-            );
+            assert!((w - wc).abs() < 1e-12 && (g - gc).abs() < 1e-12, "r = {r}: ({w}, {g}) vs ({wc}, {gc})");
         }
     }
 
@@ -214,18 +196,12 @@ mod tests {
         let w = point_weights(&g, [1.1, top + 1e-3]);
         assert!(
             w.len == 4
-                && w.iter()
-                    .filter(|((_, j), _, _)| *j as usize == g.cells[1])
-                    .map(|(_, s, _)| s)
-                    .sum::<f64>()
+                && w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum::<f64>()
                     > 0.999999
         );
         assert_eq!(point_weights(&g, [1.1, top + 0.6 * g.h[1]]).len, 0);
         // Particles themselves get no linear weights outside the grid.
-        assert_eq!(
-            stencil(Basis::Linear, &g, [1.1, top + 1e-3], [0.0; 2]).len,
-            0
-        );
+        assert_eq!(stencil(Basis::Linear, &g, [1.1, top + 1e-3], [0.0; 2]).len, 0);
     }
 
     #[test]
@@ -245,29 +221,17 @@ mod tests {
         let g = grid();
         for basis in [Basis::Gimp, Basis::Linear] {
             for k in 0..200 {
-                let x = [
-                    0.6 + 3.7 * (k as f64 / 200.0),
-                    0.3 + 1.8 * ((k * 7 % 200) as f64 / 200.0),
-                ];
+                let x = [0.6 + 3.7 * (k as f64 / 200.0), 0.3 + 1.8 * ((k * 7 % 200) as f64 / 200.0)];
                 let s = stencil(basis, &g, x, [g.h[0] / 4.0, g.h[1] / 4.0]);
                 let sum: f64 = s.iter().map(|(_, w, _)| w).sum();
                 let gx: f64 = s.iter().map(|(_, _, d)| d[0]).sum();
                 let gy: f64 = s.iter().map(|(_, _, d)| d[1]).sum();
-                assert!(
-                    (sum - 1.0).abs() < 1e-12 && gx.abs() < 1e-9 && gy.abs() < 1e-9,
-                    "{basis:?} at {x:?}"
-                );
+                assert!((sum - 1.0).abs() < 1e-12 && gx.abs() < 1e-9 && gy.abs() < 1e-9, "{basis:?} at {x:?}");
                 // Linear completeness: Σ S_i x_i = x_p.
-                let xr: f64 = s
-                    .iter()
-                    .map(|((i, _), w, _)| w * g.node_position(i as usize, 0)[0])
-                    .sum();
+                let xr: f64 = s.iter().map(|((i, _), w, _)| w * g.node_position(i as usize, 0)[0]).sum();
                 assert!((xr - x[0]).abs() < 1e-12);
                 // Σ ∇S_i x_i = 1.
-                let dxx: f64 = s
-                    .iter()
-                    .map(|((i, _), _, d)| d[0] * g.node_position(i as usize, 0)[0])
-                    .sum();
+                let dxx: f64 = s.iter().map(|((i, _), _, d)| d[0] * g.node_position(i as usize, 0)[0]).sum();
                 assert!((dxx - 1.0).abs() < 1e-9);
             }
         }
@@ -283,8 +247,7 @@ mod tests {
         let s = stencil(Basis::Gimp, &g, [0.5 + 0.125, 0.1], [0.125, 0.0625]);
         assert_eq!(s.len, 6);
         assert!(
-            s.iter()
-                .any(|((i, _), w, d)| i == 0 && w == 0.0 && d == [0.0, 0.0])
+            s.iter().any(|((i, _), w, d)| i == 0 && w == 0.0 && d == [0.0, 0.0])
                 || s.iter().any(|((i, _), w, _)| i == 1 && w == 0.0)
         );
         let s = stencil(Basis::Linear, &g, [0.5 + 0.01, 0.125], [0.125, 0.0625]);

@@ -72,10 +72,7 @@ impl BiotColumn {
     /// violation otherwise.
     pub fn validate(&self) -> Result<(), String> {
         if !self.load_amplitude.is_finite() {
-            return Err(format!(
-                "load_amplitude must be finite, got {}",
-                self.load_amplitude
-            ));
+            return Err(format!("load_amplitude must be finite, got {}", self.load_amplitude));
         }
         let positive = [
             ("height", self.height),
@@ -93,10 +90,7 @@ impl BiotColumn {
             }
         }
         if !(self.porosity > 0.0 && self.porosity < 1.0) {
-            return Err(format!(
-                "porosity must lie strictly between 0 and 1, got {}",
-                self.porosity
-            ));
+            return Err(format!("porosity must lie strictly between 0 and 1, got {}", self.porosity));
         }
         Ok(())
     }
@@ -148,11 +142,7 @@ impl BiotColumn {
             let first = [-m12, m11];
             let second = [m22, -m21];
             let norm = |v: &[Complex64; 2]| v[0].norm().max(v[1].norm());
-            let v = if norm(&first) >= norm(&second) {
-                first
-            } else {
-                second
-            };
+            let v = if norm(&first) >= norm(&second) { first } else { second };
             let scale = norm(&v);
             if !(scale.is_finite() && scale > 0.0) {
                 return Err("degenerate mode shape in the characteristic problem".to_string());
@@ -332,11 +322,7 @@ fn compression_speed_squared_and_beta(
 fn quadratic_roots(b: Complex64, c: Complex64) -> Result<[Complex64; 2], String> {
     let root = (b * b - c * 4.0).sqrt();
     // Choose the sign that makes |b ± √disc| as large as possible.
-    let sum = if (b.conj() * root).re >= 0.0 {
-        b + root
-    } else {
-        b - root
-    };
+    let sum = if (b.conj() * root).re >= 0.0 { b + root } else { b - root };
     let big = -sum * 0.5;
     if !(big.norm() > 0.0 && big.is_finite() && c.is_finite()) {
         return Err("degenerate characteristic equation".to_string());
@@ -372,9 +358,7 @@ fn solve_complex<const N: usize>(
         *cs = scale;
     }
     for k in 0..N {
-        let pivot_row = (k..N)
-            .max_by(|&i, &j| matrix[i][k].norm().total_cmp(&matrix[j][k].norm()))
-            .unwrap_or(k);
+        let pivot_row = (k..N).max_by(|&i, &j| matrix[i][k].norm().total_cmp(&matrix[j][k].norm())).unwrap_or(k);
         let pivot = matrix[pivot_row][k];
         if !(pivot.norm() > 1e-300 && pivot.is_finite()) {
             return Err("singular boundary system".to_string());
@@ -447,37 +431,19 @@ mod tests {
     }
 
     /// All regimes exercised by the tests, as (Π₁, Π₂).
-    const REGIMES: [(f64, f64); 6] = [
-        (1.0, 1.0),
-        (1.0, 1e-7),
-        (1e-6, 1e-4),
-        (10.0, 5.0),
-        (1e-8, 1e-3),
-        (100.0, 0.5),
-    ];
+    const REGIMES: [(f64, f64); 6] = [(1.0, 1.0), (1.0, 1e-7), (1e-6, 1e-4), (10.0, 5.0), (1e-8, 1e-3), (100.0, 0.5)];
 
     fn check_boundary_conditions(pi1: f64, pi2: f64) {
         let c = column(pi1, pi2);
-        let s = c
-            .solve()
-            .unwrap_or_else(|e| panic!("Π₁ = {pi1}, Π₂ = {pi2}: {e}"));
+        let s = c.solve().unwrap_or_else(|e| panic!("Π₁ = {pi1}, Π₂ = {pi2}: {e}"));
         let q = c.load_amplitude;
         let total = s.total_stress(0.0);
-        assert!(
-            (total + q).norm() < 1e-9 * q,
-            "Π = ({pi1}, {pi2}): σ(0) = {total}"
-        );
-        assert!(
-            s.pressure(0.0).norm() < 1e-9 * q,
-            "Π = ({pi1}, {pi2}): p(0) = {}",
-            s.pressure(0.0)
-        );
+        assert!((total + q).norm() < 1e-9 * q, "Π = ({pi1}, {pi2}): σ(0) = {total}");
+        assert!(s.pressure(0.0).norm() < 1e-9 * q, "Π = ({pi1}, {pi2}): p(0) = {}", s.pressure(0.0));
         let scale = (0..=100)
             .map(|i| {
                 let z = H * i as f64 / 100.0;
-                s.solid_displacement(z)
-                    .norm()
-                    .max(s.relative_displacement(z).norm())
+                s.solid_displacement(z).norm().max(s.relative_displacement(z).norm())
             })
             .fold(0.0f64, f64::max);
         assert!(scale > 0.0);
@@ -500,19 +466,14 @@ mod tests {
     /// smallest residual, which balances truncation against rounding error. A wrong solution fails for every step.
     fn ode_residual(pi1: f64, pi2: f64) -> f64 {
         let c = column(pi1, pi2);
-        let s = c
-            .solve()
-            .unwrap_or_else(|e| panic!("Π₁ = {pi1}, Π₂ = {pi2}: {e}"));
+        let s = c.solve().unwrap_or_else(|e| panic!("Π₁ = {pi1}, Π₂ = {pi2}: {e}"));
         let ec = c.constrained_modulus;
         let q = c.q_modulus;
         let n = c.porosity;
         let rho = c.mixture_density();
         let rho_w = c.water_density;
         let w2 = c.omega * c.omega;
-        let drag = Complex64::new(
-            w2 * rho_w / n,
-            -c.omega * rho_w * c.gravity / c.conductivity,
-        );
+        let drag = Complex64::new(w2 * rho_w / n, -c.omega * rho_w * c.gravity / c.conductivity);
         let mut worst: f64 = 0.0;
         for i in 1..20 {
             let z = H * i as f64 / 20.0;
@@ -522,8 +483,7 @@ mod tests {
             let max_step = 0.9 * z.min(H - z);
             for k in 0..=28 {
                 let dz = max_step * 10f64.powf(-(k as f64) / 4.0);
-                let second =
-                    |f: &dyn Fn(f64) -> Complex64| (f(z + dz) - f(z) * 2.0 + f(z - dz)) / (dz * dz);
+                let second = |f: &dyn Fn(f64) -> Complex64| (f(z + dz) - f(z) * 2.0 + f(z - dz)) / (dz * dz);
                 let upp = second(&|x| s.solid_displacement(x));
                 let wpp = second(&|x| s.relative_displacement(x));
                 let mixture = [upp * (ec + q), wpp * q, u * (w2 * rho), w * (w2 * rho_w)];
@@ -593,15 +553,9 @@ mod tests {
                 let du = strain(&|x| s.solid_displacement(x));
                 let dw = strain(&|x| s.relative_displacement(x));
                 let p = -(du + dw) * c.q_modulus;
-                assert!(
-                    (p - s.pressure(z)).norm() < 1e-6 * c.load_amplitude,
-                    "z = {z}"
-                );
+                assert!((p - s.pressure(z)).norm() < 1e-6 * c.load_amplitude, "z = {z}");
                 let sigma = du * c.constrained_modulus;
-                assert!(
-                    (sigma - s.effective_stress(z)).norm() < 1e-6 * c.load_amplitude,
-                    "z = {z}"
-                );
+                assert!((sigma - s.effective_stress(z)).norm() < 1e-6 * c.load_amplitude, "z = {z}");
             }
         }
     }
@@ -613,8 +567,7 @@ mod tests {
         let inv_ec = 1.0 / c.constrained_modulus;
         let inv_q = 1.0 / c.q_modulus;
         let gamma_w = c.water_density * c.gravity;
-        let kappa =
-            (Complex64::new(0.0, c.omega * (inv_ec + inv_q) * gamma_w / c.conductivity)).sqrt();
+        let kappa = (Complex64::new(0.0, c.omega * (inv_ec + inv_q) * gamma_w / c.conductivity)).sqrt();
         let p_u = undrained_pressure(&c);
         // |κ| H ≈ 8.7 here, so the profile is far from both the drained and the undrained limit.
         assert!((kappa * H).norm() > 5.0 && (kappa * H).norm() < 15.0);
@@ -624,15 +577,9 @@ mod tests {
             let reference = p_u * (1.0 - (kappa * (H - z)).cosh() / (kappa * H).cosh());
             worst = worst.max((s.pressure_amplitude(z) - reference.norm()).abs());
             // The phase agrees as well, not only the amplitude.
-            assert!(
-                (s.pressure(z) - reference).norm() < 1e-3 * c.load_amplitude,
-                "z = {z}"
-            );
+            assert!((s.pressure(z) - reference).norm() < 1e-3 * c.load_amplitude, "z = {z}");
         }
-        assert!(
-            worst < 1e-3 * c.load_amplitude,
-            "worst amplitude error {worst}"
-        );
+        assert!(worst < 1e-3 * c.load_amplitude, "worst amplitude error {worst}");
     }
 
     #[test]
@@ -647,15 +594,9 @@ mod tests {
         for i in 0..=40 {
             let z = 0.2 * H + 0.8 * H * i as f64 / 40.0;
             let p = s.pressure_amplitude(z);
-            assert!(
-                (p - p_u).abs() < 1e-2 * c.load_amplitude,
-                "z = {z}: |p| = {p}, p_u = {p_u}"
-            );
+            assert!((p - p_u).abs() < 1e-2 * c.load_amplitude, "z = {z}: |p| = {p}, p_u = {p_u}");
             let dynamic = p_u * (kw * (H - z)).cos() / (kw * H).cos();
-            assert!(
-                (p - dynamic).abs() < 1e-6 * c.load_amplitude,
-                "z = {z}: |p| = {p}, undrained wave {dynamic}"
-            );
+            assert!((p - dynamic).abs() < 1e-6 * c.load_amplitude, "z = {z}: |p| = {p}, undrained wave {dynamic}");
         }
         // The drained surface keeps a thin boundary layer where the pressure drops to zero.
         assert!(s.pressure_amplitude(0.0) < 1e-9 * c.load_amplitude);
@@ -669,42 +610,26 @@ mod tests {
         // Π₂ = 5 is above the first undrained resonance (√Π₂ = π/2), so the response is strongly dynamic.
         let c = column(10.0, 5.0);
         let s = c.solve().expect("solve");
-        let peak = (0..=100)
-            .map(|i| s.pressure_amplitude(H * i as f64 / 100.0))
-            .fold(0.0f64, f64::max);
-        assert!(
-            peak.is_finite() && peak > 1.5 * undrained_pressure(&c),
-            "peak {peak}"
-        );
+        let peak = (0..=100).map(|i| s.pressure_amplitude(H * i as f64 / 100.0)).fold(0.0f64, f64::max);
+        assert!(peak.is_finite() && peak > 1.5 * undrained_pressure(&c), "peak {peak}");
     }
 
     #[test]
     fn large_exponents_stay_finite() {
         let c = column(1e-8, 1e-3);
         let s = c.solve().expect("solve");
-        let lmax = s
-            .characteristic_roots()
-            .iter()
-            .fold(0.0f64, |m, l| m.max(l.re));
+        let lmax = s.characteristic_roots().iter().fold(0.0f64, |m, l| m.max(l.re));
         assert!(lmax * H > 1e4, "λH = {}", lmax * H);
         let p_u = undrained_pressure(&c);
         let kw = c.omega / ((c.constrained_modulus + c.q_modulus) / c.mixture_density()).sqrt();
         for i in 0..=200 {
             let z = H * i as f64 / 200.0;
-            let values = [
-                s.solid_displacement(z),
-                s.relative_displacement(z),
-                s.pressure(z),
-                s.effective_stress(z),
-            ];
+            let values = [s.solid_displacement(z), s.relative_displacement(z), s.pressure(z), s.effective_stress(z)];
             assert!(values.iter().all(|v| v.is_finite()), "z = {z}: {values:?}");
             if z > 0.2 * H {
                 // Practically undrained: p = p_u cos(k_w (H − z)) / cos(k_w H) with k_w = ω / V_u.
                 let reference = p_u * (kw * (H - z)).cos() / (kw * H).cos();
-                assert!(
-                    (s.pressure_amplitude(z) - reference).abs() < 1e-2 * c.load_amplitude,
-                    "z = {z}"
-                );
+                assert!((s.pressure_amplitude(z) - reference).abs() < 1e-2 * c.load_amplitude, "z = {z}");
             }
         }
     }
@@ -723,16 +648,12 @@ mod zone_parameters_for_cases {
             (10.0, 5.0, 499.9975, 0.4904975),
         ];
         for (pi1, pi2, w_case, k_case) in zones {
-            let (w, k) =
-                super::zienkiewicz_parameters(5e9, 2e9, 0.4, 2666.7, 1000.0, 9.81, 10.0, pi1, pi2);
+            let (w, k) = super::zienkiewicz_parameters(5e9, 2e9, 0.4, 2666.7, 1000.0, 9.81, 10.0, pi1, pi2);
             println!(
                 "Π1 = {pi1}, Π2 = {pi2}: ω = {w:.6} rad/s, k = {k:.6e} m/s, period {:.6} s",
                 2.0 * std::f64::consts::PI / w
             );
-            assert!(
-                (w - w_case).abs() < 1e-5 * w && (k - k_case).abs() < 1e-5 * k,
-                "zone ({pi1}, {pi2})"
-            );
+            assert!((w - w_case).abs() < 1e-5 * w && (k - k_case).abs() < 1e-5 * k, "zone ({pi1}, {pi2})");
         }
     }
 }

@@ -47,13 +47,7 @@ pub struct Metric {
 impl Metric {
     /// An error measure (reference 0).
     pub fn error(value: f64, tolerance: f64, detail: String) -> Metric {
-        Metric {
-            value,
-            reference: 0.0,
-            tolerance,
-            pass: value.is_finite() && value.abs() <= tolerance,
-            detail,
-        }
+        Metric { value, reference: 0.0, tolerance, pass: value.is_finite() && value.abs() <= tolerance, detail }
     }
 }
 
@@ -78,13 +72,7 @@ pub trait Check {
     /// Times the time stepping must land on exactly.
     fn event_times(&self) -> Vec<f64>;
     /// Called after every converged step at time `t`; returns the values of [`Check::columns`].
-    fn observe(
-        &mut self,
-        t: f64,
-        dt: f64,
-        model: &Model,
-        coll: &Collective,
-    ) -> Result<Vec<f64>, String>;
+    fn observe(&mut self, t: f64, dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String>;
     /// The metrics (name, metric) and tables at the end of the run.
     fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String>;
 }
@@ -110,21 +98,12 @@ pub(crate) struct Column {
 
 impl Column {
     fn from_case(c: &Case, model: &Model, body: &str, load: &str) -> Result<Column, String> {
-        let bi = c
-            .bodies
-            .iter()
-            .position(|b| b.name == body)
-            .ok_or(format!("no body `{body}`"))?;
+        let bi = c.bodies.iter().position(|b| b.name == body).ok_or(format!("no body `{body}`"))?;
         let b = &c.bodies[bi];
         let (lo, hi) = b.shape.bounds();
         let traction = match c.load(load) {
-            Some(Load::ParticleTraction { traction, .. })
-            | Some(Load::NodalTraction { traction, .. }) => *traction,
-            _ => {
-                return Err(format!(
-                    "verification load `{load}` must be a particle_traction or nodal_traction"
-                ))
-            }
+            Some(Load::ParticleTraction { traction, .. }) | Some(Load::NodalTraction { traction, .. }) => *traction,
+            _ => return Err(format!("verification load `{load}` must be a particle_traction or nodal_traction")),
         };
         let mi = c.material_index(&b.material).expect("validated");
         let mat = &model.materials[mi];
@@ -153,24 +132,13 @@ impl Column {
 }
 
 /// The check the case asks for, if any.
-pub fn for_case(
-    c: &Case,
-    model: &Model,
-    coll: &Collective,
-) -> Result<Option<Box<dyn Check>>, String> {
+pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box<dyn Check>>, String> {
     let Some(v) = &c.verification else {
         return Ok(None);
     };
     let end = c.end_time();
     Ok(Some(match v {
-        Verification::Terzaghi {
-            body,
-            load,
-            time_factors,
-            e_p_tolerance,
-            p_rms_tolerance,
-            settlement_tolerance,
-        } => {
+        Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let f_end = c
                 .load(load)
@@ -189,51 +157,29 @@ pub fn for_case(
                 coll,
             )?)
         }
-        Verification::HarmonicColumn {
-            body,
-            load,
-            measure_periods,
-            tolerance,
-        } => {
+        Verification::HarmonicColumn { body, load, measure_periods, tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
-            let omega = match c
-                .load(load)
-                .and_then(|l| l.time_function())
-                .and_then(|n| c.time_function(n))
-            {
-                Some(TimeFunction::Harmonic {
-                    angular_frequency, ..
-                }) => *angular_frequency,
-                _ => {
-                    return Err(format!(
-                        "verification load `{load}` must have a harmonic time function"
-                    ))
-                }
+            let omega = match c.load(load).and_then(|l| l.time_function()).and_then(|n| c.time_function(n)) {
+                Some(TimeFunction::Harmonic { angular_frequency, .. }) => *angular_frequency,
+                _ => return Err(format!("verification load `{load}` must have a harmonic time function")),
             };
-            Box::new(HarmonicCheck::new(
-                col,
-                omega,
-                end,
-                *measure_periods,
-                *tolerance,
-            )?)
+            Box::new(HarmonicCheck::new(col, omega, end, *measure_periods, *tolerance)?)
         }
-        Verification::ShockWave {
-            body,
-            load,
-            probe_depth,
-            fast_tolerance,
-            slow_tolerance,
-        } => {
-            let col = Column::from_case(c, model, body, load)?;
-            Box::new(shock::ShockCheck::new(
-                col,
-                *probe_depth,
-                *fast_tolerance,
-                *slow_tolerance,
+        Verification::ElasticColumn { body, gravity, surcharge, stress_tolerance, settlement_tolerance } => {
+            Box::new(ElasticColumnCheck::new(
+                c,
                 model,
                 coll,
+                body,
+                gravity,
+                surcharge.as_deref(),
+                *stress_tolerance,
+                *settlement_tolerance,
             )?)
+        }
+        Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
+            let col = Column::from_case(c, model, body, load)?;
+            Box::new(shock::ShockCheck::new(col, *probe_depth, *fast_tolerance, *slow_tolerance, model, coll)?)
         }
     }))
 }
@@ -275,10 +221,7 @@ impl TerzaghiCheck {
         );
         theory.validate()?;
         let targets = tvs.iter().map(|&tv| (tv, theory.time_for(tv))).collect();
-        let v0: f64 = col
-            .particles(model)
-            .map(|k| model.particles.volume[k])
-            .sum();
+        let v0: f64 = col.particles(model).map(|k| model.particles.volume[k]).sum();
         let volume0 = coll.sum(&[v0])?[0];
         Ok(TerzaghiCheck {
             col,
@@ -291,38 +234,23 @@ impl TerzaghiCheck {
     }
 
     fn settlement(&self, model: &Model, coll: &Collective) -> Result<f64, String> {
-        let v: f64 = self
-            .col
-            .particles(model)
-            .map(|k| model.particles.volume[k])
-            .sum();
+        let v: f64 = self.col.particles(model).map(|k| model.particles.volume[k]).sum();
         Ok((self.volume0 - coll.sum(&[v])?[0]) / self.col.width)
     }
 }
 
 impl Check for TerzaghiCheck {
     fn columns(&self) -> Vec<String> {
-        [
-            "terzaghi.Tv",
-            "terzaghi.settlement",
-            "terzaghi.settlement_analytical",
-            "terzaghi.U_analytical",
-        ]
-        .map(String::from)
-        .to_vec()
+        ["terzaghi.Tv", "terzaghi.settlement", "terzaghi.settlement_analytical", "terzaghi.U_analytical"]
+            .map(String::from)
+            .to_vec()
     }
 
     fn event_times(&self) -> Vec<f64> {
         self.targets.iter().map(|t| t.1).collect()
     }
 
-    fn observe(
-        &mut self,
-        t: f64,
-        _dt: f64,
-        model: &Model,
-        coll: &Collective,
-    ) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let s = self.settlement(model, coll)?;
         let q = self.theory.load;
         for &(tv, tt) in &self.targets {
@@ -330,32 +258,18 @@ impl Check for TerzaghiCheck {
                 let local: Vec<f64> = self
                     .col
                     .particles(model)
-                    .flat_map(|k| {
-                        [
-                            self.col.top - model.particles.x0[k][1],
-                            model.particles.p[k],
-                        ]
-                    })
+                    .flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]])
                     .collect();
                 let all = coll.gather(&local)?;
                 let n = all.len() / 2;
-                let sq: f64 = all
-                    .chunks(2)
-                    .map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2))
-                    .sum();
+                let sq: f64 = all.chunks(2).map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2)).sum();
                 let e_p = sq.sqrt() / n as f64;
                 let rms = (sq / n as f64).sqrt();
                 let s_ana = self.theory.settlement(t);
-                self.results
-                    .push((tv, e_p, rms, (s - s_ana).abs() / s_ana.abs(), s));
+                self.results.push((tv, e_p, rms, (s - s_ana).abs() / s_ana.abs(), s));
             }
         }
-        Ok(vec![
-            self.theory.time_factor(t),
-            s,
-            self.theory.settlement(t),
-            self.theory.degree_of_consolidation(t),
-        ])
+        Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree_of_consolidation(t)])
     }
 
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
@@ -379,39 +293,23 @@ impl Check for TerzaghiCheck {
                     if last {
                         out.push((
                             format!("p_rms_error_Tv{name}"),
-                            Metric::error(
-                                rms,
-                                rms_tol,
-                                "RMS of (P* - P) over particles, P = p/q".into(),
-                            ),
+                            Metric::error(rms, rms_tol, "RMS of (P* - P) over particles, P = p/q".into()),
                         ));
                         out.push((
                             format!("settlement_rel_error_Tv{name}"),
                             Metric::error(
                                 se,
                                 s_tol,
-                                format!(
-                                    "settlement {s:.6e} m vs Terzaghi {:.6e} m",
-                                    self.theory.settlement(tt)
-                                ),
+                                format!("settlement {s:.6e} m vs Terzaghi {:.6e} m", self.theory.settlement(tt)),
                             ),
                         ));
                     }
                 }
                 None => {
-                    out.push((
-                        format!("e_p_Tv{name}"),
-                        Metric::error(f64::NAN, ep_tol, missing.clone()),
-                    ));
+                    out.push((format!("e_p_Tv{name}"), Metric::error(f64::NAN, ep_tol, missing.clone())));
                     if last {
-                        out.push((
-                            format!("p_rms_error_Tv{name}"),
-                            Metric::error(f64::NAN, rms_tol, missing.clone()),
-                        ));
-                        out.push((
-                            format!("settlement_rel_error_Tv{name}"),
-                            Metric::error(f64::NAN, s_tol, missing),
-                        ));
+                        out.push((format!("p_rms_error_Tv{name}"), Metric::error(f64::NAN, rms_tol, missing.clone())));
+                        out.push((format!("settlement_rel_error_Tv{name}"), Metric::error(f64::NAN, s_tol, missing)));
                     }
                 }
             }
@@ -434,23 +332,16 @@ pub struct HarmonicCheck {
 }
 
 impl HarmonicCheck {
-    fn new(
-        col: Column,
-        omega: f64,
-        end: f64,
-        periods: usize,
-        tolerance: f64,
-    ) -> Result<HarmonicCheck, String> {
+    fn new(col: Column, omega: f64, end: f64, periods: usize, tolerance: f64) -> Result<HarmonicCheck, String> {
         if col.inv_q <= 0.0 {
-            return Err(
-                "the harmonic column needs a compressible pore fluid (finite water_bulk_modulus)"
-                    .into(),
-            );
+            return Err("the harmonic column needs a compressible pore fluid (finite water_bulk_modulus)".into());
         }
         let period = 2.0 * std::f64::consts::PI / omega;
         let start = end - periods as f64 * period;
         if start <= 0.0 {
-            return Err(format!("the run ({end} s) is shorter than the {periods} measured load periods ({period:.4e} s each)"));
+            return Err(format!(
+                "the run ({end} s) is shorter than the {periods} measured load periods ({period:.4e} s each)"
+            ));
         }
         let theory = biot_harmonic::BiotColumn {
             height: col.height,
@@ -465,15 +356,7 @@ impl HarmonicCheck {
             load_amplitude: col.load,
         }
         .solve()?;
-        Ok(HarmonicCheck {
-            col,
-            omega,
-            window: (start, end),
-            tolerance,
-            theory,
-            sums: Vec::new(),
-            weight: 0.0,
-        })
+        Ok(HarmonicCheck { col, omega, window: (start, end), tolerance, theory, sums: Vec::new(), weight: 0.0 })
     }
 }
 
@@ -486,22 +369,14 @@ impl Check for HarmonicCheck {
         vec![self.window.0]
     }
 
-    fn observe(
-        &mut self,
-        t: f64,
-        dt: f64,
-        model: &Model,
-        _coll: &Collective,
-    ) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, dt: f64, model: &Model, _coll: &Collective) -> Result<Vec<f64>, String> {
         if self.sums.len() != model.particles.len() {
             self.sums = vec![(0.0, 0.0); model.particles.len()];
         }
         // Right-endpoint sums (the window vanishes at both ends, so this is the trapezoidal rule).
         if t > self.window.0 + 1e-9 * dt && t <= self.window.1 + 1e-9 * dt {
             let tw = self.window.1 - self.window.0;
-            let w = (std::f64::consts::PI * (t - self.window.0) / tw)
-                .sin()
-                .powi(2);
+            let w = (std::f64::consts::PI * (t - self.window.0) / tw).sin().powi(2);
             self.weight += w * dt;
             let (c, s) = ((self.omega * t).cos(), (self.omega * t).sin());
             for k in self.col.particles(model) {
@@ -522,20 +397,14 @@ impl Check for HarmonicCheck {
             .particles(model)
             .flat_map(|k| {
                 let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
-                [
-                    self.col.top - model.particles.x0[k][1],
-                    norm * (c * c + s * s).sqrt(),
-                ]
+                [self.col.top - model.particles.x0[k][1], norm * (c * c + s * s).sqrt()]
             })
             .collect();
         let all = coll.gather(&local)?;
         // Average the particles at the same depth.
         let mut rows: Vec<(f64, f64, usize)> = Vec::new();
         for d in all.chunks(2) {
-            match rows
-                .iter_mut()
-                .find(|r| (r.0 - d[0]).abs() < 1e-9 * self.col.height)
-            {
+            match rows.iter_mut().find(|r| (r.0 - d[0]).abs() < 1e-9 * self.col.height) {
                 Some(r) => {
                     r.1 += d[1];
                     r.2 += 1;
@@ -545,38 +414,153 @@ impl Check for HarmonicCheck {
         }
         rows.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
         let q = self.col.load;
-        let table: Vec<Vec<f64>> = rows
-            .iter()
-            .map(|r| {
-                vec![
-                    r.0,
-                    r.1 / r.2 as f64 / q,
-                    self.theory.pressure_amplitude(r.0) / q,
-                ]
-            })
-            .collect();
+        let table: Vec<Vec<f64>> =
+            rows.iter().map(|r| vec![r.0, r.1 / r.2 as f64 / q, self.theory.pressure_amplitude(r.0) / q]).collect();
         let peak = table.iter().map(|r| r[2]).fold(0.0, f64::max);
-        let (worst, at) = table
-            .iter()
-            .map(|r| ((r[1] - r[2]).abs(), r[0]))
-            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+        let (worst, at) =
+            table.iter().map(|r| ((r[1] - r[2]).abs(), r[0])).fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
         let err = worst / peak;
         let metric = Metric::error(
             err,
             self.tolerance,
-            format!("largest |A - A*| = {worst:.4e} q at depth {at:.3} m; peak A* = {peak:.4e} q; ω = {:.4e} rad/s", self.omega),
+            format!(
+                "largest |A - A*| = {worst:.4e} q at depth {at:.3} m; peak A* = {peak:.4e} q; ω = {:.4e} rad/s",
+                self.omega
+            ),
         );
         Ok((
             vec![("p_amplitude_max_rel_error".into(), metric)],
             vec![Table {
                 name: "amplitude_profile.csv".into(),
-                header: vec![
-                    "depth_m",
-                    "computed_p_amplitude_over_q",
-                    "analytical_p_amplitude_over_q",
-                ],
+                header: vec!["depth_m", "computed_p_amplitude_over_q", "analytical_p_amplitude_over_q"],
                 rows: table,
             }],
+        ))
+    }
+}
+
+/// The value of a load's time function at time `t` (1 without one).
+fn load_factor(c: &Case, load: &str, t: f64) -> f64 {
+    c.load(load)
+        .and_then(|l| l.time_function())
+        .and_then(|n| c.time_function(n))
+        .map_or(1.0, |f| crate::model::loads::TimeFn::from_case(f).eval(t))
+}
+
+/// Elastic column under self-weight and surcharge (one-phase), checked against the static solution
+/// at the end of the run: σ_yy = −(ρ g d + q) at initial depth d, settlement ρ g H²/(2E_c) + q H/E_c
+/// (small strain), the settlement measured as (Σ V₀ − Σ V)/width like Terzaghi's.
+pub struct ElasticColumnCheck {
+    body: u16,
+    top: f64,
+    width: f64,
+    density: f64,
+    gravity: f64,
+    surcharge: f64,
+    settlement: f64,
+    tolerances: (f64, f64),
+    volume0: f64,
+    last_settlement: f64,
+}
+
+impl ElasticColumnCheck {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        c: &Case,
+        model: &Model,
+        coll: &Collective,
+        body: &str,
+        gravity: &str,
+        surcharge: Option<&str>,
+        stress_tol: f64,
+        settle_tol: f64,
+    ) -> Result<ElasticColumnCheck, String> {
+        let bi = c.bodies.iter().position(|b| b.name == body).ok_or(format!("no body `{body}`"))?;
+        let (lo, hi) = c.bodies[bi].shape.bounds();
+        let mat = &model.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
+        let end = c.end_time();
+        let g = match c.load(gravity) {
+            Some(Load::BodyForce { acceleration, .. }) => acceleration[1].abs() * load_factor(c, gravity, end),
+            _ => return Err(format!("`{gravity}` is not a body force")),
+        };
+        let q = match surcharge.map(|s| (s, c.load(s))) {
+            Some((s, Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }))) => {
+                traction[1].abs() * load_factor(c, s, end)
+            }
+            Some((s, _)) => return Err(format!("`{s}` is not a traction")),
+            None => 0.0,
+        };
+        let density = mat.mixture_density(mat.porosity);
+        let ec = mat.model.elastic().constrained_modulus();
+        let height = hi[1] - lo[1];
+        let v0: f64 = (0..model.particles.len())
+            .filter(|&k| model.particles.body[k] as usize == bi)
+            .map(|k| model.particles.volume[k])
+            .sum();
+        Ok(ElasticColumnCheck {
+            body: bi as u16,
+            top: hi[1],
+            width: hi[0] - lo[0],
+            density,
+            gravity: g,
+            surcharge: q,
+            settlement: density * g * height * height / (2.0 * ec) + q * height / ec,
+            tolerances: (stress_tol, settle_tol),
+            volume0: coll.sum(&[v0])?[0],
+            last_settlement: 0.0,
+        })
+    }
+}
+
+impl Check for ElasticColumnCheck {
+    fn columns(&self) -> Vec<String> {
+        vec!["column.settlement".into()]
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn observe(&mut self, _t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+        let v: f64 = (0..model.particles.len())
+            .filter(|&k| model.particles.body[k] == self.body)
+            .map(|k| model.particles.volume[k])
+            .sum();
+        self.last_settlement = (self.volume0 - coll.sum(&[v])?[0]) / self.width;
+        Ok(vec![self.last_settlement])
+    }
+
+    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
+        let ps = &model.particles;
+        let local: Vec<f64> = (0..ps.len())
+            .filter(|&k| ps.body[k] == self.body)
+            .flat_map(|k| [self.top - ps.x0[k][1], ps.stress[k][1]])
+            .collect();
+        let all = coll.gather(&local)?;
+        let exact = |d: f64| -(self.density * self.gravity * d + self.surcharge);
+        let peak = all.chunks(2).map(|d| exact(d[0]).abs()).fold(0.0, f64::max);
+        let worst = all.chunks(2).map(|d| (d[1] - exact(d[0])).abs()).fold(0.0, f64::max);
+        let s = self.last_settlement;
+        Ok((
+            vec![
+                (
+                    "stress_max_rel_error".into(),
+                    Metric::error(
+                        worst / peak,
+                        self.tolerances.0,
+                        format!("max |σ_yy − σ*| = {worst:.4e} Pa; max |σ*| = {peak:.4e} Pa"),
+                    ),
+                ),
+                (
+                    "settlement_rel_error".into(),
+                    Metric::error(
+                        (s - self.settlement).abs() / self.settlement,
+                        self.tolerances.1,
+                        format!("settlement {s:.6e} m vs static {:.6e} m", self.settlement),
+                    ),
+                ),
+            ],
+            Vec::new(),
         ))
     }
 }
@@ -587,11 +571,12 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::Terzaghi { time_factors, .. } => {
             format!("Terzaghi consolidation at T_v = {time_factors:?}")
         }
-        Verification::HarmonicColumn {
-            measure_periods, ..
-        } => format!("harmonic column (Zienkiewicz et al. 1980), last {measure_periods} periods"),
+        Verification::HarmonicColumn { measure_periods, .. } => {
+            format!("harmonic column (Zienkiewicz et al. 1980), last {measure_periods} periods")
+        }
         Verification::ShockWave { probe_depth, .. } => {
             format!("shock-wave arrival at {probe_depth} m depth")
         }
+        Verification::ElasticColumn { .. } => "static elastic column under self-weight and surcharge".into(),
     }
 }

@@ -21,11 +21,7 @@ use crate::model::Model;
 /// that noise before an arrival is never taken for one.
 pub fn pick_arrival(samples: &[(f64, f64)], t0: f64, t1: f64) -> Option<f64> {
     let scale = samples.iter().map(|s| s.1.abs()).fold(0.0, f64::max);
-    let win: Vec<(f64, f64)> = samples
-        .iter()
-        .copied()
-        .filter(|s| s.0 >= t0 && s.0 <= t1)
-        .collect();
+    let win: Vec<(f64, f64)> = samples.iter().copied().filter(|s| s.0 >= t0 && s.0 <= t1).collect();
     if win.len() < 4 {
         return None;
     }
@@ -40,11 +36,7 @@ pub fn pick_arrival(samples: &[(f64, f64)], t0: f64, t1: f64) -> Option<f64> {
     let rising = after > before;
     for w in win.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let crossed = if rising {
-            a.1 < mid && b.1 >= mid
-        } else {
-            a.1 > mid && b.1 <= mid
-        };
+        let crossed = if rising { a.1 < mid && b.1 >= mid } else { a.1 > mid && b.1 <= mid };
         if crossed {
             return Some(a.0 + (mid - a.1) / (b.1 - a.1) * (b.0 - a.0));
         }
@@ -79,25 +71,13 @@ impl ShockCheck {
             .particles(model)
             .flat_map(|k| {
                 let x = model.particles.x0[k];
-                [
-                    ((x[0] - target[0]).powi(2) + (x[1] - target[1]).powi(2)).sqrt(),
-                    model.particles.id[k] as f64,
-                    x[1],
-                ]
+                [((x[0] - target[0]).powi(2) + (x[1] - target[1]).powi(2)).sqrt(), model.particles.id[k] as f64, x[1]]
             })
             .collect();
         let all = coll.gather(&local)?;
-        let best = all.chunks(3).min_by(|a, b| {
-            a[0].partial_cmp(&b[0])
-                .unwrap()
-                .then(a[1].partial_cmp(&b[1]).unwrap())
-        });
+        let best = all.chunks(3).min_by(|a, b| a[0].partial_cmp(&b[0]).unwrap().then(a[1].partial_cmp(&b[1]).unwrap()));
         let best = best.ok_or("the shock-wave column has no particles")?;
-        let q_mod = if col.inv_q > 0.0 {
-            1.0 / col.inv_q
-        } else {
-            f64::INFINITY
-        };
+        let q_mod = if col.inv_q > 0.0 { 1.0 / col.inv_q } else { f64::INFINITY };
         let rho = (1.0 - col.porosity) * col.solid_density + col.porosity * col.water_density;
         let fast_speed = super::waves::undrained_wave_speed(col.constrained_modulus, q_mod, rho);
         let slow_speed = super::waves::damped_wave_speed(
@@ -133,13 +113,7 @@ impl Check for ShockCheck {
         Vec::new()
     }
 
-    fn observe(
-        &mut self,
-        t: f64,
-        _dt: f64,
-        model: &Model,
-        coll: &Collective,
-    ) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let local: f64 = (0..model.particles.len())
             .filter(|&k| model.particles.id[k] == self.probe)
             .map(|k| model.particles.p[k])
@@ -168,11 +142,7 @@ impl Check for ShockCheck {
                         self.depth, self.fast_speed
                     ),
                 ),
-                None => Metric::error(
-                    f64::NAN,
-                    tf,
-                    "no fast front found in p(t) (run too short?)".into(),
-                ),
+                None => Metric::error(f64::NAN, tf, "no fast front found in p(t) (run too short?)".into()),
             },
         ));
         if self.slow_expected {
@@ -213,11 +183,7 @@ mod tests {
                 let t = i as f64 * 1e-6;
                 let x = (t - t0) / 3e-6;
                 let step = 0.5 * (1.0 + (x).tanh());
-                let ring = if x > 2.0 {
-                    0.15 * (x * 1.3).sin() * (-(x - 2.0) / 20.0).exp()
-                } else {
-                    0.0
-                };
+                let ring = if x > 2.0 { 0.15 * (x * 1.3).sin() * (-(x - 2.0) / 20.0).exp() } else { 0.0 };
                 (t, 0.5 * (step + ring))
             })
             .collect();
@@ -225,10 +191,7 @@ mod tests {
         assert!((t - t0).abs() < 1e-6, "picked {t}");
         assert!(pick_arrival(&samples[..3], 0.0, 1.0).is_none());
         // Before the front there is only noise: no arrival.
-        let noisy: Vec<(f64, f64)> = samples
-            .iter()
-            .map(|&(t, p)| (t, p + 1e-6 * (t * 1e7).sin()))
-            .collect();
+        let noisy: Vec<(f64, f64)> = samples.iter().map(|&(t, p)| (t, p + 1e-6 * (t * 1e7).sin())).collect();
         assert!(pick_arrival(&noisy, 0.0, 1.5e-4).is_none());
     }
 }

@@ -42,15 +42,7 @@ impl Terzaghi {
         conductivity: f64,
         water_unit_weight: f64,
     ) -> Self {
-        Self {
-            load,
-            height,
-            constrained_modulus,
-            inv_q,
-            conductivity,
-            water_unit_weight,
-            terms: DEFAULT_TERMS,
-        }
+        Self { load, height, constrained_modulus, inv_q, conductivity, water_unit_weight, terms: DEFAULT_TERMS }
     }
 
     /// Checks that all parameters are finite and physically admissible, and returns a description of the first
@@ -71,10 +63,7 @@ impl Terzaghi {
             }
         }
         if !(self.inv_q.is_finite() && self.inv_q >= 0.0) {
-            return Err(format!(
-                "inv_q must be non-negative and finite, got {}",
-                self.inv_q
-            ));
+            return Err(format!("inv_q must be non-negative and finite, got {}", self.inv_q));
         }
         Ok(())
     }
@@ -110,11 +99,7 @@ impl Terzaghi {
         let z = depth.clamp(0.0, self.height);
         let tv = self.time_factor(t);
         if tv <= 0.0 {
-            return if z > 0.0 {
-                self.initial_pressure()
-            } else {
-                0.0
-            };
+            return if z > 0.0 { self.initial_pressure() } else { 0.0 };
         }
         let zeta = z / self.height;
         let mut sum = 0.0;
@@ -157,8 +142,7 @@ impl Terzaghi {
     /// settlement `s_∞ = q H / E_c` and the undrained settlement `s_u = (q − p0) H / E_c` ([003] Eqs. 31–32).
     pub fn settlement(&self, t: f64) -> f64 {
         let s_final = self.load * self.height / self.constrained_modulus;
-        let s_undrained =
-            (self.load - self.initial_pressure()) * self.height / self.constrained_modulus;
+        let s_undrained = (self.load - self.initial_pressure()) * self.height / self.constrained_modulus;
         s_undrained + (s_final - s_undrained) * self.degree_of_consolidation(t)
     }
 }
@@ -279,10 +263,7 @@ mod tests {
         for tv in [1e-14, 1e-12, 1e-10] {
             // U vanishes like 2√(T_v/π); a plainly truncated series would stay near 2/(π² terms) ≈ 1e-3 instead.
             let u = t.degree_of_consolidation(t.time_for(tv));
-            assert!(
-                u > 0.0 && u < 1.01 * 2.0 * (tv / PI).sqrt(),
-                "U({tv}) = {u}"
-            );
+            assert!(u > 0.0 && u < 1.01 * 2.0 * (tv / PI).sqrt(), "U({tv}) = {u}");
         }
         let u3 = t.degree_of_consolidation(t.time_for(3.0));
         assert!((1.0 - u3).abs() < 1e-3, "U(3) = {u3}");
@@ -310,10 +291,7 @@ mod tests {
         println!("worst deviation for T_v ≤ 0.05: {worst_early:e}");
         assert!(worst < 1e-4, "worst deviation {worst}");
         // Below T_v = 0.05 the short-time formula itself is exact to about 3e-11, so this bounds the series error.
-        assert!(
-            worst_early < 1e-8,
-            "worst deviation for T_v <= 0.05: {worst_early}"
-        );
+        assert!(worst_early < 1e-8, "worst deviation for T_v <= 0.05: {worst_early}");
     }
 
     #[test]
@@ -325,33 +303,20 @@ mod tests {
             let integral = simpson(|z| t.pressure(z, time), 0.0, t.height, 2000);
             let u_quadrature = 1.0 - integral / (p0 * t.height);
             let u = t.degree_of_consolidation(time);
-            assert!(
-                (u - u_quadrature).abs() < 1e-6,
-                "T_v = {tv}: U = {u}, quadrature {u_quadrature}"
-            );
+            assert!((u - u_quadrature).abs() < 1e-6, "T_v = {tv}: U = {u}, quadrature {u_quadrature}");
         }
     }
 
     #[test]
     fn settlement_matches_effective_stress_integral() {
         let t = layer();
-        assert!(
-            (t.settlement(0.0)
-                - (t.load - t.initial_pressure()) * t.height / t.constrained_modulus)
-                .abs()
-                < 1e-15
-        );
+        assert!((t.settlement(0.0) - (t.load - t.initial_pressure()) * t.height / t.constrained_modulus).abs() < 1e-15);
         let s_final = t.load * t.height / t.constrained_modulus;
         assert!((t.settlement(t.time_for(50.0)) - s_final).abs() < 1e-12 * s_final);
         for tv in [0.05, 0.3] {
             let time = t.time_for(tv);
             // The vertical effective stress is q − p, so the strain is (q − p)/E_c.
-            let s = simpson(
-                |z| (t.load - t.pressure(z, time)) / t.constrained_modulus,
-                0.0,
-                t.height,
-                2000,
-            );
+            let s = simpson(|z| (t.load - t.pressure(z, time)) / t.constrained_modulus, 0.0, t.height, 2000);
             assert!((t.settlement(time) - s).abs() < 1e-6 * s_final);
         }
     }
@@ -366,9 +331,7 @@ mod tests {
         for zeta in [0.1, 0.3, 0.5, 0.7, 0.9] {
             let z = zeta * t.height;
             let p_t = (t.pressure(z, time + dt) - t.pressure(z, time - dt)) / (2.0 * dt);
-            let p_zz = (t.pressure(z + dz, time) - 2.0 * t.pressure(z, time)
-                + t.pressure(z - dz, time))
-                / (dz * dz);
+            let p_zz = (t.pressure(z + dz, time) - 2.0 * t.pressure(z, time) + t.pressure(z - dz, time)) / (dz * dz);
             let residual = (p_t - cv * p_zz).abs() / (p_t.abs() + (cv * p_zz).abs());
             assert!(residual < 1e-4, "z/H = {zeta}: residual {residual}");
         }
@@ -397,10 +360,7 @@ mod tests {
         ];
         for (x, erfc) in reference {
             let value = erfcx(x) * (-x * x).exp();
-            assert!(
-                (value - erfc).abs() < 1e-10 * erfc,
-                "erfc({x}) = {value}, expected {erfc}"
-            );
+            assert!((value - erfc).abs() < 1e-10 * erfc, "erfc({x}) = {value}, expected {erfc}");
         }
         // Continuity at the switch between the two evaluation methods.
         assert!((erfcx(2.5 - 1e-12) - erfcx(2.5)).abs() < 1e-10);

@@ -51,16 +51,10 @@ pub fn biot_wave_speeds_without_drag(
 /// This expression does not depend on the solid density; it equals the slow no-drag root of
 /// [`biot_wave_speeds_without_drag`] only under the dynamic compatibility condition described in the module
 /// documentation.
-pub fn damped_wave_speed(
-    constrained_modulus: f64,
-    water_bulk_modulus: f64,
-    porosity: f64,
-    water_density: f64,
-) -> f64 {
+pub fn damped_wave_speed(constrained_modulus: f64, water_bulk_modulus: f64, porosity: f64, water_density: f64) -> f64 {
     let n = porosity;
     (water_bulk_modulus / water_density).sqrt()
-        * (n * constrained_modulus / ((1.0 - n) * water_bulk_modulus + n * constrained_modulus))
-            .sqrt()
+        * (n * constrained_modulus / ((1.0 - n) * water_bulk_modulus + n * constrained_modulus)).sqrt()
 }
 
 #[cfg(test)]
@@ -95,10 +89,8 @@ mod tests {
 
     #[test]
     fn no_drag_roots_solve_the_characteristic_equation() {
-        for (ec, q, n, rho_s, rho_w) in [
-            (5.0e9, 5.0e9, 0.4, 2666.7, 1000.0),
-            (1.0e8, 2.2e9 / 0.3, 0.3, 2650.0, 1000.0),
-        ] {
+        for (ec, q, n, rho_s, rho_w) in [(5.0e9, 5.0e9, 0.4, 2666.7, 1000.0), (1.0e8, 2.2e9 / 0.3, 0.3, 2650.0, 1000.0)]
+        {
             let (fast, slow) = biot_wave_speeds_without_drag(ec, q, n, rho_s, rho_w);
             assert!(fast > slow && slow > 0.0);
             assert!(characteristic(ec, q, n, rho_s, rho_w, fast).abs() < 1e-10);
@@ -137,14 +129,8 @@ mod tests {
         let (fast, slow) = biot_wave_speeds_without_drag(ec_compatible, q, n, rho_s, rho_w);
         let damped = damped_wave_speed(ec_compatible, kw, n, rho_w);
         let undrained = undrained_wave_speed(ec_compatible, q, rho);
-        assert!(
-            (slow - damped).abs() < 1e-9 * slow,
-            "slow {slow}, Eq. 35 {damped}"
-        );
-        assert!(
-            (fast - undrained).abs() < 1e-9 * fast,
-            "fast {fast}, undrained {undrained}"
-        );
+        assert!((slow - damped).abs() < 1e-9 * slow, "slow {slow}, Eq. 35 {damped}");
+        assert!((fast - undrained).abs() < 1e-9 * fast, "fast {fast}, undrained {undrained}");
         assert!((slow * slow - n * ec_compatible / ((1.0 - n) * rho_s)).abs() < 1e-9 * slow * slow);
     }
 }

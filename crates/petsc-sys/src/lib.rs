@@ -7,13 +7,7 @@
 //! The cfg flags `petsc_have_mumps`, `petsc_have_hypre`, `petsc_have_superlu_dist`,
 //! `petsc_have_suitesparse` and `petsc_have_hdf5` are set by the build script from `petscconf.h`; [`EXTERNAL_PACKAGES`] lists
 //! the same information at run time.
-#![allow(
-    non_upper_case_globals,
-    non_camel_case_types,
-    non_snake_case,
-    dead_code,
-    improper_ctypes
-)]
+#![allow(non_upper_case_globals, non_camel_case_types, non_snake_case, dead_code, improper_ctypes)]
 #![allow(clippy::all)]
 
 include!(concat!(env!("OUT_DIR"), "/bindings.rs"));

@@ -46,8 +46,7 @@ impl GhostedRange {
 
     /// Local (ghosted) node number of global node (i, j); `None` outside the block.
     pub fn node(&self, i: usize, j: usize) -> Option<usize> {
-        self.contains(i, j)
-            .then(|| (j - self.start[1]) * self.count[0] + (i - self.start[0]))
+        self.contains(i, j).then(|| (j - self.start[1]) * self.count[0] + (i - self.start[0]))
     }
 
     /// Number of nodes in the block.
@@ -62,10 +61,7 @@ impl GhostedRange {
 
     /// Global node (i, j) of local node `l`.
     pub fn ij(&self, l: usize) -> (usize, usize) {
-        (
-            self.start[0] + l % self.count[0],
-            self.start[1] + l / self.count[0],
-        )
+        (self.start[0] + l % self.count[0], self.start[1] + l / self.count[0])
     }
 }
 
@@ -87,12 +83,7 @@ impl DmDa {
     /// A 2D grid of `nodes[0] × nodes[1]` nodes with `field_names.len()` interlaced dofs per node,
     /// a box stencil of width `stencil_width`, and non-periodic boundaries. Matrices created from it
     /// are only preallocated (no zeros are stored), so their structure is what assembly puts in.
-    pub fn new_2d(
-        comm: Comm,
-        nodes: [usize; 2],
-        stencil_width: usize,
-        field_names: &[&str],
-    ) -> Result<DmDa> {
+    pub fn new_2d(comm: Comm, nodes: [usize; 2], stencil_width: usize, field_names: &[&str]) -> Result<DmDa> {
         if field_names.is_empty() {
             return Err(Error::new("a DMDA needs at least one field"));
         }
@@ -120,33 +111,21 @@ impl DmDa {
                 stencil_width,
                 owned_start: [0; 2],
                 owned_count: [0; 2],
-                ghosted: GhostedRange {
-                    start: [0; 2],
-                    count: [0; 2],
-                    dof: field_names.len(),
-                },
+                ghosted: GhostedRange { start: [0; 2], count: [0; 2], dof: field_names.len() },
             },
             local_to_global: Vec::new(),
         };
-        call!(DMSetMatrixPreallocateOnly(
-            dm.raw,
-            sys::PetscBool::PETSC_TRUE
-        ))?;
+        call!(DMSetMatrixPreallocateOnly(dm.raw, sys::PetscBool::PETSC_TRUE))?;
         call!(DMSetUp(dm.raw))?;
         for (k, name) in field_names.iter().enumerate() {
             let c = cstring(name)?;
             call!(DMDASetFieldName(dm.raw, k as Int, c.as_ptr()))?;
         }
-        let (mut xs, mut ys, mut zs, mut xm, mut ym, mut zm): (Int, Int, Int, Int, Int, Int) =
-            (0, 0, 0, 0, 0, 0);
-        call!(DMDAGetCorners(
-            dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm
-        ))?;
+        let (mut xs, mut ys, mut zs, mut xm, mut ym, mut zm): (Int, Int, Int, Int, Int, Int) = (0, 0, 0, 0, 0, 0);
+        call!(DMDAGetCorners(dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm))?;
         dm.info.owned_start = [xs as usize, ys as usize];
         dm.info.owned_count = [xm as usize, ym as usize];
-        call!(DMDAGetGhostCorners(
-            dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm
-        ))?;
+        call!(DMDAGetGhostCorners(dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm))?;
         dm.info.ghosted.start = [xs as usize, ys as usize];
         dm.info.ghosted.count = [xm as usize, ym as usize];
         let mut ltog = std::ptr::null_mut();
@@ -197,14 +176,8 @@ impl DmDa {
         // SAFETY: PETSc returns arrays of length m (x) and n (y).
         let (x, y) = unsafe {
             (
-                std::slice::from_raw_parts(lx, m as usize)
-                    .iter()
-                    .map(|&v| v as usize)
-                    .collect(),
-                std::slice::from_raw_parts(ly, n as usize)
-                    .iter()
-                    .map(|&v| v as usize)
-                    .collect(),
+                std::slice::from_raw_parts(lx, m as usize).iter().map(|&v| v as usize).collect(),
+                std::slice::from_raw_parts(ly, n as usize).iter().map(|&v| v as usize).collect(),
             )
         };
         Ok((x, y))
@@ -226,34 +199,14 @@ impl DmDa {
 
     /// Copies owned values of `global` and fills ghosts from their owners into `local`.
     pub fn global_to_local(&self, global: &dyn VecOps, local: &mut Vector) -> Result<()> {
-        call!(DMGlobalToLocalBegin(
-            self.raw,
-            global.raw(),
-            sys::InsertMode::INSERT_VALUES,
-            local.raw()
-        ))?;
-        call!(DMGlobalToLocalEnd(
-            self.raw,
-            global.raw(),
-            sys::InsertMode::INSERT_VALUES,
-            local.raw()
-        ))
+        call!(DMGlobalToLocalBegin(self.raw, global.raw(), sys::InsertMode::INSERT_VALUES, local.raw()))?;
+        call!(DMGlobalToLocalEnd(self.raw, global.raw(), sys::InsertMode::INSERT_VALUES, local.raw()))
     }
 
     /// Adds every local entry (ghosts included) into `global`; entries on ghosts go to their owners.
     pub fn local_to_global_add(&self, local: &Vector, global: &mut dyn VecOps) -> Result<()> {
-        call!(DMLocalToGlobalBegin(
-            self.raw,
-            local.raw(),
-            sys::InsertMode::ADD_VALUES,
-            global.raw()
-        ))?;
-        call!(DMLocalToGlobalEnd(
-            self.raw,
-            local.raw(),
-            sys::InsertMode::ADD_VALUES,
-            global.raw()
-        ))
+        call!(DMLocalToGlobalBegin(self.raw, local.raw(), sys::InsertMode::ADD_VALUES, global.raw()))?;
+        call!(DMLocalToGlobalEnd(self.raw, local.raw(), sys::InsertMode::ADD_VALUES, global.raw()))
     }
 
     /// A new AIJ matrix preallocated for the grid's box stencil, with the local-to-global mapping
@@ -265,11 +218,7 @@ impl DmDa {
         let m = Mat { raw };
         // PETSc 3.18's DMDA matrix creation leaves MAT_SORTED_FULL on when it only preallocates;
         // with it, every MatSetValues call replaces the whole row instead of adding to it.
-        call!(MatSetOption(
-            m.raw,
-            sys::MatOption::MAT_SORTED_FULL,
-            sys::PetscBool::PETSC_FALSE
-        ))?;
+        call!(MatSetOption(m.raw, sys::MatOption::MAT_SORTED_FULL, sys::PetscBool::PETSC_FALSE))?;
         Ok(m)
     }
 

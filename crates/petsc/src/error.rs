@@ -33,10 +33,7 @@ pub type Result<T> = std::result::Result<T, Error>;
 impl Error {
     /// An error raised on the Rust side of the binding (bad argument, failed conversion).
     pub fn new(message: impl Into<String>) -> Self {
-        Error {
-            code: sys::PETSC_ERR_ARG_WRONG as i32,
-            message: message.into(),
-        }
+        Error { code: sys::PETSC_ERR_ARG_WRONG as i32, message: message.into() }
     }
 }
 
@@ -61,9 +58,7 @@ fn generic_message(code: i32) -> String {
     let rc = unsafe { sys::PetscErrorMessage(code, &mut text, std::ptr::null_mut()) };
     if rc == 0 && !text.is_null() {
         // SAFETY: PETSc returned a pointer to a NUL-terminated static string.
-        unsafe { CStr::from_ptr(text) }
-            .to_string_lossy()
-            .into_owned()
+        unsafe { CStr::from_ptr(text) }.to_string_lossy().into_owned()
     } else {
         format!("PETSc error code {code}")
     }
@@ -98,10 +93,7 @@ pub(crate) unsafe extern "C" fn record_error(
             String::new()
         } else {
             // SAFETY: PETSc passes NUL-terminated strings.
-            unsafe { CStr::from_ptr(p) }
-                .to_string_lossy()
-                .trim()
-                .to_string()
+            unsafe { CStr::from_ptr(p) }.to_string_lossy().trim().to_string()
         }
     };
     if kind == sys::PetscErrorType::PETSC_ERROR_INITIAL {
@@ -110,11 +102,7 @@ pub(crate) unsafe extern "C" fn record_error(
             msg = generic_message(code);
         }
         let f = text(func);
-        let full = if f.is_empty() {
-            msg
-        } else {
-            format!("{f}(): {msg} [{}:{line}]", text(file))
-        };
+        let full = if f.is_empty() { msg } else { format!("{f}(): {msg} [{}:{line}]", text(file)) };
         set_pending(full);
     } else {
         PENDING.with(|p| {

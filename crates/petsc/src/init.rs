@@ -19,18 +19,9 @@ impl PetscBuild {
     pub fn get() -> PetscBuild {
         let (mut major, mut minor, mut sub, mut patch) = (0, 0, 0, 0);
         // SAFETY: PetscGetVersionNumber only writes four integers; it needs no initialisation.
-        let rc =
-            unsafe { sys::PetscGetVersionNumber(&mut major, &mut minor, &mut sub, &mut patch) };
-        let version = if rc == 0 {
-            format!("{major}.{minor}.{sub}")
-        } else {
-            "unknown".into()
-        };
-        let packages = sys::EXTERNAL_PACKAGES
-            .iter()
-            .filter(|(_, have)| *have)
-            .map(|(n, _)| *n)
-            .collect();
+        let rc = unsafe { sys::PetscGetVersionNumber(&mut major, &mut minor, &mut sub, &mut patch) };
+        let version = if rc == 0 { format!("{major}.{minor}.{sub}") } else { "unknown".into() };
+        let packages = sys::EXTERNAL_PACKAGES.iter().filter(|(_, have)| *have).map(|(n, _)| *n).collect();
         PetscBuild { version, packages }
     }
 }
@@ -53,38 +44,24 @@ impl Petsc {
     /// `["-ksp_type", "gmres"]`); they reach PETSc's options database unchanged. `options_file`, if
     /// given, is read first, so command-line options override it. The file must exist (checked here,
     /// so that a missing file is a clear error rather than a PETSc traceback).
-    pub fn initialize(
-        petsc_args: &[String],
-        options_file: Option<&Path>,
-        help: &str,
-    ) -> Result<Petsc> {
+    pub fn initialize(petsc_args: &[String], options_file: Option<&Path>, help: &str) -> Result<Petsc> {
         if let Some(f) = options_file {
             if !f.is_file() {
-                return Err(Error::new(format!(
-                    "PETSc options file {} does not exist",
-                    f.display()
-                )));
+                return Err(Error::new(format!("PETSc options file {} does not exist", f.display())));
             }
         }
         let universe = mpi::initialize().ok_or_else(|| {
-            Error::new(
-                "MPI is already initialised in this process; PETSc can be initialised only once",
-            )
+            Error::new("MPI is already initialised in this process; PETSc can be initialised only once")
         })?;
         let mut argv: Vec<CString> = vec![cstring("porompm")?];
         for a in petsc_args {
             argv.push(cstring(a)?);
         }
-        let mut argv_ptrs: Box<[*mut c_char]> = argv
-            .iter()
-            .map(|c| c.as_ptr() as *mut c_char)
-            .chain(std::iter::once(std::ptr::null_mut()))
-            .collect();
+        let mut argv_ptrs: Box<[*mut c_char]> =
+            argv.iter().map(|c| c.as_ptr() as *mut c_char).chain(std::iter::once(std::ptr::null_mut())).collect();
         let mut argc = argv.len() as i32;
         let mut argv_p = argv_ptrs.as_mut_ptr();
-        let file = options_file
-            .map(|p| cstring(&p.to_string_lossy()))
-            .transpose()?;
+        let file = options_file.map(|p| cstring(&p.to_string_lossy())).transpose()?;
         let help = cstring(help)?;
         // SAFETY: argc/argv describe NUL-terminated strings owned by `argv`, which lives as long as
         // the returned guard (PETSc keeps the pointers). The file and help strings outlive the call.
@@ -98,21 +75,11 @@ impl Petsc {
         };
         if rc != 0 {
             drop(universe);
-            return Err(Error {
-                code: rc,
-                message: format!("PetscInitialize failed (PETSc error {rc})"),
-            });
+            return Err(Error { code: rc, message: format!("PetscInitialize failed (PETSc error {rc})") });
         }
-        let guard = Petsc {
-            _argv: argv,
-            _argv_ptrs: argv_ptrs,
-            universe: Some(universe),
-        };
+        let guard = Petsc { _argv: argv, _argv_ptrs: argv_ptrs, universe: Some(universe) };
         // From here on PETSc errors are recorded, not printed.
-        call!(PetscPushErrorHandler(
-            Some(error::record_error),
-            std::ptr::null_mut()
-        ))?;
+        call!(PetscPushErrorHandler(Some(error::record_error), std::ptr::null_mut()))?;
         Ok(guard)
     }
 
@@ -123,9 +90,7 @@ impl Petsc {
 
     /// The rsmpi universe (for MPI operations outside PETSc).
     pub fn universe(&self) -> &mpi::environment::Universe {
-        self.universe
-            .as_ref()
-            .expect("universe lives as long as the guard")
+        self.universe.as_ref().expect("universe lives as long as the guard")
     }
 }
 

@@ -42,11 +42,7 @@ impl IndexSet {
         let mut p: *const Int = std::ptr::null();
         call!(ISGetIndices(self.raw, &mut p))?;
         // SAFETY: ISGetIndices returned `n` indices, valid until ISRestoreIndices.
-        let v = if n == 0 {
-            Vec::new()
-        } else {
-            unsafe { std::slice::from_raw_parts(p, n) }.to_vec()
-        };
+        let v = if n == 0 { Vec::new() } else { unsafe { std::slice::from_raw_parts(p, n) }.to_vec() };
         call!(ISRestoreIndices(self.raw, &mut p))?;
         Ok(v)
     }

@@ -68,12 +68,7 @@ pub trait KspOps {
     }
 
     /// Relative, absolute and divergence tolerances and the iteration limit (`None` keeps PETSc's).
-    fn set_tolerances(
-        &mut self,
-        rtol: Option<Real>,
-        atol: Option<Real>,
-        max_it: Option<usize>,
-    ) -> Result<()> {
+    fn set_tolerances(&mut self, rtol: Option<Real>, atol: Option<Real>, max_it: Option<usize>) -> Result<()> {
         let d = sys::PETSC_DEFAULT as Real;
         call!(KSPSetTolerances(
             self.raw(),
@@ -98,10 +93,7 @@ pub trait KspOps {
     fn pc(&mut self) -> Result<PcRef<'_>> {
         let mut pc = std::ptr::null_mut();
         call!(KSPGetPC(self.raw(), &mut pc))?;
-        Ok(PcRef {
-            raw: pc,
-            _life: PhantomData,
-        })
+        Ok(PcRef { raw: pc, _life: PhantomData })
     }
 
     /// Solves `A x = b`.
@@ -118,11 +110,7 @@ pub trait KspOps {
         call!(KSPGetIterationNumber(self.raw(), &mut its))?;
         let mut text: *const c_char = std::ptr::null();
         call!(KSPGetConvergedReasonString(self.raw(), &mut text))?;
-        Ok(LinearSolve {
-            reason: reason.0,
-            reason_text: c_str(text),
-            iterations: its as usize,
-        })
+        Ok(LinearSolve { reason: reason.0, reason_text: c_str(text), iterations: its as usize })
     }
 }
 
@@ -156,10 +144,7 @@ impl Ksp {
 
 impl KspRef<'_> {
     pub(crate) fn new(raw: sys::KSP) -> Self {
-        KspRef {
-            raw,
-            _life: PhantomData,
-        }
+        KspRef { raw, _life: PhantomData }
     }
 }
 

@@ -18,10 +18,7 @@ pub struct MatRef<'a> {
 
 impl MatRef<'_> {
     pub(crate) fn new(raw: sys::Mat) -> Self {
-        MatRef {
-            raw,
-            _life: PhantomData,
-        }
+        MatRef { raw, _life: PhantomData }
     }
 }
 
@@ -64,15 +61,9 @@ pub trait MatOps {
     /// Negative indices are ignored by PETSc (used for constrained dofs).
     fn set_values(&mut self, rows: &[Int], cols: &[Int], vals: &[Real], add: bool) -> Result<()> {
         if rows.len() * cols.len() != vals.len() {
-            return Err(Error::new(
-                "MatSetValues: block size does not match index arrays",
-            ));
+            return Err(Error::new("MatSetValues: block size does not match index arrays"));
         }
-        let mode = if add {
-            sys::InsertMode::ADD_VALUES
-        } else {
-            sys::InsertMode::INSERT_VALUES
-        };
+        let mode = if add { sys::InsertMode::ADD_VALUES } else { sys::InsertMode::INSERT_VALUES };
         call!(MatSetValues(
             self.raw(),
             rows.len() as Int,
@@ -86,23 +77,11 @@ pub trait MatOps {
 
     /// As [`MatOps::set_values`], with indices in the local (ghosted) numbering of the matrix's
     /// local-to-global mapping (set by `DMCreateMatrix`).
-    fn set_values_local(
-        &mut self,
-        rows: &[Int],
-        cols: &[Int],
-        vals: &[Real],
-        add: bool,
-    ) -> Result<()> {
+    fn set_values_local(&mut self, rows: &[Int], cols: &[Int], vals: &[Real], add: bool) -> Result<()> {
         if rows.len() * cols.len() != vals.len() {
-            return Err(Error::new(
-                "MatSetValuesLocal: block size does not match index arrays",
-            ));
+            return Err(Error::new("MatSetValuesLocal: block size does not match index arrays"));
         }
-        let mode = if add {
-            sys::InsertMode::ADD_VALUES
-        } else {
-            sys::InsertMode::INSERT_VALUES
-        };
+        let mode = if add { sys::InsertMode::ADD_VALUES } else { sys::InsertMode::INSERT_VALUES };
         call!(MatSetValuesLocal(
             self.raw(),
             rows.len() as Int,
@@ -116,14 +95,8 @@ pub trait MatOps {
 
     /// Final assembly (communicates off-rank entries, compresses storage).
     fn assemble(&mut self) -> Result<()> {
-        call!(MatAssemblyBegin(
-            self.raw(),
-            sys::MatAssemblyType::MAT_FINAL_ASSEMBLY
-        ))?;
-        call!(MatAssemblyEnd(
-            self.raw(),
-            sys::MatAssemblyType::MAT_FINAL_ASSEMBLY
-        ))
+        call!(MatAssemblyBegin(self.raw(), sys::MatAssemblyType::MAT_FINAL_ASSEMBLY))?;
+        call!(MatAssemblyEnd(self.raw(), sys::MatAssemblyType::MAT_FINAL_ASSEMBLY))
     }
 
     /// Zeroes all stored entries (keeps the structure).
@@ -165,25 +138,13 @@ pub trait MatOps {
             let mut nz: Int = 0;
             let mut cols: *const Int = std::ptr::null();
             let mut vals: *const Real = std::ptr::null();
-            call!(MatGetRow(
-                self.raw(),
-                r as Int,
-                &mut nz,
-                &mut cols,
-                &mut vals
-            ))?;
+            call!(MatGetRow(self.raw(), r as Int, &mut nz, &mut cols, &mut vals))?;
             for k in 0..nz as usize {
                 // SAFETY: MatGetRow returned `nz` column indices and values, valid until MatRestoreRow.
                 let (c, v) = unsafe { (*cols.add(k), *vals.add(k)) };
                 out[(r - lo) * ncols + c as usize] = v;
             }
-            call!(MatRestoreRow(
-                self.raw(),
-                r as Int,
-                &mut nz,
-                &mut cols,
-                &mut vals
-            ))?;
+            call!(MatRestoreRow(self.raw(), r as Int, &mut nz, &mut cols, &mut vals))?;
         }
         Ok((lo, out))
     }
@@ -191,15 +152,8 @@ pub trait MatOps {
     /// Nonzeros and memory, summed over ranks.
     fn stats(&self) -> Result<MatStats> {
         let mut info = sys::MatInfo::default();
-        call!(MatGetInfo(
-            self.raw(),
-            sys::MatInfoType::MAT_GLOBAL_SUM,
-            &mut info
-        ))?;
-        Ok(MatStats {
-            nonzeros: info.nz_used,
-            memory_bytes: info.memory,
-        })
+        call!(MatGetInfo(self.raw(), sys::MatInfoType::MAT_GLOBAL_SUM, &mut info))?;
+        Ok(MatStats { nonzeros: info.nz_used, memory_bytes: info.memory })
     }
 
     /// Gives the matrix a name.
@@ -223,37 +177,17 @@ impl MatOps for MatRef<'_> {
 impl Mat {
     /// A distributed AIJ matrix with `rows` local rows (of `global_rows`) and per-row preallocation
     /// for the diagonal (`d_nnz`) and off-diagonal (`o_nnz`) blocks of this rank.
-    pub fn new_aij(
-        comm: Comm,
-        local_rows: usize,
-        global_rows: usize,
-        d_nnz: &[Int],
-        o_nnz: &[Int],
-    ) -> Result<Mat> {
+    pub fn new_aij(comm: Comm, local_rows: usize, global_rows: usize, d_nnz: &[Int], o_nnz: &[Int]) -> Result<Mat> {
         if d_nnz.len() != local_rows || o_nnz.len() != local_rows {
-            return Err(Error::new(
-                "Mat::new_aij: preallocation arrays must have one entry per local row",
-            ));
+            return Err(Error::new("Mat::new_aij: preallocation arrays must have one entry per local row"));
         }
         let mut raw = std::ptr::null_mut();
         call!(MatCreate(comm.raw(), &mut raw))?;
         let m = Mat { raw };
-        call!(MatSetSizes(
-            m.raw,
-            local_rows as Int,
-            local_rows as Int,
-            global_rows as Int,
-            global_rows as Int
-        ))?;
+        call!(MatSetSizes(m.raw, local_rows as Int, local_rows as Int, global_rows as Int, global_rows as Int))?;
         call!(MatSetType(m.raw, sys::MATAIJ.as_ptr() as *const _))?;
         call!(MatSeqAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr()))?;
-        call!(MatMPIAIJSetPreallocation(
-            m.raw,
-            0,
-            d_nnz.as_ptr(),
-            0,
-            o_nnz.as_ptr()
-        ))?;
+        call!(MatMPIAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()))?;
         Ok(m)
     }
 

@@ -45,22 +45,14 @@ fn c_text(p: *const c_char) -> Option<String> {
 impl Options {
     /// The default (global) options database.
     pub fn global() -> Options {
-        Options {
-            raw: std::ptr::null_mut(),
-            owned: false,
-            pushed: false,
-        }
+        Options { raw: std::ptr::null_mut(), owned: false, pushed: false }
     }
 
     /// A new, empty, private database.
     pub fn new() -> Result<Options> {
         let mut raw = std::ptr::null_mut();
         call!(PetscOptionsCreate(&mut raw))?;
-        Ok(Options {
-            raw,
-            owned: true,
-            pushed: false,
-        })
+        Ok(Options { raw, owned: true, pushed: false })
     }
 
     /// Inserts options from a string in command-line form (`"-ksp_type cg -pc_type jacobi"`).
@@ -73,29 +65,17 @@ impl Options {
     /// A missing file is an error naming the file.
     pub fn insert_file(&self, comm: Comm, path: &Path) -> Result<()> {
         if !path.is_file() {
-            return Err(Error::new(format!(
-                "PETSc options file {} does not exist",
-                path.display()
-            )));
+            return Err(Error::new(format!("PETSc options file {} does not exist", path.display())));
         }
         let c = cstring(&path.to_string_lossy())?;
-        call!(PetscOptionsInsertFile(
-            comm.raw(),
-            self.raw,
-            c.as_ptr(),
-            sys::PetscBool::PETSC_TRUE
-        ))
+        call!(PetscOptionsInsertFile(comm.raw(), self.raw, c.as_ptr(), sys::PetscBool::PETSC_TRUE))
     }
 
     /// Sets one option (`name` with its leading dash), with or without a value.
     pub fn set_value(&self, name: &str, value: Option<&str>) -> Result<()> {
         let n = cstring(name)?;
         let v = value.map(cstring).transpose()?;
-        call!(PetscOptionsSetValue(
-            self.raw,
-            n.as_ptr(),
-            v.as_ref().map_or(std::ptr::null(), |v| v.as_ptr())
-        ))
+        call!(PetscOptionsSetValue(self.raw, n.as_ptr(), v.as_ref().map_or(std::ptr::null(), |v| v.as_ptr())))
     }
 
     /// Removes one option (`name` with its leading dash).
@@ -108,12 +88,7 @@ impl Options {
     pub fn has_name(&self, name: &str) -> Result<bool> {
         let n = cstring(name)?;
         let mut set = sys::PetscBool::PETSC_FALSE;
-        call!(PetscOptionsHasName(
-            self.raw,
-            std::ptr::null(),
-            n.as_ptr(),
-            &mut set
-        ))?;
+        call!(PetscOptionsHasName(self.raw, std::ptr::null(), n.as_ptr(), &mut set))?;
         Ok(from_bool(set))
     }
 
@@ -122,14 +97,7 @@ impl Options {
         let n = cstring(name)?;
         let mut buf = vec![0 as c_char; 4096];
         let mut set = sys::PetscBool::PETSC_FALSE;
-        call!(PetscOptionsGetString(
-            self.raw,
-            std::ptr::null(),
-            n.as_ptr(),
-            buf.as_mut_ptr(),
-            buf.len(),
-            &mut set
-        ))?;
+        call!(PetscOptionsGetString(self.raw, std::ptr::null(), n.as_ptr(), buf.as_mut_ptr(), buf.len(), &mut set))?;
         if !from_bool(set) {
             return Ok(None);
         }
@@ -144,12 +112,7 @@ impl Options {
         // SAFETY: PetscOptionsGetAll allocated the string with PetscMalloc; PetscTrFree releases it.
         unsafe {
             if let Some(free) = sys::PetscTrFree {
-                free(
-                    p as *mut _,
-                    line!() as i32,
-                    c"Options::all".as_ptr(),
-                    c"options.rs".as_ptr(),
-                );
+                free(p as *mut _, line!() as i32, c"Options::all".as_ptr(), c"options.rs".as_ptr());
             }
         }
         Ok(parse_option_string(&text))
@@ -160,27 +123,14 @@ impl Options {
         let mut n: sys::PetscInt = 0;
         let mut names: *mut *mut c_char = std::ptr::null_mut();
         let mut values: *mut *mut c_char = std::ptr::null_mut();
-        call!(PetscOptionsLeftGet(
-            self.raw,
-            &mut n,
-            &mut names,
-            &mut values
-        ))?;
+        call!(PetscOptionsLeftGet(self.raw, &mut n, &mut names, &mut values))?;
         let mut out = Vec::with_capacity(n as usize);
         for i in 0..n as usize {
             // SAFETY: PETSc returned arrays of `n` string pointers (values may be null).
             let (name, value) = unsafe { (c_text(*names.add(i)), c_text(*values.add(i))) };
-            out.push(OptionEntry {
-                name: name.unwrap_or_default(),
-                value,
-            });
+            out.push(OptionEntry { name: name.unwrap_or_default(), value });
         }
-        call!(PetscOptionsLeftRestore(
-            self.raw,
-            &mut n,
-            &mut names,
-            &mut values
-        ))?;
+        call!(PetscOptionsLeftRestore(self.raw, &mut n, &mut names, &mut values))?;
         Ok(out)
     }
 
@@ -221,10 +171,7 @@ pub fn parse_option_string(text: &str) -> Vec<OptionEntry> {
     for tok in text.split_whitespace() {
         let is_name = tok.starts_with('-') && tok.len() > 1 && tok.parse::<f64>().is_err();
         if is_name {
-            out.push(OptionEntry {
-                name: tok[1..].to_string(),
-                value: None,
-            });
+            out.push(OptionEntry { name: tok[1..].to_string(), value: None });
         } else if let Some(last) = out.last_mut() {
             last.value = Some(match last.value.take() {
                 Some(v) => format!("{v} {tok}"),
@@ -241,23 +188,10 @@ mod tests {
 
     #[test]
     fn option_strings_split_into_names_and_values() {
-        let v =
-            parse_option_string("-ksp_type gmres -snes_monitor -snes_lag_jacobian -2 -pc_type lu");
+        let v = parse_option_string("-ksp_type gmres -snes_monitor -snes_lag_jacobian -2 -pc_type lu");
         assert_eq!(v.len(), 4);
-        assert_eq!(
-            v[0],
-            OptionEntry {
-                name: "ksp_type".into(),
-                value: Some("gmres".into())
-            }
-        );
-        assert_eq!(
-            v[1],
-            OptionEntry {
-                name: "snes_monitor".into(),
-                value: None
-            }
-        );
+        assert_eq!(v[0], OptionEntry { name: "ksp_type".into(), value: Some("gmres".into()) });
+        assert_eq!(v[1], OptionEntry { name: "snes_monitor".into(), value: None });
         assert_eq!(v[2].value.as_deref(), Some("-2"));
         assert_eq!(v[3].to_string(), "-pc_type lu");
     }

@@ -119,9 +119,7 @@ unsafe extern "C" fn residual_trampoline(
     }
     // SAFETY: `ctx` points to the Context living on the stack of `Snes::solve` during the solve.
     let ctx = unsafe { &mut *(ctx as *mut Context) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
-        ctx.problem.residual(&VecRef::new(x), &mut VecRef::new(f))
-    }));
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.residual(&VecRef::new(x), &mut VecRef::new(f))));
     finish(outcome, "residual evaluation", ctx, || {
         // SAFETY: valid SNES handle passed by PETSc.
         unsafe { sys::SNESSetFunctionDomainError(snes) };
@@ -141,9 +139,7 @@ unsafe extern "C" fn jacobian_trampoline(
     }
     // SAFETY: as in `residual_trampoline`.
     let ctx = unsafe { &mut *(ctx as *mut Context) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
-        ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a))
-    }));
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a))));
     finish(outcome, "Jacobian assembly", ctx, || {
         // SAFETY: valid SNES handle passed by PETSc.
         unsafe { sys::SNESSetJacobianDomainError(snes) };
@@ -155,11 +151,8 @@ impl Snes {
     pub fn new(comm: Comm) -> Result<Snes> {
         let mut raw = std::ptr::null_mut();
         call!(SNESCreate(comm.raw(), &mut raw))?;
-        let mut s = Snes {
-            raw,
-            history: vec![0.0; 1000].into_boxed_slice(),
-            history_its: vec![0; 1000].into_boxed_slice(),
-        };
+        let mut s =
+            Snes { raw, history: vec![0.0; 1000].into_boxed_slice(), history_its: vec![0; 1000].into_boxed_slice() };
         call!(SNESSetConvergenceHistory(
             s.raw,
             s.history.as_mut_ptr(),
@@ -212,9 +205,7 @@ impl Snes {
     pub fn tolerances(&self) -> Result<(Real, Real, Real, usize)> {
         let (mut a, mut r, mut s) = (0.0, 0.0, 0.0);
         let (mut it, mut mf): (Int, Int) = (0, 0);
-        call!(SNESGetTolerances(
-            self.raw, &mut a, &mut r, &mut s, &mut it, &mut mf
-        ))?;
+        call!(SNESGetTolerances(self.raw, &mut a, &mut r, &mut s, &mut it, &mut mf))?;
         Ok((a, r, s, it as usize))
     }
 
@@ -252,11 +243,7 @@ impl Snes {
         let mut t: sys::SNESType = std::ptr::null();
         call!(SNESGetType(self.raw, &mut t))?;
         // SAFETY: PETSc returns a NUL-terminated static string.
-        Ok(if t.is_null() {
-            String::new()
-        } else {
-            unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned()
-        })
+        Ok(if t.is_null() { String::new() } else { unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned() })
     }
 
     /// Prints the solver configuration (what `-snes_view` prints).
@@ -268,45 +255,17 @@ impl Snes {
     ///
     /// Solver failures that PETSc reports as divergence (line search, iteration limit, domain
     /// error) come back as `Ok` with `converged == false`; only genuine errors are `Err`.
-    pub fn solve(
-        &mut self,
-        x: &mut Vector,
-        jac: &mut Mat,
-        problem: &mut dyn NonlinearProblem,
-    ) -> Result<SolveOutcome> {
-        let mut ctx = Context {
-            problem,
-            domain_error: None,
-        };
+    pub fn solve(&mut self, x: &mut Vector, jac: &mut Mat, problem: &mut dyn NonlinearProblem) -> Result<SolveOutcome> {
+        let mut ctx = Context { problem, domain_error: None };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
-        call!(SNESSetFunction(
-            self.raw,
-            std::ptr::null_mut(),
-            Some(residual_trampoline),
-            ctx_ptr
-        ))?;
-        call!(SNESSetJacobian(
-            self.raw,
-            jac.raw,
-            jac.raw,
-            Some(jacobian_trampoline),
-            ctx_ptr
-        ))?;
+        call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), ctx_ptr))?;
+        call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), ctx_ptr))?;
         let solved = call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()));
         // Never leave a pointer to this stack frame inside the SNES.
-        let unset_f = call!(SNESSetFunction(
-            self.raw,
-            std::ptr::null_mut(),
-            Some(residual_trampoline),
-            std::ptr::null_mut()
-        ));
-        let unset_j = call!(SNESSetJacobian(
-            self.raw,
-            jac.raw,
-            jac.raw,
-            Some(jacobian_trampoline),
-            std::ptr::null_mut()
-        ));
+        let unset_f =
+            call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), std::ptr::null_mut()));
+        let unset_j =
+            call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), std::ptr::null_mut()));
         solved?;
         unset_f?;
         unset_j?;
@@ -316,13 +275,8 @@ impl Snes {
         let mut text: *const c_char = std::ptr::null();
         call!(SNESGetConvergedReasonString(self.raw, &mut text))?;
         // SAFETY: PETSc returns a NUL-terminated static string.
-        let reason_text = if text.is_null() {
-            String::new()
-        } else {
-            unsafe { CStr::from_ptr(text) }
-                .to_string_lossy()
-                .into_owned()
-        };
+        let reason_text =
+            if text.is_null() { String::new() } else { unsafe { CStr::from_ptr(text) }.to_string_lossy().into_owned() };
         let mut its: Int = 0;
         call!(SNESGetIterationNumber(self.raw, &mut its))?;
         let mut lits: Int = 0;
@@ -330,12 +284,7 @@ impl Snes {
         let mut hist: *mut Real = std::ptr::null_mut();
         let mut hist_its: *mut Int = std::ptr::null_mut();
         let mut nhist: Int = 0;
-        call!(SNESGetConvergenceHistory(
-            self.raw,
-            &mut hist,
-            &mut hist_its,
-            &mut nhist
-        ))?;
+        call!(SNESGetConvergenceHistory(self.raw, &mut hist, &mut hist_its, &mut nhist))?;
         let n = (nhist.max(0) as usize).min(self.history.len());
         Ok(SolveOutcome {
             converged: reason.0 > 0,

@@ -19,10 +19,7 @@ pub struct VecRef<'a> {
 
 impl VecRef<'_> {
     pub(crate) fn new(raw: sys::Vec) -> Self {
-        VecRef {
-            raw,
-            _life: PhantomData,
-        }
+        VecRef { raw, _life: PhantomData }
     }
 }
 
@@ -131,22 +128,10 @@ pub trait VecOps {
     /// Sets (or adds) entries by global index; call [`VecOps::assemble`] afterwards.
     fn set_values(&mut self, idx: &[Int], vals: &[Real], add: bool) -> Result<()> {
         if idx.len() != vals.len() {
-            return Err(Error::new(
-                "VecSetValues: index and value arrays differ in length",
-            ));
+            return Err(Error::new("VecSetValues: index and value arrays differ in length"));
         }
-        let mode = if add {
-            sys::InsertMode::ADD_VALUES
-        } else {
-            sys::InsertMode::INSERT_VALUES
-        };
-        call!(VecSetValues(
-            self.raw(),
-            idx.len() as Int,
-            idx.as_ptr(),
-            vals.as_ptr(),
-            mode
-        ))
+        let mode = if add { sys::InsertMode::ADD_VALUES } else { sys::InsertMode::INSERT_VALUES };
+        call!(VecSetValues(self.raw(), idx.len() as Int, idx.as_ptr(), vals.as_ptr(), mode))
     }
 
     /// Completes `set_values` (communicates off-rank entries).
@@ -203,12 +188,7 @@ pub trait VecOps {
         let mut ptr: *const Real = std::ptr::null();
         call!(VecGetArrayRead(self.raw(), &mut ptr))?;
         let len = self.local_size()?;
-        Ok(ArrayRead {
-            vec: self.raw(),
-            ptr,
-            len,
-            _life: PhantomData,
-        })
+        Ok(ArrayRead { vec: self.raw(), ptr, len, _life: PhantomData })
     }
 
     /// Mutable access to this rank's entries.
@@ -216,12 +196,7 @@ pub trait VecOps {
         let mut ptr: *mut Real = std::ptr::null_mut();
         call!(VecGetArray(self.raw(), &mut ptr))?;
         let len = self.local_size()?;
-        Ok(ArrayMut {
-            vec: self.raw(),
-            ptr,
-            len,
-            _life: PhantomData,
-        })
+        Ok(ArrayMut { vec: self.raw(), ptr, len, _life: PhantomData })
     }
 
     /// Gives the vector a name (shown by viewers).

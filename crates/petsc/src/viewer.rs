@@ -14,10 +14,7 @@ impl Viewer {
     /// The ASCII viewer on standard output of `comm` (what `-snes_view` uses).
     pub fn stdout(comm: Comm) -> Viewer {
         // SAFETY: returns PETSc's persistent viewer for the communicator (not to be destroyed).
-        Viewer {
-            raw: unsafe { sys::PETSC_VIEWER_STDOUT_(comm.raw()) },
-            owned: false,
-        }
+        Viewer { raw: unsafe { sys::PETSC_VIEWER_STDOUT_(comm.raw()) }, owned: false }
     }
 
     /// An ASCII viewer writing to `path`.

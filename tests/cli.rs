@@ -1,0 +1,329 @@
+//! Command-line behaviour: `--version`, `check`, bad input (one clear line, exit code 2, never a
+//! panic or a PETSc traceback), a run that fails cleanly, MPI start-up under `mpirun -n 2`, and the
+//! block-by-block finite-difference check of the assembled tangent. Every test runs the real
+//! binary in its own process (PETSc and MPI can be initialised once per process).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_porompm")
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn porompm(args: &[&str]) -> Output {
+    Command::new(bin()).args(args).current_dir(root()).output().expect("the porompm binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Bad input ends with exit code 2 and exactly one line on stderr, `error: ...` containing `needle`.
+fn assert_one_line_error(o: &Output, needle: &str) {
+    let err = stderr(o);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(o.status.code(), Some(2), "exit code of bad input; stderr:\n{err}");
+    assert_eq!(lines.len(), 1, "one line expected, got:\n{err}");
+    assert!(lines[0].starts_with("error: "), "{err}");
+    assert!(lines[0].contains(needle), "`{needle}` not in: {err}");
+    assert!(!err.contains("panicked") && !err.contains("PETSC ERROR") && !err.contains("[0]PETSC"), "{err}");
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json exists");
+    serde_json::from_str(&text).expect("summary.json is valid JSON")
+}
+
+#[test]
+fn version_shows_petsc_318_with_mumps_and_hypre() {
+    let o = porompm(&["--version"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("PETSc 3.18."), "{text}");
+    assert!(text.contains("mumps") && text.contains("hypre"), "{text}");
+    assert!(text.contains("git "), "{text}");
+}
+
+#[test]
+fn check_describes_what_the_case_builds() {
+    let o = porompm(&["check", "cases/terzaghi.toml"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "5 dofs per node: ux, uy, p, Ux, Uy",
+        "material points: 40",
+        "unknowns of the first step: 60",
+        "particle traction on 2",
+        "Terzaghi",
+    ] {
+        assert!(text.contains(want), "`{want}` missing in:\n{text}");
+    }
+    // Overrides change what is built.
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "grid.cells=[1,20]"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("material points: 80"));
+}
+
+#[test]
+fn a_missing_case_file_is_one_clear_error() {
+    let o = porompm(&["run", "cases/no_such_case.toml", "--out", out_dir("missing").to_str().unwrap()]);
+    assert_one_line_error(&o, "cannot read cases/no_such_case.toml");
+}
+
+#[test]
+fn an_unknown_key_is_named() {
+    let dir = out_dir("unknown_key");
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("case.toml");
+    let text = std::fs::read_to_string(root().join("cases/terzaghi.toml"))
+        .unwrap()
+        .replace("porosity = 0.3", "porosity = 0.3\nporosty = 0.3");
+    std::fs::write(&case, text).unwrap();
+    let o = porompm(&["run", case.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap()]);
+    assert_one_line_error(&o, "key `materials[0].porosty`: unknown field `porosty`");
+    // The same through --set.
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "stages[0].tdt=1e-3"]);
+    assert_one_line_error(&o, "--set stages[0].tdt");
+}
+
+#[test]
+fn an_out_of_range_value_is_named_with_its_range() {
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        out_dir("range").to_str().unwrap(),
+        "--set",
+        "materials.soil.porosity=1.5",
+    ]);
+    assert_one_line_error(&o, "key `materials[0].porosity`: must be in (0, 1), got 1.5");
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "materials.soil.hydraulic_conductivity=-1e-3"]);
+    assert_one_line_error(&o, "hydraulic_conductivity`: must be a positive number");
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "time_integration.gamma=0.4"]);
+    assert_one_line_error(&o, "not unconditionally stable");
+}
+
+#[test]
+fn particles_outside_the_grid_are_refused() {
+    let o = porompm(&[
+        "check",
+        "cases/terzaghi.toml",
+        "--set",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.1,1.2]}}",
+    ]);
+    assert_one_line_error(&o, "reaches outside the grid");
+}
+
+#[test]
+fn a_missing_options_file_is_one_clear_error() {
+    let dir = out_dir("options_missing");
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--options-file",
+        "petsc_options/nope.opts",
+    ]);
+    assert_one_line_error(&o, "PETSc options file petsc_options/nope.opts does not exist");
+    assert!(!dir.join("summary.json").exists(), "nothing is written for input that fails before the run");
+}
+
+#[test]
+fn an_unused_petsc_option_fails_the_run_and_says_which() {
+    let dir = out_dir("unused_option");
+    let o =
+        porompm(&["run", "cases/terzaghi.toml", "--out", dir.to_str().unwrap(), "--quiet", "--", "-ksp_tyep", "gmres"]);
+    assert_one_line_error(&o, "-ksp_tyep gmres");
+    let s = summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("not used"));
+}
+
+#[test]
+fn a_malformed_override_is_one_clear_error() {
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "grid.cells"]);
+    assert_one_line_error(&o, "expected KEY=VALUE");
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "materials.clay.porosity=0.3"]);
+    assert_one_line_error(&o, "no element named `clay`");
+}
+
+#[test]
+fn a_completed_run_writes_its_summary_and_history() {
+    let dir = out_dir("completed");
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "stages[0].duration=0.01",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&dir);
+    assert_eq!(s["status"], "completed");
+    assert_eq!(s["steps"], 10);
+    for key in [
+        "wall_time_s",
+        "snes_iterations",
+        "ksp_iterations",
+        "dofs",
+        "particles",
+        "ranks",
+        "petsc_options",
+        "timings",
+        "verification",
+    ] {
+        assert!(s.get(key).is_some(), "summary lacks `{key}`");
+    }
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    assert_eq!(history.lines().count(), 12, "header, t = 0 and ten steps");
+    assert!(history.starts_with("time,step,dt,newton_iterations,linear_iterations,base.x"));
+}
+
+#[test]
+fn a_step_that_never_converges_is_cut_then_the_run_fails_cleanly() {
+    let dir = out_dir("diverges");
+    // One Newton iteration can never meet an unattainable tolerance.
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--",
+        "-snes_max_it",
+        "1",
+        "-snes_rtol",
+        "1e-300",
+        "-snes_stol",
+        "0",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("did not converge after 4 cuts of Δt (last Δt = 6.250e-5 s)"), "{err}");
+    let s = summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert_eq!(s["step_cuts"], 5);
+    assert_eq!(s["steps"], 0);
+    // What was written stays readable: the header and the initial state.
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    assert_eq!(history.lines().count(), 2);
+}
+
+fn mpirun(n: usize, args: &[&str]) -> Option<Output> {
+    let which = Command::new("mpirun").arg("--version").output().ok()?;
+    if !which.status.success() {
+        return None;
+    }
+    let np = n.to_string();
+    let mut all = vec!["--oversubscribe", "-n", np.as_str(), bin()];
+    all.extend_from_slice(args);
+    Some(
+        Command::new("mpirun")
+            .args(&all)
+            .current_dir(root())
+            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .output()
+            .expect("mpirun runs"),
+    )
+}
+
+#[test]
+fn mpi_starts_with_two_ranks() {
+    let o = mpirun(2, &["info"]).expect("mpirun is installed by the set-up (openmpi-bin)");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(text.contains("ranks: 2"), "{text}");
+    assert!(text.contains("collective sum over ranks: 2"), "{text}");
+}
+
+#[test]
+fn terzaghi_on_two_ranks_matches_one_rank() {
+    let one = out_dir("terzaghi_1rank");
+    let two = out_dir("terzaghi_2ranks");
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        one.to_str().unwrap(),
+        "--quiet",
+        "--options-file",
+        "petsc_options/direct-lu.opts",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = mpirun(2, &["run", "cases/terzaghi.toml", "--out", two.to_str().unwrap(), "--quiet"]).expect("mpirun");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (s1, s2) = (summary(&one), summary(&two));
+    assert_eq!(s2["ranks"], 2);
+    assert_eq!(s1["particles"], s2["particles"]);
+    assert_eq!(s1["dofs"], s2["dofs"]);
+    for (name, m) in s1["verification"].as_object().unwrap() {
+        let (a, b) = (m["value"].as_f64().unwrap(), s2["verification"][name]["value"].as_f64().unwrap());
+        // Equal within solver tolerance (sums over particles run in another order on two ranks).
+        assert!((a - b).abs() <= 1e-6 * a.abs() + 1e-12, "{name}: {a} on one rank, {b} on two");
+    }
+}
+
+#[test]
+fn the_assembled_tangent_matches_finite_differences_block_by_block() {
+    // A small two-dimensional two-phase case: every block (ux, uy, p, Ux, Uy)² is exercised.
+    let o = porompm(&[
+        "test-jacobian",
+        "cases/terzaghi.toml",
+        "--steps",
+        "3",
+        "--set",
+        "grid.cells=[2,4]",
+        "--set",
+        "grid.size=[0.2,0.4]",
+        "--set",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.2,0.4]}}",
+        "--set",
+        "loads[0].region={min=[0.0,0.2],max=[0.2,0.4]}",
+        "--set",
+        "probes=[]",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}\n{}", stderr(&o));
+    assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 25, "{text}");
+    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+}
+
+#[test]
+fn the_one_phase_tangent_matches_finite_differences_too() {
+    let o = porompm(&[
+        "test-jacobian",
+        "cases/elastic_column.toml",
+        "--steps",
+        "5",
+        "--set",
+        "grid.cells=[2,6]",
+        "--set",
+        "grid.size=[0.1,0.3]",
+        "--set",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.1,0.3]}}",
+        "--set",
+        "loads.surcharge.region={min=[0.0,0.3],max=[0.1,0.3]}",
+        "--set",
+        "probes=[]",
+        "--set",
+        "stages[0].dt=0.05",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}\n{}", stderr(&o));
+    assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 4, "{text}");
+    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+}

@@ -1,0 +1,142 @@
+//! Verification against analytical solutions, with stated tolerances (the case files' targets):
+//! every case family runs with the default solver and with `direct-lu.opts` and
+//! `fieldsplit-schur.opts`, meets its targets with each, and the strategies agree on every metric
+//! within solver tolerance. Each run is the real binary in its own process.
+
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs a case and returns its summary; panics with the run's error if it did not complete.
+fn run(case: &str, label: &str, options: Option<&str>, sets: &[&str]) -> Value {
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("verification").join(label);
+    let _ = std::fs::remove_dir_all(&out);
+    let mut args = vec![
+        "run".to_string(),
+        format!("cases/{case}.toml"),
+        "--out".into(),
+        out.display().to_string(),
+        "--quiet".into(),
+    ];
+    if let Some(o) = options {
+        args.push("--options-file".into());
+        args.push(format!("petsc_options/{o}.opts"));
+    }
+    for s in sets {
+        args.push("--set".into());
+        args.push(s.to_string());
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_porompm")).args(&args).current_dir(root()).output().expect("porompm runs");
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).expect("summary.json")).expect("JSON");
+    assert!(o.status.success() && s["status"] == "completed", "{label}: {}", String::from_utf8_lossy(&o.stderr));
+    s
+}
+
+fn metrics(s: &Value) -> BTreeMap<String, (f64, bool, f64)> {
+    s["verification"]
+        .as_object()
+        .expect("verification metrics")
+        .iter()
+        .map(|(k, m)| {
+            (
+                k.clone(),
+                (
+                    m["value"].as_f64().unwrap_or(f64::NAN),
+                    m["pass"].as_bool().unwrap(),
+                    m["tolerance"].as_f64().unwrap(),
+                ),
+            )
+        })
+        .collect()
+}
+
+/// Runs `case` with the three strategies; every metric in `expected` must exist, meet its target
+/// with each strategy, and agree across strategies to `agree` (metrics are normalised errors, so an
+/// absolute bound is the solver tolerance carried through).
+fn family(case: &str, sets: &[&str], expected: &[&str], agree: f64) -> BTreeMap<String, (f64, bool, f64)> {
+    let reference = metrics(&run(case, &format!("{case}-default"), None, sets));
+    let names: Vec<&str> = reference.keys().map(String::as_str).collect();
+    assert_eq!(names, expected, "{case}: metric names");
+    for (name, (v, pass, tol)) in &reference {
+        assert!(*pass, "{case} (default solver): {name} = {v:e} exceeds {tol:e}");
+    }
+    for strategy in ["direct-lu", "fieldsplit-schur"] {
+        let m = metrics(&run(case, &format!("{case}-{strategy}"), Some(strategy), sets));
+        for (name, (v, pass, tol)) in &m {
+            assert!(*pass, "{case} ({strategy}): {name} = {v:e} exceeds {tol:e}");
+            let r = reference[name].0;
+            assert!((v - r).abs() <= agree, "{case}: {name} = {v:e} with {strategy}, {r:e} with the default");
+        }
+    }
+    reference
+}
+
+#[test]
+fn terzaghi_consolidation_meets_its_targets_with_every_strategy() {
+    let m =
+        family("terzaghi", &[], &["e_p_Tv0.1", "e_p_Tv0.5", "p_rms_error_Tv0.5", "settlement_rel_error_Tv0.5"], 1e-6);
+    // The target at 10 cells and Δt = 1e-3 s.
+    assert!(m["e_p_Tv0.1"].0 <= 1e-2 && m["e_p_Tv0.5"].0 <= 1e-2);
+}
+
+#[test]
+fn harmonic_column_zone1_meets_five_percent() {
+    let m = family("harmonic_column_zone1", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    assert!(m["p_amplitude_max_rel_error"].0 <= 0.05);
+}
+
+#[test]
+fn harmonic_column_zone2_meets_five_percent() {
+    let m = family("harmonic_column_zone2", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    assert!(m["p_amplitude_max_rel_error"].0 <= 0.05);
+}
+
+#[test]
+fn harmonic_column_zone3_meets_ten_percent() {
+    let m = family("harmonic_column_zone3", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    assert!(m["p_amplitude_max_rel_error"].0 <= 0.10);
+}
+
+#[test]
+fn shock_wave_at_high_permeability_shows_both_waves_on_time() {
+    let m = family("shock_wave", &[], &["fast_wave_arrival_rel_error", "slow_wave_arrival_rel_error"], 1e-5);
+    assert!(m["fast_wave_arrival_rel_error"].0 <= 0.02);
+    assert!(m["slow_wave_arrival_rel_error"].0 <= 0.05);
+}
+
+#[test]
+fn shock_wave_at_low_permeability_shows_the_fast_wave_only() {
+    let s = run("shock_wave", "shock_wave-k1e-5", None, &["materials.soil.hydraulic_conductivity=1e-5"]);
+    let m = metrics(&s);
+    assert!(m["fast_wave_arrival_rel_error"].1, "{m:?}");
+    assert!(m["fast_wave_arrival_rel_error"].0 <= 0.02);
+    assert!(!m.contains_key("slow_wave_arrival_rel_error"), "no slow wave is expected at k = 1e-5 m/s: {m:?}");
+}
+
+#[test]
+fn elastic_column_one_phase_two_stages_meets_the_static_solution() {
+    // One-phase (ux, uy) layout: the fieldsplit strategy, which splits the two-phase fields, does not
+    // apply; the direct ones must agree.
+    let reference = metrics(&run("elastic_column", "elastic_column-default", None, &[]));
+    assert_eq!(
+        reference.keys().map(String::as_str).collect::<Vec<_>>(),
+        ["settlement_rel_error", "stress_max_rel_error"]
+    );
+    for strategy in [None, Some("direct-lu"), Some("direct-ldlt")] {
+        let m = match strategy {
+            None => reference.clone(),
+            Some(s) => metrics(&run("elastic_column", &format!("elastic_column-{s}"), Some(s), &[])),
+        };
+        for (name, (v, pass, tol)) in &m {
+            assert!(*pass, "{strategy:?}: {name} = {v:e} exceeds {tol:e}");
+            assert!((v - reference[name].0).abs() <= 1e-6, "{strategy:?}: {name} differs");
+        }
+    }
+    assert!(reference["stress_max_rel_error"].0 <= 0.01 && reference["settlement_rel_error"].0 <= 0.01);
+}
