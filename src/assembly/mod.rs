@@ -461,19 +461,7 @@ impl GridSystem {
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
         let out = {
-            let GridSystem { dm, x, x_local, f_local, snes, jac, step, ndof, two_phase, stages, .. } = self;
-            let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("solve called before prepare_step"))?;
-            let mut asm = Assembler {
-                dm,
-                model,
-                step,
-                x_local,
-                f_local,
-                nd: *ndof,
-                two_phase: *two_phase,
-                seconds: &mut assembly_seconds,
-                stage: &stages.assembly,
-            };
+            let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
             snes.solve(x, jac, &mut asm)?
         };
         let solve_seconds = t0.elapsed().as_secs_f64();
@@ -489,6 +477,29 @@ impl GridSystem {
             assembly_seconds,
             solve_seconds,
         })
+    }
+
+    /// Splits the system into the SNES, its solution vector and matrix, and the callbacks of the
+    /// prepared step (which borrow the rest).
+    fn split<'a>(
+        &'a mut self,
+        model: &'a Model,
+        seconds: &'a mut f64,
+    ) -> Result<(&'a mut Snes, &'a mut Vector, &'a mut Mat, Assembler<'a>), Error> {
+        let GridSystem { dm, x, x_local, f_local, snes, jac, step, ndof, two_phase, stages, .. } = self;
+        let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("the step was not prepared"))?;
+        let asm = Assembler {
+            dm,
+            model,
+            step,
+            x_local,
+            f_local,
+            nd: *ndof,
+            two_phase: *two_phase,
+            seconds,
+            stage: &stages.assembly,
+        };
+        Ok((snes, x, jac, asm))
     }
 
     /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.
@@ -701,11 +712,6 @@ impl Collective {
     }
 }
 
-/// Whether component `c` of a node is the pore pressure.
-fn self_two_phase_p(two_phase: bool, c: usize) -> bool {
-    two_phase && c == kernels::dof::P
-}
-
 /// Agreement of one field-pair block of the assembled tangent with finite differences.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct BlockCheck {
@@ -731,7 +737,8 @@ impl GridSystem {
             return Err(petsc::Error::new("the finite-difference Jacobian check runs on one rank"));
         }
         let nd = self.ndof;
-        let names = crate::model::field_names(self.two_phase);
+        let two_phase = self.two_phase;
+        let names = crate::model::field_names(two_phase);
         // A realistic iterate: part of this step's converged increment.
         self.solve(model)?;
         let mut x = self.x.duplicate()?;
@@ -739,27 +746,15 @@ impl GridSystem {
         x.scale(fraction)?;
         let n = x.local_size()?;
         let free: Vec<usize> = (0..n).filter(|o| !self.step.owned_constrained.contains(o)).collect();
-        let GridSystem { dm, x_local, f_local, jac, step, stages, two_phase, .. } = self;
-        let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("jacobian_check called before prepare_step"))?;
         let mut seconds = 0.0;
-        let mut asm = Assembler {
-            dm,
-            model,
-            step,
-            x_local,
-            f_local,
-            nd,
-            two_phase: *two_phase,
-            seconds: &mut seconds,
-            stage: &stages.assembly,
-        };
+        let (_, _, jac, mut asm) = self.split(model, &mut seconds)?;
         asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
         let (_, dense) = jac.local_rows_dense()?;
         let xv = x.read()?.to_vec();
         // The finite-difference step of a dof follows the typical size of its kind of unknown:
         // displacements (ux, uy, Ux, Uy share one scale) or pore pressure, with floors of 1e-6 of a
         // cell (m) and 1 Pa when a kind is identically zero.
-        let is_p = |o: usize| self_two_phase_p(*two_phase, o % nd);
+        let is_p = |o: usize| two_phase && o % nd == kernels::dof::P;
         let (mut typ_u, mut typ_p) = (0.0f64, 0.0f64);
         for &o in &free {
             if is_p(o) {
