@@ -100,8 +100,8 @@ pub fn describe(case: &Case, label: &str) -> String {
             "stage `{}`: {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]",
             st.name,
             st.duration,
-            st.dt,
-            (st.duration / st.dt).ceil() as usize,
+            st.dt(),
+            (st.duration / st.dt()).ceil() as usize,
             a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
             a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", ")
         );

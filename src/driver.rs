@@ -218,11 +218,11 @@ pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<Vec<assembly::Blo
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
     for _ in 0..steps {
-        sim.newton_solve(&active, stage.dt)?.map_err(RunError::Failed)?;
-        sim.update_particles(stage.dt)?.map_err(RunError::Failed)?;
-        sim.t += stage.dt;
+        sim.newton_solve(&active, stage.dt())?.map_err(RunError::Failed)?;
+        sim.update_particles(stage.dt())?.map_err(RunError::Failed)?;
+        sim.t += stage.dt();
     }
-    sim.system.prepare_step(&sim.model, &active, sim.t + stage.dt, stage.dt).map_err(RunError::Failed)?;
+    sim.system.prepare_step(&sim.model, &active, sim.t + stage.dt(), stage.dt()).map_err(RunError::Failed)?;
     sim.system.jacobian_check(&sim.model, 0.7).map_err(|e| RunError::Failed(e.to_string()))
 }
 
@@ -279,7 +279,10 @@ impl<'a> Simulation<'a> {
         let mut control = StepControl::new(stage, self.stage_end(stage));
         self.progress(&format!(
             "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
-            stage.name, self.t, control.t_end, stage.dt
+            stage.name,
+            self.t,
+            control.t_end,
+            stage.dt()
         ));
         let mut next_report = self.t + stage.duration / 10.0;
         while !control.finished(self.t) {
@@ -302,7 +305,7 @@ impl<'a> Simulation<'a> {
                     } else {
                         self.observe_only(dt)?;
                     }
-                    if self.t >= next_report - 1e-9 * stage.dt {
+                    if self.t >= next_report - 1e-9 * stage.dt() {
                         self.progress(&format!("  t = {:.6e} s, step {}", self.t, self.step));
                         next_report += stage.duration / 10.0;
                     }
@@ -458,8 +461,8 @@ struct StepControl {
 impl StepControl {
     fn new(stage: &Stage, t_end: f64) -> StepControl {
         StepControl {
-            stage_dt: stage.dt,
-            dt: stage.dt,
+            stage_dt: stage.dt(),
+            dt: stage.dt(),
             cuts: 0,
             max_cuts: stage.max_step_cuts,
             factor: stage.cut_factor,
@@ -579,7 +582,7 @@ mod tests {
         Stage {
             name: "s".into(),
             duration: 1.0,
-            dt,
+            dt: Some(dt),
             boundaries: None,
             loads: None,
             max_step_cuts: cuts,

@@ -29,7 +29,7 @@ enum Command {
         /// PETSc options file(s), applied in order after the case's own and before the command line's.
         #[arg(long = "options-file", value_name = "FILE")]
         options_file: Vec<PathBuf>,
-        /// Override a case value by its dotted path, e.g. `--set stages[0].dt=5e-4`.
+        /// Override a case value by its dotted path, e.g. `--set time.dt=5e-4`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// No progress messages.

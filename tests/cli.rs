@@ -320,7 +320,7 @@ fn the_one_phase_tangent_matches_finite_differences_too() {
         "--set",
         "probes=[]",
         "--set",
-        "stages[0].dt=0.05",
+        "time.dt=0.05",
     ]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{text}\n{}", stderr(&o));

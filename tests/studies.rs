@@ -50,7 +50,7 @@ fn terzaghi_grid_refinement() {
         let mut previous: Option<f64> = None;
         let mut rms_all = Vec::new();
         for n in [10, 20, 40, 80] {
-            let s = run(&format!("refine-{dt}-{n}"), &[format!("grid.cells=[1,{n}]"), format!("stages[0].dt={dt}")]);
+            let s = run(&format!("refine-{dt}-{n}"), &[format!("grid.cells=[1,{n}]"), format!("time.dt={dt}")]);
             let rms = value(&s, "p_rms_error_Tv0.5");
             let order = previous.map(|p| format!("{:.2}", (p / rms).log2())).unwrap_or_else(|| "–".into());
             let _ = writeln!(
@@ -82,7 +82,7 @@ fn terzaghi_grid_refinement() {
 fn terzaghi_time_step() {
     let mut text = String::from("## Terzaghi: time step (10 cells)\n\n| Δt [s] | e_p(T_v=0.1) | e_p(T_v=0.5) | RMS(T_v=0.5) | steps | wall [s] |\n|---|---|---|---|---|---|\n");
     for dt in ["4e-3", "2e-3", "1e-3", "5e-4", "2.5e-4", "1e-4"] {
-        let s = run(&format!("dt-{dt}"), &[format!("stages[0].dt={dt}")]);
+        let s = run(&format!("dt-{dt}"), &[format!("time.dt={dt}")]);
         let _ = writeln!(
             text,
             "| {dt} | {:.3e} | {:.3e} | {:.3e} | {} | {:.2} |",

@@ -59,6 +59,17 @@ pub fn parse(text: &str, origin: &str, overrides: &[Override]) -> Result<Case, C
             None => CaseError::new(format!("{origin}: key `{path}`: {msg}")),
         }
     })?;
+    let mut case = case;
+    for (i, st) in case.stages.iter_mut().enumerate() {
+        if st.dt.is_none() {
+            st.dt = case.time.dt;
+        }
+        if st.dt.is_none() {
+            return Err(CaseError::new(format!(
+                "{origin}: key `stages[{i}].dt`: give the stage a Δt, or a default in [time] dt"
+            )));
+        }
+    }
     validate::validate(&case).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
     Ok(case)
 }
@@ -218,7 +229,14 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.grid.cells, [2, 20]);
-        assert_eq!(c.stages[0].dt, 5e-4);
+        assert_eq!(c.stages[0].dt(), 5e-4);
+        // A stage without its own step takes time.dt.
+        let no_dt =
+            MINIMAL.replace("dt = 1e-3", "").replace("[[stages]]", "[time]\n        dt = 2e-3\n        [[stages]]");
+        let c = parse(&no_dt, "t.toml", &[Override::parse("time.dt=4e-3").unwrap()]).unwrap();
+        assert_eq!(c.stages[0].dt(), 4e-3);
+        let e = parse(&MINIMAL.replace("dt = 1e-3", ""), "t.toml", &[]).unwrap_err();
+        assert!(e.to_string().contains("stages[0].dt"), "{e}");
     }
 
     #[test]

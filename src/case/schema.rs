@@ -26,6 +26,9 @@ pub struct Case {
     /// Loads (tractions, body forces).
     #[serde(default)]
     pub loads: Vec<Load>,
+    /// Time-stepping defaults shared by the stages.
+    #[serde(default)]
+    pub time: Time,
     /// The analysis stages, run in order.
     pub stages: Vec<Stage>,
     /// Newmark parameters.
@@ -391,6 +394,16 @@ impl TimeFunction {
     }
 }
 
+/// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none
+/// of its own).
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Time {
+    /// Time step of the stages that do not give their own `dt` [s].
+    #[serde(default)]
+    pub dt: Option<f64>,
+}
+
 /// One analysis stage.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -399,8 +412,9 @@ pub struct Stage {
     pub name: String,
     /// Duration [s].
     pub duration: f64,
-    /// Time step [s].
-    pub dt: f64,
+    /// Time step [s]; default: `time.dt`.
+    #[serde(default)]
+    pub dt: Option<f64>,
     /// Boundaries active in this stage (default: all).
     #[serde(default)]
     pub boundaries: Option<Vec<String>>,
@@ -413,6 +427,13 @@ pub struct Stage {
     /// Factor applied to Δt at each cut.
     #[serde(default = "default_cut_factor")]
     pub cut_factor: f64,
+}
+
+impl Stage {
+    /// The stage's time step [s] (its own `dt`, else `time.dt`; resolved by [`super::parse`]).
+    pub fn dt(&self) -> f64 {
+        self.dt.unwrap_or(f64::NAN)
+    }
 }
 
 fn default_cuts() -> usize {

@@ -236,11 +236,11 @@ pub fn validate(c: &Case) -> R {
     for (i, s) in c.stages.iter().enumerate() {
         let k = |x: &str| format!("stages[{i}].{x}");
         positive(&k("duration"), s.duration)?;
-        positive(&k("dt"), s.dt)?;
-        if s.dt > s.duration * (1.0 + 1e-12) {
-            return Err(format!("key `{}`: Δt = {} exceeds the stage duration {}", k("dt"), s.dt, s.duration));
+        positive(&k("dt"), s.dt())?;
+        if s.dt() > s.duration * (1.0 + 1e-12) {
+            return Err(format!("key `{}`: Δt = {} exceeds the stage duration {}", k("dt"), s.dt(), s.duration));
         }
-        if s.duration / s.dt > 1e8 {
+        if s.duration / s.dt() > 1e8 {
             return Err(format!("key `{}`: more than 1e8 steps in the stage", k("dt")));
         }
         in_open(&k("cut_factor"), s.cut_factor, 0.0, 1.0)?;
