@@ -121,6 +121,10 @@ pub struct Summary {
     pub petsc_options: Vec<String>,
     /// Wall time per phase.
     pub timings: Timings,
+    /// Largest checkerboard index of the pore pressures over the output steps (two-phase runs; see
+    /// `verification::checkerboard`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub checkerboard_index_max: Option<f64>,
     /// Metrics against the case's analytical reference.
     pub verification: BTreeMap<String, Metric>,
     /// Whether every metric passed (absent without verification).
@@ -202,6 +206,7 @@ impl Summary {
             solver: String::new(),
             petsc_options: assembly::petsc_options().unwrap_or_default(),
             timings: Timings::default(),
+            checkerboard_index_max: None,
             verification: BTreeMap::new(),
             verification_passed: None,
         }
@@ -248,6 +253,9 @@ impl<'a> Simulation<'a> {
             ["time", "step", "dt", "newton_iterations", "linear_iterations"].map(String::from).to_vec();
         for p in &probes {
             columns.extend(probe_fields(model.two_phase).iter().map(|f| format!("{}.{f}", p.name)));
+        }
+        if model.two_phase {
+            columns.push("checkerboard_index".into());
         }
         if let Some(c) = &check {
             columns.extend(c.columns());
@@ -385,8 +393,14 @@ impl<'a> Simulation<'a> {
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
+        let recovered = if self.model.two_phase && self.model.patch_recovery {
+            Some(self.system.recovered_pressure_increments(&self.model))
+        } else {
+            None
+        };
         for (k, r) in results.iter().enumerate() {
-            self.model.update_particle(k, r, r.kin.dp, dt).map_err(|e| RunError::Failed(e.0))?;
+            let dp = recovered.as_ref().map_or(r.kin.dp, |v| v[k]);
+            self.model.update_particle(k, r, dp, dt).map_err(|e| RunError::Failed(e.0))?;
         }
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(Ok(()))
@@ -398,6 +412,11 @@ impl<'a> Simulation<'a> {
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
         row.extend(probe_values(&self.model, &self.probes, &self.coll).map_err(RunError::Failed)?);
+        if self.model.two_phase {
+            let ci = verification::checkerboard::checkerboard_index(&self.model, &self.coll).map_err(RunError::Failed)?;
+            self.summary.checkerboard_index_max = Some(self.summary.checkerboard_index_max.map_or(ci, |m: f64| m.max(ci)));
+            row.push(ci);
+        }
         if let Some(c) = self.check.as_mut() {
             row.extend(c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?);
         }

@@ -85,6 +85,8 @@ struct StepData {
     global_start: usize,
     /// Δd at convergence, per ghosted dof.
     solution: Vec<f64>,
+    /// Whether each ghosted node is active.
+    active: Vec<bool>,
     /// Unknowns solved for (unconstrained dofs), summed over ranks.
     free_dofs: usize,
 }
@@ -292,7 +294,14 @@ impl GridSystem {
                     )
                 })?);
             }
+            let first = stencils.basis.len();
             kernels::plain_basis(&st, &mut stencils.basis);
+            if model.bbar {
+                let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
+                for (b, g) in stencils.basis[first..].iter_mut().zip(gv) {
+                    b.gv = g;
+                }
+            }
             stencils.offsets.push(stencils.nodes.len());
         }
 
@@ -325,17 +334,24 @@ impl GridSystem {
             self.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
 
-        // 3. Constraints: inactive nodes, and components fixed by the active boundaries.
+        // 3. Constraints: inactive nodes, components fixed by the active side and region boundaries,
+        // and by moving surfaces (marked by the ranks owning the surface particles, summed over ranks).
+        let mut surface = vec![0.0; ng];
+        for ((i, j), comps) in model.surface_fixes(active) {
+            if let Some(l) = self.local_node(i, j) {
+                for c in (0..nd).filter(|&c| comps[c]) {
+                    surface[l as usize * nd + c] = 1.0;
+                }
+            }
+        }
+        self.sum_over_ranks(&mut surface).map_err(|e| e.to_string())?;
         let mut constrained = vec![false; ng];
         for l in 0..self.ghost.len() {
             let (i, j) = self.ghost.ij(l);
             let inactive = weight[l * nd] <= ACTIVE_WEIGHT;
-            for c in 0..nd {
-                constrained[l * nd + c] = inactive;
-            }
             let fixed = model.fixed_components(active, i, j);
             for c in 0..nd {
-                constrained[l * nd + c] |= fixed[c];
+                constrained[l * nd + c] = inactive || fixed[c] || surface[l * nd + c] > 0.0;
             }
         }
         let mut owned_constrained = Vec::new();
@@ -380,6 +396,11 @@ impl GridSystem {
             let f = load.time_fn.eval(t_new);
             match &load.target {
                 LoadTarget::ParticleTraction { particles, face, traction } => {
+                    // The traction acts at the centre of the particle's loaded face (force = traction ×
+                    // face length), with the linear weights of the cell holding the particle's centre
+                    // (extrapolated when the face lies in the next cell): exact for a surface on a grid
+                    // line, and never loading a node that the particle barely reaches (such a node has
+                    // a vanishing mass and stiffness and would be driven without bound).
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
                         let (point, length) = match face {
@@ -388,7 +409,7 @@ impl GridSystem {
                             Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
                             Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
                         };
-                        let w = shape::point_weights(&model.grid, point);
+                        let w = shape::face_weights(&model.grid, x, point);
                         for ((i, j), s, _) in w.iter() {
                             let l =
                                 self.local_node(i, j).ok_or("a traction point lies outside this rank's ghost region")?
@@ -427,6 +448,7 @@ impl GridSystem {
             owned_constrained,
             global_start,
             solution: Vec::new(),
+            active: (0..self.ghost.len()).map(|l| weight[l * nd] > ACTIVE_WEIGHT).collect(),
             free_dofs,
         };
         // The matrix structure is the union of the particles' node couplings over the free dofs.
@@ -500,6 +522,24 @@ impl GridSystem {
             stage: &stages.assembly,
         };
         Ok((snes, x, jac, asm))
+    }
+
+    /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
+    /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
+    /// interpolated increment.
+    pub fn recovered_pressure_increments(&self, model: &Model) -> Vec<f64> {
+        let nd = self.ndof;
+        let dp: Vec<f64> = (0..self.ghost.len()).map(|l| self.step.solution[l * nd + kernels::dof::P]).collect();
+        let field = crate::model::patch::PatchField {
+            grid: &model.grid,
+            start: self.ghost.start,
+            count: self.ghost.count,
+            dp: &dp,
+            active: &self.step.active,
+        };
+        (0..model.particles.len())
+            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(k).kin.dp))
+            .collect()
     }
 
     /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.

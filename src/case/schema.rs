@@ -26,6 +26,9 @@ pub struct Case {
     /// Loads (tractions, body forces).
     #[serde(default)]
     pub loads: Vec<Load>,
+    /// Stabilisation of the equal-order u–p–U discretisation and of volumetric locking.
+    #[serde(default)]
+    pub stabilisation: Stabilisation,
     /// Time-stepping defaults shared by the stages.
     #[serde(default)]
     pub time: Time,
@@ -123,11 +126,26 @@ pub struct Material {
     /// Bulk modulus of the solid grains K_s [Pa]; `inf` for incompressible grains (two-phase).
     #[serde(default)]
     pub solid_bulk_modulus: Option<f64>,
-    /// Hydraulic conductivity k [m/s] (two-phase).
+    /// Hydraulic conductivity k [m/s] (two-phase) at the initial porosity.
     #[serde(default)]
     pub hydraulic_conductivity: Option<f64>,
+    /// How the conductivity changes with the void ratio (default: constant).
+    #[serde(default)]
+    pub hydraulic_conductivity_law: ConductivityLaw,
     /// The constitutive model of the solid skeleton.
     pub model: SoilModel,
+}
+
+/// Dependence of the hydraulic conductivity on the void ratio e.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConductivityLaw {
+    /// k = k₀.
+    #[default]
+    Constant,
+    /// k = k₀ ((1 + e)/(1 + e₀))², the law under which the large-strain consolidation of Xie & Leo
+    /// (2004) has a closed form (with 1 + e = 1/(1 − n)).
+    XieLeo,
 }
 
 fn default_rho_w() -> f64 {
@@ -251,11 +269,25 @@ pub struct Boundary {
     /// A side of the grid (give `side` or `region`).
     #[serde(default)]
     pub side: Option<Side>,
-    /// Nodes inside this box (give `side` or `region`).
+    /// Nodes inside this box (give one of `side`, `region`, `surface`).
     #[serde(default)]
     pub region: Option<Region>,
+    /// The moving surface of a body: the nodes beyond the exposed faces of its boundary particles,
+    /// found again every step (a drained free surface: `fix = ["p"]`).
+    #[serde(default)]
+    pub surface: Option<Surface>,
     /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained).
     pub fix: Vec<Dof>,
+}
+
+/// The faces of a body's surface.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Surface {
+    /// The body.
+    pub body: String,
+    /// Which faces: the particles whose face in one of these directions is exposed at t = 0.
+    pub faces: Vec<Side>,
 }
 
 /// A load, scaled in time by a named time function (default: constant 1).
@@ -392,6 +424,20 @@ impl TimeFunction {
             | TimeFunction::Table { name, .. } => name,
         }
     }
+}
+
+/// Stabilisation switches.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stabilisation {
+    /// MLSA patch recovery of the pore-pressure increments ([003] §3.3, Eqs. 26–30). Default: on in
+    /// two-phase analyses.
+    #[serde(default)]
+    pub patch_recovery: Option<bool>,
+    /// B̄ for GIMP ([000] §3, Eqs. 12–16): the volumetric part of B from cell-centre gradients weighted
+    /// by the share of the particle domain in each cell. Default: off.
+    #[serde(default)]
+    pub bbar: bool,
 }
 
 /// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none
@@ -558,6 +604,22 @@ pub enum Verification {
         #[serde(default = "default_column_tol")]
         settlement_tolerance: f64,
     },
+    /// Large-strain one-dimensional consolidation (Xie & Leo 2004; [003] §4.2).
+    LargeStrainConsolidation {
+        /// The consolidating column (drained at its top).
+        body: String,
+        /// The surface load (its final magnitude is q).
+        load: String,
+        /// Degrees of consolidation U_s at which the metrics are evaluated.
+        #[serde(default = "default_us")]
+        degrees: Vec<f64>,
+        /// Pass threshold for e_p ([003] Eq. 33).
+        #[serde(default = "default_ep_tol")]
+        e_p_tolerance: f64,
+        /// Pass threshold for the relative settlement error.
+        #[serde(default = "default_ls_settle_tol")]
+        settlement_tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -589,6 +651,12 @@ fn default_settle_tol() -> f64 {
 }
 fn default_periods() -> usize {
     3
+}
+fn default_us() -> Vec<f64> {
+    vec![0.5]
+}
+fn default_ls_settle_tol() -> f64 {
+    0.03
 }
 fn default_column_tol() -> f64 {
     0.01

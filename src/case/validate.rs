@@ -195,8 +195,16 @@ pub fn validate(c: &Case) -> R {
     // Boundaries.
     unique("boundaries", c.boundaries.iter().map(|b| b.name.as_str()))?;
     for (i, b) in c.boundaries.iter().enumerate() {
-        if b.side.is_some() == b.region.is_some() {
-            return Err(format!("key `boundaries[{i}]`: give exactly one of `side` and `region`"));
+        if [b.side.is_some(), b.region.is_some(), b.surface.is_some()].iter().filter(|&&x| x).count() != 1 {
+            return Err(format!("key `boundaries[{i}]`: give exactly one of `side`, `region` and `surface`"));
+        }
+        if let Some(sf) = &b.surface {
+            if c.body(&sf.body).is_none() {
+                return Err(format!("key `boundaries[{i}].surface.body`: no body named `{}`", sf.body));
+            }
+            if sf.faces.is_empty() {
+                return Err(format!("key `boundaries[{i}].surface.faces`: list at least one face"));
+            }
         }
         if b.fix.is_empty() {
             return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
@@ -313,6 +321,14 @@ pub fn validate(c: &Case) -> R {
                 positive("verification.stress_tolerance", *stress_tolerance)?;
                 positive("verification.settlement_tolerance", *settlement_tolerance)?;
                 (body, gravity)
+            }
+            Verification::LargeStrainConsolidation { body, load, degrees, e_p_tolerance, settlement_tolerance } => {
+                if degrees.is_empty() || degrees.iter().any(|u| !(*u > 0.0 && *u < 1.0)) {
+                    return Err("key `verification.degrees`: give degrees of consolidation in (0, 1)".into());
+                }
+                positive("verification.e_p_tolerance", *e_p_tolerance)?;
+                positive("verification.settlement_tolerance", *settlement_tolerance)?;
+                (body, load)
             }
             Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
                 positive("verification.probe_depth", *probe_depth)?;

@@ -178,17 +178,45 @@ pub struct BoundaryDef {
     pub side: Option<Side>,
     /// Or which box of nodes.
     pub region: Option<Region>,
+    /// Or the moving surface of a body: (local particle index, exposed face) pairs.
+    pub surface: Option<Vec<(usize, Side)>>,
     /// Components fixed to zero.
     pub fix: Vec<Dof>,
 }
 
 impl BoundaryDef {
-    /// From the case.
-    pub fn from_case(b: &case::Boundary) -> BoundaryDef {
-        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, fix: b.fix.clone() }
+    /// From the case; a surface is resolved on this rank's particles (those of the body whose face
+    /// in a listed direction is exposed at t = 0).
+    pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles) -> BoundaryDef {
+        let surface = b.surface.as_ref().map(|sf| {
+            let body = c.bodies.iter().position(|x| x.name == sf.body).expect("validated") as u16;
+            let mut v = Vec::new();
+            for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
+                for &f in &sf.faces {
+                    if face_is_exposed(c, particles.x0[k], particles.lp[k], f) {
+                        v.push((k, f));
+                    }
+                }
+            }
+            v
+        });
+        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone() }
     }
 
-    /// Whether node (i, j) belongs to it.
+    /// Whether a node at `node` lies beyond the exposed `face` of a particle at `x`: the grid nodes
+    /// that carry a moving surface's condition are those of the surface particles' stencils on the
+    /// outer side of the particle centre.
+    pub fn beyond(face: Side, x: [f64; 2], node: [f64; 2]) -> bool {
+        match face {
+            Side::XMin => node[0] < x[0],
+            Side::XMax => node[0] > x[0],
+            Side::YMin => node[1] < x[1],
+            Side::YMax => node[1] > x[1],
+        }
+    }
+
+    /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
+    /// particles, see [`BoundaryDef::beyond`]).
     pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
         if let Some(side) = self.side {
             return match side {

@@ -103,8 +103,10 @@ pub struct Material {
     pub water_bulk_modulus: f64,
     /// Grain bulk modulus K_s [Pa].
     pub solid_bulk_modulus: f64,
-    /// Hydraulic conductivity k [m/s] (two-phase; infinite otherwise).
+    /// Hydraulic conductivity k₀ [m/s] at the initial porosity (two-phase; infinite otherwise).
     pub conductivity: f64,
+    /// How the conductivity follows the void ratio.
+    pub conductivity_law: case::ConductivityLaw,
     /// Skeleton model.
     pub model: Constitutive,
 }
@@ -129,6 +131,7 @@ impl Material {
             water_bulk_modulus: kw,
             solid_bulk_modulus: ks,
             conductivity: if two { m.hydraulic_conductivity.unwrap_or(f64::INFINITY) } else { f64::INFINITY },
+            conductivity_law: m.hydraulic_conductivity_law,
             model,
         }
     }
@@ -136,6 +139,15 @@ impl Material {
     /// Mixture density ρ = (1 − n)ρ_s + nρ_w at porosity `n` [kg/m³].
     pub fn mixture_density(&self, n: f64) -> f64 {
         (1.0 - n) * self.solid_density + n * self.water_density
+    }
+
+    /// Hydraulic conductivity at porosity `n` [m/s]: k₀, or k₀ ((1 + e)/(1 + e₀))² =
+    /// k₀ ((1 − n₀)/(1 − n))² under the law of Xie & Leo (2004).
+    pub fn conductivity_at(&self, n: f64) -> f64 {
+        match self.conductivity_law {
+            case::ConductivityLaw::Constant => self.conductivity,
+            case::ConductivityLaw::XieLeo => self.conductivity * ((1.0 - self.porosity) / (1.0 - n)).powi(2),
+        }
     }
 
     /// 1/Q at porosity `n`.
@@ -183,6 +195,19 @@ mod tests {
                 assert!((fd - u.tangent[r][c]).abs() < 1e-3 * u.tangent[0][0]);
             }
         }
+    }
+
+    #[test]
+    fn the_xie_leo_conductivity_follows_the_void_ratio_squared() {
+        let mut m = Material::from_case(
+            &crate::case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap().materials[0],
+            case::Formulation::TwoPhase,
+        );
+        assert_eq!(m.conductivity_at(0.2), m.conductivity);
+        m.conductivity_law = case::ConductivityLaw::XieLeo;
+        // n₀ = 0.3 → e₀ = 3/7; n = 0.2 → e = 1/4: ((1 + e)/(1 + e₀))² = (1.25/1.428571)².
+        let ratio = (1.25f64 / (10.0 / 7.0)).powi(2);
+        assert!((m.conductivity_at(0.2) / m.conductivity - ratio).abs() < 1e-12);
     }
 
     #[test]

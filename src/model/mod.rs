@@ -6,6 +6,7 @@ pub mod grid;
 pub mod loads;
 pub mod material;
 pub mod particles;
+pub mod patch;
 pub mod shape;
 
 use crate::case::{Case, Formulation, ShapeFunctions};
@@ -39,6 +40,10 @@ pub struct Model {
     pub beta: f64,
     /// Newmark γ.
     pub gamma: f64,
+    /// B̄ for GIMP ([000] §3).
+    pub bbar: bool,
+    /// MLSA patch recovery of the pore-pressure increments ([003] §3.3).
+    pub patch_recovery: bool,
 }
 
 /// Names of the nodal fields, in dof order: ux, uy, p, Ux, Uy (two-phase) or ux, uy.
@@ -54,6 +59,20 @@ pub fn field_names(two_phase: bool) -> &'static [&'static str] {
 pub fn grid_of(case: &Case) -> Grid {
     Grid::new(case.grid.origin, case.cell_size(), case.grid.cells)
 }
+
+/// Position of a dof component in a node's interlaced dofs (ux, uy, p, Ux, Uy).
+pub fn dof_index(d: crate::case::Dof) -> usize {
+    match d {
+        crate::case::Dof::Ux => 0,
+        crate::case::Dof::Uy => 1,
+        crate::case::Dof::P => 2,
+        crate::case::Dof::WUx => 3,
+        crate::case::Dof::WUy => 4,
+    }
+}
+
+/// Patch recovery in two-phase analyses when the case does not say.
+pub const DEFAULT_PATCH_RECOVERY: bool = false;
 
 /// Which loads and boundaries a stage switches on.
 #[derive(Debug, Clone)]
@@ -74,6 +93,7 @@ impl Model {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
         let loads = case.loads.iter().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
+        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
         Model {
             two_phase: case.analysis.formulation == Formulation::TwoPhase,
             basis: match case.analysis.shape_functions {
@@ -84,10 +104,13 @@ impl Model {
             materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
             particles,
             loads,
-            boundaries: case.boundaries.iter().map(BoundaryDef::from_case).collect(),
+            boundaries,
             g: case.analysis.g,
             beta: case.time_integration.beta,
             gamma: case.time_integration.gamma,
+            bbar: case.stabilisation.bbar,
+            patch_recovery: case.analysis.formulation == Formulation::TwoPhase
+                && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
     }
 
@@ -119,24 +142,44 @@ impl Model {
         }
     }
 
-    /// Which dof components (ux, uy, p, Ux, Uy) the active boundaries fix at node (i, j).
+    /// Which dof components (ux, uy, p, Ux, Uy) the active side and region boundaries fix at node
+    /// (i, j). Moving surfaces are in [`Model::surface_fixes`].
     pub fn fixed_components(&self, active: &Active, i: usize, j: usize) -> [bool; 5] {
         let mut fixed = [false; 5];
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
             if b.contains(&self.grid, i, j) {
                 for d in &b.fix {
-                    fixed[match d {
-                        crate::case::Dof::Ux => 0,
-                        crate::case::Dof::Uy => 1,
-                        crate::case::Dof::P => 2,
-                        crate::case::Dof::WUx => 3,
-                        crate::case::Dof::WUy => 4,
-                    }] = true;
+                    fixed[dof_index(*d)] = true;
                 }
             }
         }
         fixed
+    }
+
+    /// The nodes fixed by the active moving-surface boundaries on the current configuration: the
+    /// nodes of each surface particle's stencil (non-zero weight) that lie beyond its exposed face,
+    /// with the components fixed there.
+    pub fn surface_fixes(&self, active: &Active) -> Vec<((u32, u32), [bool; 5])> {
+        let mut out = Vec::new();
+        for &bi in &active.boundaries {
+            let b = &self.boundaries[bi];
+            let Some(list) = &b.surface else { continue };
+            let mut comps = [false; 5];
+            for d in &b.fix {
+                comps[dof_index(*d)] = true;
+            }
+            for &(k, face) in list {
+                let x = self.particles.x[k];
+                let st = shape::stencil(self.basis, &self.grid, x, self.particles.lp[k]);
+                for ((i, j), w, _) in st.iter() {
+                    if w > 0.0 && BoundaryDef::beyond(face, x, self.grid.node_position(i as usize, j as usize)) {
+                        out.push(((i, j), comps));
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Body acceleration at time `t` from the active body-force loads [m/s²].
@@ -160,7 +203,7 @@ impl Model {
         let (v, n) = (ps.volume[k], ps.porosity[k]);
         let (water_mass, drag, inv_q) = if self.two_phase {
             let gw = mat.water_density * self.g;
-            (n * mat.water_density * v, n * n * gw * v / mat.conductivity, mat.inv_q_at(n))
+            (n * mat.water_density * v, n * n * gw * v / mat.conductivity_at(n), mat.inv_q_at(n))
         } else {
             (0.0, 0.0, 0.0)
         };

@@ -132,22 +132,87 @@ pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil 
     s
 }
 
-/// Linear hat weights at a point where a force acts (the centre of a loaded particle face). A
-/// point up to half a cell outside the grid acts on the grid's edge nodes: a loaded surface that
-/// coincides with the grid's edge moves across it by small amounts (e.g. in the tension half of
-/// a cyclic load), and its load must not vanish then. Farther out there are no weights.
-pub fn point_weights(grid: &Grid, x: [f64; 2]) -> Stencil {
-    let lo = grid.origin;
-    let hi = grid.extent_max();
-    let mut y = x;
+/// Weights for a force acting at `point` on the face of a particle centred at `centre`: the bilinear
+/// functions of the cell holding the centre, evaluated (or extrapolated, by at most half a cell) at
+/// the point. For a face inside that cell these are the plain linear weights; for a face that has
+/// moved into the next cell they keep the force on the nodes the particle is attached to.
+pub fn face_weights(grid: &Grid, centre: [f64; 2], point: [f64; 2]) -> Stencil {
+    let mut s = Stencil::default();
+    let mut w = [[(0u32, 0.0); 2]; 2];
     for d in 0..2 {
-        let half = 0.5 * grid.h[d];
-        if x[d] < lo[d] - half || x[d] > hi[d] + half {
-            return Stencil::default();
-        }
-        y[d] = x[d].clamp(lo[d], hi[d]);
+        let c = ((centre[d] - grid.origin[d]) / grid.h[d]).floor().clamp(0.0, (grid.cells[d] - 1) as f64);
+        let xi = (point[d] - grid.origin[d]) / grid.h[d] - c;
+        w[d] = [(c as u32, 1.0 - xi), (c as u32 + 1, xi)];
     }
-    stencil(Basis::Linear, grid, y, [0.0, 0.0])
+    for &(j, wy) in &w[1] {
+        for &(i, wx) in &w[0] {
+            let k = s.len;
+            s.nodes[k] = (i, j);
+            s.w[k] = wx * wy;
+            s.len += 1;
+        }
+    }
+    s
+}
+
+/// Volumetric gradients of B̄ for a particle ([000] Eqs. 13–16, with the support-domain portion per
+/// cell of Coombs et al. 2018): ∇̄S_i = Σ_c f_c ∇N_i(x_c), where f_c is the share of the particle
+/// domain lying in cell c (renormalised over the cells inside the grid) and ∇N_i(x_c) the gradient of
+/// node i's bilinear function at the centre of c, (±1/(2h_x), ±1/(2h_y)) for the four nodes of c.
+/// The volumetric strain ∇̄·Δu is then the weighted average of the cell-centre volumetric strains of
+/// the cells the domain overlaps. Standard MPM (`Linear`) uses the one cell holding the particle.
+/// Returns the gradients in the order of `st.nodes` (nodes of `st` not belonging to an overlapped cell
+/// get zero).
+pub fn volumetric_gradients(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2], st: &Stencil) -> [[f64; 2]; MAX_STENCIL] {
+    let mut gv = [[0.0; 2]; MAX_STENCIL];
+    // Cells overlapped in each direction, with the length of the overlap.
+    let overlaps = |d: usize| -> ([(usize, f64); 3], usize) {
+        let mut out = [(0usize, 0.0); 3];
+        let mut n = 0;
+        let (o, h, nc) = (grid.origin[d], grid.h[d], grid.cells[d]);
+        match basis {
+            Basis::Linear => {
+                let s = ((x[d] - o) / h).clamp(0.0, nc as f64);
+                out[0] = ((s.floor() as usize).min(nc - 1), 1.0);
+                n = 1;
+            }
+            Basis::Gimp => {
+                let (a, b) = (x[d] - lp[d], x[d] + lp[d]);
+                let first = ((a - o) / h).floor().max(0.0) as usize;
+                let last = (((b - o) / h).floor().max(0.0) as usize).min(nc - 1);
+                for c in first..=last {
+                    let (lo, hi) = (o + c as f64 * h, o + (c + 1) as f64 * h);
+                    let len = b.min(hi) - a.max(lo);
+                    if len > 1e-12 * h && n < 3 {
+                        out[n] = (c, len);
+                        n += 1;
+                    }
+                }
+            }
+        }
+        (out, n)
+    };
+    let (ox, nx) = overlaps(0);
+    let (oy, ny) = overlaps(1);
+    let total: f64 = ox[..nx].iter().map(|a| a.1).sum::<f64>() * oy[..ny].iter().map(|a| a.1).sum::<f64>();
+    if total <= 0.0 {
+        return gv;
+    }
+    for &(cy, ly) in &oy[..ny] {
+        for &(cx, lx) in &ox[..nx] {
+            let f = lx * ly / total;
+            for (di, sx) in [(0u32, -1.0), (1u32, 1.0)] {
+                for (dj, sy) in [(0u32, -1.0), (1u32, 1.0)] {
+                    let node = (cx as u32 + di, cy as u32 + dj);
+                    if let Some(k) = st.nodes[..st.len].iter().position(|&n| n == node) {
+                        gv[k][0] += f * sx / (2.0 * grid.h[0]);
+                        gv[k][1] += f * sy / (2.0 * grid.h[1]);
+                    }
+                }
+            }
+        }
+    }
+    gv
 }
 
 #[cfg(test)]
@@ -184,24 +249,53 @@ mod tests {
     }
 
     #[test]
-    fn points_within_round_off_of_the_grid_edge_get_weights() {
+    fn face_weights_stay_on_the_cell_of_the_particle() {
         let g = grid();
         let top = g.extent_max()[1];
-        for y in [top, top * (1.0 + 1e-15), top - 1e-13] {
-            let w = point_weights(&g, [1.1, y]);
-            assert_eq!(w.len, 4, "y = {y:e}");
+        // A face on the grid's edge loads the edge nodes, also a hair beyond it.
+        for y in [top, top * (1.0 + 1e-15), top + 1e-3] {
+            let w = face_weights(&g, [1.1, top - 0.06], [1.1, y]);
+            let edge: f64 = w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum();
+            assert!((edge - 1.0).abs() < 0.01, "y = {y:e}: {edge}");
             assert!((w.iter().map(|(_, s, _)| s).sum::<f64>() - 1.0).abs() < 1e-12);
         }
-        // A loaded face a little above the grid still loads the top nodes; far above, nothing.
-        let w = point_weights(&g, [1.1, top + 1e-3]);
-        assert!(
-            w.len == 4
-                && w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum::<f64>()
-                    > 0.999999
-        );
-        assert_eq!(point_weights(&g, [1.1, top + 0.6 * g.h[1]]).len, 0);
-        // Particles themselves get no linear weights outside the grid.
-        assert_eq!(stencil(Basis::Linear, &g, [1.1, top + 1e-3], [0.0; 2]).len, 0);
+        // A face that crossed into the next cell extrapolates from the particle's cell: the node
+        // beyond the crossed grid line takes nothing.
+        let w = face_weights(&g, [1.1, 0.74], [1.1, 0.76]);
+        assert!(w.iter().all(|((_, j), _, _)| j <= 3), "{:?}", &w.nodes[..w.len]);
+        let w3: f64 = w.iter().filter(|((_, j), _, _)| *j == 3).map(|(_, s, _)| s).sum();
+        assert!((w3 - 1.04).abs() < 1e-12, "{w3}");
+    }
+
+    #[test]
+    fn volumetric_gradients_average_the_cell_centre_divergence() {
+        let g = grid();
+        for (basis, x, lp) in [
+            (Basis::Gimp, [1.2, 0.6], [0.125, 0.0625]),
+            (Basis::Gimp, [1.01, 0.51], [0.125, 0.0625]),
+            (Basis::Linear, [1.3, 0.6], [0.0, 0.0]),
+        ] {
+            let st = stencil(basis, &g, x, lp);
+            let gv = volumetric_gradients(basis, &g, x, lp, &st);
+            // Σ ∇̄S_i = 0 and Σ ∇̄S_i ⊗ x_i = I: a linear displacement field gives its exact divergence.
+            let sum: [f64; 2] = (0..st.len).fold([0.0; 2], |a, k| [a[0] + gv[k][0], a[1] + gv[k][1]]);
+            assert!(sum[0].abs() < 1e-12 && sum[1].abs() < 1e-12, "{basis:?} {sum:?}");
+            let mut m = [[0.0; 2]; 2];
+            for k in 0..st.len {
+                let p = g.node_position(st.nodes[k].0 as usize, st.nodes[k].1 as usize);
+                for a in 0..2 {
+                    for b in 0..2 {
+                        m[a][b] += gv[k][a] * p[b];
+                    }
+                }
+            }
+            assert!((m[0][0] - 1.0).abs() < 1e-12 && (m[1][1] - 1.0).abs() < 1e-12 && m[0][1].abs() < 1e-12, "{basis:?} {m:?}");
+        }
+        // A domain inside one cell takes that cell's centre gradients: ±1/(2h).
+        let st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);
+        let gv = volumetric_gradients(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &st);
+        let k = st.nodes[..st.len].iter().position(|&n| n == (2, 2)).unwrap();
+        assert!((gv[k][0] + 1.0).abs() < 1e-12 && (gv[k][1] + 2.0).abs() < 1e-12, "{:?}", gv[k]);
     }
 
     #[test]

@@ -20,12 +20,14 @@
 //! * Shock wave ([003] §4.1.3): see [`shock`] for how arrival times are picked.
 
 pub mod biot_harmonic;
+pub mod checkerboard;
 pub mod shock;
 pub mod terzaghi;
 pub mod waves;
+pub mod xie_leo;
 
 use crate::assembly::Collective;
-use crate::case::{self, Case, Load, TimeFunction, Verification};
+use crate::case::{self, Case, ConductivityLaw, Load, TimeFunction, Verification};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -140,22 +142,51 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
     Ok(Some(match v {
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
-            let f_end = c
-                .load(load)
-                .and_then(|l| l.time_function())
-                .and_then(|n| c.time_function(n))
-                .map(crate::model::loads::TimeFn::from_case);
-            let scale = f_end.map_or(1.0, |f| f.eval(end));
-            Box::new(TerzaghiCheck::new(
-                col,
-                scale,
-                time_factors,
-                *e_p_tolerance,
-                *p_rms_tolerance,
-                *settlement_tolerance,
-                model,
-                coll,
-            )?)
+            let theory = terzaghi::Terzaghi::new(
+                col.load * load_factor(c, load, end).abs(),
+                col.height,
+                col.constrained_modulus,
+                col.inv_q,
+                col.conductivity,
+                col.water_density * col.g,
+            );
+            theory.validate()?;
+            let targets = time_factors
+                .iter()
+                .enumerate()
+                .map(|(i, &tv)| Target {
+                    label: format!("Tv{}", tv_name(tv)),
+                    t: theory.time_for(tv),
+                    full: i + 1 == time_factors.len(),
+                    result: None,
+                })
+                .collect();
+            let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
+            Box::new(ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)?)
+        }
+        Verification::LargeStrainConsolidation { body, load, degrees, e_p_tolerance, settlement_tolerance } => {
+            let col = Column::from_case(c, model, body, load)?;
+            let bi = col.body as usize;
+            let law = c.materials[c.material_index(&c.bodies[bi].material).expect("validated")].hydraulic_conductivity_law;
+            if law != ConductivityLaw::XieLeo {
+                return Err(format!(
+                    "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{body}`"
+                ));
+            }
+            let theory = xie_leo::XieLeo {
+                load: col.load * load_factor(c, load, end).abs(),
+                height: col.height,
+                m_v: 1.0 / col.constrained_modulus,
+                conductivity: col.conductivity,
+                water_unit_weight: col.water_density * col.g,
+            };
+            theory.validate()?;
+            let targets = degrees
+                .iter()
+                .map(|&u| Target { label: format!("Us{}", tv_name(u)), t: theory.time_for_degree(u), full: true, result: None })
+                .collect();
+            let tol = (*e_p_tolerance, *e_p_tolerance, *settlement_tolerance);
+            Box::new(ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)?)
         }
         Verification::HarmonicColumn { body, load, measure_periods, tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
@@ -189,48 +220,84 @@ fn tv_name(tv: f64) -> String {
     format!("{tv}")
 }
 
-/// Terzaghi consolidation check.
-pub struct TerzaghiCheck {
-    col: Column,
-    theory: terzaghi::Terzaghi,
-    targets: Vec<(f64, f64)>,
-    tolerances: (f64, f64, f64),
-    volume0: f64,
-    results: Vec<(f64, f64, f64, f64, f64)>,
+/// The consolidation theory a [`ConsolidationCheck`] compares with.
+enum Theory {
+    /// Small strain, compressible pore fluid.
+    Terzaghi(terzaghi::Terzaghi),
+    /// Large strain (Xie & Leo 2004).
+    XieLeo(xie_leo::XieLeo),
 }
 
-impl TerzaghiCheck {
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        col: Column,
-        load_scale: f64,
-        tvs: &[f64],
-        ep_tol: f64,
-        rms_tol: f64,
-        settle_tol: f64,
-        model: &Model,
-        coll: &Collective,
-    ) -> Result<TerzaghiCheck, String> {
-        let theory = terzaghi::Terzaghi::new(
-            col.load * load_scale.abs(),
-            col.height,
-            col.constrained_modulus,
-            col.inv_q,
-            col.conductivity,
-            col.water_density * col.g,
-        );
-        theory.validate()?;
-        let targets = tvs.iter().map(|&tv| (tv, theory.time_for(tv))).collect();
+impl Theory {
+    fn load(&self) -> f64 {
+        match self {
+            Theory::Terzaghi(t) => t.load,
+            Theory::XieLeo(x) => x.load,
+        }
+    }
+    fn pressure(&self, depth: f64, t: f64) -> f64 {
+        match self {
+            Theory::Terzaghi(th) => th.pressure(depth, t),
+            Theory::XieLeo(x) => x.pressure(depth, t),
+        }
+    }
+    fn settlement(&self, t: f64) -> f64 {
+        match self {
+            Theory::Terzaghi(th) => th.settlement(t),
+            Theory::XieLeo(x) => x.settlement(t),
+        }
+    }
+    fn degree(&self, t: f64) -> f64 {
+        match self {
+            Theory::Terzaghi(th) => th.degree_of_consolidation(t),
+            Theory::XieLeo(x) => x.degree_of_consolidation(t),
+        }
+    }
+    fn time_factor(&self, t: f64) -> f64 {
+        match self {
+            Theory::Terzaghi(th) => th.time_factor(t),
+            Theory::XieLeo(x) => x.cv() * t / (x.height * x.height),
+        }
+    }
+    fn name(&self) -> &'static str {
+        match self {
+            Theory::Terzaghi(_) => "Terzaghi",
+            Theory::XieLeo(_) => "Xie & Leo",
+        }
+    }
+}
+
+/// A time at which a consolidation check evaluates its metrics.
+struct Target {
+    /// Suffix of the metric names (`Tv0.1`, `Us0.5`).
+    label: String,
+    /// Time [s].
+    t: f64,
+    /// Whether the RMS and settlement errors are reported at this time too.
+    full: bool,
+    /// (e_p, rms, settlement error, settlement) once the run has passed the time.
+    result: Option<(f64, f64, f64, f64)>,
+}
+
+/// Consolidation of a column (Terzaghi, or large strain after Xie & Leo), compared at given times.
+pub struct ConsolidationCheck {
+    col: Column,
+    theory: Theory,
+    prefix: &'static str,
+    targets: Vec<Target>,
+    tolerances: (f64, f64, f64),
+    volume0: f64,
+}
+
+impl ConsolidationCheck {
+    fn new(col: Column, theory: Theory, targets: Vec<Target>, tolerances: (f64, f64, f64), model: &Model, coll: &Collective) -> Result<Self, String> {
         let v0: f64 = col.particles(model).map(|k| model.particles.volume[k]).sum();
         let volume0 = coll.sum(&[v0])?[0];
-        Ok(TerzaghiCheck {
-            col,
-            theory,
-            targets,
-            tolerances: (ep_tol, rms_tol, settle_tol),
-            volume0,
-            results: Vec::new(),
-        })
+        let prefix = match theory {
+            Theory::Terzaghi(_) => "terzaghi",
+            Theory::XieLeo(_) => "large_strain",
+        };
+        Ok(ConsolidationCheck { col, theory, prefix, targets, tolerances, volume0 })
     }
 
     fn settlement(&self, model: &Model, coll: &Collective) -> Result<f64, String> {
@@ -239,79 +306,54 @@ impl TerzaghiCheck {
     }
 }
 
-impl Check for TerzaghiCheck {
+impl Check for ConsolidationCheck {
     fn columns(&self) -> Vec<String> {
-        ["terzaghi.Tv", "terzaghi.settlement", "terzaghi.settlement_analytical", "terzaghi.U_analytical"]
-            .map(String::from)
-            .to_vec()
+        ["Tv", "settlement", "settlement_analytical", "U_analytical"].iter().map(|c| format!("{}.{c}", self.prefix)).collect()
     }
 
     fn event_times(&self) -> Vec<f64> {
-        self.targets.iter().map(|t| t.1).collect()
+        self.targets.iter().map(|t| t.t).collect()
     }
 
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let s = self.settlement(model, coll)?;
-        let q = self.theory.load;
-        for &(tv, tt) in &self.targets {
+        let q = self.theory.load();
+        for i in 0..self.targets.len() {
+            let tt = self.targets[i].t;
             if (t - tt).abs() <= 1e-9 * tt {
-                let local: Vec<f64> = self
-                    .col
-                    .particles(model)
-                    .flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]])
-                    .collect();
+                let local: Vec<f64> =
+                    self.col.particles(model).flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]]).collect();
                 let all = coll.gather(&local)?;
                 let n = all.len() / 2;
                 let sq: f64 = all.chunks(2).map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2)).sum();
-                let e_p = sq.sqrt() / n as f64;
-                let rms = (sq / n as f64).sqrt();
                 let s_ana = self.theory.settlement(t);
-                self.results.push((tv, e_p, rms, (s - s_ana).abs() / s_ana.abs(), s));
+                self.targets[i].result = Some((sq.sqrt() / n as f64, (sq / n as f64).sqrt(), (s - s_ana).abs() / s_ana.abs(), s));
             }
         }
-        Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree_of_consolidation(t)])
+        Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
         let (ep_tol, rms_tol, s_tol) = self.tolerances;
         let mut out = Vec::new();
-        for (i, &(tv, tt)) in self.targets.iter().enumerate() {
-            let last = i + 1 == self.targets.len();
-            let r = self.results.iter().find(|r| r.0 == tv);
-            let name = tv_name(tv);
-            let missing = format!("T_v = {tv} (t = {tt:.6e} s) was not reached by the run");
-            match r {
-                Some(&(_, e_p, rms, se, s)) => {
-                    out.push((
-                        format!("e_p_Tv{name}"),
-                        Metric::error(
-                            e_p,
-                            ep_tol,
-                            format!("[003] Eq. 33 over the column's particles at t = {tt:.6e} s"),
-                        ),
-                    ));
-                    if last {
-                        out.push((
-                            format!("p_rms_error_Tv{name}"),
-                            Metric::error(rms, rms_tol, "RMS of (P* - P) over particles, P = p/q".into()),
-                        ));
-                        out.push((
-                            format!("settlement_rel_error_Tv{name}"),
-                            Metric::error(
-                                se,
-                                s_tol,
-                                format!("settlement {s:.6e} m vs Terzaghi {:.6e} m", self.theory.settlement(tt)),
-                            ),
-                        ));
-                    }
-                }
-                None => {
-                    out.push((format!("e_p_Tv{name}"), Metric::error(f64::NAN, ep_tol, missing.clone())));
-                    if last {
-                        out.push((format!("p_rms_error_Tv{name}"), Metric::error(f64::NAN, rms_tol, missing.clone())));
-                        out.push((format!("settlement_rel_error_Tv{name}"), Metric::error(f64::NAN, s_tol, missing)));
-                    }
-                }
+        for tg in &self.targets {
+            let missing = || format!("{} (t = {:.6e} s) was not reached by the run", tg.label, tg.t);
+            let (e_p, rms, se) = match tg.result {
+                Some((e_p, rms, se, s)) => (
+                    Metric::error(e_p, ep_tol, format!("[003] Eq. 33 over the column's particles at t = {:.6e} s", tg.t)),
+                    Metric::error(rms, rms_tol, "RMS of (P* - P) over particles, P = p/q".into()),
+                    Metric::error(se, s_tol, format!("settlement {s:.6e} m vs {} {:.6e} m", self.theory.name(), self.theory.settlement(tg.t))),
+                ),
+                None => (
+                    Metric::error(f64::NAN, ep_tol, missing()),
+                    Metric::error(f64::NAN, rms_tol, missing()),
+                    Metric::error(f64::NAN, s_tol, missing()),
+                ),
+            };
+            out.push((format!("e_p_{}", tg.label), e_p));
+            if tg.full {
+                out.push((format!("p_rms_error_{}", tg.label), rms));
+                out.push((format!("settlement_rel_error_{}", tg.label), se));
             }
         }
         Ok((out, Vec::new()))
@@ -578,5 +620,8 @@ pub fn describe(v: &case::Verification) -> String {
             format!("shock-wave arrival at {probe_depth} m depth")
         }
         Verification::ElasticColumn { .. } => "static elastic column under self-weight and surcharge".into(),
+        Verification::LargeStrainConsolidation { degrees, .. } => {
+            format!("large-strain consolidation (Xie & Leo 2004) at U_s = {degrees:?}")
+        }
     }
 }

@@ -1,0 +1,163 @@
+//! The checkerboard index: how much of the pore-pressure field alternates from point to point.
+//!
+//! The equal-order u–p–U discretisation can let the nodal pressures alternate (±A from node to node,
+//! [003] Fig. 12); interpolated to the material points this shows as a pattern that changes sign from
+//! one point to the next within and across cells. To separate it from the smooth field, the pore
+//! pressures of the particles in the 3 × 3 cells around each cell are fitted by least squares with a
+//! quadratic polynomial in the offsets from the cell centre (directions in which the particles do not
+//! spread, e.g. across a column one cell wide, get no terms). For every particle of the centre cell the
+//! fit gives its smooth part s_k and the residual its alternating part r_k = p_k − s_k. The index is
+//!   I = sqrt( Σ r_k² / Σ s_k² )
+//! over all particles whose neighbourhood has enough points for the fit. A field that is locally
+//! quadratic scores 0, a smooth field O(h³ p‴/p), an alternating pattern of amplitude A about A/|p|.
+
+use crate::assembly::Collective;
+use crate::model::Model;
+use std::collections::HashMap;
+
+/// The checkerboard index of the current pore pressures (0 when there is no pressure).
+pub fn checkerboard_index(model: &Model, coll: &Collective) -> Result<f64, String> {
+    let ps = &model.particles;
+    let local: Vec<f64> = (0..ps.len()).flat_map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k]]).collect();
+    let all = coll.gather(&local)?;
+    let points: Vec<[f64; 3]> = all.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    Ok(index_of(&points, model.grid.origin, model.grid.h))
+}
+
+/// The index of point values `[x, y, p]` binned on cells of size `h` from `origin`.
+pub fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
+    let cell = |p: &[f64; 3]| (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64);
+    let mut bins: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (k, p) in points.iter().enumerate() {
+        bins.entry(cell(p)).or_default().push(k);
+    }
+    let (mut r2, mut s2) = (0.0, 0.0);
+    for (&(i, j), members) in &bins {
+        let centre = [origin[0] + (i as f64 + 0.5) * h[0], origin[1] + (j as f64 + 0.5) * h[1]];
+        let local = |p: &[f64; 3]| [(p[0] - centre[0]) / h[0], (p[1] - centre[1]) / h[1]];
+        let mut nb: Vec<usize> = Vec::new();
+        for dj in -1..=1 {
+            for di in -1..=1 {
+                if let Some(v) = bins.get(&(i + di, j + dj)) {
+                    nb.extend(v);
+                }
+            }
+        }
+        let spread = |d: usize| {
+            let v: Vec<f64> = nb.iter().map(|&k| local(&points[k])[d]).collect();
+            v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min) > 1.0
+        };
+        let (ux, uy) = (spread(0), spread(1));
+        let basis = |q: [f64; 2]| -> Vec<f64> {
+            let mut b = vec![1.0];
+            if ux {
+                b.extend([q[0], q[0] * q[0]]);
+            }
+            if uy {
+                b.extend([q[1], q[1] * q[1]]);
+            }
+            if ux && uy {
+                b.push(q[0] * q[1]);
+            }
+            b
+        };
+        let m = basis([0.0, 0.0]).len();
+        if nb.len() < m + 2 {
+            continue;
+        }
+        let mut a = vec![0.0; m * m];
+        let mut rhs = vec![0.0; m];
+        for &k in &nb {
+            let q = basis(local(&points[k]));
+            for r in 0..m {
+                rhs[r] += q[r] * points[k][2];
+                for c in 0..m {
+                    a[r * m + c] += q[r] * q[c];
+                }
+            }
+        }
+        let Some(coef) = solve(&mut a, &mut rhs, m) else { continue };
+        for &k in members {
+            let s: f64 = basis(local(&points[k])).iter().zip(&coef).map(|(q, c)| q * c).sum();
+            r2 += (points[k][2] - s).powi(2);
+            s2 += s * s;
+        }
+    }
+    if s2 <= 0.0 {
+        0.0
+    } else {
+        (r2 / s2).sqrt()
+    }
+}
+
+/// Solves the m × m system by Gaussian elimination with partial pivoting; `None` if singular.
+fn solve(a: &mut [f64], b: &mut [f64], m: usize) -> Option<Vec<f64>> {
+    let scale = a.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+    for col in 0..m {
+        let piv = (col..m).max_by(|&x, &y| a[x * m + col].abs().partial_cmp(&a[y * m + col].abs()).unwrap())?;
+        if a[piv * m + col].abs() <= 1e-12 * scale {
+            return None;
+        }
+        for c in 0..m {
+            a.swap(col * m + c, piv * m + c);
+        }
+        b.swap(col, piv);
+        for r in col + 1..m {
+            let f = a[r * m + col] / a[col * m + col];
+            for c in col..m {
+                a[r * m + c] -= f * a[col * m + c];
+            }
+            b[r] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; m];
+    for r in (0..m).rev() {
+        let s: f64 = (r + 1..m).map(|c| a[r * m + c] * x[c]).sum();
+        x[r] = (b[r] - s) / a[r * m + r];
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 2 × 2 points per cell on 10 × 8 cells of 0.5 × 0.25, values from `f`.
+    fn points(f: impl Fn(f64, f64, i64, i64) -> f64) -> Vec<[f64; 3]> {
+        let mut v = Vec::new();
+        for j in 0..16i64 {
+            for i in 0..20i64 {
+                let (x, y) = ((i as f64 + 0.5) * 0.25, (j as f64 + 0.5) * 0.125);
+                v.push([x, y, f(x, y, i, j)]);
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn smooth_fields_score_nearly_zero_and_alternating_patterns_their_amplitude() {
+        let (o, h) = ([0.0, 0.0], [0.5, 0.25]);
+        assert!(index_of(&points(|x, y, _, _| 5.0 + 2.0 * x - 3.0 * y + x * y), o, h) < 1e-12);
+        // A steep exponential boundary layer (decay length 1.5 cells) still scores small.
+        let bl = index_of(&points(|_, y, _, _| 10.0 * (1.0 - (-(2.0 - y) / 0.375).exp())), o, h);
+        assert!(bl < 2e-2, "boundary layer {bl}");
+        // ±1 alternating from point to point on a uniform 10.
+        let cb = index_of(&points(|_, _, i, j| 10.0 + if (i + j) % 2 == 0 { 1.0 } else { -1.0 }), o, h);
+        assert!((cb - 0.1).abs() < 0.01, "{cb}");
+        assert_eq!(index_of(&[], o, h), 0.0);
+    }
+
+    #[test]
+    fn a_column_one_cell_wide_is_measured_along_its_axis() {
+        let col: Vec<[f64; 3]> = (0..40)
+            .map(|j| {
+                let y = (j as f64 + 0.5) * 0.025;
+                [0.025 + 0.05 * (j % 2) as f64, y, 10.0 + y + if j % 2 == 0 { 0.5 } else { -0.5 }]
+            })
+            .collect();
+        let ci = index_of(&col, [0.0, 0.0], [0.1, 0.05]);
+        assert!(ci > 0.03 && ci < 0.06, "{ci}");
+        let smooth: Vec<[f64; 3]> = col.iter().map(|p| [p[0], p[1], 10.0 + p[1] * p[1]]).collect();
+        assert!(index_of(&smooth, [0.0, 0.0], [0.1, 0.05]) < 1e-12);
+    }
+}
