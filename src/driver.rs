@@ -413,8 +413,10 @@ impl<'a> Simulation<'a> {
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
         row.extend(probe_values(&self.model, &self.probes, &self.coll).map_err(RunError::Failed)?);
         if self.model.two_phase {
-            let ci = verification::checkerboard::checkerboard_index(&self.model, &self.coll).map_err(RunError::Failed)?;
-            self.summary.checkerboard_index_max = Some(self.summary.checkerboard_index_max.map_or(ci, |m: f64| m.max(ci)));
+            let ci =
+                verification::checkerboard::checkerboard_index(&self.model, &self.coll).map_err(RunError::Failed)?;
+            self.summary.checkerboard_index_max =
+                Some(self.summary.checkerboard_index_max.map_or(ci, |m: f64| m.max(ci)));
             row.push(ci);
         }
         if let Some(c) = self.check.as_mut() {

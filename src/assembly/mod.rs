@@ -87,6 +87,8 @@ struct StepData {
     solution: Vec<f64>,
     /// Whether each ghosted node is active.
     active: Vec<bool>,
+    /// Porosity gradient at each particle at t_n (two-phase).
+    grad_n: Vec<[f64; 2]>,
     /// Unknowns solved for (unconstrained dofs), summed over ranks.
     free_dofs: usize,
 }
@@ -330,9 +332,39 @@ impl GridSystem {
                 }
             }
         }
-        for v in [&mut mass, &mut mom, &mut acc, &mut weight] {
+        // Mass-weighted nodal porosity, whose gradient at the particles enters the ∇n terms of the
+        // two-phase equations (see crate::kernels).
+        let mut porosity = vec![0.0; ng];
+        if self.two_phase {
+            for k in 0..stencils.len() {
+                let (nodes, basis) = stencils.get(k);
+                for (&node, nb) in nodes.iter().zip(basis) {
+                    porosity[node as usize * nd] += nb.s * ps.mass[k] * ps.porosity[k];
+                }
+            }
+        }
+        for v in [&mut mass, &mut mom, &mut acc, &mut weight, &mut porosity] {
             self.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
+        let grad_n: Vec<[f64; 2]> = if self.two_phase {
+            (0..stencils.len())
+                .map(|k| {
+                    let (nodes, basis) = stencils.get(k);
+                    let mut g = [0.0; 2];
+                    for (&node, nb) in nodes.iter().zip(basis) {
+                        let b = node as usize * nd;
+                        if mass[b] > 0.0 {
+                            let n = porosity[b] / mass[b];
+                            g[0] += nb.g[0] * n;
+                            g[1] += nb.g[1] * n;
+                        }
+                    }
+                    g
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
 
         // 3. Constraints: inactive nodes, components fixed by the active side and region boundaries,
         // and by moving surfaces (marked by the ranks owning the surface particles, summed over ranks).
@@ -449,6 +481,7 @@ impl GridSystem {
             global_start,
             solution: Vec::new(),
             active: (0..self.ghost.len()).map(|l| weight[l * nd] > ACTIVE_WEIGHT).collect(),
+            grad_n,
             free_dofs,
         };
         // The matrix structure is the union of the particles' node couplings over the free dofs.
@@ -584,6 +617,15 @@ fn fatal(e: petsc::Error) -> CallbackError {
     CallbackError::Fatal(e.to_string())
 }
 
+/// The kernel input of particle `k` for the prepared step.
+fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
+    let mut input = model.particle_input(k, step.body_acc);
+    if let Some(g) = step.grad_n.get(k) {
+        input.grad_n = *g;
+    }
+    input
+}
+
 impl Assembler<'_> {
     fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
         self.dm.global_to_local(x, self.x_local).map_err(fatal)?;
@@ -606,7 +648,7 @@ impl NonlinearProblem for Assembler<'_> {
             for k in 0..self.step.stencils.len() {
                 let (nodes, basis) = self.step.stencils.get(k);
                 let states = node_states(nodes, &xl, self.step, nd);
-                let input = self.model.particle_input(k, self.step.body_acc);
+                let input = particle_input(self.model, self.step, k);
                 let mat = &self.model.materials[self.model.particles.material[k] as usize];
                 let m = nodes.len() * nd;
                 kernels::residual(basis, &states[..nodes.len()], &input, &mat.model, self.two_phase, &mut buf[..m]);
@@ -643,7 +685,7 @@ impl NonlinearProblem for Assembler<'_> {
         let mut idx = [0i32; MAX_LOCAL];
         for k in 0..self.step.stencils.len() {
             let (nodes, basis) = self.step.stencils.get(k);
-            let input = self.model.particle_input(k, self.step.body_acc);
+            let input = particle_input(self.model, self.step, k);
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
             let m = nodes.len() * nd;
             // The soil tangent at the current iterate.

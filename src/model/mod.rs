@@ -217,6 +217,7 @@ impl Model {
             stress: ps.stress[k],
             p: ps.p[k],
             body_acc,
+            grad_n: [0.0; 2],
         }
     }
 

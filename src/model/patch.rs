@@ -57,7 +57,7 @@ impl PatchField<'_> {
 
     /// The active cells of node (i, j)'s patch: (X, Y, Δp) with X, Y the offsets of the cell centre
     /// from the node in cell sizes (±1/2).
-    fn patch(&self, i: i64, j: i64) -> Vec<(f64, f64, f64)> {
+    fn patch(&self, i: i64, j: i64) -> Vec<PatchPoint> {
         let mut out = Vec::with_capacity(4);
         for (ci, cj) in [(i - 1, j - 1), (i, j - 1), (i - 1, j), (i, j)] {
             if let Some(v) = self.cell(ci, cj) {
@@ -73,7 +73,8 @@ impl PatchField<'_> {
         let s = [(x[0] - g.origin[0]) / g.h[0], (x[1] - g.origin[1]) / g.h[1]];
         let nearest = [s[0].round() as i64, s[1].round() as i64];
         // The nearest node's patch, or the fullest neighbouring one (nearest among equals).
-        let mut best: Option<(usize, f64, [i64; 2], Vec<(f64, f64, f64)>)> = None;
+        // (number of active cells, squared distance, node, patch points) of the best patch so far.
+        let mut best: Option<(usize, f64, [i64; 2], Vec<PatchPoint>)> = None;
         for dj in -1..=1 {
             for di in -1..=1 {
                 let node = [nearest[0] + di, nearest[1] + dj];
@@ -98,10 +99,13 @@ impl PatchField<'_> {
     }
 }
 
+/// A sampling point of a patch: (X, Y, Δp) with X, Y in cell sizes from the patch's node.
+type PatchPoint = (f64, f64, f64);
+
 /// Least-squares fit of a₀ + a₁X + a₂Y to `pts` (dropping a slope where the points do not spread),
 /// evaluated at (X, Y).
-fn fit(pts: &[(f64, f64, f64)], x: f64, y: f64) -> f64 {
-    let spread = |f: fn(&(f64, f64, f64)) -> f64| {
+fn fit(pts: &[PatchPoint], x: f64, y: f64) -> f64 {
+    let spread = |f: fn(&PatchPoint) -> f64| {
         let lo = pts.iter().map(f).fold(f64::INFINITY, f64::min);
         let hi = pts.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
         hi - lo > 0.5
@@ -133,11 +137,11 @@ fn fit(pts: &[(f64, f64, f64)], x: f64, y: f64) -> f64 {
     // Gaussian elimination (the matrix is symmetric positive definite when the slopes are kept only
     // where the points spread).
     for col in 0..m {
-        let piv = a[col][col];
+        let pivot_row = a[col];
         for r in col + 1..m {
-            let f = a[r][col] / piv;
-            for c in col..m {
-                a[r][c] -= f * a[col][c];
+            let f = a[r][col] / pivot_row[col];
+            for (arc, pc) in a[r][col..m].iter_mut().zip(&pivot_row[col..m]) {
+                *arc -= f * pc;
             }
             b[r] -= f * b[col];
         }
@@ -184,7 +188,11 @@ mod tests {
     fn a_checkerboard_of_nodal_values_is_smoothed_out() {
         let g = Grid::new([0.0, 0.0], [0.1, 0.1], [6, 6]);
         // Smooth part 10 + checkerboard ±1 on the nodes: every cell centre averages it away.
-        let (dp, act) = field(&g, |p| 10.0 + if ((p[0] / 0.1).round() + (p[1] / 0.1).round()) as i64 % 2 == 0 { 1.0 } else { -1.0 }, |_, _| true);
+        let (dp, act) = field(
+            &g,
+            |p| 10.0 + if ((p[0] / 0.1).round() + (p[1] / 0.1).round()) as i64 % 2 == 0 { 1.0 } else { -1.0 },
+            |_, _| true,
+        );
         let pf = PatchField { grid: &g, start: [0, 0], count: g.nodes(), dp: &dp, active: &act };
         for x in [[0.12, 0.27], [0.33, 0.41], [0.05, 0.55]] {
             assert!((pf.recover(x).unwrap() - 10.0).abs() < 1e-12);

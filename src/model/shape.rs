@@ -163,7 +163,13 @@ pub fn face_weights(grid: &Grid, centre: [f64; 2], point: [f64; 2]) -> Stencil {
 /// the cells the domain overlaps. Standard MPM (`Linear`) uses the one cell holding the particle.
 /// Returns the gradients in the order of `st.nodes` (nodes of `st` not belonging to an overlapped cell
 /// get zero).
-pub fn volumetric_gradients(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2], st: &Stencil) -> [[f64; 2]; MAX_STENCIL] {
+pub fn volumetric_gradients(
+    basis: Basis,
+    grid: &Grid,
+    x: [f64; 2],
+    lp: [f64; 2],
+    st: &Stencil,
+) -> [[f64; 2]; MAX_STENCIL] {
     let mut gv = [[0.0; 2]; MAX_STENCIL];
     // Cells overlapped in each direction, with the length of the overlap.
     let overlaps = |d: usize| -> ([(usize, f64); 3], usize) {
@@ -281,15 +287,18 @@ mod tests {
             let sum: [f64; 2] = (0..st.len).fold([0.0; 2], |a, k| [a[0] + gv[k][0], a[1] + gv[k][1]]);
             assert!(sum[0].abs() < 1e-12 && sum[1].abs() < 1e-12, "{basis:?} {sum:?}");
             let mut m = [[0.0; 2]; 2];
-            for k in 0..st.len {
-                let p = g.node_position(st.nodes[k].0 as usize, st.nodes[k].1 as usize);
+            for (node, gk) in st.nodes[..st.len].iter().zip(&gv) {
+                let p = g.node_position(node.0 as usize, node.1 as usize);
                 for a in 0..2 {
                     for b in 0..2 {
-                        m[a][b] += gv[k][a] * p[b];
+                        m[a][b] += gk[a] * p[b];
                     }
                 }
             }
-            assert!((m[0][0] - 1.0).abs() < 1e-12 && (m[1][1] - 1.0).abs() < 1e-12 && m[0][1].abs() < 1e-12, "{basis:?} {m:?}");
+            assert!(
+                (m[0][0] - 1.0).abs() < 1e-12 && (m[1][1] - 1.0).abs() < 1e-12 && m[0][1].abs() < 1e-12,
+                "{basis:?} {m:?}"
+            );
         }
         // A domain inside one cell takes that cell's centre gradients: ±1/(2h).
         let st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);

@@ -167,7 +167,8 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::LargeStrainConsolidation { body, load, degrees, e_p_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let bi = col.body as usize;
-            let law = c.materials[c.material_index(&c.bodies[bi].material).expect("validated")].hydraulic_conductivity_law;
+            let law =
+                c.materials[c.material_index(&c.bodies[bi].material).expect("validated")].hydraulic_conductivity_law;
             if law != ConductivityLaw::XieLeo {
                 return Err(format!(
                     "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{body}`"
@@ -183,7 +184,12 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
             theory.validate()?;
             let targets = degrees
                 .iter()
-                .map(|&u| Target { label: format!("Us{}", tv_name(u)), t: theory.time_for_degree(u), full: true, result: None })
+                .map(|&u| Target {
+                    label: format!("Us{}", tv_name(u)),
+                    t: theory.time_for_degree(u),
+                    full: true,
+                    result: None,
+                })
                 .collect();
             let tol = (*e_p_tolerance, *e_p_tolerance, *settlement_tolerance);
             Box::new(ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)?)
@@ -290,7 +296,14 @@ pub struct ConsolidationCheck {
 }
 
 impl ConsolidationCheck {
-    fn new(col: Column, theory: Theory, targets: Vec<Target>, tolerances: (f64, f64, f64), model: &Model, coll: &Collective) -> Result<Self, String> {
+    fn new(
+        col: Column,
+        theory: Theory,
+        targets: Vec<Target>,
+        tolerances: (f64, f64, f64),
+        model: &Model,
+        coll: &Collective,
+    ) -> Result<Self, String> {
         let v0: f64 = col.particles(model).map(|k| model.particles.volume[k]).sum();
         let volume0 = coll.sum(&[v0])?[0];
         let prefix = match theory {
@@ -308,7 +321,10 @@ impl ConsolidationCheck {
 
 impl Check for ConsolidationCheck {
     fn columns(&self) -> Vec<String> {
-        ["Tv", "settlement", "settlement_analytical", "U_analytical"].iter().map(|c| format!("{}.{c}", self.prefix)).collect()
+        ["Tv", "settlement", "settlement_analytical", "U_analytical"]
+            .iter()
+            .map(|c| format!("{}.{c}", self.prefix))
+            .collect()
     }
 
     fn event_times(&self) -> Vec<f64> {
@@ -321,13 +337,17 @@ impl Check for ConsolidationCheck {
         for i in 0..self.targets.len() {
             let tt = self.targets[i].t;
             if (t - tt).abs() <= 1e-9 * tt {
-                let local: Vec<f64> =
-                    self.col.particles(model).flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]]).collect();
+                let local: Vec<f64> = self
+                    .col
+                    .particles(model)
+                    .flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]])
+                    .collect();
                 let all = coll.gather(&local)?;
                 let n = all.len() / 2;
                 let sq: f64 = all.chunks(2).map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2)).sum();
                 let s_ana = self.theory.settlement(t);
-                self.targets[i].result = Some((sq.sqrt() / n as f64, (sq / n as f64).sqrt(), (s - s_ana).abs() / s_ana.abs(), s));
+                self.targets[i].result =
+                    Some((sq.sqrt() / n as f64, (sq / n as f64).sqrt(), (s - s_ana).abs() / s_ana.abs(), s));
             }
         }
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
@@ -340,9 +360,21 @@ impl Check for ConsolidationCheck {
             let missing = || format!("{} (t = {:.6e} s) was not reached by the run", tg.label, tg.t);
             let (e_p, rms, se) = match tg.result {
                 Some((e_p, rms, se, s)) => (
-                    Metric::error(e_p, ep_tol, format!("[003] Eq. 33 over the column's particles at t = {:.6e} s", tg.t)),
+                    Metric::error(
+                        e_p,
+                        ep_tol,
+                        format!("[003] Eq. 33 over the column's particles at t = {:.6e} s", tg.t),
+                    ),
                     Metric::error(rms, rms_tol, "RMS of (P* - P) over particles, P = p/q".into()),
-                    Metric::error(se, s_tol, format!("settlement {s:.6e} m vs {} {:.6e} m", self.theory.name(), self.theory.settlement(tg.t))),
+                    Metric::error(
+                        se,
+                        s_tol,
+                        format!(
+                            "settlement {s:.6e} m vs {} {:.6e} m",
+                            self.theory.name(),
+                            self.theory.settlement(tg.t)
+                        ),
+                    ),
                 ),
                 None => (
                     Metric::error(f64::NAN, ep_tol, missing()),

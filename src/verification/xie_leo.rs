@@ -43,7 +43,7 @@ impl XieLeo {
 
     /// Checks the parameters.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.load.is_finite() && self.load > 0.0) || !(self.m_v.is_finite() && self.m_v > 0.0) {
+        if !(self.load.is_finite() && self.load > 0.0 && self.m_v.is_finite() && self.m_v > 0.0) {
             return Err(format!("load and m_v must be positive, got {} and {}", self.load, self.m_v));
         }
         self.linear().validate()
