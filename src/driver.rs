@@ -386,7 +386,7 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         let _stage = self.system.phase(Phase::ParticleUpdate).map_err(|e| RunError::Failed(e.to_string()))?;
         let n = self.model.particles.len();
-        let results: Vec<StepResult> = (0..n).map(|k| self.system.step_result(k)).collect();
+        let results: Vec<StepResult> = (0..n).map(|k| self.system.step_result(&self.model, k)).collect();
         let bad = results.iter().enumerate().find_map(|(k, r)| self.model.check_step(k, r).err());
         if self.coll.any(bad.is_some()).map_err(RunError::Failed)? {
             return Ok(Err(bad

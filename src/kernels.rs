@@ -5,9 +5,13 @@
 //! # The discrete system ([003] Eqs. 10, 16, 22, 23; [000] Eqs. 6–10, Appendix A)
 //!
 //! Unknowns of a time step are the nodal increments Δd = (Δu, Δp, ΔU) (the grid is reset every step,
-//! d_n = 0). Newmark ([003] Eqs. 20–21) gives the nodal acceleration and velocity at t_{n+1} as
-//!   a = a₀ Δd + ã_n,  v = a₁ Δd + ṽ_n,   a₀ = 1/(βΔt²), a₁ = γ/(βΔt),
-//! with predictors ã_n = −v_n/(βΔt) − (1/(2β) − 1) a_n and ṽ_n = −(γ/β − 1) v_n − (γ/(2β) − 1)Δt a_n.
+//! d_n = 0). Newmark ([003] Eqs. 20–21) gives the acceleration and velocity at t_{n+1} at a material
+//! point as
+//!   a = a₀ Σ S_i Δd_i + ã_n,  v = a₁ Σ S_i Δd_i + ṽ_n,   a₀ = 1/(βΔt²), a₁ = γ/(βΔt),
+//! with predictors ã_n = −v_n/(βΔt) − (1/(2β) − 1) a_n and ṽ_n = −(γ/β − 1) v_n − (γ/(2β) − 1)Δt a_n
+//! of the nodal v_n, a_n of [003] Eq. 19, interpolated to the point (the caller passes them as
+//! [`Predictors`]: the predictors are linear in v_n and a_n, so interpolating nodal predictors and
+//! forming predictors from interpolated values is the same).
 //! The residual of a particle at its stencil node i is
 //!   R_u,i = S_i [m_s a_u + c (v_u − v_U) − m_s b] + B̄_iᵀ (σ' − (1 − n) m p) V         ([003] 16a,c,d, 23a)
 //!   R_U,i = S_i [m_w a_U + c (v_U − v_u) − m_w b] − ∇̄S_i n p V                         ([003] 16b,d,e, 23c)
@@ -73,14 +77,15 @@ pub fn plain_basis(st: &Stencil, out: &mut Vec<NodeBasis>) {
     out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k] }));
 }
 
-/// Nodal values seen by a particle: the increment Δd, and a, v at t_{n+1} (u and U components).
+/// Nodal values seen by a particle: the increment Δd and its parts a₀Δd, a₁Δd of the acceleration
+/// and velocity at t_{n+1} (the particle adds its predictors).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NodeState {
     /// Δd (two-phase: [Δux, Δuy, Δp, ΔUx, ΔUy]; one-phase: [Δux, Δuy, ...]).
     pub d: [f64; MAX_DOF],
-    /// Acceleration at t_{n+1}.
+    /// a₀ Δd.
     pub a: [f64; MAX_DOF],
-    /// Velocity at t_{n+1}.
+    /// a₁ Δd.
     pub v: [f64; MAX_DOF],
 }
 
@@ -107,21 +112,59 @@ pub struct ParticleInput {
     pub body_acc: [f64; 2],
     /// Porosity gradient ∇n at t_n [1/m] (two-phase).
     pub grad_n: [f64; 2],
+    /// Newmark predictors of the point.
+    pub pred: Predictors,
 }
 
-/// Newmark factors a₀ = 1/(βΔt²), a₁ = γ/(βΔt).
+/// Newmark factors a₀ = 1/(βΔt²), a₁ = γ/(βΔt) of a step of length Δt.
 #[derive(Debug, Clone, Copy)]
 pub struct Newmark {
     /// 1/(βΔt²).
     pub a0: f64,
     /// γ/(βΔt).
     pub a1: f64,
+    beta: f64,
+    gamma: f64,
+    dt: f64,
 }
 
 impl Newmark {
     /// Factors for step `dt`.
     pub fn new(beta: f64, gamma: f64, dt: f64) -> Newmark {
-        Newmark { a0: 1.0 / (beta * dt * dt), a1: gamma / (beta * dt) }
+        Newmark { a0: 1.0 / (beta * dt * dt), a1: gamma / (beta * dt), beta, gamma, dt }
+    }
+
+    /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
+    /// at Δd = 0).
+    pub fn predict(&self, v: [f64; 2], a: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let (b, g, dt) = (self.beta, self.gamma, self.dt);
+        let pa = |c: usize| -v[c] / (b * dt) - (0.5 / b - 1.0) * a[c];
+        let pv = |c: usize| -(g / b - 1.0) * v[c] - (0.5 * g / b - 1.0) * dt * a[c];
+        ([pa(0), pa(1)], [pv(0), pv(1)])
+    }
+}
+
+/// Newmark predictors at a material point: the acceleration and velocity at t_{n+1} for a zero
+/// displacement increment.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Predictors {
+    /// ã_n of the solid [m/s²].
+    pub a_u: [f64; 2],
+    /// ṽ_n of the solid [m/s].
+    pub v_u: [f64; 2],
+    /// ã_n of the water [m/s²] (two-phase).
+    pub a_w: [f64; 2],
+    /// ṽ_n of the water [m/s] (two-phase).
+    pub v_w: [f64; 2],
+}
+
+impl Predictors {
+    /// The predictors for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and accelerations
+    /// at t_n (the nodal values interpolated to the point).
+    pub fn new(nm: &Newmark, v_u: [f64; 2], a_u: [f64; 2], v_w: [f64; 2], a_w: [f64; 2]) -> Predictors {
+        let (pa_u, pv_u) = nm.predict(v_u, a_u);
+        let (pa_w, pv_w) = nm.predict(v_w, a_w);
+        Predictors { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
     }
 }
 
@@ -161,9 +204,13 @@ pub struct Kinematics {
     pub dw: [f64; 2],
 }
 
-/// Interpolates nodal values to the particle.
-pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], two_phase: bool) -> Kinematics {
-    let mut k = Kinematics::default();
+/// Interpolates nodal values to the particle and adds its Newmark predictors.
+pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors, two_phase: bool) -> Kinematics {
+    let mut k = Kinematics { a_u: pred.a_u, v_u: pred.v_u, ..Kinematics::default() };
+    if two_phase {
+        k.a_w = pred.a_w;
+        k.v_w = pred.v_w;
+    }
     for (b, st) in basis.iter().zip(states) {
         for (d, row) in k.deps.iter_mut().zip(bbar(b)) {
             *d += row[0] * st.d[dof::UX] + row[1] * st.d[dof::UY];
@@ -196,7 +243,7 @@ pub fn residual(
     out: &mut [f64],
 ) -> StressUpdate {
     let nd = if two_phase { 5 } else { 2 };
-    let kin = interpolate(basis, states, two_phase);
+    let kin = interpolate(basis, states, &part.pred, two_phase);
     let upd = model.update(&part.stress, &kin.deps);
     let v = part.volume;
     let n = part.porosity;
@@ -303,13 +350,15 @@ pub fn tangent(basis: &[NodeBasis], part: &ParticleInput, dsig: &Mat4, nm: Newma
 pub struct StepResult {
     /// Interpolated kinematics at the converged increments.
     pub kin: Kinematics,
+    /// Deformation gradient of the step, I + ∇Δu (rows).
+    pub f_inc: [[f64; 2]; 2],
     /// det(I + ∇Δu): volume ratio of the step.
     pub jacobian: f64,
 }
 
 /// Kinematics of the converged step at a particle, including the volume ratio J = det(I + ∇Δu).
-pub fn step_result(basis: &[NodeBasis], states: &[NodeState], two_phase: bool) -> StepResult {
-    let kin = interpolate(basis, states, two_phase);
+pub fn step_result(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors, two_phase: bool) -> StepResult {
+    let kin = interpolate(basis, states, pred, two_phase);
     let mut f = [[1.0, 0.0], [0.0, 1.0]];
     for (b, st) in basis.iter().zip(states) {
         for (a, fa) in f.iter_mut().enumerate() {
@@ -318,7 +367,7 @@ pub fn step_result(basis: &[NodeBasis], states: &[NodeState], two_phase: bool) -
             }
         }
     }
-    StepResult { kin, jacobian: f[0][0] * f[1][1] - f[0][1] * f[1][0] }
+    StepResult { kin, f_inc: f, jacobian: f[0][0] * f[1][1] - f[0][1] * f[1][0] }
 }
 
 #[cfg(test)]
@@ -351,22 +400,42 @@ mod tests {
             p: 500.0,
             body_acc: [0.0, -9.81],
             grad_n: [0.7, -1.3],
+            pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
         }
     }
 
     /// Nodal states from increments, as the assembly builds them.
-    fn states(d: &[f64], nd: usize, nm: Newmark, pa: &[f64], pv: &[f64]) -> Vec<NodeState> {
+    fn states(d: &[f64], nd: usize, nm: Newmark) -> Vec<NodeState> {
         (0..d.len() / nd)
             .map(|k| {
                 let mut s = NodeState::default();
                 for c in 0..nd {
                     s.d[c] = d[k * nd + c];
-                    s.a[c] = nm.a0 * d[k * nd + c] + pa[k * nd + c];
-                    s.v[c] = nm.a1 * d[k * nd + c] + pv[k * nd + c];
+                    s.a[c] = nm.a0 * d[k * nd + c];
+                    s.v[c] = nm.a1 * d[k * nd + c];
                 }
                 s
             })
             .collect()
+    }
+
+    #[test]
+    fn newmark_reproduces_a_uniformly_accelerated_motion() {
+        // A point with v_n, a_n moved by Δd = v_n Δt + a_n Δt²/2 keeps a_n and reaches v_n + a_n Δt
+        // ([003] Eqs. 20–21) for any β, γ.
+        for (beta, gamma) in [(0.25, 0.5), (0.3025, 0.6)] {
+            let (dt, v, a) = (2e-3, [0.4, -1.1], [3.0, -9.81]);
+            let nm = Newmark::new(beta, gamma, dt);
+            let pred = Predictors::new(&nm, v, a, v, a);
+            let d = [v[0] * dt + 0.5 * a[0] * dt * dt, v[1] * dt + 0.5 * a[1] * dt * dt];
+            let basis = [NodeBasis { s: 1.0, g: [0.0; 2], gv: [0.0; 2] }];
+            let st = states(&[d[0], d[1], 0.0, d[0], d[1]], 5, nm);
+            let k = interpolate(&basis, &st, &pred, true);
+            for c in 0..2 {
+                assert!((k.a_u[c] - a[c]).abs() < 1e-9 && (k.a_w[c] - a[c]).abs() < 1e-9, "{k:?}");
+                assert!((k.v_u[c] - (v[c] + a[c] * dt)).abs() < 1e-12, "{k:?}");
+            }
+        }
     }
 
     /// The tangent is the derivative of the residual, block by block (u–u, u–p, u–U, p–*, U–*).
@@ -379,11 +448,9 @@ mod tests {
             let nm = Newmark::new(0.25, 0.5, 1e-3);
             let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
             let d0: Vec<f64> = (0..m).map(|i| 1e-5 * ((i as f64) * 0.37).sin()).collect();
-            let pa: Vec<f64> = (0..m).map(|i| 0.3 * ((i as f64) * 1.7).cos()).collect();
-            let pv: Vec<f64> = (0..m).map(|i| 0.01 * ((i as f64) * 0.3).cos()).collect();
             let p = part();
             let mut r0 = vec![0.0; m];
-            let upd = residual(&basis, &states(&d0, nd, nm, &pa, &pv), &p, &model, two_phase, &mut r0);
+            let upd = residual(&basis, &states(&d0, nd, nm), &p, &model, two_phase, &mut r0);
             // A dirty buffer: the kernel must write every entry (the assembly reuses its buffer).
             let mut t = vec![f64::NAN; m * m];
             tangent(&basis, &p, &upd.tangent, nm, two_phase, &mut t);
@@ -396,8 +463,8 @@ mod tests {
                 dp[c] += h;
                 dm[c] -= h;
                 let (mut rp, mut rm) = (vec![0.0; m], vec![0.0; m]);
-                residual(&basis, &states(&dp, nd, nm, &pa, &pv), &p, &model, two_phase, &mut rp);
-                residual(&basis, &states(&dm, nd, nm, &pa, &pv), &p, &model, two_phase, &mut rm);
+                residual(&basis, &states(&dp, nd, nm), &p, &model, two_phase, &mut rp);
+                residual(&basis, &states(&dm, nd, nm), &p, &model, two_phase, &mut rm);
                 for r in 0..m {
                     let fd = (rp[r] - rm[r]) / (2.0 * h);
                     let e = worst.entry((r % nd, c % nd)).or_insert(0.0);
@@ -434,6 +501,7 @@ mod tests {
         p.stress = [0.0; 4];
         p.p = 0.0;
         p.grad_n = [0.0; 2];
+        p.pred = Predictors::default();
         let st = vec![NodeState::default(); 4];
         let mut r = vec![0.0; 20];
         residual(&basis, &st, &p, &Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)), true, &mut r);
@@ -466,8 +534,10 @@ mod tests {
                 s
             })
             .collect();
-        let r = step_result(&basis, &st, false);
+        let r = step_result(&basis, &st, &Predictors::default(), false);
         assert!((r.jacobian - 0.99 * 0.98).abs() < 1e-14);
+        assert!((r.f_inc[0][0] - 0.99).abs() < 1e-14 && (r.f_inc[1][1] - 0.98).abs() < 1e-14);
+        assert!(r.f_inc[0][1].abs() < 1e-14 && r.f_inc[1][0].abs() < 1e-14);
         assert!((r.kin.deps[0] + 0.01).abs() < 1e-14 && (r.kin.deps[1] + 0.02).abs() < 1e-14);
         assert!((r.kin.du[0] + 0.003).abs() < 1e-14);
     }

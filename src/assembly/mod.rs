@@ -4,8 +4,9 @@
 //! distribution of nodes over ranks, ghost nodes and matrix preallocation come from PETSc. Every
 //! step ([`GridSystem::prepare_step`]):
 //! 1. each particle's stencil (nodes, S, ∇S) is computed once on the configuration x_n;
-//! 2. masses, momenta and mass-weighted accelerations are mapped to the nodes ([003] Eq. 19) and
-//!    summed over ranks; they give the Newmark predictors of every nodal dof;
+//! 2. masses, momenta, mass-weighted accelerations and porosities are mapped to the nodes ([003]
+//!    Eq. 19) and summed over ranks; interpolated back, they give each particle its Newmark
+//!    predictors and its porosity gradient;
 //! 3. a node is active when the weights of the particles reaching it sum to more than
 //!    [`ACTIVE_WEIGHT`]; dofs of inactive nodes and the components fixed by active boundaries are
 //!    constrained (residual x − 0, identity row and zero column in the tangent);
@@ -72,9 +73,6 @@ struct StepData {
     nm: Option<kernels::Newmark>,
     body_acc: [f64; 2],
     stencils: Stencils,
-    /// Newmark predictors ã_n, ṽ_n per ghosted dof.
-    pred_a: Vec<f64>,
-    pred_v: Vec<f64>,
     /// External nodal forces at t_{n+1} (tractions) per ghosted dof.
     fext: Vec<f64>,
     /// Constrained flag per ghosted dof.
@@ -89,6 +87,8 @@ struct StepData {
     active: Vec<bool>,
     /// Porosity gradient at each particle at t_n (two-phase).
     grad_n: Vec<[f64; 2]>,
+    /// v_u, a_u, v_w, a_w at t_n at each particle, from the nodal projections.
+    smooth: Vec<[[f64; 2]; 4]>,
     /// Unknowns solved for (unconstrained dofs), summed over ranks.
     free_dofs: usize,
 }
@@ -406,20 +406,29 @@ impl GridSystem {
         }
         let free_dofs = self.comm.sum_usize(free).map_err(|e| e.to_string())?;
 
-        // Newmark predictors ([003] Eq. 21) from v_n = momentum/mass, a_n = (mass-weighted a)/mass.
-        let (beta, gamma) = (model.beta, model.gamma);
-        let mut pred_a = vec![0.0; ng];
-        let mut pred_v = vec![0.0; ng];
-        for q in 0..ng {
-            let c = q % nd;
-            if constrained[q] || c == 2 && self.two_phase || mass[q] <= 0.0 {
-                continue;
-            }
-            let v = mom[q] / mass[q];
-            let a = acc[q] / mass[q];
-            pred_a[q] = -v / (beta * dt) - (0.5 / beta - 1.0) * a;
-            pred_v[q] = -(gamma / beta - 1.0) * v - (0.5 * gamma / beta - 1.0) * dt * a;
-        }
+        // Velocities and accelerations at t_n interpolated back from the nodal projections ([003]
+        // Eq. 19b–c): the predictors of [003] Eq. 21 formed on the nodes and interpolated to a point
+        // are the predictors of these values (they are linear in v and a). A constrained component
+        // has zero velocity and acceleration.
+        let smooth: Vec<[[f64; 2]; 4]> = (0..stencils.len())
+            .map(|k| {
+                let (nodes, basis) = stencils.get(k);
+                let mut out = [[0.0; 2]; 4];
+                for (&node, nb) in nodes.iter().zip(basis) {
+                    let b = node as usize * nd;
+                    // (dof, slot of its velocity in `out`, component): solid x, y, then water x, y.
+                    for (c, slot, comp) in [(0, 0, 0), (1, 0, 1), (3, 2, 0), (4, 2, 1)] {
+                        let q = b + c;
+                        if c >= nd || constrained[q] || mass[q] <= 0.0 {
+                            continue;
+                        }
+                        out[slot][comp] += nb.s * mom[q] / mass[q];
+                        out[slot + 1][comp] += nb.s * acc[q] / mass[q];
+                    }
+                }
+                out
+            })
+            .collect();
 
         // 4. Tractions at t_{n+1}.
         let mut fext = vec![0.0; ng];
@@ -429,10 +438,7 @@ impl GridSystem {
             match &load.target {
                 LoadTarget::ParticleTraction { particles, face, traction } => {
                     // The traction acts at the centre of the particle's loaded face (force = traction ×
-                    // face length), with the linear weights of the cell holding the particle's centre
-                    // (extrapolated when the face lies in the next cell): exact for a surface on a grid
-                    // line, and never loading a node that the particle barely reaches (such a node has
-                    // a vanishing mass and stiffness and would be driven without bound).
+                    // current face length) with the bilinear weights there (see shape::face_weights).
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
                         let (point, length) = match face {
@@ -441,7 +447,7 @@ impl GridSystem {
                             Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
                             Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
                         };
-                        let w = shape::face_weights(&model.grid, x, point);
+                        let w = shape::face_weights(&model.grid, point);
                         for ((i, j), s, _) in w.iter() {
                             let l =
                                 self.local_node(i, j).ok_or("a traction point lies outside this rank's ghost region")?
@@ -473,8 +479,6 @@ impl GridSystem {
             nm: Some(nm),
             body_acc: model.body_acceleration(active, t_new),
             stencils,
-            pred_a,
-            pred_v,
             fext,
             constrained,
             owned_constrained,
@@ -482,6 +486,7 @@ impl GridSystem {
             solution: Vec::new(),
             active: (0..self.ghost.len()).map(|l| weight[l * nd] > ACTIVE_WEIGHT).collect(),
             grad_n,
+            smooth,
             free_dofs,
         };
         // The matrix structure is the union of the particles' node couplings over the free dofs.
@@ -571,19 +576,20 @@ impl GridSystem {
             active: &self.step.active,
         };
         (0..model.particles.len())
-            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(k).kin.dp))
+            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).kin.dp))
             .collect()
     }
 
     /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.
-    pub fn step_result(&self, k: usize) -> StepResult {
+    pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
         let (nodes, basis) = self.step.stencils.get(k);
         let states = node_states(nodes, &self.step.solution, &self.step, self.ndof);
-        kernels::step_result(basis, &states[..nodes.len()], self.two_phase)
+        let pred = particle_input(model, &self.step, k).pred;
+        kernels::step_result(basis, &states[..nodes.len()], &pred, self.two_phase)
     }
 }
 
-/// Nodal states of a particle's stencil from the increments `xl` and the step's predictors.
+/// Nodal states of a particle's stencil from the increments `xl`.
 #[inline]
 fn node_states(nodes: &[u32], xl: &[f64], step: &StepData, nd: usize) -> [NodeState; MAX_NODES] {
     let nm = step.nm.expect("prepared");
@@ -593,8 +599,8 @@ fn node_states(nodes: &[u32], xl: &[f64], step: &StepData, nd: usize) -> [NodeSt
         for c in 0..nd {
             let d = xl[b + c];
             out[n].d[c] = d;
-            out[n].a[c] = nm.a0 * d + step.pred_a[b + c];
-            out[n].v[c] = nm.a1 * d + step.pred_v[b + c];
+            out[n].a[c] = nm.a0 * d;
+            out[n].v[c] = nm.a1 * d;
         }
     }
     out
@@ -623,6 +629,9 @@ fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::Particle
     if let Some(g) = step.grad_n.get(k) {
         input.grad_n = *g;
     }
+    let nm = step.nm.as_ref().expect("prepared");
+    let s = &step.smooth[k];
+    input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
     input
 }
 
@@ -690,7 +699,7 @@ impl NonlinearProblem for Assembler<'_> {
             let m = nodes.len() * nd;
             // The soil tangent at the current iterate.
             let states = node_states(nodes, &xl, self.step, nd);
-            let kin = kernels::interpolate(basis, &states[..nodes.len()], self.two_phase);
+            let kin = kernels::interpolate(basis, &states[..nodes.len()], &input.pred, self.two_phase);
             let dsig = mat.model.update(&input.stress, &kin.deps).tangent;
             kernels::tangent(basis, &input, &dsig, nm, self.two_phase, &mut block[..m * m]);
             for (n, &node) in nodes.iter().enumerate() {

@@ -57,7 +57,9 @@ pub struct Case {
 pub struct Analysis {
     /// `two_phase`: the u–p–U system (5 dofs per node); `one_phase`: total-stress u system (2 dofs).
     pub formulation: Formulation,
-    /// Basis functions: `gimp` (uGIMP, [003] Eqs. 13–15) or `linear` (standard MPM).
+    /// Basis functions: `gimp` (GIMP, [003] Eqs. 13–15, with particle domains that follow the
+    /// material stretch as in iGIMP), `ugimp` (GIMP with the undeformed domains) or `linear`
+    /// (standard MPM).
     #[serde(default = "default_shape")]
     pub shape_functions: ShapeFunctions,
     /// Gravitational acceleration g [m/s²] used in Darcy's law (γ_w = ρ_w g). It is a material
@@ -87,8 +89,15 @@ pub enum Formulation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ShapeFunctions {
-    /// Undeformed GIMP: particle domain of half-width l_p = h / (2 × particles per cell).
+    /// GIMP whose particle domains follow the deformation: the half-widths are
+    /// l_p = l_p0 ⊙ diag(U) with U = sqrt(FᵀF) the right stretch tensor (Charlton, Coombs & Augarde
+    /// 2017, iGIMP; as in AMPLE), starting from l_p0 = h / (2 × particles per cell). The domain then
+    /// keeps the particle's volume under compression or extension along the grid axes, so a surface
+    /// particle's domain ends at the material's surface.
     Gimp,
+    /// Undeformed GIMP (uGIMP): the domains keep l_p0 for the whole run. Adequate for small strains;
+    /// under large compression the domain outgrows the particle's volume.
+    Ugimp,
     /// Standard MPM: bilinear hat functions evaluated at the particle.
     Linear,
 }
@@ -430,8 +439,9 @@ impl TimeFunction {
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Stabilisation {
-    /// MLSA patch recovery of the pore-pressure increments ([003] §3.3, Eqs. 26–30). Default: on in
-    /// two-phase analyses.
+    /// MLSA patch recovery of the pore-pressure increments ([003] §3.3, Eqs. 26–30). Default: off
+    /// (see `DEFAULT_PATCH_RECOVERY` in crate::model for the measurements behind that choice); cases
+    /// with large deformations need it.
     #[serde(default)]
     pub patch_recovery: Option<bool>,
     /// B̄ for GIMP ([000] §3, Eqs. 12–16): the volumetric part of B from cell-centre gradients weighted
@@ -616,6 +626,9 @@ pub enum Verification {
         /// Pass threshold for e_p ([003] Eq. 33).
         #[serde(default = "default_ep_tol")]
         e_p_tolerance: f64,
+        /// Pass threshold for the plain RMS of the normalised pressure error.
+        #[serde(default = "default_rms_tol")]
+        p_rms_tolerance: f64,
         /// Pass threshold for the relative settlement error.
         #[serde(default = "default_ls_settle_tol")]
         settlement_tolerance: f64,

@@ -322,11 +322,19 @@ pub fn validate(c: &Case) -> R {
                 positive("verification.settlement_tolerance", *settlement_tolerance)?;
                 (body, gravity)
             }
-            Verification::LargeStrainConsolidation { body, load, degrees, e_p_tolerance, settlement_tolerance } => {
+            Verification::LargeStrainConsolidation {
+                body,
+                load,
+                degrees,
+                e_p_tolerance,
+                p_rms_tolerance,
+                settlement_tolerance,
+            } => {
                 if degrees.is_empty() || degrees.iter().any(|u| !(*u > 0.0 && *u < 1.0)) {
                     return Err("key `verification.degrees`: give degrees of consolidation in (0, 1)".into());
                 }
                 positive("verification.e_p_tolerance", *e_p_tolerance)?;
+                positive("verification.p_rms_tolerance", *p_rms_tolerance)?;
                 positive("verification.settlement_tolerance", *settlement_tolerance)?;
                 (body, load)
             }

@@ -203,15 +203,16 @@ impl BoundaryDef {
         BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone() }
     }
 
-    /// Whether a node at `node` lies beyond the exposed `face` of a particle at `x`: the grid nodes
-    /// that carry a moving surface's condition are those of the surface particles' stencils on the
-    /// outer side of the particle centre.
-    pub fn beyond(face: Side, x: [f64; 2], node: [f64; 2]) -> bool {
+    /// Whether a node at `node` lies on or beyond the exposed `face` of a particle at `x` with domain
+    /// half-widths `lp` (within `tol`): the grid nodes that carry a moving surface's condition are
+    /// those of the surface particles' stencils outside the material, so that no node inside the
+    /// material is constrained.
+    pub fn beyond(face: Side, x: [f64; 2], lp: [f64; 2], node: [f64; 2], tol: f64) -> bool {
         match face {
-            Side::XMin => node[0] < x[0],
-            Side::XMax => node[0] > x[0],
-            Side::YMin => node[1] < x[1],
-            Side::YMax => node[1] > x[1],
+            Side::XMin => node[0] <= x[0] - lp[0] + tol,
+            Side::XMax => node[0] >= x[0] + lp[0] - tol,
+            Side::YMin => node[1] <= x[1] - lp[1] + tol,
+            Side::YMax => node[1] >= x[1] + lp[1] - tol,
         }
     }
 

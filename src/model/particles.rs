@@ -21,8 +21,13 @@ pub struct Particles {
     pub x0: Vec<[f64; 2]>,
     /// Total solid displacement [m].
     pub disp: Vec<[f64; 2]>,
-    /// Half-widths of the (undeformed) GIMP domain l_p [m].
+    /// Half-widths of the GIMP domain l_p [m] (see `ShapeFunctions::Gimp` for how they follow the
+    /// deformation).
     pub lp: Vec<[f64; 2]>,
+    /// Half-widths of the GIMP domain at t = 0 [m].
+    pub lp0: Vec<[f64; 2]>,
+    /// In-plane deformation gradient F = ∂x/∂X of the solid, rows [[F_xx, F_xy], [F_yx, F_yy]] [-].
+    pub def_grad: Vec<[[f64; 2]; 2]>,
     /// Volume per metre of thickness [m²·1 m].
     pub volume: Vec<f64>,
     /// Porosity [-].
@@ -101,6 +106,8 @@ impl Particles {
                             ps.x0.push(x);
                             ps.disp.push([0.0; 2]);
                             ps.lp.push(lp);
+                            ps.lp0.push(lp);
+                            ps.def_grad.push([[1.0, 0.0], [0.0, 1.0]]);
                             ps.volume.push(vol);
                             ps.porosity.push(mat.porosity);
                             ps.mass.push(mass);

@@ -115,6 +115,20 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
     (out, n)
 }
 
+/// The right stretch tensor U = sqrt(FᵀF) of an in-plane deformation gradient F (polar
+/// decomposition F = RU), in closed form for 2 × 2: with C = FᵀF, s = sqrt(det C) and
+/// t = sqrt(tr C + 2s), U = (C + s I)/t. Its diagonal scales the GIMP domains (iGIMP, Charlton et
+/// al. 2017): a rigid rotation leaves them unchanged, a stretch along an axis scales that axis.
+pub fn right_stretch(f: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let c = [
+        [f[0][0] * f[0][0] + f[1][0] * f[1][0], f[0][0] * f[0][1] + f[1][0] * f[1][1]],
+        [f[0][1] * f[0][0] + f[1][1] * f[1][0], f[0][1] * f[0][1] + f[1][1] * f[1][1]],
+    ];
+    let s = (c[0][0] * c[1][1] - c[0][1] * c[1][0]).max(0.0).sqrt();
+    let t = (c[0][0] + c[1][1] + 2.0 * s).sqrt();
+    [[(c[0][0] + s) / t, c[0][1] / t], [c[1][0] / t, (c[1][1] + s) / t]]
+}
+
 /// Builds the stencil of a particle at `x` with half-widths `lp` on `grid`.
 pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil {
     let (wx, nx) = weights_1d(basis, x[0], lp[0], grid.origin[0], grid.h[0], grid.cells[0]);
@@ -132,16 +146,19 @@ pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil 
     s
 }
 
-/// Weights for a force acting at `point` on the face of a particle centred at `centre`: the bilinear
-/// functions of the cell holding the centre, evaluated (or extrapolated, by at most half a cell) at
-/// the point. For a face inside that cell these are the plain linear weights; for a face that has
-/// moved into the next cell they keep the force on the nodes the particle is attached to.
-pub fn face_weights(grid: &Grid, centre: [f64; 2], point: [f64; 2]) -> Stencil {
+/// Weights for a force acting at `point` on the face of a particle: the bilinear hat functions
+/// N_i(point) of the cell holding the point (points on the grid's edge belong to its last cell).
+/// They are consistent with GIMP's internal force when the particle domain ends at the material's
+/// surface (domains that follow the stretch, `ShapeFunctions::Gimp`): for a uniform stress σ,
+/// ∫_Ω_p ∇N_i σ dV = N_i(x_face) σ A_face − N_i(x_opposite) σ A_face, so a surface traction equal to σ
+/// is balanced node by node, and it moves continuously as the surface crosses grid lines.
+pub fn face_weights(grid: &Grid, point: [f64; 2]) -> Stencil {
     let mut s = Stencil::default();
     let mut w = [[(0u32, 0.0); 2]; 2];
     for d in 0..2 {
-        let c = ((centre[d] - grid.origin[d]) / grid.h[d]).floor().clamp(0.0, (grid.cells[d] - 1) as f64);
-        let xi = (point[d] - grid.origin[d]) / grid.h[d] - c;
+        let r = ((point[d] - grid.origin[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64);
+        let c = r.floor().min((grid.cells[d] - 1) as f64);
+        let xi = r - c;
         w[d] = [(c as u32, 1.0 - xi), (c as u32 + 1, xi)];
     }
     for &(j, wy) in &w[1] {
@@ -225,6 +242,26 @@ pub fn volumetric_gradients(
 mod tests {
     use super::*;
 
+    #[test]
+    fn the_right_stretch_ignores_rotation_and_squares_to_ftf() {
+        let (c, sn) = (0.6f64.cos(), 0.6f64.sin());
+        let stretch = [[1.3, 0.2], [0.2, 0.7]];
+        // F = R U with R a rotation by 0.6 rad.
+        let f = [
+            [c * stretch[0][0] - sn * stretch[1][0], c * stretch[0][1] - sn * stretch[1][1]],
+            [sn * stretch[0][0] + c * stretch[1][0], sn * stretch[0][1] + c * stretch[1][1]],
+        ];
+        let u = right_stretch(f);
+        for a in 0..2 {
+            for b in 0..2 {
+                assert!((u[a][b] - stretch[a][b]).abs() < 1e-12, "{u:?}");
+            }
+        }
+        // Uniaxial compression: U = F.
+        let u = right_stretch([[1.0, 0.0], [0.0, 0.82]]);
+        assert!((u[0][0] - 1.0).abs() < 1e-15 && (u[1][1] - 0.82).abs() < 1e-15 && u[0][1].abs() < 1e-15);
+    }
+
     fn grid() -> Grid {
         Grid::new([0.0, 0.0], [0.5, 0.25], [10, 10])
     }
@@ -255,22 +292,39 @@ mod tests {
     }
 
     #[test]
-    fn face_weights_stay_on_the_cell_of_the_particle() {
+    fn face_weights_are_the_hat_functions_and_move_continuously() {
         let g = grid();
         let top = g.extent_max()[1];
         // A face on the grid's edge loads the edge nodes, also a hair beyond it.
-        for y in [top, top * (1.0 + 1e-15), top + 1e-3] {
-            let w = face_weights(&g, [1.1, top - 0.06], [1.1, y]);
+        for y in [top, top * (1.0 + 1e-15)] {
+            let w = face_weights(&g, [1.1, y]);
             let edge: f64 = w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum();
-            assert!((edge - 1.0).abs() < 0.01, "y = {y:e}: {edge}");
-            assert!((w.iter().map(|(_, s, _)| s).sum::<f64>() - 1.0).abs() < 1e-12);
+            assert!((edge - 1.0).abs() < 1e-12, "y = {y:e}: {edge}");
         }
-        // A face that crossed into the next cell extrapolates from the particle's cell: the node
-        // beyond the crossed grid line takes nothing.
-        let w = face_weights(&g, [1.1, 0.74], [1.1, 0.76]);
-        assert!(w.iter().all(|((_, j), _, _)| j <= 3), "{:?}", &w.nodes[..w.len]);
-        let w3: f64 = w.iter().filter(|((_, j), _, _)| *j == 3).map(|(_, s, _)| s).sum();
-        assert!((w3 - 1.04).abs() < 1e-12, "{w3}");
+        // Crossing the grid line y = 0.75 changes no weight by more than the motion.
+        let (a, b) = (face_weights(&g, [1.1, 0.75 - 1e-9]), face_weights(&g, [1.1, 0.75 + 1e-9]));
+        for j in 2..=4u32 {
+            let on = |w: &Stencil| -> f64 { w.iter().filter(|((_, jj), _, _)| *jj == j).map(|(_, s, _)| s).sum() };
+            assert!((on(&a) - on(&b)).abs() < 1e-7, "row {j}: {} vs {}", on(&a), on(&b));
+        }
+        assert!((a.iter().map(|(_, s, _)| s).sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn face_weights_balance_the_gimp_internal_force_of_a_uniform_stress() {
+        // ∫_Ω_p ∂S_i/∂y dV (GIMP, [003] Eq. 14 times V) equals the top-face weights minus the
+        // bottom-face weights times the face length, for domains across a horizontal grid line.
+        let g = grid();
+        for (x, lp) in [([1.2, 0.74], [0.1, 0.05]), ([1.2, 0.78], [0.2, 0.03]), ([1.2, 0.9], [0.2, 0.1])] {
+            let st = stencil(Basis::Gimp, &g, x, lp);
+            let (top, bottom) = (face_weights(&g, [x[0], x[1] + lp[1]]), face_weights(&g, [x[0], x[1] - lp[1]]));
+            let v = 4.0 * lp[0] * lp[1];
+            for (node, _, dw) in st.iter() {
+                let at = |w: &Stencil| w.iter().filter(|(n, _, _)| *n == node).map(|(_, s, _)| s).sum::<f64>();
+                let expected = (at(&top) - at(&bottom)) * 2.0 * lp[0];
+                assert!((dw[1] * v - expected).abs() < 1e-12, "{x:?} {node:?}: {} vs {expected}", dw[1] * v);
+            }
+        }
     }
 
     #[test]

@@ -164,7 +164,14 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
             let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
             Box::new(ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)?)
         }
-        Verification::LargeStrainConsolidation { body, load, degrees, e_p_tolerance, settlement_tolerance } => {
+        Verification::LargeStrainConsolidation {
+            body,
+            load,
+            degrees,
+            e_p_tolerance,
+            p_rms_tolerance,
+            settlement_tolerance,
+        } => {
             let col = Column::from_case(c, model, body, load)?;
             let bi = col.body as usize;
             let law =
@@ -191,7 +198,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                     result: None,
                 })
                 .collect();
-            let tol = (*e_p_tolerance, *e_p_tolerance, *settlement_tolerance);
+            let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
             Box::new(ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)?)
         }
         Verification::HarmonicColumn { body, load, measure_periods, tolerance } => {
