@@ -1,6 +1,6 @@
 //! `porompm check`: what a case will build, computed without PETSc (one process).
 
-use crate::assembly::ACTIVE_WEIGHT;
+use crate::assembly::MIN_FILLED_FRACTION;
 use crate::case::{Case, Load, SoilModel};
 use crate::model::{shape, Model};
 use std::fmt::Write;
@@ -51,20 +51,21 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     let _ = writeln!(s, "material points: {}", model.particles.len());
 
-    // Active nodes and unknowns of the first step.
-    let mut weight = vec![0.0; g.node_count()];
+    // Active nodes (filled fraction of their support, as in crate::assembly) and unknowns of the
+    // first step.
+    let mut filled = vec![0.0; g.node_count()];
     for k in 0..model.particles.len() {
         let st = shape::stencil(model.basis, g, model.particles.x[k], model.particles.lp[k]);
         for ((i, j), w, _) in st.iter() {
-            weight[j as usize * g.nodes()[0] + i as usize] += w;
+            filled[j as usize * g.nodes()[0] + i as usize] += w * model.particles.volume[k] / (g.h[0] * g.h[1]);
         }
     }
-    let active_nodes = weight.iter().filter(|&&w| w > ACTIVE_WEIGHT).count();
+    let active_nodes = filled.iter().filter(|&&f| f > MIN_FILLED_FRACTION).count();
     let first = model.active(&case.stages[0]);
     let mut unknowns = 0;
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {
-            if weight[j * g.nodes()[0] + i] > ACTIVE_WEIGHT {
+            if filled[j * g.nodes()[0] + i] > MIN_FILLED_FRACTION {
                 let fixed = model.fixed_components(&first, i, j);
                 unknowns += (0..nd).filter(|&c| !fixed[c]).count();
             }

@@ -281,8 +281,8 @@ pub struct Boundary {
     /// Nodes inside this box (give one of `side`, `region`, `surface`).
     #[serde(default)]
     pub region: Option<Region>,
-    /// The moving surface of a body: the nodes beyond the exposed faces of its boundary particles,
-    /// found again every step (a drained free surface: `fix = ["p"]`).
+    /// The moving surface of a body: the nodes on or beyond the exposed faces of its boundary
+    /// particles, found again every step (a drained free surface: `fix = ["p"]`).
     #[serde(default)]
     pub surface: Option<Surface>,
     /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained).
