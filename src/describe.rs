@@ -86,12 +86,28 @@ pub fn describe(case: &Case, label: &str) -> String {
         };
         let _ = writeln!(s, "load `{}`: {kind}", l.name);
     }
-    for b in &model.boundaries {
+    for (bi, b) in model.boundaries.iter().enumerate() {
+        let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
+        if let Some(list) = &b.surface {
+            // Resolved per step; at t = 0 from the particles' faces.
+            let only = crate::model::Active { loads: Vec::new(), boundaries: vec![bi] };
+            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only).into_iter().map(|(n, _)| n).collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            let _ = writeln!(
+                s,
+                "boundary `{}`: {} fixed on a moving surface of {} particle faces ({} nodes at t = 0)",
+                b.name,
+                fix.join(", "),
+                list.len(),
+                nodes.len()
+            );
+            continue;
+        }
         let count = (0..g.nodes()[1])
             .flat_map(|j| (0..g.nodes()[0]).map(move |i| (i, j)))
             .filter(|&(i, j)| b.contains(g, i, j))
             .count();
-        let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
         let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
     }
     for st in &case.stages {
@@ -110,9 +126,16 @@ pub fn describe(case: &Case, label: &str) -> String {
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
     let _ = writeln!(
         s,
-        "features: gravity {}; return mapping {}; B-bar off; patch recovery off",
+        "features: gravity {}; return mapping {}; B-bar {}; patch recovery {}; GIMP domains {}",
         if gravity { "on" } else { "off" },
-        if model.materials.iter().all(|m| m.model.is_linear()) { "never called (elastic)" } else { "on" }
+        if model.materials.iter().all(|m| m.model.is_linear()) { "never called (elastic)" } else { "on" },
+        if model.bbar { "on" } else { "off" },
+        if model.patch_recovery { "on" } else { "off" },
+        match (model.basis, model.stretch_domains) {
+            (crate::model::shape::Basis::Linear, _) => "none (linear basis)",
+            (_, true) => "follow the stretch",
+            (_, false) => "undeformed",
+        }
     );
     let _ = writeln!(s, "Newmark: β = {}, γ = {}", case.time_integration.beta, case.time_integration.gamma);
     let _ = writeln!(

@@ -8,10 +8,14 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn run(label: &str, sets: &[String]) -> Value {
+    run_case("terzaghi", label, sets)
+}
+
+fn run_case(case: &str, label: &str, sets: &[String]) -> Value {
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("studies").join(label);
     let _ = std::fs::remove_dir_all(&out);
     let mut args: Vec<String> =
-        vec!["run".into(), "cases/terzaghi.toml".into(), "--out".into(), out.display().to_string(), "--quiet".into()];
+        vec!["run".into(), format!("cases/{case}.toml"), "--out".into(), out.display().to_string(), "--quiet".into()];
     for s in sets {
         args.push("--set".into());
         args.push(s.clone());
@@ -95,4 +99,35 @@ fn terzaghi_time_step() {
         assert!(value(&s, "e_p_Tv0.5") <= 1e-2, "e_p target at Δt = {dt}");
     }
     save("terzaghi_time_step.md", &text);
+}
+
+/// Large-strain consolidation ([003] §4.2, Fig. 10): refinement 10 → 20 → 40 cells at the case's
+/// Δt = 1e-4 s. The settlement error at U_s = 0.5 must fall at every refinement and stay within 3 %
+/// at 10 cells.
+#[test]
+#[ignore]
+fn large_strain_consolidation_grid_refinement() {
+    let mut text = String::from(
+        "## Large-strain consolidation: grid refinement (column 0.1 × 1.0 m, 200 kPa, Xie & Leo 2004)\n\n\
+         | cells | h [m] | e_p(U_s=0.5) | RMS(U_s=0.5) | settlement error | order (settlement) | wall [s] |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    let mut errors = Vec::new();
+    for n in [10, 20, 40] {
+        let s = run_case("large_strain_consolidation", &format!("large-strain-{n}"), &[format!("grid.cells=[1,{n}]")]);
+        let se = value(&s, "settlement_rel_error_Us0.5");
+        let order = errors.last().map(|p: &f64| format!("{:.2}", (p / se).log2())).unwrap_or_else(|| "–".into());
+        let _ = writeln!(
+            text,
+            "| {n} | {:.4} | {:.3e} | {:.3e} | {se:.3e} | {order} | {:.2} |",
+            1.0 / n as f64,
+            value(&s, "e_p_Us0.5"),
+            value(&s, "p_rms_error_Us0.5"),
+            s["wall_time_s"].as_f64().unwrap()
+        );
+        errors.push(se);
+    }
+    save("large_strain_refinement.md", &text);
+    assert!(errors[0] <= 0.03, "settlement error at 10 cells: {}", errors[0]);
+    assert!(errors.windows(2).all(|w| w[1] < w[0]), "the settlement error must fall: {errors:?}");
 }
