@@ -37,6 +37,39 @@ pub fn describe(case: &Case, label: &str) -> String {
             SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
                 format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
             }
+            SoilModel::MohrCoulomb {
+                young_modulus,
+                poisson_ratio,
+                friction_angle,
+                cohesion,
+                residual_cohesion,
+                softening_strain,
+                dilation_angle,
+                critical_dilation_angle,
+                dilation_decay,
+                tension_cutoff,
+            } => {
+                let mut t = format!(
+                    "{}, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, φ = {friction_angle}°, c = {cohesion:.4e} Pa, ψ = {dilation_angle}°",
+                    if *friction_angle == 0.0 { "Tresca (Mohr–Coulomb with φ = 0)" } else { "Mohr–Coulomb" }
+                );
+                if let (Some(r), Some(e)) = (residual_cohesion, softening_strain) {
+                    t += &format!(", softening to c_r = {r:.4e} Pa at ε̄ = {e}");
+                }
+                if let Some(pc) = critical_dilation_angle {
+                    t += &format!(", ψ → {pc}° with η = {dilation_decay}");
+                }
+                if let Some(tc) = tension_cutoff {
+                    t += &format!(", tension cut-off {tc:.4e} Pa");
+                }
+                t
+            }
+            SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
+                format!(
+                    "von Mises, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, c = {cohesion:.4e} Pa → c_r = {:.4e} Pa, H_s = {softening_modulus:.4e} Pa",
+                    residual_cohesion.unwrap_or(*cohesion)
+                )
+            }
         };
         let _ = writeln!(s, "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³", m.name, m.porosity, m.solid_density);
     }

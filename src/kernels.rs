@@ -37,8 +37,8 @@
 //! Each node carries the gradient ∇S_i used for the deviatoric part of B and a gradient ∇̄S_i for the
 //! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B.
 
-use crate::model::material::{Constitutive, Mat4, StressUpdate};
 use crate::model::shape::Stencil;
+use crate::model::soil::{Constitutive, Mat4, StressUpdate};
 
 /// Largest number of stencil nodes of a particle (4 × 4, see [`crate::model::shape::MAX_STENCIL`]).
 pub const MAX_NODES: usize = crate::model::shape::MAX_STENCIL;
@@ -106,6 +106,8 @@ pub struct ParticleInput {
     pub inv_q: f64,
     /// Effective stress at t_n [Pa].
     pub stress: [f64; 4],
+    /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
+    pub eps_pd: f64,
     /// Pore pressure at t_n [Pa].
     pub p: f64,
     /// Body acceleration at t_{n+1} [m/s²].
@@ -244,7 +246,7 @@ pub fn residual(
 ) -> StressUpdate {
     let nd = if two_phase { 5 } else { 2 };
     let kin = interpolate(basis, states, &part.pred, two_phase);
-    let upd = model.update(&part.stress, &kin.deps);
+    let upd = model.update(&part.stress, part.eps_pd, &kin.deps);
     let v = part.volume;
     let n = part.porosity;
     let p_new = part.p + kin.dp;
@@ -373,7 +375,7 @@ pub fn step_result(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::material::LinearElastic;
+    use crate::model::soil::LinearElastic;
 
     fn sample(nn: usize) -> Vec<NodeBasis> {
         (0..nn)
@@ -397,6 +399,7 @@ mod tests {
             drag: 7.0e3,
             inv_q: 3.0e-9,
             stress: [-1.0e3, -2.0e3, 150.0, -1.2e3],
+            eps_pd: 0.0,
             p: 500.0,
             body_acc: [0.0, -9.81],
             grad_n: [0.7, -1.3],

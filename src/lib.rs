@@ -9,6 +9,7 @@ pub mod assembly;
 pub mod case;
 pub mod describe;
 pub mod driver;
+pub mod element_test;
 pub mod io;
 pub mod kernels;
 pub mod model;

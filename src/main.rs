@@ -65,6 +65,19 @@ enum Command {
         #[arg(last = true)]
         petsc: Vec<String>,
     },
+    /// Drive one material point of a soil model along a load path (strain, stress or mixed control)
+    /// and write element_test.csv into DIR: stress, strain, p, q, ε̄, the return's region and the
+    /// Newton residuals of the stress control per increment.
+    ElementTest {
+        /// The soil model: a TOML file with a `[model]` table as in a case's `[materials.model]`.
+        material: PathBuf,
+        /// The load path (TOML): initial stress and segments; see element_tests/ for examples.
+        #[arg(long, value_name = "PATH.toml")]
+        path: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
     /// Print the MPI and PETSc environment and check a collective operation.
     Info {
         /// PETSc options, after `--`.
@@ -203,6 +216,35 @@ fn test_jacobian(
     Ok(())
 }
 
+fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure> {
+    let mtext = io::read_text(material).map_err(input)?;
+    let m = case::element::parse_material(&mtext, &material.display().to_string()).map_err(|e| input(e.to_string()))?;
+    let ptext = io::read_text(path).map_err(input)?;
+    let p = case::element::parse_path(&ptext, &path.display().to_string()).map_err(|e| input(e.to_string()))?;
+    let model = porompm::model::material::soil_model(&m.model);
+    let rows = porompm::element_test::run(&model, &p).map_err(|e| Failure { code: 1, message: e })?;
+    let file =
+        io::write_csv(out, "element_test.csv", &porompm::element_test::HEADER, &porompm::element_test::table(&rows))
+            .map_err(input)?;
+    if let Some(last) = rows.last() {
+        let peak_q = rows.iter().map(|r| r.q()).fold(0.0, f64::max);
+        println!(
+            "{} increments; final stress [xx, yy, xy, zz] = [{:.4e}, {:.4e}, {:.4e}, {:.4e}] Pa, p = {:.4e} Pa, q = {:.4e} Pa (peak {:.4e}), ε̄ = {:.4e}",
+            rows.len(),
+            last.stress[0],
+            last.stress[1],
+            last.stress[2],
+            last.stress[3],
+            last.mean(),
+            last.q(),
+            peak_q,
+            last.eps_pd
+        );
+    }
+    println!("wrote {}", file.display());
+    Ok(())
+}
+
 fn info(petsc_args: &[String]) -> Result<(), Failure> {
     let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
         .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
@@ -234,6 +276,7 @@ fn main() -> ExitCode {
         Command::TestJacobian { case, steps, tolerance, set, petsc } => {
             test_jacobian(case, *steps, *tolerance, set, petsc)
         }
+        Command::ElementTest { material, path, out } => element_test(material, path, out),
         Command::Info { petsc } => info(petsc),
     };
     match result {

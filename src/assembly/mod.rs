@@ -706,7 +706,7 @@ impl NonlinearProblem for Assembler<'_> {
             // The soil tangent at the current iterate.
             let states = node_states(nodes, &xl, self.step, nd);
             let kin = kernels::interpolate(basis, &states[..nodes.len()], &input.pred, self.two_phase);
-            let dsig = mat.model.update(&input.stress, &kin.deps).tangent;
+            let dsig = mat.model.update(&input.stress, input.eps_pd, &kin.deps).tangent;
             kernels::tangent(basis, &input, &dsig, nm, self.two_phase, &mut block[..m * m]);
             for (n, &node) in nodes.iter().enumerate() {
                 let b = node as usize * nd;

@@ -3,6 +3,7 @@
 //! [`parse`] turns the text of a case file plus the command line's overrides into a validated
 //! [`Case`]; every error names the file, the key and what is wrong, in one line.
 
+pub mod element;
 pub mod overrides;
 pub mod schema;
 mod validate;

@@ -173,6 +173,52 @@ pub enum SoilModel {
         /// Poisson's ratio ν [-].
         poisson_ratio: f64,
     },
+    /// Mohr–Coulomb, non-associated, with linear cohesion softening, a dilation angle decaying with
+    /// plastic strain and an optional tension cut-off ([000] §4; Tresca with `friction_angle = 0`,
+    /// the cohesion being the undrained strength).
+    MohrCoulomb {
+        /// Young's modulus E [Pa].
+        young_modulus: f64,
+        /// Poisson's ratio ν [-].
+        poisson_ratio: f64,
+        /// Friction angle φ [degrees], 0 ≤ φ < 90.
+        friction_angle: f64,
+        /// Peak cohesion c_p [Pa].
+        cohesion: f64,
+        /// Residual cohesion c_r [Pa] (default: no softening).
+        #[serde(default)]
+        residual_cohesion: Option<f64>,
+        /// Accumulated deviatoric plastic strain ε_p^r at which c_r is reached [-].
+        #[serde(default)]
+        softening_strain: Option<f64>,
+        /// Initial dilation angle ψ_ini [degrees] (default 0).
+        #[serde(default)]
+        dilation_angle: f64,
+        /// Critical-state dilation angle ψ_crit [degrees] (default: ψ_ini, i.e. constant).
+        #[serde(default)]
+        critical_dilation_angle: Option<f64>,
+        /// Decay rate η ≥ 0 of ψ = ψ_crit + (ψ_ini − ψ_crit) exp(−η ε̄) [-] (default 0).
+        #[serde(default)]
+        dilation_decay: f64,
+        /// Tensile strength of a cut-off σ_i ≤ t [Pa] (default: none).
+        #[serde(default)]
+        tension_cutoff: Option<f64>,
+    },
+    /// Von Mises with linear softening ([001] §3.2): q ≤ √3 c(ε̄), c = max(c_p + H_s ε̄, c_r).
+    VonMises {
+        /// Young's modulus E [Pa].
+        young_modulus: f64,
+        /// Poisson's ratio ν [-].
+        poisson_ratio: f64,
+        /// Peak shear strength c_p [Pa].
+        cohesion: f64,
+        /// Residual shear strength c_r [Pa] (default: c_p).
+        #[serde(default)]
+        residual_cohesion: Option<f64>,
+        /// Softening modulus H_s = dc/dε̄ ≤ 0 [Pa] (default 0).
+        #[serde(default)]
+        softening_modulus: f64,
+    },
 }
 
 /// A body filled with material points.

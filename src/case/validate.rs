@@ -30,6 +30,22 @@ fn in_open(key: &str, v: f64, lo: f64, hi: f64) -> R {
     }
 }
 
+fn in_closed_open(key: &str, v: f64, lo: f64, hi: f64) -> R {
+    if v >= lo && v < hi {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be in [{lo}, {hi}), got {v}"))
+    }
+}
+
+fn non_negative(key: &str, v: f64) -> R {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be a non-negative number, got {v}"))
+    }
+}
+
 fn finite2(key: &str, v: [f64; 2]) -> R {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -81,12 +97,7 @@ pub fn validate(c: &Case) -> R {
         in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
         positive(&k("solid_density"), m.solid_density)?;
         positive(&k("water_density"), m.water_density)?;
-        match &m.model {
-            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-                positive(&k("model.young_modulus"), *young_modulus)?;
-                in_open(&k("model.poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
-            }
-        }
+        soil_model(&k("model"), &m.model)?;
         if two_phase {
             for (f, v) in
                 [("water_bulk_modulus", m.water_bulk_modulus), ("hydraulic_conductivity", m.hydraulic_conductivity)]
@@ -374,6 +385,86 @@ pub fn validate(c: &Case) -> R {
                         "key `verification`: the consolidation and wave references need a two_phase analysis".into()
                     );
                 }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks a soil model's parameters; `prefix` is the key of its table (e.g. `materials[0].model`).
+pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
+    let k = |f: &str| format!("{prefix}.{f}");
+    match model {
+        SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+            positive(&k("young_modulus"), *young_modulus)?;
+            in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
+        }
+        SoilModel::MohrCoulomb {
+            young_modulus,
+            poisson_ratio,
+            friction_angle,
+            cohesion,
+            residual_cohesion,
+            softening_strain,
+            dilation_angle,
+            critical_dilation_angle,
+            dilation_decay,
+            tension_cutoff,
+        } => {
+            positive(&k("young_modulus"), *young_modulus)?;
+            in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
+            in_closed_open(&k("friction_angle"), *friction_angle, 0.0, 90.0)?;
+            non_negative(&k("cohesion"), *cohesion)?;
+            for (f, v) in
+                [("dilation_angle", Some(*dilation_angle)), ("critical_dilation_angle", *critical_dilation_angle)]
+            {
+                if let Some(v) = v {
+                    if !(v > -90.0 && v <= *friction_angle) {
+                        return Err(format!(
+                            "key `{}`: must be in (-90, friction_angle = {friction_angle}], got {v}",
+                            k(f)
+                        ));
+                    }
+                }
+            }
+            non_negative(&k("dilation_decay"), *dilation_decay)?;
+            if let Some(r) = residual_cohesion {
+                non_negative(&k("residual_cohesion"), *r)?;
+                if *r != *cohesion && softening_strain.is_none() {
+                    return Err(format!(
+                        "key `{}`: required when residual_cohesion differs from cohesion",
+                        k("softening_strain")
+                    ));
+                }
+            }
+            if let Some(e) = softening_strain {
+                positive(&k("softening_strain"), *e)?;
+            }
+            if let Some(t) = tension_cutoff {
+                non_negative(&k("tension_cutoff"), *t)?;
+            }
+            if *friction_angle == 0.0 && *cohesion == 0.0 {
+                return Err(format!(
+                    "key `{}`: a Tresca material (friction_angle = 0) needs a positive cohesion",
+                    k("cohesion")
+                ));
+            }
+        }
+        SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
+            positive(&k("young_modulus"), *young_modulus)?;
+            in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
+            positive(&k("cohesion"), *cohesion)?;
+            if let Some(r) = residual_cohesion {
+                non_negative(&k("residual_cohesion"), *r)?;
+            }
+            // Softening steeper than the elastic shear stiffness has no unique return.
+            let g = young_modulus / (2.0 * (1.0 + poisson_ratio));
+            if !(*softening_modulus <= 0.0 && *softening_modulus > -3f64.sqrt() * g) {
+                return Err(format!(
+                    "key `{}`: must be in (-√3 G, 0] = ({:.4e}, 0], got {softening_modulus}",
+                    k("softening_modulus"),
+                    -3f64.sqrt() * g
+                ));
             }
         }
     }

@@ -16,6 +16,21 @@ pub fn read_text(path: &Path) -> Result<String, String> {
     fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
 }
 
+/// Writes a CSV file `name` with `header` and text `rows` into `dir` (created if needed),
+/// atomically.
+pub fn write_csv(dir: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> Result<PathBuf, String> {
+    fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+    let mut text = header.join(",");
+    text.push('\n');
+    for r in rows {
+        text.push_str(&r.join(","));
+        text.push('\n');
+    }
+    let path = dir.join(name);
+    write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
 /// The output directory of a run.
 pub struct RunOutput {
     dir: Option<PathBuf>,

@@ -1,90 +1,8 @@
-//! Materials: phase properties of the mixture and the constitutive model of the skeleton.
-//!
-//! Stress and strain are 4-vectors [xx, yy, xy, zz] (plane strain; engineering shear strain
-//! γ_xy = 2ε_xy; tension positive). A soil model maps a stress and a strain increment to the new
-//! stress and the consistent tangent dσ/dε (4×4).
+//! Materials: phase properties of the mixture, permeability laws and the skeleton's soil model
+//! ([`super::soil`]).
 
+use super::soil::{Constitutive, LinearElastic, MohrCoulomb, VonMises};
 use crate::case::{self, Formulation, SoilModel};
-
-/// A 4×4 matrix in the stress-vector basis.
-pub type Mat4 = [[f64; 4]; 4];
-
-/// Result of a stress update.
-#[derive(Debug, Clone, Copy)]
-pub struct StressUpdate {
-    /// The updated stress [Pa].
-    pub stress: [f64; 4],
-    /// Consistent tangent dσ/dΔε [Pa].
-    pub tangent: Mat4,
-}
-
-/// Isotropic linear elasticity in plane strain.
-#[derive(Debug, Clone, Copy)]
-pub struct LinearElastic {
-    /// Young's modulus [Pa].
-    pub young: f64,
-    /// Poisson's ratio [-].
-    pub poisson: f64,
-    /// Elastic matrix D^e.
-    pub d: Mat4,
-}
-
-impl LinearElastic {
-    /// Elasticity with Young's modulus `e` [Pa] and Poisson's ratio `nu`.
-    pub fn new(e: f64, nu: f64) -> Self {
-        let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-        let mu = e / (2.0 * (1.0 + nu));
-        let a = lam + 2.0 * mu;
-        let d = [[a, lam, 0.0, lam], [lam, a, 0.0, lam], [0.0, 0.0, mu, 0.0], [lam, lam, 0.0, a]];
-        LinearElastic { young: e, poisson: nu, d }
-    }
-
-    /// Constrained (oedometric) modulus E_c = E(1 − ν)/((1 + ν)(1 − 2ν)) [Pa].
-    pub fn constrained_modulus(&self) -> f64 {
-        self.d[0][0]
-    }
-
-    /// Shear modulus [Pa].
-    pub fn shear_modulus(&self) -> f64 {
-        self.d[2][2]
-    }
-}
-
-/// The constitutive model of the skeleton.
-#[derive(Debug, Clone, Copy)]
-pub enum Constitutive {
-    /// Linear elasticity (never calls a return mapping).
-    LinearElastic(LinearElastic),
-}
-
-impl Constitutive {
-    /// New stress and consistent tangent for the strain increment `deps` from `stress`
-    /// ([003] Eq. 24c: σ' ← σ' + D Δε for the elastic skeleton).
-    #[inline]
-    pub fn update(&self, stress: &[f64; 4], deps: &[f64; 4]) -> StressUpdate {
-        match self {
-            Constitutive::LinearElastic(el) => {
-                let mut s = *stress;
-                for (r, sr) in s.iter_mut().enumerate() {
-                    *sr += (0..4).map(|c| el.d[r][c] * deps[c]).sum::<f64>();
-                }
-                StressUpdate { stress: s, tangent: el.d }
-            }
-        }
-    }
-
-    /// Elastic part (for the reference solutions and time-step estimates).
-    pub fn elastic(&self) -> &LinearElastic {
-        match self {
-            Constitutive::LinearElastic(el) => el,
-        }
-    }
-
-    /// Whether the model is linear (its tangent never changes).
-    pub fn is_linear(&self) -> bool {
-        matches!(self, Constitutive::LinearElastic(_))
-    }
-}
 
 /// A material as the solver uses it.
 #[derive(Debug, Clone)]
@@ -114,11 +32,7 @@ pub struct Material {
 impl Material {
     /// Builds the solver's material from the case's.
     pub fn from_case(m: &case::Material, formulation: Formulation) -> Material {
-        let model = match m.model {
-            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-                Constitutive::LinearElastic(LinearElastic::new(young_modulus, poisson_ratio))
-            }
-        };
+        let model = soil_model(&m.model);
         let two = formulation == Formulation::TwoPhase;
         let kw = if two { m.water_bulk_modulus.unwrap_or(f64::INFINITY) } else { f64::INFINITY };
         let ks = m.solid_bulk_modulus.unwrap_or(f64::INFINITY);
@@ -156,6 +70,57 @@ impl Material {
     }
 }
 
+/// The solver's soil model for the case's (angles from degrees to radians).
+pub fn soil_model(m: &SoilModel) -> Constitutive {
+    match *m {
+        SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+            Constitutive::LinearElastic(LinearElastic::new(young_modulus, poisson_ratio))
+        }
+        SoilModel::MohrCoulomb {
+            young_modulus,
+            poisson_ratio,
+            friction_angle,
+            cohesion,
+            residual_cohesion,
+            softening_strain,
+            dilation_angle,
+            critical_dilation_angle,
+            dilation_decay,
+            tension_cutoff,
+        } => {
+            let el = LinearElastic::new(young_modulus, poisson_ratio);
+            let psi = dilation_angle.to_radians();
+            Constitutive::MohrCoulomb(
+                el,
+                MohrCoulomb {
+                    shear: el.shear_modulus(),
+                    lame: el.lame(),
+                    phi: friction_angle.to_radians(),
+                    cohesion,
+                    residual_cohesion: residual_cohesion.unwrap_or(cohesion),
+                    softening_strain: softening_strain.unwrap_or(f64::INFINITY),
+                    psi_ini: psi,
+                    psi_crit: critical_dilation_angle.map_or(psi, f64::to_radians),
+                    eta: dilation_decay,
+                    tension: tension_cutoff,
+                },
+            )
+        }
+        SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
+            let el = LinearElastic::new(young_modulus, poisson_ratio);
+            Constitutive::VonMises(
+                el,
+                VonMises {
+                    shear: el.shear_modulus(),
+                    cohesion,
+                    residual_cohesion: residual_cohesion.unwrap_or(cohesion),
+                    softening_modulus,
+                },
+            )
+        }
+    }
+}
+
 /// 1/Q = n/K_w + (1 − n)/K_s ([003] Eq. 5); infinite moduli contribute nothing.
 pub fn inv_q(n: f64, kw: f64, ks: f64) -> f64 {
     let t = |k: f64| if k.is_infinite() { 0.0 } else { 1.0 / k };
@@ -165,37 +130,6 @@ pub fn inv_q(n: f64, kw: f64, ks: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn plane_strain_elasticity_gives_the_constrained_modulus_in_an_oedometer() {
-        let el = LinearElastic::new(1e7, 0.3);
-        let m = Constitutive::LinearElastic(el);
-        let u = m.update(&[0.0; 4], &[0.0, -1e-3, 0.0, 0.0]);
-        let ec = 1e7 * 0.7 / (1.3 * 0.4);
-        assert!((u.stress[1] + ec * 1e-3).abs() < 1e-6 * ec);
-        // Lateral stress ratio ν/(1 − ν) and σ_zz = σ_xx in an oedometer.
-        assert!((u.stress[0] / u.stress[1] - 0.3 / 0.7).abs() < 1e-12);
-        assert!((u.stress[3] - u.stress[0]).abs() < 1e-9);
-        assert!((el.shear_modulus() - 1e7 / 2.6).abs() < 1e-6);
-    }
-
-    #[test]
-    fn elastic_update_is_additive_and_the_tangent_is_d() {
-        let m = Constitutive::LinearElastic(LinearElastic::new(2e7, 0.25));
-        let s0 = [1.0, -2.0, 0.5, 3.0];
-        let de = [1e-4, -2e-4, 3e-4, 0.0];
-        let u = m.update(&s0, &de);
-        // Finite-difference check of the tangent.
-        for c in 0..4 {
-            let mut dp = de;
-            dp[c] += 1e-7;
-            let up = m.update(&s0, &dp);
-            for r in 0..4 {
-                let fd = (up.stress[r] - u.stress[r]) / 1e-7;
-                assert!((fd - u.tangent[r][c]).abs() < 1e-3 * u.tangent[0][0]);
-            }
-        }
-    }
 
     #[test]
     fn the_xie_leo_conductivity_follows_the_void_ratio_squared() {

@@ -3,11 +3,13 @@
 //! [`crate::assembly`].
 
 pub mod grid;
+pub mod linalg;
 pub mod loads;
 pub mod material;
 pub mod particles;
 pub mod patch;
 pub mod shape;
+pub mod soil;
 
 use crate::case::{Case, Formulation, ShapeFunctions};
 use crate::kernels::{ParticleInput, StepResult};
@@ -224,6 +226,7 @@ impl Model {
             drag,
             inv_q,
             stress: ps.stress[k],
+            eps_pd: ps.eps_pd[k],
             p: ps.p[k],
             body_acc,
             grad_n: [0.0; 2],
@@ -276,7 +279,9 @@ impl Model {
             ps.disp[k][c] += kin.du[c];
         }
         let mat = &self.materials[ps.material[k] as usize];
-        ps.stress[k] = mat.model.update(&ps.stress[k], &kin.deps).stress;
+        let upd = mat.model.update(&ps.stress[k], ps.eps_pd[k], &kin.deps);
+        ps.stress[k] = upd.stress;
+        ps.eps_pd[k] = upd.eps_pd;
         ps.p[k] += dp;
         ps.volume[k] *= j;
         ps.porosity[k] = n_new;

@@ -134,23 +134,8 @@ fn fit(pts: &[PatchPoint], x: f64, y: f64) -> f64 {
             }
         }
     }
-    // Gaussian elimination (the matrix is symmetric positive definite when the slopes are kept only
-    // where the points spread).
-    for col in 0..m {
-        let pivot_row = a[col];
-        for r in col + 1..m {
-            let f = a[r][col] / pivot_row[col];
-            for (arc, pc) in a[r][col..m].iter_mut().zip(&pivot_row[col..m]) {
-                *arc -= f * pc;
-            }
-            b[r] -= f * b[col];
-        }
-    }
-    let mut coef = [0.0; 3];
-    for r in (0..m).rev() {
-        let s: f64 = (r + 1..m).map(|c| a[r][c] * coef[c]).sum();
-        coef[r] = (b[r] - s) / a[r][r];
-    }
+    // Symmetric positive definite when the slopes are kept only where the points spread.
+    let coef = crate::model::linalg::solve(a, b, m).unwrap_or([b[0] / a[0][0], 0.0, 0.0]);
     basis((x, y)).iter().zip(coef).map(|(q, c)| q * c).sum()
 }
 

@@ -1,0 +1,205 @@
+//! Soil models: the stress update of a material point and its consistent tangent.
+//!
+//! Stress and strain are 4-vectors [xx, yy, xy, zz] (plane strain; engineering shear strain
+//! γ_xy = 2ε_xy; tension positive). A model maps the stress σ_n, its internal variables and a strain
+//! increment Δε to σ_{n+1}, the new internal variables and the consistent tangent dσ_{n+1}/dΔε (4×4),
+//! the exact derivative of the algorithm, which gives Newton's method its quadratic convergence.
+//!
+//! The elastoplastic models are isotropic: the elastic trial stress σ_trial = σ_n + D Δε is returned
+//! in its principal frame ([`principal`]), and the tangent is dσ/dσ_trial · D with dσ/dσ_trial from
+//! the principal-space derivative of the return and the spin term of the in-plane directions.
+//! Internal variable: the accumulated deviatoric plastic strain ε̄ = Σ sqrt(2/3 Δe_p : Δe_p)
+//! ([000] §4.1.2's e_p^d), which drives softening and dilatancy.
+
+pub mod mohr_coulomb;
+pub mod principal;
+pub mod von_mises;
+
+pub use mohr_coulomb::MohrCoulomb;
+pub use von_mises::VonMises;
+
+use principal::{mul4, Principal};
+
+/// A 4×4 matrix in the stress-vector basis.
+pub type Mat4 = [[f64; 4]; 4];
+
+/// Where a return mapping ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Region {
+    /// No plastic flow.
+    Elastic,
+    /// One yield plane (Mohr–Coulomb main plane, or the von Mises cylinder).
+    Plane,
+    /// Mohr–Coulomb edge σ₂ = σ₃ (triaxial compression).
+    EdgeLeft,
+    /// Mohr–Coulomb edge σ₁ = σ₂ (triaxial extension).
+    EdgeRight,
+    /// The apex of the Mohr–Coulomb cone.
+    Apex,
+    /// Tension cut-off planes only.
+    Tension,
+    /// The main plane together with tension planes.
+    TensionCorner,
+}
+
+/// A return in principal space: stresses, ∂σ_i/∂λ_j, ε̄ after the step, and the region.
+#[derive(Debug, Clone, Copy)]
+pub struct ReturnResult {
+    /// Returned principal stresses.
+    pub stress: [f64; 3],
+    /// ∂σ_i/∂σ_trial,j in principal space.
+    pub tangent: [[f64; 3]; 3],
+    /// ε̄ at the end of the step.
+    pub eps: f64,
+    /// Region of the return.
+    pub region: Region,
+}
+
+impl ReturnResult {
+    fn elastic(trial: [f64; 3], eps: f64) -> ReturnResult {
+        ReturnResult {
+            stress: trial,
+            tangent: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            eps,
+            region: Region::Elastic,
+        }
+    }
+}
+
+/// Result of a stress update.
+#[derive(Debug, Clone, Copy)]
+pub struct StressUpdate {
+    /// The updated stress [Pa].
+    pub stress: [f64; 4],
+    /// Consistent tangent dσ/dΔε [Pa].
+    pub tangent: Mat4,
+    /// Accumulated deviatoric plastic strain ε̄ after the step [-].
+    pub eps_pd: f64,
+    /// Where the return ended.
+    pub region: Region,
+}
+
+/// Isotropic linear elasticity in plane strain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearElastic {
+    /// Young's modulus [Pa].
+    pub young: f64,
+    /// Poisson's ratio [-].
+    pub poisson: f64,
+    /// Elastic matrix D^e.
+    pub d: Mat4,
+}
+
+impl LinearElastic {
+    /// Elasticity with Young's modulus `e` [Pa] and Poisson's ratio `nu`.
+    pub fn new(e: f64, nu: f64) -> Self {
+        let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = e / (2.0 * (1.0 + nu));
+        let a = lam + 2.0 * mu;
+        let d = [[a, lam, 0.0, lam], [lam, a, 0.0, lam], [0.0, 0.0, mu, 0.0], [lam, lam, 0.0, a]];
+        LinearElastic { young: e, poisson: nu, d }
+    }
+
+    /// Constrained (oedometric) modulus E_c = E(1 − ν)/((1 + ν)(1 − 2ν)) [Pa].
+    pub fn constrained_modulus(&self) -> f64 {
+        self.d[0][0]
+    }
+
+    /// Shear modulus G [Pa].
+    pub fn shear_modulus(&self) -> f64 {
+        self.d[2][2]
+    }
+
+    /// Lamé's λ [Pa].
+    pub fn lame(&self) -> f64 {
+        self.d[0][1]
+    }
+
+    /// σ + D Δε.
+    pub fn trial(&self, stress: &[f64; 4], deps: &[f64; 4]) -> [f64; 4] {
+        let mut s = *stress;
+        for (r, sr) in s.iter_mut().enumerate() {
+            *sr += (0..4).map(|c| self.d[r][c] * deps[c]).sum::<f64>();
+        }
+        s
+    }
+}
+
+/// The constitutive model of the skeleton.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Constitutive {
+    /// Linear elasticity (never calls a return mapping).
+    LinearElastic(LinearElastic),
+    /// Mohr–Coulomb (Tresca with φ = 0).
+    MohrCoulomb(LinearElastic, MohrCoulomb),
+    /// Von Mises.
+    VonMises(LinearElastic, VonMises),
+}
+
+impl Constitutive {
+    /// New stress, internal variable and consistent tangent for the strain increment `deps` from
+    /// `stress` and ε̄ = `eps_pd` ([003] Eq. 24c, [000] Eq. 11d with D^ep).
+    #[inline]
+    pub fn update(&self, stress: &[f64; 4], eps_pd: f64, deps: &[f64; 4]) -> StressUpdate {
+        match self {
+            Constitutive::LinearElastic(el) => {
+                StressUpdate { stress: el.trial(stress, deps), tangent: el.d, eps_pd, region: Region::Elastic }
+            }
+            Constitutive::MohrCoulomb(el, mc) => {
+                isotropic_return(el, stress, eps_pd, deps, |l, e| {
+                    // Sort descending, return, and map back.
+                    let mut order = [0usize, 1, 2];
+                    order.sort_by(|&a, &b| l[b].total_cmp(&l[a]));
+                    let sorted = [l[order[0]], l[order[1]], l[order[2]]];
+                    let r = mc.return_sorted(&sorted, e);
+                    let mut stress = [0.0; 3];
+                    let mut tangent = [[0.0; 3]; 3];
+                    for i in 0..3 {
+                        stress[order[i]] = r.stress[i];
+                        for j in 0..3 {
+                            tangent[order[i]][order[j]] = r.tangent[i][j];
+                        }
+                    }
+                    ReturnResult { stress, tangent, ..r }
+                })
+            }
+            Constitutive::VonMises(el, vm) => {
+                isotropic_return(el, stress, eps_pd, deps, |l, e| vm.return_principal(l, e))
+            }
+        }
+    }
+
+    /// Elastic part (for the reference solutions and time-step estimates).
+    pub fn elastic(&self) -> &LinearElastic {
+        match self {
+            Constitutive::LinearElastic(el) | Constitutive::MohrCoulomb(el, _) | Constitutive::VonMises(el, _) => el,
+        }
+    }
+
+    /// Whether the model is linear (its tangent never changes).
+    pub fn is_linear(&self) -> bool {
+        matches!(self, Constitutive::LinearElastic(_))
+    }
+}
+
+/// Elastic trial, return of the principal values by `ret`, and the tangent through the principal
+/// frame.
+fn isotropic_return(
+    el: &LinearElastic,
+    stress: &[f64; 4],
+    eps: f64,
+    deps: &[f64; 4],
+    ret: impl Fn(&[f64; 3], f64) -> ReturnResult,
+) -> StressUpdate {
+    let trial = el.trial(stress, deps);
+    let p = Principal::of(&trial);
+    let r = ret(&p.values, eps);
+    if r.region == Region::Elastic {
+        return StressUpdate { stress: trial, tangent: el.d, eps_pd: eps, region: Region::Elastic };
+    }
+    let dsdt = p.derivative(&r.stress, &r.tangent);
+    StressUpdate { stress: p.compose(&r.stress), tangent: mul4(&dsdt, &el.d), eps_pd: r.eps, region: r.region }
+}
+
+#[cfg(test)]
+mod tests;

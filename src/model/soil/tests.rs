@@ -1,0 +1,273 @@
+use super::*;
+
+const KPA: f64 = 1e3;
+
+fn mc(phi_deg: f64, c: f64, psi_deg: f64, tension: Option<f64>) -> Constitutive {
+    let el = LinearElastic::new(10e3 * KPA, 0.3);
+    Constitutive::MohrCoulomb(
+        el,
+        MohrCoulomb {
+            shear: el.shear_modulus(),
+            lame: el.lame(),
+            phi: phi_deg.to_radians(),
+            cohesion: c,
+            residual_cohesion: c,
+            softening_strain: f64::INFINITY,
+            psi_ini: psi_deg.to_radians(),
+            psi_crit: psi_deg.to_radians(),
+            eta: 0.0,
+            tension,
+        },
+    )
+}
+
+fn softening_mc() -> Constitutive {
+    let el = LinearElastic::new(10e3 * KPA, 0.3);
+    Constitutive::MohrCoulomb(
+        el,
+        MohrCoulomb {
+            shear: el.shear_modulus(),
+            lame: el.lame(),
+            phi: 25f64.to_radians(),
+            cohesion: 20.0 * KPA,
+            residual_cohesion: 5.0 * KPA,
+            softening_strain: 0.05,
+            psi_ini: (-5f64).to_radians(),
+            psi_crit: 0.0,
+            eta: 25.0,
+            tension: Some(2.0 * KPA),
+        },
+    )
+}
+
+fn vm(c: f64, c_r: f64, h: f64) -> Constitutive {
+    let el = LinearElastic::new(1e3 * KPA, 0.35);
+    Constitutive::VonMises(
+        el,
+        VonMises { shear: el.shear_modulus(), cohesion: c, residual_cohesion: c_r, softening_modulus: h },
+    )
+}
+
+/// The stress [xx, yy, xy, zz] with principal values `l` (l[2] out of plane) rotated by `theta`.
+fn stress_with(l: [f64; 3], theta: f64) -> [f64; 4] {
+    Principal { values: l, dir: [theta.cos(), theta.sin()] }.compose(&l)
+}
+
+/// A start state and strain increment whose elastic trial is `trial`.
+fn start_for(model: &Constitutive, trial: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+    let deps = [1.3e-4, -2.1e-4, 0.7e-4, 0.0];
+    let el = model.elastic();
+    let de = el.trial(&[0.0; 4], &deps);
+    let s0 = [trial[0] - de[0], trial[1] - de[1], trial[2] - de[2], trial[3] - de[3]];
+    (s0, deps)
+}
+
+/// Largest |analytic − central difference| of the tangent, relative to the elastic modulus.
+fn tangent_error(model: &Constitutive, s0: &[f64; 4], eps: f64, deps: &[f64; 4]) -> f64 {
+    let u = model.update(s0, eps, deps);
+    let scale = model.elastic().d[0][0];
+    let mut worst: f64 = 0.0;
+    for c in 0..4 {
+        let h = 1e-9;
+        let (mut dp, mut dm) = (*deps, *deps);
+        dp[c] += h;
+        dm[c] -= h;
+        let (up, um) = (model.update(s0, eps, &dp), model.update(s0, eps, &dm));
+        for r in 0..4 {
+            let fd = (up.stress[r] - um.stress[r]) / (2.0 * h);
+            worst = worst.max((fd - u.tangent[r][c]).abs() / scale);
+        }
+    }
+    worst
+}
+
+fn principal_sorted(s: &[f64; 4]) -> [f64; 3] {
+    let mut v = Principal::of(s).values;
+    v.sort_by(|a, b| b.total_cmp(a));
+    v
+}
+
+fn mc_f(m: &MohrCoulomb, s: &[f64; 3], eps: f64) -> f64 {
+    let (c, _) = m.cohesion_at(eps);
+    (s[0] - s[2]) + (s[0] + s[2]) * m.phi.sin() - 2.0 * c * m.phi.cos()
+}
+
+#[test]
+fn plane_strain_elasticity_gives_the_constrained_modulus_in_an_oedometer() {
+    let el = LinearElastic::new(1e7, 0.3);
+    let m = Constitutive::LinearElastic(el);
+    let u = m.update(&[0.0; 4], 0.0, &[0.0, -1e-3, 0.0, 0.0]);
+    let ec = 1e7 * 0.7 / (1.3 * 0.4);
+    assert!((u.stress[1] + ec * 1e-3).abs() < 1e-6 * ec);
+    assert!((u.stress[0] / u.stress[1] - 0.3 / 0.7).abs() < 1e-12);
+    assert!((u.stress[3] - u.stress[0]).abs() < 1e-9);
+    assert!((el.shear_modulus() - 1e7 / 2.6).abs() < 1e-6);
+}
+
+#[test]
+fn an_elastic_step_of_a_plastic_model_is_elastic() {
+    let m = mc(30.0, 10.0 * KPA, 10.0, None);
+    let s0 = [-50.0 * KPA, -60.0 * KPA, 2.0 * KPA, -55.0 * KPA];
+    let de = [1e-6, -1e-6, 0.0, 0.0];
+    let u = m.update(&s0, 0.0, &de);
+    assert_eq!(u.region, Region::Elastic);
+    assert_eq!(u.tangent, m.elastic().d);
+    assert_eq!(u.eps_pd, 0.0);
+}
+
+#[test]
+fn mohr_coulomb_returns_to_the_surface_in_every_region_with_the_exact_tangent() {
+    // Trial principal stresses chosen in each region (kPa), with the out-of-plane one at each position.
+    let cases: [(Constitutive, [f64; 3], Region); 7] = [
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -50.0, -150.0], Region::Plane),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -140.0, -150.0], Region::EdgeLeft),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -15.0, -150.0], Region::EdgeRight),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [50.0, 40.0, 30.0], Region::Apex),
+        (mc(30.0, 10.0 * KPA, 10.0, Some(5.0 * KPA)), [8.0, -5.0, -10.0], Region::Tension),
+        (mc(30.0, 10.0 * KPA, 10.0, Some(5.0 * KPA)), [40.0, -5.0, -10.0], Region::TensionCorner),
+        (mc(0.0, 10.0 * KPA, 0.0, None), [-10.0, -30.0, -60.0], Region::Plane),
+    ];
+    for (model, l, region) in cases {
+        let Constitutive::MohrCoulomb(_, p) = model else { unreachable!() };
+        for (perm, theta) in [([0, 1, 2], 0.3), ([2, 0, 1], -1.1), ([1, 2, 0], 2.0)] {
+            let trial = stress_with([l[perm[0]] * KPA, l[perm[1]] * KPA, l[perm[2]] * KPA], theta);
+            let (s0, de) = start_for(&model, trial);
+            let u = model.update(&s0, 0.0, &de);
+            assert_eq!(u.region, region, "{l:?} {perm:?}");
+            let s = principal_sorted(&u.stress);
+            let f = mc_f(&p, &s, u.eps_pd);
+            assert!(f <= 1e-6 * KPA, "{region:?}: f = {f}");
+            if !matches!(region, Region::Tension | Region::Apex) {
+                assert!(f.abs() <= 1e-6 * KPA, "{region:?}: on the surface, f = {f}");
+            }
+            if let Some(t) = p.tension {
+                assert!(s[0] <= t + 1e-6, "{region:?}: σ₁ = {} above the cut-off {t}", s[0]);
+            }
+            match region {
+                Region::EdgeLeft => assert!((s[1] - s[2]).abs() < 1e-6 * KPA, "{s:?}"),
+                Region::EdgeRight => assert!((s[0] - s[1]).abs() < 1e-6 * KPA, "{s:?}"),
+                Region::Apex => {
+                    let apex = p.cohesion / p.phi.tan();
+                    assert!(s.iter().all(|v| (v - apex).abs() < 1e-6 * KPA), "{s:?} vs {apex}");
+                }
+                _ => {}
+            }
+            assert!(u.eps_pd > 0.0);
+            let e = tangent_error(&model, &s0, 0.0, &de);
+            assert!(e < 1e-6, "{region:?} {perm:?}: tangent error {e:e}");
+        }
+    }
+}
+
+#[test]
+fn softening_and_dilatancy_evolve_and_the_tangent_stays_exact() {
+    let model = softening_mc();
+    let Constitutive::MohrCoulomb(_, p) = model else { unreachable!() };
+    // Cohesion falls linearly to the residual value, ψ decays towards ψ_crit.
+    assert_eq!(p.cohesion_at(0.0).0, 20.0 * KPA);
+    assert!((p.cohesion_at(0.025).0 - 12.5 * KPA).abs() < 1e-9);
+    assert_eq!(p.cohesion_at(0.1), (5.0 * KPA, 0.0));
+    assert!((p.dilation_at(0.1) - (-5f64).to_radians() * (-2.5f64).exp()).abs() < 1e-12);
+    for (l, eps0) in [([-10.0, -80.0, -300.0], 0.0), ([-10.0, -80.0, -300.0], 0.02), ([-5.0, -280.0, -300.0], 0.01)] {
+        let trial = stress_with([l[0] * KPA, l[1] * KPA, l[2] * KPA], 0.4);
+        let (s0, de) = start_for(&model, trial);
+        let u = model.update(&s0, eps0, &de);
+        assert_ne!(u.region, Region::Elastic);
+        assert!(u.eps_pd > eps0);
+        let f = mc_f(&p, &principal_sorted(&u.stress), u.eps_pd);
+        assert!(f.abs() < 1e-6 * KPA, "f = {f} with the softened cohesion");
+        let e = tangent_error(&model, &s0, eps0, &de);
+        assert!(e < 1e-6, "tangent error {e:e} at ε̄ = {eps0}");
+    }
+    // Past ε_r the cohesion is the residual one.
+    let trial = stress_with([-10.0 * KPA, -80.0 * KPA, -300.0 * KPA], 0.0);
+    let (s0, de) = start_for(&model, trial);
+    let u = model.update(&s0, 0.2, &de);
+    assert!(mc_f(&p, &principal_sorted(&u.stress), u.eps_pd).abs() < 1e-6 * KPA);
+}
+
+#[test]
+fn negative_dilation_contracts_and_positive_dilation_dilates() {
+    // In a plastic step the plastic volume change has the sign of sin ψ (tension positive):
+    // tr Δε_p = Δγ · 2 sin ψ on the main plane.
+    for (psi, sign) in [(-5.0, -1.0), (5.0, 1.0)] {
+        let model = mc(25.0, 3.0 * KPA, psi, None);
+        let trial = stress_with([-10.0 * KPA, -40.0 * KPA, -120.0 * KPA], 0.2);
+        let (s0, de) = start_for(&model, trial);
+        let u = model.update(&s0, 0.0, &de);
+        assert_eq!(u.region, Region::Plane);
+        // Δσ_mean = K (Δε_v − Δε_v^p): the returned mean is above (below) the trial mean for
+        // contraction (dilation) under compression positive... here tension positive.
+        let el = model.elastic();
+        let k = el.lame() + 2.0 * el.shear_modulus() / 3.0;
+        let dmean = (u.stress[0] + u.stress[1] + u.stress[3] - trial[0] - trial[1] - trial[3]) / 3.0;
+        let dev_p = -dmean / k;
+        assert!(dev_p * sign > 0.0, "ψ = {psi}: plastic volume change {dev_p}");
+    }
+}
+
+#[test]
+fn the_return_is_invariant_to_a_rotation_of_the_stress() {
+    let model = softening_mc();
+    let l = [-10.0 * KPA, -80.0 * KPA, -300.0 * KPA];
+    let a = model.update(&start_for(&model, stress_with(l, 0.0)).0, 0.0, &start_for(&model, stress_with(l, 0.0)).1);
+    for theta in [0.5, 1.3, -2.2] {
+        let (s0, de) = start_for(&model, stress_with(l, theta));
+        let b = model.update(&s0, 0.0, &de);
+        let (pa, pb) = (principal_sorted(&a.stress), principal_sorted(&b.stress));
+        for k in 0..3 {
+            assert!((pa[k] - pb[k]).abs() < 1e-6, "θ = {theta}: {pa:?} vs {pb:?}");
+        }
+        assert!((a.eps_pd - b.eps_pd).abs() < 1e-12);
+        // The returned stress is coaxial with the trial stress.
+        let (ta, tb) = (Principal::of(&stress_with(l, theta)), Principal::of(&b.stress));
+        let cross = ta.dir[0] * tb.dir[1] - ta.dir[1] * tb.dir[0];
+        assert!(cross.abs() < 1e-9 || (b.stress[0] - b.stress[1]).abs() < 1e-6, "θ = {theta}");
+    }
+}
+
+#[test]
+fn tresca_limits_the_largest_shear_stress_to_the_cohesion() {
+    let model = mc(0.0, 10.0 * KPA, 0.0, None);
+    for l in [[0.0, -35.0, -80.0], [-20.0, -25.0, -90.0], [-5.0, -70.0, -72.0]] {
+        let trial = stress_with([l[0] * KPA, l[1] * KPA, l[2] * KPA], 0.7);
+        let (s0, de) = start_for(&model, trial);
+        let u = model.update(&s0, 0.0, &de);
+        let s = principal_sorted(&u.stress);
+        assert!(((s[0] - s[2]) / 2.0 - 10.0 * KPA).abs() < 1e-6, "{s:?}");
+        // Isochoric: the mean stress is the trial's.
+        let mean = |v: &[f64; 4]| (v[0] + v[1] + v[3]) / 3.0;
+        assert!((mean(&u.stress) - mean(&trial)).abs() < 1e-6);
+        assert!(tangent_error(&model, &s0, 0.0, &de) < 1e-6);
+    }
+}
+
+#[test]
+fn von_mises_returns_radially_and_softens_to_the_residual_strength() {
+    let model = vm(12.0 * KPA, 3.0 * KPA, -30.0 * KPA);
+    let Constitutive::VonMises(_, p) = model else { unreachable!() };
+    let q = |s: &[f64; 4]| {
+        let m = (s[0] + s[1] + s[3]) / 3.0;
+        (1.5 * ((s[0] - m).powi(2) + (s[1] - m).powi(2) + (s[3] - m).powi(2) + 2.0 * s[2] * s[2])).sqrt()
+    };
+    for (eps0, l) in [
+        (0.0, [0.0, -40.0, -10.0]),
+        (0.1, [5.0, -60.0, -20.0]),
+        (0.29, [0.0, -40.0, -10.0]),
+        (0.5, [0.0, -40.0, -10.0]),
+    ] {
+        let trial = stress_with([l[0] * KPA, l[1] * KPA, l[2] * KPA], -0.6);
+        let (s0, de) = start_for(&model, trial);
+        let u = model.update(&s0, eps0, &de);
+        assert_eq!(u.region, Region::Plane);
+        let (c, _) = p.cohesion_at(u.eps_pd);
+        assert!(
+            (q(&u.stress) - 3f64.sqrt() * c).abs() < 1e-6,
+            "ε̄ {eps0}: q = {} vs √3 c = {}",
+            q(&u.stress),
+            3f64.sqrt() * c
+        );
+        assert!(tangent_error(&model, &s0, eps0, &de) < 1e-6, "tangent at ε̄ = {eps0}");
+    }
+    assert_eq!(p.cohesion_at(1.0).0, 3.0 * KPA);
+}
