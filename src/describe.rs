@@ -141,7 +141,12 @@ pub fn describe(case: &Case, label: &str) -> String {
             .flat_map(|j| (0..g.nodes()[0]).map(move |i| (i, j)))
             .filter(|&(i, j)| b.contains(g, i, j))
             .count();
-        let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
+        let ignored = if nd == 2 && b.fix.iter().all(|d| !matches!(d, crate::case::Dof::Ux | crate::case::Dof::Uy)) {
+            " (water-phase components: ignored in a one_phase analysis)"
+        } else {
+            ""
+        };
+        let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes{ignored}", b.name, fix.join(", "));
     }
     for st in &case.stages {
         let a = model.active(st);

@@ -125,17 +125,30 @@ pub struct Summary {
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub checkerboard_index_max: Option<f64>,
+    /// Why the run ended before the last stage's end although nothing failed (e.g. a footing
+    /// that reached the settlement its check stops at).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
     /// Metrics against the case's analytical reference.
     pub verification: BTreeMap<String, Metric>,
+    /// Quantities computed from the run without a reference to compare with: per probe the final
+    /// displacement magnitude `<probe>.displacement` [m], in two-phase runs the excess pore pressure
+    /// of largest magnitude (signed) `<probe>.excess_p_peak` and at the end `<probe>.excess_p_final`
+    /// [Pa]; and the check's own (e.g. the bearing pressure at given settlements).
+    pub results: BTreeMap<String, f64>,
     /// Whether every metric passed (absent without verification).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verification_passed: Option<bool>,
 }
 
-/// A probe: the particle nearest to a point at t = 0.
+/// A probe: the particle nearest to a point at t = 0, and what is tracked over the run.
 struct Probe {
     name: String,
     id: u64,
+    /// Its values after the last step ([`probe_fields`] order).
+    last: Vec<f64>,
+    /// The excess pore pressure of largest magnitude so far, with its sign.
+    excess_extreme: f64,
 }
 
 struct Simulation<'a> {
@@ -162,6 +175,11 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         let mut sim = Simulation::set_up(req, out, &mut summary)?;
         for stage in &req.case.stages {
             sim.run_stage(stage)?;
+            if let Some(why) = sim.check.as_ref().and_then(|c| c.stop()) {
+                sim.progress(&format!("stopped at t = {:.6e} s: {why}", sim.t));
+                sim.summary.stopped = Some(why);
+                break;
+            }
         }
         sim.finish()
     });
@@ -207,7 +225,9 @@ impl Summary {
             petsc_options: assembly::petsc_options().unwrap_or_default(),
             timings: Timings::default(),
             checkerboard_index_max: None,
+            stopped: None,
             verification: BTreeMap::new(),
+            results: BTreeMap::new(),
             verification_passed: None,
         }
     }
@@ -317,6 +337,12 @@ impl<'a> Simulation<'a> {
                         self.progress(&format!("  t = {:.6e} s, step {}", self.t, self.step));
                         next_report += stage.duration / 10.0;
                     }
+                    if self.check.as_ref().is_some_and(|c| c.stop().is_some()) {
+                        if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
+                            self.record_step(dt)?;
+                        }
+                        return Ok(());
+                    }
                 }
                 Err(why) => {
                     self.summary.step_cuts += 1;
@@ -411,7 +437,7 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
-        row.extend(probe_values(&self.model, &self.probes, &self.coll).map_err(RunError::Failed)?);
+        row.extend(update_probes(&self.model, &mut self.probes, &self.coll).map_err(RunError::Failed)?);
         if self.model.two_phase {
             let ci =
                 verification::checkerboard::checkerboard_index(&self.model, &self.coll).map_err(RunError::Failed)?;
@@ -429,15 +455,28 @@ impl<'a> Simulation<'a> {
 
     /// The check's observation on steps without a history row.
     fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
+        update_probes(&self.model, &mut self.probes, &self.coll).map_err(RunError::Failed)?;
         if let Some(c) = self.check.as_mut() {
             c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?;
         }
         Ok(())
     }
 
-    /// Metrics and tables of the check.
+    /// Results of the probes, and metrics, results and tables of the check.
     fn finish(mut self) -> Result<(), RunError> {
+        for pr in &self.probes {
+            if pr.last.len() >= 4 {
+                self.summary.results.insert(format!("{}.displacement", pr.name), pr.last[2].hypot(pr.last[3]));
+            }
+            if self.model.two_phase {
+                self.summary.results.insert(format!("{}.excess_p_peak", pr.name), pr.excess_extreme);
+                if let Some(&e) = pr.last.last() {
+                    self.summary.results.insert(format!("{}.excess_p_final", pr.name), e);
+                }
+            }
+        }
         if let Some(c) = self.check.as_mut() {
+            self.summary.results.extend(c.results());
             let (metrics, tables) = c.finish(&self.model, &self.coll).map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
             for t in &tables {
@@ -469,11 +508,16 @@ impl<'a> Simulation<'a> {
 /// Time-step control within a stage: the Δt of the next try, cuts after a failed try, regrowth
 /// after successes, and landing exactly on event times (e.g. the times a verification needs) and
 /// on the stage end.
+/// Accepted steps after which a cut Δt grows back by one factor.
+const GROW_AFTER: usize = 3;
+
 #[derive(Debug, Clone)]
 struct StepControl {
     stage_dt: f64,
     dt: f64,
     cuts: usize,
+    /// Accepted steps since Δt last changed.
+    successes: usize,
     max_cuts: usize,
     factor: f64,
     t_end: f64,
@@ -485,6 +529,7 @@ impl StepControl {
             stage_dt: stage.dt(),
             dt: stage.dt(),
             cuts: 0,
+            successes: 0,
             max_cuts: stage.max_step_cuts,
             factor: stage.cut_factor,
             t_end,
@@ -526,10 +571,16 @@ impl StepControl {
         }
     }
 
-    /// After an accepted step: reset the cut count and let Δt grow back towards the stage's.
+    /// After an accepted step: reset the cut count, and after [`GROW_AFTER`] accepted steps at the
+    /// same Δt let it grow back towards the stage's (growing after every step would retry the Δt
+    /// that just failed at once, which costs a full failed Newton solve each time in a plastic run).
     fn accepted(&mut self) {
         self.cuts = 0;
-        self.dt = (self.dt / self.factor).min(self.stage_dt);
+        self.successes += 1;
+        if self.successes >= GROW_AFTER {
+            self.dt = (self.dt / self.factor).min(self.stage_dt);
+            self.successes = 0;
+        }
     }
 
     /// After a failed try of length `dt_tried`: cut, or `Err` if the cuts are exhausted.
@@ -539,15 +590,16 @@ impl StepControl {
             return Err(());
         }
         self.dt = dt_tried * self.factor;
+        self.successes = 0;
         Ok(())
     }
 }
 
 fn probe_fields(two_phase: bool) -> &'static [&'static str] {
     if two_phase {
-        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "p"]
+        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "eps_pd", "p", "p_excess"]
     } else {
-        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy"]
+        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "eps_pd"]
     }
 }
 
@@ -565,9 +617,25 @@ fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Prob
             .chunks(2)
             .min_by(|a, b| a[0].partial_cmp(&b[0]).unwrap().then(a[1].partial_cmp(&b[1]).unwrap()))
             .ok_or(format!("probe `{}`: there are no material points", p.name))?;
-        out.push(Probe { name: p.name.clone(), id: best[1] as u64 });
+        out.push(Probe { name: p.name.clone(), id: best[1] as u64, last: Vec::new(), excess_extreme: 0.0 });
     }
     Ok(out)
+}
+
+/// Updates every probe's values and extremes; returns the values of all probes in order.
+fn update_probes(model: &Model, probes: &mut [Probe], coll: &Collective) -> Result<Vec<f64>, String> {
+    let all = probe_values(model, probes, coll)?;
+    let nf = probe_fields(model.two_phase).len();
+    for (i, pr) in probes.iter_mut().enumerate() {
+        pr.last = all[i * nf..(i + 1) * nf].to_vec();
+        if model.two_phase {
+            let e = pr.last[nf - 1];
+            if e.abs() > pr.excess_extreme.abs() {
+                pr.excess_extreme = e;
+            }
+        }
+    }
+    Ok(all)
 }
 
 fn probe_values(model: &Model, probes: &[Probe], coll: &Collective) -> Result<Vec<f64>, String> {
@@ -587,7 +655,9 @@ fn probe_values(model: &Model, probes: &[Probe], coll: &Collective) -> Result<Ve
                 s[0],
                 s[1],
                 s[2],
+                ps.eps_pd[k],
                 ps.p[k],
+                ps.p[k] - ps.p0[k],
             ];
             local[i * nf..(i + 1) * nf].copy_from_slice(&v[..nf]);
         }
@@ -633,11 +703,17 @@ mod tests {
         assert!((c.next(0.0, &[]) - 0.05).abs() < 1e-15);
         // A third failure in a row exceeds max_step_cuts = 2.
         assert!(c.clone().rejected(0.05).is_err());
-        // Success resets the count and doubles Δt back, never above the stage's.
+        // Success resets the count; every GROW_AFTER successes double Δt back, never above the
+        // stage's.
         c.accepted();
-        assert!((c.dt - 0.1).abs() < 1e-15 && c.cuts == 0);
-        c.accepted();
-        c.accepted();
+        assert!((c.dt - 0.05).abs() < 1e-15 && c.cuts == 0);
+        for _ in 1..GROW_AFTER {
+            c.accepted();
+        }
+        assert!((c.dt - 0.1).abs() < 1e-15);
+        for _ in 0..3 * GROW_AFTER {
+            c.accepted();
+        }
         assert_eq!(c.dt, 0.2);
     }
 }

@@ -358,18 +358,61 @@ pub struct StepResult {
     pub jacobian: f64,
 }
 
-/// Kinematics of the converged step at a particle, including the volume ratio J = det(I + ∇Δu).
+/// Kinematics of the converged step at a particle, with its deformation gradient F = I + ∇Δu and
+/// volume ratio J = det F. With B̄ the volume follows the B̄ volumetric strain that the stress sees
+/// (an F̄ update, as Coombs et al. 2018 do for the MPM): J̄ = J (1 + ∇̄·Δu)/(1 + ∇·Δu) and
+/// F̄ = sqrt(J̄/J) F. Otherwise the points of a cell could trade volume among themselves at no
+/// energy (B̄ only sees the cell's average) until one of them is crushed.
 pub fn step_result(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors, two_phase: bool) -> StepResult {
     let kin = interpolate(basis, states, pred, two_phase);
     let mut f = [[1.0, 0.0], [0.0, 1.0]];
+    let (mut div, mut div_bar) = (0.0, 0.0);
     for (b, st) in basis.iter().zip(states) {
         for (a, fa) in f.iter_mut().enumerate() {
             for (fac, g) in fa.iter_mut().zip(b.g) {
                 *fac += st.d[a] * g;
             }
         }
+        div += b.g[0] * st.d[dof::UX] + b.g[1] * st.d[dof::UY];
+        div_bar += b.gv[0] * st.d[dof::UX] + b.gv[1] * st.d[dof::UY];
     }
-    StepResult { kin, f_inc: f, jacobian: f[0][0] * f[1][1] - f[0][1] * f[1][0] }
+    let j = f[0][0] * f[1][1] - f[0][1] * f[1][0];
+    if div_bar == div || 1.0 + div <= 0.0 || 1.0 + div_bar <= 0.0 {
+        return StepResult { kin, f_inc: f, jacobian: j };
+    }
+    let j_bar = j * (1.0 + div_bar) / (1.0 + div);
+    let scale = (j_bar / j).sqrt();
+    let f_bar = [[f[0][0] * scale, f[0][1] * scale], [f[1][0] * scale, f[1][1] * scale]];
+    StepResult { kin, f_inc: f_bar, jacobian: j_bar }
+}
+
+/// Pressure-projection stabilisation of one cell (Bochev & Dohrmann 2006; Dohrmann & Bochev 2004,
+/// for equal-order pressures): S_kl = Σ_p w_p (N_k(x_p) − N̄_k)(N_l(x_p) − N̄_l) over the material
+/// points p of the cell, with N the cell's four bilinear functions at the points, w_p = τ_p V_p and
+/// N̄ the w-weighted cell averages. Δpᵀ S Δp penalises the part of the pressure increment that is
+/// not constant in the cell, which the volumetric coupling of equal-order (and B̄) interpolation
+/// cannot see; it vanishes for a cell-wise constant field. The caller subtracts S Δp from the
+/// continuity rows (the sign of −P).
+pub fn pressure_projection(n: &[[f64; 4]], w: &[f64]) -> [[f64; 4]; 4] {
+    let total: f64 = w.iter().sum();
+    let mut out = [[0.0; 4]; 4];
+    if total <= 0.0 {
+        return out;
+    }
+    let mut mean = [0.0; 4];
+    for (np, wp) in n.iter().zip(w) {
+        for k in 0..4 {
+            mean[k] += wp * np[k] / total;
+        }
+    }
+    for (np, wp) in n.iter().zip(w) {
+        for k in 0..4 {
+            for l in 0..4 {
+                out[k][l] += wp * (np[k] - mean[k]) * (np[l] - mean[l]);
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -511,6 +554,25 @@ mod tests {
         let fy: f64 = (0..4).map(|k| r[k * 5 + 1] + r[k * 5 + 4]).sum();
         assert!((fy - (p.mass + p.water_mass) * 9.81).abs() < 1e-12);
         assert!((0..4).all(|k| r[k * 5 + 2] == 0.0));
+    }
+
+    #[test]
+    fn the_pressure_projection_ignores_constants_and_penalises_the_rest() {
+        // Four points of a unit cell at the quarter points.
+        let pts = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
+        let n: Vec<[f64; 4]> =
+            pts.iter().map(|&(x, y)| [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]).collect();
+        let s = pressure_projection(&n, &[0.25; 4]);
+        let apply = |p: [f64; 4]| -> f64 { (0..4).map(|k| (0..4).map(|l| p[k] * s[k][l] * p[l]).sum::<f64>()).sum() };
+        assert!(apply([1.0; 4]).abs() < 1e-15, "a constant is not penalised");
+        // The checkerboard (+ − − +) and a linear field are.
+        assert!(apply([1.0, -1.0, -1.0, 1.0]) > 1e-3);
+        assert!(apply([0.0, 1.0, 0.0, 1.0]) > 1e-3);
+        for (k, row) in s.iter().enumerate() {
+            for (l, v) in row.iter().enumerate() {
+                assert!((v - s[l][k]).abs() < 1e-15);
+            }
+        }
     }
 
     #[test]

@@ -76,7 +76,8 @@ impl Stencils {
 #[derive(Debug, Default)]
 struct StepData {
     nm: Option<kernels::Newmark>,
-    body_acc: [f64; 2],
+    /// Body acceleration at t_{n+1} per body.
+    body_acc: Vec<[f64; 2]>,
     stencils: Stencils,
     /// External nodal forces at t_{n+1} (tractions) per ghosted dof.
     fext: Vec<f64>,
@@ -94,6 +95,9 @@ struct StepData {
     grad_n: Vec<[f64; 2]>,
     /// v_u, a_u, v_w, a_w at t_n at each particle, from the nodal projections.
     smooth: Vec<[[f64; 2]; 4]>,
+    /// Pressure-projection blocks: the local p dofs of a cell's four nodes (−1 if constrained) and
+    /// the 4 × 4 block S (see `kernels::pressure_projection`).
+    projection: Vec<([i32; 4], [[f64; 4]; 4])>,
     /// Unknowns solved for (unconstrained dofs), summed over ranks.
     free_dofs: usize,
 }
@@ -436,6 +440,45 @@ impl GridSystem {
             })
             .collect();
 
+        // Pressure-projection blocks, cell by cell over this rank's particles (grouped by the cell
+        // holding their centre).
+        let mut projection = Vec::new();
+        if let (true, Some(alpha)) = (self.two_phase, model.pressure_projection) {
+            let g = &model.grid;
+            let mut cells: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
+            for k in 0..ps.len() {
+                if let Some(c) = g.cell_of(ps.x[k]) {
+                    cells.entry(c).or_default().push(k);
+                }
+            }
+            for ((ci, cj), members) in cells {
+                let mut idx = [-1i32; 4];
+                let corners = [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)];
+                for (slot, &(i, j)) in corners.iter().enumerate() {
+                    if let Some(l) = self.local_node(i as u32, j as u32) {
+                        let q = l as usize * nd + kernels::dof::P;
+                        idx[slot] = if constrained[q] { -1 } else { q as i32 };
+                    }
+                }
+                let o = g.node_position(ci, cj);
+                let n: Vec<[f64; 4]> = members
+                    .iter()
+                    .map(|&k| {
+                        let (x, y) = ((ps.x[k][0] - o[0]) / g.h[0], (ps.x[k][1] - o[1]) / g.h[1]);
+                        [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]
+                    })
+                    .collect();
+                let w: Vec<f64> = members
+                    .iter()
+                    .map(|&k| {
+                        let shear = model.materials[ps.material[k] as usize].model.elastic().shear_modulus();
+                        alpha / shear * ps.volume[k]
+                    })
+                    .collect();
+                projection.push((idx, kernels::pressure_projection(&n, &w)));
+            }
+        }
+
         // 4. Tractions at t_{n+1}.
         let mut fext = vec![0.0; ng];
         for &li in &active.loads {
@@ -483,7 +526,7 @@ impl GridSystem {
         let global_start = self.x.ownership_range().map_err(|e| e.to_string())?.0;
         self.step = StepData {
             nm: Some(nm),
-            body_acc: model.body_acceleration(active, t_new),
+            body_acc: model.body_accelerations(active, t_new),
             stencils,
             fext,
             constrained,
@@ -493,6 +536,7 @@ impl GridSystem {
             active: (0..self.ghost.len()).map(|l| weight[l * nd] > MIN_FILLED_FRACTION).collect(),
             grad_n,
             smooth,
+            projection,
             free_dofs,
         };
         // The matrix structure is the union of the particles' node couplings over the free dofs.
@@ -631,7 +675,7 @@ fn fatal(e: petsc::Error) -> CallbackError {
 
 /// The kernel input of particle `k` for the prepared step.
 fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
-    let mut input = model.particle_input(k, step.body_acc);
+    let mut input = model.particle_input(k, &step.body_acc);
     if let Some(g) = step.grad_n.get(k) {
         input.grad_n = *g;
     }
@@ -672,6 +716,17 @@ impl NonlinearProblem for Assembler<'_> {
                     for c in 0..nd {
                         fl[b + c] += buf[n * nd + c];
                     }
+                }
+            }
+            // Pressure projection: −S Δp in the continuity rows.
+            for (idx, s) in &self.step.projection {
+                for (a, &ra) in idx.iter().enumerate() {
+                    if ra < 0 {
+                        continue;
+                    }
+                    let v: f64 =
+                        idx.iter().enumerate().filter(|(_, &q)| q >= 0).map(|(b, &q)| s[a][b] * xl[q as usize]).sum();
+                    fl[ra as usize] -= v;
                 }
             }
         }
@@ -715,6 +770,10 @@ impl NonlinearProblem for Assembler<'_> {
                 }
             }
             j.set_values_local(&idx[..m], &idx[..m], &block[..m * m], true).map_err(fatal)?;
+        }
+        for (idx, s) in &self.step.projection {
+            let neg: Vec<f64> = s.iter().flat_map(|r| r.iter().map(|v| -v)).collect();
+            j.set_values_local(idx, idx, &neg, true).map_err(fatal)?;
         }
         for &o in &self.step.owned_constrained {
             let g = (self.step.global_start + o) as i32;

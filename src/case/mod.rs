@@ -5,6 +5,7 @@
 
 pub mod element;
 pub mod overrides;
+pub mod parameters;
 pub mod schema;
 mod validate;
 
@@ -48,6 +49,7 @@ pub fn parse(text: &str, origin: &str, overrides: &[Override]) -> Result<Case, C
         let path = overrides::apply(&mut doc, ov).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
         set_paths.push((path, ov.key.clone()));
     }
+    parameters::expand(&mut doc).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
     let case: Case = serde_path_to_error::deserialize(doc).map_err(|e| {
         let path = e.path().to_string();
         let msg = e.inner().message().trim().to_string();
@@ -109,6 +111,40 @@ impl Case {
     /// Cell size in x and y [m].
     pub fn cell_size(&self) -> [f64; 2] {
         [self.grid.size[0] / self.grid.cells[0] as f64, self.grid.size[1] / self.grid.cells[1] as f64]
+    }
+}
+
+impl Case {
+    /// The first body containing `p` (bodies earlier in the file take precedence), if any.
+    pub fn body_at(&self, p: [f64; 2]) -> Option<&Body> {
+        self.bodies.iter().find(|b| b.shape.contains(p))
+    }
+
+    /// Mass density of the material at `p` [kg/m³]: the saturated mixture (1 − n)ρ_s + nρ_w, or 0
+    /// outside every body.
+    pub fn density_at(&self, p: [f64; 2]) -> f64 {
+        self.body_at(p).map_or(0.0, |b| {
+            let m = &self.materials[self.material_index(&b.material).expect("validated")];
+            (1.0 - m.porosity) * m.solid_density + m.porosity * m.water_density
+        })
+    }
+
+    /// The top of the material above `p` (the highest point of the bodies on the vertical line
+    /// through p, sampled at `dy`), and ∫_y^{top} ρ dy along it [kg/m²].
+    pub fn column_above(&self, p: [f64; 2], dy: f64) -> (f64, f64) {
+        let top = self.bodies.iter().map(|b| b.shape.bounds().1[1]).fold(p[1], f64::max);
+        let n = ((top - p[1]) / dy).ceil().max(1.0) as usize;
+        let h = (top - p[1]) / n as f64;
+        let (mut mass, mut surface) = (0.0, p[1]);
+        for i in 0..n {
+            let y = p[1] + (i as f64 + 0.5) * h;
+            let rho = self.density_at([p[0], y]);
+            mass += rho * h;
+            if rho > 0.0 {
+                surface = p[1] + (i + 1) as f64 * h;
+            }
+        }
+        (surface, mass)
     }
 }
 

@@ -9,6 +9,10 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
+    /// Named numbers used by `"= expression"` values elsewhere in the file (see
+    /// [`super::parameters`]); `--set parameters.NAME=VALUE` changes them.
+    #[serde(default)]
+    pub parameters: std::collections::BTreeMap<String, f64>,
     /// Physics switches that shape the discrete system.
     pub analysis: Analysis,
     /// The background grid.
@@ -234,6 +238,53 @@ pub struct Body {
     pub particles_per_cell: usize,
     /// The region it occupies at t = 0.
     pub shape: Shape,
+    /// Geostatic initial stress (default: stress-free).
+    #[serde(default)]
+    pub initial_stress: Option<InitialStress>,
+}
+
+/// A geostatic initial state in equilibrium with gravity g = `analysis.g` acting from t = 0 (the
+/// case must apply that gravity in full from the start): at a point at height y under a column of
+/// material reaching y_top at its x, the total vertical stress is σ_v = −g ∫_y^{y_top} ρ dy (the
+/// densities of the bodies met along the column), the pore pressure p = ρ_w g (y_w − y) below the
+/// water table y_w (two-phase), the effective stresses σ'_yy = σ_v + p, σ'_xx = σ'_zz = K₀ σ'_yy,
+/// σ'_xy = 0. Near a slope this is not in equilibrium; the first steps redistribute it.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialStress {
+    /// Coefficient of earth pressure at rest K₀ = σ'_h/σ'_v [-].
+    pub k0: f64,
+    /// The water table (two-phase): `"surface"` (the top of the material in each column, the
+    /// default) or a height [m].
+    #[serde(default)]
+    pub water_table: WaterTable,
+}
+
+/// Where the pore pressure of a geostatic state is zero.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum WaterTable {
+    /// `"surface"`: the top of the material in each column.
+    #[default]
+    #[serde(with = "surface_word")]
+    Surface,
+    /// A height [m].
+    Level(f64),
+}
+
+mod surface_word {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str("surface")
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+        let w = String::deserialize(d)?;
+        if w == "surface" {
+            Ok(())
+        } else {
+            Err(serde::de::Error::custom(format!("expected \"surface\" or a height, got \"{w}\"")))
+        }
+    }
 }
 
 fn default_ppc() -> usize {
@@ -331,7 +382,8 @@ pub struct Boundary {
     /// particles, found again every step (a drained free surface: `fix = ["p"]`).
     #[serde(default)]
     pub surface: Option<Surface>,
-    /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained).
+    /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained). In a one_phase analysis
+    /// the water-phase components have no dofs and are ignored.
     pub fix: Vec<Dof>,
 }
 
@@ -355,8 +407,11 @@ pub enum Load {
     ParticleTraction {
         /// Name used by stages and verification.
         name: String,
-        /// Particles carrying it.
+        /// Particles carrying it (centres inside at t = 0).
         region: Region,
+        /// Only particles of this body (default: any).
+        #[serde(default)]
+        body: Option<String>,
         /// Which face of each particle domain carries it.
         face: Side,
         /// Traction vector [Pa].
@@ -387,6 +442,9 @@ pub enum Load {
         name: String,
         /// Acceleration vector [m/s²].
         acceleration: [f64; 2],
+        /// The bodies it acts on (default: all), e.g. a footing whose unit weight is ramped up.
+        #[serde(default)]
+        bodies: Option<Vec<String>>,
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
@@ -494,6 +552,12 @@ pub struct Stabilisation {
     /// by the share of the particle domain in each cell. Default: off.
     #[serde(default)]
     pub bbar: bool,
+    /// Pressure-projection stabilisation of the equal-order pressure (Bochev & Dohrmann 2006): the
+    /// factor α of τ = α/G (G the skeleton's shear modulus) in the cell-wise penalty on the
+    /// non-constant part of the pressure increment (see `kernels::pressure_projection`). Default:
+    /// none.
+    #[serde(default)]
+    pub pressure_projection: Option<f64>,
 }
 
 /// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none
@@ -660,6 +724,38 @@ pub enum Verification {
         #[serde(default = "default_column_tol")]
         settlement_tolerance: f64,
     },
+    /// Load–settlement of a strip footing and its bearing capacity ([000] §4.1, §4.3; see
+    /// `verification::bearing`).
+    BearingCapacity {
+        /// The soil body (its cohesion normalises the pressure).
+        soil: String,
+        /// The load: a traction (its pressure), or a body force on the footing body (its weight
+        /// over `loaded_width`).
+        load: String,
+        /// Width carrying the load in the model [m] (the half-width in a half model).
+        loaded_width: f64,
+        /// Footing breadth B [m] (normalises the settlement).
+        breadth: f64,
+        /// The settlement is the downward displacement of the material point nearest to this point
+        /// at t = 0 [m].
+        settlement_point: [f64; 2],
+        /// d/B at which q_ult is read for the metric `bearing_capacity_ratio` (none: no metric).
+        #[serde(default)]
+        failure_settlement: Option<f64>,
+        /// Reference q_ult/c (default 2 + π, Prandtl).
+        #[serde(default = "default_prandtl")]
+        reference: f64,
+        /// Largest accepted |(q_ult/c)/reference − 1|.
+        #[serde(default = "default_bearing_tol")]
+        tolerance: f64,
+        /// d/B values at which q/c is reported in summary.json `results`.
+        #[serde(default)]
+        report_settlements: Vec<f64>,
+        /// d/B at which the run ends, completed (a load-controlled footing beyond its limit load
+        /// runs away; default: run to the end).
+        #[serde(default)]
+        stop_settlement: Option<f64>,
+    },
     /// Large-strain one-dimensional consolidation (Xie & Leo 2004; [003] §4.2).
     LargeStrainConsolidation {
         /// The consolidating column (drained at its top).
@@ -715,6 +811,12 @@ fn default_us() -> Vec<f64> {
     vec![0.5]
 }
 fn default_ls_settle_tol() -> f64 {
+    0.03
+}
+fn default_prandtl() -> f64 {
+    2.0 + std::f64::consts::PI
+}
+fn default_bearing_tol() -> f64 {
     0.03
 }
 fn default_column_tol() -> f64 {

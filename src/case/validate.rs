@@ -155,6 +155,14 @@ pub fn validate(c: &Case) -> R {
                 }
             }
         }
+        if let Some(init) = &b.initial_stress {
+            positive(&format!("bodies[{i}].initial_stress.k0"), init.k0)?;
+            if let crate::case::WaterTable::Level(y) = init.water_table {
+                if !y.is_finite() {
+                    return Err(format!("key `bodies[{i}].initial_stress.water_table`: must be finite"));
+                }
+            }
+        }
         let (bmin, bmax) = b.shape.bounds();
         if !inside_grid(bmin) || !inside_grid(bmax) {
             return Err(format!(
@@ -220,11 +228,8 @@ pub fn validate(c: &Case) -> R {
         if b.fix.is_empty() {
             return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
         }
-        if !two_phase {
-            if let Some(d) = b.fix.iter().find(|d| !matches!(d, Dof::Ux | Dof::Uy)) {
-                return Err(format!("key `boundaries[{i}].fix`: `{d:?}` exists only in a two_phase analysis (one_phase nodes carry ux, uy)"));
-            }
-        }
+        // In a one_phase analysis the water-phase components (p, Ux, Uy) have no dofs and are
+        // ignored, so that one case file can switch formulation with `--set analysis.formulation`.
     }
 
     // Loads.
@@ -245,6 +250,16 @@ pub fn validate(c: &Case) -> R {
                 }
             }
             Load::BodyForce { acceleration, .. } => finite2(&format!("loads[{i}].acceleration"), *acceleration)?,
+        }
+        let bodies: Vec<&String> = match l {
+            Load::ParticleTraction { body: Some(b), .. } => vec![b],
+            Load::BodyForce { bodies: Some(bs), .. } => bs.iter().collect(),
+            _ => Vec::new(),
+        };
+        for b in bodies {
+            if c.body(b).is_none() {
+                return Err(format!("key `loads[{i}]`: no body named `{b}`"));
+            }
         }
     }
 
@@ -355,9 +370,43 @@ pub fn validate(c: &Case) -> R {
                 positive("verification.slow_tolerance", *slow_tolerance)?;
                 (body, load)
             }
+            Verification::BearingCapacity {
+                soil,
+                load,
+                loaded_width,
+                breadth,
+                settlement_point,
+                failure_settlement,
+                reference,
+                tolerance,
+                report_settlements,
+                stop_settlement,
+            } => {
+                positive("verification.loaded_width", *loaded_width)?;
+                if let Some(s) = stop_settlement {
+                    positive("verification.stop_settlement", *s)?;
+                }
+                positive("verification.breadth", *breadth)?;
+                finite2("verification.settlement_point", *settlement_point)?;
+                if let Some(f) = failure_settlement {
+                    positive("verification.failure_settlement", *f)?;
+                }
+                positive("verification.reference", *reference)?;
+                positive("verification.tolerance", *tolerance)?;
+                for (j, r) in report_settlements.iter().enumerate() {
+                    positive(&format!("verification.report_settlements[{j}]"), *r)?;
+                }
+                if matches!(c.load(load), Some(Load::BodyForce { bodies: None, .. })) {
+                    return Err(format!(
+                        "key `verification.load`: the body force `{load}` must name the footing body in `bodies`"
+                    ));
+                }
+                (soil, load)
+            }
         };
         if c.body(body).is_none() {
-            return Err(format!("key `verification.body`: no body named `{body}`"));
+            let key = if matches!(v, Verification::BearingCapacity { .. }) { "soil" } else { "body" };
+            return Err(format!("key `verification.{key}`: no body named `{body}`"));
         }
         if c.load(load).is_none() {
             return Err(format!(
@@ -379,6 +428,7 @@ pub fn validate(c: &Case) -> R {
                     return Err("key `verification`: the elastic column reference is for a one_phase analysis".into());
                 }
             }
+            Verification::BearingCapacity { .. } => {}
             _ => {
                 if !two_phase {
                     return Err(

@@ -85,8 +85,8 @@ pub enum LoadTarget {
     ParticleTraction { particles: Vec<usize>, face: Side, traction: [f64; 2] },
     /// Forces on grid nodes (i, j, tributary length [m]).
     NodalTraction { nodes: Vec<(usize, usize, f64)>, traction: [f64; 2] },
-    /// Body acceleration on all particles.
-    BodyForce { acceleration: [f64; 2] },
+    /// Body acceleration on the particles of the listed bodies (all if None).
+    BodyForce { acceleration: [f64; 2], bodies: Option<Vec<u16>> },
 }
 
 impl LoadDef {
@@ -95,10 +95,13 @@ impl LoadDef {
         let time_fn =
             l.time_function().and_then(|n| c.time_function(n)).map(TimeFn::from_case).unwrap_or(TimeFn::Constant(1.0));
         let target = match l {
-            case::Load::ParticleTraction { region, face, traction, .. } => LoadTarget::ParticleTraction {
+            case::Load::ParticleTraction { region, body, face, traction, .. } => LoadTarget::ParticleTraction {
                 particles: (0..particles.len())
                     .filter(|&k| {
-                        region.contains(particles.x0[k]) && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
+                        let in_body = body.as_ref().is_none_or(|b| c.bodies[particles.body[k] as usize].name == *b);
+                        in_body
+                            && region.contains(particles.x0[k])
+                            && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
                     })
                     .collect(),
                 face: *face,
@@ -107,7 +110,12 @@ impl LoadDef {
             case::Load::NodalTraction { region, traction, .. } => {
                 LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: *traction }
             }
-            case::Load::BodyForce { acceleration, .. } => LoadTarget::BodyForce { acceleration: *acceleration },
+            case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
+                acceleration: *acceleration,
+                bodies: bodies.as_ref().map(|names| {
+                    names.iter().filter_map(|n| c.bodies.iter().position(|b| b.name == *n)).map(|i| i as u16).collect()
+                }),
+            },
         };
         LoadDef { name: l.name().to_string(), time_fn, target }
     }

@@ -48,6 +48,10 @@ pub struct Model {
     pub bbar: bool,
     /// MLSA patch recovery of the pore-pressure increments ([003] §3.3).
     pub patch_recovery: bool,
+    /// Number of bodies of the case.
+    pub n_bodies: usize,
+    /// Factor α of the pressure-projection stabilisation τ = α/G (two-phase), if on.
+    pub pressure_projection: Option<f64>,
 }
 
 /// Names of the nodal fields, in dof order: ux, uy, p, Ux, Uy (two-phase) or ux, uy.
@@ -118,6 +122,12 @@ impl Model {
             beta: case.time_integration.beta,
             gamma: case.time_integration.gamma,
             bbar: case.stabilisation.bbar,
+            n_bodies: case.bodies.len(),
+            pressure_projection: if case.analysis.formulation == Formulation::TwoPhase {
+                case.stabilisation.pressure_projection
+            } else {
+                None
+            },
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
@@ -193,22 +203,28 @@ impl Model {
         out
     }
 
-    /// Body acceleration at time `t` from the active body-force loads [m/s²].
-    pub fn body_acceleration(&self, active: &Active, t: f64) -> [f64; 2] {
-        let mut b = [0.0; 2];
+    /// Body acceleration at time `t` of the particles of each body, from the active body-force loads
+    /// [m/s²] (indexed by body).
+    pub fn body_accelerations(&self, active: &Active, t: f64) -> Vec<[f64; 2]> {
+        let nb = self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(self.n_bodies);
+        let mut out = vec![[0.0; 2]; nb];
         for &i in &active.loads {
-            if let LoadTarget::BodyForce { acceleration } = &self.loads[i].target {
+            if let LoadTarget::BodyForce { acceleration, bodies } = &self.loads[i].target {
                 let f = self.loads[i].time_fn.eval(t);
-                b[0] += acceleration[0] * f;
-                b[1] += acceleration[1] * f;
+                for (b, a) in out.iter_mut().enumerate() {
+                    if bodies.as_ref().is_none_or(|l| l.contains(&(b as u16))) {
+                        a[0] += acceleration[0] * f;
+                        a[1] += acceleration[1] * f;
+                    }
+                }
             }
         }
-        b
+        out
     }
 
     /// The kernel input of particle `k` at the start of the step.
     #[inline]
-    pub fn particle_input(&self, k: usize, body_acc: [f64; 2]) -> ParticleInput {
+    pub fn particle_input(&self, k: usize, body_acc: &[[f64; 2]]) -> ParticleInput {
         let ps = &self.particles;
         let mat = &self.materials[ps.material[k] as usize];
         let (v, n) = (ps.volume[k], ps.porosity[k]);
@@ -228,7 +244,7 @@ impl Model {
             stress: ps.stress[k],
             eps_pd: ps.eps_pd[k],
             p: ps.p[k],
-            body_acc,
+            body_acc: body_acc[ps.body[k] as usize],
             grad_n: [0.0; 2],
             pred: Default::default(),
         }

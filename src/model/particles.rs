@@ -47,6 +47,8 @@ pub struct Particles {
     pub stress: Vec<[f64; 4]>,
     /// Pore pressure (compression positive) [Pa].
     pub p: Vec<f64>,
+    /// Pore pressure at t = 0 [Pa] (the excess pore pressure is p − p₀).
+    pub p0: Vec<f64>,
     /// Deviatoric plastic strain ε_p^d = sqrt(2/3 e_p : e_p) [-].
     pub eps_pd: Vec<f64>,
 }
@@ -115,8 +117,13 @@ impl Particles {
                             ps.acc.push([0.0; 2]);
                             ps.vel_w.push([0.0; 2]);
                             ps.acc_w.push([0.0; 2]);
-                            ps.stress.push([0.0; 4]);
-                            ps.p.push(0.0);
+                            let (stress, p) = match &body.initial_stress {
+                                Some(init) => geostatic(case, grid, init, x, two_phase),
+                                None => ([0.0; 4], 0.0),
+                            };
+                            ps.stress.push(stress);
+                            ps.p.push(p);
+                            ps.p0.push(p);
                             ps.eps_pd.push(0.0);
                         }
                     }
@@ -125,6 +132,33 @@ impl Particles {
         }
         ps
     }
+}
+
+/// The geostatic effective stress and pore pressure at `x` (see [`crate::case::InitialStress`]).
+fn geostatic(
+    case: &Case,
+    grid: &Grid,
+    init: &crate::case::InitialStress,
+    x: [f64; 2],
+    two_phase: bool,
+) -> ([f64; 4], f64) {
+    let g = case.analysis.g;
+    let (surface, mass) = case.column_above(x, grid.h[1] / 50.0);
+    let sigma_v = -g * mass;
+    let p = if two_phase {
+        let rho_w = case
+            .body_at(x)
+            .map_or(1000.0, |b| case.materials[case.material_index(&b.material).expect("validated")].water_density);
+        let level = match init.water_table {
+            crate::case::WaterTable::Surface => surface,
+            crate::case::WaterTable::Level(y) => y,
+        };
+        rho_w * g * (level - x[1]).max(0.0)
+    } else {
+        0.0
+    };
+    let sv = sigma_v + p;
+    ([init.k0 * sv, sv, 0.0, init.k0 * sv], p)
 }
 
 #[cfg(test)]

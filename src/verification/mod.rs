@@ -19,6 +19,7 @@
 //!   depth profile (particles at the same depth averaged).
 //! * Shock wave ([003] §4.1.3): see [`shock`] for how arrival times are picked.
 
+pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
 pub mod shock;
@@ -77,6 +78,14 @@ pub trait Check {
     fn observe(&mut self, t: f64, dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String>;
     /// The metrics (name, metric) and tables at the end of the run.
     fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String>;
+    /// Some(reason) once the run has shown what the check needs and should end (completed).
+    fn stop(&self) -> Option<String> {
+        None
+    }
+    /// Quantities without a reference (summary.json `results`), available after [`Check::finish`].
+    fn results(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
 }
 
 /// Geometry and soil of a loaded one-dimensional column, taken from the case.
@@ -221,6 +230,34 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                 *settlement_tolerance,
             )?)
         }
+        Verification::BearingCapacity {
+            soil,
+            load,
+            loaded_width,
+            breadth,
+            settlement_point,
+            failure_settlement,
+            reference,
+            tolerance,
+            report_settlements,
+            stop_settlement,
+        } => Box::new(bearing::BearingCheck::new(
+            c,
+            model,
+            coll,
+            &bearing::BearingSpec {
+                soil,
+                load,
+                loaded_width: *loaded_width,
+                breadth: *breadth,
+                settlement_point: *settlement_point,
+                failure_settlement: *failure_settlement,
+                reference: *reference,
+                tolerance: *tolerance,
+                report_settlements,
+                stop_settlement: *stop_settlement,
+            },
+        )?),
         Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             Box::new(shock::ShockCheck::new(col, *probe_depth, *fast_tolerance, *slow_tolerance, model, coll)?)
@@ -662,5 +699,9 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::LargeStrainConsolidation { degrees, .. } => {
             format!("large-strain consolidation (Xie & Leo 2004) at U_s = {degrees:?}")
         }
+        Verification::BearingCapacity { failure_settlement, reference, .. } => match failure_settlement {
+            Some(f) => format!("bearing capacity: q_ult/c at d/B = {f} against {reference:.4}"),
+            None => "load–settlement curve of a footing".into(),
+        },
     }
 }

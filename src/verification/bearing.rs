@@ -1,0 +1,228 @@
+//! Bearing capacity of a strip footing: the load–settlement curve of a run and the ultimate
+//! pressure read from it ([000] §4.1, §4.3).
+//!
+//! Every step the check records the footing pressure q and the settlement d:
+//! * q is the applied pressure: |traction_y| f(t) for a traction load, or, for a body force acting on
+//!   a footing body ([000] §4.1.2: a footing of increasing unit weight), the weight of that body's
+//!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest);
+//! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0.
+//!
+//! The curve goes to `load_settlement.csv` and history.csv (q, q/c, d/B). With `failure_settlement`,
+//! q_ult is the pressure at which d/B first reaches it (interpolated between steps), and the metric
+//! `bearing_capacity_ratio` = (q_ult/c)/reference, with reference 2 + π for Prandtl's undrained
+//! strip footing; c is the soil's cohesion. `results` gets q/c at each of `report_settlements`
+//! (interpolated) and the largest q/c reached. With `stop_settlement` the run ends (completed) once
+//! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
+
+use super::{Check, Findings, Metric, Table};
+use crate::assembly::Collective;
+use crate::case::{Case, Load, SoilModel};
+use crate::model::Model;
+
+/// The load–settlement check.
+pub struct BearingCheck {
+    load: LoadKind,
+    time_fn: crate::model::loads::TimeFn,
+    cohesion: f64,
+    breadth: f64,
+    point_id: u64,
+    failure: Option<f64>,
+    reference: f64,
+    tolerance: f64,
+    report: Vec<f64>,
+    stop_at: Option<f64>,
+    /// (t, d/B, q/c) per step.
+    curve: Vec<[f64; 3]>,
+}
+
+enum LoadKind {
+    /// |traction_y| [Pa].
+    Traction(f64),
+    /// |b_y| [m/s²], bodies, loaded width [m].
+    Weight(f64, Vec<u16>, f64),
+}
+
+/// Parameters of [`BearingCheck::new`], as in the case's `[verification]`.
+pub struct BearingSpec<'a> {
+    /// The soil body.
+    pub soil: &'a str,
+    /// The load.
+    pub load: &'a str,
+    /// Loaded width in the model [m].
+    pub loaded_width: f64,
+    /// Footing breadth B [m].
+    pub breadth: f64,
+    /// Where the settlement is measured at t = 0.
+    pub settlement_point: [f64; 2],
+    /// d/B at which q_ult is read.
+    pub failure_settlement: Option<f64>,
+    /// Reference q_ult/c.
+    pub reference: f64,
+    /// Tolerance of the ratio.
+    pub tolerance: f64,
+    /// d/B values at which q/c is reported.
+    pub report_settlements: &'a [f64],
+    /// d/B at which the run stops.
+    pub stop_settlement: Option<f64>,
+}
+
+impl BearingCheck {
+    /// Builds the check from the case.
+    pub fn new(c: &Case, model: &Model, coll: &Collective, spec: &BearingSpec) -> Result<BearingCheck, String> {
+        let soil = c.body(spec.soil).ok_or(format!("no body `{}`", spec.soil))?;
+        let mat = c.material(&soil.material).expect("validated");
+        let cohesion = match &mat.model {
+            SoilModel::MohrCoulomb { cohesion, .. } | SoilModel::VonMises { cohesion, .. } => *cohesion,
+            SoilModel::LinearElastic { .. } => {
+                return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil))
+            }
+        };
+        if cohesion <= 0.0 {
+            return Err("the bearing capacity check normalises by the cohesion, which must be positive".into());
+        }
+        let load = match c.load(spec.load) {
+            Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }) => {
+                LoadKind::Traction(traction[1].abs())
+            }
+            Some(Load::BodyForce { acceleration, bodies, .. }) => {
+                let names = bodies.clone().unwrap_or_default();
+                if names.is_empty() {
+                    return Err(format!("the body force `{}` must name the footing body in `bodies`", spec.load));
+                }
+                let idx = names
+                    .iter()
+                    .map(|n| c.bodies.iter().position(|b| b.name == *n).map(|i| i as u16))
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or("unknown body")?;
+                LoadKind::Weight(acceleration[1].abs(), idx, spec.loaded_width)
+            }
+            None => return Err(format!("no load `{}`", spec.load)),
+        };
+        let time_fn = c
+            .load(spec.load)
+            .and_then(|l| l.time_function())
+            .and_then(|n| c.time_function(n))
+            .map(crate::model::loads::TimeFn::from_case)
+            .unwrap_or(crate::model::loads::TimeFn::Constant(1.0));
+        // The material point nearest to the settlement point (over all ranks).
+        let ps = &model.particles;
+        let local: Vec<f64> = (0..ps.len())
+            .flat_map(|k| {
+                let d = (ps.x0[k][0] - spec.settlement_point[0]).hypot(ps.x0[k][1] - spec.settlement_point[1]);
+                [d, ps.id[k] as f64]
+            })
+            .collect();
+        let all = coll.gather(&local)?;
+        let best = all
+            .chunks(2)
+            .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
+            .ok_or("there are no material points")?;
+        Ok(BearingCheck {
+            load,
+            time_fn,
+            cohesion,
+            breadth: spec.breadth,
+            point_id: best[1] as u64,
+            failure: spec.failure_settlement,
+            reference: spec.reference,
+            tolerance: spec.tolerance,
+            report: spec.report_settlements.to_vec(),
+            stop_at: spec.stop_settlement,
+            curve: Vec::new(),
+        })
+    }
+
+    fn pressure(&self, t: f64, model: &Model, coll: &Collective) -> Result<f64, String> {
+        let f = self.time_fn.eval(t);
+        Ok(match &self.load {
+            LoadKind::Traction(q) => q * f,
+            LoadKind::Weight(b, bodies, width) => {
+                let ps = &model.particles;
+                let local: f64 = (0..ps.len())
+                    .filter(|&k| bodies.contains(&ps.body[k]))
+                    .map(|k| {
+                        let mw = if model.two_phase {
+                            ps.porosity[k] * model.materials[ps.material[k] as usize].water_density * ps.volume[k]
+                        } else {
+                            0.0
+                        };
+                        ps.mass[k] + mw
+                    })
+                    .sum();
+                coll.sum(&[local])?[0] * b * f / width
+            }
+        })
+    }
+
+    /// q/c at the first crossing of d/B = `target` (interpolated), if reached.
+    fn at(&self, target: f64) -> Option<f64> {
+        self.curve.windows(2).find(|w| w[0][1] < target && w[1][1] >= target).map(|w| {
+            let s = (target - w[0][1]) / (w[1][1] - w[0][1]);
+            w[0][2] + s * (w[1][2] - w[0][2])
+        })
+    }
+}
+
+impl Check for BearingCheck {
+    fn columns(&self) -> Vec<String> {
+        ["bearing.q", "bearing.q_over_c", "bearing.d_over_B"].iter().map(|s| s.to_string()).collect()
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+        let q = self.pressure(t, model, coll)?;
+        let ps = &model.particles;
+        let local: f64 = (0..ps.len()).find(|&k| ps.id[k] == self.point_id).map_or(0.0, |k| -ps.disp[k][1]);
+        let d = coll.sum(&[local])?[0];
+        let row = [t, d / self.breadth, q / self.cohesion];
+        if self.curve.last().is_none_or(|l| l[0] < t) {
+            self.curve.push(row);
+        }
+        Ok(vec![q, row[2], row[1]])
+    }
+
+    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+        let mut metrics = Vec::new();
+        if let Some(fs) = self.failure {
+            let m = match self.at(fs) {
+                Some(qc) => Metric {
+                    value: qc / self.reference,
+                    reference: 1.0,
+                    tolerance: self.tolerance,
+                    pass: (qc / self.reference - 1.0).abs() <= self.tolerance,
+                    detail: format!("q_ult/c = {qc:.4} at d/B = {fs} vs {:.4}; (q_ult/c)/reference", self.reference),
+                },
+                None => Metric {
+                    value: f64::NAN,
+                    reference: 1.0,
+                    tolerance: self.tolerance,
+                    pass: false,
+                    detail: format!("the settlement never reached d/B = {fs}"),
+                },
+            };
+            metrics.push(("bearing_capacity_ratio".to_string(), m));
+        }
+        let table = Table {
+            name: "load_settlement.csv".into(),
+            header: vec!["time", "d_over_B", "q_over_c"],
+            rows: self.curve.iter().map(|r| r.to_vec()).collect(),
+        };
+        Ok((metrics, vec![table]))
+    }
+
+    fn stop(&self) -> Option<String> {
+        let (stop, last) = (self.stop_at?, self.curve.last()?);
+        (last[1] >= stop).then(|| format!("the footing settlement reached d/B = {:.4} ≥ {stop}", last[1]))
+    }
+
+    fn results(&self) -> Vec<(String, f64)> {
+        let mut out: Vec<(String, f64)> =
+            self.report.iter().filter_map(|&s| self.at(s).map(|qc| (format!("q_over_c_at_dB{s}"), qc))).collect();
+        out.push(("q_over_c_max".into(), self.curve.iter().map(|r| r[2]).fold(f64::NEG_INFINITY, f64::max)));
+        out.push(("d_over_B_final".into(), self.curve.last().map_or(0.0, |r| r[1])));
+        out
+    }
+}
