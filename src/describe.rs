@@ -152,13 +152,16 @@ pub fn describe(case: &Case, label: &str) -> String {
         let a = model.active(st);
         let _ = writeln!(
             s,
-            "stage `{}`: {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]",
+            "stage `{}`: {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]{}",
             st.name,
             st.duration,
             st.dt(),
             (st.duration / st.dt()).ceil() as usize,
             a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
-            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", ")
+            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
+            st.time_integration
+                .as_ref()
+                .map_or(String::new(), |t| format!("; Newmark β = {}, γ = {}", t.beta, t.gamma))
         );
     }
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));

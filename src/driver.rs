@@ -173,15 +173,16 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
     let mut summary = Summary::new(req);
     let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| {
         let mut sim = Simulation::set_up(req, out, &mut summary)?;
-        for stage in &req.case.stages {
-            sim.run_stage(stage)?;
-            if let Some(why) = sim.check.as_ref().and_then(|c| c.stop()) {
-                sim.progress(&format!("stopped at t = {:.6e} s: {why}", sim.t));
-                sim.summary.stopped = Some(why);
-                break;
+        let stages = sim.run_stages(&req.case.stages);
+        match stages {
+            Ok(()) => sim.finish(),
+            Err(e) => {
+                // A failed run still reports what its probes and check saw up to the failure
+                // (results, tables, metrics of the events it reached); its status stays `failed`.
+                let _ = sim.finish();
+                Err(e)
             }
         }
-        sim.finish()
     });
     summary.wall_time_s = start.elapsed().as_secs_f64();
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
@@ -191,6 +192,10 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         Some(e) => {
             summary.status = "failed".into();
             summary.error = Some(e.message().to_string());
+            // Metrics of a failed run are partial: they never count as a pass.
+            if summary.verification_passed.is_some() {
+                summary.verification_passed = Some(false);
+            }
         }
     }
     let written = out.write_summary(&summary);
@@ -235,8 +240,9 @@ impl Summary {
 
 /// Runs `steps` steps of the first stage, prepares the next one and compares its assembled tangent
 /// with central finite differences of the assembled residual, block by block (one rank, small
-/// cases). Nothing is written.
-pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<Vec<assembly::BlockCheck>, RunError> {
+/// cases). Also returns how many material points have yielded (ε̄ > 0), so that a check of a
+/// plastic case can tell that the plastic tangent took part. Nothing is written.
+pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
     let mut summary = Summary::new(req);
     let mut out = RunOutput::create(&req.out_dir, false).map_err(RunError::Input)?;
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
@@ -248,7 +254,8 @@ pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<Vec<assembly::Blo
         sim.t += stage.dt();
     }
     sim.system.prepare_step(&sim.model, &active, sim.t + stage.dt(), stage.dt()).map_err(RunError::Failed)?;
-    sim.system.jacobian_check(&sim.model, 0.7).map_err(|e| RunError::Failed(e.to_string()))
+    let blocks = sim.system.jacobian_check(&sim.model, 0.7).map_err(|e| RunError::Failed(e.to_string()))?;
+    Ok((blocks, sim.model.particles.eps_pd.iter().filter(|&&e| e > 0.0).count()))
 }
 
 impl<'a> Simulation<'a> {
@@ -301,9 +308,24 @@ impl<'a> Simulation<'a> {
         Ok(sim)
     }
 
+    /// The stage loop: every stage in turn, until the check asks to stop.
+    fn run_stages(&mut self, stages: &[Stage]) -> Result<(), RunError> {
+        for stage in stages {
+            self.run_stage(stage)?;
+            if let Some(why) = self.check.as_ref().and_then(|c| c.stop()) {
+                self.progress(&format!("stopped at t = {:.6e} s: {why}", self.t));
+                self.summary.stopped = Some(why);
+                break;
+            }
+        }
+        Ok(())
+    }
+
     /// The time-step loop of one stage.
     fn run_stage(&mut self, stage: &Stage) -> Result<(), RunError> {
         let active = self.model.active(stage);
+        let newmark = stage.time_integration.as_ref().unwrap_or(&self.case.time_integration);
+        (self.model.beta, self.model.gamma) = (newmark.beta, newmark.gamma);
         let mut control = StepControl::new(stage, self.stage_end(stage));
         self.progress(&format!(
             "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
@@ -678,6 +700,7 @@ mod tests {
             loads: None,
             max_step_cuts: cuts,
             cut_factor: 0.5,
+            time_integration: None,
         }
     }
 

@@ -193,7 +193,8 @@ fn test_jacobian(
     };
     let result = driver::test_jacobian(&req, steps);
     drop(petsc);
-    let blocks = result.map_err(|e| Failure { code: 1, message: e.message().to_string() })?;
+    let (blocks, yielded) = result.map_err(|e| Failure { code: 1, message: e.message().to_string() })?;
+    println!("material points that have yielded: {yielded}");
     println!(
         "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps)",
         "row", "col", "max|J-Jfd|", "max|J|", "relative"

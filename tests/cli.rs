@@ -355,3 +355,97 @@ fn the_one_phase_tangent_matches_finite_differences_too() {
     assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 4, "{text}");
     assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
 }
+
+/// The element test drives loose sand through plane-strain compression at constant lateral stress:
+/// the CSV has a row per increment, the lateral stress stays at its control value and the final
+/// state lies on the Mohr–Coulomb surface (σ₁ − σ₃) + (σ₁ + σ₃) sin φ = 2c cos φ (tension positive).
+#[test]
+fn the_element_test_writes_a_plane_strain_path_ending_on_the_mohr_coulomb_surface() {
+    let dir = out_dir("element_test");
+    let o = porompm(&[
+        "element-test",
+        "element_tests/loose_sand.toml",
+        "--path",
+        "element_tests/plane_strain.toml",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(dir.join("element_test.csv")).expect("element_test.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 200, "one row per increment");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let last = rows.last().unwrap();
+    let v = |name: &str| last[col(name)].parse::<f64>().unwrap();
+    assert!((v("sig_xx") + 100e3).abs() < 1e-3, "lateral stress held: {}", v("sig_xx"));
+    let mut s = [v("sig_xx"), v("sig_yy"), v("sig_zz")];
+    s.sort_by(f64::total_cmp);
+    let (s1, s3) = (s[2], s[0]);
+    let (phi, c) = (25f64.to_radians(), 3.0e3);
+    let f = (s1 - s3) + (s1 + s3) * phi.sin() - 2.0 * c * phi.cos();
+    assert!(f.abs() < 1e-6 * s3.abs(), "yield function at the end: {f} Pa");
+    assert!(v("eps_pd") > 0.01, "the sand has yielded");
+    assert_eq!(last[col("region")], "plane");
+}
+
+#[test]
+fn an_element_test_with_a_missing_path_file_is_one_clear_error() {
+    let dir = out_dir("element_test_missing");
+    let o = porompm(&[
+        "element-test",
+        "element_tests/loose_sand.toml",
+        "--path",
+        "element_tests/no_such_path.toml",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, "no_such_path.toml");
+}
+
+/// Case parameters: a `"= expr"` value that names an unknown parameter is refused with its key.
+#[test]
+fn an_expression_with_an_unknown_parameter_is_named() {
+    let o = porompm(&["check", "cases/slope_sand.toml", "--set", "materials.sand.model.cohesion== 2 * nonesuch"]);
+    assert_one_line_error(&o, "nonesuch");
+}
+
+/// The tangent of plastic, non-associated Mohr–Coulomb points (ψ ≠ φ, evolving dilatancy) with B̄
+/// and the pressure-projection block, on the small slumping block after ten steps under gravity:
+/// most points have yielded and every block still matches central differences.
+#[test]
+fn the_plastic_tangent_with_pressure_projection_matches_finite_differences() {
+    let o = porompm(&[
+        "test-jacobian",
+        "cases/slumping_block.toml",
+        "--steps",
+        "10",
+        "--set",
+        "stabilisation.bbar=true",
+        "--set",
+        "stabilisation.pressure_projection=1.0",
+        "--set",
+        "grid.cells=[6,5]",
+        "--set",
+        "grid.size=[0.75,0.625]",
+        "--set",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.5,0.5]}}",
+        "--set",
+        "probes=[]",
+        "--set",
+        "time.dt=0.02",
+        "--set",
+        "materials[0].model={type=\"mohr_coulomb\",young_modulus=1e6,poisson_ratio=0.3,friction_angle=20.0,\
+         cohesion=2000.0,dilation_angle=-5.0,critical_dilation_angle=0.0,dilation_decay=25.0}",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}\n{}", stderr(&o));
+    let yielded: usize = text
+        .lines()
+        .find_map(|l| l.strip_prefix("material points that have yielded: "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no yield count in:\n{text}"));
+    assert!(yielded >= 10, "only {yielded} points have yielded:\n{text}");
+    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+}

@@ -593,6 +593,11 @@ pub struct Stage {
     /// Factor applied to Δt at each cut.
     #[serde(default = "default_cut_factor")]
     pub cut_factor: f64,
+    /// Newmark parameters of this stage (default: the case's `time_integration`). A settling
+    /// stage can damp the transient of an unbalanced initial state numerically, e.g.
+    /// `{ beta = 0.49, gamma = 0.9 }` with a Δt near the lowest period of the soil.
+    #[serde(default)]
+    pub time_integration: Option<TimeIntegration>,
 }
 
 impl Stage {

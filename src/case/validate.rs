@@ -294,11 +294,18 @@ pub fn validate(c: &Case) -> R {
     }
 
     // Newmark: unconditional stability of the average-acceleration family needs 2β ≥ γ ≥ 1/2.
-    let (beta, gamma) = (c.time_integration.beta, c.time_integration.gamma);
-    if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta <= 1.0) {
-        return Err(format!(
-            "key `time_integration`: β = {beta}, γ = {gamma} is not unconditionally stable; use 2β ≥ γ ≥ 1/2 (default β = 1/4, γ = 1/2)"
-        ));
+    let newmarks = std::iter::once(("time_integration".to_string(), &c.time_integration)).chain(
+        c.stages
+            .iter()
+            .filter_map(|s| s.time_integration.as_ref().map(|t| (format!("stages.{}.time_integration", s.name), t))),
+    );
+    for (key, ti) in newmarks {
+        let (beta, gamma) = (ti.beta, ti.gamma);
+        if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta <= 1.0) {
+            return Err(format!(
+                "key `{key}`: β = {beta}, γ = {gamma} is not unconditionally stable; use 2β ≥ γ ≥ 1/2 (default β = 1/4, γ = 1/2)"
+            ));
+        }
     }
     if c.output.history_every == 0 {
         return Err("key `output.history_every`: must be at least 1".into());

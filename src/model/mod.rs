@@ -250,12 +250,13 @@ impl Model {
         }
     }
 
-    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and the
-    /// porosity it implies, n = 1 − (1 − n₀)/J, inside (0, 1).
+    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and, in
+    /// a two-phase run, the porosity it implies, n = 1 − (1 − n₀)/J, inside (0, 1). A one-phase
+    /// (total-stress) run has no porosity among its state variables: it keeps the initial value.
     pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
         let j = step.jacobian;
         let ps = &self.particles;
-        let n_new = 1.0 - (1.0 - ps.porosity[k]) / j;
+        let n_new = if self.two_phase { 1.0 - (1.0 - ps.porosity[k]) / j } else { ps.porosity[k] };
         if j.is_nan() || j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
             return Err(InadmissibleStep(format!(
                 "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
@@ -279,7 +280,7 @@ impl Model {
         self.check_step(k, step)?;
         let j = step.jacobian;
         let ps = &mut self.particles;
-        let n_new = 1.0 - (1.0 - ps.porosity[k]) / j;
+        let n_new = if self.two_phase { 1.0 - (1.0 - ps.porosity[k]) / j } else { ps.porosity[k] };
         let kin = &step.kin;
         let g = self.gamma;
         for c in 0..2 {

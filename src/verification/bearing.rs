@@ -5,7 +5,9 @@
 //! * q is the applied pressure: |traction_y| f(t) for a traction load, or, for a body force acting on
 //!   a footing body ([000] §4.1.2: a footing of increasing unit weight), the weight of that body's
 //!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest);
-//! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0.
+//! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0,
+//!   counted from the last observation before the load starts (q = 0), so that a gravity stage
+//!   before the loading does not count as settlement.
 //!
 //! The curve goes to `load_settlement.csv` and history.csv (q, q/c, d/B). With `failure_settlement`,
 //! q_ult is the pressure at which d/B first reaches it (interpolated between steps), and the metric
@@ -31,6 +33,8 @@ pub struct BearingCheck {
     tolerance: f64,
     report: Vec<f64>,
     stop_at: Option<f64>,
+    /// Downward displacement of the point while q = 0 [m].
+    baseline: f64,
     /// (t, d/B, q/c) per step.
     curve: Vec<[f64; 3]>,
 }
@@ -128,6 +132,7 @@ impl BearingCheck {
             tolerance: spec.tolerance,
             report: spec.report_settlements.to_vec(),
             stop_at: spec.stop_settlement,
+            baseline: 0.0,
             curve: Vec::new(),
         })
     }
@@ -176,7 +181,11 @@ impl Check for BearingCheck {
         let q = self.pressure(t, model, coll)?;
         let ps = &model.particles;
         let local: f64 = (0..ps.len()).find(|&k| ps.id[k] == self.point_id).map_or(0.0, |k| -ps.disp[k][1]);
-        let d = coll.sum(&[local])?[0];
+        let mut d = coll.sum(&[local])?[0];
+        if q == 0.0 {
+            self.baseline = d;
+        }
+        d -= self.baseline;
         let row = [t, d / self.breadth, q / self.cohesion];
         if self.curve.last().is_none_or(|l| l[0] < t) {
             self.curve.push(row);
