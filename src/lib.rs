@@ -13,6 +13,7 @@ pub mod element_test;
 pub mod io;
 pub mod kernels;
 pub mod model;
+pub mod plot;
 pub mod verification;
 
 /// porompm's version and git revision.
