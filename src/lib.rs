@@ -14,6 +14,7 @@ pub mod io;
 pub mod kernels;
 pub mod model;
 pub mod plot;
+pub mod sweep;
 pub mod verification;
 
 /// porompm's version and git revision.

@@ -45,6 +45,19 @@ pub fn peak_memory_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
+/// Creates a directory and its parents if needed.
+pub fn create_dir(dir: &Path) -> Result<(), String> {
+    fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))
+}
+
+/// Writes a text file `name` into `dir` (created if needed), atomically.
+pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String> {
+    create_dir(dir)?;
+    let path = dir.join(name);
+    write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
 /// The output directory of a run.
 pub struct RunOutput {
     dir: Option<PathBuf>,

@@ -7,6 +7,7 @@
 //! non-positive values.
 
 use crate::plot::{Axis, Figure, Style};
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -89,7 +90,7 @@ fn tick(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 {
         "0".into()
-    } else if (1e-3..1e5).contains(&a) {
+    } else if (1e-4..1e5).contains(&a) {
         let s = format!("{v:.6}");
         let s = s.trim_end_matches('0').trim_end_matches('.');
         s.to_string()
@@ -131,6 +132,30 @@ fn legend_corner(f: &Figure, xr: (f64, f64), yr: (f64, f64)) -> SeriesLabelPosit
     }
 }
 
+/// A logarithmic axis over `r` with labelled ticks at 1, 2, 5 × 10^k (every integer multiple when
+/// the range spans less than a decade and a half, powers of ten only beyond five decades) and
+/// light grid lines at every integer multiple.
+fn log_axis(r: (f64, f64)) -> WithKeyPoints<LogCoord<f64>> {
+    let decades = (r.1 / r.0).log10();
+    let bold: &[f64] = if decades < 1.5 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else if decades <= 5.0 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    let points = |ms: &[f64]| {
+        let (k0, k1) = (r.0.log10().floor() as i32, r.1.log10().ceil() as i32);
+        (k0..=k1)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| *v >= r.0 && *v <= r.1)
+            .collect::<Vec<f64>>()
+    };
+    LogCoord::from((r.0..r.1).log_scale())
+        .with_key_points(points(bold))
+        .with_light_points(points(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]))
+}
+
 fn render(path: &Path, f: &Figure) -> Result<(), String> {
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
@@ -139,9 +164,9 @@ fn render(path: &Path, f: &Figure) -> Result<(), String> {
     let yr = range(&f.y, f.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     match (f.x.log, f.y.log) {
         (false, false) => draw(&root, f, xr.0..xr.1, yr.0..yr.1, xr, yr)?,
-        (true, false) => draw(&root, f, (xr.0..xr.1).log_scale(), yr.0..yr.1, xr, yr)?,
-        (false, true) => draw(&root, f, xr.0..xr.1, (yr.0..yr.1).log_scale(), xr, yr)?,
-        (true, true) => draw(&root, f, (xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale(), xr, yr)?,
+        (true, false) => draw(&root, f, log_axis(xr), yr.0..yr.1, xr, yr)?,
+        (false, true) => draw(&root, f, xr.0..xr.1, log_axis(yr), xr, yr)?,
+        (true, true) => draw(&root, f, log_axis(xr), log_axis(yr), xr, yr)?,
     }
     root.present().map_err(|e| e.to_string())
 }
@@ -228,9 +253,9 @@ where
                 .filter(|(p, _)| drawable(&f.x, p.0) && drawable(&f.y, p.1))
                 .map(|(p, l)| (to_axis(&f.x, p.0), to_axis(&f.y, p.1), l.clone()));
             chart
-                .draw_series(
-                    labelled.map(|(x, y, l)| Text::new(l, (x, y), ("sans-serif", 14).into_font().color(&c)).into_dyn()),
-                )
+                .draw_series(labelled.map(|(x, y, l)| {
+                    EmptyElement::at((x, y)) + Text::new(l, (7, 5), ("sans-serif", 15).into_font().color(&c))
+                }))
                 .map_err(err)?;
         }
     }
