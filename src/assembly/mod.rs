@@ -19,6 +19,8 @@
 //! particles, call the pure kernels of [`crate::kernels`] and scatter the small dense blocks with
 //! local (ghosted) indices; PETSc sums contributions to nodes owned by other ranks.
 
+mod bench;
+
 use crate::case::Side;
 use crate::kernels::{self, NodeBasis, NodeState, StepResult, MAX_LOCAL, MAX_NODES};
 use crate::model::loads::LoadTarget;
