@@ -10,7 +10,8 @@
 //! * Run i (numbered from 0, strategies outermost, then the `--vary` keys in order with the last
 //!   one varying fastest) writes into `DIR/run_<i>`. A run that fails (a step that does not
 //!   converge, an invalid varied value, a crash) cannot stop the sweep: it becomes a row with its
-//!   status and the reason (the run's one-line error), and the sweep goes on.
+//!   status and the reason (the run's one-line error), and the sweep goes on. Each run's standard
+//!   error is kept as `DIR/run_<i>/stderr.txt`.
 //! * Exit status: 2 for bad input of the sweep itself (malformed `--vary`, a case that does not
 //!   parse with the fixed `--set`s, a missing options file, a `--metric` no run reports), 1 if every
 //!   run failed, else 0 (some failed rows are a result, not an error of the sweep).
@@ -291,6 +292,8 @@ fn run_one(req: &SweepRequest, strategies: &[Strategy], spec: &RunSpec) -> RunRo
         Err(e) => ("crashed".to_string(), None, format!("cannot start {}: {e}", req.exe.display())),
         Ok(o) => {
             let stderr = String::from_utf8_lossy(&o.stderr);
+            // The run's own messages stay next to its results (best effort: the row says the rest).
+            let _ = io::write_text(&dir, "stderr.txt", &stderr);
             let last = stderr
                 .lines()
                 .rev()
