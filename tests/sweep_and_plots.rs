@@ -93,7 +93,7 @@ fn a_sweep_runs_every_combination_and_keeps_failed_runs_as_rows() {
 }
 
 #[test]
-fn a_sweep_with_bad_input_stops_before_running() {
+fn bad_input_of_a_sweep_exits_with_2_and_a_sweep_whose_runs_all_fail_with_1() {
     let out = out_dir("bad");
     let o = porompm(&["sweep", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--vary", "time.dt"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
@@ -102,6 +102,19 @@ fn a_sweep_with_bad_input_stops_before_running() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("nope.opts does not exist"), "{}", stderr(&o));
     assert!(!out.join("sweep.csv").exists());
+    // A metric that no run reports is bad input, found once the runs are done.
+    let o = porompm(&[
+        "sweep",
+        "cases/terzaghi.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--vary",
+        "time.dt=4e-3",
+        "--metric",
+        "no_such_metric",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--metric no_such_metric: no run reports it (metrics: e_p_Tv0.1"), "{}", stderr(&o));
     // Every run failing is a failure of the sweep (exit 1), with its table written.
     let o = porompm(&["sweep", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--vary", "time.dt=-1"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
