@@ -500,10 +500,12 @@ impl<'a> Simulation<'a> {
             }
             self.summary.verification = metrics.into_iter().collect();
         }
-        let mut figures = self.check.as_ref().map(|c| c.figures()).unwrap_or_default();
-        figures.extend(crate::plot::probe_histories(&self.history.0, &self.history.1, PROBE_FIGURES));
-        if let Err(e) = self.out.write_figures(&figures) {
-            eprintln!("warning: the plots were not drawn: {e}");
+        if self.out.is_writer() {
+            let mut figures = self.check.as_ref().map(|c| c.figures()).unwrap_or_default();
+            figures.extend(crate::plot::probe_histories(&self.history.0, &self.history.1, PROBE_FIGURES));
+            if let Err(e) = self.out.write_figures(&figures) {
+                eprintln!("warning: the plots were not drawn: {e}");
+            }
         }
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())
