@@ -2,13 +2,15 @@
 # Installs what porompm needs on Debian 12, and nothing that is already there (idempotent).
 #   Debian packages: PETSc 3.18 (petsc-dev: MUMPS, hypre, SuperLU_dist, SuiteSparse inside), OpenMPI,
 #   HDF5 (OpenMPI build), clang/libclang for bindgen, pkg-config, and the serial OpenBLAS (Debian's
-#   reference BLAS is several times slower inside the direct solvers).
+#   reference BLAS is several times slower inside the direct solvers); for the PNG plots (plotters'
+#   text through font-kit), the fontconfig and FreeType development files and the DejaVu fonts.
 #   Rust: cargo and rustc through rustup, if no cargo is found.
 # Run as root or with sudo available.
 set -euo pipefail
 
 packages=(petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev clang libclang-dev pkg-config
-          libopenblas0-serial make git ca-certificates curl)
+          libopenblas0-serial libfontconfig1-dev libfreetype-dev fonts-dejavu-core
+          make git ca-certificates curl)
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -121,6 +121,10 @@ pub struct Summary {
     pub petsc_options: Vec<String>,
     /// Wall time per phase.
     pub timings: Timings,
+    /// Peak resident memory of the process (rank 0) at the end of the run [MiB]: `VmHWM` of
+    /// `/proc/self/status`, absent where the system does not report it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_memory_mib: Option<f64>,
     /// Largest checkerboard index of the pore pressures over the output steps (two-phase runs; see
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -165,6 +169,8 @@ struct Simulation<'a> {
     summary: &'a mut Summary,
     options_checked: bool,
     last_newton: (usize, usize),
+    /// The columns and rows of history.csv, kept for the probe figures.
+    history: (Vec<String>, Vec<Vec<f64>>),
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -185,6 +191,7 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         }
     });
     summary.wall_time_s = start.elapsed().as_secs_f64();
+    summary.peak_memory_mib = crate::io::peak_memory_mib();
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
     let err = result.err();
     match &err {
@@ -229,6 +236,7 @@ impl Summary {
             solver: String::new(),
             petsc_options: assembly::petsc_options().unwrap_or_default(),
             timings: Timings::default(),
+            peak_memory_mib: None,
             checkerboard_index_max: None,
             stopped: None,
             verification: BTreeMap::new(),
@@ -271,6 +279,7 @@ impl<'a> Simulation<'a> {
         let two_phase = case.analysis.formulation == crate::case::Formulation::TwoPhase;
         let system =
             GridSystem::new(req.comm, &crate::model::grid_of(case), two_phase).map_err(|e| input(e.to_string()))?;
+        let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
         let check = verification::for_case(case, &model, &coll).map_err(|e| input(format!("verification: {e}")))?;
         let probes = find_probes(case, &model, &coll).map_err(input)?;
@@ -288,6 +297,7 @@ impl<'a> Simulation<'a> {
             columns.extend(c.columns());
         }
         out.start_history(&columns).map_err(input)?;
+        drop(setup_stage);
         summary.timings.setup_s = t0.elapsed().as_secs_f64();
         let mut sim = Simulation {
             case,
@@ -303,6 +313,7 @@ impl<'a> Simulation<'a> {
             summary,
             options_checked: false,
             last_newton: (0, 0),
+            history: (columns, Vec::new()),
         };
         sim.record_step(0.0)?;
         Ok(sim)
@@ -471,6 +482,9 @@ impl<'a> Simulation<'a> {
             row.extend(c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?);
         }
         self.out.history_row(&row).map_err(RunError::Failed)?;
+        if self.out.is_writer() {
+            self.history.1.push(row);
+        }
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -484,8 +498,10 @@ impl<'a> Simulation<'a> {
         Ok(())
     }
 
-    /// Results of the probes, and metrics, results and tables of the check.
+    /// Results of the probes, metrics, results and tables of the check, and the figures.
     fn finish(mut self) -> Result<(), RunError> {
+        let t0 = Instant::now();
+        let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         for pr in &self.probes {
             if pr.last.len() >= 4 {
                 self.summary.results.insert(format!("{}.displacement", pr.name), pr.last[2].hypot(pr.last[3]));
@@ -506,6 +522,14 @@ impl<'a> Simulation<'a> {
             }
             self.summary.verification = metrics.into_iter().collect();
         }
+        if self.out.is_writer() {
+            let mut figures = self.check.as_ref().map(|c| c.figures()).unwrap_or_default();
+            figures.extend(crate::plot::probe_histories(&self.history.0, &self.history.1, PROBE_FIGURES));
+            if let Err(e) = self.out.write_figures(&figures) {
+                eprintln!("warning: the plots were not drawn: {e}");
+            }
+        }
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -616,6 +640,13 @@ impl StepControl {
         Ok(())
     }
 }
+
+/// The probe figures: (history.csv field, axis label, scale, file stem).
+const PROBE_FIGURES: &[(&str, &str, f64, &str)] = &[
+    ("p_excess", "excess pore pressure [kPa]", 1e-3, "excess_pore_pressure"),
+    ("uy", "vertical displacement [mm]", 1e3, "vertical_displacement"),
+    ("ux", "horizontal displacement [mm]", 1e3, "horizontal_displacement"),
+];
 
 fn probe_fields(two_phase: bool) -> &'static [&'static str] {
     if two_phase {

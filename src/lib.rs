@@ -13,6 +13,8 @@ pub mod element_test;
 pub mod io;
 pub mod kernels;
 pub mod model;
+pub mod plot;
+pub mod sweep;
 pub mod verification;
 
 /// porompm's version and git revision.

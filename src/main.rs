@@ -39,6 +39,35 @@ enum Command {
         #[arg(last = true, value_name = "PETSC_OPTIONS")]
         petsc: Vec<String>,
     },
+    /// Run a case once per solver strategy (options file) and combination of varied values, each
+    /// as a child `porompm run` into DIR/run_<i>; write DIR/sweep.csv, DIR/sweep.md and
+    /// DIR/work_precision.png. Exits with 2 on bad input, 1 if every run failed.
+    Sweep {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// One solver strategy per PETSc options file (none: porompm's defaults).
+        #[arg(long = "options-file", value_name = "FILE")]
+        options_file: Vec<PathBuf>,
+        /// Vary a case value: `KEY=V1,V2,...`; commas inside [] or {} or quotes do not separate
+        /// values, and a list with a `;` is split at `;` only (e.g. `grid.cells=[1,20];[1,40]`).
+        #[arg(long = "vary", value_name = "KEY=V1,V2,...")]
+        vary: Vec<String>,
+        /// Override a case value in every run, e.g. `--set time.dt=5e-4`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// The error metric of work_precision.png (default: the case's first verification metric).
+        #[arg(long, value_name = "NAME")]
+        metric: Option<String>,
+        /// No progress lines.
+        #[arg(long)]
+        quiet: bool,
+        /// PETSc options for every run, after `--`.
+        #[arg(last = true, value_name = "PETSC_OPTIONS")]
+        petsc: Vec<String>,
+    },
     /// Parse and validate a case and print what it will build.
     Check {
         /// The case file (TOML).
@@ -246,6 +275,46 @@ fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure>
     Ok(())
 }
 
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    case: &Path,
+    out: &Path,
+    options_files: &[PathBuf],
+    vary: &[String],
+    sets: &[String],
+    metric: &Option<String>,
+    quiet: bool,
+    petsc: &[String],
+) -> Result<(), Failure> {
+    use porompm::sweep::{self, SweepError};
+    let varies = vary.iter().map(|v| sweep::Vary::parse(v)).collect::<Result<Vec<_>, _>>().map_err(input)?;
+    let exe = std::env::current_exe().map_err(|e| input(format!("cannot find the porompm executable: {e}")))?;
+    let req = sweep::SweepRequest {
+        exe,
+        case: case.to_path_buf(),
+        out: out.to_path_buf(),
+        options_files: options_files.to_vec(),
+        varies,
+        sets: sets.to_vec(),
+        metric: metric.clone(),
+        petsc: petsc.to_vec(),
+        quiet,
+    };
+    match sweep::run(&req) {
+        Ok(o) => {
+            let failed = o.rows.iter().filter(|r| r.status != "completed").count();
+            eprintln!(
+                "{} runs, {failed} not completed; wrote {}",
+                o.rows.len(),
+                o.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+            );
+            Ok(())
+        }
+        Err(SweepError::Input(m)) => Err(input(m)),
+        Err(SweepError::AllFailed(m)) => Err(Failure { code: 1, message: m }),
+    }
+}
+
 fn info(petsc_args: &[String]) -> Result<(), Failure> {
     let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
         .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
@@ -271,6 +340,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run { case, out, options_file, set, quiet, petsc } => run(case, out, options_file, set, *quiet, petsc),
+        Command::Sweep { case, out, options_file, vary, set, metric, quiet, petsc } => {
+            sweep(case, out, options_file, vary, set, metric, *quiet, petsc)
+        }
         Command::Check { case, set } => {
             load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
         }

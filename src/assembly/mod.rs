@@ -19,6 +19,8 @@
 //! particles, call the pure kernels of [`crate::kernels`] and scatter the small dense blocks with
 //! local (ghosted) indices; PETSc sums contributions to nodes owned by other ranks.
 
+mod bench;
+
 use crate::case::Side;
 use crate::kernels::{self, NodeBasis, NodeState, StepResult, MAX_LOCAL, MAX_NODES};
 use crate::model::loads::LoadTarget;
@@ -125,6 +127,7 @@ pub struct StepSolve {
 
 /// The PETSc log stages of a run (shown by `-log_view`).
 struct Stages {
+    run_setup: LogStage,
     setup: LogStage,
     solve: LogStage,
     assembly: LogStage,
@@ -135,6 +138,8 @@ struct Stages {
 /// The phases of a step, for log stages.
 #[derive(Debug, Clone, Copy)]
 pub enum Phase {
+    /// Setting up the run: material points, verification, probes, output.
+    Setup,
     /// Mapping to the grid, constraints, loads.
     StepSetup,
     /// The Newton solve (assembly and linear solves).
@@ -201,6 +206,7 @@ impl GridSystem {
         }
         snes.set_from_options()?;
         let stages = Stages {
+            run_setup: LogStage::register("porompm: setup")?,
             setup: LogStage::register("porompm: step setup")?,
             solve: LogStage::register("porompm: Newton solve")?,
             assembly: LogStage::register("porompm: assembly")?,
@@ -240,6 +246,7 @@ impl GridSystem {
     /// Enters a log stage until the guard is dropped.
     pub fn phase(&self, p: Phase) -> Result<StageGuard, Error> {
         match p {
+            Phase::Setup => self.stages.run_setup.push(),
             Phase::StepSetup => self.stages.setup.push(),
             Phase::NewtonSolve => self.stages.solve.push(),
             Phase::ParticleUpdate => self.stages.update.push(),

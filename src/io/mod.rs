@@ -6,6 +6,8 @@
 //! `"completed"` or `"failed"`; a run that dies in between never looks complete.
 //! `history.csv` is flushed row by row, so it stays readable whatever happens.
 
+pub mod plot;
+
 use serde::Serialize;
 use std::fs::{self, File};
 use std::io::{BufWriter, Write};
@@ -26,6 +28,31 @@ pub fn write_csv(dir: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) 
         text.push_str(&r.join(","));
         text.push('\n');
     }
+    let path = dir.join(name);
+    write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// Where a run's figures go, inside its output directory.
+pub const PLOTS_DIR: &str = "plots";
+
+/// The peak resident memory of this process so far [MiB] (`VmHWM` of `/proc/self/status`), if the
+/// system reports it.
+pub fn peak_memory_mib() -> Option<f64> {
+    let status = fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// Creates a directory and its parents if needed.
+pub fn create_dir(dir: &Path) -> Result<(), String> {
+    fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))
+}
+
+/// Writes a text file `name` into `dir` (created if needed), atomically.
+pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String> {
+    create_dir(dir)?;
     let path = dir.join(name);
     write_atomic(&path, text.as_bytes())?;
     Ok(path)
@@ -60,7 +87,17 @@ impl RunOutput {
                 fs::remove_file(&p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
             }
         }
+        let plots = dir.join(PLOTS_DIR);
+        if plots.is_dir() {
+            fs::remove_dir_all(&plots).map_err(|e| format!("cannot remove old {}: {e}", plots.display()))?;
+        }
         Ok(RunOutput { dir: Some(dir.to_path_buf()), history: None })
+    }
+
+    /// Draws the figures as PNG files into `plots/` (created if needed) and returns the paths.
+    pub fn write_figures(&self, figures: &[crate::plot::Figure]) -> Result<Vec<PathBuf>, String> {
+        let Some(dir) = &self.dir else { return Ok(Vec::new()) };
+        plot::write_figures(&dir.join(PLOTS_DIR), figures)
     }
 
     /// Whether this rank writes.
@@ -128,6 +165,12 @@ mod tests {
         assert!(h.starts_with("time,p\n5.0000000000e-1,1.2500000000e0"));
         assert!(fs::read_to_string(dir.join("summary.json")).unwrap().contains("running"));
         assert!(fs::read_to_string(dir.join("t.csv")).unwrap().starts_with("a,b\n"));
+        fs::create_dir_all(dir.join(PLOTS_DIR)).unwrap();
+        fs::write(dir.join(PLOTS_DIR).join("old.png"), "stale").unwrap();
+        RunOutput::create(&dir, true).unwrap();
+        assert!(!dir.join(PLOTS_DIR).exists(), "stale plots must not survive");
+        let peak = peak_memory_mib().unwrap();
+        assert!(peak > 1.0 && peak < 1e6, "{peak} MiB");
         let silent = RunOutput::create(&dir.join("never"), false).unwrap();
         silent.write_summary(&serde_json::json!({})).unwrap();
         assert!(!dir.join("never").exists());

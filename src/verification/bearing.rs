@@ -222,6 +222,10 @@ impl Check for BearingCheck {
         Ok((metrics, vec![table]))
     }
 
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        vec![super::figures::load_settlement(&self.curve, self.reference)]
+    }
+
     fn stop(&self) -> Option<String> {
         let (stop, last) = (self.stop_at?, self.curve.last()?);
         (last[1] >= stop).then(|| format!("the footing settlement reached d/B = {:.4} ≥ {stop}", last[1]))

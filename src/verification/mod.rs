@@ -22,6 +22,7 @@
 pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
+pub mod figures;
 pub mod shock;
 pub mod terzaghi;
 pub mod waves;
@@ -84,6 +85,11 @@ pub trait Check {
     }
     /// Quantities without a reference (summary.json `results`), available after [`Check::finish`].
     fn results(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
+    /// Figures comparing the run with the reference (drawn into `plots/`), available after
+    /// [`Check::finish`].
+    fn figures(&self) -> Vec<crate::plot::Figure> {
         Vec::new()
     }
 }
@@ -168,6 +174,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                     t: theory.time_for(tv),
                     full: i + 1 == time_factors.len(),
                     result: None,
+                    profile: Vec::new(),
                 })
                 .collect();
             let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
@@ -205,6 +212,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                     t: theory.time_for_degree(u),
                     full: true,
                     result: None,
+                    profile: Vec::new(),
                 })
                 .collect();
             let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
@@ -327,6 +335,8 @@ struct Target {
     full: bool,
     /// (e_p, rms, settlement error, settlement) once the run has passed the time.
     result: Option<(f64, f64, f64, f64)>,
+    /// (initial depth, p/q) of every particle of the column at that time.
+    profile: Vec<(f64, f64)>,
 }
 
 /// Consolidation of a column (Terzaghi, or large strain after Xie & Leo), compared at given times.
@@ -337,6 +347,8 @@ pub struct ConsolidationCheck {
     targets: Vec<Target>,
     tolerances: (f64, f64, f64),
     volume0: f64,
+    /// (t, settlement, reference settlement) after every step.
+    history: Vec<(f64, f64, f64)>,
 }
 
 impl ConsolidationCheck {
@@ -354,7 +366,7 @@ impl ConsolidationCheck {
             Theory::Terzaghi(_) => "terzaghi",
             Theory::XieLeo(_) => "large_strain",
         };
-        Ok(ConsolidationCheck { col, theory, prefix, targets, tolerances, volume0 })
+        Ok(ConsolidationCheck { col, theory, prefix, targets, tolerances, volume0, history: Vec::new() })
     }
 
     fn settlement(&self, model: &Model, coll: &Collective) -> Result<f64, String> {
@@ -392,8 +404,10 @@ impl Check for ConsolidationCheck {
                 let s_ana = self.theory.settlement(t);
                 self.targets[i].result =
                     Some((sq.sqrt() / n as f64, (sq / n as f64).sqrt(), (s - s_ana).abs() / s_ana.abs(), s));
+                self.targets[i].profile = all.chunks(2).map(|d| (d[0], d[1] / q)).collect();
             }
         }
+        self.history.push((t, s, self.theory.settlement(t)));
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
@@ -434,6 +448,49 @@ impl Check for ConsolidationCheck {
         }
         Ok((out, Vec::new()))
     }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        let q = self.theory.load();
+        let h = self.col.height;
+        let (what, stem, depth) = match self.theory {
+            Theory::Terzaghi(_) => ("Terzaghi consolidation", "terzaghi", "depth below the drained top [m]"),
+            Theory::XieLeo(_) => {
+                ("Large-strain consolidation", "large_strain", "initial depth below the drained top [m]")
+            }
+        };
+        let profiles: Vec<_> = self
+            .targets
+            .iter()
+            .filter(|tg| !tg.profile.is_empty())
+            .map(|tg| {
+                let label = format!(
+                    "{} (t = {:.4e} s)",
+                    tg.label.replacen("Tv", "T_v = ", 1).replacen("Us", "U_s = ", 1),
+                    tg.t
+                );
+                let depths = figures::sample(0.0, h, 200, |d| d);
+                let ana = depths.iter().map(|&d| (d, self.theory.pressure(d, tg.t) / q)).collect();
+                (label, tg.profile.clone(), ana)
+            })
+            .collect();
+        let computed: Vec<(f64, f64)> = self.history.iter().map(|r| (r.0, r.1)).collect();
+        let reference: Vec<(f64, f64)> = self.history.iter().map(|r| (r.0, r.2)).collect();
+        vec![
+            figures::pressure_profiles(
+                &format!("{stem}_pressure_profiles.png"),
+                &format!("{what}: pore pressure profiles"),
+                depth,
+                self.theory.name(),
+                &profiles,
+            ),
+            figures::settlement_history(
+                &format!("{stem}_settlement.png"),
+                &format!("{what}: settlement of the column"),
+                &computed,
+                Some((self.theory.name(), &reference)),
+            ),
+        ]
+    }
 }
 
 /// Steady-state harmonic column check.
@@ -447,6 +504,8 @@ pub struct HarmonicCheck {
     sums: Vec<(f64, f64)>,
     /// ∫ w dt.
     weight: f64,
+    /// (depth, computed |p|/q) after [`Check::finish`].
+    profile: Vec<(f64, f64)>,
 }
 
 impl HarmonicCheck {
@@ -474,7 +533,16 @@ impl HarmonicCheck {
             load_amplitude: col.load,
         }
         .solve()?;
-        Ok(HarmonicCheck { col, omega, window: (start, end), tolerance, theory, sums: Vec::new(), weight: 0.0 })
+        Ok(HarmonicCheck {
+            col,
+            omega,
+            window: (start, end),
+            tolerance,
+            theory,
+            sums: Vec::new(),
+            weight: 0.0,
+            profile: Vec::new(),
+        })
     }
 }
 
@@ -538,6 +606,7 @@ impl Check for HarmonicCheck {
         let (worst, at) =
             table.iter().map(|r| ((r[1] - r[2]).abs(), r[0])).fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
         let err = worst / peak;
+        self.profile = table.iter().map(|r| (r[0], r[1])).collect();
         let metric = Metric::error(
             err,
             self.tolerance,
@@ -554,6 +623,25 @@ impl Check for HarmonicCheck {
                 rows: table,
             }],
         ))
+    }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        let q = self.col.load;
+        let h = self.col.height;
+        let reference: Vec<(f64, f64)> = figures::sample(0.0, h, 400, |d| d)
+            .into_iter()
+            .map(|d| (d, self.theory.pressure_amplitude(d) / q))
+            .collect();
+        vec![figures::depth_profile(
+            "harmonic_amplitude_profile.png",
+            &format!("Harmonic column: pore pressure amplitude (ω = {:.4e} rad/s)", self.omega),
+            "pore pressure amplitude |p|/q [-]",
+            "depth below the loaded top [m]",
+            "MPM (particles at one depth averaged)",
+            &self.profile,
+            "Biot, steady state",
+            &reference,
+        )]
     }
 }
 
@@ -579,6 +667,11 @@ pub struct ElasticColumnCheck {
     tolerances: (f64, f64),
     volume0: f64,
     last_settlement: f64,
+    /// (t, settlement) after every step.
+    history: Vec<(f64, f64)>,
+    /// (initial depth, σ_yy) of the column's particles after [`Check::finish`].
+    stress_profile: Vec<(f64, f64)>,
+    height: f64,
 }
 
 impl ElasticColumnCheck {
@@ -626,6 +719,9 @@ impl ElasticColumnCheck {
             tolerances: (stress_tol, settle_tol),
             volume0: coll.sum(&[v0])?[0],
             last_settlement: 0.0,
+            history: Vec::new(),
+            stress_profile: Vec::new(),
+            height,
         })
     }
 }
@@ -639,12 +735,13 @@ impl Check for ElasticColumnCheck {
         Vec::new()
     }
 
-    fn observe(&mut self, _t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let v: f64 = (0..model.particles.len())
             .filter(|&k| model.particles.body[k] == self.body)
             .map(|k| model.particles.volume[k])
             .sum();
         self.last_settlement = (self.volume0 - coll.sum(&[v])?[0]) / self.width;
+        self.history.push((t, self.last_settlement));
         Ok(vec![self.last_settlement])
     }
 
@@ -658,6 +755,7 @@ impl Check for ElasticColumnCheck {
         let exact = |d: f64| -(self.density * self.gravity * d + self.surcharge);
         let peak = all.chunks(2).map(|d| exact(d[0]).abs()).fold(0.0, f64::max);
         let worst = all.chunks(2).map(|d| (d[1] - exact(d[0])).abs()).fold(0.0, f64::max);
+        self.stress_profile = all.chunks(2).map(|d| (d[0], d[1])).collect();
         let s = self.last_settlement;
         Ok((
             vec![
@@ -680,6 +778,34 @@ impl Check for ElasticColumnCheck {
             ],
             Vec::new(),
         ))
+    }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        let kpa = |v: &[(f64, f64)]| v.iter().map(|&(d, s)| (d, 1e-3 * s)).collect::<Vec<_>>();
+        let exact: Vec<(f64, f64)> =
+            [0.0, self.height].iter().map(|&d| (d, -(self.density * self.gravity * d + self.surcharge))).collect();
+        let t_end = self.history.last().map_or(0.0, |r| r.0);
+        let t_start = self.history.first().map_or(0.0, |r| r.0);
+        let mut settle = figures::settlement_history(
+            "elastic_column_settlement.png",
+            "Elastic column: settlement under self-weight, then the surcharge",
+            &self.history,
+            Some(("static solution, final load", &[(t_start, self.settlement), (t_end, self.settlement)])),
+        );
+        settle.series[1].label = "static solution under the final load".into();
+        vec![
+            figures::depth_profile(
+                "elastic_column_stress.png",
+                "Elastic column: vertical stress at the end of the run",
+                "vertical stress σ_yy [kPa]",
+                "initial depth below the top [m]",
+                "MPM",
+                &kpa(&self.stress_profile),
+                "static solution −(ρ g d + q)",
+                &kpa(&exact),
+            ),
+            settle,
+        ]
     }
 }
 

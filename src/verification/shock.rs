@@ -54,6 +54,8 @@ pub struct ShockCheck {
     slow_expected: bool,
     tolerances: (f64, f64),
     samples: Vec<(f64, f64)>,
+    /// Picked (fast, slow) arrivals after [`Check::finish`].
+    picked: (Option<f64>, Option<f64>),
 }
 
 impl ShockCheck {
@@ -99,6 +101,7 @@ impl ShockCheck {
             slow_expected,
             tolerances: (fast_tol, slow_tol),
             samples: vec![(0.0, 0.0)],
+            picked: (None, None),
             col,
         })
     }
@@ -131,6 +134,7 @@ impl Check for ShockCheck {
         // Fast front: between the start and halfway to the slow front.
         let split = 0.5 * (t_fast + t_slow);
         let fast = pick_arrival(&self.samples, 0.0, split);
+        self.picked.0 = fast;
         out.push((
             "fast_wave_arrival_rel_error".to_string(),
             match fast {
@@ -148,6 +152,7 @@ impl Check for ShockCheck {
         if self.slow_expected {
             let end = split + 2.0 * (t_slow - split);
             let slow = pick_arrival(&self.samples, split, end);
+            self.picked.1 = slow;
             out.push((
                 "slow_wave_arrival_rel_error".to_string(),
                 match slow {
@@ -168,6 +173,18 @@ impl Check for ShockCheck {
             ));
         }
         Ok((out, Vec::new()))
+    }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        let q = self.col.load;
+        let over_q: Vec<(f64, f64)> = self.samples.iter().map(|&(t, p)| (t, p / q)).collect();
+        let mut expected = vec![("fast arrival d/V_u", self.depth / self.fast_speed)];
+        let mut picked = vec![("fast arrival", self.picked.0)];
+        if self.slow_expected {
+            expected.push(("slow arrival d/V_d", self.depth / self.slow_speed));
+            picked.push(("slow arrival", self.picked.1));
+        }
+        vec![super::figures::shock_history(&over_q, self.depth, &expected, &picked)]
     }
 }
 

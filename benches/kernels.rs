@@ -1,0 +1,223 @@
+//! Benchmarks of the per-particle kernels and of one global assembly, in material points per
+//! second (`cargo bench`; criterion's reports go to target/criterion/).
+//!
+//! * `shape/gimp_stencil`: GIMP weights and gradients of every particle of the slumping block
+//!   (two particles per cell and direction, so 3 × 3-node stencils), with B̄'s volumetric gradients.
+//! * `kernels/residual`, `kernels/tangent`: the u–p–U residual and tangent blocks of one particle
+//!   (linear elastic soil) at a non-zero nodal increment.
+//! * `soil/linear_elastic`, `soil/mohr_coulomb_plastic`: one stress update per particle; the
+//!   Mohr–Coulomb increment is a shear that yields every particle (checked before timing).
+//! * `patch/recover`: MLSA patch recovery of Δp at every particle.
+//! * `assembly/residual_and_jacobian`: the residual and Jacobian of one Newton iteration assembled into
+//!   PETSc (`GridSystem::assemble_once`) on the slumping block at its first step.
+//!
+//! PETSc is initialised once for the whole run in `main`.
+
+use criterion::{black_box, Criterion, Throughput};
+use porompm::case::{self, Override};
+use porompm::kernels::{self, NodeBasis, NodeState, Predictors};
+use porompm::model::patch::PatchField;
+use porompm::model::shape::{self, Basis};
+use porompm::model::soil::Region;
+use porompm::model::Model;
+use std::path::Path;
+use std::time::Duration;
+
+fn load(case_file: &str, sets: &[&str]) -> case::Case {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(case_file);
+    let text = porompm::io::read_text(&path).expect("the case file is readable");
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).expect("valid override")).collect();
+    case::parse(&text, case_file, &overrides).expect("the case parses")
+}
+
+/// A small deterministic pseudo-random sequence in [-1, 1].
+fn noise(i: usize) -> f64 {
+    let x = (i as f64 * 12.9898).sin() * 43758.5453;
+    2.0 * (x - x.floor()) - 1.0
+}
+
+/// The GIMP basis with B̄ of every particle.
+fn bases(model: &Model) -> Vec<Vec<NodeBasis>> {
+    let ps = &model.particles;
+    (0..ps.len())
+        .map(|k| {
+            let st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+            let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
+            (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n] }).collect()
+        })
+        .collect()
+}
+
+fn group<'a>(
+    c: &'a mut Criterion,
+    name: &str,
+    n: usize,
+) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.throughput(Throughput::Elements(n as u64));
+    g.warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3)).sample_size(30);
+    g
+}
+
+fn particle_kernels(c: &mut Criterion) {
+    let case = load("cases/slumping_block.toml", &[]);
+    let model = Model::build(&case, |_, _| true);
+    let ps = &model.particles;
+    let n = ps.len();
+    assert_eq!(model.basis, Basis::Gimp);
+
+    let mut g = group(c, "shape", n);
+    g.bench_function("gimp_stencil", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                let st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+                let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
+                sum += st.w[0] + gv[0][0];
+            }
+            black_box(sum)
+        })
+    });
+    g.finish();
+
+    let basis = bases(&model);
+    let nm = kernels::Newmark::new(model.beta, model.gamma, 1e-3);
+    let states: Vec<Vec<NodeState>> = basis
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            (0..b.len())
+                .map(|m| {
+                    let mut s = NodeState::default();
+                    for c in 0..5 {
+                        let d = 1e-6 * noise(97 * k + 5 * m + c) * if c == 2 { 1e6 } else { 1.0 };
+                        s.d[c] = d;
+                        s.a[c] = nm.a0 * d;
+                        s.v[c] = nm.a1 * d;
+                    }
+                    s
+                })
+                .collect()
+        })
+        .collect();
+    let body_acc = vec![[0.0, -9.81]; model.n_bodies];
+    let inputs: Vec<kernels::ParticleInput> = (0..n)
+        .map(|k| {
+            let mut input = model.particle_input(k, &body_acc);
+            input.pred = Predictors::new(&nm, [0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
+            input
+        })
+        .collect();
+    let soil = &model.materials[ps.material[0] as usize].model;
+    let mut g = group(c, "kernels", n);
+    g.bench_function("residual", |b| {
+        let mut buf = [0.0; kernels::MAX_LOCAL];
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                let m = basis[k].len() * 5;
+                kernels::residual(&basis[k], &states[k], &inputs[k], soil, true, &mut buf[..m]);
+                sum += buf[0];
+            }
+            black_box(sum)
+        })
+    });
+    g.bench_function("tangent", |b| {
+        let mut block = vec![0.0; kernels::MAX_LOCAL * kernels::MAX_LOCAL];
+        let dsig = soil.elastic().d;
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                let m = basis[k].len() * 5;
+                kernels::tangent(&basis[k], &inputs[k], &dsig, nm, true, &mut block[..m * m]);
+                sum += block[0];
+            }
+            black_box(sum)
+        })
+    });
+    g.finish();
+
+    // Stress updates: the slumping block's elastic soil, and a Mohr–Coulomb soil (φ = 30°) sheared
+    // into yield.
+    let deps: Vec<[f64; 4]> =
+        (0..n).map(|k| [1e-5 * noise(k), -1e-5 * noise(k + 1), 1e-5 * noise(k + 2), 0.0]).collect();
+    let mut g = group(c, "soil", n);
+    g.bench_function("linear_elastic", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for (stress, d) in ps.stress.iter().zip(&deps) {
+                sum += soil.update(stress, 0.0, d).stress[0];
+            }
+            black_box(sum)
+        })
+    });
+    let footing = load("cases/footing_sd.toml", &["materials.clay.model.friction_angle=30"]);
+    let mc = porompm::model::material::soil_model(&footing.materials[0].model);
+    let stress0 = [-2e3, -2e3, 0.0, -2e3];
+    // Isochoric (the soil is nearly incompressible, ν = 0.49): ε_xx = −ε_yy.
+    let shear: Vec<[f64; 4]> = (0..n)
+        .map(|k| {
+            let a = 1e-2 * (1.0 + 0.1 * noise(k));
+            [a, -a, 2e-3 * noise(k + 7), 0.0]
+        })
+        .collect();
+    for d in &shear {
+        let u = mc.update(&stress0, 0.0, d);
+        assert!(!matches!(u.region, Region::Elastic), "the benchmark step must yield: {mc:?} {d:?} {u:?}");
+    }
+    g.bench_function("mohr_coulomb_plastic", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for d in &shear {
+                sum += mc.update(&stress0, 0.0, d).stress[0];
+            }
+            black_box(sum)
+        })
+    });
+    g.finish();
+
+    let nodes = model.grid.nodes();
+    let dp: Vec<f64> = (0..model.grid.node_count()).map(noise).collect();
+    let active = vec![true; dp.len()];
+    let field = PatchField { grid: &model.grid, start: [0, 0], count: nodes, dp: &dp, active: &active };
+    let mut g = group(c, "patch", n);
+    g.bench_function("recover", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                sum += field.recover(ps.x[k]).unwrap_or(0.0);
+            }
+            black_box(sum)
+        })
+    });
+    g.finish();
+}
+
+fn global_assembly(c: &mut Criterion, comm: petsc::Comm) {
+    let case = load("cases/slumping_block.toml", &[]);
+    let system = porompm::assembly::GridSystem::new(comm, &porompm::model::grid_of(&case), true);
+    let mut system = system.expect("the grid system is created");
+    let model = Model::build(&case, |i, j| system.owns_cell(i, j));
+    let stage = &case.stages[0];
+    let active = model.active(stage);
+    system.prepare_step(&model, &active, stage.dt(), stage.dt()).expect("the first step is prepared");
+    system.assemble_once(&model).expect("the system assembles");
+    let mut g = group(c, "assembly", model.particles.len());
+    g.bench_function("residual_and_jacobian", |b| b.iter(|| black_box(system.assemble_once(&model).unwrap())));
+    g.finish();
+    eprintln!(
+        "assembly: {} material points, {} grid dofs ({} unknowns)",
+        model.particles.len(),
+        system.total_dofs(),
+        system.free_dofs()
+    );
+}
+
+fn main() {
+    let petsc = petsc::Petsc::initialize(&[], None, "porompm-bench").expect("PETSc initialises");
+    let mut c = Criterion::default().configure_from_args();
+    particle_kernels(&mut c);
+    global_assembly(&mut c, petsc.world());
+    c.final_summary();
+    drop(petsc);
+}
