@@ -18,6 +18,7 @@ use crate::case::{Case, Stage};
 use crate::io::RunOutput;
 use crate::kernels::StepResult;
 use crate::model::Model;
+use crate::progress::Progress;
 use crate::verification::{self, Check, Metric};
 use petsc::Comm;
 use serde::Serialize;
@@ -159,7 +160,7 @@ struct Simulation<'a> {
     probes: Vec<Probe>,
     out: &'a mut RunOutput,
     coll: Collective,
-    quiet: bool,
+    display: Progress,
     t: f64,
     step: usize,
     summary: &'a mut Summary,
@@ -290,7 +291,7 @@ impl<'a> Simulation<'a> {
             probes,
             out,
             coll,
-            quiet: req.quiet,
+            display: Progress::new(!req.quiet && coll.rank() == 0, case.end_time()),
             t: 0.0,
             step: 0,
             summary,
@@ -312,7 +313,6 @@ impl<'a> Simulation<'a> {
             control.t_end,
             stage.dt()
         ));
-        let mut next_report = self.t + stage.duration / 10.0;
         while !control.finished(self.t) {
             let events = self.check.as_ref().map(|c| c.event_times()).unwrap_or_default();
             let dt = control.next(self.t, &events);
@@ -333,10 +333,7 @@ impl<'a> Simulation<'a> {
                     } else {
                         self.observe_only(dt)?;
                     }
-                    if self.t >= next_report - 1e-9 * stage.dt() {
-                        self.progress(&format!("  t = {:.6e} s, step {}", self.t, self.step));
-                        next_report += stage.duration / 10.0;
-                    }
+                    self.display.step(&stage.name, self.step, self.t, self.last_newton.0);
                     if self.check.as_ref().is_some_and(|c| c.stop().is_some()) {
                         if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
                             self.record_step(dt)?;
@@ -499,9 +496,7 @@ impl<'a> Simulation<'a> {
     }
 
     fn progress(&self, msg: &str) {
-        if !self.quiet && self.coll.rank() == 0 {
-            eprintln!("{msg}");
-        }
+        self.display.message(msg);
     }
 }
 

@@ -13,6 +13,8 @@ pub mod element_test;
 pub mod io;
 pub mod kernels;
 pub mod model;
+pub mod progress;
+pub mod report;
 pub mod verification;
 
 /// porompm's version and git revision.

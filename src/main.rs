@@ -32,7 +32,8 @@ enum Command {
         /// Override a case value by its dotted path, e.g. `--set time.dt=5e-4`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// No progress messages.
+        /// No progress bar and no progress messages (the bar is shown only when standard error is
+        /// a terminal).
         #[arg(long)]
         quiet: bool,
         /// PETSc options, after `--` (they reach PETSc's options database unchanged).
@@ -77,6 +78,11 @@ enum Command {
         /// Output directory (created if needed).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+    },
+    /// Print a run's summary.json (finished, failed or still running) as a readable table.
+    Report {
+        /// The run's output directory.
+        dir: PathBuf,
     },
     /// Print the MPI and PETSc environment and check a collective operation.
     Info {
@@ -270,6 +276,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run { case, out, options_file, set, quiet, petsc } => run(case, out, options_file, set, *quiet, petsc),
+        Command::Report { dir } => porompm::report::report(dir).map(|t| print!("{t}")).map_err(input),
         Command::Check { case, set } => {
             load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
         }
