@@ -9,7 +9,8 @@
 //! │       ├── newton_solve: map to grid, constraints, loads; SNES on the Newmark residual
 //! │       ├── if converged: update_particles ([003] Eq. 24, [000] Eq. 11) unless inadmissible
 //! │       ├── if not: cut Δt (stage.cut_factor), retry; fail after stage.max_step_cuts cuts in a row
-//! │       └── record_step: probes, check, history.csv
+//! │       ├── record_step: probes, check, history.csv
+//! │       └── every output.fields_every steps and at the stage end: fields.h5/.xdmf
 //! └── finish: verification metrics, summary.json
 //! ```
 
@@ -166,6 +167,8 @@ struct Simulation<'a> {
     summary: &'a mut Summary,
     options_checked: bool,
     last_newton: (usize, usize),
+    /// Step of the last field output.
+    fields_step: Option<usize>,
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -282,6 +285,9 @@ impl<'a> Simulation<'a> {
             columns.extend(c.columns());
         }
         out.start_history(&columns).map_err(input)?;
+        if case.output.fields_every > 0 {
+            out.start_fields(crate::fields::grid_geometry(&model)).map_err(input)?;
+        }
         summary.timings.setup_s = t0.elapsed().as_secs_f64();
         let mut sim = Simulation {
             case,
@@ -297,8 +303,10 @@ impl<'a> Simulation<'a> {
             summary,
             options_checked: false,
             last_newton: (0, 0),
+            fields_step: None,
         };
         sim.record_step(0.0)?;
+        sim.write_fields()?;
         Ok(sim)
     }
 
@@ -334,7 +342,12 @@ impl<'a> Simulation<'a> {
                         self.observe_only(dt)?;
                     }
                     self.display.step(&stage.name, self.step, self.t, self.last_newton.0);
-                    if self.check.as_ref().is_some_and(|c| c.stop().is_some()) {
+                    let every = self.case.output.fields_every;
+                    let stopping = self.check.as_ref().is_some_and(|c| c.stop().is_some());
+                    if every > 0 && (self.step.is_multiple_of(every) || control.finished(self.t) || stopping) {
+                        self.write_fields()?;
+                    }
+                    if stopping {
                         if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
                             self.record_step(dt)?;
                         }
@@ -497,6 +510,20 @@ impl<'a> Simulation<'a> {
 
     fn progress(&self, msg: &str) {
         self.display.message(msg);
+    }
+
+    /// One output time of `fields.h5`/`fields.xdmf` (once per step at most).
+    fn write_fields(&mut self) -> Result<(), RunError> {
+        if self.case.output.fields_every == 0 || self.fields_step == Some(self.step) {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let nodes = self.system.owned_node_records();
+        let frame = crate::fields::frame(&self.model, &nodes, &self.coll, self.t).map_err(RunError::Failed)?;
+        self.out.write_fields(&frame).map_err(RunError::Failed)?;
+        self.fields_step = Some(self.step);
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
     }
 }
 

@@ -10,6 +10,7 @@ pub mod case;
 pub mod describe;
 pub mod driver;
 pub mod element_test;
+pub mod fields;
 pub mod io;
 pub mod kernels;
 pub mod model;

@@ -19,7 +19,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a case: writes summary.json and history.csv into DIR.
+    /// Run a case: writes summary.json, history.csv and fields.h5/fields.xdmf into DIR.
     Run {
         /// The case file (TOML).
         case: PathBuf,

@@ -1,4 +1,6 @@
-//! `porompm report` and the quiet progress display. Every test runs the real binary.
+//! What a run leaves behind besides summary.json: the field files read
+//! back by ParaView's own XDMF reader (pvbatch, installed by scripts/setup.sh), `porompm report`,
+//! and the quiet progress display. Every test runs the real binary.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -47,9 +49,81 @@ fn assert_one_line_error(o: &Output, needle: &str) {
 }
 
 #[test]
+fn paraview_reads_the_fields_as_written() {
+    let dir = out_dir("paraview");
+    run_terzaghi(&dir, &["--set", "output.fields_every=200"]);
+    let s = summary(&dir);
+    let pvbatch = Command::new("pvbatch")
+        .arg(root().join("tests/paraview/read_fields.py"))
+        .arg(dir.join("fields.xdmf"))
+        .current_dir(&dir)
+        .output()
+        .expect("pvbatch runs (Debian packages paraview and python3-paraview; scripts/setup.sh installs them)");
+    let text = String::from_utf8_lossy(&pvbatch.stdout);
+    assert!(pvbatch.status.success(), "pvbatch failed:\n{text}\n{}", String::from_utf8_lossy(&pvbatch.stderr));
+    let pv_err = String::from_utf8_lossy(&pvbatch.stderr);
+    assert!(!pv_err.contains("Error") && !pv_err.contains("ERR|"), "ParaView complained:\n{pv_err}");
+    let v: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).expect("the script's JSON");
+    println!("read back with ParaView {} ({})", v["paraview_version"], v["reader"]);
+
+    // Output times: t = 0, every 200 steps, and the stage end.
+    let times: Vec<f64> = v["times"].as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect();
+    assert_eq!(times.len(), 5, "{times:?}");
+    assert_eq!(times[0], 0.0);
+    assert!((times[4] - s["time_s"].as_f64().unwrap()).abs() < 1e-12);
+
+    let n = s["particles"].as_u64().unwrap();
+    let p = &v["blocks"]["particles"];
+    assert_eq!(p["points"].as_u64(), Some(n));
+    for (name, comps) in [
+        ("displacement", 3),
+        ("velocity", 3),
+        ("stress_xx", 1),
+        ("stress_yy", 1),
+        ("stress_xy", 1),
+        ("stress_zz", 1),
+        ("mean_stress", 1),
+        ("q", 1),
+        ("eps_pd", 1),
+        ("p", 1),
+        ("p_excess", 1),
+        ("material_id", 1),
+        ("body_id", 1),
+    ] {
+        assert_eq!(p["arrays"][name], serde_json::json!([comps, n]), "particle array {name}");
+    }
+    let g = &v["blocks"]["grid"];
+    assert_eq!(g["points"], 22, "2 × 11 nodes");
+    for (name, comps) in [("active", 1), ("du", 3), ("dp", 1), ("dU", 3)] {
+        assert_eq!(g["arrays"][name], serde_json::json!([comps, 22]), "grid array {name}");
+    }
+    let b: Vec<f64> = g["bounds"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    assert!(b[0].abs() < 1e-12 && (b[1] - 0.1).abs() < 1e-12 && b[2].abs() < 1e-12 && (b[3] - 1.0).abs() < 1e-12);
+
+    // The pore pressure ParaView shows at the probe `middle` (the particle that started nearest to
+    // (0.025, 0.525)) is the last value of history.csv's `middle.p`.
+    let pos = p["position"].as_array().unwrap();
+    let disp = p["displacement"].as_array().unwrap();
+    let start = |k: usize, c: usize| pos[k][c].as_f64().unwrap() - disp[k][c].as_f64().unwrap();
+    let k = (0..pos.len())
+        .min_by(|&a, &b| {
+            let d = |k| (start(k, 0) - 0.025).hypot(start(k, 1) - 0.525);
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let pv_p = p["p"][k][0].as_f64().unwrap();
+    let h = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let header: Vec<&str> = h.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|c| *c == "middle.p").unwrap();
+    let hist_p: f64 = h.lines().last().unwrap().split(',').nth(col).unwrap().parse().unwrap();
+    assert!((pv_p - hist_p).abs() <= 1e-9 * hist_p.abs(), "ParaView p = {pv_p}, history.csv {hist_p}");
+}
+
+#[test]
 fn report_prints_the_summary_and_names_a_bad_directory() {
     let dir = out_dir("report");
-    run_terzaghi(&dir, &[]);
+    run_terzaghi(&dir, &["--set", "output.fields_every=0"]);
+    assert!(!dir.join("fields.h5").exists(), "fields_every = 0 writes no fields");
     let o = porompm(&["report", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
