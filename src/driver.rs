@@ -10,9 +10,13 @@
 //! │       ├── if converged: update_particles ([003] Eq. 24, [000] Eq. 11) unless inadmissible
 //! │       ├── if not: cut Δt (stage.cut_factor), retry; fail after stage.max_step_cuts cuts in a row
 //! │       ├── record_step: probes, check, history.csv
-//! │       └── every output.fields_every steps and at the stage end: fields.h5/.xdmf
+//! │       └── every output.fields_every steps and at the stage end: fields.h5/.xdmf;
+//! │           every --checkpoint-every steps: checkpoint.h5
 //! └── finish: verification metrics, summary.json
 //! ```
+//!
+//! A restarted run (`--restart`) sets up as usual, then takes the particles, time, step, stage and
+//! step control from the checkpoint ([`crate::state`]) and continues in that stage.
 
 use crate::assembly::{self, Collective, GridSystem, Phase};
 use crate::case::{Case, Stage};
@@ -20,6 +24,7 @@ use crate::io::RunOutput;
 use crate::kernels::StepResult;
 use crate::model::Model;
 use crate::progress::Progress;
+use crate::state::{self, Checkpoint};
 use crate::verification::{self, Check, Metric};
 use petsc::Comm;
 use serde::Serialize;
@@ -41,6 +46,10 @@ pub struct RunRequest<'a> {
     pub quiet: bool,
     /// The run's communicator.
     pub comm: Comm,
+    /// Write `checkpoint.h5` every this many steps (0: never).
+    pub checkpoint_every: usize,
+    /// Continue from this checkpoint (its path as given, and its content).
+    pub restart: Option<(String, Checkpoint)>,
 }
 
 /// Why a run stopped early.
@@ -141,6 +150,9 @@ pub struct Summary {
     /// Whether every metric passed (absent without verification).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verification_passed: Option<bool>,
+    /// The checkpoint this run continued from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restarted_from: Option<state::RestartInfo>,
 }
 
 /// A probe: the particle nearest to a point at t = 0, and what is tracked over the run.
@@ -167,8 +179,11 @@ struct Simulation<'a> {
     summary: &'a mut Summary,
     options_checked: bool,
     last_newton: (usize, usize),
+    /// Where a restarted run continues: the stage's index, its Δt and accepted steps at that Δt.
+    resume: Option<(usize, f64, usize)>,
     /// Step of the last field output.
     fields_step: Option<usize>,
+    checkpoint_every: usize,
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -177,7 +192,8 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
     let mut summary = Summary::new(req);
     let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| {
         let mut sim = Simulation::set_up(req, out, &mut summary)?;
-        for stage in &req.case.stages {
+        let first = sim.resume.map_or(0, |r| r.0);
+        for stage in &req.case.stages[first..] {
             sim.run_stage(stage)?;
             if let Some(why) = sim.check.as_ref().and_then(|c| c.stop()) {
                 sim.progress(&format!("stopped at t = {:.6e} s: {why}", sim.t));
@@ -233,6 +249,7 @@ impl Summary {
             verification: BTreeMap::new(),
             results: BTreeMap::new(),
             verification_passed: None,
+            restarted_from: None,
         }
     }
 }
@@ -303,8 +320,13 @@ impl<'a> Simulation<'a> {
             summary,
             options_checked: false,
             last_newton: (0, 0),
+            resume: None,
             fields_step: None,
+            checkpoint_every: req.checkpoint_every,
         };
+        if let Some((label, cp)) = &req.restart {
+            sim.restore(label, cp)?;
+        }
         sim.record_step(0.0)?;
         sim.write_fields()?;
         Ok(sim)
@@ -314,6 +336,11 @@ impl<'a> Simulation<'a> {
     fn run_stage(&mut self, stage: &Stage) -> Result<(), RunError> {
         let active = self.model.active(stage);
         let mut control = StepControl::new(stage, self.stage_end(stage));
+        let stage_index = self.case.stages.iter().position(|s| std::ptr::eq(s, stage)).unwrap_or(0);
+        if let Some((_, dt, successes)) = self.resume.take() {
+            control.dt = dt;
+            control.successes = successes;
+        }
         self.progress(&format!(
             "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
             stage.name,
@@ -346,6 +373,9 @@ impl<'a> Simulation<'a> {
                     let stopping = self.check.as_ref().is_some_and(|c| c.stop().is_some());
                     if every > 0 && (self.step.is_multiple_of(every) || control.finished(self.t) || stopping) {
                         self.write_fields()?;
+                    }
+                    if self.checkpoint_every > 0 && self.step.is_multiple_of(self.checkpoint_every) {
+                        self.write_checkpoint(stage_index, &control)?;
                     }
                     if stopping {
                         if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
@@ -523,6 +553,75 @@ impl<'a> Simulation<'a> {
         self.out.write_fields(&frame).map_err(RunError::Failed)?;
         self.fields_step = Some(self.step);
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Writes `checkpoint.h5` after an accepted step in stage `stage_index`.
+    fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
+        let t0 = Instant::now();
+        let ps = &self.model.particles;
+        let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
+        let all = self.coll.gather(&local).map_err(RunError::Failed)?;
+        let s = &self.summary;
+        let cp = Checkpoint {
+            case_fingerprint: state::case_fingerprint(self.case),
+            time: self.t,
+            step: self.step as u64,
+            stage: stage_index as u64,
+            dt: control.dt,
+            successes: control.successes as u64,
+            counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
+            checkerboard_max: s.checkerboard_index_max.unwrap_or(f64::NAN),
+            probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
+            check_state: self.check.as_ref().and_then(|c| c.checkpoint_state()),
+            particles: state::sorted_records(&all),
+        };
+        self.out.write_checkpoint(&cp).map_err(RunError::Failed)?;
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Continues from checkpoint `cp` (read from `label`): refuses one of another case, then takes
+    /// its particles, time, counters, probe extremes, check state and step control.
+    fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
+        let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
+        state::check_case(cp, self.case).map_err(refuse)?;
+        let restored = cp.restore_particles(&mut self.model.particles, self.summary.particles);
+        if self.coll.any(restored.is_err()).map_err(RunError::Failed)? {
+            return Err(refuse(
+                restored.err().unwrap_or_else(|| "another rank could not take its material points".into()),
+            ));
+        }
+        self.t = cp.time;
+        self.step = cp.step as usize;
+        let s = &mut *self.summary;
+        s.time_s = cp.time;
+        s.steps = self.step;
+        [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses] = cp.counters.map(|c| c as usize);
+        s.checkerboard_index_max = (!cp.checkerboard_max.is_nan()).then_some(cp.checkerboard_max);
+        self.system.reused_patterns = s.matrix_structure_reuses;
+        for (p, &e) in self.probes.iter_mut().zip(&cp.probe_extremes) {
+            p.excess_extreme = e;
+        }
+        let mut note = None;
+        if let Some(c) = self.check.as_mut() {
+            match &cp.check_state {
+                Some(st) => c.restore_state(st).map_err(|e| refuse(format!("verification state: {e}")))?,
+                None => {
+                    note = Some(format!(
+                    "the verification check keeps no checkpoint state: its metrics use the run from t = {:.6e} s only",
+                    cp.time
+                ))
+                }
+            }
+        }
+        if let Some(n) = &note {
+            self.progress(&format!("restart: {n}"));
+        }
+        self.summary.restarted_from =
+            Some(state::RestartInfo { checkpoint: label.to_string(), time_s: cp.time, step: self.step, note });
+        self.resume = Some((cp.stage as usize, cp.dt, cp.successes as usize));
+        self.progress(&format!("restarted from {label} at t = {:.6e} s, step {}", cp.time, cp.step));
         Ok(())
     }
 }

@@ -16,6 +16,7 @@ pub mod kernels;
 pub mod model;
 pub mod progress;
 pub mod report;
+pub mod state;
 pub mod verification;
 
 /// porompm's version and git revision.

@@ -1,7 +1,8 @@
-//! What a run leaves behind besides summary.json: the field files read
+//! What a run leaves behind besides summary.json: checkpoints and restarts, the field files read
 //! back by ParaView's own XDMF reader (pvbatch, installed by scripts/setup.sh), `porompm report`,
 //! and the quiet progress display. Every test runs the real binary.
 
+use hdf5_metno as h5;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -39,6 +40,14 @@ fn run_terzaghi(dir: &Path, extra: &[&str]) {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// The last output time's particle field `name` of `fields.h5`, sorted by particle id.
+fn last_particle_field(dir: &Path, name: &str) -> Vec<f64> {
+    let f = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
+    let frames = f.group("particles").unwrap().member_names().unwrap();
+    let last = frames.iter().map(|n| n.parse::<usize>().unwrap()).max().unwrap();
+    f.dataset(&format!("particles/{last}/{name}")).unwrap().read_raw::<f64>().unwrap()
+}
+
 /// Bad input: exit code 2 and one line `error: ...` containing `needle`, without HDF5 diagnostics.
 fn assert_one_line_error(o: &Output, needle: &str) {
     let err = stderr(o);
@@ -46,6 +55,85 @@ fn assert_one_line_error(o: &Output, needle: &str) {
     assert_eq!(o.status.code(), Some(2), "exit code of bad input; stderr:\n{err}");
     assert_eq!(lines.len(), 1, "one line expected, got:\n{err}");
     assert!(lines[0].starts_with("error: ") && lines[0].contains(needle), "`{needle}` not in: {err}");
+}
+
+#[test]
+fn a_restart_from_the_middle_of_terzaghi_reproduces_the_uninterrupted_run() {
+    // The uninterrupted run writes one checkpoint, at step 350 of 601 (t = 0.349 s).
+    let full = out_dir("restart-full");
+    run_terzaghi(&full, &["--checkpoint-every", "350"]);
+    let cp = full.join("checkpoint.h5");
+    assert!(cp.is_file() && !full.join("checkpoint.h5.tmp").exists());
+    let again = out_dir("restart-continued");
+    run_terzaghi(&again, &["--restart", cp.to_str().unwrap()]);
+
+    let (a, b) = (summary(&full), summary(&again));
+    assert_eq!(b["status"], "completed");
+    assert_eq!(b["restarted_from"]["step"], 350);
+    assert_eq!(a["steps"], b["steps"], "the restarted run counts the steps before the restart");
+    assert_eq!(a["snes_iterations"], b["snes_iterations"]);
+
+    let (pa, pb) = (last_particle_field(&full, "p"), last_particle_field(&again, "p"));
+    assert_eq!(pa.len(), 40);
+    let scale = pa.iter().fold(0.0f64, |m, p| m.max(p.abs()));
+    let diff = pa.iter().zip(&pb).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale;
+    println!("restart at step 350: max |p_restart − p_full| / max |p_full| = {diff:.3e} over {} particles", pa.len());
+    assert!(diff <= 1e-10, "restart changed the final pore pressure by {diff:.3e} (relative)");
+
+    // Both Terzaghi targets: T_v = 0.1 was passed before the checkpoint (restored), T_v = 0.5 after
+    // (computed by the restarted run).
+    for m in ["e_p_Tv0.1", "e_p_Tv0.5", "settlement_rel_error_Tv0.5"] {
+        let (x, y) = (a["verification"][m]["value"].as_f64().unwrap(), b["verification"][m]["value"].as_f64().unwrap());
+        assert!((x - y).abs() <= 1e-10 * x.abs(), "{m}: {x} vs {y}");
+    }
+    // history.csv of the restarted run starts at the checkpoint's time.
+    let h = std::fs::read_to_string(again.join("history.csv")).unwrap();
+    let first: f64 = h.lines().nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!((first - b["restarted_from"]["time_s"].as_f64().unwrap()).abs() < 1e-9 && first > 0.3);
+}
+
+#[test]
+fn a_checkpoint_of_another_case_or_a_damaged_one_is_refused() {
+    let dir = out_dir("refused");
+    run_terzaghi(&dir, &["--checkpoint-every", "100", "--set", "stages.consolidation.duration=0.1"]);
+    let cp = dir.join("checkpoint.h5");
+    let other = out_dir("refused-other");
+    fn args<'a>(other: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+        let mut a = vec!["run", "cases/terzaghi.toml", "--out", other.to_str().unwrap(), "--restart"];
+        a.extend_from_slice(extra);
+        a
+    }
+    // The checkpoint's case ran to 0.1 s; the case file as it is runs to 0.6 s.
+    let o = porompm(&args(&other, &[cp.to_str().unwrap()]));
+    assert_one_line_error(&o, "different case");
+    let o = porompm(&args(
+        &other,
+        &[cp.to_str().unwrap(), "--set", "stages.consolidation.duration=0.1", "--set", "grid.cells=[1,20]"],
+    ));
+    assert_one_line_error(&o, "different case");
+    // Same case, other output settings: accepted.
+    let o = porompm(&args(
+        &other,
+        &[cp.to_str().unwrap(), "--set", "stages.consolidation.duration=0.1", "--set", "output.fields_every=0"],
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // A checkpoint cut short, as by a crash during a copy.
+    let bytes = std::fs::read(&cp).unwrap();
+    let cut = dir.join("cut.h5");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let o = porompm(&args(&other, &[cut.to_str().unwrap()]));
+    assert_one_line_error(&o, "cut.h5");
+    // One flipped byte in the particle data is caught by the checksum (or by HDF5 itself).
+    let mut flipped = bytes.clone();
+    let at = bytes.len() - bytes.len() / 5;
+    flipped[at] ^= 0x40;
+    let bad = dir.join("flipped.h5");
+    std::fs::write(&bad, &flipped).unwrap();
+    let o = porompm(&args(&other, &[bad.to_str().unwrap(), "--set", "stages.consolidation.duration=0.1"]));
+    assert_one_line_error(&o, "flipped.h5");
+    let o = porompm(&args(&other, &["no/such/checkpoint.h5"]));
+    assert_one_line_error(&o, "does not exist");
 }
 
 #[test]

@@ -6,6 +6,7 @@
 //! `"completed"` or `"failed"`; a run that dies in between never looks complete.
 //! `history.csv` is flushed row by row, so it stays readable whatever happens.
 
+pub mod checkpoint;
 pub mod fields;
 
 use serde::Serialize;
@@ -112,6 +113,12 @@ impl RunOutput {
             Some(f) => f.write(frame),
             None => Ok(()),
         }
+    }
+
+    /// Writes `checkpoint.h5` atomically (see [`checkpoint`]).
+    pub fn write_checkpoint(&self, cp: &crate::state::Checkpoint) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        checkpoint::write(&dir.join("checkpoint.h5"), cp)
     }
 
     /// Writes a CSV table `name` (header, rows) atomically.

@@ -213,6 +213,18 @@ impl Check for BearingCheck {
         Ok((metrics, vec![table]))
     }
 
+    fn checkpoint_state(&self) -> Option<Vec<f64>> {
+        Some(self.curve.iter().flatten().copied().collect())
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        if !state.len().is_multiple_of(3) {
+            return Err(format!("{} values do not make rows of a load-settlement curve", state.len()));
+        }
+        self.curve = state.chunks(3).map(|r| [r[0], r[1], r[2]]).collect();
+        Ok(())
+    }
+
     fn stop(&self) -> Option<String> {
         let (stop, last) = (self.stop_at?, self.curve.last()?);
         (last[1] >= stop).then(|| format!("the footing settlement reached d/B = {:.4} ≥ {stop}", last[1]))

@@ -86,6 +86,16 @@ pub trait Check {
     fn results(&self) -> Vec<(String, f64)> {
         Vec::new()
     }
+    /// What the check has gathered so far, the same on every rank, for a checkpoint; `None` if the
+    /// check cannot keep it (a run restarted from the checkpoint then computes the check from the
+    /// restart time on only).
+    fn checkpoint_state(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// Continues from a [`Check::checkpoint_state`] of the same case.
+    fn restore_state(&mut self, _state: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// Geometry and soil of a loaded one-dimensional column, taken from the case.
@@ -397,6 +407,28 @@ impl Check for ConsolidationCheck {
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
+    fn checkpoint_state(&self) -> Option<Vec<f64>> {
+        Some(
+            self.targets
+                .iter()
+                .flat_map(|t| match t.result {
+                    Some((a, b, c, d)) => [1.0, a, b, c, d],
+                    None => [0.0; 5],
+                })
+                .collect(),
+        )
+    }
+
+    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+        if state.len() != 5 * self.targets.len() {
+            return Err(format!("{} values for {} consolidation targets", state.len(), self.targets.len()));
+        }
+        for (t, r) in self.targets.iter_mut().zip(state.chunks(5)) {
+            t.result = (r[0] > 0.5).then_some((r[1], r[2], r[3], r[4]));
+        }
+        Ok(())
+    }
+
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
         let (ep_tol, rms_tol, s_tol) = self.tolerances;
         let mut out = Vec::new();
@@ -633,6 +665,11 @@ impl ElasticColumnCheck {
 impl Check for ElasticColumnCheck {
     fn columns(&self) -> Vec<String> {
         vec!["column.settlement".into()]
+    }
+
+    /// Its metrics come from the final state alone.
+    fn checkpoint_state(&self) -> Option<Vec<f64>> {
+        Some(Vec::new())
     }
 
     fn event_times(&self) -> Vec<f64> {
