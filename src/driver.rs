@@ -203,6 +203,9 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         }
         sim.finish()
     });
+    // The field files' index lists every output time, also of a failed run.
+    let indexed = out.finish_fields();
+    let result = result.and_then(|_| indexed.map_err(RunError::Failed));
     summary.wall_time_s = start.elapsed().as_secs_f64();
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
     let err = result.err();

@@ -115,6 +115,14 @@ impl RunOutput {
         }
     }
 
+    /// Completes the field files' XDMF index (see [`fields::FieldFiles::finish`]).
+    pub fn finish_fields(&mut self) -> Result<(), String> {
+        match self.fields.as_mut() {
+            Some(f) => f.finish(),
+            None => Ok(()),
+        }
+    }
+
     /// Writes `checkpoint.h5` atomically (see [`checkpoint`]).
     pub fn write_checkpoint(&self, cp: &crate::state::Checkpoint) -> Result<(), String> {
         let Some(dir) = &self.dir else { return Ok(()) };
