@@ -93,6 +93,39 @@ fn a_restart_from_the_middle_of_terzaghi_reproduces_the_uninterrupted_run() {
 }
 
 #[test]
+fn a_run_killed_while_checkpointing_leaves_a_checkpoint_that_restarts_right() {
+    let full = out_dir("killed-full");
+    run_terzaghi(&full, &[]);
+    // Checkpoint after every step, and kill the run (SIGKILL) soon after its first checkpoint,
+    // most likely in the middle of writing another one.
+    let dir = out_dir("killed");
+    let mut child = Command::new(bin())
+        .args(["run", "cases/terzaghi.toml", "--out", dir.to_str().unwrap(), "--quiet", "--checkpoint-every", "1"])
+        .current_dir(root())
+        .spawn()
+        .expect("porompm starts");
+    let cp = dir.join("checkpoint.h5");
+    let start = std::time::Instant::now();
+    while !cp.exists() && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(37));
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the run was to be killed before its end");
+    let torn = dir.join("checkpoint.h5.tmp").exists();
+    let again = out_dir("killed-continued");
+    run_terzaghi(&again, &["--restart", cp.to_str().unwrap()]);
+    let step = summary(&again)["restarted_from"]["step"].as_u64().unwrap();
+    assert!((1..601).contains(&step), "restarted at step {step}");
+    println!("killed after step {step}; a partly written checkpoint.h5.tmp was left: {torn}");
+    let (pa, pb) = (last_particle_field(&full, "p"), last_particle_field(&again, "p"));
+    let scale = pa.iter().fold(0.0f64, |m, p| m.max(p.abs()));
+    let diff = pa.iter().zip(&pb).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale;
+    assert!(diff <= 1e-10, "restart at step {step} after a kill: relative difference {diff:.3e}");
+}
+
+#[test]
 fn a_checkpoint_of_another_case_or_a_damaged_one_is_refused() {
     let dir = out_dir("refused");
     run_terzaghi(&dir, &["--checkpoint-every", "100", "--set", "stages.consolidation.duration=0.1"]);
