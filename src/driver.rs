@@ -565,6 +565,10 @@ impl<'a> Simulation<'a> {
         let ps = &self.model.particles;
         let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
         let all = self.coll.gather(&local).map_err(RunError::Failed)?;
+        let check_state = match self.check.as_ref() {
+            Some(c) => c.checkpoint_state(&self.model, &self.coll).map_err(RunError::Failed)?,
+            None => None,
+        };
         let s = &self.summary;
         let cp = Checkpoint {
             case_fingerprint: state::case_fingerprint(self.case),
@@ -576,7 +580,7 @@ impl<'a> Simulation<'a> {
             counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
             checkerboard_max: s.checkerboard_index_max.unwrap_or(f64::NAN),
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
-            check_state: self.check.as_ref().and_then(|c| c.checkpoint_state()),
+            check_state,
             particles: state::sorted_records(&all),
         };
         self.out.write_checkpoint(&cp).map_err(RunError::Failed)?;
@@ -609,7 +613,7 @@ impl<'a> Simulation<'a> {
         let mut note = None;
         if let Some(c) = self.check.as_mut() {
             match &cp.check_state {
-                Some(st) => c.restore_state(st).map_err(|e| refuse(format!("verification state: {e}")))?,
+                Some(st) => c.restore_state(st, &self.model).map_err(|e| refuse(format!("verification state: {e}")))?,
                 None => {
                     note = Some(format!(
                     "the verification check keeps no checkpoint state: its metrics use the run from t = {:.6e} s only",

@@ -213,11 +213,11 @@ impl Check for BearingCheck {
         Ok((metrics, vec![table]))
     }
 
-    fn checkpoint_state(&self) -> Option<Vec<f64>> {
-        Some(self.curve.iter().flatten().copied().collect())
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(self.curve.iter().flatten().copied().collect()))
     }
 
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
         if !state.len().is_multiple_of(3) {
             return Err(format!("{} values do not make rows of a load-settlement curve", state.len()));
         }

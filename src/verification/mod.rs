@@ -86,14 +86,15 @@ pub trait Check {
     fn results(&self) -> Vec<(String, f64)> {
         Vec::new()
     }
-    /// What the check has gathered so far, the same on every rank, for a checkpoint; `None` if the
-    /// check cannot keep it (a run restarted from the checkpoint then computes the check from the
-    /// restart time on only).
-    fn checkpoint_state(&self) -> Option<Vec<f64>> {
-        None
+    /// What the check has gathered so far, the same on every rank (a collective call), for a
+    /// checkpoint; `None` if the check cannot keep it (a run restarted from the checkpoint then
+    /// computes the check from the restart time on only).
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(None)
     }
-    /// Continues from a [`Check::checkpoint_state`] of the same case.
-    fn restore_state(&mut self, _state: &[f64]) -> Result<(), String> {
+    /// Continues from a [`Check::checkpoint_state`] of the same case, with this rank's particles
+    /// already restored.
+    fn restore_state(&mut self, _state: &[f64], _model: &Model) -> Result<(), String> {
         Ok(())
     }
 }
@@ -407,8 +408,8 @@ impl Check for ConsolidationCheck {
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
-    fn checkpoint_state(&self) -> Option<Vec<f64>> {
-        Some(
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(
             self.targets
                 .iter()
                 .flat_map(|t| match t.result {
@@ -416,10 +417,10 @@ impl Check for ConsolidationCheck {
                     None => [0.0; 5],
                 })
                 .collect(),
-        )
+        ))
     }
 
-    fn restore_state(&mut self, state: &[f64]) -> Result<(), String> {
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
         if state.len() != 5 * self.targets.len() {
             return Err(format!("{} values for {} consolidation targets", state.len(), self.targets.len()));
         }
@@ -535,6 +536,34 @@ impl Check for HarmonicCheck {
             }
         }
         Ok(Vec::new())
+    }
+
+    /// ∫ w dt, then (particle id, ∫ w p cos ωt dt, ∫ w p sin ωt dt) of every particle of the column.
+    fn checkpoint_state(&self, model: &Model, coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        let local: Vec<f64> = self
+            .col
+            .particles(model)
+            .flat_map(|k| {
+                let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
+                [model.particles.id[k] as f64, c, s]
+            })
+            .collect();
+        let mut state = vec![self.weight];
+        state.extend(coll.gather(&local)?);
+        Ok(Some(state))
+    }
+
+    fn restore_state(&mut self, state: &[f64], model: &Model) -> Result<(), String> {
+        if state.is_empty() || !(state.len() - 1).is_multiple_of(3) {
+            return Err(format!("{} values do not make the harmonic sums", state.len()));
+        }
+        self.weight = state[0];
+        let sums: std::collections::HashMap<u64, (f64, f64)> =
+            state[1..].chunks(3).map(|r| (r[0] as u64, (r[1], r[2]))).collect();
+        self.sums = (0..model.particles.len())
+            .map(|k| sums.get(&model.particles.id[k]).copied().unwrap_or((0.0, 0.0)))
+            .collect();
+        Ok(())
     }
 
     fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
@@ -668,8 +697,8 @@ impl Check for ElasticColumnCheck {
     }
 
     /// Its metrics come from the final state alone.
-    fn checkpoint_state(&self) -> Option<Vec<f64>> {
-        Some(Vec::new())
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(Vec::new()))
     }
 
     fn event_times(&self) -> Vec<f64> {
