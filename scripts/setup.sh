@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # Installs what porompm needs on Debian 12, and nothing that is already there (idempotent).
 #   Debian packages: PETSc 3.18 (petsc-dev: MUMPS, hypre, SuperLU_dist, SuiteSparse inside), OpenMPI,
-#   HDF5 (OpenMPI build), clang/libclang for bindgen, pkg-config, and the serial OpenBLAS (Debian's
-#   reference BLAS is several times slower inside the direct solvers); for the PNG plots (plotters'
-#   text through font-kit), the fontconfig and FreeType development files and the DejaVu fonts.
+#   HDF5 (OpenMPI build: the one PETSc links, used by porompm's fields.h5 and checkpoint.h5 through
+#   hdf5-metno), clang/libclang for bindgen, pkg-config, the serial OpenBLAS (Debian's reference
+#   BLAS is several times slower inside the direct solvers), for the PNG plots (plotters' text
+#   through font-kit) the fontconfig and FreeType development files and the DejaVu fonts, and
+#   ParaView with its Python (`pvbatch`), with which the tests read fields.xdmf back.
 #   Rust: cargo and rustc through rustup, if no cargo is found.
 # Run as root or with sudo available.
 set -euo pipefail
 
 packages=(petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev clang libclang-dev pkg-config
           libopenblas0-serial libfontconfig1-dev libfreetype-dev fonts-dejavu-core
-          make git ca-certificates curl)
+          make git ca-certificates curl paraview python3-paraview)
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -9,15 +9,22 @@
 //! │       ├── newton_solve: map to grid, constraints, loads; SNES on the Newmark residual
 //! │       ├── if converged: update_particles ([003] Eq. 24, [000] Eq. 11) unless inadmissible
 //! │       ├── if not: cut Δt (stage.cut_factor), retry; fail after stage.max_step_cuts cuts in a row
-//! │       └── record_step: probes, check, history.csv
+//! │       ├── record_step: probes, check, history.csv
+//! │       └── every output.fields_every steps and at the stage end: fields.h5/.xdmf;
+//! │           every --checkpoint-every steps: checkpoint.h5
 //! └── finish: verification metrics, summary.json
 //! ```
+//!
+//! A restarted run (`--restart`) sets up as usual, then takes the particles, time, step, stage and
+//! step control from the checkpoint ([`crate::state`]) and continues in that stage.
 
 use crate::assembly::{self, Collective, GridSystem, Phase};
 use crate::case::{Case, Stage};
 use crate::io::RunOutput;
 use crate::kernels::StepResult;
 use crate::model::Model;
+use crate::progress::Progress;
+use crate::state::{self, Checkpoint};
 use crate::verification::{self, Check, Metric};
 use petsc::Comm;
 use serde::Serialize;
@@ -39,6 +46,10 @@ pub struct RunRequest<'a> {
     pub quiet: bool,
     /// The run's communicator.
     pub comm: Comm,
+    /// Write `checkpoint.h5` every this many steps (0: never).
+    pub checkpoint_every: usize,
+    /// Continue from this checkpoint (its path as given, and its content).
+    pub restart: Option<(String, Checkpoint)>,
 }
 
 /// Why a run stopped early.
@@ -143,6 +154,9 @@ pub struct Summary {
     /// Whether every metric passed (absent without verification).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verification_passed: Option<bool>,
+    /// The checkpoint this run continued from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restarted_from: Option<state::RestartInfo>,
 }
 
 /// A probe: the particle nearest to a point at t = 0, and what is tracked over the run.
@@ -163,7 +177,7 @@ struct Simulation<'a> {
     probes: Vec<Probe>,
     out: &'a mut RunOutput,
     coll: Collective,
-    quiet: bool,
+    display: Progress,
     t: f64,
     step: usize,
     summary: &'a mut Summary,
@@ -171,6 +185,11 @@ struct Simulation<'a> {
     last_newton: (usize, usize),
     /// The columns and rows of history.csv, kept for the probe figures.
     history: (Vec<String>, Vec<Vec<f64>>),
+    /// Where a restarted run continues: the stage's index, its Δt and accepted steps at that Δt.
+    resume: Option<(usize, f64, usize)>,
+    /// Step of the last field output.
+    fields_step: Option<usize>,
+    checkpoint_every: usize,
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -190,6 +209,9 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
             }
         }
     });
+    // The field files' index lists every output time, also of a failed run.
+    let indexed = out.finish_fields();
+    let result = result.and_then(|_| indexed.map_err(RunError::Failed));
     summary.wall_time_s = start.elapsed().as_secs_f64();
     summary.peak_memory_mib = crate::io::peak_memory_mib();
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
@@ -242,6 +264,7 @@ impl Summary {
             verification: BTreeMap::new(),
             results: BTreeMap::new(),
             verification_passed: None,
+            restarted_from: None,
         }
     }
 }
@@ -297,6 +320,9 @@ impl<'a> Simulation<'a> {
             columns.extend(c.columns());
         }
         out.start_history(&columns).map_err(input)?;
+        if case.output.fields_every > 0 {
+            out.start_fields(crate::fields::grid_geometry(&model)).map_err(input)?;
+        }
         drop(setup_stage);
         summary.timings.setup_s = t0.elapsed().as_secs_f64();
         let mut sim = Simulation {
@@ -307,21 +333,30 @@ impl<'a> Simulation<'a> {
             probes,
             out,
             coll,
-            quiet: req.quiet,
+            display: Progress::new(!req.quiet && coll.rank() == 0, case.end_time()),
             t: 0.0,
             step: 0,
             summary,
             options_checked: false,
             last_newton: (0, 0),
             history: (columns, Vec::new()),
+            resume: None,
+            fields_step: None,
+            checkpoint_every: req.checkpoint_every,
         };
+        if let Some((label, cp)) = &req.restart {
+            sim.restore(label, cp)?;
+        }
         sim.record_step(0.0)?;
+        sim.write_fields()?;
         Ok(sim)
     }
 
     /// The stage loop: every stage in turn, until the check asks to stop.
     fn run_stages(&mut self, stages: &[Stage]) -> Result<(), RunError> {
-        for stage in stages {
+        // A restarted run continues in the stage of its checkpoint.
+        let first = self.resume.map_or(0, |r| r.0);
+        for stage in &stages[first..] {
             self.run_stage(stage)?;
             if let Some(why) = self.check.as_ref().and_then(|c| c.stop()) {
                 self.progress(&format!("stopped at t = {:.6e} s: {why}", self.t));
@@ -338,6 +373,11 @@ impl<'a> Simulation<'a> {
         let newmark = stage.time_integration.as_ref().unwrap_or(&self.case.time_integration);
         (self.model.beta, self.model.gamma) = (newmark.beta, newmark.gamma);
         let mut control = StepControl::new(stage, self.stage_end(stage));
+        let stage_index = self.case.stages.iter().position(|s| std::ptr::eq(s, stage)).unwrap_or(0);
+        if let Some((_, dt, successes)) = self.resume.take() {
+            control.dt = dt;
+            control.successes = successes;
+        }
         self.progress(&format!(
             "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
             stage.name,
@@ -345,7 +385,6 @@ impl<'a> Simulation<'a> {
             control.t_end,
             stage.dt()
         ));
-        let mut next_report = self.t + stage.duration / 10.0;
         while !control.finished(self.t) {
             let events = self.check.as_ref().map(|c| c.event_times()).unwrap_or_default();
             let dt = control.next(self.t, &events);
@@ -366,11 +405,16 @@ impl<'a> Simulation<'a> {
                     } else {
                         self.observe_only(dt)?;
                     }
-                    if self.t >= next_report - 1e-9 * stage.dt() {
-                        self.progress(&format!("  t = {:.6e} s, step {}", self.t, self.step));
-                        next_report += stage.duration / 10.0;
+                    self.display.step(&stage.name, self.step, self.t, self.last_newton.0);
+                    let every = self.case.output.fields_every;
+                    let stopping = self.check.as_ref().is_some_and(|c| c.stop().is_some());
+                    if every > 0 && (self.step.is_multiple_of(every) || control.finished(self.t) || stopping) {
+                        self.write_fields()?;
                     }
-                    if self.check.as_ref().is_some_and(|c| c.stop().is_some()) {
+                    if self.checkpoint_every > 0 && self.step.is_multiple_of(self.checkpoint_every) {
+                        self.write_checkpoint(stage_index, &control)?;
+                    }
+                    if stopping {
                         if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
                             self.record_step(dt)?;
                         }
@@ -545,9 +589,94 @@ impl<'a> Simulation<'a> {
     }
 
     fn progress(&self, msg: &str) {
-        if !self.quiet && self.coll.rank() == 0 {
-            eprintln!("{msg}");
+        self.display.message(msg);
+    }
+
+    /// One output time of `fields.h5`/`fields.xdmf` (once per step at most).
+    fn write_fields(&mut self) -> Result<(), RunError> {
+        if self.case.output.fields_every == 0 || self.fields_step == Some(self.step) {
+            return Ok(());
         }
+        let t0 = Instant::now();
+        let nodes = self.system.owned_node_records();
+        let frame = crate::fields::frame(&self.model, &nodes, &self.coll, self.t).map_err(RunError::Failed)?;
+        self.out.write_fields(&frame).map_err(RunError::Failed)?;
+        self.fields_step = Some(self.step);
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Writes `checkpoint.h5` after an accepted step in stage `stage_index`.
+    fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
+        let t0 = Instant::now();
+        let ps = &self.model.particles;
+        let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
+        let all = self.coll.gather(&local).map_err(RunError::Failed)?;
+        let check_state = match self.check.as_ref() {
+            Some(c) => c.checkpoint_state(&self.model, &self.coll).map_err(RunError::Failed)?,
+            None => None,
+        };
+        let s = &self.summary;
+        let cp = Checkpoint {
+            case_fingerprint: state::case_fingerprint(self.case),
+            time: self.t,
+            step: self.step as u64,
+            stage: stage_index as u64,
+            dt: control.dt,
+            successes: control.successes as u64,
+            counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
+            checkerboard_max: s.checkerboard_index_max.unwrap_or(f64::NAN),
+            probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
+            check_state,
+            particles: state::sorted_records(&all),
+        };
+        self.out.write_checkpoint(&cp).map_err(RunError::Failed)?;
+        self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Continues from checkpoint `cp` (read from `label`): refuses one of another case, then takes
+    /// its particles, time, counters, probe extremes, check state and step control.
+    fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
+        let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
+        state::check_case(cp, self.case).map_err(refuse)?;
+        let restored = cp.restore_particles(&mut self.model.particles, self.summary.particles);
+        if self.coll.any(restored.is_err()).map_err(RunError::Failed)? {
+            return Err(refuse(
+                restored.err().unwrap_or_else(|| "another rank could not take its material points".into()),
+            ));
+        }
+        self.t = cp.time;
+        self.step = cp.step as usize;
+        let s = &mut *self.summary;
+        s.time_s = cp.time;
+        s.steps = self.step;
+        [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses] = cp.counters.map(|c| c as usize);
+        s.checkerboard_index_max = (!cp.checkerboard_max.is_nan()).then_some(cp.checkerboard_max);
+        self.system.reused_patterns = s.matrix_structure_reuses;
+        for (p, &e) in self.probes.iter_mut().zip(&cp.probe_extremes) {
+            p.excess_extreme = e;
+        }
+        let mut note = None;
+        if let Some(c) = self.check.as_mut() {
+            match &cp.check_state {
+                Some(st) => c.restore_state(st, &self.model).map_err(|e| refuse(format!("verification state: {e}")))?,
+                None => {
+                    note = Some(format!(
+                    "the verification check keeps no checkpoint state: its metrics use the run from t = {:.6e} s only",
+                    cp.time
+                ))
+                }
+            }
+        }
+        if let Some(n) = &note {
+            self.progress(&format!("restart: {n}"));
+        }
+        self.summary.restarted_from =
+            Some(state::RestartInfo { checkpoint: label.to_string(), time_s: cp.time, step: self.step, note });
+        self.resume = Some((cp.stage as usize, cp.dt, cp.successes as usize));
+        self.progress(&format!("restarted from {label} at t = {:.6e} s, step {}", cp.time, cp.step));
+        Ok(())
     }
 }
 

@@ -10,10 +10,14 @@ pub mod case;
 pub mod describe;
 pub mod driver;
 pub mod element_test;
+pub mod fields;
 pub mod io;
 pub mod kernels;
 pub mod model;
 pub mod plot;
+pub mod progress;
+pub mod report;
+pub mod state;
 pub mod sweep;
 pub mod verification;
 

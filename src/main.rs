@@ -19,7 +19,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a case: writes summary.json and history.csv into DIR.
+    /// Run a case: writes summary.json, history.csv and fields.h5/fields.xdmf into DIR.
     Run {
         /// The case file (TOML).
         case: PathBuf,
@@ -32,9 +32,16 @@ enum Command {
         /// Override a case value by its dotted path, e.g. `--set time.dt=5e-4`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// No progress messages.
+        /// No progress bar and no progress messages (the bar is shown only when standard error is
+        /// a terminal).
         #[arg(long)]
         quiet: bool,
+        /// Write the full state to DIR/checkpoint.h5 every N steps (atomically; 0: never).
+        #[arg(long = "checkpoint-every", value_name = "N", default_value_t = 0)]
+        checkpoint_every: usize,
+        /// Continue from a checkpoint.h5 written by a run of the same case.
+        #[arg(long, value_name = "CHECKPOINT")]
+        restart: Option<PathBuf>,
         /// PETSc options, after `--` (they reach PETSc's options database unchanged).
         #[arg(last = true, value_name = "PETSC_OPTIONS")]
         petsc: Vec<String>,
@@ -107,6 +114,11 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
+    /// Print a run's summary.json (finished, failed or still running) as a readable table.
+    Report {
+        /// The run's output directory.
+        dir: PathBuf,
+    },
     /// Print the MPI and PETSc environment and check a collective operation.
     Info {
         /// PETSc options, after `--`.
@@ -132,15 +144,30 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
     case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
 
+/// Checkpointing and restart of `porompm run`.
+struct Continuation<'a> {
+    checkpoint_every: usize,
+    restart: Option<&'a Path>,
+}
+
 fn run(
     case_path: &Path,
     out: &Path,
     options_files: &[PathBuf],
     sets: &[String],
     quiet: bool,
+    cont: Continuation,
     petsc_args: &[String],
 ) -> Result<(), Failure> {
     let c = load_case(case_path, sets)?;
+    let restart = match cont.restart {
+        Some(p) => {
+            let cp = io::checkpoint::read(p).map_err(input)?;
+            porompm::state::check_case(&cp, &c).map_err(|e| input(format!("checkpoint {}: {e}", p.display())))?;
+            Some((p.display().to_string(), cp))
+        }
+        None => None,
+    };
     // Options files: the case's own (relative to the case file), then the command line's.
     let mut files: Vec<PathBuf> = Vec::new();
     if let Some(f) = &c.solver.options_file {
@@ -170,6 +197,8 @@ fn run(
         out_dir: out.to_path_buf(),
         quiet,
         comm,
+        checkpoint_every: cont.checkpoint_every,
+        restart,
     };
     let (summary, err) = driver::run(&req, &mut output);
     drop(output);
@@ -219,6 +248,8 @@ fn test_jacobian(
         out_dir: PathBuf::from("."),
         quiet: true,
         comm: petsc.world(),
+        checkpoint_every: 0,
+        restart: None,
     };
     let result = driver::test_jacobian(&req, steps);
     drop(petsc);
@@ -339,10 +370,14 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run { case, out, options_file, set, quiet, petsc } => run(case, out, options_file, set, *quiet, petsc),
+        Command::Run { case, out, options_file, set, quiet, checkpoint_every, restart, petsc } => {
+            let cont = Continuation { checkpoint_every: *checkpoint_every, restart: restart.as_deref() };
+            run(case, out, options_file, set, *quiet, cont, petsc)
+        }
         Command::Sweep { case, out, options_file, vary, set, metric, quiet, petsc } => {
             sweep(case, out, options_file, vary, set, metric, *quiet, petsc)
         }
+        Command::Report { dir } => porompm::report::report(dir).map(|t| print!("{t}")).map_err(input),
         Command::Check { case, set } => {
             load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
         }

@@ -637,6 +637,28 @@ impl GridSystem {
             .collect()
     }
 
+    /// The nodes this rank owns after the last solve, as records of 7 values: global node index
+    /// j·n_x + i, active flag (1 or 0), and the nodal increments Δd of the step (ux, uy, p, Ux, Uy;
+    /// zeros beyond the dofs of one-phase runs). Empty before the first solve.
+    pub fn owned_node_records(&self) -> Vec<f64> {
+        let (nd, nx) = (self.ndof, self.dm.info().nodes[0]);
+        let mut out = Vec::new();
+        if self.step.solution.is_empty() {
+            return out;
+        }
+        for j in self.owned_start[1]..self.owned_start[1] + self.owned_count[1] {
+            for i in self.owned_start[0]..self.owned_start[0] + self.owned_count[0] {
+                let Some(l) = self.ghost.node(i, j) else { continue };
+                out.push((j * nx + i) as f64);
+                out.push(if self.step.active.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
+                for c in 0..5 {
+                    out.push(if c < nd { self.step.solution[l * nd + c] } else { 0.0 });
+                }
+            }
+        }
+        out
+    }
+
     /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.
     pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
         let (nodes, basis) = self.step.stencils.get(k);

@@ -655,15 +655,27 @@ pub struct Output {
     /// Write a history row every this many steps (the last step of a stage is always written).
     #[serde(default = "default_every")]
     pub history_every: usize,
+    /// Write the particle and grid fields to `fields.h5`/`fields.xdmf` every this many steps
+    /// [steps], and always at t = 0 (or the restart time) and at the end of every stage; 0 writes
+    /// no fields.
+    #[serde(default = "default_fields_every")]
+    pub fields_every: usize,
 }
 
 fn default_every() -> usize {
     1
 }
 
+/// Field output every 100 steps unless the case says otherwise.
+pub const DEFAULT_FIELDS_EVERY: usize = 100;
+
+fn default_fields_every() -> usize {
+    DEFAULT_FIELDS_EVERY
+}
+
 impl Default for Output {
     fn default() -> Self {
-        Output { history_every: 1 }
+        Output { history_every: 1, fields_every: DEFAULT_FIELDS_EVERY }
     }
 }
 

@@ -6,6 +6,8 @@
 //! `"completed"` or `"failed"`; a run that dies in between never looks complete.
 //! `history.csv` is flushed row by row, so it stays readable whatever happens.
 
+pub mod checkpoint;
+pub mod fields;
 pub mod plot;
 
 use serde::Serialize;
@@ -62,10 +64,11 @@ pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String>
 pub struct RunOutput {
     dir: Option<PathBuf>,
     history: Option<BufWriter<File>>,
+    fields: Option<fields::FieldFiles>,
 }
 
 /// Writes `content` to `path` atomically (write a temporary file, then rename).
-fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
+pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
     let tmp = path.with_extension("tmp");
     let mut f = File::create(&tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
     f.write_all(content).and_then(|_| f.sync_all()).map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
@@ -78,10 +81,10 @@ impl RunOutput {
     /// for this run's.
     pub fn create(dir: &Path, writer: bool) -> Result<RunOutput, String> {
         if !writer {
-            return Ok(RunOutput { dir: None, history: None });
+            return Ok(RunOutput { dir: None, history: None, fields: None });
         }
         fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
-        for old in ["summary.json", "history.csv", "amplitude_profile.csv"] {
+        for old in ["summary.json", "history.csv", "amplitude_profile.csv", "fields.h5", "fields.xdmf"] {
             let p = dir.join(old);
             if p.exists() {
                 fs::remove_file(&p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
@@ -91,7 +94,7 @@ impl RunOutput {
         if plots.is_dir() {
             fs::remove_dir_all(&plots).map_err(|e| format!("cannot remove old {}: {e}", plots.display()))?;
         }
-        Ok(RunOutput { dir: Some(dir.to_path_buf()), history: None })
+        Ok(RunOutput { dir: Some(dir.to_path_buf()), history: None, fields: None })
     }
 
     /// Draws the figures as PNG files into `plots/` (created if needed) and returns the paths.
@@ -131,6 +134,35 @@ impl RunOutput {
         };
         let line: Vec<String> = values.iter().map(|v| format!("{v:.10e}")).collect();
         writeln!(w, "{}", line.join(",")).and_then(|_| w.flush()).map_err(|e| format!("cannot write history.csv: {e}"))
+    }
+
+    /// Starts `fields.h5`/`fields.xdmf` for a grid.
+    pub fn start_fields(&mut self, grid: fields::GridGeometry) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        self.fields = Some(fields::FieldFiles::create(dir, grid)?);
+        Ok(())
+    }
+
+    /// Appends one output time to the field files (if started).
+    pub fn write_fields(&mut self, frame: &fields::Frame) -> Result<(), String> {
+        match self.fields.as_mut() {
+            Some(f) => f.write(frame),
+            None => Ok(()),
+        }
+    }
+
+    /// Completes the field files' XDMF index (see [`fields::FieldFiles::finish`]).
+    pub fn finish_fields(&mut self) -> Result<(), String> {
+        match self.fields.as_mut() {
+            Some(f) => f.finish(),
+            None => Ok(()),
+        }
+    }
+
+    /// Writes `checkpoint.h5` atomically (see [`checkpoint`]).
+    pub fn write_checkpoint(&self, cp: &crate::state::Checkpoint) -> Result<(), String> {
+        let Some(dir) = &self.dir else { return Ok(()) };
+        checkpoint::write(&dir.join("checkpoint.h5"), cp)
     }
 
     /// Writes a CSV table `name` (header, rows) atomically.

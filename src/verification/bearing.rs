@@ -226,6 +226,22 @@ impl Check for BearingCheck {
         vec![super::figures::load_settlement(&self.curve, self.reference)]
     }
 
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(std::iter::once(self.baseline).chain(self.curve.iter().flatten().copied()).collect()))
+    }
+
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+        let Some((&baseline, rows)) = state.split_first() else {
+            return Err("an empty load-settlement state".into());
+        };
+        if !rows.len().is_multiple_of(3) {
+            return Err(format!("{} values do not make rows of a load-settlement curve", rows.len()));
+        }
+        self.baseline = baseline;
+        self.curve = rows.chunks(3).map(|r| [r[0], r[1], r[2]]).collect();
+        Ok(())
+    }
+
     fn stop(&self) -> Option<String> {
         let (stop, last) = (self.stop_at?, self.curve.last()?);
         (last[1] >= stop).then(|| format!("the footing settlement reached d/B = {:.4} ≥ {stop}", last[1]))

@@ -92,6 +92,18 @@ pub trait Check {
     fn figures(&self) -> Vec<crate::plot::Figure> {
         Vec::new()
     }
+
+    /// What the check has gathered so far, the same on every rank (a collective call), for a
+    /// checkpoint; `None` if the check cannot keep it (a run restarted from the checkpoint then
+    /// computes the check from the restart time on only).
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(None)
+    }
+    /// Continues from a [`Check::checkpoint_state`] of the same case, with this rank's particles
+    /// already restored.
+    fn restore_state(&mut self, _state: &[f64], _model: &Model) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// Geometry and soil of a loaded one-dimensional column, taken from the case.
@@ -411,6 +423,28 @@ impl Check for ConsolidationCheck {
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(
+            self.targets
+                .iter()
+                .flat_map(|t| match t.result {
+                    Some((a, b, c, d)) => [1.0, a, b, c, d],
+                    None => [0.0; 5],
+                })
+                .collect(),
+        ))
+    }
+
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+        if state.len() != 5 * self.targets.len() {
+            return Err(format!("{} values for {} consolidation targets", state.len(), self.targets.len()));
+        }
+        for (t, r) in self.targets.iter_mut().zip(state.chunks(5)) {
+            t.result = (r[0] > 0.5).then_some((r[1], r[2], r[3], r[4]));
+        }
+        Ok(())
+    }
+
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
         let (ep_tol, rms_tol, s_tol) = self.tolerances;
         let mut out = Vec::new();
@@ -573,6 +607,34 @@ impl Check for HarmonicCheck {
         Ok(Vec::new())
     }
 
+    /// ∫ w dt, then (particle id, ∫ w p cos ωt dt, ∫ w p sin ωt dt) of every particle of the column.
+    fn checkpoint_state(&self, model: &Model, coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        let local: Vec<f64> = self
+            .col
+            .particles(model)
+            .flat_map(|k| {
+                let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
+                [model.particles.id[k] as f64, c, s]
+            })
+            .collect();
+        let mut state = vec![self.weight];
+        state.extend(coll.gather(&local)?);
+        Ok(Some(state))
+    }
+
+    fn restore_state(&mut self, state: &[f64], model: &Model) -> Result<(), String> {
+        if state.is_empty() || !(state.len() - 1).is_multiple_of(3) {
+            return Err(format!("{} values do not make the harmonic sums", state.len()));
+        }
+        self.weight = state[0];
+        let sums: std::collections::HashMap<u64, (f64, f64)> =
+            state[1..].chunks(3).map(|r| (r[0] as u64, (r[1], r[2]))).collect();
+        self.sums = (0..model.particles.len())
+            .map(|k| sums.get(&model.particles.id[k]).copied().unwrap_or((0.0, 0.0)))
+            .collect();
+        Ok(())
+    }
+
     fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
         if self.weight <= 0.0 {
             return Err("the measurement window of the harmonic column was never reached".into());
@@ -729,6 +791,11 @@ impl ElasticColumnCheck {
 impl Check for ElasticColumnCheck {
     fn columns(&self) -> Vec<String> {
         vec!["column.settlement".into()]
+    }
+
+    /// Its metrics come from the final state alone.
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(Vec::new()))
     }
 
     fn event_times(&self) -> Vec<f64> {

@@ -126,6 +126,20 @@ impl Check for ShockCheck {
         Ok(vec![p, p / self.col.load])
     }
 
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(self.samples.iter().flat_map(|&(t, p)| [t, p]).collect()))
+    }
+
+    /// The last sample (at the checkpoint's time) is left out: the restarted run observes it again.
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+        if state.len() < 2 || !state.len().is_multiple_of(2) {
+            return Err(format!("{} values do not make (t, p) samples", state.len()));
+        }
+        self.samples = state.chunks(2).map(|r| (r[0], r[1])).collect();
+        self.samples.pop();
+        Ok(())
+    }
+
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
         let t_fast = self.depth / self.fast_speed;
         let t_slow = self.depth / self.slow_speed;

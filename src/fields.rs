@@ -1,0 +1,111 @@
+//! The fields written to `fields.h5`/`fields.xdmf` at an output time, gathered from all ranks (the
+//! file itself is written by rank 0 through [`crate::io::fields`]).
+//!
+//! Particle fields (sorted by particle id): `position` and `displacement` [m], `velocity` [m/s]
+//! (3 components, z = 0), the effective stress components `stress_xx`, `stress_yy`, `stress_xy`,
+//! `stress_zz` [Pa] (tension positive; total stress in one-phase runs), the mean effective stress
+//! `mean_stress` = −(σ'_xx + σ'_yy + σ'_zz)/3 [Pa] (compression positive), the deviatoric stress
+//! `q` = sqrt(3/2 s:s) [Pa], the deviatoric plastic strain `eps_pd` [-], `material_id`, `body_id`,
+//! `particle_id`, and in two-phase runs the pore pressure `p` and the excess pore pressure
+//! `p_excess` = p − p₀ [Pa].
+//!
+//! Grid fields: `active` (1 where the node took part in the last step) and the nodal increments of
+//! the last step, `du` [m] (and in two-phase runs `dp` [Pa] and `dU` [m]); all zero before the
+//! first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's geometry.
+
+use crate::assembly::Collective;
+use crate::io::fields::{Field, Frame, GridGeometry, Values};
+use crate::model::Model;
+
+/// Values per particle record in the gather.
+const PREC: usize = 16;
+
+/// The grid's geometry for the field files.
+pub fn grid_geometry(model: &Model) -> GridGeometry {
+    GridGeometry { origin: model.grid.origin, spacing: model.grid.h, nodes: model.grid.nodes() }
+}
+
+fn vec3(v: impl Iterator<Item = [f64; 2]>) -> Vec<f64> {
+    v.flat_map(|a| [a[0], a[1], 0.0]).collect()
+}
+
+/// The fields at time `t`, on every rank. `node_records` are this rank's
+/// [`crate::assembly::GridSystem::owned_node_records`].
+pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> Result<Frame, String> {
+    let ps = &model.particles;
+    let local: Vec<f64> = (0..ps.len())
+        .flat_map(|k| {
+            let s = ps.stress[k];
+            [
+                ps.id[k] as f64,
+                ps.body[k] as f64,
+                ps.material[k] as f64,
+                ps.x[k][0],
+                ps.x[k][1],
+                ps.disp[k][0],
+                ps.disp[k][1],
+                ps.vel[k][0],
+                ps.vel[k][1],
+                s[0],
+                s[1],
+                s[2],
+                s[3],
+                ps.p[k],
+                ps.p0[k],
+                ps.eps_pd[k],
+            ]
+        })
+        .collect();
+    let mut all: Vec<[f64; PREC]> =
+        coll.gather(&local)?.chunks_exact(PREC).map(|c| c.try_into().expect("PREC values")).collect();
+    all.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let real = |f: &dyn Fn(&[f64; PREC]) -> f64| Values::Real(all.iter().map(f).collect());
+    let int = |i: usize| Values::Int(all.iter().map(|r| r[i] as i32).collect());
+    let scalar = |name, values| Field { name, components: 1, values };
+    let mean = |r: &[f64; PREC]| (r[9] + r[10] + r[12]) / 3.0;
+    let mut pf = vec![
+        Field { name: "position", components: 3, values: Values::Real(vec3(all.iter().map(|r| [r[3], r[4]]))) },
+        Field { name: "displacement", components: 3, values: Values::Real(vec3(all.iter().map(|r| [r[5], r[6]]))) },
+        Field { name: "velocity", components: 3, values: Values::Real(vec3(all.iter().map(|r| [r[7], r[8]]))) },
+        scalar("stress_xx", real(&|r| r[9])),
+        scalar("stress_yy", real(&|r| r[10])),
+        scalar("stress_xy", real(&|r| r[11])),
+        scalar("stress_zz", real(&|r| r[12])),
+        scalar("mean_stress", real(&|r| -mean(r))),
+        scalar(
+            "q",
+            real(&|r| {
+                let m = mean(r);
+                (1.5 * ((r[9] - m).powi(2) + (r[10] - m).powi(2) + (r[12] - m).powi(2) + 2.0 * r[11] * r[11])).sqrt()
+            }),
+        ),
+        scalar("eps_pd", real(&|r| r[15])),
+        scalar("material_id", int(2)),
+        scalar("body_id", int(1)),
+        scalar("particle_id", Values::Real(all.iter().map(|r| r[0]).collect())),
+    ];
+    if model.two_phase {
+        pf.push(scalar("p", real(&|r| r[13])));
+        pf.push(scalar("p_excess", real(&|r| r[13] - r[14])));
+    }
+
+    let n_nodes = model.grid.node_count();
+    let mut active = vec![0; n_nodes];
+    let mut d = vec![[0.0; 5]; n_nodes];
+    for r in coll.gather(node_records)?.chunks_exact(7) {
+        let n = r[0] as usize;
+        if n < n_nodes {
+            active[n] = (r[1] > 0.5) as i32;
+            d[n].copy_from_slice(&r[2..7]);
+        }
+    }
+    let mut gf = vec![
+        Field { name: "active", components: 1, values: Values::Int(active) },
+        Field { name: "du", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[0], v[1]]))) },
+    ];
+    if model.two_phase {
+        gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[2]).collect()) });
+        gf.push(Field { name: "dU", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[3], v[4]]))) });
+    }
+    Ok(Frame { time: t, particles: all.len(), particle_fields: pf, grid_fields: gf })
+}

@@ -1,0 +1,216 @@
+//! `checkpoint.h5`: reading and writing a [`Checkpoint`] (see [`crate::state`] for what it holds).
+//!
+//! Layout: root attributes `format` ("porompm-checkpoint"), `version`, `case_fingerprint`, `time`
+//! [s], `step`, `stage`, `dt` [s], `successes`, `checkerboard_max`, `has_check_state`, then
+//! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
+//! iterations, matrix-structure reuses), `probe_extremes` [Pa], `check_state`, and one dataset per
+//! particle array under `/particles` (n × components, SI units, sorted by id).
+//!
+//! Atomicity: the file is written as `<name>.tmp`, closed, synced to disk, and renamed over the
+//! old checkpoint (then the directory is synced). A run killed while writing leaves the previous
+//! checkpoint in place and at most a stray `.tmp`. On reading, a file without `complete`, of
+//! another format version, or whose content does not match its checksum is refused.
+
+use crate::state::{Checkpoint, PARTICLE_FIELDS, RECORD};
+use hdf5_metno as h5;
+use hdf5_metno::types::VarLenUnicode;
+use std::fs;
+use std::path::Path;
+
+const FORMAT: &str = "porompm-checkpoint";
+
+fn attr_f64(loc: &h5::Location, name: &str, v: f64) -> h5::Result<()> {
+    loc.new_attr::<f64>().create(name)?.write_scalar(&v)
+}
+
+fn attr_u64(loc: &h5::Location, name: &str, v: u64) -> h5::Result<()> {
+    loc.new_attr::<u64>().create(name)?.write_scalar(&v)
+}
+
+fn dataset_f64(g: &h5::Group, name: &str, shape: &[usize], data: &[f64]) -> h5::Result<()> {
+    g.new_dataset::<f64>().shape(shape.to_vec()).create(name)?.write_raw(data)
+}
+
+/// Writes `cp` to `path` atomically (see the module documentation).
+pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), String> {
+    let tmp = path.with_extension("h5.tmp");
+    let fail = |e: h5::Error| format!("cannot write checkpoint {}: {e}", tmp.display());
+    if tmp.exists() {
+        fs::remove_file(&tmp).map_err(|e| format!("cannot remove {}: {e}", tmp.display()))?;
+    }
+    {
+        let f = h5::File::create(&tmp).map_err(fail)?;
+        let format: VarLenUnicode = FORMAT.parse().expect("ASCII");
+        f.new_attr::<VarLenUnicode>().create("format").and_then(|a| a.write_scalar(&format)).map_err(fail)?;
+        let loc: &h5::Location = &f;
+        attr_u64(loc, "version", crate::state::FORMAT_VERSION).map_err(fail)?;
+        attr_u64(loc, "case_fingerprint", cp.case_fingerprint).map_err(fail)?;
+        attr_f64(loc, "time", cp.time).map_err(fail)?;
+        attr_u64(loc, "step", cp.step).map_err(fail)?;
+        attr_u64(loc, "stage", cp.stage).map_err(fail)?;
+        attr_f64(loc, "dt", cp.dt).map_err(fail)?;
+        attr_u64(loc, "successes", cp.successes).map_err(fail)?;
+        attr_f64(loc, "checkerboard_max", cp.checkerboard_max).map_err(fail)?;
+        attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64).map_err(fail)?;
+        f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..])).map_err(fail)?;
+        dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes).map_err(fail)?;
+        let state = cp.check_state.clone().unwrap_or_default();
+        dataset_f64(&f, "check_state", &[state.len()], &state).map_err(fail)?;
+        let g = f.create_group("particles").map_err(fail)?;
+        let n = cp.particles.len();
+        let mut offset = 0;
+        for (name, comps) in PARTICLE_FIELDS {
+            let data: Vec<f64> = cp.particles.iter().flat_map(|r| r[offset..offset + comps].to_vec()).collect();
+            dataset_f64(&g, name, &[n, comps], &data).map_err(fail)?;
+            offset += comps;
+        }
+        attr_u64(loc, "checksum", cp.checksum()).map_err(fail)?;
+        attr_u64(loc, "complete", 1).map_err(fail)?;
+        f.flush().map_err(fail)?;
+        f.close().map_err(fail)?;
+    }
+    let sync = |p: &Path| fs::File::open(p).and_then(|f| f.sync_all());
+    sync(&tmp).map_err(|e| format!("cannot sync {}: {e}", tmp.display()))?;
+    fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        sync(dir).map_err(|e| format!("cannot sync {}: {e}", dir.display()))?;
+    }
+    Ok(())
+}
+
+/// Reads and verifies a checkpoint (format, version, completeness, checksum).
+pub fn read(path: &Path) -> Result<Checkpoint, String> {
+    let name = path.display();
+    if !path.is_file() {
+        return Err(format!("checkpoint {name} does not exist"));
+    }
+    let f = h5::File::open(path)
+        .map_err(|_| format!("checkpoint {name} cannot be opened (not an HDF5 file, or truncated)"))?;
+    let bad = |what: &str| format!("checkpoint {name} is not a porompm checkpoint ({what})");
+    let format = f.attr("format").and_then(|a| a.read_scalar::<VarLenUnicode>()).map_err(|_| bad("no `format`"))?;
+    if format.as_str() != FORMAT {
+        return Err(bad(&format!("format `{}`", format.as_str())));
+    }
+    let u = |n: &str| f.attr(n).and_then(|a| a.read_scalar::<u64>());
+    let x = |n: &str| f.attr(n).and_then(|a| a.read_scalar::<f64>());
+    let version = u("version").map_err(|_| bad("no `version`"))?;
+    if version != crate::state::FORMAT_VERSION {
+        return Err(format!(
+            "checkpoint {name} has format version {version}; this porompm reads version {}",
+            crate::state::FORMAT_VERSION
+        ));
+    }
+    if u("complete").ok() != Some(1) {
+        return Err(format!("checkpoint {name} is incomplete (its writing was interrupted)"));
+    }
+    let corrupt = |e: h5::Error| format!("checkpoint {name} cannot be read: {e}");
+    let counters: Vec<u64> = f.dataset("counters").and_then(|d| d.read_raw()).map_err(corrupt)?;
+    let vec_f64 = |n: &str| f.dataset(n).and_then(|d| d.read_raw::<f64>());
+    let has_state = u("has_check_state").map_err(corrupt)? == 1;
+    let state = vec_f64("check_state").map_err(corrupt)?;
+    let g = f.group("particles").map_err(corrupt)?;
+    let mut columns = Vec::new();
+    let mut n = None;
+    for (field, comps) in PARTICLE_FIELDS {
+        let d = g.dataset(field).map_err(corrupt)?;
+        let shape = d.shape();
+        if shape.len() != 2 || shape[1] != comps || n.is_some_and(|n| n != shape[0]) {
+            return Err(format!("checkpoint {name}: particle array `{field}` has shape {shape:?}"));
+        }
+        n = Some(shape[0]);
+        columns.push(d.read_raw::<f64>().map_err(corrupt)?);
+    }
+    let n = n.unwrap_or(0);
+    let particles = (0..n)
+        .map(|k| {
+            let mut r = [0.0; RECORD];
+            let mut o = 0;
+            for (c, (_, comps)) in columns.iter().zip(PARTICLE_FIELDS) {
+                r[o..o + comps].copy_from_slice(&c[k * comps..(k + 1) * comps]);
+                o += comps;
+            }
+            r
+        })
+        .collect();
+    let cp = Checkpoint {
+        case_fingerprint: u("case_fingerprint").map_err(corrupt)?,
+        time: x("time").map_err(corrupt)?,
+        step: u("step").map_err(corrupt)?,
+        stage: u("stage").map_err(corrupt)?,
+        dt: x("dt").map_err(corrupt)?,
+        successes: u("successes").map_err(corrupt)?,
+        counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 4 values"))?,
+        checkerboard_max: x("checkerboard_max").map_err(corrupt)?,
+        probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
+        check_state: has_state.then_some(state),
+        particles,
+    };
+    let stored = u("checksum").map_err(corrupt)?;
+    if stored != cp.checksum() {
+        return Err(format!("checkpoint {name} is corrupt: its content does not match its checksum"));
+    }
+    Ok(cp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Checkpoint {
+        let mut r = [0.0; RECORD];
+        for (i, v) in r.iter_mut().enumerate() {
+            *v = i as f64 * 0.5 + 1.0 / 3.0;
+        }
+        let mut r2 = r;
+        r2[0] = 99.0;
+        Checkpoint {
+            case_fingerprint: 0xdead_beef_0123,
+            time: 0.3 + 1e-17,
+            step: 300,
+            stage: 1,
+            dt: 1e-3 / 3.0,
+            successes: 2,
+            counters: [1, 301, 302, 7],
+            checkerboard_max: f64::NAN,
+            probe_extremes: vec![-12.5, 3.0],
+            check_state: Some(vec![1.0, 2.0]),
+            particles: vec![r, r2],
+        }
+    }
+
+    #[test]
+    fn a_checkpoint_round_trips_exactly_and_a_tampered_or_partial_one_is_refused() {
+        let dir = std::env::temp_dir().join(format!("porompm-cp-test-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("checkpoint.h5");
+        let cp = sample();
+        write(&path, &cp).unwrap();
+        assert!(!dir.join("checkpoint.h5.tmp").exists());
+        let back = read(&path).unwrap();
+        assert_eq!(back.checksum(), cp.checksum());
+        assert_eq!(back.particles, cp.particles);
+        assert_eq!(back.time.to_bits(), cp.time.to_bits());
+        assert!(back.checkerboard_max.is_nan() && back.check_state == cp.check_state);
+
+        // Change one particle value behind the checksum's back.
+        {
+            let f = h5::File::open_rw(&path).unwrap();
+            let d = f.dataset("particles/p").unwrap();
+            d.write_raw(&[1.0, 2.0][..]).unwrap();
+        }
+        assert!(read(&path).unwrap_err().contains("does not match its checksum"));
+
+        // A file whose writing stopped before `complete`.
+        write(&path, &cp).unwrap();
+        {
+            let f = h5::File::open_rw(&path).unwrap();
+            f.delete_attr("complete").unwrap();
+        }
+        assert!(read(&path).unwrap_err().contains("incomplete"));
+
+        fs::write(&path, "not hdf5").unwrap();
+        assert!(read(&path).unwrap_err().contains("not an HDF5 file, or truncated"));
+        assert!(read(&dir.join("none.h5")).unwrap_err().contains("does not exist"));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}

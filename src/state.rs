@@ -1,0 +1,352 @@
+//! Checkpoints: everything the next step of a run depends on, so that a run restarted from a
+//! checkpoint ends with the same fields as the uninterrupted run (to round-off).
+//!
+//! The state is: every particle array (including the soil model's internal variables, which are
+//! the stress and ε_p^d, and the Newmark velocities and accelerations of both phases), the time,
+//! the step count, the index of the stage, the step control's Δt and its count of accepted steps
+//! since Δt last changed, the run's counters, the probes' excess-pressure extremes, the largest
+//! checkerboard index so far, and what the verification check has gathered (if the check can keep
+//! it; see [`crate::verification::Check::checkpoint_state`]). Everything else (grid, loads,
+//! boundaries, matrices) is rebuilt from the case.
+//!
+//! A checkpoint names its case by a fingerprint of the validated case without its `[output]` table
+//! (output intervals may differ between the runs), and carries a checksum of its content. Reading
+//! and writing the file is [`crate::io::checkpoint`]'s job; this module is pure.
+
+use crate::case::Case;
+use crate::model::particles::Particles;
+use std::collections::HashMap;
+
+/// Version of the checkpoint layout; a file of another version is refused.
+pub const FORMAT_VERSION: u64 = 1;
+
+/// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
+pub const PARTICLE_FIELDS: [(&str, usize); 20] = [
+    ("id", 1),
+    ("body", 1),
+    ("material", 1),
+    ("x", 2),
+    ("x0", 2),
+    ("disp", 2),
+    ("lp", 2),
+    ("lp0", 2),
+    ("def_grad", 4),
+    ("volume", 1),
+    ("porosity", 1),
+    ("mass", 1),
+    ("vel", 2),
+    ("acc", 2),
+    ("vel_w", 2),
+    ("acc_w", 2),
+    ("stress", 4),
+    ("p", 1),
+    ("p0", 1),
+    ("eps_pd", 1),
+];
+
+/// Values per particle record (the sum of [`PARTICLE_FIELDS`]' components).
+pub const RECORD: usize = 35;
+
+/// `summary.json`'s `restarted_from`: the checkpoint a run continued from.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RestartInfo {
+    /// The checkpoint file, as given.
+    pub checkpoint: String,
+    /// Its time [s].
+    pub time_s: f64,
+    /// Its step count.
+    pub step: usize,
+    /// What the restarted run could not restore, if anything.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The state of a run after an accepted step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checkpoint {
+    /// [`case_fingerprint`] of the case that wrote it.
+    pub case_fingerprint: u64,
+    /// Simulated time [s].
+    pub time: f64,
+    /// Accepted steps so far.
+    pub step: u64,
+    /// Index of the stage the run was in.
+    pub stage: u64,
+    /// The step control's current Δt [s].
+    pub dt: f64,
+    /// Accepted steps since Δt last changed.
+    pub successes: u64,
+    /// Step cuts, Newton iterations, Krylov iterations and matrix-structure reuses so far.
+    pub counters: [u64; 4],
+    /// Largest checkerboard index so far (NaN: none yet).
+    pub checkerboard_max: f64,
+    /// The probes' signed excess-pressure extremes, in case order.
+    pub probe_extremes: Vec<f64>,
+    /// The verification check's own state (`None`: the check keeps none).
+    pub check_state: Option<Vec<f64>>,
+    /// Particle records ([`pack`]) of all ranks, sorted by id.
+    pub particles: Vec<[f64; RECORD]>,
+}
+
+/// FNV-1a, 64 bit.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        for &x in b {
+            self.0 ^= x as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.u64(v.to_bits());
+    }
+}
+
+/// A fingerprint of the case as validated (after `--set` overrides), without its `[output]` table.
+pub fn case_fingerprint(case: &Case) -> u64 {
+    let mut c = case.clone();
+    c.output = Default::default();
+    let text = serde_json::to_string(&c).unwrap_or_default();
+    let mut h = Fnv::new();
+    h.bytes(text.as_bytes());
+    h.0
+}
+
+/// Refuses a checkpoint written by another case (or with other `--set` values).
+pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
+    let fp = case_fingerprint(case);
+    if cp.case_fingerprint != fp {
+        return Err(format!(
+            "it was written by a different case or other --set values (case fingerprint {:016x}, this run {fp:016x})",
+            cp.case_fingerprint
+        ));
+    }
+    if cp.stage as usize >= case.stages.len() || cp.probe_extremes.len() != case.probes.len() {
+        return Err("its stage or probes do not match the case".into());
+    }
+    Ok(())
+}
+
+/// The record of particle `k` (ids are exact in f64: they stay below 2⁵³).
+pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
+    let mut r = [0.0; RECORD];
+    let f = &ps.def_grad[k];
+    let parts: [&[f64]; 20] = [
+        &[ps.id[k] as f64],
+        &[ps.body[k] as f64],
+        &[ps.material[k] as f64],
+        &ps.x[k],
+        &ps.x0[k],
+        &ps.disp[k],
+        &ps.lp[k],
+        &ps.lp0[k],
+        &[f[0][0], f[0][1], f[1][0], f[1][1]],
+        &[ps.volume[k]],
+        &[ps.porosity[k]],
+        &[ps.mass[k]],
+        &ps.vel[k],
+        &ps.acc[k],
+        &ps.vel_w[k],
+        &ps.acc_w[k],
+        &ps.stress[k],
+        &[ps.p[k]],
+        &[ps.p0[k]],
+        &[ps.eps_pd[k]],
+    ];
+    let mut i = 0;
+    for p in parts {
+        r[i..i + p.len()].copy_from_slice(p);
+        i += p.len();
+    }
+    r
+}
+
+/// Overwrites particle `k` with record `r` (same id, body and material, checked by the caller).
+fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
+    let two = |o: usize| [r[o], r[o + 1]];
+    ps.x[k] = two(3);
+    ps.x0[k] = two(5);
+    ps.disp[k] = two(7);
+    ps.lp[k] = two(9);
+    ps.lp0[k] = two(11);
+    ps.def_grad[k] = [[r[13], r[14]], [r[15], r[16]]];
+    ps.volume[k] = r[17];
+    ps.porosity[k] = r[18];
+    ps.mass[k] = r[19];
+    ps.vel[k] = two(20);
+    ps.acc[k] = two(22);
+    ps.vel_w[k] = two(24);
+    ps.acc_w[k] = two(26);
+    ps.stress[k] = [r[28], r[29], r[30], r[31]];
+    ps.p[k] = r[32];
+    ps.p0[k] = r[33];
+    ps.eps_pd[k] = r[34];
+}
+
+/// Records of all ranks' particles (concatenated by the caller), sorted by id.
+pub fn sorted_records(flat: &[f64]) -> Vec<[f64; RECORD]> {
+    let mut out: Vec<[f64; RECORD]> = flat.chunks_exact(RECORD).map(|c| c.try_into().expect("RECORD values")).collect();
+    out.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    out
+}
+
+impl Checkpoint {
+    /// The checksum of the content (stored with the file and verified on reading).
+    pub fn checksum(&self) -> u64 {
+        let mut h = Fnv::new();
+        h.u64(FORMAT_VERSION);
+        h.u64(self.case_fingerprint);
+        h.f64(self.time);
+        h.u64(self.step);
+        h.u64(self.stage);
+        h.f64(self.dt);
+        h.u64(self.successes);
+        for c in self.counters {
+            h.u64(c);
+        }
+        h.f64(self.checkerboard_max);
+        h.u64(self.probe_extremes.len() as u64);
+        for &v in &self.probe_extremes {
+            h.f64(v);
+        }
+        match &self.check_state {
+            None => h.u64(u64::MAX),
+            Some(s) => {
+                h.u64(s.len() as u64);
+                for &v in s {
+                    h.f64(v);
+                }
+            }
+        }
+        h.u64(self.particles.len() as u64);
+        for r in &self.particles {
+            for &v in r {
+                h.f64(v);
+            }
+        }
+        h.0
+    }
+
+    /// Overwrites this rank's particles with their records. Every local particle must be in the
+    /// checkpoint with the same body and material; `total` is the particle count over all ranks.
+    pub fn restore_particles(&self, ps: &mut Particles, total: usize) -> Result<(), String> {
+        if total != self.particles.len() {
+            return Err(format!(
+                "it holds {} material points but this case has {total} (a different case or grid)",
+                self.particles.len()
+            ));
+        }
+        let index: HashMap<u64, usize> = self.particles.iter().enumerate().map(|(i, r)| (r[0] as u64, i)).collect();
+        for k in 0..ps.len() {
+            let r = index
+                .get(&ps.id[k])
+                .map(|&i| &self.particles[i])
+                .ok_or_else(|| format!("material point {} of this case is not in it", ps.id[k]))?;
+            if r[1] as u16 != ps.body[k] || r[2] as u16 != ps.material[k] {
+                return Err(format!("material point {} belongs to another body or material in it", ps.id[k]));
+            }
+            unpack(ps, k, r);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case;
+
+    fn particles() -> (Case, Particles) {
+        let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let g = crate::model::grid_of(&c);
+        let ps = Particles::generate(&c, &g, |_, _| true);
+        (c, ps)
+    }
+
+    #[test]
+    fn records_round_trip_every_particle_array() {
+        assert_eq!(PARTICLE_FIELDS.iter().map(|f| f.1).sum::<usize>(), RECORD);
+        let (_, mut ps) = particles();
+        // Give every array a distinct value so that a swapped slot would show.
+        let k = 3;
+        let mut v = 0.5;
+        let mut next = || {
+            v += 1.25;
+            v
+        };
+        ps.x[k] = [next(), next()];
+        ps.x0[k] = [next(), next()];
+        ps.disp[k] = [next(), next()];
+        ps.lp[k] = [next(), next()];
+        ps.lp0[k] = [next(), next()];
+        ps.def_grad[k] = [[next(), next()], [next(), next()]];
+        ps.volume[k] = next();
+        ps.porosity[k] = next();
+        ps.mass[k] = next();
+        ps.vel[k] = [next(), next()];
+        ps.acc[k] = [next(), next()];
+        ps.vel_w[k] = [next(), next()];
+        ps.acc_w[k] = [next(), next()];
+        ps.stress[k] = [next(), next(), next(), next()];
+        ps.p[k] = next();
+        ps.p0[k] = next();
+        ps.eps_pd[k] = next();
+        let flat: Vec<f64> = (0..ps.len()).rev().flat_map(|k| pack(&ps, k)).collect();
+        let records = sorted_records(&flat);
+        assert!(records.windows(2).all(|w| w[0][0] < w[1][0]), "sorted by id");
+        let cp = Checkpoint {
+            case_fingerprint: 1,
+            time: 0.25,
+            step: 7,
+            stage: 0,
+            dt: 1e-3,
+            successes: 2,
+            counters: [1, 2, 3, 4],
+            checkerboard_max: f64::NAN,
+            probe_extremes: vec![],
+            check_state: None,
+            particles: records,
+        };
+        let (_, mut fresh) = particles();
+        cp.restore_particles(&mut fresh, ps.len()).unwrap();
+        assert_eq!(format!("{fresh:?}"), format!("{ps:?}"));
+        assert!(cp.restore_particles(&mut fresh, ps.len() + 1).unwrap_err().contains("holds 40 material points"));
+    }
+
+    #[test]
+    fn the_checksum_and_the_fingerprint_see_every_change() {
+        let (c, ps) = particles();
+        let cp = Checkpoint {
+            case_fingerprint: case_fingerprint(&c),
+            time: 0.25,
+            step: 7,
+            stage: 0,
+            dt: 1e-3,
+            successes: 2,
+            counters: [1, 2, 3, 4],
+            checkerboard_max: 0.1,
+            probe_extremes: vec![1.0],
+            check_state: Some(vec![2.0]),
+            particles: (0..ps.len()).map(|k| pack(&ps, k)).collect(),
+        };
+        let mut other = cp.clone();
+        other.particles[5][32] += 1e-12;
+        assert_ne!(cp.checksum(), other.checksum());
+        let mut other = cp.clone();
+        other.check_state = None;
+        assert_ne!(cp.checksum(), other.checksum());
+        // The output table does not change the fingerprint; the physics does.
+        let mut c2 = c.clone();
+        c2.output.history_every = 5;
+        assert_eq!(case_fingerprint(&c2), cp.case_fingerprint);
+        c2.time.dt = Some(2e-3);
+        assert_ne!(case_fingerprint(&c2), cp.case_fingerprint);
+    }
+}
