@@ -182,8 +182,8 @@ impl GridSystem {
     /// Creates the DMDA for the grid and dof layout, and the SNES with porompm's defaults, then
     /// lets the PETSc options database override them. Defaults: Newton with full steps, relative
     /// residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on one rank (the
-    /// fastest of the measured strategies on the verification cases, see docs/solvers.md) and by
-    /// MUMPS on several ranks (UMFPACK is sequential).
+    /// fastest of the measured strategies on the verification cases, see docs/solvers.md) up to
+    /// [`UMFPACK_MAX_GRID_DOFS`], and by MUMPS beyond and on several ranks (UMFPACK is sequential).
     pub fn new(comm: Comm, grid: &crate::model::grid::Grid, two_phase: bool) -> Result<GridSystem, Error> {
         let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, crate::model::field_names(two_phase))?;
         let info = *dm.info();
@@ -202,7 +202,8 @@ impl GridSystem {
             ksp.set_type("preonly")?;
             let mut pc = ksp.pc()?;
             pc.set_type("lu")?;
-            pc.set_factor_solver_type(default_factor_package(comm))?;
+            let grid_dofs = grid.nodes()[0] * grid.nodes()[1] * crate::model::field_names(two_phase).len();
+            pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
         let stages = Stages {
@@ -814,9 +815,18 @@ impl NonlinearProblem for Assembler<'_> {
     }
 }
 
-/// The factorisation package of the default solver: UMFPACK on one rank, MUMPS otherwise.
-pub fn default_factor_package(comm: Comm) -> &'static str {
-    if comm.size() == 1 && petsc::PetscBuild::get().packages.contains(&"suitesparse") {
+/// Grid dofs above which the default LU is MUMPS also on one rank: Debian's UMFPACK (32-bit
+/// indices) failed in its numeric factorisation on the slumping block at 1.04e5 unknowns (grid
+/// 216 × 162, 1.8e5 grid dofs), where MUMPS factorised it; at 2e4 unknowns both took the same time.
+pub const UMFPACK_MAX_GRID_DOFS: usize = 50_000;
+
+/// The factorisation package of the default solver: UMFPACK on one rank for grids up to
+/// [`UMFPACK_MAX_GRID_DOFS`], MUMPS otherwise.
+pub fn default_factor_package(comm: Comm, grid_dofs: usize) -> &'static str {
+    if comm.size() == 1
+        && grid_dofs <= UMFPACK_MAX_GRID_DOFS
+        && petsc::PetscBuild::get().packages.contains(&"suitesparse")
+    {
         "umfpack"
     } else {
         "mumps"
