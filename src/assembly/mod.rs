@@ -329,11 +329,7 @@ impl GridSystem {
         let (mut mass, mut mom, mut acc, mut weight) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         for k in 0..stencils.len() {
             let (nodes, basis) = stencils.get(k);
-            let mw = if self.two_phase {
-                ps.porosity[k] * model.materials[ps.material[k] as usize].water_density * ps.volume[k]
-            } else {
-                0.0
-            };
+            let mw = model.water_mass(k);
             for (&node, nb) in nodes.iter().zip(basis) {
                 let b = node as usize * nd;
                 let s = nb.s;

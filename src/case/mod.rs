@@ -88,6 +88,11 @@ impl Case {
         self.materials.iter().position(|m| m.name == name)
     }
 
+    /// Index of the body called `name` (the particles' `body` id).
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
     /// The body called `name`.
     pub fn body(&self, name: &str) -> Option<&Body> {
         self.bodies.iter().find(|b| b.name == name)

@@ -112,9 +112,9 @@ impl LoadDef {
             }
             case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
                 acceleration: *acceleration,
-                bodies: bodies.as_ref().map(|names| {
-                    names.iter().filter_map(|n| c.bodies.iter().position(|b| b.name == *n)).map(|i| i as u16).collect()
-                }),
+                bodies: bodies
+                    .as_ref()
+                    .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
             },
         };
         LoadDef { name: l.name().to_string(), time_fn, target }
@@ -197,7 +197,7 @@ impl BoundaryDef {
     /// in a listed direction is exposed at t = 0).
     pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles) -> BoundaryDef {
         let surface = b.surface.as_ref().map(|sf| {
-            let body = c.bodies.iter().position(|x| x.name == sf.body).expect("validated") as u16;
+            let body = c.body_index(&sf.body).expect("validated") as u16;
             let mut v = Vec::new();
             for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
                 for &f in &sf.faces {

@@ -222,6 +222,29 @@ impl Model {
         out
     }
 
+    /// The pore water's mass n ρ_w V carried by particle `k` (zero in a one-phase run) [kg].
+    #[inline]
+    pub fn water_mass(&self, k: usize) -> f64 {
+        let ps = &self.particles;
+        if self.two_phase {
+            ps.porosity[k] * self.materials[ps.material[k] as usize].water_density * ps.volume[k]
+        } else {
+            0.0
+        }
+    }
+
+    /// The porosity of particle `k` after a step with volume ratio J, by conservation of solid mass,
+    /// n = 1 − (1 − n₀)/J; a one-phase (total-stress) run has no porosity among its state variables
+    /// and keeps the initial value.
+    fn porosity_after(&self, k: usize, j: f64) -> f64 {
+        let n = self.particles.porosity[k];
+        if self.two_phase {
+            1.0 - (1.0 - n) / j
+        } else {
+            n
+        }
+    }
+
     /// The kernel input of particle `k` at the start of the step.
     #[inline]
     pub fn particle_input(&self, k: usize, body_acc: &[[f64; 2]]) -> ParticleInput {
@@ -230,7 +253,7 @@ impl Model {
         let (v, n) = (ps.volume[k], ps.porosity[k]);
         let (water_mass, drag, inv_q) = if self.two_phase {
             let gw = mat.water_density * self.g;
-            (n * mat.water_density * v, n * n * gw * v / mat.conductivity_at(n), mat.inv_q_at(n))
+            (self.water_mass(k), n * n * gw * v / mat.conductivity_at(n), mat.inv_q_at(n))
         } else {
             (0.0, 0.0, 0.0)
         };
@@ -250,13 +273,12 @@ impl Model {
         }
     }
 
-    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and, in
-    /// a two-phase run, the porosity it implies, n = 1 − (1 − n₀)/J, inside (0, 1). A one-phase
-    /// (total-stress) run has no porosity among its state variables: it keeps the initial value.
+    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and the
+    /// porosity it implies ([`Model::porosity_after`]) inside (0, 1).
     pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
         let j = step.jacobian;
         let ps = &self.particles;
-        let n_new = if self.two_phase { 1.0 - (1.0 - ps.porosity[k]) / j } else { ps.porosity[k] };
+        let n_new = self.porosity_after(k, j);
         if j.is_nan() || j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
             return Err(InadmissibleStep(format!(
                 "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
@@ -279,8 +301,8 @@ impl Model {
     pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
         self.check_step(k, step)?;
         let j = step.jacobian;
+        let n_new = self.porosity_after(k, j);
         let ps = &mut self.particles;
-        let n_new = if self.two_phase { 1.0 - (1.0 - ps.porosity[k]) / j } else { ps.porosity[k] };
         let kin = &step.kin;
         let g = self.gamma;
         for c in 0..2 {

@@ -84,7 +84,8 @@ impl BearingCheck {
         if cohesion <= 0.0 {
             return Err("the bearing capacity check normalises by the cohesion, which must be positive".into());
         }
-        let load = match c.load(spec.load) {
+        let case_load = c.load(spec.load);
+        let load = match case_load {
             Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }) => {
                 LoadKind::Traction(traction[1].abs())
             }
@@ -95,15 +96,14 @@ impl BearingCheck {
                 }
                 let idx = names
                     .iter()
-                    .map(|n| c.bodies.iter().position(|b| b.name == *n).map(|i| i as u16))
+                    .map(|n| c.body_index(n).map(|i| i as u16))
                     .collect::<Option<Vec<_>>>()
                     .ok_or("unknown body")?;
                 LoadKind::Weight(acceleration[1].abs(), idx, spec.loaded_width)
             }
             None => return Err(format!("no load `{}`", spec.load)),
         };
-        let time_fn = c
-            .load(spec.load)
+        let time_fn = case_load
             .and_then(|l| l.time_function())
             .and_then(|n| c.time_function(n))
             .map(crate::model::loads::TimeFn::from_case)
@@ -145,14 +145,7 @@ impl BearingCheck {
                 let ps = &model.particles;
                 let local: f64 = (0..ps.len())
                     .filter(|&k| bodies.contains(&ps.body[k]))
-                    .map(|k| {
-                        let mw = if model.two_phase {
-                            ps.porosity[k] * model.materials[ps.material[k] as usize].water_density * ps.volume[k]
-                        } else {
-                            0.0
-                        };
-                        ps.mass[k] + mw
-                    })
+                    .map(|k| ps.mass[k] + model.water_mass(k))
                     .sum();
                 coll.sum(&[local])?[0] * b * f / width
             }

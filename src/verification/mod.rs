@@ -127,7 +127,7 @@ pub(crate) struct Column {
 
 impl Column {
     fn from_case(c: &Case, model: &Model, body: &str, load: &str) -> Result<Column, String> {
-        let bi = c.bodies.iter().position(|b| b.name == body).ok_or(format!("no body `{body}`"))?;
+        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
         let b = &c.bodies[bi];
         let (lo, hi) = b.shape.bounds();
         let traction = match c.load(load) {
@@ -748,7 +748,7 @@ impl ElasticColumnCheck {
         stress_tol: f64,
         settle_tol: f64,
     ) -> Result<ElasticColumnCheck, String> {
-        let bi = c.bodies.iter().position(|b| b.name == body).ok_or(format!("no body `{body}`"))?;
+        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
         let (lo, hi) = c.bodies[bi].shape.bounds();
         let mat = &model.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
         let end = c.end_time();
