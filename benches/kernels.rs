@@ -116,7 +116,8 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                kernels::residual(&basis[k], &states[k], &inputs[k], soil, true, &mut buf[..m]);
+                let pt = kernels::Point::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                kernels::residual(&pt, &mut buf[..m]);
                 sum += buf[0];
             }
             black_box(sum)
@@ -124,12 +125,12 @@ fn particle_kernels(c: &mut Criterion) {
     });
     g.bench_function("tangent", |b| {
         let mut block = vec![0.0; kernels::MAX_LOCAL * kernels::MAX_LOCAL];
-        let dsig = soil.elastic().d;
         b.iter(|| {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                kernels::tangent(&basis[k], &inputs[k], &dsig, nm, true, &mut block[..m * m]);
+                let pt = kernels::Point::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }
             black_box(sum)
@@ -193,14 +194,17 @@ fn particle_kernels(c: &mut Criterion) {
     g.finish();
 }
 
-fn global_assembly(c: &mut Criterion, comm: petsc::Comm) {
+fn global_assembly(c: &mut Criterion) {
     let case = load("cases/slumping_block.toml", &[]);
-    let system = porompm::assembly::GridSystem::new(comm, &porompm::model::grid_of(&case), true);
+    let coll = porompm::parallel::Collective::world();
+    let layout = kernels::Layout::UPU;
+    let system = porompm::assembly::GridSystem::new(&coll, &porompm::model::grid_of(&case), layout);
     let mut system = system.expect("the grid system is created");
     let model = Model::build(&case, |i, j| system.owns_cell(i, j));
     let stage = &case.stages[0];
     let active = model.active(stage);
-    system.prepare_step(&model, &active, stage.dt(), stage.dt()).expect("the first step is prepared");
+    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
+    system.prepare_step(&model, &active, stage.dt(), stage.dt(), &coll, &names).expect("the first step is prepared");
     system.assemble_once(&model).expect("the system assembles");
     let mut g = group(c, "assembly", model.particles.len());
     g.bench_function("residual_and_jacobian", |b| b.iter(|| black_box(system.assemble_once(&model).unwrap())));
@@ -217,7 +221,7 @@ fn main() {
     let petsc = petsc::Petsc::initialize(&[], None, "porompm-bench").expect("PETSc initialises");
     let mut c = Criterion::default().configure_from_args();
     particle_kernels(&mut c);
-    global_assembly(&mut c, petsc.world());
+    global_assembly(&mut c);
     c.final_summary();
     drop(petsc);
 }

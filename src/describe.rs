@@ -1,6 +1,6 @@
 //! `porompm check`: what a case will build, computed without PETSc (one process).
 
-use crate::assembly::MIN_FILLED_FRACTION;
+use crate::assembly::WELL_FILLED_FRACTION;
 use crate::case::{Case, Load, SoilModel};
 use crate::model::{shape, Model};
 use std::fmt::Write;
@@ -93,14 +93,14 @@ pub fn describe(case: &Case, label: &str) -> String {
             filled[j as usize * g.nodes()[0] + i as usize] += w * model.particles.volume[k] / (g.h[0] * g.h[1]);
         }
     }
-    let active_nodes = filled.iter().filter(|&&f| f > MIN_FILLED_FRACTION).count();
+    let active_nodes = filled.iter().filter(|&&f| f > WELL_FILLED_FRACTION).count();
     let first = model.active(&case.stages[0]);
     let mut unknowns = 0;
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {
-            if filled[j * g.nodes()[0] + i] > MIN_FILLED_FRACTION {
-                let fixed = model.fixed_components(&first, i, j);
-                unknowns += (0..nd).filter(|&c| !fixed[c]).count();
+            if filled[j * g.nodes()[0] + i] > WELL_FILLED_FRACTION {
+                let fixed = model.fixing_boundaries(&first, i, j);
+                unknowns += (0..nd).filter(|&c| fixed[c].is_none()).count();
             }
         }
     }
@@ -124,7 +124,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         if let Some(list) = &b.surface {
             // Resolved per step; at t = 0 from the particles' faces.
             let only = crate::model::Active { loads: Vec::new(), boundaries: vec![bi] };
-            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only).into_iter().map(|(n, _)| n).collect();
+            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only).into_iter().map(|(n, _, _)| n).collect();
             nodes.sort_unstable();
             nodes.dedup();
             let _ = writeln!(

@@ -18,15 +18,15 @@
 //! A restarted run (`--restart`) sets up as usual, then takes the particles, time, step, stage and
 //! step control from the checkpoint ([`crate::state`]) and continues in that stage.
 
-use crate::assembly::{self, Collective, GridSystem, Phase};
+use crate::assembly::{self, GridSystem, Phase, StepForces};
 use crate::case::{Case, Stage};
 use crate::io::RunOutput;
 use crate::kernels::StepResult;
 use crate::model::Model;
+use crate::parallel::Collective;
 use crate::progress::Progress;
 use crate::state::{self, Checkpoint};
 use crate::verification::{self, Check, Metric};
-use petsc::Comm;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -44,8 +44,8 @@ pub struct RunRequest<'a> {
     pub out_dir: PathBuf,
     /// No progress lines.
     pub quiet: bool,
-    /// The run's communicator.
-    pub comm: Comm,
+    /// The run's ranks.
+    pub coll: &'a Collective,
     /// Write `checkpoint.h5` every this many steps (0: never).
     pub checkpoint_every: usize,
     /// Continue from this checkpoint (its path as given, and its content).
@@ -140,6 +140,10 @@ pub struct Summary {
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub checkerboard_index_max: Option<f64>,
+    /// The worst relative error of the equilibrium identity ∫σ dV = Σ x ⊗ (F_ext + R − F_inertia)
+    /// over the converged steps (see `Simulation::record_equilibrium`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub equilibrium_error: Option<f64>,
     /// Why the run ended before the last stage's end although nothing failed (e.g. a footing
     /// that reached the settlement its check stops at).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -176,7 +180,7 @@ struct Simulation<'a> {
     check: Option<Box<dyn Check>>,
     probes: Vec<Probe>,
     out: &'a mut RunOutput,
-    coll: Collective,
+    coll: &'a Collective,
     display: Progress,
     t: f64,
     step: usize,
@@ -190,6 +194,10 @@ struct Simulation<'a> {
     /// Step of the last field output.
     fields_step: Option<usize>,
     checkpoint_every: usize,
+    /// Names of the bodies (for messages).
+    body_names: Vec<String>,
+    /// The last converged step's equilibrium error and boundary reactions.
+    equilibrium: (f64, Vec<[f64; 2]>),
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -254,12 +262,13 @@ impl Summary {
             dofs: 0,
             grid_dofs: 0,
             particles: 0,
-            ranks: req.comm.size(),
+            ranks: req.coll.size(),
             solver: String::new(),
             petsc_options: assembly::petsc_options().unwrap_or_default(),
             timings: Timings::default(),
             peak_memory_mib: None,
             checkerboard_index_max: None,
+            equilibrium_error: None,
             stopped: None,
             verification: BTreeMap::new(),
             results: BTreeMap::new(),
@@ -271,9 +280,15 @@ impl Summary {
 
 /// Runs `steps` steps of the first stage, prepares the next one and compares its assembled tangent
 /// with central finite differences of the assembled residual, block by block (one rank, small
-/// cases). Also returns how many material points have yielded (ε̄ > 0), so that a check of a
-/// plastic case can tell that the plastic tangent took part. Nothing is written.
-pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
+/// cases; see `assembly::check`). `flip` negates one (row field, column field) block of the
+/// assembled tangent first, to see the check fail. Also returns how many material points have
+/// yielded (ε̄ > 0), so that a check of a plastic case can tell that the plastic tangent took part.
+/// Nothing is written.
+pub fn test_jacobian(
+    req: &RunRequest,
+    steps: usize,
+    flip: Option<(usize, usize)>,
+) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
     let mut summary = Summary::new(req);
     let mut out = RunOutput::create(&req.out_dir, false).map_err(RunError::Input)?;
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
@@ -284,8 +299,11 @@ pub fn test_jacobian(req: &RunRequest, steps: usize) -> Result<(Vec<assembly::Bl
         sim.update_particles(stage.dt())?.map_err(RunError::Failed)?;
         sim.t += stage.dt();
     }
-    sim.system.prepare_step(&sim.model, &active, sim.t + stage.dt(), stage.dt()).map_err(RunError::Failed)?;
-    let blocks = sim.system.jacobian_check(&sim.model, 0.7).map_err(|e| RunError::Failed(e.to_string()))?;
+    let names = sim.body_names.clone();
+    sim.system
+        .prepare_step(&sim.model, &active, sim.t + stage.dt(), stage.dt(), req.coll, &names)
+        .map_err(RunError::Failed)?;
+    let blocks = sim.system.jacobian_check(&sim.model, 0.7, flip).map_err(|e| RunError::Failed(e.to_string()))?;
     Ok((blocks, sim.model.particles.eps_pd.iter().filter(|&&e| e > 0.0).count()))
 }
 
@@ -297,15 +315,15 @@ impl<'a> Simulation<'a> {
     ) -> Result<Simulation<'a>, RunError> {
         let t0 = Instant::now();
         let case = req.case;
-        let coll = Collective::new(req.comm);
+        let coll = req.coll;
         let input = |e: String| RunError::Input(e);
         let two_phase = case.analysis.formulation == crate::case::Formulation::TwoPhase;
-        let system =
-            GridSystem::new(req.comm, &crate::model::grid_of(case), two_phase).map_err(|e| input(e.to_string()))?;
+        let layout = crate::kernels::Layout::of(two_phase);
+        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout).map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
-        let check = verification::for_case(case, &model, &coll).map_err(|e| input(format!("verification: {e}")))?;
-        let probes = find_probes(case, &model, &coll).map_err(input)?;
+        let check = verification::for_case(case, &model, coll).map_err(|e| input(format!("verification: {e}")))?;
+        let probes = find_probes(case, &model, coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
         summary.grid_dofs = system.total_dofs();
         let mut columns: Vec<String> =
@@ -315,6 +333,11 @@ impl<'a> Simulation<'a> {
         }
         if model.two_phase {
             columns.push("checkerboard_index".into());
+        }
+        columns.push("equilibrium_error".into());
+        for b in &case.boundaries {
+            columns.push(format!("{}.reaction_x", b.name));
+            columns.push(format!("{}.reaction_y", b.name));
         }
         if let Some(c) = &check {
             columns.extend(c.columns());
@@ -343,6 +366,8 @@ impl<'a> Simulation<'a> {
             resume: None,
             fields_step: None,
             checkpoint_every: req.checkpoint_every,
+            body_names: case.bodies.iter().map(|b| b.name.clone()).collect(),
+            equilibrium: (0.0, vec![[0.0; 2]; case.boundaries.len()]),
         };
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
@@ -390,7 +415,14 @@ impl<'a> Simulation<'a> {
             let dt = control.next(self.t, &events);
             let outcome = self.newton_solve(&active, dt)?;
             let admitted = match outcome {
-                Ok(()) => self.update_particles(dt)?,
+                Ok(()) => {
+                    let forces = self.system.step_forces(&self.model, self.coll).map_err(RunError::Failed)?;
+                    let updated = self.update_particles(dt)?;
+                    if updated.is_ok() {
+                        self.record_equilibrium(&forces)?;
+                    }
+                    updated
+                }
                 Err(why) => Err(why),
             };
             match admitted {
@@ -441,13 +473,9 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         {
             let _stage = self.system.phase(Phase::StepSetup).map_err(|e| RunError::Failed(e.to_string()))?;
-            let prepared = self.system.prepare_step(&self.model, active, self.t + dt, dt);
-            let failed = self.coll.any(prepared.is_err()).map_err(RunError::Failed)?;
-            if let Err(e) = prepared {
-                return Err(RunError::Failed(e));
-            } else if failed {
-                return Err(RunError::Failed("another rank could not prepare the step".into()));
-            }
+            self.system
+                .prepare_step(&self.model, active, self.t + dt, dt, self.coll, &self.body_names)
+                .map_err(RunError::Failed)?;
         }
         self.summary.timings.step_setup_s += t0.elapsed().as_secs_f64();
         self.summary.dofs = self.system.free_dofs();
@@ -502,11 +530,42 @@ impl<'a> Simulation<'a> {
             None
         };
         for (k, r) in results.iter().enumerate() {
-            let dp = recovered.as_ref().map_or(r.kin.dp, |v| v[k]);
+            let dp = recovered.as_ref().map_or(r.interp.dp, |v| v[k]);
             self.model.update_particle(k, r, dp, dt).map_err(|e| RunError::Failed(e.0))?;
         }
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(Ok(()))
+    }
+
+    /// The equilibrium identity of the converged step ([`StepForces`]): the volume integral of the
+    /// total Cauchy stress over the updated material points, ∫σ dV = Σ_p (σ' − p m) V_p, against the
+    /// first moment of the external forces, the reactions and the inertia forces about the same
+    /// point, Σ_i x_i ⊗ (F_ext + R − F_inertia)_i on the nodes at t_{n+1}. The relative error (in the
+    /// Frobenius norm, against the largest of the moments) is kept for the history row and its
+    /// worst for summary.json, with the boundaries' reactions.
+    fn record_equilibrium(&mut self, forces: &StepForces) -> Result<(), RunError> {
+        let ps = &self.model.particles;
+        let mut local = [0.0; 4];
+        for k in 0..ps.len() {
+            let s = ps.stress[k];
+            let p = if self.model.two_phase { ps.p[k] } else { 0.0 };
+            let v = ps.volume[k];
+            local[0] += (s[0] - p) * v;
+            local[1] += s[2] * v;
+            local[2] += s[2] * v;
+            local[3] += (s[1] - p) * v;
+        }
+        let lhs = self.coll.sum(&local).map_err(RunError::Failed)?;
+        let m = &forces.moment;
+        let diff = [lhs[0] - m[0][0], lhs[1] - m[0][1], lhs[2] - m[1][0], lhs[3] - m[1][1]];
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let scale = norm(&lhs).max(forces.scale);
+        let error = if scale > 0.0 { norm(&diff) / scale } else { 0.0 };
+        self.equilibrium = (error, forces.reactions.clone());
+        let worst =
+            self.summary.equilibrium_error.map_or(error, |w: f64| if error.is_nan() { error } else { w.max(error) });
+        self.summary.equilibrium_error = Some(worst);
+        Ok(())
     }
 
     /// Probes, check and one row of history.csv.
@@ -514,16 +573,20 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
-        row.extend(update_probes(&self.model, &mut self.probes, &self.coll).map_err(RunError::Failed)?);
+        row.extend(update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?);
         if self.model.two_phase {
             let ci =
-                verification::checkerboard::checkerboard_index(&self.model, &self.coll).map_err(RunError::Failed)?;
+                verification::checkerboard::checkerboard_index(&self.model, self.coll).map_err(RunError::Failed)?;
             self.summary.checkerboard_index_max =
                 Some(self.summary.checkerboard_index_max.map_or(ci, |m: f64| m.max(ci)));
             row.push(ci);
         }
+        row.push(self.equilibrium.0);
+        for r in &self.equilibrium.1 {
+            row.extend(r);
+        }
         if let Some(c) = self.check.as_mut() {
-            row.extend(c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?);
+            row.extend(c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?);
         }
         self.out.history_row(&row).map_err(RunError::Failed)?;
         if self.out.is_writer() {
@@ -535,9 +598,9 @@ impl<'a> Simulation<'a> {
 
     /// The check's observation on steps without a history row.
     fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
-        update_probes(&self.model, &mut self.probes, &self.coll).map_err(RunError::Failed)?;
+        update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?;
         if let Some(c) = self.check.as_mut() {
-            c.observe(self.t, dt, &self.model, &self.coll).map_err(RunError::Failed)?;
+            c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?;
         }
         Ok(())
     }
@@ -559,7 +622,7 @@ impl<'a> Simulation<'a> {
         }
         if let Some(c) = self.check.as_mut() {
             self.summary.results.extend(c.results());
-            let (metrics, tables) = c.finish(&self.model, &self.coll).map_err(RunError::Failed)?;
+            let (metrics, tables) = c.finish(&self.model, self.coll).map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
             for t in &tables {
                 self.out.write_table(&t.name, &t.header, &t.rows).map_err(RunError::Failed)?;
@@ -599,7 +662,7 @@ impl<'a> Simulation<'a> {
         }
         let t0 = Instant::now();
         let nodes = self.system.owned_node_records();
-        let frame = crate::fields::frame(&self.model, &nodes, &self.coll, self.t).map_err(RunError::Failed)?;
+        let frame = crate::fields::frame(&self.model, &nodes, self.coll, self.t).map_err(RunError::Failed)?;
         self.out.write_fields(&frame).map_err(RunError::Failed)?;
         self.fields_step = Some(self.step);
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
@@ -613,7 +676,7 @@ impl<'a> Simulation<'a> {
         let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
         let all = self.coll.gather(&local).map_err(RunError::Failed)?;
         let check_state = match self.check.as_ref() {
-            Some(c) => c.checkpoint_state(&self.model, &self.coll).map_err(RunError::Failed)?,
+            Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
             None => None,
         };
         let s = &self.summary;
@@ -797,7 +860,7 @@ fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Prob
         let all = coll.gather(&local)?;
         let best = all
             .chunks(2)
-            .min_by(|a, b| a[0].partial_cmp(&b[0]).unwrap().then(a[1].partial_cmp(&b[1]).unwrap()))
+            .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
             .ok_or(format!("probe `{}`: there are no material points", p.name))?;
         out.push(Probe { name: p.name.clone(), id: best[1] as u64, last: Vec::new(), excess_extreme: 0.0 });
     }

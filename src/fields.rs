@@ -13,9 +13,9 @@
 //! the last step, `du` [m] (and in two-phase runs `dp` [Pa] and `dU` [m]); all zero before the
 //! first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's geometry.
 
-use crate::assembly::Collective;
 use crate::io::fields::{Field, Frame, GridGeometry, Values};
 use crate::model::Model;
+use crate::parallel::Collective;
 
 /// Values per particle record in the gather.
 const PREC: usize = 16;

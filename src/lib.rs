@@ -14,6 +14,7 @@ pub mod fields;
 pub mod io;
 pub mod kernels;
 pub mod model;
+pub mod parallel;
 pub mod plot;
 pub mod progress;
 pub mod report;

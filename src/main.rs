@@ -4,9 +4,11 @@
 //! override, options file, unused PETSc option). Every error is one line on standard error.
 
 use clap::{Parser, Subcommand};
+use mpi::raw::AsRaw;
 use porompm::case::{self, Override};
 use porompm::driver::{self, RunError, RunRequest};
 use porompm::io::{self, RunOutput};
+use porompm::parallel::Collective;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -94,6 +96,10 @@ enum Command {
         /// Largest accepted relative difference per block.
         #[arg(long, default_value_t = 1e-6)]
         tolerance: f64,
+        /// Negate one block of the assembled tangent before the comparison, given as ROW,COL fields
+        /// (e.g. `p,p`): the check must then fail (to see that it sees that block).
+        #[arg(long = "flip-block", value_name = "ROW,COL")]
+        flip_block: Option<String>,
         /// Override a case value by its dotted path.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -186,23 +192,21 @@ fn run(
         args.push(f.display().to_string());
     }
     args.extend(petsc_args.iter().cloned());
-    let petsc =
-        petsc::Petsc::initialize(&args, None, "porompm").map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
-    let comm = petsc.world();
-    let mut output = RunOutput::create(out, comm.rank() == 0).map_err(input)?;
+    let (universe, coll, petsc) = start_mpi_and_petsc(&args)?;
+    let mut output = RunOutput::create(out, coll.rank() == 0).map_err(input)?;
     let req = RunRequest {
         case: &c,
         case_label: case_path.display().to_string(),
         overrides: sets.to_vec(),
         out_dir: out.to_path_buf(),
         quiet,
-        comm,
+        coll: &coll,
         checkpoint_every: cont.checkpoint_every,
         restart,
     };
     let (summary, err) = driver::run(&req, &mut output);
     drop(output);
-    if comm.rank() == 0 && !quiet {
+    if coll.rank() == 0 && !quiet {
         for (name, m) in &summary.verification {
             eprintln!(
                 "{name} = {:.4e} (tolerance {:.1e}) {}  [{}]",
@@ -224,6 +228,7 @@ fn run(
         );
     }
     drop(petsc);
+    drop(universe);
     match err {
         None => Ok(()),
         Some(RunError::Input(m)) => Err(input(m)),
@@ -235,28 +240,44 @@ fn test_jacobian(
     case_path: &Path,
     steps: usize,
     tolerance: f64,
+    flip: Option<&str>,
     sets: &[String],
     petsc_args: &[String],
 ) -> Result<(), Failure> {
     let c = load_case(case_path, sets)?;
-    let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
-        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    let names = porompm::model::field_names(c.analysis.formulation == case::Formulation::TwoPhase);
+    let flip = match flip {
+        None => None,
+        Some(f) => {
+            let parts: Vec<&str> = f.split(',').collect();
+            let find = |n: &str| names.iter().position(|x| *x == n.trim());
+            match parts.as_slice() {
+                [r, c] => match (find(r), find(c)) {
+                    (Some(r), Some(c)) => Some((r, c)),
+                    _ => return Err(input(format!("--flip-block {f}: the fields are {}", names.join(", ")))),
+                },
+                _ => return Err(input(format!("--flip-block {f}: expected ROW,COL, e.g. p,p"))),
+            }
+        }
+    };
+    let (universe, coll, petsc) = start_mpi_and_petsc(petsc_args)?;
     let req = RunRequest {
         case: &c,
         case_label: case_path.display().to_string(),
         overrides: sets.to_vec(),
         out_dir: PathBuf::from("."),
         quiet: true,
-        comm: petsc.world(),
+        coll: &coll,
         checkpoint_every: 0,
         restart: None,
     };
-    let result = driver::test_jacobian(&req, steps);
+    let result = driver::test_jacobian(&req, steps, flip);
     drop(petsc);
+    drop(universe);
     let (blocks, yielded) = result.map_err(|e| Failure { code: 1, message: e.message().to_string() })?;
     println!("material points that have yielded: {yielded}");
     println!(
-        "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps)",
+        "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps, scaled by D^-1/2 · D^-1/2)",
         "row", "col", "max|J-Jfd|", "max|J|", "relative"
     );
     let mut worst: f64 = 0.0;
@@ -275,6 +296,17 @@ fn test_jacobian(
     }
     println!("all blocks agree within {tolerance:.1e} (worst {worst:.3e})");
     Ok(())
+}
+
+/// Initialises MPI (rsmpi) and then PETSc on its world communicator; the caller drops them in
+/// reverse order.
+fn start_mpi_and_petsc(args: &[String]) -> Result<(mpi::environment::Universe, Collective, petsc::Petsc), Failure> {
+    let universe = mpi::initialize().ok_or_else(|| input("MPI could not be initialised (already initialised?)"))?;
+    let coll = Collective::world();
+    let comm = petsc::Comm::from_raw(coll.communicator().as_raw());
+    let petsc = petsc::Petsc::initialize_on(comm, args, None, "porompm")
+        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    Ok((universe, coll, petsc))
 }
 
 fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure> {
@@ -347,20 +379,18 @@ fn sweep(
 }
 
 fn info(petsc_args: &[String]) -> Result<(), Failure> {
-    let petsc = petsc::Petsc::initialize(petsc_args, None, "porompm")
-        .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
-    let comm = petsc.world();
-    let coll = porompm::assembly::Collective::new(comm);
+    let (universe, coll, petsc) = start_mpi_and_petsc(petsc_args)?;
     let total = coll.sum(&[1.0]).map_err(|e| Failure { code: 1, message: e })?[0];
-    let ranks = coll.gather(&[comm.rank() as f64]).map_err(|e| Failure { code: 1, message: e })?;
-    if comm.rank() == 0 {
+    let ranks = coll.gather(&[coll.rank() as f64]).map_err(|e| Failure { code: 1, message: e })?;
+    if coll.rank() == 0 {
         let b = petsc::PetscBuild::get();
         println!("porompm {}", porompm::VERSION);
         println!("PETSc {} with {}", b.version, b.packages.join(", "));
-        println!("ranks: {}", comm.size());
+        println!("ranks: {}", coll.size());
         println!("collective sum over ranks: {total} (ranks reporting: {ranks:?})");
     }
     drop(petsc);
+    drop(universe);
     if total as usize != ranks.len() {
         return Err(Failure { code: 1, message: "the collective sum does not match the number of ranks".into() });
     }
@@ -381,8 +411,8 @@ fn main() -> ExitCode {
         Command::Check { case, set } => {
             load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
         }
-        Command::TestJacobian { case, steps, tolerance, set, petsc } => {
-            test_jacobian(case, *steps, *tolerance, set, petsc)
+        Command::TestJacobian { case, steps, tolerance, flip_block, set, petsc } => {
+            test_jacobian(case, *steps, *tolerance, flip_block.as_deref(), set, petsc)
         }
         Command::ElementTest { material, path, out } => element_test(material, path, out),
         Command::Info { petsc } => info(petsc),

@@ -16,21 +16,11 @@ impl GridSystem {
     /// work of one Newton iteration (every particle's kernels, scattered into PETSc's vector and
     /// matrix) without the linear solve. Returns the 2-norm of the residual.
     pub fn assemble_once(&mut self, model: &Model) -> Result<f64, Error> {
-        let GridSystem { dm, x, x_local, f_local, work_global, jac, step, ndof, two_phase, stages, .. } = self;
-        let jac = jac.as_mut().ok_or_else(|| Error::new("the step was not prepared"))?;
-        x.set_all(0.0)?;
+        self.x.set_all(0.0)?;
         let mut seconds = 0.0;
-        let mut asm = Assembler {
-            dm,
-            model,
-            step,
-            x_local,
-            f_local,
-            nd: *ndof,
-            two_phase: *two_phase,
-            seconds: &mut seconds,
-            stage: &stages.assembly,
-        };
+        let GridSystem { dm, x, x_local, f_local, work_global, jac, step, stages, .. } = self;
+        let jac = jac.as_mut().ok_or_else(|| Error::new("the step was not prepared"))?;
+        let mut asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
         asm.residual(&x.as_ref(), &mut work_global.as_ref()).map_err(error)?;
         asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(error)?;
         work_global.norm2()

@@ -1,107 +1,83 @@
 //! The global system: the only application module that talks to PETSc.
 //!
-//! A DMDA holds the background grid (dofs ux, uy, p, Ux, Uy interlaced, or ux, uy), so that the
-//! distribution of nodes over ranks, ghost nodes and matrix preallocation come from PETSc. Every
-//! step ([`GridSystem::prepare_step`]):
-//! 1. each particle's stencil (nodes, S, ∇S) is computed once on the configuration x_n;
-//! 2. masses, momenta, mass-weighted accelerations and porosities are mapped to the nodes ([003]
-//!    Eq. 19) and summed over ranks; interpolated back, they give each particle its Newmark
-//!    predictors and its porosity gradient;
-//! 3. a node is active when the material fills more than [`MIN_FILLED_FRACTION`] of a cell in its
-//!    support; dofs of inactive nodes and the components fixed by active boundaries are
-//!    constrained (residual x − 0, identity row and zero column in the tangent);
-//! 4. the external tractions at t_{n+1} are assembled; a fresh matrix is created when the
-//!    particle–node connectivity or the constraints changed (its structure follows the particles),
-//!    otherwise the previous one is reused, so PETSc keeps the symbolic factorisation and only
-//!    refactorises numerically.
+//! A DMDA holds the background grid (dofs of the layout interlaced per node), so that the
+//! distribution of nodes over ranks, ghost nodes and the global numbering come from PETSc. Every
+//! step ([`GridSystem::prepare_step`]) runs the same named steps, whatever the analysis:
+//! 1. [`stencils::build`]: each particle's stencil (nodes, S, ∇S, ∇̄S) on x_n, once per step; a
+//!    support reaching past the grid is an error;
+//! 2. [`GridSystem::project`]: masses, momenta, mass-weighted accelerations, porosities and filled
+//!    fractions mapped to the nodes ([003] Eq. 19) and summed over ranks;
+//! 3. [`dofs::build`]: the dof map — free dofs, dofs fixed by the active boundaries (with their
+//!    prescribed increments) and the dofs of nodes the material barely fills;
+//! 4. [`stencils::extend`]: each particle's effective stencil, extending the motion of barely
+//!    filled nodes from well-filled ones (see [`stencils`]), then its Newmark predictors and
+//!    porosity gradient, the pressure-projection blocks and the external forces at t_{n+1}, with
+//!    the check that every applied force reaches a node that carries it;
+//! 5. [`pattern`]: the COO pattern of the matrix, kept while it holds every pair the particles need.
 //!
-//! [`GridSystem::solve`] then runs PETSc SNES with residual and Jacobian callbacks that loop over
-//! particles, call the pure kernels of [`crate::kernels`] and scatter the small dense blocks with
-//! local (ghosted) indices; PETSc sums contributions to nodes owned by other ranks.
+//! [`GridSystem::solve`] then runs PETSc SNES with residual and Jacobian callbacks
+//! ([`callbacks`]) that loop over particles, call the pure kernels of [`crate::kernels`], map their
+//! blocks through the extensions and add them to a local vector (summed over ranks by PETSc) and to
+//! one COO value array. Every decision that leads to a collective is agreed across ranks first
+//! ([`Collective::agree`]).
 
 mod bench;
+mod callbacks;
+mod check;
+pub mod dofs;
+pub mod pattern;
+pub mod stencils;
+
+pub use check::BlockCheck;
+pub use stencils::WELL_FILLED_FRACTION;
 
 use crate::case::Side;
-use crate::kernels::{self, NodeBasis, NodeState, StepResult, MAX_LOCAL, MAX_NODES};
+use crate::kernels::{self, Layout, StepResult};
 use crate::model::loads::LoadTarget;
-use crate::model::shape::{self, Stencil};
+use crate::model::shape;
 use crate::model::{Active, Model};
+use crate::parallel::Collective;
+use callbacks::Assembler;
+use dofs::DofMap;
+use mpi::raw::AsRaw;
+use pattern::Pattern;
 use petsc::ksp::KspOps;
-use petsc::mat::MatOps;
-use petsc::snes::NonlinearProblem;
-use petsc::{
-    CallbackError, Comm, DmDa, GhostedRange, LogStage, Mat, MatRef, Options, Snes, StageGuard, VecOps, VecRef, Vector,
-};
+use petsc::{Comm, DmDa, GhostedRange, LogStage, Mat, Options, Snes, StageGuard, VecOps, Vector};
 use std::time::Instant;
-
-/// A node takes part in the solve when the material fills more than this fraction of a cell's area
-/// in its support, φ_i = Σ_p S_ip V_p / (h_x h_y) (1 for a node inside the material, 1/4 at the
-/// corner of a block on grid lines). Nodes that a particle domain barely reaches have a stiffness
-/// ∝ ε and a mass ∝ ε² for an overlap ε: their dofs are ill-determined, and when such a node carried
-/// a drained condition or a free pressure at a moving surface (slumping block, large-strain column)
-/// the run blew up within a few steps. Leaving them out costs the particle the weight ε² of that node.
-pub const MIN_FILLED_FRACTION: f64 = 1e-3;
+use stencils::Stencils;
 
 /// Errors of the global system.
 pub type Error = petsc::Error;
-
-/// The stencils of all particles for one step, in this rank's ghosted node numbering, stored
-/// flat: particle k uses entries `offsets[k]..offsets[k + 1]` of `nodes` and `basis`.
-#[derive(Debug, Clone, Default)]
-struct Stencils {
-    offsets: Vec<usize>,
-    nodes: Vec<u32>,
-    basis: Vec<NodeBasis>,
-}
-
-impl Stencils {
-    fn len(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
-    }
-
-    fn nodes(&self, k: usize) -> &[u32] {
-        &self.nodes[self.offsets[k]..self.offsets[k + 1]]
-    }
-
-    fn get(&self, k: usize) -> (&[u32], &[NodeBasis]) {
-        let r = self.offsets[k]..self.offsets[k + 1];
-        (&self.nodes[r.clone()], &self.basis[r])
-    }
-
-    /// Whether every particle couples only nodes it coupled in `old`.
-    fn within(&self, old: &Stencils) -> bool {
-        self.len() == old.len() && (0..self.len()).all(|k| self.nodes(k).iter().all(|x| old.nodes(k).contains(x)))
-    }
-}
 
 /// Per-step data shared by the callbacks.
 #[derive(Debug, Default)]
 struct StepData {
     nm: Option<kernels::Newmark>,
+    layout: Option<Layout>,
     /// Body acceleration at t_{n+1} per body.
     body_acc: Vec<[f64; 2]>,
     stencils: Stencils,
-    /// External nodal forces at t_{n+1} (tractions) per ghosted dof.
+    dofs: DofMap,
+    /// External nodal forces at t_{n+1} (tractions) per ghosted dof, on the nodes that carry them.
     fext: Vec<f64>,
-    /// Constrained flag per ghosted dof.
-    constrained: Vec<bool>,
-    /// Offsets of constrained dofs in the owned part of global vectors.
-    owned_constrained: Vec<usize>,
-    /// Global index of the first owned dof.
-    global_start: usize,
-    /// Δd at convergence, per ghosted dof.
+    /// Δd at convergence, per ghosted dof (extended motion is not stored here).
     solution: Vec<f64>,
-    /// Whether each ghosted node is active.
-    active: Vec<bool>,
     /// Porosity gradient at each particle at t_n (two-phase).
     grad_n: Vec<[f64; 2]>,
     /// v_u, a_u, v_w, a_w at t_n at each particle, from the nodal projections.
     smooth: Vec<[[f64; 2]; 4]>,
-    /// Pressure-projection blocks: the local p dofs of a cell's four nodes (−1 if constrained) and
-    /// the 4 × 4 block S (see `kernels::pressure_projection`).
-    projection: Vec<([i32; 4], [[f64; 4]; 4])>,
-    /// Unknowns solved for (unconstrained dofs), summed over ranks.
-    free_dofs: usize,
+    /// Pressure-projection blocks: a cell's four nodes and the 4 × 4 block S (see
+    /// `kernels::pressure_projection`).
+    projection: Vec<([u32; 4], [[f64; 4]; 4])>,
+    /// Each particle's COO slot map: offsets and blocks (see [`pattern::Pattern::slots`]).
+    slot_offsets: Vec<usize>,
+    slots: Vec<u32>,
+    /// Number of blocks of the pattern.
+    pattern_blocks: usize,
+    /// The pattern block of every corner pair (a, b) of each pressure-projection cell, 4a + b.
+    projection_blocks: Vec<[u32; 16]>,
+    /// (diagonal block, component) of every owned fixed dof.
+    fixed_diagonals: Vec<(u32, usize)>,
 }
 
 /// Outcome of one nonlinear step solve.
@@ -123,6 +99,23 @@ pub struct StepSolve {
     pub assembly_seconds: f64,
     /// Wall time of the whole SNES solve [s].
     pub solve_seconds: f64,
+}
+
+/// The forces of a converged step, summed over ranks, for the equilibrium identity and the
+/// boundaries' reactions.
+#[derive(Debug, Clone, Default)]
+pub struct StepForces {
+    /// Σ_i x'_i ⊗ (F_ext,i + R_i − F_inertia,i) over the nodes, with x' = x + Δu the nodes' positions
+    /// at t_{n+1} relative to `origin` (in-plane, rows a, columns b: x_a F_b).
+    pub moment: [[f64; 2]; 2],
+    /// The largest of the moments of the external forces, the reactions and the inertia forces
+    /// (Frobenius norms), which scales the identity's error.
+    pub scale: f64,
+    /// The reference point of the moments [m].
+    pub origin: [f64; 2],
+    /// The reaction of each boundary (index into `Model::boundaries`) on the material: the force
+    /// the fixed dofs of both phases exert [N per m].
+    pub reactions: Vec<[f64; 2]>,
 }
 
 /// The PETSc log stages of a run (shown by `-log_view`).
@@ -154,11 +147,14 @@ pub enum Phase {
 pub struct GridSystem {
     comm: Comm,
     dm: DmDa,
-    ndof: usize,
-    two_phase: bool,
+    layout: Layout,
     ghost: GhostedRange,
     owned_start: [usize; 2],
     owned_count: [usize; 2],
+    /// Ghosted indices of the owned nodes, row by row.
+    owned_nodes: Vec<u32>,
+    /// Global index of every ghosted dof.
+    l2g: Vec<i32>,
     x: Vector,
     x_local: Vector,
     f_local: Vector,
@@ -166,8 +162,7 @@ pub struct GridSystem {
     work_global: Vector,
     snes: Snes,
     jac: Option<Mat>,
-    /// Stencil nodes of each particle and the free dofs when the matrix was created.
-    pattern: Option<(Stencils, Vec<bool>)>,
+    pattern: Option<Pattern>,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
     step: StepData,
@@ -175,23 +170,41 @@ pub struct GridSystem {
 }
 
 /// Ghost width in nodes: a GIMP particle of a cell reaches at most one cell beyond it, so the
-/// nodes of a rank's cells plus two rows cover every node its particles touch.
+/// nodes of a rank's cells plus two rows cover every node its particles touch, and the nodes its
+/// barely filled nodes are extended from (they lie towards the particle).
 const STENCIL_WIDTH: usize = 2;
 
 impl GridSystem {
-    /// Creates the DMDA for the grid and dof layout, and the SNES with porompm's defaults, then
-    /// lets the PETSc options database override them. Defaults: Newton with full steps, relative
-    /// residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on one rank (the
-    /// fastest of the measured strategies on the verification cases, see docs/solvers.md) up to
-    /// [`UMFPACK_MAX_GRID_DOFS`], and by MUMPS beyond and on several ranks (UMFPACK is sequential).
-    pub fn new(comm: Comm, grid: &crate::model::grid::Grid, two_phase: bool) -> Result<GridSystem, Error> {
-        let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, crate::model::field_names(two_phase))?;
+    /// Creates the DMDA for the grid and dof layout on the run's communicator, and the SNES with
+    /// porompm's defaults, then lets the PETSc options database override them. Defaults: Newton with
+    /// full steps, relative residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on
+    /// one rank (the fastest of the measured strategies on the verification cases, see
+    /// docs/solvers.md) up to [`UMFPACK_MAX_GRID_DOFS`], and by MUMPS beyond and on several ranks
+    /// (UMFPACK is sequential).
+    pub fn new(coll: &Collective, grid: &crate::model::grid::Grid, layout: Layout) -> Result<GridSystem, Error> {
+        let comm = Comm::from_raw(coll.communicator().as_raw());
+        let names = &crate::model::field_names(layout.w.is_some())[..layout.nd];
+        let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, names)?;
         let info = *dm.info();
         let x = dm.create_global_vector()?;
         let x_local = dm.create_local_vector()?;
         let f_local = dm.create_local_vector()?;
         let work_local = dm.create_local_vector()?;
         let work_global = dm.create_global_vector()?;
+        let l2g: Vec<i32> = dm.local_to_global().to_vec();
+        if l2g.len() != info.ghosted.len() * layout.nd {
+            return Err(Error::new(format!(
+                "the DMDA's local-to-global map has {} entries for {} ghosted dofs",
+                l2g.len(),
+                info.ghosted.len() * layout.nd
+            )));
+        }
+        let mut owned_nodes = Vec::new();
+        for j in info.owned_start[1]..info.owned_start[1] + info.owned_count[1] {
+            for i in info.owned_start[0]..info.owned_start[0] + info.owned_count[0] {
+                owned_nodes.push(info.ghosted.node(i, j).expect("owned nodes are ghosted") as u32);
+            }
+        }
         let mut snes = Snes::new(comm)?;
         snes.set_dm(&dm)?;
         snes.set_type("newtonls")?;
@@ -202,7 +215,7 @@ impl GridSystem {
             ksp.set_type("preonly")?;
             let mut pc = ksp.pc()?;
             pc.set_type("lu")?;
-            let grid_dofs = grid.nodes()[0] * grid.nodes()[1] * crate::model::field_names(two_phase).len();
+            let grid_dofs = grid.nodes()[0] * grid.nodes()[1] * layout.nd;
             pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
@@ -217,11 +230,12 @@ impl GridSystem {
         Ok(GridSystem {
             comm,
             dm,
-            ndof: if two_phase { 5 } else { 2 },
-            two_phase,
+            layout,
             ghost: info.ghosted,
             owned_start: info.owned_start,
             owned_count: info.owned_count,
+            owned_nodes,
+            l2g,
             x,
             x_local,
             f_local,
@@ -255,20 +269,20 @@ impl GridSystem {
         }
     }
 
-    /// Unknowns of the last prepared step (unconstrained dofs over all ranks).
+    /// Unknowns of the last prepared step (free dofs over all ranks).
     pub fn free_dofs(&self) -> usize {
-        self.step.free_dofs
+        self.step.dofs.free_dofs
     }
 
     /// Total dofs of the grid (all nodes × dofs per node).
     pub fn total_dofs(&self) -> usize {
         let [nx, ny] = self.dm.info().nodes;
-        nx * ny * self.ndof
+        nx * ny * self.layout.nd
     }
 
-    /// The communicator.
-    pub fn comm(&self) -> Comm {
-        self.comm
+    /// The dof layout.
+    pub fn layout(&self) -> Layout {
+        self.layout
     }
 
     /// Sums a ghosted per-dof array over ranks: afterwards every ghost holds the global total.
@@ -281,210 +295,313 @@ impl GridSystem {
         Ok(())
     }
 
-    fn local_node(&self, i: u32, j: u32) -> Option<u32> {
-        self.ghost.node(i as usize, j as usize).map(|n| n as u32)
+    /// The motion components of the layout (u, and U if there is water).
+    fn motion(&self) -> Vec<usize> {
+        let mut m = vec![0, 1];
+        if let Some(w) = self.layout.w {
+            m.extend([w, w + 1]);
+        }
+        m
     }
 
     /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
-    /// boundaries (see the module documentation).
-    pub fn prepare_step(&mut self, model: &Model, active: &Active, t_new: f64, dt: f64) -> Result<(), String> {
-        let nd = self.ndof;
-        let ng = self.ghost.len() * nd;
-        let ps = &model.particles;
-        let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
-
+    /// boundaries (see the module documentation). Collective; every rank returns the same outcome.
+    pub fn prepare_step(
+        &mut self,
+        model: &Model,
+        active: &Active,
+        t_new: f64,
+        dt: f64,
+        coll: &Collective,
+        body_names: &[String],
+    ) -> Result<(), String> {
+        let nd = self.layout.nd;
         // 1. Stencils on x_n.
-        let mut stencils = Stencils { offsets: Vec::with_capacity(ps.len() + 1), ..Default::default() };
-        stencils.offsets.push(0);
-        for k in 0..ps.len() {
-            let st: Stencil = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-            if st.iter().all(|(_, w, _)| w == 0.0) {
-                return Err(format!(
-                    "material point {} at ({:.4}, {:.4}) m has left the grid",
-                    ps.id[k], ps.x[k][0], ps.x[k][1]
-                ));
-            }
-            for &(i, j) in &st.nodes[..st.len] {
-                stencils.nodes.push(self.local_node(i, j).ok_or_else(|| {
-                    format!(
-                        "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \
-                         (particle migration between ranks is not implemented yet)",
-                        ps.id[k], ps.x[k][0], ps.x[k][1]
-                    )
-                })?);
-            }
-            let first = stencils.basis.len();
-            kernels::plain_basis(&st, &mut stencils.basis);
-            if model.bbar {
-                let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
-                for (b, g) in stencils.basis[first..].iter_mut().zip(gv) {
-                    b.gv = g;
+        let (mut st, crossings) = coll.agree(stencils::build(model, &self.ghost))?;
+        // 2. Projections to the nodes, summed over ranks.
+        let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
+        // 3. The dof map.
+        // Moving surfaces: per surface boundary, the dofs any rank's particles fix, summed over ranks;
+        // a dof takes the first such boundary in case order.
+        let fixes = model.surface_fixes(active);
+        let mut surface = vec![0.0; self.ghost.len() * nd];
+        for &bi in active.boundaries.iter().filter(|&&b| model.boundaries[b].surface.is_some()) {
+            let mut marks = vec![0.0; self.ghost.len() * nd];
+            for ((i, j), _, comps) in fixes.iter().filter(|f| f.1 == bi) {
+                if let Some(l) = self.ghost.node(*i as usize, *j as usize) {
+                    for c in (0..nd).filter(|&c| comps[c]) {
+                        marks[l * nd + c] = 1.0;
+                    }
                 }
             }
-            stencils.offsets.push(stencils.nodes.len());
+            self.sum_over_ranks(&mut marks).map_err(|e| e.to_string())?;
+            for (s, m) in surface.iter_mut().zip(&marks) {
+                if *s == 0.0 && *m > 0.0 {
+                    *s = (bi + 1) as f64;
+                }
+            }
         }
+        let mut dofs = dofs::build(
+            model,
+            active,
+            (t_new - dt, t_new),
+            &self.ghost,
+            self.owned_start,
+            self.owned_count,
+            nd,
+            &nodal.phi,
+            &surface,
+            WELL_FILLED_FRACTION,
+            self.layout.w,
+        );
+        dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
+        coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
+        // 4. Effective stencils, predictors, porosity gradients, projection blocks, loads.
+        stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
+        let (smooth, grad_n) = self.predictors(model, &st, &dofs, &nodal);
+        let projection = self.projection_blocks(model);
+        let fext = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
+        let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
+        self.step = StepData {
+            nm: Some(nm),
+            layout: Some(self.layout),
+            body_acc: model.body_accelerations(active, t_new),
+            stencils: st,
+            dofs,
+            fext,
+            solution: Vec::new(),
+            grad_n,
+            smooth,
+            projection,
+            ..StepData::default()
+        };
+        self.check_loads(model, active, t_new, coll)?;
+        // 5. The matrix pattern: kept if every rank finds every pair in it.
+        let kept = self.pattern.as_ref().and_then(|p| p.slots(&self.step.stencils));
+        let rebuild = coll.any(kept.is_none())?;
+        let (pattern_slots, pattern) = if rebuild {
+            let [nx, ny] = self.ghost.count;
+            let p = Pattern::build(&self.step.stencils, &self.owned_nodes, nx, ny);
+            let slots = p.slots(&self.step.stencils).expect("the new pattern holds every pair");
+            let (rows, cols) = p.coo(nd, &self.l2g);
+            let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());
+            self.jac = Some(coll.agree(made)?);
+            (slots, p)
+        } else {
+            self.reused_patterns += 1;
+            (kept.expect("every rank kept the pattern"), self.pattern.take().expect("a pattern to keep"))
+        };
+        self.step.slot_offsets = pattern_slots.0;
+        self.step.slots = pattern_slots.1;
+        self.step.pattern_blocks = pattern.len();
+        let projection_blocks: Option<Vec<[u32; 16]>> = self
+            .step
+            .projection
+            .iter()
+            .map(|(nodes, _)| {
+                let mut b = [0u32; 16];
+                for (a, &na) in nodes.iter().enumerate() {
+                    for (c, &nc) in nodes.iter().enumerate() {
+                        b[a * 4 + c] = pattern.block(na, nc)?;
+                    }
+                }
+                Some(b)
+            })
+            .collect();
+        self.step.projection_blocks =
+            projection_blocks.ok_or("a pressure-projection cell's nodes are not coupled by any particle")?;
+        self.step.fixed_diagonals = self
+            .step
+            .dofs
+            .owned_fixed
+            .iter()
+            .map(|&(_, q)| {
+                (pattern.block((q / nd) as u32, (q / nd) as u32).expect("owned diagonal blocks are listed"), q % nd)
+            })
+            .collect();
+        self.pattern = Some(pattern);
+        Ok(())
+    }
 
-        // 2. Nodal masses, momenta, mass-weighted accelerations ([003] Eq. 19) and filled fractions.
+    /// Step 2: nodal masses, momenta and mass-weighted accelerations ([003] Eq. 19), mass-weighted
+    /// porosities and filled fractions, summed over ranks.
+    fn project(&mut self, model: &Model, st: &Stencils) -> Result<Nodal, Error> {
+        let nd = self.layout.nd;
+        let ng = self.ghost.len() * nd;
+        let ps = &model.particles;
         let cell_area = model.grid.h[0] * model.grid.h[1];
-        let (mut mass, mut mom, mut acc, mut weight) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
-        for k in 0..stencils.len() {
-            let (nodes, basis) = stencils.get(k);
+        let (mut mass, mut mom, mut acc) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
+        let (mut phi, mut porosity) = (vec![0.0; ng], vec![0.0; ng]);
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
             let mw = model.water_mass(k);
             for (&node, nb) in nodes.iter().zip(basis) {
                 let b = node as usize * nd;
                 let s = nb.s;
-                weight[b] += s * ps.volume[k] / cell_area;
+                phi[b] += s * ps.volume[k] / cell_area;
+                porosity[b] += s * ps.mass[k] * ps.porosity[k];
                 for c in 0..2 {
                     mass[b + c] += s * ps.mass[k];
                     mom[b + c] += s * ps.mass[k] * ps.vel[k][c];
                     acc[b + c] += s * ps.mass[k] * ps.acc[k][c];
-                    if self.two_phase {
-                        mass[b + 3 + c] += s * mw;
-                        mom[b + 3 + c] += s * mw * ps.vel_w[k][c];
-                        acc[b + 3 + c] += s * mw * ps.acc_w[k][c];
+                    if let Some(w) = self.layout.w {
+                        mass[b + w + c] += s * mw;
+                        mom[b + w + c] += s * mw * ps.vel_w[k][c];
+                        acc[b + w + c] += s * mw * ps.acc_w[k][c];
                     }
                 }
             }
         }
-        // Mass-weighted nodal porosity, whose gradient at the particles enters the ∇n terms of the
-        // two-phase equations (see crate::kernels).
-        let mut porosity = vec![0.0; ng];
-        if self.two_phase {
-            for k in 0..stencils.len() {
-                let (nodes, basis) = stencils.get(k);
-                for (&node, nb) in nodes.iter().zip(basis) {
-                    porosity[node as usize * nd] += nb.s * ps.mass[k] * ps.porosity[k];
-                }
+        for v in [&mut mass, &mut mom, &mut acc, &mut phi, &mut porosity] {
+            self.sum_over_ranks(v)?;
+        }
+        let n = self.ghost.len();
+        Ok(Nodal {
+            phi: (0..n).map(|l| phi[l * nd]).collect(),
+            porosity: (0..n).map(|l| if mass[l * nd] > 0.0 { porosity[l * nd] / mass[l * nd] } else { 0.0 }).collect(),
+            mass,
+            mom,
+            acc,
+        })
+    }
+
+    /// Step 4: the Newmark predictors' velocities and accelerations at t_n interpolated to each
+    /// particle from the nodal projections ([003] Eq. 19b–c; the predictors of [003] Eq. 21 formed
+    /// on the nodes and interpolated are the predictors of these values, being linear in v and a),
+    /// and the porosity gradient at each particle (two-phase). A component held still by a boundary
+    /// has zero velocity and acceleration; an extended node takes its masters'.
+    fn predictors(
+        &self,
+        model: &Model,
+        st: &Stencils,
+        dofs: &DofMap,
+        nodal: &Nodal,
+    ) -> (Vec<[[f64; 2]; 4]>, Vec<[f64; 2]>) {
+        let nd = self.layout.nd;
+        let value = |l: usize, c: usize, of: &[f64]| -> f64 {
+            let q = l * nd + c;
+            let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
+            if still || nodal.mass[q] <= 0.0 {
+                0.0
+            } else {
+                of[q] / nodal.mass[q]
             }
-        }
-        for v in [&mut mass, &mut mom, &mut acc, &mut weight, &mut porosity] {
-            self.sum_over_ranks(v).map_err(|e| e.to_string())?;
-        }
-        let grad_n: Vec<[f64; 2]> = if self.two_phase {
-            (0..stencils.len())
-                .map(|k| {
-                    let (nodes, basis) = stencils.get(k);
-                    let mut g = [0.0; 2];
-                    for (&node, nb) in nodes.iter().zip(basis) {
-                        let b = node as usize * nd;
-                        if mass[b] > 0.0 {
-                            let n = porosity[b] / mass[b];
-                            g[0] += nb.g[0] * n;
-                            g[1] += nb.g[1] * n;
-                        }
-                    }
-                    g
-                })
-                .collect()
-        } else {
-            Vec::new()
         };
-
-        // 3. Constraints: inactive nodes, components fixed by the active side and region boundaries,
-        // and by moving surfaces (marked by the ranks owning the surface particles, summed over ranks).
-        let mut surface = vec![0.0; ng];
-        for ((i, j), comps) in model.surface_fixes(active) {
-            if let Some(l) = self.local_node(i, j) {
-                for c in (0..nd).filter(|&c| comps[c]) {
-                    surface[l as usize * nd + c] = 1.0;
-                }
-            }
+        // (dof, slot of its velocity in the output, component): solid x, y, then water x, y.
+        let mut comps = vec![(0usize, 0usize, 0usize), (1, 0, 1)];
+        if let Some(w) = self.layout.w {
+            comps.extend([(w, 2, 0), (w + 1, 2, 1)]);
         }
-        self.sum_over_ranks(&mut surface).map_err(|e| e.to_string())?;
-        let mut constrained = vec![false; ng];
-        for l in 0..self.ghost.len() {
-            let (i, j) = self.ghost.ij(l);
-            let inactive = weight[l * nd] <= MIN_FILLED_FRACTION;
-            let fixed = model.fixed_components(active, i, j);
-            for c in 0..nd {
-                constrained[l * nd + c] = inactive || fixed[c] || surface[l * nd + c] > 0.0;
-            }
-        }
-        let mut owned_constrained = Vec::new();
-        let mut free = 0usize;
-        for jj in 0..self.owned_count[1] {
-            for ii in 0..self.owned_count[0] {
-                let l = self
-                    .ghost
-                    .node(self.owned_start[0] + ii, self.owned_start[1] + jj)
-                    .expect("owned nodes are ghosted");
-                for c in 0..nd {
-                    let o = (jj * self.owned_count[0] + ii) * nd + c;
-                    if constrained[l * nd + c] {
-                        owned_constrained.push(o);
+        let two_phase = self.layout.w.is_some();
+        let mut smooth = Vec::with_capacity(st.len());
+        let mut grad_n = Vec::with_capacity(if two_phase { st.len() } else { 0 });
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
+            let eff = st.effective(k);
+            let ext = st.extensions(k);
+            let mut out = [[0.0; 2]; 4];
+            let mut g = [0.0; 2];
+            for (slot, (&node, nb)) in nodes.iter().zip(basis).enumerate() {
+                let e = ext.iter().find(|e| e.slot as usize == slot);
+                let of_masters = |f: &dyn Fn(usize) -> f64| -> f64 {
+                    let e = e.expect("extended");
+                    (0..e.n as usize).map(|m| e.masters[m].1 * f(eff[e.masters[m].0 as usize] as usize)).sum()
+                };
+                for &(c, s, comp) in &comps {
+                    let extended = e.is_some_and(|e| e.mask & (1 << c) != 0);
+                    let (v, a) = if extended {
+                        (of_masters(&|l| value(l, c, &nodal.mom)), of_masters(&|l| value(l, c, &nodal.acc)))
                     } else {
-                        free += 1;
-                    }
+                        (value(node as usize, c, &nodal.mom), value(node as usize, c, &nodal.acc))
+                    };
+                    out[s][comp] += nb.s * v;
+                    out[s + 1][comp] += nb.s * a;
+                }
+                if two_phase {
+                    let n =
+                        if e.is_some() { of_masters(&|l| nodal.porosity[l]) } else { nodal.porosity[node as usize] };
+                    g[0] += nb.g[0] * n;
+                    g[1] += nb.g[1] * n;
                 }
             }
+            smooth.push(out);
+            if two_phase {
+                grad_n.push(g);
+            }
         }
-        let free_dofs = self.comm.sum_usize(free).map_err(|e| e.to_string())?;
+        (smooth, grad_n)
+    }
 
-        // Velocities and accelerations at t_n interpolated back from the nodal projections ([003]
-        // Eq. 19b–c): the predictors of [003] Eq. 21 formed on the nodes and interpolated to a point
-        // are the predictors of these values (they are linear in v and a). A constrained component
-        // has zero velocity and acceleration.
-        let smooth: Vec<[[f64; 2]; 4]> = (0..stencils.len())
-            .map(|k| {
-                let (nodes, basis) = stencils.get(k);
-                let mut out = [[0.0; 2]; 4];
-                for (&node, nb) in nodes.iter().zip(basis) {
-                    let b = node as usize * nd;
-                    // (dof, slot of its velocity in `out`, component): solid x, y, then water x, y.
-                    for (c, slot, comp) in [(0, 0, 0), (1, 0, 1), (3, 2, 0), (4, 2, 1)] {
-                        let q = b + c;
-                        if c >= nd || constrained[q] || mass[q] <= 0.0 {
-                            continue;
+    /// Step 4: the pressure-projection blocks, cell by cell over this rank's particles (grouped by
+    /// the cell holding their centre).
+    fn projection_blocks(&self, model: &Model) -> Vec<([u32; 4], [[f64; 4]; 4])> {
+        let mut out = Vec::new();
+        let (Some(_), Some(alpha)) = (self.layout.p, model.pressure_projection) else { return out };
+        let g = &model.grid;
+        let ps = &model.particles;
+        let mut cells: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
+        for k in 0..ps.len() {
+            if let Some(c) = g.cell_of(ps.x[k]) {
+                cells.entry(c).or_default().push(k);
+            }
+        }
+        for ((ci, cj), members) in cells {
+            let corners = [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)];
+            let Some(nodes) =
+                corners.iter().map(|&(i, j)| self.ghost.node(i, j).map(|l| l as u32)).collect::<Option<Vec<u32>>>()
+            else {
+                continue;
+            };
+            let o = g.node_position(ci, cj);
+            let n: Vec<[f64; 4]> = members
+                .iter()
+                .map(|&k| {
+                    let (x, y) = ((ps.x[k][0] - o[0]) / g.h[0], (ps.x[k][1] - o[1]) / g.h[1]);
+                    [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]
+                })
+                .collect();
+            let w: Vec<f64> = members
+                .iter()
+                .map(|&k| {
+                    let shear = model.materials[ps.material[k] as usize].model.elastic().shear_modulus();
+                    alpha / shear * ps.volume[k]
+                })
+                .collect();
+            out.push(([nodes[0], nodes[1], nodes[2], nodes[3]], kernels::pressure_projection(&n, &w)));
+        }
+        out
+    }
+
+    /// Step 4: the external forces at t_{n+1} per ghosted dof. A traction's share at a node whose
+    /// motion is extended goes to the node's masters (extended towards the loaded particle); a share
+    /// that no node can carry stays where it is, and [`GridSystem::check_loads`] reports it.
+    fn external_forces(&self, model: &Model, active: &Active, t_new: f64, dofs: &DofMap) -> Result<Vec<f64>, String> {
+        let nd = self.layout.nd;
+        let ps = &model.particles;
+        let g = &model.grid;
+        let mut fext = vec![0.0; self.ghost.len() * nd];
+        let tiny = 1e-9 * g.h[0].min(g.h[1]);
+        let is_well = |i: i64, j: i64| -> bool {
+            i >= 0 && j >= 0 && self.ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
+        };
+        let mut add = |l: usize, force: [f64; 2], toward: [f64; 2]| {
+            for c in 0..2 {
+                if dofs.well[l] || dofs.boundary_fixed(l, c) {
+                    fext[l * nd + c] += force[c];
+                    continue;
+                }
+                let (i, j) = self.ghost.ij(l);
+                match stencils::extension((i, j), g.node_position(i, j), toward, &is_well, tiny) {
+                    Some((masters, coefs, n)) => {
+                        for m in 0..n {
+                            let ml = self.ghost.node(masters[m].0 as usize, masters[m].1 as usize).expect("well");
+                            fext[ml * nd + c] += coefs[m] * force[c];
                         }
-                        out[slot][comp] += nb.s * mom[q] / mass[q];
-                        out[slot + 1][comp] += nb.s * acc[q] / mass[q];
                     }
-                }
-                out
-            })
-            .collect();
-
-        // Pressure-projection blocks, cell by cell over this rank's particles (grouped by the cell
-        // holding their centre).
-        let mut projection = Vec::new();
-        if let (true, Some(alpha)) = (self.two_phase, model.pressure_projection) {
-            let g = &model.grid;
-            let mut cells: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
-            for k in 0..ps.len() {
-                if let Some(c) = g.cell_of(ps.x[k]) {
-                    cells.entry(c).or_default().push(k);
+                    None => fext[l * nd + c] += force[c],
                 }
             }
-            for ((ci, cj), members) in cells {
-                let mut idx = [-1i32; 4];
-                let corners = [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)];
-                for (slot, &(i, j)) in corners.iter().enumerate() {
-                    if let Some(l) = self.local_node(i as u32, j as u32) {
-                        let q = l as usize * nd + kernels::dof::P;
-                        idx[slot] = if constrained[q] { -1 } else { q as i32 };
-                    }
-                }
-                let o = g.node_position(ci, cj);
-                let n: Vec<[f64; 4]> = members
-                    .iter()
-                    .map(|&k| {
-                        let (x, y) = ((ps.x[k][0] - o[0]) / g.h[0], (ps.x[k][1] - o[1]) / g.h[1]);
-                        [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]
-                    })
-                    .collect();
-                let w: Vec<f64> = members
-                    .iter()
-                    .map(|&k| {
-                        let shear = model.materials[ps.material[k] as usize].model.elastic().shear_modulus();
-                        alpha / shear * ps.volume[k]
-                    })
-                    .collect();
-                projection.push((idx, kernels::pressure_projection(&n, &w)));
-            }
-        }
-
-        // 4. Tractions at t_{n+1}.
-        let mut fext = vec![0.0; ng];
+        };
         for &li in &active.loads {
             let load = &model.loads[li];
             let f = load.time_fn.eval(t_new);
@@ -494,20 +611,16 @@ impl GridSystem {
                     // current face length) with the bilinear weights there (see shape::face_weights).
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
-                        let (point, length) = match face {
-                            Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
-                            Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
-                            Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
-                            Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
-                        };
-                        let w = shape::face_weights(&model.grid, point);
+                        let (point, length) = face_point(*face, x, lp);
+                        let w = shape::face_weights(g, point);
                         for ((i, j), s, _) in w.iter() {
-                            let l =
-                                self.local_node(i, j).ok_or("a traction point lies outside this rank's ghost region")?
-                                    as usize;
-                            for c in 0..2 {
-                                fext[l * nd + c] += s * traction[c] * f * length;
-                            }
+                            let l = self.ghost.node(i as usize, j as usize).ok_or_else(|| {
+                                format!(
+                                    "the traction `{}` on material point {} acts outside this rank's ghost region",
+                                    load.name, ps.id[k]
+                                )
+                            })?;
+                            add(l, [s * traction[0] * f * length, s * traction[1] * f * length], x);
                         }
                     }
                 }
@@ -516,62 +629,100 @@ impl GridSystem {
                         let owned = (self.owned_start[0]..self.owned_start[0] + self.owned_count[0]).contains(&i)
                             && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1]).contains(&j);
                         if owned {
-                            let l = self.ghost.node(i, j).expect("owned") * nd;
-                            for c in 0..2 {
-                                fext[l + c] += traction[c] * f * trib;
-                            }
+                            let l = self.ghost.node(i, j).expect("owned");
+                            let p = g.node_position(i, j);
+                            add(l, [traction[0] * f * trib, traction[1] * f * trib], p);
                         }
                     }
                 }
                 LoadTarget::BodyForce { .. } => {}
             }
         }
+        Ok(fext)
+    }
 
-        let global_start = self.x.ownership_range().map_err(|e| e.to_string())?.0;
-        self.step = StepData {
-            nm: Some(nm),
-            body_acc: model.body_accelerations(active, t_new),
-            stencils,
-            fext,
-            constrained,
-            owned_constrained,
-            global_start,
-            solution: Vec::new(),
-            active: (0..self.ghost.len()).map(|l| weight[l * nd] > MIN_FILLED_FRACTION).collect(),
-            grad_n,
-            smooth,
-            projection,
-            free_dofs,
-        };
-        // The matrix structure is the union of the particles' node couplings over the free dofs.
-        // It can be kept while every particle couples a subset of the nodes it coupled when the
-        // matrix was created and no constrained dof became free: PETSc then keeps the stored
-        // pattern (unused entries stay zero) and refactorises numerically only.
-        let reusable = match &self.pattern {
-            Some((old, free)) => {
-                self.step.stencils.within(old)
-                    && free.iter().zip(&self.step.constrained).all(|(&was_free, &c)| was_free || c)
+    /// The load accounting of a step: the tractions the case applies at t_{n+1} against the forces
+    /// assembled on nodes that carry them (free, or fixed by a boundary, whose reaction then takes
+    /// them). A difference beyond round-off means that part of a load would be lost: an error
+    /// naming the load.
+    fn check_loads(&mut self, model: &Model, active: &Active, t_new: f64, coll: &Collective) -> Result<(), String> {
+        let nd = self.layout.nd;
+        let ps = &model.particles;
+        let mut applied = [0.0; 2];
+        let mut names = Vec::new();
+        for &li in &active.loads {
+            let load = &model.loads[li];
+            let f = load.time_fn.eval(t_new);
+            match &load.target {
+                LoadTarget::ParticleTraction { particles, face, traction } => {
+                    for &k in particles {
+                        let length = face_point(*face, ps.x[k], ps.lp[k]).1;
+                        for c in 0..2 {
+                            applied[c] += traction[c] * f * length;
+                        }
+                    }
+                    names.push(load.name.clone());
+                }
+                LoadTarget::NodalTraction { nodes, traction } => {
+                    for &(i, j, trib) in nodes {
+                        let owned = (self.owned_start[0]..self.owned_start[0] + self.owned_count[0]).contains(&i)
+                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1]).contains(&j);
+                        if owned {
+                            for c in 0..2 {
+                                applied[c] += traction[c] * f * trib;
+                            }
+                        }
+                    }
+                    names.push(load.name.clone());
+                }
+                LoadTarget::BodyForce { .. } => {}
             }
-            None => false,
-        };
-        if reusable && self.jac.is_some() {
-            self.reused_patterns += 1;
-        } else {
-            self.jac = Some(self.dm.create_matrix().map_err(|e| e.to_string())?);
-            let nodes_only = Stencils {
-                offsets: self.step.stencils.offsets.clone(),
-                nodes: self.step.stencils.nodes.clone(),
-                basis: Vec::new(),
-            };
-            self.pattern = Some((nodes_only, self.step.constrained.iter().map(|c| !c).collect()));
+        }
+        if names.is_empty() {
+            return Ok(());
+        }
+        let mut summed = self.step.fext.clone();
+        self.sum_over_ranks(&mut summed).map_err(|e| e.to_string())?;
+        let mut carried = [0.0; 2];
+        let mut magnitude = 0.0f64;
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            for (c, carried_c) in carried.iter_mut().enumerate() {
+                let q = l * nd + c;
+                magnitude = magnitude.max(summed[q].abs());
+                if !self.step.dofs.fixed[q] || self.step.dofs.boundary_fixed(l, c) {
+                    *carried_c += summed[q];
+                }
+            }
+        }
+        let totals = coll.sum(&[applied[0], applied[1], carried[0], carried[1]])?;
+        let scale = coll.max(&[magnitude])?[0].max(totals[0].abs()).max(totals[1].abs());
+        let lost = [totals[0] - totals[2], totals[1] - totals[3]];
+        if lost[0].hypot(lost[1]) > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+            return Err(format!(
+                "at t = {t_new:.6e} s the load(s) {} apply ({:.6e}, {:.6e}) N/m but the grid carries ({:.6e}, {:.6e}) N/m: \
+                 part of the load acts on nodes the material does not fill",
+                names.join(", "),
+                totals[0],
+                totals[1],
+                totals[2],
+                totals[3]
+            ));
         }
         Ok(())
     }
 
-    /// Solves the prepared step by Newton's method from Δd = 0.
+    /// Solves the prepared step by Newton's method from Δd = 0 (with every fixed dof at its
+    /// prescribed increment).
     pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
         let _stage = self.stages.solve.push()?;
-        self.x.set_all(0.0)?;
+        {
+            let mut x = self.x.write()?;
+            x.fill(0.0);
+            for &(o, q) in &self.step.dofs.owned_fixed {
+                x[o] = self.step.dofs.value[q];
+            }
+        }
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
         let out = {
@@ -600,214 +751,145 @@ impl GridSystem {
         model: &'a Model,
         seconds: &'a mut f64,
     ) -> Result<(&'a mut Snes, &'a mut Vector, &'a mut Mat, Assembler<'a>), Error> {
-        let GridSystem { dm, x, x_local, f_local, snes, jac, step, ndof, two_phase, stages, .. } = self;
+        let GridSystem { dm, x, x_local, f_local, snes, jac, step, stages, .. } = self;
         let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("the step was not prepared"))?;
-        let asm = Assembler {
-            dm,
-            model,
-            step,
-            x_local,
-            f_local,
-            nd: *ndof,
-            two_phase: *two_phase,
-            seconds,
-            stage: &stages.assembly,
-        };
+        let asm = Assembler::new(dm, model, step, x_local, f_local, seconds, &stages.assembly);
         Ok((snes, x, jac, asm))
+    }
+
+    /// The forces of the converged step (collective): the moment of the external, reaction and
+    /// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
+    /// reaction.
+    pub fn step_forces(&mut self, model: &Model, coll: &Collective) -> Result<StepForces, String> {
+        let nd = self.layout.nd;
+        let ng = self.ghost.len() * nd;
+        let (mut all, mut inertia) = (vec![0.0; ng], vec![0.0; ng]);
+        {
+            let xl = self.step.solution.clone();
+            let mut seconds = 0.0;
+            let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
+            let asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
+            asm.nodal_terms(&xl, &mut all, &mut inertia);
+        }
+        let mut fext = self.step.fext.clone();
+        for v in [&mut all, &mut inertia, &mut fext] {
+            self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+        }
+        let g = &model.grid;
+        let hi = g.extent_max();
+        let origin = [0.5 * (g.origin[0] + hi[0]), 0.5 * (g.origin[1] + hi[1])];
+        let nb = model.boundaries.len();
+        // [total moment (4), external (4), reaction (4), inertia (4), reactions per boundary (2 nb)]
+        let mut local = vec![0.0; 16 + 2 * nb];
+        // (dof component, in-plane direction) of the solid and water motion.
+        let motion: Vec<(usize, usize)> =
+            self.motion().into_iter().map(|c| (c, if c < 2 { c } else { c - self.layout.w.unwrap_or(0) })).collect();
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            let (i, j) = self.ghost.ij(l);
+            let p = g.node_position(i, j);
+            let u = &self.step.solution[l * nd..l * nd + 2];
+            let xr = [p[0] + u[0] - origin[0], p[1] + u[1] - origin[1]];
+            for &(c, dir) in &motion {
+                let q = l * nd + c;
+                let b = self.step.dofs.boundary[q];
+                let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
+                if (b as usize) < nb {
+                    local[16 + 2 * b as usize + dir] += reaction;
+                }
+                for (row, x) in xr.iter().enumerate() {
+                    let k = row * 2 + dir;
+                    local[k] += x * (fext[q] + reaction - inertia[q]);
+                    local[4 + k] += x * fext[q];
+                    local[8 + k] += x * reaction;
+                    local[12 + k] += x * inertia[q];
+                }
+            }
+        }
+        let s = coll.sum(&local)?;
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok(StepForces {
+            moment: [[s[0], s[1]], [s[2], s[3]]],
+            scale: norm(&s[4..8]).max(norm(&s[8..12])).max(norm(&s[12..16])),
+            origin,
+            reactions: (0..nb).map(|b| [s[16 + 2 * b], s[17 + 2 * b]]).collect(),
+        })
     }
 
     /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
     /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
     /// interpolated increment.
     pub fn recovered_pressure_increments(&self, model: &Model) -> Vec<f64> {
-        let nd = self.ndof;
-        let dp: Vec<f64> = (0..self.ghost.len()).map(|l| self.step.solution[l * nd + kernels::dof::P]).collect();
+        let nd = self.layout.nd;
+        let p = self.layout.p.expect("a pressure");
+        let dp: Vec<f64> = (0..self.ghost.len()).map(|l| self.step.solution[l * nd + p]).collect();
         let field = crate::model::patch::PatchField {
             grid: &model.grid,
             start: self.ghost.start,
             count: self.ghost.count,
             dp: &dp,
-            active: &self.step.active,
+            active: &self.step.dofs.well,
         };
         (0..model.particles.len())
-            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).kin.dp))
+            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).interp.dp))
             .collect()
     }
 
     /// The nodes this rank owns after the last solve, as records of 7 values: global node index
-    /// j·n_x + i, active flag (1 or 0), and the nodal increments Δd of the step (ux, uy, p, Ux, Uy;
-    /// zeros beyond the dofs of one-phase runs). Empty before the first solve.
+    /// j·n_x + i, active (well-filled) flag (1 or 0), and the nodal increments Δd of the step (ux,
+    /// uy, p, Ux, Uy; zeros beyond the dofs of the layout). Empty before the first solve.
     pub fn owned_node_records(&self) -> Vec<f64> {
-        let (nd, nx) = (self.ndof, self.dm.info().nodes[0]);
+        let (nd, nx) = (self.layout.nd, self.dm.info().nodes[0]);
         let mut out = Vec::new();
         if self.step.solution.is_empty() {
             return out;
         }
-        for j in self.owned_start[1]..self.owned_start[1] + self.owned_count[1] {
-            for i in self.owned_start[0]..self.owned_start[0] + self.owned_count[0] {
-                let Some(l) = self.ghost.node(i, j) else { continue };
-                out.push((j * nx + i) as f64);
-                out.push(if self.step.active.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
-                for c in 0..5 {
-                    out.push(if c < nd { self.step.solution[l * nd + c] } else { 0.0 });
-                }
+        let names = crate::model::field_names(true);
+        let own = crate::model::field_names(self.layout.w.is_some());
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            let (i, j) = self.ghost.ij(l);
+            out.push((j * nx + i) as f64);
+            out.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
+            for name in names {
+                let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| self.step.solution[l * nd + c]);
+                out.push(v);
             }
         }
         out
     }
 
-    /// The converged step at particle `k` (kinematics and volume ratio) for the particle update.
+    /// The converged step at particle `k` for the particle update: exactly the point the converged
+    /// residual evaluated.
     pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
         let (nodes, basis) = self.step.stencils.get(k);
-        let states = node_states(nodes, &self.step.solution, &self.step, self.ndof);
-        let pred = particle_input(model, &self.step, k).pred;
-        kernels::step_result(basis, &states[..nodes.len()], &pred, self.two_phase)
+        let states = callbacks::node_states(&self.step, k, &self.step.solution);
+        let input = callbacks::particle_input(model, &self.step, k);
+        let mat = &model.materials[model.particles.material[k] as usize];
+        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, self.layout);
+        StepResult::of(&pt)
     }
 }
 
-/// Nodal states of a particle's stencil from the increments `xl`.
-#[inline]
-fn node_states(nodes: &[u32], xl: &[f64], step: &StepData, nd: usize) -> [NodeState; MAX_NODES] {
-    let nm = step.nm.expect("prepared");
-    let mut out = [NodeState::default(); MAX_NODES];
-    for (n, &node) in nodes.iter().enumerate() {
-        let b = node as usize * nd;
-        for c in 0..nd {
-            let d = xl[b + c];
-            out[n].d[c] = d;
-            out[n].a[c] = nm.a0 * d;
-            out[n].v[c] = nm.a1 * d;
-        }
-    }
-    out
+/// Nodal projections of a step.
+struct Nodal {
+    /// Filled fraction per ghosted node.
+    phi: Vec<f64>,
+    /// Mass-weighted porosity per ghosted node.
+    porosity: Vec<f64>,
+    /// Per ghosted dof.
+    mass: Vec<f64>,
+    mom: Vec<f64>,
+    acc: Vec<f64>,
 }
 
-/// The residual and Jacobian callbacks of one step.
-struct Assembler<'a> {
-    dm: &'a DmDa,
-    model: &'a Model,
-    step: &'a StepData,
-    x_local: &'a mut Vector,
-    f_local: &'a mut Vector,
-    nd: usize,
-    two_phase: bool,
-    seconds: &'a mut f64,
-    stage: &'a LogStage,
-}
-
-fn fatal(e: petsc::Error) -> CallbackError {
-    CallbackError::Fatal(e.to_string())
-}
-
-/// The kernel input of particle `k` for the prepared step.
-fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
-    let mut input = model.particle_input(k, &step.body_acc);
-    if let Some(g) = step.grad_n.get(k) {
-        input.grad_n = *g;
-    }
-    let nm = step.nm.as_ref().expect("prepared");
-    let s = &step.smooth[k];
-    input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
-    input
-}
-
-impl Assembler<'_> {
-    fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
-        self.dm.global_to_local(x, self.x_local).map_err(fatal)?;
-        Ok(self.x_local.read().map_err(fatal)?.to_vec())
-    }
-}
-
-impl NonlinearProblem for Assembler<'_> {
-    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
-        let _stage = self.stage.push().map_err(fatal)?;
-        let t0 = Instant::now();
-        let xl = self.gather(x)?;
-        let nd = self.nd;
-        {
-            let mut fl = self.f_local.write().map_err(fatal)?;
-            for (q, v) in fl.iter_mut().enumerate() {
-                *v = -self.step.fext[q];
-            }
-            let mut buf = [0.0; MAX_LOCAL];
-            for k in 0..self.step.stencils.len() {
-                let (nodes, basis) = self.step.stencils.get(k);
-                let states = node_states(nodes, &xl, self.step, nd);
-                let input = particle_input(self.model, self.step, k);
-                let mat = &self.model.materials[self.model.particles.material[k] as usize];
-                let m = nodes.len() * nd;
-                kernels::residual(basis, &states[..nodes.len()], &input, &mat.model, self.two_phase, &mut buf[..m]);
-                for (n, &node) in nodes.iter().enumerate() {
-                    let b = node as usize * nd;
-                    for c in 0..nd {
-                        fl[b + c] += buf[n * nd + c];
-                    }
-                }
-            }
-            // Pressure projection: −S Δp in the continuity rows.
-            for (idx, s) in &self.step.projection {
-                for (a, &ra) in idx.iter().enumerate() {
-                    if ra < 0 {
-                        continue;
-                    }
-                    let v: f64 =
-                        idx.iter().enumerate().filter(|(_, &q)| q >= 0).map(|(b, &q)| s[a][b] * xl[q as usize]).sum();
-                    fl[ra as usize] -= v;
-                }
-            }
-        }
-        f.set_all(0.0).map_err(fatal)?;
-        self.dm.local_to_global_add(self.f_local, f).map_err(fatal)?;
-        {
-            // Constrained dofs: residual x − 0 (Dirichlet value zero).
-            let xo = x.read().map_err(fatal)?;
-            let mut fo = f.write().map_err(fatal)?;
-            for &o in &self.step.owned_constrained {
-                fo[o] = xo[o];
-            }
-        }
-        *self.seconds += t0.elapsed().as_secs_f64();
-        Ok(())
-    }
-
-    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
-        let _stage = self.stage.push().map_err(fatal)?;
-        let t0 = Instant::now();
-        let xl = self.gather(x)?;
-        let nd = self.nd;
-        let nm = self.step.nm.expect("prepared");
-        j.zero_entries().map_err(fatal)?;
-        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
-        let mut idx = [0i32; MAX_LOCAL];
-        for k in 0..self.step.stencils.len() {
-            let (nodes, basis) = self.step.stencils.get(k);
-            let input = particle_input(self.model, self.step, k);
-            let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            let m = nodes.len() * nd;
-            // The soil tangent at the current iterate.
-            let states = node_states(nodes, &xl, self.step, nd);
-            let kin = kernels::interpolate(basis, &states[..nodes.len()], &input.pred, self.two_phase);
-            let dsig = mat.model.update(&input.stress, input.eps_pd, &kin.deps).tangent;
-            kernels::tangent(basis, &input, &dsig, nm, self.two_phase, &mut block[..m * m]);
-            for (n, &node) in nodes.iter().enumerate() {
-                let b = node as usize * nd;
-                for c in 0..nd {
-                    idx[n * nd + c] = if self.step.constrained[b + c] { -1 } else { (b + c) as i32 };
-                }
-            }
-            j.set_values_local(&idx[..m], &idx[..m], &block[..m * m], true).map_err(fatal)?;
-        }
-        for (idx, s) in &self.step.projection {
-            let neg: Vec<f64> = s.iter().flat_map(|r| r.iter().map(|v| -v)).collect();
-            j.set_values_local(idx, idx, &neg, true).map_err(fatal)?;
-        }
-        for &o in &self.step.owned_constrained {
-            let g = (self.step.global_start + o) as i32;
-            j.set_values(&[g], &[g], &[1.0], true).map_err(fatal)?;
-        }
-        j.assemble().map_err(fatal)?;
-        *self.seconds += t0.elapsed().as_secs_f64();
-        Ok(())
+/// The centre of a particle's `face` and the face's length.
+fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
+    match face {
+        Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
+        Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
+        Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
+        Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
     }
 }
 
@@ -854,155 +936,4 @@ pub fn describe_solver(sys: &mut GridSystem) -> Result<String, Error> {
     };
     let newton = if lag > 1 || lag == -1 || lag == -2 { "modified Newton (lagged Jacobian)" } else { "Newton" };
     Ok(format!("{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"))
-}
-
-/// Reductions over ranks for code outside this module (observers, probes, summaries).
-#[derive(Clone, Copy)]
-pub struct Collective {
-    comm: Comm,
-}
-
-impl Collective {
-    /// Over the run's communicator.
-    pub fn new(comm: Comm) -> Collective {
-        Collective { comm }
-    }
-
-    /// This rank.
-    pub fn rank(&self) -> usize {
-        self.comm.rank()
-    }
-
-    /// Number of ranks.
-    pub fn size(&self) -> usize {
-        self.comm.size()
-    }
-
-    /// Element-wise sum over ranks.
-    pub fn sum(&self, v: &[f64]) -> Result<Vec<f64>, String> {
-        let mut d = v.to_vec();
-        self.comm.sum_f64(&mut d).map_err(|e| e.to_string())?;
-        Ok(d)
-    }
-
-    /// Element-wise maximum over ranks.
-    pub fn max(&self, v: &[f64]) -> Result<Vec<f64>, String> {
-        let mut d = v.to_vec();
-        self.comm.max_f64(&mut d).map_err(|e| e.to_string())?;
-        Ok(d)
-    }
-
-    /// Every rank's values concatenated in rank order, on every rank.
-    pub fn gather(&self, v: &[f64]) -> Result<Vec<f64>, String> {
-        self.comm.all_gather_f64(v).map_err(|e| e.to_string())
-    }
-
-    /// Whether any rank reports `flag`.
-    pub fn any(&self, flag: bool) -> Result<bool, String> {
-        Ok(self.max(&[if flag { 1.0 } else { 0.0 }])?[0] > 0.5)
-    }
-}
-
-/// Agreement of one field-pair block of the assembled tangent with finite differences.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct BlockCheck {
-    /// Row field (`ux`, `uy`, `p`, `Ux`, `Uy`).
-    pub row: &'static str,
-    /// Column field.
-    pub col: &'static str,
-    /// max |J − J_fd| over the block.
-    pub max_abs_error: f64,
-    /// max |J| over the block.
-    pub max_abs_entry: f64,
-    /// max |J − J_fd| / max |J| of the block (of the block's rows if the block is zero).
-    pub relative_error: f64,
-}
-
-impl GridSystem {
-    /// Compares the assembled tangent of the prepared step with central finite differences of the
-    /// assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
-    /// converged increment of this step). One rank only (it builds the dense FD Jacobian: small
-    /// cases only).
-    pub fn jacobian_check(&mut self, model: &Model, fraction: f64) -> Result<Vec<BlockCheck>, Error> {
-        if self.comm.size() != 1 {
-            return Err(petsc::Error::new("the finite-difference Jacobian check runs on one rank"));
-        }
-        let nd = self.ndof;
-        let two_phase = self.two_phase;
-        let names = crate::model::field_names(two_phase);
-        // A realistic iterate: part of this step's converged increment.
-        self.solve(model)?;
-        let mut x = self.x.duplicate()?;
-        self.x.copy_to(&mut x)?;
-        x.scale(fraction)?;
-        let n = x.local_size()?;
-        let free: Vec<usize> = (0..n).filter(|o| !self.step.owned_constrained.contains(o)).collect();
-        let mut seconds = 0.0;
-        let (_, _, jac, mut asm) = self.split(model, &mut seconds)?;
-        asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
-        let (_, dense) = jac.local_rows_dense()?;
-        let xv = x.read()?.to_vec();
-        // The finite-difference step of a dof follows the typical size of its kind of unknown:
-        // displacements (ux, uy, Ux, Uy share one scale) or pore pressure, with floors of 1e-6 of a
-        // cell (m) and 1 Pa when a kind is identically zero.
-        let is_p = |o: usize| two_phase && o % nd == kernels::dof::P;
-        let (mut typ_u, mut typ_p) = (0.0f64, 0.0f64);
-        for &o in &free {
-            if is_p(o) {
-                typ_p = typ_p.max(xv[o].abs());
-            } else {
-                typ_u = typ_u.max(xv[o].abs());
-            }
-        }
-        let h_cell = model.grid.h[0].min(model.grid.h[1]);
-        let typical: Vec<f64> =
-            (0..nd).map(|c| if is_p(c) { typ_p.max(1.0) } else { typ_u.max(1e-6 * h_cell) }).collect();
-        let mut fd = vec![0.0; n * n];
-        let (mut xp, mut fp, mut fm) = (x.duplicate()?, x.duplicate()?, x.duplicate()?);
-        for &c in &free {
-            let h = 1e-6 * (xv[c].abs() + typical[c % nd]);
-            for (sign, out) in [(1.0, &mut fp), (-1.0, &mut fm)] {
-                {
-                    let mut w = xp.write()?;
-                    w.copy_from_slice(&xv);
-                    w[c] += sign * h;
-                }
-                asm.residual(&xp.as_ref(), &mut out.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
-            }
-            let (a, b) = (fp.read()?, fm.read()?);
-            for &r in &free {
-                fd[r * n + c] = (a[r] - b[r]) / (2.0 * h);
-            }
-        }
-        // A block is measured against the largest entry of its rows, so that blocks that are zero
-        // (e.g. ux–Uy) are judged by their finite-difference noise relative to that scale.
-        let row_scale: Vec<f64> = (0..nd)
-            .map(|rf| {
-                free.iter()
-                    .filter(|&&r| r % nd == rf)
-                    .flat_map(|&r| free.iter().map(move |&c| (r, c)))
-                    .fold(0.0f64, |m, (r, c)| m.max(dense[r * n + c].abs()))
-            })
-            .collect();
-        let mut out = Vec::new();
-        for rf in 0..nd {
-            for cf in 0..nd {
-                let (mut err, mut big) = (0.0f64, 0.0f64);
-                for &r in free.iter().filter(|&&r| r % nd == rf) {
-                    for &c in free.iter().filter(|&&c| c % nd == cf) {
-                        err = err.max((dense[r * n + c] - fd[r * n + c]).abs());
-                        big = big.max(dense[r * n + c].abs());
-                    }
-                }
-                out.push(BlockCheck {
-                    row: names[rf],
-                    col: names[cf],
-                    max_abs_error: err,
-                    max_abs_entry: big,
-                    relative_error: err / big.max(row_scale[rf]).max(f64::MIN_POSITIVE),
-                });
-            }
-        }
-        Ok(out)
-    }
 }

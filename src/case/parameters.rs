@@ -39,7 +39,9 @@ fn walk(v: &mut Value, path: &str, params: &[(String, f64)]) -> Result<(), Strin
         Value::String(s) => {
             if let Some(expr) = s.trim_start().strip_prefix('=') {
                 let x = eval(expr, params).map_err(|e| format!("key `{path}`: expression `{}`: {e}", expr.trim()))?;
-                *v = Value::Float(x);
+                // An integral value may fill an integer key (e.g. a number of cells); float keys take
+                // integers too.
+                *v = if x.fract() == 0.0 && x.abs() < 9.0e15 { Value::Integer(x as i64) } else { Value::Float(x) };
             }
         }
         Value::Array(a) => {
@@ -254,13 +256,15 @@ mod tests {
             [parameters]
             w = 4.0
             [grid]
-            size = ["= 2 * w", 3.0]
+            size = ["= 2 * w", "= w / 3"]
             name = "plain"
             "#,
         )
         .unwrap();
         expand(&mut doc).unwrap();
-        assert_eq!(doc["grid"]["size"][0].as_float(), Some(8.0));
+        // An integral value becomes an integer (so that it may fill an integer key), others floats.
+        assert_eq!(doc["grid"]["size"][0].as_integer(), Some(8));
+        assert_eq!(doc["grid"]["size"][1].as_float(), Some(4.0 / 3.0));
         assert_eq!(doc["grid"]["name"].as_str(), Some("plain"));
         let mut bad: Value = toml::from_str("[grid]\nsize = [\"= w\", 1.0]\n").unwrap();
         let e = expand(&mut bad).unwrap_err();

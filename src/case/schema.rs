@@ -365,8 +365,10 @@ impl std::fmt::Display for Dof {
     }
 }
 
-/// Homogeneous Dirichlet conditions (fixed displacement components, drained p = 0) on the grid
-/// nodes of a side or of a box.
+/// Dirichlet conditions on the grid nodes of a side, of a box or of a body's moving surface: the
+/// listed components are fixed, to zero (drained p = 0, a fixed or sliding wall), or moving with a
+/// prescribed displacement or velocity (a loading platen, a displacement-driven rigid footing: all
+/// its nodes move together, and the boundary's reaction is the force that drives it).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Boundary {
@@ -382,9 +384,22 @@ pub struct Boundary {
     /// particles, found again every step (a drained free surface: `fix = ["p"]`).
     #[serde(default)]
     pub surface: Option<Surface>,
-    /// Components set to zero: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained). In a one_phase analysis
-    /// the water-phase components have no dofs and are ignored.
+    /// Components fixed: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained). In a one_phase analysis the
+    /// water-phase components have no dofs and are ignored. Fixed to zero unless `displacement` or
+    /// `velocity` moves them.
     pub fix: Vec<Dof>,
+    /// Prescribed displacement [m] of the fixed displacement components: at time t the nodes have
+    /// moved by `displacement` × f(t) (f the time function; constant 1 without one). Fixed water
+    /// components move with the solid (the boundary is impermeable to flow across it).
+    #[serde(default)]
+    pub displacement: Option<[f64; 2]>,
+    /// Prescribed velocity [m/s] of the fixed displacement components, scaled by the time function:
+    /// the nodes move by ∫ `velocity` f(t) dt.
+    #[serde(default)]
+    pub velocity: Option<[f64; 2]>,
+    /// Name of the time function scaling `displacement` or `velocity`.
+    #[serde(default)]
+    pub time_function: Option<String>,
 }
 
 /// The faces of a body's surface.
@@ -395,6 +410,10 @@ pub struct Surface {
     pub body: String,
     /// Which faces: the particles whose face in one of these directions is exposed at t = 0.
     pub faces: Vec<Side>,
+    /// Only the particles whose centres lie in this box at t = 0 (default: all of the body's), e.g.
+    /// the part of the ground under a footing [m].
+    #[serde(default)]
+    pub region: Option<Region>,
 }
 
 /// A load, scaled in time by a named time function (default: constant 1).

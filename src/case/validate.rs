@@ -228,6 +228,33 @@ pub fn validate(c: &Case) -> R {
         if b.fix.is_empty() {
             return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
         }
+        if b.displacement.is_some() && b.velocity.is_some() {
+            return Err(format!("key `boundaries[{i}]`: give `displacement` or `velocity`, not both"));
+        }
+        let motion = b.displacement.or(b.velocity);
+        if let Some(m) = motion {
+            let key = if b.displacement.is_some() { "displacement" } else { "velocity" };
+            if m.iter().any(|v| !v.is_finite()) {
+                return Err(format!("key `boundaries[{i}].{key}`: must be finite"));
+            }
+            for (c, dof) in [(0, Dof::Ux), (1, Dof::Uy)] {
+                if m[c] != 0.0 && !b.fix.contains(&dof) {
+                    return Err(format!(
+                        "key `boundaries[{i}].{key}`: component {c} moves `{dof}`, which `fix` does not list"
+                    ));
+                }
+            }
+        }
+        if let Some(tf) = &b.time_function {
+            if motion.is_none() {
+                return Err(format!(
+                    "key `boundaries[{i}].time_function`: only a `displacement` or `velocity` has a time function"
+                ));
+            }
+            if c.time_function(tf).is_none() {
+                return Err(format!("key `boundaries[{i}].time_function`: no time function named `{tf}`"));
+            }
+        }
         // In a one_phase analysis the water-phase components (p, Ux, Uy) have no dofs and are
         // ignored, so that one case file can switch formulation with `--set analysis.formulation`.
     }

@@ -166,7 +166,7 @@ pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)>
     };
     let dir = if spread(0) >= spread(1) { 0 } else { 1 };
     let coord = |n: &(usize, usize)| grid.node_position(n.0, n.1)[dir];
-    sel.sort_by(|a, b| coord(a).partial_cmp(&coord(b)).unwrap());
+    sel.sort_by(|a, b| coord(a).total_cmp(&coord(b)));
     let m = sel.len();
     (0..m)
         .map(|k| {
@@ -177,7 +177,46 @@ pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)>
         .collect()
 }
 
-/// A set of homogeneous Dirichlet conditions.
+/// A prescribed motion of a boundary's fixed displacement components.
+#[derive(Debug, Clone)]
+pub struct Motion {
+    /// Whether `vector` is a displacement [m] (true) or a velocity [m/s].
+    pub is_displacement: bool,
+    /// The displacement or velocity at time-function value 1.
+    pub vector: [f64; 2],
+    /// The time function.
+    pub time_fn: TimeFn,
+}
+
+impl Motion {
+    /// The prescribed displacement at time `t` [m]: d f(t), or ∫₀ᵗ v f dτ.
+    pub fn displacement_at(&self, t: f64) -> [f64; 2] {
+        let s = if self.is_displacement { self.time_fn.eval(t) } else { self.integral(0.0, t) };
+        [self.vector[0] * s, self.vector[1] * s]
+    }
+
+    /// The prescribed displacement over t0 → t1 [m].
+    pub fn increment(&self, t0: f64, t1: f64) -> [f64; 2] {
+        let s =
+            if self.is_displacement { self.time_fn.eval(t1) - self.time_fn.eval(t0) } else { self.integral(t0, t1) };
+        [self.vector[0] * s, self.vector[1] * s]
+    }
+
+    /// ∫_{t0}^{t1} f dτ by the composite Simpson rule on 32 intervals (exact for piecewise linear
+    /// and quadratic functions without kinks inside the interval).
+    fn integral(&self, t0: f64, t1: f64) -> f64 {
+        let n = 32;
+        let h = (t1 - t0) / n as f64;
+        if h == 0.0 {
+            return 0.0;
+        }
+        let f = |k: usize| self.time_fn.eval(t0 + k as f64 * h);
+        let inner: f64 = (1..n).map(|k| if k % 2 == 1 { 4.0 * f(k) } else { 2.0 * f(k) }).sum();
+        h / 3.0 * (f(0) + inner + f(n))
+    }
+}
+
+/// A set of Dirichlet conditions.
 #[derive(Debug, Clone)]
 pub struct BoundaryDef {
     /// Name from the case.
@@ -188,18 +227,23 @@ pub struct BoundaryDef {
     pub region: Option<Region>,
     /// Or the moving surface of a body: (local particle index, exposed face) pairs.
     pub surface: Option<Vec<(usize, Side)>>,
-    /// Components fixed to zero.
+    /// Components fixed.
     pub fix: Vec<Dof>,
+    /// Their prescribed motion (none: fixed to zero).
+    pub motion: Option<Motion>,
 }
 
 impl BoundaryDef {
-    /// From the case; a surface is resolved on this rank's particles (those of the body whose face
-    /// in a listed direction is exposed at t = 0).
+    /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
+    /// surface's region if it has one, whose face in a listed direction is exposed at t = 0).
     pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles) -> BoundaryDef {
         let surface = b.surface.as_ref().map(|sf| {
             let body = c.body_index(&sf.body).expect("validated") as u16;
             let mut v = Vec::new();
             for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
+                if sf.region.is_some_and(|r| !r.contains(particles.x0[k])) {
+                    continue;
+                }
                 for &f in &sf.faces {
                     if face_is_exposed(c, particles.x0[k], particles.lp[k], f) {
                         v.push((k, f));
@@ -208,7 +252,19 @@ impl BoundaryDef {
             }
             v
         });
-        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone() }
+        let time_fn = || {
+            b.time_function
+                .as_ref()
+                .and_then(|n| c.time_function(n))
+                .map(TimeFn::from_case)
+                .unwrap_or(TimeFn::Constant(1.0))
+        };
+        let motion = match (b.displacement, b.velocity) {
+            (Some(d), _) => Some(Motion { is_displacement: true, vector: d, time_fn: time_fn() }),
+            (None, Some(v)) => Some(Motion { is_displacement: false, vector: v, time_fn: time_fn() }),
+            _ => None,
+        };
+        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone(), motion }
     }
 
     /// Whether a node at `node` lies on or beyond the exposed `face` of a particle at `x` with domain

@@ -161,25 +161,27 @@ impl Model {
         }
     }
 
-    /// Which dof components (ux, uy, p, Ux, Uy) the active side and region boundaries fix at node
-    /// (i, j). Moving surfaces are in [`Model::surface_fixes`].
-    pub fn fixed_components(&self, active: &Active, i: usize, j: usize) -> [bool; 5] {
-        let mut fixed = [false; 5];
+    /// For each dof component (ux, uy, p, Ux, Uy) at node (i, j), the first active side or region
+    /// boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are in
+    /// [`Model::surface_fixes`].
+    pub fn fixing_boundaries(&self, active: &Active, i: usize, j: usize) -> [Option<usize>; 5] {
+        let mut by = [None; 5];
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
-            if b.contains(&self.grid, i, j) {
+            if b.surface.is_none() && b.contains(&self.grid, i, j) {
                 for d in &b.fix {
-                    fixed[dof_index(*d)] = true;
+                    let c = dof_index(*d);
+                    by[c] = by[c].or(Some(bi));
                 }
             }
         }
-        fixed
+        by
     }
 
     /// The nodes fixed by the active moving-surface boundaries on the current configuration: the
     /// nodes of each surface particle's stencil (non-zero weight) on or beyond its exposed face,
-    /// with the components fixed there.
-    pub fn surface_fixes(&self, active: &Active) -> Vec<((u32, u32), [bool; 5])> {
+    /// with the boundary's index and the components fixed there.
+    pub fn surface_fixes(&self, active: &Active) -> Vec<((u32, u32), usize, [bool; 5])> {
         let mut out = Vec::new();
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
@@ -195,7 +197,7 @@ impl Model {
                 for ((i, j), w, _) in st.iter() {
                     let node = self.grid.node_position(i as usize, j as usize);
                     if w > 0.0 && BoundaryDef::beyond(face, x, lp, node, tol) {
-                        out.push(((i, j), comps));
+                        out.push(((i, j), bi, comps));
                     }
                 }
             }
@@ -273,13 +275,28 @@ impl Model {
         }
     }
 
-    /// Whether particle `k` may take the converged step: its volume ratio J must be positive and the
-    /// porosity it implies ([`Model::porosity_after`]) inside (0, 1).
+    /// Whether particle `k` may take the converged step: every quantity it would take must be finite,
+    /// its volume ratio J positive and the porosity it implies ([`Model::porosity_after`]) inside
+    /// (0, 1). The message names the particle and the quantity.
     pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
         let j = step.jacobian;
         let ps = &self.particles;
+        let it = &step.interp;
+        let finite = [
+            ("displacement increment", it.du[0].is_finite() && it.du[1].is_finite()),
+            ("velocity", it.v_u[0].is_finite() && it.v_u[1].is_finite() && it.a_u.iter().all(|a| a.is_finite())),
+            ("effective stress", step.upd.stress.iter().all(|s| s.is_finite())),
+            ("pore pressure increment", it.dp.is_finite()),
+            ("volume ratio", j.is_finite()),
+        ];
+        if let Some((what, _)) = finite.iter().find(|f| !f.1) {
+            return Err(InadmissibleStep(format!(
+                "material point {} at ({:.4}, {:.4}) m: its {what} is not finite (NaN or Inf)",
+                ps.id[k], ps.x[k][0], ps.x[k][1]
+            )));
+        }
         let n_new = self.porosity_after(k, j);
-        if j.is_nan() || j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
+        if j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
             return Err(InadmissibleStep(format!(
                 "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
                 ps.id[k], ps.x[k][0], ps.x[k][1]
@@ -292,10 +309,11 @@ impl Model {
     /// the nodal Newmark accelerations ([003] Eq. 24a), velocities by the Newmark rule
     /// v_{n+1} = v_n + Δt((1 − γ)a_n + γ a_{n+1}) on the point (a FLIP update, where [003] Eq. 24b
     /// interpolates the nodal velocities: that PIC update damps the transients of the verification
-    /// cases measurably, e.g. the Terzaghi settlement error rises from 2e-5 to 1.5e-3),
-    /// stress by the soil model, pore pressure by `dp` (the interpolated or recovered increment),
-    /// position and displacement by the interpolated solid increment, deformation gradient by
-    /// F_{n+1} = (I + ∇Δu) F_n, volume by J = det(I + ∇Δu), porosity by conservation of solid mass:
+    /// cases measurably, e.g. the Terzaghi settlement error rises from 2e-5 to 1.5e-3), the
+    /// effective stress and ε̄ exactly as the converged residual computed them (objective update,
+    /// see [`crate::kernels::kinematics`]), pore pressure by `dp` (the interpolated or recovered
+    /// increment), position and displacement by the interpolated solid increment, deformation
+    /// gradient by F_{n+1} = F̄ F_n, volume by J_v, porosity by conservation of solid mass:
     /// (1 − n_{n+1}) V_{n+1} = (1 − n_n) V_n, and (GIMP with stretching domains) the domain
     /// half-widths by l_p = l_p0 ⊙ diag(sqrt(FᵀF)) (iGIMP), at most half a cell.
     pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
@@ -303,24 +321,22 @@ impl Model {
         let j = step.jacobian;
         let n_new = self.porosity_after(k, j);
         let ps = &mut self.particles;
-        let kin = &step.kin;
+        let it = &step.interp;
         let g = self.gamma;
         for c in 0..2 {
-            ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * kin.a_u[c]);
-            ps.acc[k][c] = kin.a_u[c];
+            ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.a_u[c]);
+            ps.acc[k][c] = it.a_u[c];
             if self.two_phase {
-                ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * kin.a_w[c]);
-                ps.acc_w[k][c] = kin.a_w[c];
+                ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * it.a_w[c]);
+                ps.acc_w[k][c] = it.a_w[c];
             }
         }
         for c in 0..2 {
-            ps.x[k][c] += kin.du[c];
-            ps.disp[k][c] += kin.du[c];
+            ps.x[k][c] += it.du[c];
+            ps.disp[k][c] += it.du[c];
         }
-        let mat = &self.materials[ps.material[k] as usize];
-        let upd = mat.model.update(&ps.stress[k], ps.eps_pd[k], &kin.deps);
-        ps.stress[k] = upd.stress;
-        ps.eps_pd[k] = upd.eps_pd;
+        ps.stress[k] = step.upd.stress;
+        ps.eps_pd[k] = step.upd.eps_pd;
         ps.p[k] += dp;
         ps.volume[k] *= j;
         ps.porosity[k] = n_new;

@@ -17,9 +17,9 @@
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
 use super::{Check, Findings, Metric, Table};
-use crate::assembly::Collective;
 use crate::case::{Case, Load, SoilModel};
 use crate::model::Model;
+use crate::parallel::Collective;
 
 /// The load–settlement check.
 pub struct BearingCheck {

@@ -11,8 +11,8 @@
 //! over all particles whose neighbourhood has enough points for the fit. A field that is locally
 //! quadratic scores 0, a smooth field O(h³ p‴/p), an alternating pattern of amplitude A about A/|p|.
 
-use crate::assembly::Collective;
 use crate::model::Model;
+use crate::parallel::Collective;
 use std::collections::HashMap;
 
 /// The checkerboard index of the current pore pressures (0 when there is no pressure).
@@ -94,7 +94,7 @@ pub fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
 fn solve(a: &mut [f64], b: &mut [f64], m: usize) -> Option<Vec<f64>> {
     let scale = a.iter().fold(0.0f64, |x, v| x.max(v.abs()));
     for col in 0..m {
-        let piv = (col..m).max_by(|&x, &y| a[x * m + col].abs().partial_cmp(&a[y * m + col].abs()).unwrap())?;
+        let piv = (col..m).max_by(|&x, &y| a[x * m + col].abs().total_cmp(&a[y * m + col].abs()))?;
         if a[piv * m + col].abs() <= 1e-12 * scale {
             return None;
         }

@@ -28,9 +28,9 @@ pub mod terzaghi;
 pub mod waves;
 pub mod xie_leo;
 
-use crate::assembly::Collective;
 use crate::case::{self, Case, ConductivityLaw, Load, TimeFunction, Verification};
 use crate::model::Model;
+use crate::parallel::Collective;
 use serde::Serialize;
 
 /// One verification metric as written to `summary.json`.
@@ -660,7 +660,7 @@ impl Check for HarmonicCheck {
                 None => rows.push((d[0], d[1], 1)),
             }
         }
-        rows.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
         let q = self.col.load;
         let table: Vec<Vec<f64>> =
             rows.iter().map(|r| vec![r.0, r.1 / r.2 as f64 / q, self.theory.pressure_amplitude(r.0) / q]).collect();

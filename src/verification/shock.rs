@@ -9,8 +9,8 @@
 //! ringing) is documented at [`pick_arrival`].
 
 use super::{Check, Column, Findings, Metric};
-use crate::assembly::Collective;
 use crate::model::Model;
+use crate::parallel::Collective;
 
 /// Time at which a front passes, picked from samples `(t, p)` restricted to `[t0, t1]`:
 /// the first time p crosses the mid-level between its value at `t0` and the level it settles at
@@ -27,7 +27,7 @@ pub fn pick_arrival(samples: &[(f64, f64)], t0: f64, t1: f64) -> Option<f64> {
     }
     let before = win[0].1;
     let mut tail: Vec<f64> = win[win.len() / 2..].iter().map(|s| s.1).collect();
-    tail.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    tail.sort_by(|a, b| a.total_cmp(b));
     let after = tail[tail.len() / 2];
     if (after - before).abs() < 0.05 * scale || scale == 0.0 {
         return None;
@@ -77,7 +77,7 @@ impl ShockCheck {
             })
             .collect();
         let all = coll.gather(&local)?;
-        let best = all.chunks(3).min_by(|a, b| a[0].partial_cmp(&b[0]).unwrap().then(a[1].partial_cmp(&b[1]).unwrap()));
+        let best = all.chunks(3).min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
         let best = best.ok_or("the shock-wave column has no particles")?;
         let q_mod = if col.inv_q > 0.0 { 1.0 / col.inv_q } else { f64::INFINITY };
         let rho = (1.0 - col.porosity) * col.solid_density + col.porosity * col.water_density;

@@ -30,6 +30,11 @@ impl Comm {
         Comm(unsafe { ffi::RSMPI_COMM_SELF })
     }
 
+    /// The communicator of a raw MPI handle (e.g. rsmpi's `as_raw()` of the world communicator).
+    pub fn from_raw(raw: sys::MPI_Comm) -> Comm {
+        Comm(raw)
+    }
+
     /// The raw handle, for `petsc-sys` calls.
     pub fn raw(&self) -> sys::MPI_Comm {
         self.0

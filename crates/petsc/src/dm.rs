@@ -209,6 +209,27 @@ impl DmDa {
         call!(DMLocalToGlobalEnd(self.raw, local.raw(), sys::InsertMode::ADD_VALUES, global.raw()))
     }
 
+    /// Creates an AIJ matrix of the DMDA's layout whose nonzero pattern is exactly the given
+    /// coordinate list (`rows[k]`, `cols[k]` global indices; repeated pairs are summed by
+    /// [`crate::mat::MatOps::set_values_coo`], negative ones ignored): the DMDA's own box
+    /// preallocation is skipped, so any reach of the particles' stencils fits. The values follow
+    /// the list's order in every later `set_values_coo`.
+    pub fn create_matrix_coo(&self, rows: &[Int], cols: &[Int]) -> Result<Mat> {
+        if rows.len() != cols.len() {
+            return Err(Error::new("COO preallocation: row and column lists differ in length"));
+        }
+        let aij = cstring("aij")?;
+        call!(DMSetMatType(self.raw, aij.as_ptr()))?;
+        call!(DMSetMatrixPreallocateSkip(self.raw, sys::PetscBool::PETSC_TRUE))?;
+        let mut raw = std::ptr::null_mut();
+        call!(DMCreateMatrix(self.raw, &mut raw))?;
+        let m = Mat { raw };
+        // PETSc may reorder the index arrays in place: hand it copies.
+        let (mut i, mut j) = (rows.to_vec(), cols.to_vec());
+        call!(MatSetPreallocationCOO(m.raw, i.len() as sys::PetscCount, i.as_mut_ptr(), j.as_mut_ptr()))?;
+        Ok(m)
+    }
+
     /// A new AIJ matrix preallocated for the grid's box stencil, with the local-to-global mapping
     /// set (so `set_values_local` works). Nothing is stored until values are set; entries outside
     /// the stencil are an error.

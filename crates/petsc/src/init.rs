@@ -38,21 +38,34 @@ pub struct Petsc {
 }
 
 impl Petsc {
-    /// Initialises MPI (through rsmpi) and then PETSc.
+    /// Initialises MPI (through rsmpi) and then PETSc, for programs that leave MPI to this guard
+    /// (the PETSc smoke tests, the benchmarks). See [`Petsc::initialize_on`] for the arguments.
+    pub fn initialize(petsc_args: &[String], options_file: Option<&Path>, help: &str) -> Result<Petsc> {
+        let universe = mpi::initialize().ok_or_else(|| {
+            Error::new("MPI is already initialised in this process; PETSc can be initialised only once")
+        })?;
+        let mut guard = Self::start(None, petsc_args, options_file, help)?;
+        guard.universe = Some(universe);
+        Ok(guard)
+    }
+
+    /// Initialises PETSc on the communicator `world` of an MPI that the caller initialised (and
+    /// will finalise after dropping this guard): PETSC_COMM_WORLD becomes `world`.
     ///
     /// `petsc_args` are PETSc command-line options exactly as the user gave them (e.g.
     /// `["-ksp_type", "gmres"]`); they reach PETSc's options database unchanged. `options_file`, if
     /// given, is read first, so command-line options override it. The file must exist (checked here,
     /// so that a missing file is a clear error rather than a PETSc traceback).
-    pub fn initialize(petsc_args: &[String], options_file: Option<&Path>, help: &str) -> Result<Petsc> {
+    pub fn initialize_on(world: Comm, petsc_args: &[String], options_file: Option<&Path>, help: &str) -> Result<Petsc> {
+        Self::start(Some(world), petsc_args, options_file, help)
+    }
+
+    fn start(world: Option<Comm>, petsc_args: &[String], options_file: Option<&Path>, help: &str) -> Result<Petsc> {
         if let Some(f) = options_file {
             if !f.is_file() {
                 return Err(Error::new(format!("PETSc options file {} does not exist", f.display())));
             }
         }
-        let universe = mpi::initialize().ok_or_else(|| {
-            Error::new("MPI is already initialised in this process; PETSc can be initialised only once")
-        })?;
         let mut argv: Vec<CString> = vec![cstring("porompm")?];
         for a in petsc_args {
             argv.push(cstring(a)?);
@@ -63,6 +76,11 @@ impl Petsc {
         let mut argv_p = argv_ptrs.as_mut_ptr();
         let file = options_file.map(|p| cstring(&p.to_string_lossy())).transpose()?;
         let help = cstring(help)?;
+        if let Some(w) = world {
+            // SAFETY: PETSC_COMM_WORLD is a plain global that PETSc reads in PetscInitialize; it
+            // may be set before, and nothing else touches it concurrently.
+            unsafe { sys::PETSC_COMM_WORLD = w.raw() };
+        }
         // SAFETY: argc/argv describe NUL-terminated strings owned by `argv`, which lives as long as
         // the returned guard (PETSc keeps the pointers). The file and help strings outlive the call.
         let rc = unsafe {
@@ -74,10 +92,9 @@ impl Petsc {
             )
         };
         if rc != 0 {
-            drop(universe);
             return Err(Error { code: rc, message: format!("PetscInitialize failed (PETSc error {rc})") });
         }
-        let guard = Petsc { _argv: argv, _argv_ptrs: argv_ptrs, universe: Some(universe) };
+        let guard = Petsc { _argv: argv, _argv_ptrs: argv_ptrs, universe: None };
         // From here on PETSc errors are recorded, not printed.
         call!(PetscPushErrorHandler(Some(error::record_error), std::ptr::null_mut()))?;
         Ok(guard)
@@ -86,11 +103,6 @@ impl Petsc {
     /// `PETSC_COMM_WORLD`.
     pub fn world(&self) -> Comm {
         Comm::world()
-    }
-
-    /// The rsmpi universe (for MPI operations outside PETSc).
-    pub fn universe(&self) -> &mpi::environment::Universe {
-        self.universe.as_ref().expect("universe lives as long as the guard")
     }
 }
 
@@ -102,7 +114,7 @@ impl Drop for Petsc {
             sys::PetscPopErrorHandler();
             sys::PetscFinalize();
         }
-        // The universe (MPI_Finalize) is dropped after this, with the fields.
+        // A universe this guard created (MPI_Finalize) is dropped after this.
         self.universe.take();
     }
 }

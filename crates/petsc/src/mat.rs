@@ -93,6 +93,15 @@ pub trait MatOps {
         ))
     }
 
+    /// Sets all values of a matrix created with a coordinate list (see
+    /// [`crate::DmDa::create_matrix_coo`]), in the list's order; entries listed more than once
+    /// (also on other ranks) are summed, and the matrix is assembled. `add` adds to the current
+    /// values instead of replacing them.
+    fn set_values_coo(&mut self, vals: &[Real], add: bool) -> Result<()> {
+        let mode = if add { sys::InsertMode::ADD_VALUES } else { sys::InsertMode::INSERT_VALUES };
+        call!(MatSetValuesCOO(self.raw(), vals.as_ptr(), mode))
+    }
+
     /// Final assembly (communicates off-rank entries, compresses storage).
     fn assemble(&mut self) -> Result<()> {
         call!(MatAssemblyBegin(self.raw(), sys::MatAssemblyType::MAT_FINAL_ASSEMBLY))?;

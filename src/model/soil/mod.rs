@@ -23,6 +23,9 @@ use principal::{mul4, Principal};
 /// A 4×4 matrix in the stress-vector basis.
 pub type Mat4 = [[f64; 4]; 4];
 
+/// The 4×4 identity.
+pub const IDENTITY4: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+
 /// Where a return mapping ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Region {
@@ -73,6 +76,10 @@ pub struct StressUpdate {
     pub stress: [f64; 4],
     /// Consistent tangent dσ/dΔε [Pa].
     pub tangent: Mat4,
+    /// dσ/dσ_trial of the return (identity for an elastic step), with σ_trial = σ_n + D Δε; the
+    /// derivative with respect to the stress the step starts from (rotated by the objective
+    /// update) is the same, and `tangent` = `trial_tangent` · D.
+    pub trial_tangent: Mat4,
     /// Accumulated deviatoric plastic strain ε̄ after the step [-].
     pub eps_pd: f64,
     /// Where the return ended.
@@ -142,9 +149,13 @@ impl Constitutive {
     #[inline]
     pub fn update(&self, stress: &[f64; 4], eps_pd: f64, deps: &[f64; 4]) -> StressUpdate {
         match self {
-            Constitutive::LinearElastic(el) => {
-                StressUpdate { stress: el.trial(stress, deps), tangent: el.d, eps_pd, region: Region::Elastic }
-            }
+            Constitutive::LinearElastic(el) => StressUpdate {
+                stress: el.trial(stress, deps),
+                tangent: el.d,
+                trial_tangent: IDENTITY4,
+                eps_pd,
+                region: Region::Elastic,
+            },
             Constitutive::MohrCoulomb(el, mc) => {
                 isotropic_return(el, stress, eps_pd, deps, |l, e| {
                     // Sort descending, return, and map back.
@@ -195,10 +206,22 @@ fn isotropic_return(
     let p = Principal::of(&trial);
     let r = ret(&p.values, eps);
     if r.region == Region::Elastic {
-        return StressUpdate { stress: trial, tangent: el.d, eps_pd: eps, region: Region::Elastic };
+        return StressUpdate {
+            stress: trial,
+            tangent: el.d,
+            trial_tangent: IDENTITY4,
+            eps_pd: eps,
+            region: Region::Elastic,
+        };
     }
     let dsdt = p.derivative(&r.stress, &r.tangent);
-    StressUpdate { stress: p.compose(&r.stress), tangent: mul4(&dsdt, &el.d), eps_pd: r.eps, region: r.region }
+    StressUpdate {
+        stress: p.compose(&r.stress),
+        tangent: mul4(&dsdt, &el.d),
+        trial_tangent: dsdt,
+        eps_pd: r.eps,
+        region: r.region,
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,324 @@
+//! The residual and Jacobian callbacks of one step: every particle's kernels, mapped through its
+//! extensions (see [`super::stencils`]) onto the nodes that carry unknowns, added into a ghosted
+//! vector (summed over ranks by PETSc) and into the COO value array of the matrix.
+
+use super::StepData;
+use crate::kernels::{self, NodeState, MAX_LOCAL, MAX_NODES};
+use crate::model::Model;
+use petsc::mat::MatOps;
+use petsc::snes::NonlinearProblem;
+use petsc::{CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
+use std::time::Instant;
+
+/// Largest number of effective nodes of a particle (its raw stencil plus masters of extended
+/// nodes outside it).
+const MAX_EFF: usize = MAX_NODES + 8;
+
+fn fatal(e: petsc::Error) -> CallbackError {
+    CallbackError::Fatal(e.to_string())
+}
+
+/// The kernel input of particle `k` for the prepared step.
+pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
+    let mut input = model.particle_input(k, &step.body_acc);
+    if let Some(g) = step.grad_n.get(k) {
+        input.grad_n = *g;
+    }
+    let nm = step.nm.as_ref().expect("prepared");
+    let s = &step.smooth[k];
+    input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
+    input
+}
+
+/// The nodal states of particle `k`'s raw stencil from the ghosted increments `xl`, with the
+/// motion of extended nodes taken from their masters.
+pub(super) fn node_states(step: &StepData, k: usize, xl: &[f64]) -> [NodeState; MAX_NODES] {
+    let nm = step.nm.expect("prepared");
+    let nd = step.dofs.nd;
+    let (nodes, _) = step.stencils.get(k);
+    let eff = step.stencils.effective(k);
+    let mut d = [[0.0; kernels::MAX_DOF]; MAX_NODES];
+    for (n, &node) in nodes.iter().enumerate() {
+        let b = node as usize * nd;
+        d[n][..nd].copy_from_slice(&xl[b..b + nd]);
+    }
+    for e in step.stencils.extensions(k) {
+        for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
+            d[e.slot as usize][c] =
+                (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
+        }
+    }
+    let mut out = [NodeState::default(); MAX_NODES];
+    for n in 0..nodes.len() {
+        out[n] = NodeState::new(&d[n][..nd], &nm);
+    }
+    out
+}
+
+/// For every raw local dof of particle `k`, where it goes among the effective dofs: one (dof, 1)
+/// pair, or the masters of an extended component. Returns the number of effective dofs.
+fn transform(step: &StepData, k: usize, out: &mut Vec<Vec<(usize, f64)>>) -> usize {
+    let nd = step.dofs.nd;
+    let (nodes, _) = step.stencils.get(k);
+    out.clear();
+    out.extend((0..nodes.len() * nd).map(|a| vec![(a, 1.0)]));
+    for e in step.stencils.extensions(k) {
+        for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
+            out[e.slot as usize * nd + c] =
+                (0..e.n as usize).map(|m| (e.masters[m].0 as usize * nd + c, e.masters[m].1)).collect();
+        }
+    }
+    step.stencils.effective(k).len() * nd
+}
+
+/// The callbacks of one step.
+pub(super) struct Assembler<'a> {
+    dm: &'a DmDa,
+    model: &'a Model,
+    step: &'a StepData,
+    x_local: &'a mut Vector,
+    f_local: &'a mut Vector,
+    seconds: &'a mut f64,
+    stage: &'a LogStage,
+    values: Vec<f64>,
+}
+
+impl<'a> Assembler<'a> {
+    pub(super) fn new(
+        dm: &'a DmDa,
+        model: &'a Model,
+        step: &'a StepData,
+        x_local: &'a mut Vector,
+        f_local: &'a mut Vector,
+        seconds: &'a mut f64,
+        stage: &'a LogStage,
+    ) -> Assembler<'a> {
+        Assembler { dm, model, step, x_local, f_local, seconds, stage, values: Vec::new() }
+    }
+
+    fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
+        self.dm.global_to_local(x, self.x_local).map_err(fatal)?;
+        Ok(self.x_local.read().map_err(fatal)?.to_vec())
+    }
+
+    /// The point of particle `k` at the ghosted increments `xl`.
+    fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+        let step = self.step;
+        let (nodes, basis) = step.stencils.get(k);
+        let states = node_states(step, k, xl);
+        let input = particle_input(self.model, step, k);
+        let mat = &self.model.materials[self.model.particles.material[k] as usize];
+        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
+        kernels::residual(&pt, buf);
+        pt.size()
+    }
+
+    /// Adds particle `k`'s raw residual block `r` (length m) to the ghosted array `f` through its
+    /// extensions.
+    fn scatter(&self, k: usize, r: &[f64], f: &mut [f64]) {
+        let nd = self.step.dofs.nd;
+        let (nodes, _) = self.step.stencils.get(k);
+        let eff = self.step.stencils.effective(k);
+        let mut moved = [false; MAX_LOCAL];
+        for e in self.step.stencils.extensions(k) {
+            for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
+                let a = e.slot as usize * nd + c;
+                moved[a] = true;
+                for m in 0..e.n as usize {
+                    f[eff[e.masters[m].0 as usize] as usize * nd + c] += e.masters[m].1 * r[a];
+                }
+            }
+        }
+        for (n, &node) in nodes.iter().enumerate() {
+            for c in 0..nd {
+                if !moved[n * nd + c] {
+                    f[node as usize * nd + c] += r[n * nd + c];
+                }
+            }
+        }
+    }
+
+    /// The kernel terms of the converged step summed per ghosted dof (this rank's particles): all
+    /// terms into `all`, the inertia term (with the body force) alone into `inertia`.
+    pub(super) fn nodal_terms(&self, xl: &[f64], all: &mut [f64], inertia: &mut [f64]) {
+        let step = self.step;
+        let mut buf = [0.0; MAX_LOCAL];
+        let mut ibuf = [0.0; MAX_LOCAL];
+        for k in 0..step.stencils.len() {
+            let (nodes, basis) = step.stencils.get(k);
+            let states = node_states(step, k, xl);
+            let input = particle_input(self.model, step, k);
+            let mat = &self.model.materials[self.model.particles.material[k] as usize];
+            let pt =
+                kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
+            let m = pt.size();
+            kernels::residual(&pt, &mut buf[..m]);
+            ibuf[..m].fill(0.0);
+            kernels::inertia::residual(&pt, &mut ibuf[..m]);
+            self.scatter(k, &buf[..m], all);
+            self.scatter(k, &ibuf[..m], inertia);
+        }
+        self.add_projection(xl, all);
+    }
+
+    /// −S Δp of the pressure projection in the continuity rows of `f`.
+    fn add_projection(&self, xl: &[f64], f: &mut [f64]) {
+        let Some(p) = self.step.layout.and_then(|l| l.p) else { return };
+        let nd = self.step.dofs.nd;
+        for (nodes, s) in &self.step.projection {
+            for (a, &na) in nodes.iter().enumerate() {
+                let ra = na as usize * nd + p;
+                if self.step.dofs.fixed[ra] {
+                    continue;
+                }
+                let v: f64 = nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(b, &nb)| {
+                        let q = nb as usize * nd + p;
+                        if self.step.dofs.fixed[q] {
+                            0.0
+                        } else {
+                            s[a][b] * xl[q]
+                        }
+                    })
+                    .sum();
+                f[ra] -= v;
+            }
+        }
+    }
+
+    /// Adds particle `k`'s tangent block to the COO values.
+    fn add_tangent(
+        &self,
+        k: usize,
+        block: &[f64],
+        m: usize,
+        tr: &mut Vec<Vec<(usize, f64)>>,
+        eff_block: &mut [f64],
+        values: &mut [f64],
+    ) {
+        let step = self.step;
+        let nd = step.dofs.nd;
+        let has_ext = !step.stencils.extensions(k).is_empty();
+        let eff = step.stencils.effective(k);
+        let (me, kb): (usize, &[f64]) = if has_ext {
+            let me = transform(step, k, tr);
+            eff_block[..me * me].fill(0.0);
+            for a in 0..m {
+                for &(ea, wa) in &tr[a] {
+                    for b in 0..m {
+                        let v = block[a * m + b];
+                        if v == 0.0 {
+                            continue;
+                        }
+                        for &(eb, wb) in &tr[b] {
+                            eff_block[ea * me + eb] += wa * wb * v;
+                        }
+                    }
+                }
+            }
+            (me, &eff_block[..me * me])
+        } else {
+            (m, &block[..m * m])
+        };
+        let ne = me / nd;
+        let slots = &step.slots[step.slot_offsets[k]..step.slot_offsets[k + 1]];
+        let fixed = &step.dofs.fixed;
+        for p in 0..ne {
+            let rp = eff[p] as usize * nd;
+            for q in 0..ne {
+                let cq = eff[q] as usize * nd;
+                let base = slots[p * ne + q] as usize * nd * nd;
+                for c1 in 0..nd {
+                    if fixed[rp + c1] {
+                        continue;
+                    }
+                    let row = &kb[(p * nd + c1) * me + q * nd..(p * nd + c1) * me + q * nd + nd];
+                    for c2 in 0..nd {
+                        if !fixed[cq + c2] {
+                            values[base + c1 * nd + c2] += row[c2];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl NonlinearProblem for Assembler<'_> {
+    fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
+        let _stage = self.stage.push().map_err(fatal)?;
+        let t0 = Instant::now();
+        let xl = self.gather(x)?;
+        let mut fl = vec![0.0; xl.len()];
+        for (v, e) in fl.iter_mut().zip(&self.step.fext) {
+            *v = -e;
+        }
+        let mut buf = [0.0; MAX_LOCAL];
+        for k in 0..self.step.stencils.len() {
+            let m = self.residual_of(k, &xl, &mut buf);
+            self.scatter(k, &buf[..m], &mut fl);
+        }
+        self.add_projection(&xl, &mut fl);
+        self.f_local.write().map_err(fatal)?.copy_from_slice(&fl);
+        f.set_all(0.0).map_err(fatal)?;
+        self.dm.local_to_global_add(self.f_local, f).map_err(fatal)?;
+        {
+            // Fixed dofs: residual x − prescribed increment.
+            let xo = x.read().map_err(fatal)?;
+            let mut fo = f.write().map_err(fatal)?;
+            for &(o, q) in &self.step.dofs.owned_fixed {
+                fo[o] = xo[o] - self.step.dofs.value[q];
+            }
+        }
+        *self.seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+        let _stage = self.stage.push().map_err(fatal)?;
+        let t0 = Instant::now();
+        let xl = self.gather(x)?;
+        let step = self.step;
+        let nd = step.dofs.nd;
+        let nm = step.nm.expect("prepared");
+        let layout = step.layout.expect("prepared");
+        let mut values = std::mem::take(&mut self.values);
+        values.clear();
+        values.resize(step.pattern_blocks * nd * nd, 0.0);
+        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
+        let mut eff_block = vec![0.0; MAX_EFF * kernels::MAX_DOF * MAX_EFF * kernels::MAX_DOF];
+        let mut tr = Vec::new();
+        for k in 0..step.stencils.len() {
+            let (nodes, basis) = step.stencils.get(k);
+            let input = particle_input(self.model, step, k);
+            let mat = &self.model.materials[self.model.particles.material[k] as usize];
+            let states = node_states(step, k, &xl);
+            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout);
+            let m = pt.size();
+            kernels::tangent(&pt, &nm, &mut block[..m * m]);
+            self.add_tangent(k, &block, m, &mut tr, &mut eff_block, &mut values);
+        }
+        if let Some(p) = layout.p {
+            for ((nodes, s), blocks) in step.projection.iter().zip(&step.projection_blocks) {
+                for (a, &na) in nodes.iter().enumerate() {
+                    for (b, &nb) in nodes.iter().enumerate() {
+                        let (ra, cb) = (na as usize * nd + p, nb as usize * nd + p);
+                        if !step.dofs.fixed[ra] && !step.dofs.fixed[cb] {
+                            values[blocks[a * 4 + b] as usize * nd * nd + p * nd + p] -= s[a][b];
+                        }
+                    }
+                }
+            }
+        }
+        // Fixed dofs: a unit diagonal (every other entry of their rows and columns stays zero).
+        for &(blk, c) in &step.fixed_diagonals {
+            values[blk as usize * nd * nd + c * nd + c] = 1.0;
+        }
+        j.set_values_coo(&values, false).map_err(fatal)?;
+        self.values = values;
+        *self.seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+}

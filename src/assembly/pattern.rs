@@ -1,0 +1,173 @@
+//! The matrix pattern of a step as a coordinate (COO) list, and where each particle adds its
+//! tangent into it (step 5 of a step).
+//!
+//! The list holds each (node a, node b) block of dofs once: the pairs of every particle's effective
+//! stencil and the diagonal block of every owned node (so that fixed dofs always find their unit
+//! diagonal). Each particle keeps a slot map: the block of every pair of its effective nodes. A
+//! Jacobian then adds every particle's dense block into one value array in list order and hands it
+//! to PETSc at once (`MatSetValuesCOO`), which is several times faster than inserting the blocks
+//! one by one (../shared/solver-findings.md §3). Listing the blocks, not the particles' entries,
+//! keeps the memory at a few hundred bytes per particle.
+//!
+//! The pattern is kept from step to step while every pair a particle needs is already in it (the
+//! matrix then keeps its structure, and a direct solver its symbolic factorisation); otherwise a
+//! new one is built. The decision involves a collective (the matrix is created on all ranks), so the
+//! caller agrees on it across ranks.
+
+use super::stencils::Stencils;
+use std::collections::HashMap;
+
+/// No block.
+const NONE: u32 = u32::MAX;
+
+/// Offsets (Δi, Δj) within ±REACH nodes are looked up in a dense table; farther ones in a map.
+const REACH: i64 = 3;
+const WIDTH: usize = (2 * REACH + 1) as usize;
+
+/// The node-pair blocks of the matrix.
+#[derive(Debug, Clone, Default)]
+pub struct Pattern {
+    /// Ghosted-node pairs (a, b), one nd × nd block each, in list order.
+    pub pairs: Vec<(u32, u32)>,
+    /// Dense lookup: `near[a * WIDTH² + offset(a, b)]` is the block of (a, b).
+    near: Vec<u32>,
+    /// Pairs whose nodes are farther apart than REACH.
+    far: HashMap<(u32, u32), u32>,
+    /// Columns of the ghosted node grid (to turn node indices into (i, j)).
+    nx: usize,
+}
+
+impl Pattern {
+    fn offset(&self, a: u32, b: u32) -> Option<usize> {
+        let (a, b, nx) = (a as i64, b as i64, self.nx as i64);
+        let (di, dj) = (b % nx - a % nx, b / nx - a / nx);
+        if di.abs() > REACH || dj.abs() > REACH {
+            return None;
+        }
+        Some(a as usize * WIDTH * WIDTH + ((dj + REACH) as usize) * WIDTH + (di + REACH) as usize)
+    }
+
+    /// The block of pair (a, b), if the pattern has it.
+    pub fn block(&self, a: u32, b: u32) -> Option<u32> {
+        let v = match self.offset(a, b) {
+            Some(o) => self.near[o],
+            None => *self.far.get(&(a, b)).unwrap_or(&NONE),
+        };
+        (v != NONE).then_some(v)
+    }
+
+    fn insert(&mut self, a: u32, b: u32) -> u32 {
+        if let Some(v) = self.block(a, b) {
+            return v;
+        }
+        let v = self.pairs.len() as u32;
+        self.pairs.push((a, b));
+        match self.offset(a, b) {
+            Some(o) => self.near[o] = v,
+            None => {
+                self.far.insert((a, b), v);
+            }
+        }
+        v
+    }
+
+    /// The pattern of the particles' effective stencils and the `owned` nodes' diagonal blocks, on a
+    /// ghosted grid of `nx × ny` nodes.
+    pub fn build(st: &Stencils, owned: &[u32], nx: usize, ny: usize) -> Pattern {
+        let mut p = Pattern { pairs: Vec::new(), near: vec![NONE; nx * ny * WIDTH * WIDTH], far: HashMap::new(), nx };
+        for &a in owned {
+            p.insert(a, a);
+        }
+        for k in 0..st.len() {
+            let eff = st.effective(k);
+            for &a in eff {
+                for &b in eff {
+                    p.insert(a, b);
+                }
+            }
+        }
+        p
+    }
+
+    /// Every particle's slot map (the block of each pair of its effective nodes, row-major), or
+    /// `None` if some pair is missing from this pattern.
+    pub fn slots(&self, st: &Stencils) -> Option<(Vec<usize>, Vec<u32>)> {
+        let mut offsets = Vec::with_capacity(st.len() + 1);
+        offsets.push(0);
+        let mut slots = Vec::new();
+        for k in 0..st.len() {
+            let eff = st.effective(k);
+            for &a in eff {
+                for &b in eff {
+                    slots.push(self.block(a, b)?);
+                }
+            }
+            offsets.push(slots.len());
+        }
+        Some((offsets, slots))
+    }
+
+    /// Number of blocks.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Whether the pattern is empty.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// The COO lists (global row and column of every entry, block by block, row-major in a block)
+    /// for `nd` dofs per node, with `l2g` the global index of every ghosted dof.
+    pub fn coo(&self, nd: usize, l2g: &[i32]) -> (Vec<i32>, Vec<i32>) {
+        let n = self.pairs.len() * nd * nd;
+        let (mut rows, mut cols) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for &(a, b) in &self.pairs {
+            for c1 in 0..nd {
+                for c2 in 0..nd {
+                    rows.push(l2g[a as usize * nd + c1]);
+                    cols.push(l2g[b as usize * nd + c2]);
+                }
+            }
+        }
+        (rows, cols)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stencils(lists: &[&[u32]]) -> Stencils {
+        let mut st = Stencils::default();
+        st.offsets.push(0);
+        st.eff_offsets.push(0);
+        for l in lists {
+            st.nodes.extend_from_slice(l);
+            st.eff_nodes.extend_from_slice(l);
+            st.offsets.push(st.nodes.len());
+            st.eff_offsets.push(st.eff_nodes.len());
+        }
+        st
+    }
+
+    #[test]
+    fn pairs_are_listed_once_and_every_particle_finds_its_blocks() {
+        // A 10 × 10 ghosted grid; two particles sharing nodes, one reaching 5 columns (a far pair).
+        let st = stencils(&[&[11, 12, 21, 22], &[12, 13, 22, 23], &[30, 35]]);
+        let p = Pattern::build(&st, &[11], 10, 10);
+        // 16 + 16 − 4 shared + 4 for the far particle; (11, 11) is already a particle pair.
+        assert_eq!(p.len(), 16 + 16 - 4 + 4);
+        let (offsets, slots) = p.slots(&st).unwrap();
+        assert_eq!(offsets, vec![0, 16, 32, 36]);
+        assert!(slots.iter().all(|&s| (s as usize) < p.len()));
+        assert_eq!(p.pairs[slots[16 + 1] as usize], (12, 13));
+        assert_eq!(p.pairs[slots[32 + 1] as usize], (30, 35));
+        // A particle needing a pair the pattern lacks.
+        let other = stencils(&[&[11, 44]]);
+        assert!(p.slots(&other).is_none());
+        let (rows, cols) = p.coo(2, &(0..200).collect::<Vec<i32>>());
+        assert_eq!(rows.len(), p.len() * 4);
+        assert_eq!((rows[1], cols[1]), (22, 23));
+    }
+}

@@ -1,0 +1,344 @@
+//! The particle–grid maps of a step: each particle's stencil (nodes, S, ∇S, ∇̄S on x_n), computed
+//! once per step, and its map to the nodes that carry unknowns.
+//!
+//! # Nodes that the material barely reaches
+//! A node is *well filled* when the material fills more than [`WELL_FILLED_FRACTION`] of a cell's
+//! area in its support, φ_i = Σ_p S_ip V_p / (h_x h_y) (1 inside the material, 1/2 on a straight
+//! edge, 1/4 at a convex corner of a body on grid lines). A node that a particle domain reaches by
+//! a sliver δ has S ∝ δ² but ∇S ∝ δ (and, with B̄, ∇̄S ∝ δ): its mass and stiffness are tiny, so its
+//! dofs are ill-determined, yet fixing them to zero makes it a support whose reaction is of order
+//! δ σ — a nearly incompressible body loaded past a few percent of a cell lost half its load to such
+//! supports. Instead, the motion of such a node (u and U components) is *extended* from well-filled
+//! nodes by a linear extrapolation towards the particle that reaches it, which reproduces every
+//! linear field exactly (so patch tests and the equilibrium identity hold), in this order:
+//! 1. along the grid line of the axis on which the particle lies farther away:
+//!    u_s = 2u_a − u_b with a, b the next two nodes towards the particle (both well filled);
+//! 2. along the other axis;
+//! 3. from the triangle of the cell corner towards the particle: u_s = u_a + u_b − u_c.
+//!
+//! The choice depends only on the particle's position and on φ, so it is the same on every rank.
+//! Without any of the three (a node diagonal to a body's corner), the node stays fixed: its
+//! influence on the particle is of second order in the sliver. The pore pressure of a node that is
+//! not well filled is fixed to zero (the material's free surface is drained), as before.
+//! This is the extension of aggregated unfitted finite elements (Badia, Verdugo & Martín 2018)
+//! with the particle's side as the aggregate.
+
+use super::dofs::DofMap;
+use crate::kernels::{self, NodeBasis};
+use crate::model::shape::{self, Basis};
+use crate::model::Model;
+use petsc::GhostedRange;
+
+/// Fraction of a cell's area that the material must fill in a node's support for the node to carry
+/// unknowns of its own (see the module documentation).
+pub const WELL_FILLED_FRACTION: f64 = 1e-2;
+
+/// Largest number of master nodes of one extended node.
+pub const MAX_MASTERS: usize = 3;
+
+/// An extension: the masters' (i, j), their coefficients, and how many are used.
+pub type ExtensionCoefficients = ([(i64, i64); MAX_MASTERS], [f64; MAX_MASTERS], usize);
+
+/// How a raw stencil slot's motion is extended: from up to three other nodes.
+#[derive(Debug, Clone, Copy)]
+pub struct Extension {
+    /// The raw slot whose motion is extended.
+    pub slot: u8,
+    /// Effective slots of the masters and their coefficients.
+    pub masters: [(u8, f64); MAX_MASTERS],
+    /// Number of masters used.
+    pub n: u8,
+    /// The node's dof components that are extended (bit c: component c), its motion components
+    /// that no boundary fixes.
+    pub mask: u8,
+}
+
+/// The stencils of all particles for one step, in this rank's ghosted node numbering, stored flat:
+/// particle k uses entries `offsets[k]..offsets[k + 1]` of `nodes` and `basis` (the raw stencil),
+/// `eff_offsets[k]..eff_offsets[k + 1]` of `eff_nodes` (its raw nodes, in the same order, then the
+/// masters of its extended nodes that are not in the raw stencil), and `ext_offsets[k]..` of `ext`.
+#[derive(Debug, Clone, Default)]
+pub struct Stencils {
+    pub offsets: Vec<usize>,
+    pub nodes: Vec<u32>,
+    pub basis: Vec<NodeBasis>,
+    pub eff_offsets: Vec<usize>,
+    pub eff_nodes: Vec<u32>,
+    pub ext_offsets: Vec<usize>,
+    pub ext: Vec<Extension>,
+}
+
+impl Stencils {
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Raw nodes and basis of particle `k`.
+    pub fn get(&self, k: usize) -> (&[u32], &[NodeBasis]) {
+        let r = self.offsets[k]..self.offsets[k + 1];
+        (&self.nodes[r.clone()], &self.basis[r])
+    }
+
+    /// Effective nodes of particle `k` (its raw nodes first).
+    pub fn effective(&self, k: usize) -> &[u32] {
+        &self.eff_nodes[self.eff_offsets[k]..self.eff_offsets[k + 1]]
+    }
+
+    /// Extensions of particle `k`.
+    pub fn extensions(&self, k: usize) -> &[Extension] {
+        let r = self.ext_offsets.get(k).copied().unwrap_or(0)..self.ext_offsets.get(k + 1).copied().unwrap_or(0);
+        &self.ext[r]
+    }
+}
+
+/// A particle whose support reaches past a side of the grid.
+#[derive(Debug, Clone, Copy)]
+pub struct Crossing {
+    /// The particle.
+    pub k: usize,
+    /// The side (0: x_min, 1: x_max, 2: y_min, 3: y_max).
+    pub side: usize,
+}
+
+/// The names of the grid's sides, in [`Crossing::side`] order.
+pub const SIDES: [&str; 4] = ["x_min", "x_max", "y_min", "y_max"];
+
+/// Builds the raw stencils on x_n (step 1 of a step), and lists the particles whose support
+/// reaches past the grid (GIMP: their domain, beyond round-off; linear: their centre), for
+/// [`check_edges`]. Fails, naming the particle, when a stencil node lies outside this rank's ghost
+/// region or a position is not finite.
+pub fn build(model: &Model, ghost: &GhostedRange) -> Result<(Stencils, Vec<Crossing>), String> {
+    let ps = &model.particles;
+    let g = &model.grid;
+    let mut out = Stencils { offsets: Vec::with_capacity(ps.len() + 1), ..Default::default() };
+    let mut crossings = Vec::new();
+    out.offsets.push(0);
+    let hi = g.extent_max();
+    let tol = 1e-9 * g.h[0].min(g.h[1]);
+    for k in 0..ps.len() {
+        let (x, lp) = (ps.x[k], ps.lp[k]);
+        if !(x[0].is_finite() && x[1].is_finite()) {
+            return Err(format!("material point {}: its position is not finite (NaN or Inf)", ps.id[k]));
+        }
+        let reach = if model.basis == Basis::Linear { [0.0; 2] } else { lp };
+        let past = [
+            x[0] - reach[0] < g.origin[0] - tol,
+            x[0] + reach[0] > hi[0] + tol,
+            x[1] - reach[1] < g.origin[1] - tol,
+            x[1] + reach[1] > hi[1] + tol,
+        ];
+        for (side, &p) in past.iter().enumerate() {
+            if p {
+                crossings.push(Crossing { k, side });
+            }
+        }
+        let st = shape::stencil(model.basis, g, x, lp);
+        if st.len == 0 {
+            return Err(format!("material point {} at ({:.4}, {:.4}) m has left the grid", ps.id[k], x[0], x[1]));
+        }
+        for &(i, j) in &st.nodes[..st.len] {
+            let l = ghost.node(i as usize, j as usize).ok_or_else(|| {
+                format!(
+                    "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \
+                     (particle migration between ranks is not implemented yet)",
+                    ps.id[k], x[0], x[1]
+                )
+            })?;
+            out.nodes.push(l as u32);
+        }
+        let first = out.basis.len();
+        kernels::plain_basis(&st, &mut out.basis);
+        if model.bbar {
+            let gv = shape::volumetric_gradients(model.basis, g, x, lp, &st);
+            for (b, v) in out.basis[first..].iter_mut().zip(gv) {
+                b.gv = v;
+            }
+        }
+        out.offsets.push(out.nodes.len());
+    }
+    Ok((out, crossings))
+}
+
+/// The grid's edge. A support that reaches past a side of the grid loses the part of its basis
+/// beyond it (the partition of unity, and with it part of the particle's internal force and load).
+/// Where the particle's nodes on that side are held in the side's normal direction by a boundary
+/// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
+/// as its reaction; on any other side the run must stop, naming the particle, its body, the time
+/// and the side. (Linear MPM: a centre outside the grid always stops the run.)
+pub fn check_edges(
+    model: &Model,
+    st: &Stencils,
+    crossings: &[Crossing],
+    dofs: &DofMap,
+    ghost: &GhostedRange,
+    t: f64,
+    body_names: &[String],
+) -> Result<(), String> {
+    let ps = &model.particles;
+    let g = &model.grid;
+    for c in crossings {
+        let (nodes, _) = st.get(c.k);
+        let normal = c.side / 2;
+        let on_side = |l: u32| {
+            let (i, j) = ghost.ij(l as usize);
+            match c.side {
+                0 => i == 0,
+                1 => i == g.cells[0],
+                2 => j == 0,
+                _ => j == g.cells[1],
+            }
+        };
+        let wall = model.basis != Basis::Linear && {
+            let side_nodes: Vec<u32> = nodes.iter().copied().filter(|&l| on_side(l)).collect();
+            !side_nodes.is_empty() && side_nodes.iter().all(|&l| dofs.boundary_fixed(l as usize, normal))
+        };
+        if !wall {
+            let x = ps.x[c.k];
+            let body = body_names.get(ps.body[c.k] as usize).map_or("?", |s| s.as_str());
+            return Err(format!(
+                "at t = {t:.6e} s material point {} of body `{body}` at ({:.4}, {:.4}) m reaches past the grid's {} \
+                 edge, where no boundary holds it: its support would lose the part beyond the grid, and with it \
+                 part of its load; enlarge the grid",
+                ps.id[c.k], x[0], x[1], SIDES[c.side]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Coefficients extending node (i, j) from well-filled nodes towards the point `toward` (see the
+/// module documentation); `well(i, j)` says whether a node is well filled (false outside the
+/// ghost region or the grid).
+pub fn extension(
+    node: (usize, usize),
+    pos: [f64; 2],
+    toward: [f64; 2],
+    well: &dyn Fn(i64, i64) -> bool,
+    tiny: f64,
+) -> Option<ExtensionCoefficients> {
+    let (i, j) = (node.0 as i64, node.1 as i64);
+    let d = [toward[0] - pos[0], toward[1] - pos[1]];
+    let dir = |c: usize| {
+        if d[c] > tiny {
+            1i64
+        } else if d[c] < -tiny {
+            -1
+        } else {
+            0
+        }
+    };
+    let (dx, dy) = (dir(0), dir(1));
+    let axes = if d[0].abs() >= d[1].abs() { [0usize, 1] } else { [1, 0] };
+    for axis in axes {
+        let (sx, sy) = if axis == 0 { (dx, 0) } else { (0, dy) };
+        if sx == 0 && sy == 0 {
+            continue;
+        }
+        let a = (i + sx, j + sy);
+        let b = (i + 2 * sx, j + 2 * sy);
+        if well(a.0, a.1) && well(b.0, b.1) {
+            return Some(([a, b, (0, 0)], [2.0, -1.0, 0.0], 2));
+        }
+    }
+    if dx != 0 && dy != 0 {
+        let (a, b, c) = ((i + dx, j), (i, j + dy), (i + dx, j + dy));
+        if well(a.0, a.1) && well(b.0, b.1) && well(c.0, c.1) {
+            return Some(([a, b, c], [1.0, 1.0, -1.0], 3));
+        }
+    }
+    None
+}
+
+/// Adds the effective stencils and extensions (step 4 of a step) for the dof map `dofs` and the
+/// motion components `motion` of the layout (u and U).
+pub fn extend(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &DofMap, motion: &[usize]) {
+    let ps = &model.particles;
+    let g = &model.grid;
+    let is_well = |i: i64, j: i64| -> bool {
+        if i < 0 || j < 0 {
+            return false;
+        }
+        ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
+    };
+    let tiny = 1e-9 * g.h[0].min(g.h[1]);
+    st.eff_offsets.clear();
+    st.eff_nodes.clear();
+    st.ext_offsets.clear();
+    st.ext.clear();
+    st.eff_offsets.push(0);
+    st.ext_offsets.push(0);
+    for k in 0..st.len() {
+        let raw = st.offsets[k]..st.offsets[k + 1];
+        let start = st.eff_nodes.len();
+        st.eff_nodes.extend_from_slice(&st.nodes[raw.clone()]);
+        for (slot, idx) in raw.clone().enumerate() {
+            let l = st.nodes[idx] as usize;
+            let b = st.basis[idx];
+            if dofs.well[l] || (b.s == 0.0 && b.g == [0.0; 2] && b.gv == [0.0; 2]) {
+                continue;
+            }
+            let mask = motion.iter().filter(|&&c| !dofs.boundary_fixed(l, c)).fold(0u8, |m, &c| m | (1 << c));
+            if mask == 0 {
+                continue;
+            }
+            let (i, j) = ghost.ij(l);
+            let Some((masters, coefs, n)) = extension((i, j), g.node_position(i, j), ps.x[k], &is_well, tiny) else {
+                continue;
+            };
+            let mut e = Extension { slot: slot as u8, masters: [(0, 0.0); MAX_MASTERS], n: n as u8, mask };
+            for (m, (&(mi, mj), &c)) in masters.iter().zip(&coefs).take(n).enumerate() {
+                let ml = ghost.node(mi as usize, mj as usize).expect("well nodes are ghosted") as u32;
+                let pos = match st.eff_nodes[start..].iter().position(|&x| x == ml) {
+                    Some(p) => p,
+                    None => {
+                        st.eff_nodes.push(ml);
+                        st.eff_nodes.len() - 1 - start
+                    }
+                };
+                e.masters[m] = (pos as u8, c);
+            }
+            st.ext.push(e);
+        }
+        st.eff_offsets.push(st.eff_nodes.len());
+        st.ext_offsets.push(st.ext.len());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_extension_reproduces_linear_fields_and_reaches_towards_the_particle() {
+        // Well filled: i ≤ 3 (a body to the left of x = 3), any j.
+        let well = |i: i64, j: i64| (0..=3).contains(&i) && (0..10).contains(&j);
+        let pos = |i: i64, j: i64| [i as f64, j as f64];
+        // Node (4, 5) reached from a particle at (3.8, 5.2): x-line from (3, 5) and (2, 5).
+        let (m, c, n) = extension((4, 5), [4.0, 5.0], [3.8, 5.2], &well, 1e-12).unwrap();
+        assert_eq!(n, 2);
+        assert_eq!(&m[..2], &[(3, 5), (2, 5)]);
+        for f in [|x: [f64; 2]| 1.0 + 2.0 * x[0] - 3.0 * x[1], |x: [f64; 2]| x[1]] {
+            let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();
+            assert!((v - f([4.0, 5.0])).abs() < 1e-12);
+        }
+        // A node diagonal to a corner (well: i ≤ 3 and j ≤ 3): no line, no triangle.
+        let corner = |i: i64, j: i64| (0..=3).contains(&i) && (0..=3).contains(&j);
+        assert!(extension((4, 4), [4.0, 4.0], [3.8, 3.8], &corner, 1e-12).is_none());
+        // Node (4, 3) beside the corner, reached from (3.8, 2.9): x-line.
+        let (m, _, n) = extension((4, 3), [4.0, 3.0], [3.8, 2.9], &corner, 1e-12).unwrap();
+        assert_eq!((n, m[0], m[1]), (2, (3, 3), (2, 3)));
+        // A triangle when neither line has two well nodes: only (1, 1), (1, 2), (2, 1) are well.
+        let tri = |i: i64, j: i64| [(1, 1), (1, 2), (2, 1)].contains(&(i, j));
+        let (m, c, n) = extension((2, 2), [2.0, 2.0], [1.9, 1.8], &tri, 1e-12).unwrap();
+        assert_eq!(n, 3);
+        let f = |x: [f64; 2]| 0.5 - x[0] + 4.0 * x[1];
+        let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();
+        assert!((v - f([2.0, 2.0])).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,302 @@
+//! Finite-strain kinematics of one material point over a step, in the updated Lagrangian frame of
+//! the reset grid (plane strain).
+//!
+//! The grid carries the step's displacement increments Δu_i. With ∇S_i the gradients of the
+//! point's basis functions on the configuration x_n and ∇̄S_i those of B̄'s volumetric part ([000]
+//! Eqs. 13–16; equal to ∇S_i without B̄), two incremental deformation gradients follow:
+//!   F = I + H,  H = Σ Δu_i ⊗ ∇S_i,        F_v = I + H_v,  H_v = Σ Δu_i ⊗ ∇̄S_i,
+//! with J = det F and J_v = det F_v. The point's volume at t_{n+1} is V_{n+1} = J_v V_n (the volume
+//! follows the volumetric deformation the stress sees; an F̄ update, as Coombs et al. 2018 do).
+//!
+//! **Current configuration.** The residual is written on the configuration x_{n+1} = x_n + Δu, so
+//! that a converged step is in equilibrium where the material is: the gradients there are
+//! ∇'S_i = F⁻ᵀ ∇S_i and ∇̄'S_i = F_v⁻ᵀ ∇̄S_i (Σ_i (x_i + Δu_i) ⊗ ∇'S_i = I exactly), and the internal
+//! force of the Cauchy stress σ_{n+1} is f_i = B̄'_iᵀ σ_{n+1} V_{n+1} with B̄' built from them
+//! ([000] Eq. 16 on x_{n+1}).
+//!
+//! **Objective stress update (Hughes & Winget 1980).** The strain increment and the rotation are
+//! taken on the mid-step configuration x_{n+1/2}: L = H F_h⁻¹ with F_h = I + H/2 (and L_v likewise
+//! from H_v),
+//!   Δε = sym L − ⅓ tr(L) m + ⅓ tr(L_v) m     (m = [1, 1, 0, 1]; B̄: the volumetric part from L_v),
+//!   ω = ½(L_yx − L_xy),  R = (I − ½W)⁻¹(I + ½W), a rotation by θ = 2 atan(ω/2),
+//! and the soil model starts from the rotated stress R σ_n Rᵀ. A rigid rotation by α gives
+//! sym L = 0 and θ = α exactly, so the stress turns with the material to round-off.
+
+use super::NodeBasis;
+
+/// A 2 × 2 matrix, rows first.
+pub type M2 = [[f64; 2]; 2];
+
+const I2: M2 = [[1.0, 0.0], [0.0, 1.0]];
+
+fn det(a: &M2) -> f64 {
+    a[0][0] * a[1][1] - a[0][1] * a[1][0]
+}
+
+fn inverse(a: &M2) -> M2 {
+    let d = det(a);
+    [[a[1][1] / d, -a[0][1] / d], [-a[1][0] / d, a[0][0] / d]]
+}
+
+fn mul(a: &M2, b: &M2) -> M2 {
+    let mut c = [[0.0; 2]; 2];
+    for (i, ci) in c.iter_mut().enumerate() {
+        for (j, cij) in ci.iter_mut().enumerate() {
+            *cij = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+        }
+    }
+    c
+}
+
+/// aᵀ v.
+fn mul_t(a: &M2, v: [f64; 2]) -> [f64; 2] {
+    [a[0][0] * v[0] + a[1][0] * v[1], a[0][1] * v[0] + a[1][1] * v[1]]
+}
+
+/// The kinematics of a point for given nodal increments (see the module documentation).
+#[derive(Debug, Clone, Copy)]
+pub struct Kinematics {
+    /// F = I + H.
+    pub f: M2,
+    /// J = det F.
+    pub j: f64,
+    /// F_v = I + H_v.
+    pub fv: M2,
+    /// J_v = det F_v: the volume ratio of the step.
+    pub jv: f64,
+    /// F⁻¹ (the transpose pushes gradients forward).
+    f_inv: M2,
+    /// F_v⁻¹.
+    fv_inv: M2,
+    /// F_h⁻¹ = (I + H/2)⁻¹.
+    fh_inv: M2,
+    /// (I + H_v/2)⁻¹.
+    fvh_inv: M2,
+    /// L = H F_h⁻¹.
+    l: M2,
+    /// L_v = H_v F_vh⁻¹.
+    lv: M2,
+    /// Strain increment Δε [xx, yy, γxy, zz].
+    pub deps: [f64; 4],
+    /// ω = ½(L_yx − L_xy).
+    pub omega: f64,
+    /// Rotation angle of the step θ = 2 atan(ω/2) [rad].
+    pub theta: f64,
+}
+
+impl Kinematics {
+    /// The kinematics for displacement increments `du[k]` at the nodes of `basis`.
+    pub fn new(basis: &[NodeBasis], du: impl Iterator<Item = [f64; 2]>) -> Kinematics {
+        let (mut h, mut hv) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+        for (b, u) in basis.iter().zip(du) {
+            for a in 0..2 {
+                for c in 0..2 {
+                    h[a][c] += u[a] * b.g[c];
+                    hv[a][c] += u[a] * b.gv[c];
+                }
+            }
+        }
+        let add = |a: &M2, s: f64| [[1.0 + s * a[0][0], s * a[0][1]], [s * a[1][0], 1.0 + s * a[1][1]]];
+        let (f, fv) = (add(&h, 1.0), add(&hv, 1.0));
+        let (fh_inv, fvh_inv) = (inverse(&add(&h, 0.5)), inverse(&add(&hv, 0.5)));
+        let l = mul(&h, &fh_inv);
+        let lv = mul(&hv, &fvh_inv);
+        let tr = l[0][0] + l[1][1];
+        let trv = lv[0][0] + lv[1][1];
+        let vol = (trv - tr) / 3.0;
+        let deps = [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol];
+        let omega = 0.5 * (l[1][0] - l[0][1]);
+        Kinematics {
+            f,
+            j: det(&f),
+            fv,
+            jv: det(&fv),
+            f_inv: inverse(&f),
+            fv_inv: inverse(&fv),
+            fh_inv,
+            fvh_inv,
+            l,
+            lv,
+            deps,
+            omega,
+            theta: 2.0 * (0.5 * omega).atan(),
+        }
+    }
+
+    /// The kinematics of a step without motion.
+    pub fn rest() -> Kinematics {
+        Kinematics {
+            f: I2,
+            j: 1.0,
+            fv: I2,
+            jv: 1.0,
+            f_inv: I2,
+            fv_inv: I2,
+            fh_inv: I2,
+            fvh_inv: I2,
+            l: [[0.0; 2]; 2],
+            lv: [[0.0; 2]; 2],
+            deps: [0.0; 4],
+            omega: 0.0,
+            theta: 0.0,
+        }
+    }
+
+    /// The gradients of a node's basis function on x_{n+1}: (∇'S, ∇̄'S) = (F⁻ᵀ∇S, F_v⁻ᵀ∇̄S).
+    #[inline]
+    pub fn spatial(&self, b: &NodeBasis) -> ([f64; 2], [f64; 2]) {
+        (mul_t(&self.f_inv, b.g), mul_t(&self.fv_inv, b.gv))
+    }
+
+    /// ∂Δε/∂Δu_l (4 strain components × 2 displacement components) for a node with basis `b`.
+    ///
+    /// dL = (I − L/2) dH F_h⁻¹ with dH = e_d ⊗ ∇S_l, so dL_ab = (I − L/2)_ad (F_h⁻ᵀ∇S_l)_b; the
+    /// same for L_v with ∇̄S_l.
+    pub fn deps_derivative(&self, b: &NodeBasis) -> [[f64; 2]; 4] {
+        let gh = mul_t(&self.fh_inv, b.g);
+        let gvh = mul_t(&self.fvh_inv, b.gv);
+        // Column d: the strain increment of a unit increment of component d.
+        let column = |d: usize| -> [f64; 4] {
+            // dL[a][c] = (I − L/2)[a][d] gh[c].
+            let dl = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
+            let dlv = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.lv[a][d]) * gvh[c];
+            let tr = dl(0, 0) + dl(1, 1);
+            let trv = dlv(0, 0) + dlv(1, 1);
+            let vol = (trv - tr) / 3.0;
+            [dl(0, 0) + vol, dl(1, 1) + vol, dl(0, 1) + dl(1, 0), vol]
+        };
+        let (c0, c1) = (column(0), column(1));
+        std::array::from_fn(|r| [c0[r], c1[r]])
+    }
+
+    /// ∂θ/∂Δu_l (2 displacement components) for a node with basis `b`.
+    pub fn theta_derivative(&self, b: &NodeBasis) -> [f64; 2] {
+        let gh = mul_t(&self.fh_inv, b.g);
+        let factor = 1.0 / (1.0 + 0.25 * self.omega * self.omega);
+        let mut out = [0.0; 2];
+        for (d, o) in out.iter_mut().enumerate() {
+            let dl = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
+            *o = factor * 0.5 * (dl(1, 0) - dl(0, 1));
+        }
+        out
+    }
+
+    /// The incremental deformation gradient the particle keeps: F̄ = (J_v/J)^{1/2} F, whose
+    /// determinant is J_v (so that the domain and the volume follow the same volume change).
+    pub fn f_bar(&self) -> M2 {
+        let s = if self.j > 0.0 && self.jv > 0.0 { (self.jv / self.j).sqrt() } else { 1.0 };
+        [[self.f[0][0] * s, self.f[0][1] * s], [self.f[1][0] * s, self.f[1][1] * s]]
+    }
+}
+
+/// The stress σ [xx, yy, xy, zz] rotated in the plane by θ: R σ Rᵀ (σ_zz unchanged).
+pub fn rotate(s: &[f64; 4], theta: f64) -> [f64; 4] {
+    if theta == 0.0 {
+        return *s;
+    }
+    let (c, sn) = (theta.cos(), theta.sin());
+    let r = [[c, -sn], [sn, c]];
+    let m = [[s[0], s[2]], [s[2], s[1]]];
+    let rm = mul(&r, &m);
+    let rt = [[c, sn], [-sn, c]];
+    let out = mul(&rm, &rt);
+    [out[0][0], out[1][1], 0.5 * (out[0][1] + out[1][0]), s[3]]
+}
+
+/// d(R σ Rᵀ)/dθ at the rotated stress `s`: [−2σ_xy, 2σ_xy, σ_xx − σ_yy, 0].
+pub fn rotate_derivative(s: &[f64; 4]) -> [f64; 4] {
+    [-2.0 * s[2], 2.0 * s[2], s[0] - s[1], 0.0]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn basis() -> Vec<NodeBasis> {
+        (0..5)
+            .map(|k| {
+                let x = k as f64;
+                NodeBasis {
+                    s: 0.2,
+                    g: [(x * 1.3).cos() * 3.0, (x * 0.9).sin() * 2.0],
+                    gv: [(x * 1.1).cos() * 2.5, (x * 0.4).sin() * 1.5],
+                }
+            })
+            .collect()
+    }
+
+    fn du(k: usize, scale: f64) -> [f64; 2] {
+        let x = k as f64;
+        [scale * (0.3 + x * 0.7).sin(), scale * (1.1 * x - 0.2).cos()]
+    }
+
+    #[test]
+    fn derivatives_match_central_differences() {
+        let b = basis();
+        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.02)).collect();
+        let k0 = Kinematics::new(&b, u.iter().copied());
+        let h = 1e-7;
+        for l in 0..b.len() {
+            let de = k0.deps_derivative(&b[l]);
+            let dt = k0.theta_derivative(&b[l]);
+            for d in 0..2 {
+                let shifted = |s: f64| {
+                    let mut v = u.clone();
+                    v[l][d] += s;
+                    Kinematics::new(&b, v.into_iter())
+                };
+                let (p, m) = (shifted(h), shifted(-h));
+                for (r, der) in de.iter().enumerate() {
+                    let fd = (p.deps[r] - m.deps[r]) / (2.0 * h);
+                    assert!(
+                        (fd - der[d]).abs() < 1e-7 * (1.0 + fd.abs()),
+                        "deps[{r}] node {l} comp {d}: {fd} vs {}",
+                        der[d]
+                    );
+                }
+                let fd = (p.theta - m.theta) / (2.0 * h);
+                assert!((fd - dt[d]).abs() < 1e-7 * (1.0 + fd.abs()), "theta node {l} comp {d}: {fd} vs {}", dt[d]);
+            }
+        }
+    }
+
+    #[test]
+    fn a_rigid_rotation_has_no_strain_and_its_exact_angle() {
+        // Nodes of a unit square moved by a rigid rotation α about the origin; bilinear gradients
+        // of a point at its centre reproduce the linear field exactly.
+        let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+        let b: Vec<NodeBasis> = pts
+            .iter()
+            .map(|&(x, y): &(f64, f64)| {
+                let g = [if x == 0.0 { -0.5 } else { 0.5 }, if y == 0.0 { -0.5 } else { 0.5 }];
+                NodeBasis { s: 0.25, g, gv: g }
+            })
+            .collect();
+        for alpha in [0.1f64, 0.9, -1.4] {
+            let (c, s) = (alpha.cos(), alpha.sin());
+            let u = pts.iter().map(|&(x, y)| [c * x - s * y - x, s * x + c * y - y]);
+            let k = Kinematics::new(&b, u);
+            assert!(k.deps.iter().all(|e| e.abs() < 1e-14), "{:?}", k.deps);
+            assert!((k.theta - alpha).abs() < 1e-14, "{} vs {alpha}", k.theta);
+            assert!((k.j - 1.0).abs() < 1e-14 && (k.jv - 1.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn rotation_of_stress_and_its_derivative() {
+        let s = [3.0, -1.0, 0.7, 2.0];
+        let r = rotate(&s, 0.3);
+        // Invariants in the plane are kept.
+        assert!(((r[0] + r[1]) - (s[0] + s[1])).abs() < 1e-14);
+        assert!(((r[0] * r[1] - r[2] * r[2]) - (s[0] * s[1] - s[2] * s[2])).abs() < 1e-13);
+        let h = 1e-6;
+        let (p, m) = (rotate(&s, 0.3 + h), rotate(&s, 0.3 - h));
+        let d = rotate_derivative(&r);
+        for c in 0..4 {
+            assert!(((p[c] - m[c]) / (2.0 * h) - d[c]).abs() < 1e-8);
+        }
+        // Four quarter turns are the identity; one is the swap of xx and yy with σ_xy negated.
+        let q = rotate(&s, std::f64::consts::FRAC_PI_2);
+        assert!((q[0] - s[1]).abs() < 1e-14 && (q[1] - s[0]).abs() < 1e-14 && (q[2] + s[2]).abs() < 1e-14);
+    }
+}

@@ -1,0 +1,434 @@
+//! Per-particle kernels: pure functions from one material point and the nodal values of its
+//! stencil to a small dense residual block and tangent block. Nothing here knows about PETSc,
+//! ranks, global numbering or constraints.
+//!
+//! # The discrete system ([003] Eqs. 10, 16, 22, 23; [000] Eqs. 6–10, Appendix A)
+//!
+//! Unknowns of a time step are the nodal increments Δd = (Δu, Δp, ΔU) (the grid is reset every step,
+//! d_n = 0). Newmark ([003] Eqs. 20–21) gives the acceleration and velocity at t_{n+1} at a material
+//! point as
+//!   a = a₀ Σ S_i Δd_i + ã_n,  v = a₁ Σ S_i Δd_i + ṽ_n,   a₀ = 1/(βΔt²), a₁ = γ/(βΔt),
+//! with predictors ã_n = −v_n/(βΔt) − (1/(2β) − 1) a_n and ṽ_n = −(γ/β − 1) v_n − (γ/(2β) − 1)Δt a_n
+//! of the nodal v_n, a_n of [003] Eq. 19, interpolated to the point (the caller passes them as
+//! [`Predictors`]).
+//!
+//! The residual of a particle is a sum of terms, each in its own module with its exact tangent and
+//! its own finite-difference test:
+//!
+//! | term | rows | residual at stencil node i |
+//! |---|---|---|
+//! | [`inertia`] | u, U | S_i m_s (a_u − b), S_i m_w (a_U − b) ([003] 16a, b) |
+//! | [`inertia::drag`] | u, U | ±S_i c (v_u − v_U), c = n²γ_w V/k ([003] 16c–e) |
+//! | [`stress`] | u | B̄'_iᵀ σ'_{n+1} V_{n+1} ([003] 23a on x_{n+1}) |
+//! | [`stress::pore_pressure`] | u, U | −(1 − n) p ∇̄'S_i V_{n+1}, −n p ∇̄'S_i V_{n+1} ([003] 23a, c) |
+//! | [`flow::porosity_gradient`] | u, U, p | ±S_i p ∇n V, −S_i ∇n·(ΔU − Δu) V |
+//! | [`flow::continuity`] | p | −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V ([003] 23b) |
+//!
+//! with m_s = (1 − n)ρ_s V (the mixture's mass in one-phase runs), m_w = nρ_w V, p = p_n + Σ S_j Δp_j,
+//! σ' the effective stress after the soil model's objective update (see [`kinematics`]) and ∇̄'
+//! the B̄ gradients on the current configuration. Eq. 23b is written for the step's increments (the
+//! grid is reset every step), which makes the continuity rows zero at Δd = 0 and linear in Δd.
+//!
+//! [003] writes these equations for a uniform porosity. When the porosity varies (large strain,
+//! several materials), the exact balances differ from them by three terms, which vanish for uniform
+//! n: the water is pushed by −n∇p, not −∇(np), so it gets +p∇n and the skeleton its reaction −p∇n;
+//! and the continuity equation ∇·u̇ + ∇·(n(U̇ − u̇)) + ṗ/Q = 0 has ∇n·(U̇ − u̇) besides the divergences
+//! ([`flow::porosity_gradient`]). Without them a large-strain column settles by about its strain too
+//! much (11 % at m_v q = 0.1).
+//!
+//! The tangent is the exact derivative of the residual: with small strains and without rotation it
+//! is K̄ = a₀M + a₁C + K of [003] Eq. 22 with −G₁, −G₂ off the diagonal and −P (not the +P printed in
+//! [003] Eq. 10) in the p–p block; the current configuration and the objective update add the
+//! geometric and rotational terms of [`stress`]. It is not symmetric in general.
+//!
+//! # B̄
+//! Each node carries the gradient ∇S_i used for the deviatoric part of B and a gradient ∇̄S_i for the
+//! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B.
+
+pub mod flow;
+pub mod inertia;
+pub mod kinematics;
+pub mod stress;
+
+use crate::model::shape::Stencil;
+use crate::model::soil::{Constitutive, StressUpdate};
+pub use kinematics::Kinematics;
+
+/// Largest number of stencil nodes of a particle (4 × 4, see [`crate::model::shape::MAX_STENCIL`]).
+pub const MAX_NODES: usize = crate::model::shape::MAX_STENCIL;
+/// Largest number of dofs per node (u–p–U).
+pub const MAX_DOF: usize = 5;
+/// Largest local block dimension.
+pub const MAX_LOCAL: usize = MAX_NODES * MAX_DOF;
+
+/// Component indices within a node of the two-phase layout.
+pub mod dof {
+    /// Solid displacement x.
+    pub const UX: usize = 0;
+    /// Solid displacement y.
+    pub const UY: usize = 1;
+    /// Pore pressure.
+    pub const P: usize = 2;
+    /// Water displacement x.
+    pub const WX: usize = 3;
+    /// Water displacement y.
+    pub const WY: usize = 4;
+}
+
+/// Which unknowns a node carries and where: the solid displacement always at 0 and 1, then the
+/// pore pressure and the water displacement if the system has them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    /// Dofs per node.
+    pub nd: usize,
+    /// Offset of the pore pressure.
+    pub p: Option<usize>,
+    /// Offset of the water displacement's x component.
+    pub w: Option<usize>,
+}
+
+impl Layout {
+    /// u (one-phase: total stress or dry).
+    pub const U: Layout = Layout { nd: 2, p: None, w: None };
+    /// u–p–U.
+    pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX) };
+
+    /// The layout of a formulation.
+    pub fn of(two_phase: bool) -> Layout {
+        if two_phase {
+            Layout::UPU
+        } else {
+            Layout::U
+        }
+    }
+}
+
+/// Basis values of one stencil node for one particle.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NodeBasis {
+    /// S_i.
+    pub s: f64,
+    /// ∇S_i (deviatoric part of B̄), on x_n.
+    pub g: [f64; 2],
+    /// ∇̄S_i (volumetric part of B̄; equals `g` without B̄), on x_n.
+    pub gv: [f64; 2],
+}
+
+/// The basis of a whole stencil without B̄, appended to `out`.
+pub fn plain_basis(st: &Stencil, out: &mut Vec<NodeBasis>) {
+    out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k] }));
+}
+
+/// Nodal values seen by a particle: the increment Δd and its parts a₀Δd, a₁Δd of the acceleration
+/// and velocity at t_{n+1} (the particle adds its predictors).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NodeState {
+    /// Δd in the node's layout.
+    pub d: [f64; MAX_DOF],
+    /// a₀ Δd.
+    pub a: [f64; MAX_DOF],
+    /// a₁ Δd.
+    pub v: [f64; MAX_DOF],
+}
+
+impl NodeState {
+    /// The state of a node with increments `d` under Newmark factors `nm`.
+    pub fn new(d: &[f64], nm: &Newmark) -> NodeState {
+        let mut s = NodeState::default();
+        for (c, &x) in d.iter().enumerate() {
+            s.d[c] = x;
+            s.a[c] = nm.a0 * x;
+            s.v[c] = nm.a1 * x;
+        }
+        s
+    }
+}
+
+/// The particle quantities the kernels need (at t_n).
+#[derive(Debug, Clone, Copy)]
+pub struct ParticleInput {
+    /// Volume V [m³ per m].
+    pub volume: f64,
+    /// Porosity n.
+    pub porosity: f64,
+    /// Mass of the u equation (grains, or mixture in one-phase) [kg].
+    pub mass: f64,
+    /// Water mass n ρ_w V [kg] (two-phase).
+    pub water_mass: f64,
+    /// Drag coefficient n² γ_w V / k [N s/m] (two-phase).
+    pub drag: f64,
+    /// 1/Q [1/Pa] (two-phase).
+    pub inv_q: f64,
+    /// Effective stress at t_n [Pa].
+    pub stress: [f64; 4],
+    /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
+    pub eps_pd: f64,
+    /// Pore pressure at t_n [Pa].
+    pub p: f64,
+    /// Body acceleration at t_{n+1} [m/s²].
+    pub body_acc: [f64; 2],
+    /// Porosity gradient ∇n at t_n [1/m] (two-phase).
+    pub grad_n: [f64; 2],
+    /// Newmark predictors of the point.
+    pub pred: Predictors,
+}
+
+/// Newmark factors a₀ = 1/(βΔt²), a₁ = γ/(βΔt) of a step of length Δt.
+#[derive(Debug, Clone, Copy)]
+pub struct Newmark {
+    /// 1/(βΔt²).
+    pub a0: f64,
+    /// γ/(βΔt).
+    pub a1: f64,
+    beta: f64,
+    gamma: f64,
+    dt: f64,
+}
+
+impl Newmark {
+    /// Factors for step `dt`.
+    pub fn new(beta: f64, gamma: f64, dt: f64) -> Newmark {
+        Newmark { a0: 1.0 / (beta * dt * dt), a1: gamma / (beta * dt), beta, gamma, dt }
+    }
+
+    /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
+    /// at Δd = 0).
+    pub fn predict(&self, v: [f64; 2], a: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let (b, g, dt) = (self.beta, self.gamma, self.dt);
+        let pa = |c: usize| -v[c] / (b * dt) - (0.5 / b - 1.0) * a[c];
+        let pv = |c: usize| -(g / b - 1.0) * v[c] - (0.5 * g / b - 1.0) * dt * a[c];
+        ([pa(0), pa(1)], [pv(0), pv(1)])
+    }
+}
+
+/// Newmark predictors at a material point: the acceleration and velocity at t_{n+1} for a zero
+/// displacement increment.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Predictors {
+    /// ã_n of the solid [m/s²].
+    pub a_u: [f64; 2],
+    /// ṽ_n of the solid [m/s].
+    pub v_u: [f64; 2],
+    /// ã_n of the water [m/s²] (two-phase).
+    pub a_w: [f64; 2],
+    /// ṽ_n of the water [m/s] (two-phase).
+    pub v_w: [f64; 2],
+}
+
+impl Predictors {
+    /// The predictors for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and accelerations
+    /// at t_n (the nodal values interpolated to the point).
+    pub fn new(nm: &Newmark, v_u: [f64; 2], a_u: [f64; 2], v_w: [f64; 2], a_w: [f64; 2]) -> Predictors {
+        let (pa_u, pv_u) = nm.predict(v_u, a_u);
+        let (pa_w, pv_w) = nm.predict(v_w, a_w);
+        Predictors { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
+    }
+}
+
+/// B̄ of one node from its deviatoric gradient `g` and volumetric gradient `gv`: 4 strain rows ×
+/// 2 displacement components ([000] Eq. 16).
+#[inline]
+pub fn bbar(g: [f64; 2], gv: [f64; 2]) -> [[f64; 2]; 4] {
+    let (gx, gy, vx, vy) = (g[0], g[1], gv[0], gv[1]);
+    let t = 1.0 / 3.0;
+    [
+        [2.0 * t * gx + t * vx, -t * gy + t * vy],
+        [-t * gx + t * vx, 2.0 * t * gy + t * vy],
+        [gy, gx],
+        [-t * gx + t * vx, -t * gy + t * vy],
+    ]
+}
+
+/// Values interpolated to a particle from the nodal increments, with its Newmark predictors.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Interp {
+    /// Solid displacement increment Σ S Δu.
+    pub du: [f64; 2],
+    /// Water displacement increment Σ S ΔU.
+    pub dw: [f64; 2],
+    /// Pressure increment Σ S Δp.
+    pub dp: f64,
+    /// Volumetric strain increment of the solid on x_n, ∇̄·Δu = Σ ∇̄S·Δu.
+    pub dvol_u: f64,
+    /// Volumetric strain increment of the water on x_n, ∇̄·ΔU.
+    pub dvol_w: f64,
+    /// Solid acceleration at t_{n+1}.
+    pub a_u: [f64; 2],
+    /// Water acceleration at t_{n+1}.
+    pub a_w: [f64; 2],
+    /// Solid velocity at t_{n+1}.
+    pub v_u: [f64; 2],
+    /// Water velocity at t_{n+1}.
+    pub v_w: [f64; 2],
+}
+
+/// Interpolates nodal values to the particle and adds its Newmark predictors.
+pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors, layout: Layout) -> Interp {
+    let mut k = Interp { a_u: pred.a_u, v_u: pred.v_u, ..Interp::default() };
+    if layout.w.is_some() {
+        k.a_w = pred.a_w;
+        k.v_w = pred.v_w;
+    }
+    for (b, st) in basis.iter().zip(states) {
+        for c in 0..2 {
+            k.a_u[c] += b.s * st.a[c];
+            k.v_u[c] += b.s * st.v[c];
+            k.du[c] += b.s * st.d[c];
+            k.dvol_u += b.gv[c] * st.d[c];
+        }
+        if let Some(p) = layout.p {
+            k.dp += b.s * st.d[p];
+        }
+        if let Some(w) = layout.w {
+            for c in 0..2 {
+                k.dvol_w += b.gv[c] * st.d[w + c];
+                k.a_w[c] += b.s * st.a[w + c];
+                k.v_w[c] += b.s * st.v[w + c];
+                k.dw[c] += b.s * st.d[w + c];
+            }
+        }
+    }
+    k
+}
+
+/// Everything the terms need at one particle for the current iterate: the interpolated values, the
+/// kinematics, the gradients on x_{n+1} and the soil model's update from the rotated stress.
+#[derive(Debug, Clone, Copy)]
+pub struct Point<'a> {
+    /// The stencil's basis on x_n.
+    pub basis: &'a [NodeBasis],
+    /// The particle at t_n.
+    pub part: &'a ParticleInput,
+    /// Which dofs the nodes carry.
+    pub layout: Layout,
+    /// Interpolated increments, velocities and accelerations.
+    pub interp: Interp,
+    /// Finite-strain kinematics of the step.
+    pub kin: Kinematics,
+    /// The effective stress at t_n rotated with the material (Hughes–Winget).
+    pub rotated: [f64; 4],
+    /// The soil model's update from `rotated` by the strain increment.
+    pub upd: StressUpdate,
+    /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}.
+    pub spatial: [([f64; 2], [f64; 2]); MAX_NODES],
+    /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
+    pub p: f64,
+}
+
+impl<'a> Point<'a> {
+    /// Evaluates the point for the nodal `states` (same order as `basis`).
+    pub fn new(
+        basis: &'a [NodeBasis],
+        states: &[NodeState],
+        part: &'a ParticleInput,
+        model: &Constitutive,
+        layout: Layout,
+    ) -> Point<'a> {
+        let interp = interpolate(basis, states, &part.pred, layout);
+        let kin = Kinematics::new(basis, states.iter().map(|s| [s.d[0], s.d[1]]));
+        let rotated = kinematics::rotate(&part.stress, kin.theta);
+        let upd = model.update(&rotated, part.eps_pd, &kin.deps);
+        let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
+        for (s, b) in spatial.iter_mut().zip(basis) {
+            *s = kin.spatial(b);
+        }
+        Point { basis, part, layout, interp, kin, rotated, upd, spatial, p: part.p + interp.dp }
+    }
+
+    /// Number of local dofs (stencil nodes × dofs per node).
+    pub fn size(&self) -> usize {
+        self.basis.len() * self.layout.nd
+    }
+
+    /// V_{n+1} = J_v V_n.
+    pub fn volume_new(&self) -> f64 {
+        self.part.volume * self.kin.jv
+    }
+}
+
+/// The residual block of the dynamic system (length `nn × nd`, node-major): the sum of every term
+/// of the layout (see the module documentation). `out` is overwritten.
+pub fn residual(pt: &Point, out: &mut [f64]) {
+    out[..pt.size()].fill(0.0);
+    inertia::residual(pt, out);
+    stress::residual(pt, out);
+    if pt.layout.w.is_some() {
+        inertia::drag::residual(pt, out);
+        stress::pore_pressure::residual(pt, out);
+        flow::porosity_gradient::residual(pt, out);
+    }
+    if pt.layout.p.is_some() {
+        flow::continuity::residual(pt, out);
+    }
+}
+
+/// The tangent block d(residual)/d(Δd) of the dynamic system, row-major `(nn·nd)²`. Every entry of
+/// `out` is written (the zero couplings too), so the buffer may be reused from particle to particle.
+pub fn tangent(pt: &Point, nm: &Newmark, out: &mut [f64]) {
+    let m = pt.size();
+    out[..m * m].fill(0.0);
+    inertia::tangent(pt, nm, out);
+    stress::tangent(pt, out);
+    if pt.layout.w.is_some() {
+        inertia::drag::tangent(pt, nm, out);
+        stress::pore_pressure::tangent(pt, out);
+        flow::porosity_gradient::tangent(pt, out);
+    }
+    if pt.layout.p.is_some() {
+        flow::continuity::tangent(pt, out);
+    }
+}
+
+/// What the particle update of [003] Eq. 24 / [000] Eq. 11 takes from a converged step: exactly the
+/// state the converged residual used, so that the stress stored at the particle and the stress in
+/// the residual cannot part ways.
+#[derive(Debug, Clone, Copy)]
+pub struct StepResult {
+    /// Interpolated increments, velocities and accelerations.
+    pub interp: Interp,
+    /// The soil model's update (effective stress and ε̄ at t_{n+1}).
+    pub upd: StressUpdate,
+    /// Incremental deformation gradient the particle keeps, F̄ = (J_v/J)^{1/2} F.
+    pub f_inc: [[f64; 2]; 2],
+    /// Volume ratio of the step, J_v.
+    pub jacobian: f64,
+}
+
+impl StepResult {
+    /// The result of the converged point.
+    pub fn of(pt: &Point) -> StepResult {
+        StepResult { interp: pt.interp, upd: pt.upd, f_inc: pt.kin.f_bar(), jacobian: pt.kin.jv }
+    }
+}
+
+/// Pressure-projection stabilisation of one cell (Bochev & Dohrmann 2006; Dohrmann & Bochev 2004,
+/// for equal-order pressures): S_kl = Σ_p w_p (N_k(x_p) − N̄_k)(N_l(x_p) − N̄_l) over the material
+/// points p of the cell, with N the cell's four bilinear functions at the points, w_p = τ_p V_p and
+/// N̄ the w-weighted cell averages. Δpᵀ S Δp penalises the part of the pressure increment that is
+/// not constant in the cell, which the volumetric coupling of equal-order (and B̄) interpolation
+/// cannot see; it vanishes for a cell-wise constant field. The caller subtracts S Δp from the
+/// continuity rows (the sign of −P).
+pub fn pressure_projection(n: &[[f64; 4]], w: &[f64]) -> [[f64; 4]; 4] {
+    let total: f64 = w.iter().sum();
+    let mut out = [[0.0; 4]; 4];
+    if total <= 0.0 {
+        return out;
+    }
+    let mut mean = [0.0; 4];
+    for (np, wp) in n.iter().zip(w) {
+        for k in 0..4 {
+            mean[k] += wp * np[k] / total;
+        }
+    }
+    for (np, wp) in n.iter().zip(w) {
+        for k in 0..4 {
+            for l in 0..4 {
+                out[k][l] += wp * (np[k] - mean[k]) * (np[l] - mean[l]);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+pub(crate) mod tests;

@@ -1,0 +1,144 @@
+//! The divergence of the effective stress on the current configuration ([003] Eq. 23a, [000]
+//! Eq. 16 on x_{n+1}) and the pore pressure's forces on both phases ([`pore_pressure`]).
+//!
+//! Residual in the u rows: f_i = B̄'_iᵀ σ'_{n+1} V_{n+1} = V_{n+1} (dev σ' ∇'S_i + σ'_m ∇̄'S_i) (in
+//! the plane; σ'_m the mean stress including σ'_zz), with ∇' and ∇̄' the gradients on x_{n+1} and
+//! σ'_{n+1} the soil model's update from the rotated stress (see [`super::kinematics`]).
+//!
+//! Its derivative with respect to Δu_l (component d) has three parts:
+//! * material: V_{n+1} B̄'_iᵀ A_l with A_l = ∂σ'/∂Δu_l = T (∂(Rσ_nRᵀ)/∂θ) ∂θ/∂Δu_l + D_alg ∂Δε/∂Δu_l
+//!   (T = ∂σ'/∂σ_trial of the return, D_alg = T D);
+//! * volume: f_i,c (∇̄'S_l)_d, from ∂J_v/∂Δu_l,d = J_v (∇̄'S_l)_d;
+//! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
+//!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
+
+use super::{bbar, kinematics, Point};
+
+/// In-plane deviatoric stress and the mean stress of [xx, yy, xy, zz].
+fn split(s: &[f64; 4]) -> ([[f64; 2]; 2], f64) {
+    let pm = (s[0] + s[1] + s[3]) / 3.0;
+    ([[s[0] - pm, s[2]], [s[2], s[1] - pm]], pm)
+}
+
+/// The force of stress `s` on a node with gradients (g, gv) on x_{n+1}, per unit volume.
+#[inline]
+fn traction(dev: &[[f64; 2]; 2], pm: f64, g: [f64; 2], gv: [f64; 2]) -> [f64; 2] {
+    [dev[0][0] * g[0] + dev[0][1] * g[1] + pm * gv[0], dev[1][0] * g[0] + dev[1][1] * g[1] + pm * gv[1]]
+}
+
+/// Adds the effective-stress residual in the u rows.
+pub fn residual(pt: &Point, out: &mut [f64]) {
+    let nd = pt.layout.nd;
+    let v = pt.volume_new();
+    let (dev, pm) = split(&pt.upd.stress);
+    for k in 0..pt.basis.len() {
+        let (g, gv) = pt.spatial[k];
+        let t = traction(&dev, pm, g, gv);
+        out[k * nd] += t[0] * v;
+        out[k * nd + 1] += t[1] * v;
+    }
+}
+
+/// Adds the u–u tangent of the effective-stress term (material, volume and geometric parts).
+pub fn tangent(pt: &Point, out: &mut [f64]) {
+    let (nd, m) = (pt.layout.nd, pt.size());
+    let v = pt.volume_new();
+    let s = &pt.upd.stress;
+    let (dev, pm) = split(s);
+    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
+    // ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
+    let drot = kinematics::rotate_derivative(&pt.rotated);
+    let t_drot: [f64; 4] = std::array::from_fn(|r| (0..4).map(|q| t_mat[r][q] * drot[q]).sum());
+    // A_l = ∂σ'/∂Δu_l (4 × 2) for every node.
+    let mut a = [[[0.0; 2]; 4]; super::MAX_NODES];
+    for (l, bl) in pt.basis.iter().enumerate() {
+        let de = pt.kin.deps_derivative(bl);
+        let dt = pt.kin.theta_derivative(bl);
+        for r in 0..4 {
+            for d in 0..2 {
+                a[l][r][d] = t_drot[r] * dt[d] + (0..4).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+            }
+        }
+    }
+    for k in 0..pt.basis.len() {
+        let (gk, gvk) = pt.spatial[k];
+        let bk = bbar(gk, gvk);
+        let tk = traction(&dev, pm, gk, gvk);
+        for l in 0..pt.basis.len() {
+            let (gl, gvl) = pt.spatial[l];
+            let dev_gl = [dev[0][0] * gl[0] + dev[0][1] * gl[1], dev[1][0] * gl[0] + dev[1][1] * gl[1]];
+            for c in 0..2 {
+                for d in 0..2 {
+                    let material: f64 = (0..4).map(|r| bk[r][c] * a[l][r][d]).sum();
+                    let volume = tk[c] * gvl[d];
+                    let geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
+                    out[(k * nd + c) * m + l * nd + d] += v * (material + volume + geometric);
+                }
+            }
+        }
+    }
+}
+
+/// The pore pressure's forces: −(1 − n) p ∇̄'S_i V_{n+1} on the solid and −n p ∇̄'S_i V_{n+1} on the
+/// water ([003] Eqs. 23a, 23c on x_{n+1}); in a layout without water the solid carries p whole.
+pub mod pore_pressure {
+    use super::super::Point;
+
+    /// The fractions of p carried by the solid and the water equations.
+    fn shares(pt: &Point) -> (f64, f64) {
+        let n = pt.part.porosity;
+        if pt.layout.w.is_some() {
+            (1.0 - n, n)
+        } else {
+            (1.0, 0.0)
+        }
+    }
+
+    /// Adds the pressure forces (layouts with a pressure).
+    pub fn residual(pt: &Point, out: &mut [f64]) {
+        if pt.layout.p.is_none() {
+            return;
+        }
+        let nd = pt.layout.nd;
+        let (fs, fw) = shares(pt);
+        let pv = pt.p * pt.volume_new();
+        for k in 0..pt.basis.len() {
+            let gv = pt.spatial[k].1;
+            for c in 0..2 {
+                out[k * nd + c] -= fs * pv * gv[c];
+                if let Some(w) = pt.layout.w {
+                    out[k * nd + w + c] -= fw * pv * gv[c];
+                }
+            }
+        }
+    }
+
+    /// Adds the u–p and U–p couplings (−G₁, −G₂ on x_{n+1}) and their geometric u–u and U–u parts.
+    pub fn tangent(pt: &Point, out: &mut [f64]) {
+        let Some(p) = pt.layout.p else { return };
+        let (nd, m) = (pt.layout.nd, pt.size());
+        let (fs, fw) = shares(pt);
+        let v = pt.volume_new();
+        for k in 0..pt.basis.len() {
+            let gvk = pt.spatial[k].1;
+            for (l, bl) in pt.basis.iter().enumerate() {
+                let gvl = pt.spatial[l].1;
+                for c in 0..2 {
+                    let ru = (k * nd + c) * m;
+                    out[ru + l * nd + p] -= fs * v * gvk[c] * bl.s;
+                    for d in 0..2 {
+                        // ∂(J_v ∇̄'S_k,c)/∂Δu_l,d = J_v (∇̄'S_l,d ∇̄'S_k,c − ∇̄'S_l,c ∇̄'S_k,d).
+                        let geo = pt.p * v * (gvl[d] * gvk[c] - gvl[c] * gvk[d]);
+                        out[ru + l * nd + d] -= fs * geo;
+                        if let Some(w) = pt.layout.w {
+                            out[(k * nd + w + c) * m + l * nd + d] -= fw * geo;
+                        }
+                    }
+                    if let Some(w) = pt.layout.w {
+                        out[(k * nd + w + c) * m + l * nd + p] -= fw * v * gvk[c] * bl.s;
+                    }
+                }
+            }
+        }
+    }
+}

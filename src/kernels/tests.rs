@@ -1,0 +1,410 @@
+//! Unit tests of the kernels: each term's tangent against central differences of its own residual,
+//! block by block and each block against its own scale, so that a wrong sign in a block whose
+//! entries are 10⁻¹⁵ of the largest entry of the tangent still fails; and the properties of the
+//! whole point (rest, rigid rotation, Newmark).
+
+use super::*;
+use crate::case::SoilModel;
+use crate::model::material::soil_model;
+use crate::model::soil::LinearElastic;
+
+/// A non-associated Mohr–Coulomb soil with softening.
+fn mohr_coulomb(cohesion: f64) -> Constitutive {
+    soil_model(&SoilModel::MohrCoulomb {
+        young_modulus: 1e7,
+        poisson_ratio: 0.3,
+        friction_angle: 30.0,
+        cohesion,
+        residual_cohesion: Some(0.5 * cohesion),
+        softening_strain: Some(0.05),
+        dilation_angle: 5.0,
+        critical_dilation_angle: Some(0.0),
+        dilation_decay: 10.0,
+        tension_cutoff: None,
+    })
+}
+
+/// The agreement of one (row field, column field) block of a tangent with finite differences.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BlockError {
+    pub row: usize,
+    pub col: usize,
+    /// max |J − FD| over the block.
+    pub err: f64,
+    /// max |J| over the block.
+    pub jmax: f64,
+    /// max |FD| over the block.
+    pub fdmax: f64,
+    /// The finite-difference noise expected in the block.
+    pub noise: f64,
+}
+
+impl BlockError {
+    /// Whether the block agrees: within 1e-6 of its own scale, or within the noise for a block
+    /// that is zero.
+    pub fn pass(&self) -> bool {
+        self.err <= 1e-6 * self.jmax.max(self.fdmax) + self.noise
+    }
+}
+
+/// Compares `tangent` (row-major m × m) with central differences of `residual` at `d0`, with the
+/// step `h[field]` for each field of a node of `nd` dofs.
+pub(crate) fn fd_blocks(
+    nd: usize,
+    d0: &[f64],
+    h: &[f64],
+    residual: &dyn Fn(&[f64]) -> Vec<f64>,
+    tangent: &[f64],
+) -> Vec<BlockError> {
+    let m = d0.len();
+    let mut fd = vec![0.0; m * m];
+    for c in 0..m {
+        let hc = h[c % nd];
+        let (mut dp, mut dm) = (d0.to_vec(), d0.to_vec());
+        dp[c] += hc;
+        dm[c] -= hc;
+        let (rp, rm) = (residual(&dp), residual(&dm));
+        for r in 0..m {
+            fd[r * m + c] = (rp[r] - rm[r]) / (2.0 * hc);
+        }
+    }
+    // Expected round-off of a difference quotient in row field a, column field b: the residual's
+    // change over one step of each column field, times 1e-8, divided by h_b.
+    let change = |a: usize| -> f64 {
+        (0..m)
+            .filter(|r| r % nd == a)
+            .flat_map(|r| (0..m).map(move |c| (r, c)))
+            .fold(0.0f64, |s, (r, c)| s.max(tangent[r * m + c].abs() * h[c % nd]))
+    };
+    let mut out = Vec::new();
+    for a in 0..nd {
+        let ch = change(a);
+        for (b, &hb) in h.iter().enumerate().take(nd) {
+            let (mut err, mut jmax, mut fdmax) = (0.0f64, 0.0f64, 0.0f64);
+            for r in (0..m).filter(|r| r % nd == a) {
+                for c in (0..m).filter(|c| c % nd == b) {
+                    err = err.max((tangent[r * m + c] - fd[r * m + c]).abs());
+                    jmax = jmax.max(tangent[r * m + c].abs());
+                    fdmax = fdmax.max(fd[r * m + c].abs());
+                }
+            }
+            out.push(BlockError { row: a, col: b, err, jmax, fdmax, noise: 1e-8 * ch / hb });
+        }
+    }
+    out
+}
+
+fn sample(nn: usize) -> Vec<NodeBasis> {
+    (0..nn)
+        .map(|k| {
+            let x = k as f64;
+            NodeBasis {
+                s: 0.05 + 0.1 * (x * 0.7).sin().abs(),
+                g: [(x * 1.3).cos() * 3.0, (x * 0.9).sin() * 2.0],
+                gv: [(x * 1.1).cos() * 2.5, (x * 0.4).sin() * 1.5],
+            }
+        })
+        .collect()
+}
+
+fn part() -> ParticleInput {
+    ParticleInput {
+        volume: 2.5e-3,
+        porosity: 0.35,
+        mass: 4.3,
+        water_mass: 0.9,
+        drag: 7.0e3,
+        inv_q: 3.0e-9,
+        stress: [-1.0e3, -2.0e3, 150.0, -1.2e3],
+        eps_pd: 0.0,
+        p: 500.0,
+        body_acc: [0.0, -9.81],
+        grad_n: [0.7, -1.3],
+        pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
+    }
+}
+
+fn states(d: &[f64], nd: usize, nm: &Newmark) -> Vec<NodeState> {
+    d.chunks(nd).map(|c| NodeState::new(c, nm)).collect()
+}
+
+/// Increments of typical size: displacements of 1e-3 m (strains of a few 1e-3, rotations), 500 Pa.
+fn increments(m: usize, layout: Layout) -> Vec<f64> {
+    (0..m)
+        .map(|i| {
+            let s = ((i as f64) * 0.37 + 0.1).sin();
+            if Some(i % layout.nd) == layout.p {
+                500.0 * s
+            } else {
+                1e-3 * s
+            }
+        })
+        .collect()
+}
+
+fn steps(layout: Layout) -> Vec<f64> {
+    (0..layout.nd).map(|c| if Some(c) == layout.p { 1e-3 } else { 1e-9 }).collect()
+}
+
+type Term = (&'static str, fn(&Point, &mut [f64]), fn(&Point, &Newmark, &mut [f64]));
+
+/// Every term with its residual and tangent.
+fn terms() -> Vec<Term> {
+    vec![
+        ("inertia", inertia::residual, inertia::tangent),
+        ("drag", inertia::drag::residual, inertia::drag::tangent),
+        ("effective stress", stress::residual, |p, _, o| stress::tangent(p, o)),
+        ("pore pressure", stress::pore_pressure::residual, |p, _, o| stress::pore_pressure::tangent(p, o)),
+        ("porosity gradient", flow::porosity_gradient::residual, |p, _, o| flow::porosity_gradient::tangent(p, o)),
+        ("continuity", flow::continuity::residual, |p, _, o| flow::continuity::tangent(p, o)),
+        ("all", |p, o| residual(p, o), tangent),
+    ]
+}
+
+fn models() -> Vec<(&'static str, Constitutive, [f64; 4])> {
+    let el = LinearElastic::new(1e7, 0.3);
+    // A Mohr–Coulomb point close to its yield surface, so the step returns plastically.
+    vec![
+        ("elastic", Constitutive::LinearElastic(el), [-1.0e3, -2.0e3, 150.0, -1.2e3]),
+        ("mohr-coulomb", mohr_coulomb(1.0e3), [-1.0e4, -4.0e4, 9.0e3, -2.0e4]),
+    ]
+}
+
+/// Runs the finite-difference check of one term; returns the blocks.
+fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layout) -> Vec<BlockError> {
+    let basis = sample(6);
+    let nd = layout.nd;
+    let m = basis.len() * nd;
+    let nm = Newmark::new(0.25, 0.5, 1e-3);
+    let mut p = part();
+    p.stress = stress;
+    let d0 = increments(m, layout);
+    let res = |d: &[f64]| {
+        let st = states(d, nd, &nm);
+        let pt = Point::new(&basis, &st, &p, model, layout);
+        let mut r = vec![0.0; m];
+        (term.1)(&pt, &mut r);
+        r
+    };
+    let st = states(&d0, nd, &nm);
+    let pt = Point::new(&basis, &st, &p, model, layout);
+    let mut t = vec![0.0; m * m];
+    (term.2)(&pt, &nm, &mut t);
+    fd_blocks(nd, &d0, &steps(layout), &res, &t)
+}
+
+#[test]
+fn every_term_matches_central_differences_block_by_block() {
+    let names = ["ux", "uy", "p", "Ux", "Uy"];
+    for layout in [Layout::UPU, Layout::U] {
+        for (mname, model, stress) in models() {
+            for term in terms() {
+                for b in check_term(&term, &model, stress, layout) {
+                    assert!(
+                        b.pass(),
+                        "{} ({mname}, nd = {}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
+                        term.0,
+                        layout.nd,
+                        names[b.row],
+                        names[b.col],
+                        b.err,
+                        b.jmax,
+                        b.fdmax,
+                        b.noise
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn the_plastic_sample_really_returns() {
+    let (_, model, stress) = models()[1];
+    let basis = sample(6);
+    let nm = Newmark::new(0.25, 0.5, 1e-3);
+    let mut p = part();
+    p.stress = stress;
+    let d0 = increments(basis.len() * 5, Layout::UPU);
+    let st = states(&d0, 5, &nm);
+    let pt = Point::new(&basis, &st, &p, &model, Layout::UPU);
+    assert!(pt.upd.eps_pd > 0.0, "{:?}", pt.upd.region);
+    assert!(pt.kin.theta.abs() > 1e-4, "the sample must rotate: θ = {}", pt.kin.theta);
+}
+
+/// The check is not blind: a wrong sign in any non-zero block of any term, however small its
+/// entries against the rest of the tangent (p–p ≈ 1e-13, u–u ≈ 1e5 here), fails it.
+#[test]
+fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
+    let layout = Layout::UPU;
+    let (_, model, stress) = models()[0];
+    let basis = sample(6);
+    let nd = layout.nd;
+    let m = basis.len() * nd;
+    let nm = Newmark::new(0.25, 0.5, 1e-3);
+    let p = ParticleInput { stress, ..part() };
+    let d0 = increments(m, layout);
+    let mut flipped_blocks = 0;
+    for term in terms() {
+        let res = |d: &[f64]| {
+            let st = states(d, nd, &nm);
+            let pt = Point::new(&basis, &st, &p, &model, layout);
+            let mut r = vec![0.0; m];
+            (term.1)(&pt, &mut r);
+            r
+        };
+        let st = states(&d0, nd, &nm);
+        let pt = Point::new(&basis, &st, &p, &model, layout);
+        let mut t = vec![0.0; m * m];
+        (term.2)(&pt, &nm, &mut t);
+        for a in 0..nd {
+            for b in 0..nd {
+                let mut wrong = t.clone();
+                let mut any = false;
+                for r in (0..m).filter(|r| r % nd == a) {
+                    for c in (0..m).filter(|c| c % nd == b) {
+                        any |= wrong[r * m + c] != 0.0;
+                        wrong[r * m + c] = -wrong[r * m + c];
+                    }
+                }
+                if !any {
+                    continue;
+                }
+                flipped_blocks += 1;
+                let blocks = fd_blocks(nd, &d0, &steps(layout), &res, &wrong);
+                let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
+                assert!(caught, "{}: a flipped {a}–{b} block passed", term.0);
+            }
+        }
+    }
+    assert!(flipped_blocks > 40, "only {flipped_blocks} blocks were flipped");
+}
+
+#[test]
+fn newmark_reproduces_a_uniformly_accelerated_motion() {
+    // A point with v_n, a_n moved by Δd = v_n Δt + a_n Δt²/2 keeps a_n and reaches v_n + a_n Δt
+    // ([003] Eqs. 20–21) for any β, γ.
+    for (beta, gamma) in [(0.25, 0.5), (0.3025, 0.6)] {
+        let (dt, v, a) = (2e-3, [0.4, -1.1], [3.0, -9.81]);
+        let nm = Newmark::new(beta, gamma, dt);
+        let pred = Predictors::new(&nm, v, a, v, a);
+        let d = [v[0] * dt + 0.5 * a[0] * dt * dt, v[1] * dt + 0.5 * a[1] * dt * dt];
+        let basis = [NodeBasis { s: 1.0, g: [0.0; 2], gv: [0.0; 2] }];
+        let st = states(&[d[0], d[1], 0.0, d[0], d[1]], 5, &nm);
+        let k = interpolate(&basis, &st, &pred, Layout::UPU);
+        for c in 0..2 {
+            assert!((k.a_u[c] - a[c]).abs() < 1e-9 && (k.a_w[c] - a[c]).abs() < 1e-9, "{k:?}");
+            assert!((k.v_u[c] - (v[c] + a[c] * dt)).abs() < 1e-12, "{k:?}");
+        }
+    }
+}
+
+#[test]
+fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
+    // A particle at rest with zero stress under gravity: the u-rows carry −S m_s b, the U-rows −S m_w b,
+    // the p-rows are zero; the sum over nodes of the vertical u+U forces is −(m_s + m_w) g when Σ S = 1.
+    let mut basis = sample(4);
+    let total: f64 = basis.iter().map(|b| b.s).sum();
+    for b in basis.iter_mut() {
+        b.s /= total;
+    }
+    let mut p = part();
+    p.stress = [0.0; 4];
+    p.p = 0.0;
+    p.grad_n = [0.0; 2];
+    p.pred = Predictors::default();
+    let st = vec![NodeState::default(); 4];
+    let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
+    let pt = Point::new(&basis, &st, &p, &model, Layout::UPU);
+    let mut r = vec![0.0; 20];
+    residual(&pt, &mut r);
+    let fy: f64 = (0..4).map(|k| r[k * 5 + 1] + r[k * 5 + 4]).sum();
+    assert!((fy - (p.mass + p.water_mass) * 9.81).abs() < 1e-12);
+    assert!((0..4).all(|k| r[k * 5 + 2] == 0.0));
+}
+
+/// Bilinear functions of the unit square evaluated for a point at `x` (S, ∇S; B̄ gradients equal).
+fn unit_square(x: [f64; 2]) -> Vec<NodeBasis> {
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+        .iter()
+        .map(|&(nx, ny): &(f64, f64)| {
+            let sx = if nx == 0.0 { 1.0 - x[0] } else { x[0] };
+            let sy = if ny == 0.0 { 1.0 - x[1] } else { x[1] };
+            let gx = if nx == 0.0 { -1.0 } else { 1.0 };
+            let gy = if ny == 0.0 { -1.0 } else { 1.0 };
+            NodeBasis { s: sx * sy, g: [gx * sy, sx * gy], gv: [gx * sy, sx * gy] }
+        })
+        .collect()
+}
+
+#[test]
+fn volume_ratio_and_strain_of_a_uniform_compression() {
+    // Δu = (−0.01 x, −0.02 y): F = diag(0.99, 0.98); the mid-step strain is the exact
+    // L = H (I + H/2)⁻¹, the volume ratio det F.
+    let basis = unit_square([0.3, 0.6]);
+    let nm = Newmark::new(0.25, 0.5, 1.0);
+    let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+    let st: Vec<NodeState> = pts.iter().map(|&(x, y)| NodeState::new(&[-0.01 * x, -0.02 * y], &nm)).collect();
+    let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
+    let p = ParticleInput { stress: [0.0; 4], ..part() };
+    let pt = Point::new(&basis, &st, &p, &model, Layout::U);
+    let r = StepResult::of(&pt);
+    assert!((r.jacobian - 0.99 * 0.98).abs() < 1e-14);
+    assert!((r.f_inc[0][0] - 0.99).abs() < 1e-14 && (r.f_inc[1][1] - 0.98).abs() < 1e-14);
+    assert!(r.f_inc[0][1].abs() < 1e-14 && r.f_inc[1][0].abs() < 1e-14);
+    assert!((pt.kin.deps[0] + 0.01 / 0.995).abs() < 1e-14 && (pt.kin.deps[1] + 0.02 / 0.99).abs() < 1e-14);
+    assert!((r.interp.du[0] + 0.003).abs() < 1e-14);
+}
+
+/// A stressed point turned rigidly by 90° in 10 and in 100 steps keeps its principal stresses to
+/// round-off and ends with R σ Rᵀ (Hughes–Winget is exact for rigid rotations).
+#[test]
+fn a_rigid_rotation_turns_the_stress_with_the_material() {
+    for model in [Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)), mohr_coulomb(1.0e5)] {
+        for n in [10usize, 100] {
+            let s0 = [-3.0e4, -1.0e4, 4.0e3, -2.0e4];
+            let mut s = s0;
+            let alpha = std::f64::consts::FRAC_PI_2 / n as f64;
+            let (c, sn) = (alpha.cos(), alpha.sin());
+            let basis = unit_square([0.5, 0.5]);
+            let nm = Newmark::new(0.25, 0.5, 1.0);
+            let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+            let st: Vec<NodeState> = pts
+                .iter()
+                .map(|&(x, y)| {
+                    NodeState::new(
+                        &[c * (x - 0.5) - sn * (y - 0.5) - (x - 0.5), sn * (x - 0.5) + c * (y - 0.5) - (y - 0.5)],
+                        &nm,
+                    )
+                })
+                .collect();
+            for _ in 0..n {
+                let p = ParticleInput { stress: s, ..part() };
+                s = Point::new(&basis, &st, &p, &model, Layout::U).upd.stress;
+            }
+            // A quarter turn: σ_xx ↔ σ_yy, σ_xy → −σ_xy.
+            let expected = [s0[1], s0[0], -s0[2], s0[3]];
+            let worst = (0..4).map(|i| (s[i] - expected[i]).abs()).fold(0.0, f64::max);
+            assert!(worst < 1e-9 * 3.0e4, "{n} steps: {s:?} vs {expected:?}");
+        }
+    }
+}
+
+#[test]
+fn the_pressure_projection_ignores_constants_and_penalises_the_rest() {
+    // Four points of a unit cell at the quarter points.
+    let pts = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
+    let n: Vec<[f64; 4]> =
+        pts.iter().map(|&(x, y)| [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]).collect();
+    let s = pressure_projection(&n, &[0.25; 4]);
+    let apply = |p: [f64; 4]| -> f64 { (0..4).map(|k| (0..4).map(|l| p[k] * s[k][l] * p[l]).sum::<f64>()).sum() };
+    assert!(apply([1.0; 4]).abs() < 1e-15, "a constant is not penalised");
+    // The checkerboard (+ − − +) and a linear field are.
+    assert!(apply([1.0, -1.0, -1.0, 1.0]) > 1e-3);
+    assert!(apply([0.0, 1.0, 0.0, 1.0]) > 1e-3);
+    for (k, row) in s.iter().enumerate() {
+        for (l, v) in row.iter().enumerate() {
+            assert!((v - s[l][k]).abs() < 1e-15);
+        }
+    }
+}

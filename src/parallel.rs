@@ -1,0 +1,135 @@
+//! Collective operations over the run's ranks, on rsmpi (MPI's lifetime belongs to `main`, which
+//! initialises it before PETSc and finalises it after).
+//!
+//! Every decision that leads to a collective operation (a new matrix, a step cut, a stage end, an
+//! output or checkpoint) must be the same on every rank, and an error raised on one rank between
+//! two collectives must reach the others before they enter the next one, or the run hangs. The
+//! pattern is: compute the local outcome, then [`Collective::agree`] on it: every rank returns the
+//! same `Ok` or the same error (that of the lowest failing rank).
+
+use mpi::collective::SystemOperation;
+use mpi::datatype::PartitionMut;
+use mpi::topology::{Communicator, SimpleCommunicator};
+use mpi::traits::*;
+
+/// The run's communicator (MPI_COMM_WORLD) and its reductions.
+pub struct Collective {
+    world: SimpleCommunicator,
+}
+
+impl Default for Collective {
+    fn default() -> Self {
+        Collective::world()
+    }
+}
+
+impl Collective {
+    /// All ranks of the run. MPI must be initialised.
+    pub fn world() -> Collective {
+        Collective { world: SimpleCommunicator::world() }
+    }
+
+    /// The communicator (for PETSc and for point-to-point exchanges).
+    pub fn communicator(&self) -> &SimpleCommunicator {
+        &self.world
+    }
+
+    /// This rank.
+    pub fn rank(&self) -> usize {
+        self.world.rank() as usize
+    }
+
+    /// Number of ranks.
+    pub fn size(&self) -> usize {
+        self.world.size() as usize
+    }
+
+    fn reduce(&self, v: &[f64], op: SystemOperation) -> Vec<f64> {
+        let mut out = vec![0.0; v.len()];
+        if !v.is_empty() {
+            self.world.all_reduce_into(v, &mut out[..], op);
+        }
+        out
+    }
+
+    /// Element-wise sum over ranks.
+    pub fn sum(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        Ok(self.reduce(v, SystemOperation::sum()))
+    }
+
+    /// Element-wise maximum over ranks.
+    pub fn max(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        Ok(self.reduce(v, SystemOperation::max()))
+    }
+
+    /// Element-wise minimum over ranks.
+    pub fn min(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        Ok(self.reduce(v, SystemOperation::min()))
+    }
+
+    /// Exact sum of counts over ranks.
+    pub fn sum_count(&self, v: u64) -> u64 {
+        let mut out = 0u64;
+        self.world.all_reduce_into(&v, &mut out, SystemOperation::sum());
+        out
+    }
+
+    /// Every rank's values concatenated in rank order, on every rank.
+    pub fn gather(&self, v: &[f64]) -> Result<Vec<f64>, String> {
+        Ok(self.gather_of(v))
+    }
+
+    /// Every rank's records (any MPI-equivalent type) concatenated in rank order, on every rank.
+    pub fn gather_of<T: Equivalence + Default + Clone>(&self, v: &[T]) -> Vec<T> {
+        let size = self.size();
+        let n = v.len() as i32;
+        let mut counts = vec![0i32; size];
+        self.world.all_gather_into(&n, &mut counts[..]);
+        let displs: Vec<i32> = counts
+            .iter()
+            .scan(0i32, |acc, &c| {
+                let d = *acc;
+                *acc += c;
+                Some(d)
+            })
+            .collect();
+        let total: i32 = counts.iter().sum();
+        let mut out = vec![T::default(); total as usize];
+        {
+            let mut part = PartitionMut::new(&mut out[..], counts, displs);
+            self.world.all_gather_varcount_into(v, &mut part);
+        }
+        out
+    }
+
+    /// Whether any rank reports `flag`.
+    pub fn any(&self, flag: bool) -> Result<bool, String> {
+        let mine = flag as i32;
+        let mut out = 0i32;
+        self.world.all_reduce_into(&mine, &mut out, SystemOperation::max());
+        Ok(out > 0)
+    }
+
+    /// Agreement on a local outcome: `Ok` on every rank if every rank is `Ok`; otherwise every rank
+    /// returns the error of the lowest failing rank (prefixed with that rank on several ranks).
+    pub fn agree<T>(&self, local: Result<T, String>) -> Result<T, String> {
+        let mine = if local.is_err() { self.rank() as i32 } else { i32::MAX };
+        let mut first = i32::MAX;
+        self.world.all_reduce_into(&mine, &mut first, SystemOperation::min());
+        if first == i32::MAX {
+            return local;
+        }
+        let root = self.world.process_at_rank(first);
+        let text = match (&local, self.rank() as i32 == first) {
+            (Err(m), true) => m.clone(),
+            _ => String::new(),
+        };
+        let mut len = text.len() as u64;
+        root.broadcast_into(&mut len);
+        let mut bytes = text.into_bytes();
+        bytes.resize(len as usize, 0);
+        root.broadcast_into(&mut bytes[..]);
+        let msg = String::from_utf8_lossy(&bytes).into_owned();
+        Err(if self.size() > 1 { format!("{msg} (rank {first})") } else { msg })
+    }
+}
