@@ -339,6 +339,10 @@ impl<'a> Simulation<'a> {
             columns.push(format!("{}.reaction_x", b.name));
             columns.push(format!("{}.reaction_y", b.name));
         }
+        for b in model.boundaries.iter().filter(|b| b.motion.is_some()) {
+            columns.push(format!("{}.displacement_x", b.name));
+            columns.push(format!("{}.displacement_y", b.name));
+        }
         if let Some(c) = &check {
             columns.extend(c.columns());
         }
@@ -584,6 +588,9 @@ impl<'a> Simulation<'a> {
         row.push(self.equilibrium.0);
         for r in &self.equilibrium.1 {
             row.extend(r);
+        }
+        for m in self.model.boundaries.iter().filter_map(|b| b.motion.as_ref()) {
+            row.extend(m.displacement_at(self.t));
         }
         if let Some(c) = self.check.as_mut() {
             row.extend(c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?);

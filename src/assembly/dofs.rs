@@ -78,7 +78,7 @@ pub fn build(
                 if let Some(motion) = &model.boundaries[b].motion {
                     let dir = if c < 2 { Some(c) } else { layout_water.and_then(|w| (c >= w).then(|| c - w)) };
                     if let Some(d) = dir.filter(|&d| d < 2) {
-                        m.value[q] = motion.increment(t0, t1)[d];
+                        m.value[q] = motion.increment_at(model.grid.node_position(i, j), t0, t1)[d];
                     }
                 }
             }

@@ -241,6 +241,16 @@ pub struct Body {
     /// Geostatic initial stress (default: stress-free).
     #[serde(default)]
     pub initial_stress: Option<InitialStress>,
+    /// A uniform initial effective stress [xx, yy, xy, zz] [Pa] (tension positive), instead of a
+    /// geostatic one (e.g. for patch tests and rigid-rotation checks).
+    #[serde(default)]
+    pub uniform_stress: Option<[f64; 4]>,
+    /// Displacement of every material point from the centre of its sub-cell, as a fraction of the
+    /// point spacing in each direction, drawn from a fixed pseudo-random sequence keyed by the
+    /// point's id (the same on any number of ranks); 0 ≤ value < 0.5 (default 0: a regular
+    /// arrangement) [-].
+    #[serde(default)]
+    pub perturbation: f64,
 }
 
 /// A geostatic initial state in equilibrium with gravity g = `analysis.g` acting from t = 0 (the
@@ -397,7 +407,16 @@ pub struct Boundary {
     /// the nodes move by ∫ `velocity` f(t) dt.
     #[serde(default)]
     pub velocity: Option<[f64; 2]>,
-    /// Name of the time function scaling `displacement` or `velocity`.
+    /// A velocity gradient L [1/s] of a homogeneous flow about `center`, scaled by the time
+    /// function with `velocity` (its translation part, default zero): over a step the node at x moves
+    /// by (exp(L s) − I)(x − c) + v s with s = ∫ f dt — exactly the step of a uniform deformation
+    /// (e.g. a rigid rotation ω: L = [[0, −ω], [ω, 0]]).
+    #[serde(default)]
+    pub velocity_gradient: Option<[[f64; 2]; 2]>,
+    /// Centre c of the `velocity_gradient`'s flow [m] (default: the origin).
+    #[serde(default)]
+    pub center: Option<[f64; 2]>,
+    /// Name of the time function scaling `displacement`, `velocity` or `velocity_gradient`.
     #[serde(default)]
     pub time_function: Option<String>,
 }
@@ -811,6 +830,22 @@ pub enum Verification {
         #[serde(default = "default_ls_settle_tol")]
         settlement_tolerance: f64,
     },
+    /// A homogeneous deformation (patch test, rigid rotation): a body whose boundary nodes follow a
+    /// boundary's `velocity_gradient` must carry one uniform stress, equal to the linear-elastic
+    /// one of the flow, R σ₀ Rᵀ + D ln V with F = exp(L ∫f) = V R (exact for a pure stretch and for
+    /// a pure rotation).
+    Patch {
+        /// The body (linear elastic).
+        body: String,
+        /// The boundary whose homogeneous flow drives it.
+        boundary: String,
+        /// Largest accepted spread of the particles' stresses, max ‖σ_p − σ̄‖/‖σ̄‖.
+        #[serde(default = "default_spread_tol")]
+        spread_tolerance: f64,
+        /// Largest accepted ‖σ̄ − σ*‖/‖σ*‖ against the linear-elastic stress of the flow.
+        #[serde(default = "default_patch_tol")]
+        tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -828,6 +863,12 @@ pub enum Verification {
     },
 }
 
+fn default_spread_tol() -> f64 {
+    1e-9
+}
+fn default_patch_tol() -> f64 {
+    1e-6
+}
 fn default_tv() -> Vec<f64> {
     vec![0.1, 0.5]
 }

@@ -155,6 +155,17 @@ pub fn validate(c: &Case) -> R {
                 }
             }
         }
+        if !(0.0..0.5).contains(&b.perturbation) {
+            return Err(format!("key `bodies[{i}].perturbation`: must be in [0, 0.5), got {}", b.perturbation));
+        }
+        if let Some(s) = &b.uniform_stress {
+            if b.initial_stress.is_some() {
+                return Err(format!("key `bodies[{i}]`: give `initial_stress` or `uniform_stress`, not both"));
+            }
+            if s.iter().any(|v| !v.is_finite()) {
+                return Err(format!("key `bodies[{i}].uniform_stress`: must be finite"));
+            }
+        }
         if let Some(init) = &b.initial_stress {
             positive(&format!("bodies[{i}].initial_stress.k0"), init.k0)?;
             if let crate::case::WaterTable::Level(y) = init.water_table {
@@ -231,7 +242,25 @@ pub fn validate(c: &Case) -> R {
         if b.displacement.is_some() && b.velocity.is_some() {
             return Err(format!("key `boundaries[{i}]`: give `displacement` or `velocity`, not both"));
         }
-        let motion = b.displacement.or(b.velocity);
+        if let Some(l) = &b.velocity_gradient {
+            if b.displacement.is_some() {
+                return Err(format!(
+                    "key `boundaries[{i}].velocity_gradient`: goes with `velocity`, not `displacement`"
+                ));
+            }
+            if l.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(format!("key `boundaries[{i}].velocity_gradient`: must be finite"));
+            }
+            if !(b.fix.contains(&Dof::Ux) && b.fix.contains(&Dof::Uy)) {
+                return Err(format!(
+                    "key `boundaries[{i}].velocity_gradient`: moves both `ux` and `uy`, so `fix` must list them"
+                ));
+            }
+        }
+        if let Some(cn) = &b.center {
+            finite2(&format!("boundaries[{i}].center"), *cn)?;
+        }
+        let motion = b.displacement.or(b.velocity).or(b.velocity_gradient.map(|_| [0.0; 2]));
         if let Some(m) = motion {
             let key = if b.displacement.is_some() { "displacement" } else { "velocity" };
             if m.iter().any(|v| !v.is_finite()) {
@@ -350,6 +379,30 @@ pub fn validate(c: &Case) -> R {
     // Verification references.
     if let Some(v) = &c.verification {
         let (body, load) = match v {
+            Verification::Patch { body, boundary, spread_tolerance, tolerance } => {
+                positive("verification.spread_tolerance", *spread_tolerance)?;
+                positive("verification.tolerance", *tolerance)?;
+                let Some(b) = c.body(body) else {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                };
+                let mat = &c.materials[c.material_index(&b.material).expect("validated")];
+                if !matches!(mat.model, SoilModel::LinearElastic { .. }) {
+                    return Err(format!(
+                        "key `verification.body`: the patch reference needs a linear elastic body, and `{body}` is not"
+                    ));
+                }
+                match c.boundaries.iter().find(|x| &x.name == boundary) {
+                    Some(x) if x.velocity_gradient.is_some() => {}
+                    Some(_) => {
+                        return Err(format!("key `verification.boundary`: `{boundary}` has no `velocity_gradient`"))
+                    }
+                    None => return Err(format!("key `verification.boundary`: no boundary named `{boundary}`")),
+                }
+                if two_phase {
+                    return Err("key `verification`: the patch reference is for a one_phase analysis".into());
+                }
+                return Ok(());
+            }
             Verification::Terzaghi {
                 body,
                 load,

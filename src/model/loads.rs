@@ -184,11 +184,50 @@ pub struct Motion {
     pub is_displacement: bool,
     /// The displacement or velocity at time-function value 1.
     pub vector: [f64; 2],
+    /// The velocity gradient L of a homogeneous flow [1/s] and its centre [m].
+    pub gradient: Option<([[f64; 2]; 2], [f64; 2])>,
     /// The time function.
     pub time_fn: TimeFn,
 }
 
+/// exp(A) of a 2 × 2 matrix, in closed form: with s = tr A/2 and δ = ((a − d)/2)² + bc,
+/// exp(A) = e^s (C I + S (A − sI)) with C = cosh √δ, S = sinh √δ/√δ (cos and sin for δ < 0).
+pub fn exp2(a: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let s = 0.5 * (a[0][0] + a[1][1]);
+    let delta = 0.25 * (a[0][0] - a[1][1]).powi(2) + a[0][1] * a[1][0];
+    let (c, sn) = if delta.abs() < 1e-12 {
+        (1.0 + 0.5 * delta, 1.0 + delta / 6.0)
+    } else if delta > 0.0 {
+        let q = delta.sqrt();
+        (q.cosh(), q.sinh() / q)
+    } else {
+        let q = (-delta).sqrt();
+        (q.cos(), q.sin() / q)
+    };
+    let e = s.exp();
+    [[e * (c + sn * (a[0][0] - s)), e * sn * a[0][1]], [e * sn * a[1][0], e * (c + sn * (a[1][1] - s))]]
+}
+
 impl Motion {
+    /// The increment over t0 → t1 of the node at `x` [m]: the uniform increment, plus
+    /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt.
+    pub fn increment_at(&self, x: [f64; 2], t0: f64, t1: f64) -> [f64; 2] {
+        let mut d = self.increment(t0, t1);
+        if let Some((l, c)) = &self.gradient {
+            let s = self.integral(t0, t1);
+            let e = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
+            let r = [x[0] - c[0], x[1] - c[1]];
+            d[0] += (e[0][0] - 1.0) * r[0] + e[0][1] * r[1];
+            d[1] += e[1][0] * r[0] + (e[1][1] - 1.0) * r[1];
+        }
+        d
+    }
+
+    /// ∫₀ᵗ f dτ: the argument of the flow's exponential at `t`.
+    pub fn flow_parameter(&self, t: f64) -> f64 {
+        self.integral(0.0, t)
+    }
+
     /// The prescribed displacement at time `t` [m]: d f(t), or ∫₀ᵗ v f dτ.
     pub fn displacement_at(&self, t: f64) -> [f64; 2] {
         let s = if self.is_displacement { self.time_fn.eval(t) } else { self.integral(0.0, t) };
@@ -259,29 +298,20 @@ impl BoundaryDef {
                 .map(TimeFn::from_case)
                 .unwrap_or(TimeFn::Constant(1.0))
         };
-        let motion = match (b.displacement, b.velocity) {
-            (Some(d), _) => Some(Motion { is_displacement: true, vector: d, time_fn: time_fn() }),
-            (None, Some(v)) => Some(Motion { is_displacement: false, vector: v, time_fn: time_fn() }),
+        let gradient = b.velocity_gradient.map(|l| (l, b.center.unwrap_or([0.0; 2])));
+        let motion = match (b.displacement, b.velocity, gradient) {
+            (Some(d), _, _) => Some(Motion { is_displacement: true, vector: d, gradient: None, time_fn: time_fn() }),
+            (None, Some(v), g) => Some(Motion { is_displacement: false, vector: v, gradient: g, time_fn: time_fn() }),
+            (None, None, Some(g)) => {
+                Some(Motion { is_displacement: false, vector: [0.0; 2], gradient: Some(g), time_fn: time_fn() })
+            }
             _ => None,
         };
         BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone(), motion }
     }
 
-    /// Whether a node at `node` lies on or beyond the exposed `face` of a particle at `x` with domain
-    /// half-widths `lp` (within `tol`): the grid nodes that carry a moving surface's condition are
-    /// those of the surface particles' stencils outside the material, so that no node inside the
-    /// material is constrained.
-    pub fn beyond(face: Side, x: [f64; 2], lp: [f64; 2], node: [f64; 2], tol: f64) -> bool {
-        match face {
-            Side::XMin => node[0] <= x[0] - lp[0] + tol,
-            Side::XMax => node[0] >= x[0] + lp[0] - tol,
-            Side::YMin => node[1] <= x[1] - lp[1] + tol,
-            Side::YMax => node[1] >= x[1] + lp[1] - tol,
-        }
-    }
-
     /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
-    /// particles, see [`BoundaryDef::beyond`]).
+    /// particles, see [`crate::model::Model::surface_fixes`]).
     pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
         if let Some(side) = self.side {
             return match side {

@@ -11,7 +11,7 @@ pub mod patch;
 pub mod shape;
 pub mod soil;
 
-use crate::case::{Case, Formulation, ShapeFunctions};
+use crate::case::{Case, Formulation, ShapeFunctions, Side};
 use crate::kernels::{ParticleInput, StepResult};
 use grid::Grid;
 use loads::{BoundaryDef, LoadDef, LoadTarget};
@@ -178,11 +178,20 @@ impl Model {
         by
     }
 
-    /// The nodes fixed by the active moving-surface boundaries on the current configuration: the
-    /// nodes of each surface particle's stencil (non-zero weight) on or beyond its exposed face,
-    /// with the boundary's index and the components fixed there.
+    /// The nodes fixed by the active moving-surface boundaries on the current configuration, with
+    /// the boundary's index and the components fixed there. For each surface particle the exposed
+    /// face's outward normal turns with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson), and among the
+    /// nodes of its stencil with a non-zero weight:
+    /// * the pore pressure (a drained surface) is fixed at the nodes on or beyond the face,
+    ///   (x_i − x_p)·n ≥ l_p(n) (the domain's extent along n), so that no node inside the material is
+    ///   drained (draining nodes up to l_p inside made the large-strain column fail);
+    /// * the motion (a wall, a platen, a patch's boundary) is prescribed at the nodes on the face's
+    ///   side of the particle, (x_i − x_p)·n ≥ 0: they include the well-filled node just inside a
+    ///   face that has moved past a grid line, which carries the boundary's reaction (the nodes
+    ///   beyond the face alone are barely filled and cannot).
     pub fn surface_fixes(&self, active: &Active) -> Vec<((u32, u32), usize, [bool; 5])> {
         let mut out = Vec::new();
+        let tol = 1e-9 * self.grid.h[0].min(self.grid.h[1]);
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
             let Some(list) = &b.surface else { continue };
@@ -191,13 +200,31 @@ impl Model {
                 comps[dof_index(*d)] = true;
             }
             for &(k, face) in list {
-                let (x, lp) = (self.particles.x[k], self.particles.lp[k]);
+                let (x, lp, f) = (self.particles.x[k], self.particles.lp[k], self.particles.def_grad[k]);
+                let n0 = match face {
+                    Side::XMin => [-1.0, 0.0],
+                    Side::XMax => [1.0, 0.0],
+                    Side::YMin => [0.0, -1.0],
+                    Side::YMax => [0.0, 1.0],
+                };
+                // F⁻ᵀ n₀ up to the factor 1/det F.
+                let m = [f[1][1] * n0[0] - f[1][0] * n0[1], -f[0][1] * n0[0] + f[0][0] * n0[1]];
+                let len = m[0].hypot(m[1]);
+                let n = if len > 0.0 { [m[0] / len, m[1] / len] } else { n0 };
+                let extent = n[0].abs() * lp[0] + n[1].abs() * lp[1];
                 let st = shape::stencil(self.basis, &self.grid, x, lp);
-                let tol = 1e-9 * self.grid.h[0].min(self.grid.h[1]);
                 for ((i, j), w, _) in st.iter() {
+                    if w <= 0.0 {
+                        continue;
+                    }
                     let node = self.grid.node_position(i as usize, j as usize);
-                    if w > 0.0 && BoundaryDef::beyond(face, x, lp, node, tol) {
-                        out.push(((i, j), bi, comps));
+                    let along = (node[0] - x[0]) * n[0] + (node[1] - x[1]) * n[1];
+                    let mut c = [false; 5];
+                    for d in 0..5 {
+                        c[d] = comps[d] && if d == 2 { along >= extent - tol } else { along >= -tol };
+                    }
+                    if c.iter().any(|&v| v) {
+                        out.push(((i, j), bi, c));
                     }
                 }
             }

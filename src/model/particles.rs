@@ -88,9 +88,10 @@ impl Particles {
                             let gi = (ci * n + si) as u64;
                             let gj = (cj * n + sj) as u64;
                             let id = ((b as u64) << 48) | (gj * (grid.cells[0] * 8) as u64 + gi);
+                            let shake = [jitter(id, 0), jitter(id, 1)].map(|r| body.perturbation * (2.0 * r - 1.0));
                             let x = [
-                                grid.origin[0] + (ci as f64 + (si as f64 + 0.5) / n as f64) * grid.h[0],
-                                grid.origin[1] + (cj as f64 + (sj as f64 + 0.5) / n as f64) * grid.h[1],
+                                grid.origin[0] + (ci as f64 + (si as f64 + 0.5 + shake[0]) / n as f64) * grid.h[0],
+                                grid.origin[1] + (cj as f64 + (sj as f64 + 0.5 + shake[1]) / n as f64) * grid.h[1],
                             ];
                             let earlier = case.bodies[..b].iter().any(|o| o.shape.contains(x));
                             if !body.shape.contains(x) || earlier || !owned(ci, cj) {
@@ -117,9 +118,10 @@ impl Particles {
                             ps.acc.push([0.0; 2]);
                             ps.vel_w.push([0.0; 2]);
                             ps.acc_w.push([0.0; 2]);
-                            let (stress, p) = match &body.initial_stress {
-                                Some(init) => geostatic(case, grid, init, x, two_phase),
-                                None => ([0.0; 4], 0.0),
+                            let (stress, p) = match (&body.initial_stress, &body.uniform_stress) {
+                                (Some(init), _) => geostatic(case, grid, init, x, two_phase),
+                                (None, Some(s)) => (*s, 0.0),
+                                (None, None) => ([0.0; 4], 0.0),
                             };
                             ps.stress.push(stress);
                             ps.p.push(p);
@@ -132,6 +134,16 @@ impl Particles {
         }
         ps
     }
+}
+
+/// A pseudo-random number in [0, 1) from a point's id and a stream (SplitMix64): the same point
+/// gets the same number on any rank.
+fn jitter(id: u64, stream: u64) -> f64 {
+    let mut z = id.wrapping_mul(2).wrapping_add(stream).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
 /// The geostatic effective stress and pore pressure at `x` (see [`crate::case::InitialStress`]).
