@@ -112,8 +112,8 @@ impl PatchCheck {
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
         let mut local = [0.0; 5];
         for &k in &mine {
-            for c in 0..4 {
-                local[c] += ps.stress[k][c];
+            for (l, s) in local.iter_mut().zip(ps.stress[k]) {
+                *l += s;
             }
             local[4] += 1.0;
         }
