@@ -41,8 +41,8 @@ fn bases(model: &Model) -> Vec<Vec<NodeBasis>> {
     let ps = &model.particles;
     (0..ps.len())
         .map(|k| {
-            let st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-            let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
+            let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+            let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j));
             (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n] }).collect()
         })
         .collect()
@@ -71,8 +71,9 @@ fn particle_kernels(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = 0.0;
             for k in 0..n {
-                let st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-                let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &st);
+                let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+                let gv =
+                    shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j));
                 sum += st.w[0] + gv[0][0];
             }
             black_box(sum)

@@ -112,6 +112,9 @@ pub fn describe(case: &Case, label: &str) -> String {
                 format!("particle traction on {} material points", l.size())
             }
             Some(Load::NodalTraction { .. }) => format!("nodal traction on {} nodes", l.size()),
+            Some(Load::LinePressure { pressure, .. }) => {
+                format!("pressure {pressure} Pa on a line ({} Gauss points)", l.size())
+            }
             Some(Load::BodyForce { acceleration, .. }) => {
                 format!("body force {acceleration:?} m/s²")
             }

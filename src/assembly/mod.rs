@@ -316,8 +316,19 @@ impl GridSystem {
         body_names: &[String],
     ) -> Result<(), String> {
         let nd = self.layout.nd;
-        // 1. Stencils on x_n.
-        let (mut st, crossings) = coll.agree(stencils::build(model, &self.ghost))?;
+        // 1. Stencils on x_n (B̄'s cells first: which cells the material fills, summed over ranks).
+        let roots = if model.bbar {
+            let mut phi = vec![0.0; self.ghost.len() * nd];
+            for (l, f) in stencils::cell_fractions(model, &self.ghost).into_iter().enumerate() {
+                phi[l * nd] = f;
+            }
+            self.sum_over_ranks(&mut phi).map_err(|e| e.to_string())?;
+            let per_cell: Vec<f64> = (0..self.ghost.len()).map(|l| phi[l * nd]).collect();
+            stencils::CellRoots::new(&self.ghost, model.grid.cells, &per_cell)
+        } else {
+            stencils::CellRoots::identity()
+        };
+        let (mut st, crossings) = coll.agree(stencils::build(model, &self.ghost, &roots))?;
         // 2. Projections to the nodes, summed over ranks.
         let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
         // 3. The dof map.
@@ -635,6 +646,21 @@ impl GridSystem {
                         }
                     }
                 }
+                LoadTarget::LinePressure { points, pressure } => {
+                    // Each Gauss point on the rank owning the cell that holds it.
+                    for &(point, force) in points {
+                        if !g.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
+                            continue;
+                        }
+                        // Shares on unfilled nodes are extended from the material's side.
+                        let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
+                        let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
+                        for ((i, j), s, _) in shape::face_weights(g, point).iter() {
+                            let l = self.ghost.node(i as usize, j as usize).expect("an owned cell's nodes are ghosted");
+                            add(l, [s * force[0] * pressure * f, s * force[1] * pressure * f], inward);
+                        }
+                    }
+                }
                 LoadTarget::BodyForce { .. } => {}
             }
         }
@@ -670,6 +696,16 @@ impl GridSystem {
                         if owned {
                             for c in 0..2 {
                                 applied[c] += traction[c] * f * trib;
+                            }
+                        }
+                    }
+                    names.push(load.name.clone());
+                }
+                LoadTarget::LinePressure { points, pressure } => {
+                    for &(point, force) in points {
+                        if model.grid.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
+                            for c in 0..2 {
+                                applied[c] += force[c] * pressure * f;
                             }
                         }
                     }

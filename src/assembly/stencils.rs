@@ -97,6 +97,114 @@ impl Stencils {
     }
 }
 
+/// Fraction of a cell's area the material (the union of the particles' domains) must fill for the
+/// cell's centre to give B̄ a volumetric strain of its own; a sparser cell takes that of a
+/// well-filled neighbour (see `shape::volumetric_gradients`).
+pub const CELL_FILLED_FRACTION: f64 = 0.5;
+
+/// For every cell of the ghosted box, the cell whose volumetric strain it takes in B̄.
+#[derive(Debug, Clone, Default)]
+pub struct CellRoots {
+    start: [usize; 2],
+    count: [usize; 2],
+    root: Vec<(u32, u32)>,
+}
+
+impl CellRoots {
+    /// Every cell its own root.
+    pub fn identity() -> CellRoots {
+        CellRoots::default()
+    }
+
+    /// The roots from the cells' filled fractions `phi` (per ghosted node (i, j) for cell (i, j),
+    /// summed over ranks): a cell filled below [`CELL_FILLED_FRACTION`] takes the most filled of its
+    /// eight neighbours that is filled above it (ties: the first in row order), if any.
+    pub fn new(ghost: &GhostedRange, cells: [usize; 2], phi: &[f64]) -> CellRoots {
+        let n = ghost.len();
+        let at = |i: i64, j: i64| -> Option<f64> {
+            if i < 0 || j < 0 || i as usize >= cells[0] || j as usize >= cells[1] {
+                return None;
+            }
+            ghost.node(i as usize, j as usize).map(|l| phi[l])
+        };
+        let root = (0..n)
+            .map(|l| {
+                let (i, j) = ghost.ij(l);
+                let own = at(i as i64, j as i64).unwrap_or(0.0);
+                if own >= CELL_FILLED_FRACTION {
+                    return (i as u32, j as u32);
+                }
+                let mut best: Option<((i64, i64), f64)> = None;
+                for dj in -1..=1i64 {
+                    for di in -1..=1i64 {
+                        let (ni, nj) = (i as i64 + di, j as i64 + dj);
+                        if let Some(f) = at(ni, nj).filter(|&f| f >= CELL_FILLED_FRACTION) {
+                            if best.is_none_or(|b| f > b.1) {
+                                best = Some(((ni, nj), f));
+                            }
+                        }
+                    }
+                }
+                best.map_or((i as u32, j as u32), |((ni, nj), _)| (ni as u32, nj as u32))
+            })
+            .collect();
+        CellRoots { start: ghost.start, count: ghost.count, root }
+    }
+
+    /// The root of cell (i, j) (itself outside the ghosted box).
+    pub fn root(&self, i: usize, j: usize) -> (usize, usize) {
+        let inside = i >= self.start[0]
+            && j >= self.start[1]
+            && i < self.start[0] + self.count[0]
+            && j < self.start[1] + self.count[1];
+        if !inside || self.root.is_empty() {
+            return (i, j);
+        }
+        let r = self.root[(j - self.start[1]) * self.count[0] + (i - self.start[0])];
+        (r.0 as usize, r.1 as usize)
+    }
+}
+
+/// The area of the particles' domains in every cell (their GIMP domains, or their volumes for linear
+/// MPM) as a fraction of the cell, on this rank's particles, per ghosted node (i, j) for cell (i, j).
+pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
+    let g = &model.grid;
+    let ps = &model.particles;
+    let mut out = vec![0.0; ghost.len()];
+    let area = g.h[0] * g.h[1];
+    for k in 0..ps.len() {
+        let (x, lp) = (ps.x[k], ps.lp[k]);
+        if model.basis == Basis::Linear {
+            if let Some(l) = g.cell_of(x).and_then(|(i, j)| ghost.node(i, j)) {
+                out[l] += ps.volume[k] / area;
+            }
+            continue;
+        }
+        let span = |d: usize| -> Vec<(usize, f64)> {
+            let (o, h, nc) = (g.origin[d], g.h[d], g.cells[d]);
+            let (a, b) = (x[d] - lp[d], x[d] + lp[d]);
+            let first = ((a - o) / h).floor().max(0.0) as usize;
+            let last = (((b - o) / h).floor().max(0.0) as usize).min(nc - 1);
+            (first..=last)
+                .filter_map(|c| {
+                    let len = b.min(o + (c + 1) as f64 * h) - a.max(o + c as f64 * h);
+                    (len > 0.0).then_some((c, len))
+                })
+                .collect()
+        };
+        // The domain's area is scaled to the particle's volume.
+        let scale = ps.volume[k] / (4.0 * lp[0] * lp[1]);
+        for (cy, ly) in span(1) {
+            for &(cx, lx) in &span(0) {
+                if let Some(l) = ghost.node(cx, cy) {
+                    out[l] += lx * ly * scale / area;
+                }
+            }
+        }
+    }
+    out
+}
+
 /// A particle whose support reaches past a side of the grid.
 #[derive(Debug, Clone, Copy)]
 pub struct Crossing {
@@ -113,7 +221,7 @@ pub const SIDES: [&str; 4] = ["x_min", "x_max", "y_min", "y_max"];
 /// reaches past the grid (GIMP: their domain, beyond round-off; linear: their centre), for
 /// [`check_edges`]. Fails, naming the particle, when a stencil node lies outside this rank's ghost
 /// region or a position is not finite.
-pub fn build(model: &Model, ghost: &GhostedRange) -> Result<(Stencils, Vec<Crossing>), String> {
+pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(Stencils, Vec<Crossing>), String> {
     let ps = &model.particles;
     let g = &model.grid;
     let mut out = Stencils { offsets: Vec::with_capacity(ps.len() + 1), ..Default::default() };
@@ -138,7 +246,9 @@ pub fn build(model: &Model, ghost: &GhostedRange) -> Result<(Stencils, Vec<Cross
                 crossings.push(Crossing { k, side });
             }
         }
-        let st = shape::stencil(model.basis, g, x, lp);
+        let mut st = shape::stencil(model.basis, g, x, lp);
+        let gv =
+            model.bbar.then(|| shape::volumetric_gradients(model.basis, g, x, lp, &mut st, &|i, j| roots.root(i, j)));
         if st.len == 0 {
             return Err(format!("material point {} at ({:.4}, {:.4}) m has left the grid", ps.id[k], x[0], x[1]));
         }
@@ -154,8 +264,7 @@ pub fn build(model: &Model, ghost: &GhostedRange) -> Result<(Stencils, Vec<Cross
         }
         let first = out.basis.len();
         kernels::plain_basis(&st, &mut out.basis);
-        if model.bbar {
-            let gv = shape::volumetric_gradients(model.basis, g, x, lp, &st);
+        if let Some(gv) = gv {
             for (b, v) in out.basis[first..].iter_mut().zip(gv) {
                 b.gv = v;
             }

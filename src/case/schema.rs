@@ -474,6 +474,23 @@ pub enum Load {
         #[serde(default)]
         time_function: Option<String>,
     },
+    /// A pressure [Pa] on a polyline fixed in space (e.g. the inside of a cylinder), pushing the
+    /// material that lies on the left of the direction of travel along `points`: the force per
+    /// metre is p n with n the unit normal to the left. It is integrated along each segment with
+    /// two Gauss points and distributed with the bilinear hat functions of the cell holding each
+    /// point (nodes the material does not fill pass their share to filled ones). Fixed in space:
+    /// for small deformations.
+    LinePressure {
+        /// Name used by stages and verification.
+        name: String,
+        /// The polyline's points [m], at least two.
+        points: Vec<[f64; 2]>,
+        /// The pressure [Pa].
+        pressure: f64,
+        /// Name of the time function scaling it.
+        #[serde(default)]
+        time_function: Option<String>,
+    },
     /// A body acceleration [m/s²] on every particle (gravity: [0, -9.81]), acting on both phases.
     BodyForce {
         /// Name used by stages.
@@ -493,9 +510,10 @@ impl Load {
     /// The load's name.
     pub fn name(&self) -> &str {
         match self {
-            Load::ParticleTraction { name, .. } | Load::NodalTraction { name, .. } | Load::BodyForce { name, .. } => {
-                name
-            }
+            Load::ParticleTraction { name, .. }
+            | Load::NodalTraction { name, .. }
+            | Load::LinePressure { name, .. }
+            | Load::BodyForce { name, .. } => name,
         }
     }
 
@@ -504,6 +522,7 @@ impl Load {
         match self {
             Load::ParticleTraction { time_function, .. }
             | Load::NodalTraction { time_function, .. }
+            | Load::LinePressure { time_function, .. }
             | Load::BodyForce { time_function, .. } => time_function.as_deref(),
         }
     }
@@ -846,6 +865,31 @@ pub enum Verification {
         #[serde(default = "default_patch_tol")]
         tolerance: f64,
     },
+    /// A thick-walled cylinder under internal pressure in plane strain (Lamé): a quarter of it
+    /// (symmetry on the axes through `center`), linear elastic, loaded by a `line_pressure` on its
+    /// inner circle. Metrics: the relative L2 errors (weighted by the points' volumes) of the radial
+    /// displacement and of σ_rr and σ_θθ over the body's points against
+    /// u_r = (1 + ν) p a² ((1 − 2ν) r + b²/r) / (E (b² − a²)),
+    /// σ_rr = p a² (1 − b²/r²)/(b² − a²), σ_θθ = p a² (1 + b²/r²)/(b² − a²).
+    Lame {
+        /// The cylinder's body (linear elastic).
+        body: String,
+        /// The internal pressure (a `line_pressure`; p at the run's end).
+        load: String,
+        /// The cylinder's axis [m].
+        #[serde(default)]
+        center: [f64; 2],
+        /// Inner radius a [m].
+        inner_radius: f64,
+        /// Outer radius b [m].
+        outer_radius: f64,
+        /// Largest accepted relative L2 error of u_r.
+        #[serde(default = "default_lame_tol")]
+        displacement_tolerance: f64,
+        /// Largest accepted relative L2 error of σ_rr and of σ_θθ.
+        #[serde(default = "default_lame_tol")]
+        stress_tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -863,6 +907,9 @@ pub enum Verification {
     },
 }
 
+fn default_lame_tol() -> f64 {
+    0.05
+}
 fn default_spread_tol() -> f64 {
     1e-9
 }

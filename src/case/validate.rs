@@ -306,6 +306,20 @@ pub fn validate(c: &Case) -> R {
                 }
             }
             Load::BodyForce { acceleration, .. } => finite2(&format!("loads[{i}].acceleration"), *acceleration)?,
+            Load::LinePressure { points, pressure, .. } => {
+                if points.len() < 2 {
+                    return Err(format!("key `loads[{i}].points`: a line needs at least two points"));
+                }
+                for (j, p) in points.iter().enumerate() {
+                    finite2(&format!("loads[{i}].points[{j}]"), *p)?;
+                    if !inside_grid(*p) {
+                        return Err(format!("key `loads[{i}].points[{j}]`: {p:?} is outside the grid"));
+                    }
+                }
+                if !pressure.is_finite() {
+                    return Err(format!("key `loads[{i}].pressure`: must be finite"));
+                }
+            }
         }
         let bodies: Vec<&String> = match l {
             Load::ParticleTraction { body: Some(b), .. } => vec![b],
@@ -379,6 +393,37 @@ pub fn validate(c: &Case) -> R {
     // Verification references.
     if let Some(v) = &c.verification {
         let (body, load) = match v {
+            Verification::Lame {
+                body,
+                load,
+                center,
+                inner_radius,
+                outer_radius,
+                displacement_tolerance,
+                stress_tolerance,
+            } => {
+                finite2("verification.center", *center)?;
+                positive("verification.inner_radius", *inner_radius)?;
+                positive("verification.outer_radius", *outer_radius)?;
+                if outer_radius <= inner_radius {
+                    return Err("key `verification.outer_radius`: must exceed `inner_radius`".into());
+                }
+                positive("verification.displacement_tolerance", *displacement_tolerance)?;
+                positive("verification.stress_tolerance", *stress_tolerance)?;
+                if !matches!(c.load(load), Some(Load::LinePressure { .. })) {
+                    return Err(format!("key `verification.load`: `{load}` must be a line_pressure load"));
+                }
+                if let Some(b) = c.body(body) {
+                    let mat = &c.materials[c.material_index(&b.material).expect("validated")];
+                    if !matches!(mat.model, SoilModel::LinearElastic { .. }) {
+                        return Err(format!("key `verification.body`: the Lamé reference needs a linear elastic body, and `{body}` is not"));
+                    }
+                }
+                if two_phase {
+                    return Err("key `verification`: the Lamé reference is for a one_phase analysis".into());
+                }
+                (body, load)
+            }
             Verification::Patch { body, boundary, spread_tolerance, tolerance } => {
                 positive("verification.spread_tolerance", *spread_tolerance)?;
                 positive("verification.tolerance", *tolerance)?;
@@ -515,7 +560,7 @@ pub fn validate(c: &Case) -> R {
                     return Err("key `verification`: the elastic column reference is for a one_phase analysis".into());
                 }
             }
-            Verification::BearingCapacity { .. } => {}
+            Verification::BearingCapacity { .. } | Verification::Lame { .. } => {}
             _ => {
                 if !two_phase {
                     return Err(

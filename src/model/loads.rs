@@ -87,6 +87,9 @@ pub enum LoadTarget {
     NodalTraction { nodes: Vec<(usize, usize, f64)>, traction: [f64; 2] },
     /// Body acceleration on the particles of the listed bodies (all if None).
     BodyForce { acceleration: [f64; 2], bodies: Option<Vec<u16>> },
+    /// A pressure on a fixed polyline: its Gauss points with the force per unit pressure there
+    /// (weight × length × the unit normal to the left) [m].
+    LinePressure { points: Vec<([f64; 2], [f64; 2])>, pressure: f64 },
 }
 
 impl LoadDef {
@@ -110,6 +113,9 @@ impl LoadDef {
             case::Load::NodalTraction { region, traction, .. } => {
                 LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: *traction }
             }
+            case::Load::LinePressure { points, pressure, .. } => {
+                LoadTarget::LinePressure { points: line_gauss_points(points), pressure: *pressure }
+            }
             case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
                 acceleration: *acceleration,
                 bodies: bodies
@@ -125,6 +131,7 @@ impl LoadDef {
         match &self.target {
             LoadTarget::ParticleTraction { particles, .. } => particles.len(),
             LoadTarget::NodalTraction { nodes, .. } => nodes.len(),
+            LoadTarget::LinePressure { points, .. } => points.len(),
             LoadTarget::BodyForce { .. } => 0,
         }
     }
@@ -143,6 +150,25 @@ pub fn face_is_exposed(c: &case::Case, x: [f64; 2], lp: [f64; 2], face: Side) ->
         Side::YMax => [x[0], x[1] + e * lp[1]],
     };
     !c.bodies.iter().any(|b| b.shape.contains(p))
+}
+
+/// The two Gauss points of each segment of a polyline, with the force per unit pressure there:
+/// (half the segment's length) × the unit normal to the left of the direction of travel.
+pub fn line_gauss_points(points: &[[f64; 2]]) -> Vec<([f64; 2], [f64; 2])> {
+    let g = 0.5 / 3f64.sqrt();
+    let mut out = Vec::new();
+    for w in points.windows(2) {
+        let d = [w[1][0] - w[0][0], w[1][1] - w[0][1]];
+        let len = d[0].hypot(d[1]);
+        if len == 0.0 {
+            continue;
+        }
+        let normal = [-d[1] / len, d[0] / len];
+        for s in [0.5 - g, 0.5 + g] {
+            out.push(([w[0][0] + s * d[0], w[0][1] + s * d[1]], [0.5 * len * normal[0], 0.5 * len * normal[1]]));
+        }
+    }
+    out
 }
 
 /// Grid nodes inside `region`, with the length of line each stands for: half the distance to its

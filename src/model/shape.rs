@@ -46,8 +46,9 @@ pub fn gimp_1d(r: f64, lp: f64, h: f64) -> (f64, f64) {
 }
 
 /// Largest stencil: 4 × 4 nodes (a domain of one particle per cell touches the grid lines on both
-/// sides; two or more particles per cell reach at most 3 × 3 nodes).
-pub const MAX_STENCIL: usize = 16;
+/// sides; two or more particles per cell reach at most 3 × 3 nodes), plus the nodes of B̄'s root
+/// cells outside them (a 5 × 5 box at most).
+pub const MAX_STENCIL: usize = 25;
 
 /// Nodes, weights and weight gradients of one particle.
 #[derive(Debug, Clone, Copy)]
@@ -173,19 +174,24 @@ pub fn face_weights(grid: &Grid, point: [f64; 2]) -> Stencil {
 }
 
 /// Volumetric gradients of B̄ for a particle ([000] Eqs. 13–16, with the support-domain portion per
-/// cell of Coombs et al. 2018): ∇̄S_i = Σ_c f_c ∇N_i(x_c), where f_c is the share of the particle
-/// domain lying in cell c (renormalised over the cells inside the grid) and ∇N_i(x_c) the gradient of
-/// node i's bilinear function at the centre of c, (±1/(2h_x), ±1/(2h_y)) for the four nodes of c.
-/// The volumetric strain ∇̄·Δu is then the weighted average of the cell-centre volumetric strains of
-/// the cells the domain overlaps. Standard MPM (`Linear`) uses the one cell holding the particle.
-/// Returns the gradients in the order of `st.nodes` (nodes of `st` not belonging to an overlapped cell
-/// get zero).
+/// cell of Coombs et al. 2018): ∇̄S_i = Σ_c f_c ∇N_i(x_{r(c)}), where f_c is the share of the
+/// particle domain lying in cell c (renormalised over the cells inside the grid) and ∇N_i(x_r) the
+/// gradient of node i's bilinear function at the centre of cell r(c), (±1/(2h_x), ±1/(2h_y)) for
+/// the four nodes of r. The volumetric strain ∇̄·Δu is then the weighted average of cell-centre
+/// volumetric strains. `root(c)` is the cell whose volumetric strain cell c takes: c itself, or for
+/// a cell the material barely fills a well-filled neighbour (see `assembly::stencils::cell_roots`:
+/// each sparse cut cell would otherwise add a volumetric constraint with almost no freedom behind
+/// it, and nearly incompressible bodies showed alternating pressure spikes along curved free
+/// surfaces). Standard MPM (`Linear`) uses the one cell holding the particle. Nodes of a root cell
+/// that are not in `st` are appended to it with zero weight and gradient. Returns the gradients in
+/// the order of `st.nodes`.
 pub fn volumetric_gradients(
     basis: Basis,
     grid: &Grid,
     x: [f64; 2],
     lp: [f64; 2],
-    st: &Stencil,
+    st: &mut Stencil,
+    root: &dyn Fn(usize, usize) -> (usize, usize),
 ) -> [[f64; 2]; MAX_STENCIL] {
     let mut gv = [[0.0; 2]; MAX_STENCIL];
     // Cells overlapped in each direction, with the length of the overlap.
@@ -224,13 +230,23 @@ pub fn volumetric_gradients(
     for &(cy, ly) in &oy[..ny] {
         for &(cx, lx) in &ox[..nx] {
             let f = lx * ly / total;
+            let (rx, ry) = root(cx, cy);
             for (di, sx) in [(0u32, -1.0), (1u32, 1.0)] {
                 for (dj, sy) in [(0u32, -1.0), (1u32, 1.0)] {
-                    let node = (cx as u32 + di, cy as u32 + dj);
-                    if let Some(k) = st.nodes[..st.len].iter().position(|&n| n == node) {
-                        gv[k][0] += f * sx / (2.0 * grid.h[0]);
-                        gv[k][1] += f * sy / (2.0 * grid.h[1]);
-                    }
+                    let node = (rx as u32 + di, ry as u32 + dj);
+                    let k = match st.nodes[..st.len].iter().position(|&n| n == node) {
+                        Some(k) => k,
+                        None if st.len < MAX_STENCIL => {
+                            st.nodes[st.len] = node;
+                            st.w[st.len] = 0.0;
+                            st.dw[st.len] = [0.0; 2];
+                            st.len += 1;
+                            st.len - 1
+                        }
+                        None => continue,
+                    };
+                    gv[k][0] += f * sx / (2.0 * grid.h[0]);
+                    gv[k][1] += f * sy / (2.0 * grid.h[1]);
                 }
             }
         }
@@ -335,8 +351,8 @@ mod tests {
             (Basis::Gimp, [1.01, 0.51], [0.125, 0.0625]),
             (Basis::Linear, [1.3, 0.6], [0.0, 0.0]),
         ] {
-            let st = stencil(basis, &g, x, lp);
-            let gv = volumetric_gradients(basis, &g, x, lp, &st);
+            let mut st = stencil(basis, &g, x, lp);
+            let gv = volumetric_gradients(basis, &g, x, lp, &mut st, &|i, j| (i, j));
             // Σ ∇̄S_i = 0 and Σ ∇̄S_i ⊗ x_i = I: a linear displacement field gives its exact divergence.
             let sum: [f64; 2] = (0..st.len).fold([0.0; 2], |a, k| [a[0] + gv[k][0], a[1] + gv[k][1]]);
             assert!(sum[0].abs() < 1e-12 && sum[1].abs() < 1e-12, "{basis:?} {sum:?}");
@@ -355,8 +371,8 @@ mod tests {
             );
         }
         // A domain inside one cell takes that cell's centre gradients: ±1/(2h).
-        let st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);
-        let gv = volumetric_gradients(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &st);
+        let mut st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);
+        let gv = volumetric_gradients(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &mut st, &|i, j| (i, j));
         let k = st.nodes[..st.len].iter().position(|&n| n == (2, 2)).unwrap();
         assert!((gv[k][0] + 1.0).abs() < 1e-12 && (gv[k][1] + 2.0).abs() < 1e-12, "{:?}", gv[k]);
     }

@@ -101,6 +101,9 @@ impl BearingCheck {
                     .ok_or("unknown body")?;
                 LoadKind::Weight(acceleration[1].abs(), idx, spec.loaded_width)
             }
+            Some(Load::LinePressure { .. }) => {
+                return Err(format!("the load `{}` of a bearing check must be a traction or a weight", spec.load))
+            }
             None => return Err(format!("no load `{}`", spec.load)),
         };
         let time_fn = case_load

@@ -23,6 +23,7 @@ pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
 pub mod figures;
+pub mod lame;
 pub mod patch;
 pub mod shock;
 pub mod terzaghi;
@@ -169,6 +170,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
     let end = c.end_time();
     Ok(Some(match v {
         Verification::Patch { .. } => Box::new(patch::PatchCheck::new(c, model)?),
+        Verification::Lame { .. } => Box::new(lame::LameCheck::new(c)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -893,6 +895,9 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::ElasticColumn { .. } => "static elastic column under self-weight and surcharge".into(),
         Verification::LargeStrainConsolidation { degrees, .. } => {
             format!("large-strain consolidation (Xie & Leo 2004) at U_s = {degrees:?}")
+        }
+        Verification::Lame { inner_radius, outer_radius, .. } => {
+            format!("Lamé cylinder, a = {inner_radius} m, b = {outer_radius} m: u_r, σ_rr, σ_θθ")
         }
         Verification::Patch { boundary, .. } => {
             format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")
