@@ -420,7 +420,15 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            eprintln!("error: {}", f.message);
+            // Under mpirun every rank ends with the same, agreed error: rank 0 prints it.
+            let rank = ["OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"]
+                .iter()
+                .find_map(|v| std::env::var(v).ok())
+                .and_then(|r| r.parse::<usize>().ok())
+                .unwrap_or(0);
+            if rank == 0 {
+                eprintln!("error: {}", f.message);
+            }
             ExitCode::from(f.code)
         }
     }

@@ -250,6 +250,44 @@ fn mpi_starts_with_two_ranks() {
     assert!(text.contains("collective sum over ranks: 2"), "{text}");
 }
 
+/// The slumping block's whole run on two ranks: a matrix rebuilt on one rank's decision used to
+/// hang the other in the collective; every such decision is now agreed. Same results as one rank.
+#[test]
+fn the_slumping_block_on_two_ranks_matches_one_rank() {
+    let one = out_dir("slump_1rank");
+    let two = out_dir("slump_2ranks");
+    let o = porompm(&["run", "cases/slumping_block.toml", "--out", one.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o =
+        mpirun(2, &["run", "cases/slumping_block.toml", "--out", two.to_str().unwrap(), "--quiet"]).expect("mpirun");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (s1, s2) = (summary(&one), summary(&two));
+    assert_eq!((s1["steps"].clone(), s2["ranks"].clone()), (s2["steps"].clone(), 2.into()));
+    let (c1, c2) = (s1["checkerboard_index_max"].as_f64().unwrap(), s2["checkerboard_index_max"].as_f64().unwrap());
+    assert!((c1 - c2).abs() <= 1e-8 * c1, "checkerboard index {c1} on one rank, {c2} on two");
+    for (name, v) in s1["results"].as_object().unwrap() {
+        let (a, b) = (v.as_f64().unwrap(), s2["results"][name].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-8 * a.abs() + 1e-12, "{name}: {a} on one rank, {b} on two");
+    }
+}
+
+/// An error raised on one rank between collectives (a particle leaving its rank's ghost region,
+/// before particles migrate) ends the run on every rank with that rank's message: no hang, one
+/// error line, summary.json `failed`.
+#[test]
+fn an_error_on_one_rank_ends_every_rank_with_its_message() {
+    let dir = out_dir("falling_2ranks");
+    let o = mpirun(2, &["run", "tests/cases/falling_block.toml", "--out", dir.to_str().unwrap(), "--quiet"])
+        .expect("mpirun");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let s = summary(&dir);
+    let err = s["error"].as_str().unwrap();
+    assert_eq!(s["status"], "failed");
+    assert!(err.contains("outside this rank's ghost region") && err.contains("(rank 1)"), "{err}");
+    let lines = stderr(&o).lines().filter(|l| l.starts_with("error:")).count();
+    assert_eq!(lines, 1, "{}", stderr(&o));
+}
+
 #[test]
 fn terzaghi_on_two_ranks_matches_one_rank() {
     let one = out_dir("terzaghi_1rank");

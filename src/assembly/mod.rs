@@ -392,7 +392,8 @@ impl GridSystem {
         let rebuild = coll.any(kept.is_none())?;
         let (pattern_slots, pattern) = if rebuild {
             let [nx, ny] = self.ghost.count;
-            let p = Pattern::build(&self.step.stencils, &self.owned_nodes, nx, ny);
+            let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
+            let p = Pattern::build(&self.step.stencils, &self.owned_nodes, &groups, nx, ny);
             let slots = p.slots(&self.step.stencils).expect("the new pattern holds every pair");
             let (rows, cols) = p.coo(nd, &self.l2g);
             let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());

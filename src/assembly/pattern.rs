@@ -71,9 +71,10 @@ impl Pattern {
         v
     }
 
-    /// The pattern of the particles' effective stencils and the `owned` nodes' diagonal blocks, on a
-    /// ghosted grid of `nx × ny` nodes.
-    pub fn build(st: &Stencils, owned: &[u32], nx: usize, ny: usize) -> Pattern {
+    /// The pattern of the particles' effective stencils, the `owned` nodes' diagonal blocks and the
+    /// pairs of each of the node `groups` (tied faces, pressure-projection cells), on a ghosted grid
+    /// of `nx × ny` nodes.
+    pub fn build(st: &Stencils, owned: &[u32], groups: &[Vec<u32>], nx: usize, ny: usize) -> Pattern {
         let mut p = Pattern { pairs: Vec::new(), near: vec![NONE; nx * ny * WIDTH * WIDTH], far: HashMap::new(), nx };
         for &a in owned {
             p.insert(a, a);
@@ -82,6 +83,13 @@ impl Pattern {
             let eff = st.effective(k);
             for &a in eff {
                 for &b in eff {
+                    p.insert(a, b);
+                }
+            }
+        }
+        for g in groups {
+            for &a in g {
+                for &b in g {
                     p.insert(a, b);
                 }
             }
@@ -155,7 +163,7 @@ mod tests {
     fn pairs_are_listed_once_and_every_particle_finds_its_blocks() {
         // A 10 × 10 ghosted grid; two particles sharing nodes, one reaching 5 columns (a far pair).
         let st = stencils(&[&[11, 12, 21, 22], &[12, 13, 22, 23], &[30, 35]]);
-        let p = Pattern::build(&st, &[11], 10, 10);
+        let p = Pattern::build(&st, &[11], &[], 10, 10);
         // 16 + 16 − 4 shared + 4 for the far particle; (11, 11) is already a particle pair.
         assert_eq!(p.len(), 16 + 16 - 4 + 4);
         let (offsets, slots) = p.slots(&st).unwrap();
