@@ -237,3 +237,46 @@ fn slope_clay_runs_out_with_bbar_and_locks_without() {
     assert!(with > 0.25, "toe run-out with B̄: {with} m");
     assert!(with > 1.8 * without, "toe run-out with B̄ {with} m, without {without} m");
 }
+
+/// One and 4 × 4 material points per cell: GIMP's 4 × 4-node stencils at one point per cell and
+/// the 16 points of a cell fit the matrix pattern (built from the stencils, not from a box of
+/// width 2). The undrained footing completes with both; the slumping block completes with 4 × 4,
+/// and at one point per cell ends cleanly when a step diverges (one quadrature point per cell
+/// leaves the equal-order u–p–U pressure and GIMP's hourglass modes unconstrained).
+#[test]
+fn one_and_sixteen_points_per_cell_run() {
+    for ppc in [1, 4] {
+        let s = run(
+            "footing_sd",
+            &format!("footing_sd-ppc{ppc}"),
+            None,
+            &[
+                &format!("bodies.soil.particles_per_cell={ppc}"),
+                "parameters.h=0.5",
+                "verification.settlement_point=[0.05,4.95]",
+            ],
+        );
+        let ratio = s["verification"]["bearing_capacity_ratio"]["value"].as_f64().unwrap();
+        assert!(ratio.is_finite() && ratio > 1.0, "{ppc} per cell: q_ult/c/(2 + π) = {ratio}");
+    }
+    let s = run(
+        "slumping_block",
+        "slumping-ppc4",
+        None,
+        &["bodies.block.particles_per_cell=4", "stages.slump.duration=0.05"],
+    );
+    assert_eq!(s["steps"], 50);
+    let dir = out_dir("slumping-ppc1");
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
+        .args(["run", "cases/slumping_block.toml", "--out", dir.to_str().unwrap(), "--quiet"])
+        .args(["--set", "bodies.block.particles_per_cell=1", "--set", "stages.slump.duration=0.05"])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = s["error"].as_str().unwrap();
+    assert!(s["status"] == "failed" && err.contains("did not converge") && !err.contains("malloc"), "{err}");
+    assert!(s["steps"].as_u64().unwrap() >= 10, "{}", s["steps"]);
+}
