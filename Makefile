@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study lint clean
+.PHONY: setup build run test study gold lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -23,7 +23,11 @@ test: setup
 
 # Long convergence studies (tables in target/studies/).
 study: build
-	cargo test --release --locked --test studies -- --ignored --nocapture --test-threads=1
+	cargo test --release --locked --test studies --test gold -- --ignored --nocapture --test-threads=1
+
+# Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
+gold: setup
+	PORO_GOLD_REFRESH=1 cargo test --release --locked --test gold
 
 lint:
 	cargo fmt --check

@@ -507,10 +507,15 @@ impl<'a> Simulation<'a> {
         if solve.converged {
             Ok(Ok(()))
         } else {
-            let why = match solve.domain_error {
+            let mut why = match solve.domain_error {
                 Some(d) => format!("{} ({d})", solve.reason),
                 None => solve.reason,
             };
+            // Name the first material point whose residual was not finite during the solve (the
+            // lowest rank's, agreed by all ranks), so that a NaN or Inf says where it appeared.
+            if let Err(where_) = self.coll.agree(solve.nonfinite.map_or(Ok(()), Err)) {
+                why = format!("{why}; {where_}");
+            }
             Ok(Err(why))
         }
     }

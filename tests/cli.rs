@@ -487,3 +487,30 @@ fn the_plastic_tangent_with_pressure_projection_matches_finite_differences() {
     assert!(yielded >= 10, "only {yielded} points have yielded:\n{text}");
     assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
 }
+
+/// A load that overflows the Newton update (NaN in the solve) ends the run `failed` on every rank
+/// of a 2-rank run, with one error line and no panic; nothing aborts.
+#[test]
+fn a_nan_in_the_solve_ends_every_rank_failed() {
+    let dir = out_dir("nan_2ranks");
+    let o = mpirun(
+        2,
+        &[
+            "run",
+            "cases/terzaghi.toml",
+            "--out",
+            dir.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "loads.surface.traction=[0,-1e150]",
+        ],
+    )
+    .expect("mpirun");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let s = summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("DIVERGED_FNORM_NAN"), "{}", s["error"]);
+    let err = stderr(&o);
+    assert_eq!(err.lines().filter(|l| l.starts_with("error:")).count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

@@ -22,11 +22,18 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A PNG file of a real figure: the PNG signature and more than a blank canvas's bytes.
-fn assert_png(path: &Path) {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is not a PNG", path.display());
-    assert!(bytes.len() > 20_000, "{} has only {} bytes", path.display(), bytes.len());
+/// A PNG figure with `series` drawn series: it decodes, has the figure size, and at least
+/// `series` of the series colours each cover more than 300 pixels (a line across the chart; the
+/// legend's sample alone covers fewer), so a blank or half-drawn chart fails.
+fn assert_png(path: &Path, series: usize) {
+    use porompm::io::plot::{SERIES_COLOURS, SIZE};
+    let img = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8();
+    assert_eq!(img.dimensions(), SIZE, "{}", path.display());
+    let counts: Vec<usize> =
+        // Black and grey (the last two) also draw the frame and the text: not counted.
+        SERIES_COLOURS[..6].iter().map(|c| img.pixels().filter(|p| p.0 == *c).count()).collect();
+    let drawn = counts.iter().filter(|n| **n > 300).count();
+    assert!(drawn >= series, "{}: {drawn} series drawn (pixels per colour {counts:?})", path.display());
 }
 
 /// Splits a CSV line at commas outside double quotes.
@@ -88,7 +95,7 @@ fn a_sweep_runs_every_combination_and_keeps_failed_runs_as_rows() {
     }
     let md = std::fs::read_to_string(out.join("sweep.md")).unwrap();
     assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 1 + 6, "{md}");
-    assert_png(&out.join("work_precision.png"));
+    assert_png(&out.join("work_precision.png"), 2);
     assert!(out.join("run_0").join("summary.json").is_file());
 }
 
@@ -127,8 +134,10 @@ fn a_verification_run_draws_its_figures() {
     let o = porompm(&["run", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--quiet"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let plots = out.join("plots");
-    for f in ["terzaghi_pressure_profiles.png", "terzaghi_settlement.png", "probes_excess_pore_pressure.png"] {
-        assert_png(&plots.join(f));
+    for (f, series) in
+        [("terzaghi_pressure_profiles.png", 2), ("terzaghi_settlement.png", 2), ("probes_excess_pore_pressure.png", 2)]
+    {
+        assert_png(&plots.join(f), series);
     }
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

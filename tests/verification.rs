@@ -185,21 +185,11 @@ fn slumping_block_stays_smooth_with_patch_recovery_and_shows_the_mandel_cryer_ri
     let last = p3.last().unwrap().1;
     assert!(t_peak > 0.25 && last < 0.99 * peak, "P3 peaks at t = {t_peak} s ({peak} Pa), ends at {last} Pa");
 
-    let out = out_dir("slumping_block-nopatch");
-    let _ = std::fs::remove_dir_all(&out);
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(["run", "cases/slumping_block.toml", "--out", &out.display().to_string(), "--quiet"])
-        .args(["--set", "stabilisation.patch_recovery=false"])
-        .current_dir(root())
-        .output()
-        .expect("porompm runs");
-    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    if o.status.success() {
-        let unpatched = s["checkerboard_index_max"].as_f64().unwrap();
-        assert!(unpatched >= 3.0 * ci, "checkerboard index {unpatched} without patch recovery, {ci} with it");
-    } else {
-        assert_eq!(s["status"], "failed", "a failed unpatched run must say so");
-    }
+    // Without patch recovery the run completes (measured 2026-11-24) with a checkerboard index
+    // of 0.147 against 0.0087 with it; both must hold, a failed run fails this test.
+    let unpatched = run("slumping_block", "slumping_block-nopatch", None, &["stabilisation.patch_recovery=false"]);
+    let unpatched = unpatched["checkerboard_index_max"].as_f64().unwrap();
+    assert!(unpatched >= 3.0 * ci, "checkerboard index {unpatched} without patch recovery, {ci} with it");
 }
 
 /// A number from summary.json `results` (NaN when absent).
@@ -208,19 +198,29 @@ fn result(s: &Value, name: &str) -> f64 {
 }
 
 #[test]
-fn footing_sd_fails_near_prandtl_with_bbar_and_locks_without() {
-    // Regression of the small-deformation undrained footing at h = 0.25 m ([000] §4.1.1). With B̄
-    // the footing fails: q_ult/c at d/B = 0.01 was measured 5.64, (2 + π)·1.097 — above the issue's
-    // 3 % (the error falls with h: 1.18, 1.10, 1.06 at h = 0.5, 0.25, 0.1 m; see the case file).
-    // Without B̄ the nearly incompressible plastic flow locks: no failure up to q/c = 7.
+fn footing_sd_converges_towards_prandtl_with_bbar_and_locks_without() {
+    // The small-deformation undrained footing ([000] §4.1.1) with B̄ fails at a q_ult/c that
+    // approaches 2 + π under refinement: measured (q_ult/c)/(2 + π) = 1.183 / 1.098 / 1.057 at
+    // h = 0.5 / 0.25 / 0.1 m (order ≈ 0.9 then 0.6; the case's target, 6 % at h = 0.25 m, is not
+    // met and the run reports it as FAIL; see docs/verification.md). Here: the error must fall by
+    // at least 1.6× from h = 0.5 to 0.25 m (1.87× measured) and each run's pass flag must agree
+    // with its value; the values themselves are pinned by the gold test. Without B̄ the nearly
+    // incompressible plastic flow locks: no failure up to q/c = 7.
+    let coarse = run("footing_sd", "footing_sd-h0.5", None, &["parameters.h=0.5"]);
     let with = run("footing_sd", "footing_sd-bbar", None, &[]);
-    let ratio = with["verification"]["bearing_capacity_ratio"]["value"].as_f64().unwrap();
-    assert!((1.06..=1.13).contains(&ratio), "bearing_capacity_ratio with B̄: {ratio}");
+    let m = |s: &Value| {
+        let b = &s["verification"]["bearing_capacity_ratio"];
+        let (v, tol) = (b["value"].as_f64().unwrap(), b["tolerance"].as_f64().unwrap());
+        assert_eq!(b["pass"].as_bool().unwrap(), (v - 1.0).abs() <= tol, "pass flag of {v}");
+        v
+    };
+    let (r05, r025) = (m(&coarse), m(&with));
+    assert!(r025 > 1.0 && (r05 - 1.0) >= 1.6 * (r025 - 1.0), "q_ult/c/(2 + π) = {r05} at h = 0.5 m, {r025} at 0.25 m");
     let without = run("footing_sd", "footing_sd-nobbar", None, &["stabilisation.bbar=false"]);
     let q_max = result(&without, "q_over_c_max");
     let at_fail = result(&without, "q_over_c_at_dB0.01");
     assert!(
-        at_fail.is_nan() || at_fail > 1.2 * ratio * (2.0 + std::f64::consts::PI),
+        at_fail.is_nan() || at_fail > 1.2 * r025 * (2.0 + std::f64::consts::PI),
         "without B̄ q/c at d/B = 0.01 is {at_fail} (max {q_max}): not locked"
     );
     assert!(q_max > 6.9, "without B̄ the load reaches q/c = {q_max} only");

@@ -81,6 +81,9 @@ pub(super) struct Assembler<'a> {
     seconds: &'a mut f64,
     stage: &'a LogStage,
     values: Vec<f64>,
+    /// The first material point whose residual block was not finite in this solve (on this
+    /// rank), with the quantity that was not.
+    pub(super) nonfinite: Option<String>,
 }
 
 impl<'a> Assembler<'a> {
@@ -93,7 +96,7 @@ impl<'a> Assembler<'a> {
         seconds: &'a mut f64,
         stage: &'a LogStage,
     ) -> Assembler<'a> {
-        Assembler { dm, model, step, x_local, f_local, seconds, stage, values: Vec::new() }
+        Assembler { dm, model, step, x_local, f_local, seconds, stage, values: Vec::new(), nonfinite: None }
     }
 
     fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
@@ -101,16 +104,37 @@ impl<'a> Assembler<'a> {
         Ok(self.x_local.read().map_err(fatal)?.to_vec())
     }
 
-    /// The point of particle `k` at the ghosted increments `xl`.
-    fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+    /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
+    fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point) -> R) -> R {
         let step = self.step;
         let (nodes, basis) = step.stencils.get(k);
         let states = node_states(step, k, xl);
         let input = particle_input(self.model, step, k);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
-        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
-        kernels::residual(&pt, buf);
-        pt.size()
+        f(&kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared")))
+    }
+
+    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
+    fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+        self.with_point(k, xl, |pt| {
+            kernels::residual(pt, buf);
+            pt.size()
+        })
+    }
+
+    /// Names particle `k`, whose residual at `xl` is not finite, and the first of its quantities
+    /// that is not.
+    fn describe_nonfinite(&self, k: usize, xl: &[f64]) -> String {
+        match self.with_point(k, xl, |pt| self.model.check_step(k, &kernels::StepResult::of(pt))) {
+            Err(e) if e.0.contains("not finite") => e.0,
+            _ => {
+                let ps = &self.model.particles;
+                format!(
+                    "material point {} at ({:.4}, {:.4}) m: its residual (internal, inertia or flow terms) is not finite (NaN or Inf)",
+                    ps.id[k], ps.x[k][0], ps.x[k][1]
+                )
+            }
+        }
     }
 
     /// Adds particle `k`'s raw residual block `r` (length m) to the ghosted array `f` through its
@@ -258,6 +282,9 @@ impl NonlinearProblem for Assembler<'_> {
         let mut buf = [0.0; MAX_LOCAL];
         for k in 0..self.step.stencils.len() {
             let m = self.residual_of(k, &xl, &mut buf);
+            if self.nonfinite.is_none() && !buf[..m].iter().all(|r| r.is_finite()) {
+                self.nonfinite = Some(self.describe_nonfinite(k, &xl));
+            }
             self.scatter(k, &buf[..m], &mut fl);
         }
         self.add_projection(&xl, &mut fl);

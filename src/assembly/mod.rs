@@ -95,6 +95,9 @@ pub struct StepSolve {
     pub residual_history: Vec<f64>,
     /// A domain error raised by the callbacks.
     pub domain_error: Option<String>,
+    /// The first material point (on this rank) whose residual was not finite during the solve,
+    /// with the quantity that was not.
+    pub nonfinite: Option<String>,
     /// Wall time spent in the residual and Jacobian callbacks [s].
     pub assembly_seconds: f64,
     /// Wall time of the whole SNES solve [s].
@@ -762,9 +765,10 @@ impl GridSystem {
         }
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
-        let out = {
+        let (out, nonfinite) = {
             let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
-            snes.solve(x, jac, &mut asm)?
+            let out = snes.solve(x, jac, &mut asm)?;
+            (out, asm.nonfinite.take())
         };
         let solve_seconds = t0.elapsed().as_secs_f64();
         self.dm.global_to_local(&self.x, &mut self.x_local)?;
@@ -776,6 +780,7 @@ impl GridSystem {
             linear_iterations: out.linear_iterations,
             residual_history: out.residual_history,
             domain_error: out.domain_error,
+            nonfinite,
             assembly_seconds,
             solve_seconds,
         })

@@ -14,22 +14,24 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Width and height of every figure [px].
-const SIZE: (u32, u32) = (1000, 650);
+pub const SIZE: (u32, u32) = (1000, 650);
 
-/// Colours of the series, by [`crate::plot::Series::colour`] (cycled).
-const COLOURS: [RGBColor; 8] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(86, 180, 233),
-    RGBColor(230, 159, 0),
-    RGBColor(0, 0, 0),
-    RGBColor(120, 120, 120),
+/// Colours of the series (RGB), by [`crate::plot::Series::colour`] (cycled); public so that tests
+/// can find the drawn series in a figure's pixels.
+pub const SERIES_COLOURS: [[u8; 3]; 8] = [
+    [0, 114, 178],
+    [213, 94, 0],
+    [0, 158, 115],
+    [204, 121, 167],
+    [86, 180, 233],
+    [230, 159, 0],
+    [0, 0, 0],
+    [120, 120, 120],
 ];
 
 fn colour(i: usize) -> RGBColor {
-    COLOURS[i % COLOURS.len()]
+    let [r, g, b] = SERIES_COLOURS[i % SERIES_COLOURS.len()];
+    RGBColor(r, g, b)
 }
 
 /// Writes every figure that has data as `<dir>/<figure.file>` (the directory is created if needed)
