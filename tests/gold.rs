@@ -93,25 +93,6 @@ fn run(case: &str, label: &str, sets: &[String], extra: &[String], options: &[&s
     (out, s)
 }
 
-/// Whether a history column is a probe, reaction or boundary-motion value worth keeping.
-fn kept_column(name: &str) -> bool {
-    const KINDS: [&str; 12] = [
-        ".ux",
-        ".uy",
-        ".sxx",
-        ".syy",
-        ".sxy",
-        ".p",
-        ".p_excess",
-        ".reaction_x",
-        ".reaction_y",
-        ".displacement_x",
-        ".displacement_y",
-        ".settlement",
-    ];
-    KINDS.iter().any(|k| name.ends_with(k)) || name.starts_with("bearing.q") || name.starts_with("lame.")
-}
-
 /// The kind of a value, for the scale of its absolute floor.
 fn kind(key: &str) -> &'static str {
     if key.starts_with("verification.") {
@@ -127,6 +108,12 @@ fn kind(key: &str) -> &'static str {
         "reaction_x" | "reaction_y" => "force",
         _ => "other",
     }
+}
+
+/// Whether a history column is a probe, reaction or boundary-motion value worth keeping (one of
+/// the kinds above), or a footing's load (`bearing.q…`) or a Lamé check column.
+fn kept_column(name: &str) -> bool {
+    kind(name) != "other" || name.starts_with("bearing.q") || name.starts_with("lame.")
 }
 
 /// The values of a run: metrics, results, steps and the kept history columns at the row nearest

@@ -125,9 +125,9 @@ impl<'a> Assembler<'a> {
     /// Names particle `k`, whose residual at `xl` is not finite, and the first of its quantities
     /// that is not.
     fn describe_nonfinite(&self, k: usize, xl: &[f64]) -> String {
-        match self.with_point(k, xl, |pt| self.model.check_step(k, &kernels::StepResult::of(pt))) {
-            Err(e) if e.0.contains("not finite") => e.0,
-            _ => {
+        match self.with_point(k, xl, |pt| self.model.nonfinite(k, &kernels::StepResult::of(pt))) {
+            Some(e) => e.0,
+            None => {
                 let ps = &self.model.particles;
                 format!(
                     "material point {} at ({:.4}, {:.4}) m: its residual (internal, inertia or flow terms) is not finite (NaN or Inf)",

@@ -253,7 +253,8 @@ impl GridSystem {
         })
     }
 
-    /// Whether this rank owns cell (i, j): the cell's lower-left node is owned.
+    /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
+    /// it is.
     pub fn owns_cell(&self, i: usize, j: usize) -> bool {
         i >= self.owned_start[0]
             && i < self.owned_start[0] + self.owned_count[0]
@@ -374,7 +375,7 @@ impl GridSystem {
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         let (smooth, grad_n) = self.predictors(model, &st, &dofs, &nodal);
         let projection = self.projection_blocks(model);
-        let fext = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
+        let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
         let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
         self.step = StepData {
             nm: Some(nm),
@@ -389,7 +390,7 @@ impl GridSystem {
             projection,
             ..StepData::default()
         };
-        self.check_loads(model, active, t_new, coll)?;
+        self.check_loads(&applied, t_new, coll)?;
         // 5. The matrix pattern: kept if every rank finds every pair in it.
         let kept = self.pattern.as_ref().and_then(|p| p.slots(&self.step.stencils));
         let rebuild = coll.any(kept.is_none())?;
@@ -590,11 +591,20 @@ impl GridSystem {
     /// Step 4: the external forces at t_{n+1} per ghosted dof. A traction's share at a node whose
     /// motion is extended goes to the node's masters (extended towards the loaded particle); a share
     /// that no node can carry stays where it is, and [`GridSystem::check_loads`] reports it.
-    fn external_forces(&self, model: &Model, active: &Active, t_new: f64, dofs: &DofMap) -> Result<Vec<f64>, String> {
+    /// Returns the nodal forces and, for that check, the total force the loads apply on this rank
+    /// (before it is shared out to nodes).
+    fn external_forces(
+        &self,
+        model: &Model,
+        active: &Active,
+        t_new: f64,
+        dofs: &DofMap,
+    ) -> Result<(Vec<f64>, AppliedLoads), String> {
         let nd = self.layout.nd;
         let ps = &model.particles;
         let g = &model.grid;
         let mut fext = vec![0.0; self.ghost.len() * nd];
+        let mut applied = AppliedLoads::default();
         let tiny = 1e-9 * g.h[0].min(g.h[1]);
         let is_well = |i: i64, j: i64| -> bool {
             i >= 0 && j >= 0 && self.ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
@@ -620,6 +630,9 @@ impl GridSystem {
         for &li in &active.loads {
             let load = &model.loads[li];
             let f = load.time_fn.eval(t_new);
+            if !matches!(load.target, LoadTarget::BodyForce { .. }) {
+                applied.names.push(load.name.clone());
+            }
             match &load.target {
                 LoadTarget::ParticleTraction { particles, face, traction } => {
                     // The traction acts at the centre of the particle's loaded face (force = traction ×
@@ -627,6 +640,7 @@ impl GridSystem {
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
                         let (point, length) = face_point(*face, x, lp);
+                        applied.add([traction[0] * f * length, traction[1] * f * length]);
                         let w = shape::face_weights(g, point);
                         for ((i, j), s, _) in w.iter() {
                             let l = self.ghost.node(i as usize, j as usize).ok_or_else(|| {
@@ -640,14 +654,11 @@ impl GridSystem {
                     }
                 }
                 LoadTarget::NodalTraction { nodes, traction } => {
-                    for &(i, j, trib) in nodes {
-                        let owned = (self.owned_start[0]..self.owned_start[0] + self.owned_count[0]).contains(&i)
-                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1]).contains(&j);
-                        if owned {
-                            let l = self.ghost.node(i, j).expect("owned");
-                            let p = g.node_position(i, j);
-                            add(l, [traction[0] * f * trib, traction[1] * f * trib], p);
-                        }
+                    for &(i, j, trib) in nodes.iter().filter(|&&(i, j, _)| self.owns_cell(i, j)) {
+                        let l = self.ghost.node(i, j).expect("owned");
+                        let force = [traction[0] * f * trib, traction[1] * f * trib];
+                        applied.add(force);
+                        add(l, force, g.node_position(i, j));
                     }
                 }
                 LoadTarget::LinePressure { points, pressure } => {
@@ -656,6 +667,7 @@ impl GridSystem {
                         if !g.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
                             continue;
                         }
+                        applied.add([force[0] * pressure * f, force[1] * pressure * f]);
                         // Shares on unfilled nodes are extended from the material's side.
                         let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
                         let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
@@ -668,56 +680,16 @@ impl GridSystem {
                 LoadTarget::BodyForce { .. } => {}
             }
         }
-        Ok(fext)
+        Ok((fext, applied))
     }
 
     /// The load accounting of a step: the tractions the case applies at t_{n+1} against the forces
     /// assembled on nodes that carry them (free, or fixed by a boundary, whose reaction then takes
     /// them). A difference beyond round-off means that part of a load would be lost: an error
     /// naming the load.
-    fn check_loads(&mut self, model: &Model, active: &Active, t_new: f64, coll: &Collective) -> Result<(), String> {
+    fn check_loads(&mut self, applied: &AppliedLoads, t_new: f64, coll: &Collective) -> Result<(), String> {
         let nd = self.layout.nd;
-        let ps = &model.particles;
-        let mut applied = [0.0; 2];
-        let mut names = Vec::new();
-        for &li in &active.loads {
-            let load = &model.loads[li];
-            let f = load.time_fn.eval(t_new);
-            match &load.target {
-                LoadTarget::ParticleTraction { particles, face, traction } => {
-                    for &k in particles {
-                        let length = face_point(*face, ps.x[k], ps.lp[k]).1;
-                        for c in 0..2 {
-                            applied[c] += traction[c] * f * length;
-                        }
-                    }
-                    names.push(load.name.clone());
-                }
-                LoadTarget::NodalTraction { nodes, traction } => {
-                    for &(i, j, trib) in nodes {
-                        let owned = (self.owned_start[0]..self.owned_start[0] + self.owned_count[0]).contains(&i)
-                            && (self.owned_start[1]..self.owned_start[1] + self.owned_count[1]).contains(&j);
-                        if owned {
-                            for c in 0..2 {
-                                applied[c] += traction[c] * f * trib;
-                            }
-                        }
-                    }
-                    names.push(load.name.clone());
-                }
-                LoadTarget::LinePressure { points, pressure } => {
-                    for &(point, force) in points {
-                        if model.grid.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
-                            for c in 0..2 {
-                                applied[c] += force[c] * pressure * f;
-                            }
-                        }
-                    }
-                    names.push(load.name.clone());
-                }
-                LoadTarget::BodyForce { .. } => {}
-            }
-        }
+        let (applied, names) = (applied.total, &applied.names);
         if names.is_empty() {
             return Ok(());
         }
@@ -910,6 +882,23 @@ impl GridSystem {
         let mat = &model.materials[model.particles.material[k] as usize];
         let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, self.layout);
         StepResult::of(&pt)
+    }
+}
+
+/// The tractions of a step as the case applies them (before they are shared out to nodes), on
+/// this rank, for [`GridSystem::check_loads`].
+#[derive(Debug, Clone, Default)]
+struct AppliedLoads {
+    /// Total force [N/m].
+    total: [f64; 2],
+    /// The traction loads that are active.
+    names: Vec<String>,
+}
+
+impl AppliedLoads {
+    fn add(&mut self, force: [f64; 2]) {
+        self.total[0] += force[0];
+        self.total[1] += force[1];
     }
 }
 

@@ -306,22 +306,11 @@ impl Model {
     /// its volume ratio J positive and the porosity it implies ([`Model::porosity_after`]) inside
     /// (0, 1). The message names the particle and the quantity.
     pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
+        if let Some(e) = self.nonfinite(k, step) {
+            return Err(e);
+        }
         let j = step.jacobian;
         let ps = &self.particles;
-        let it = &step.interp;
-        let finite = [
-            ("displacement increment", it.du[0].is_finite() && it.du[1].is_finite()),
-            ("velocity", it.v_u[0].is_finite() && it.v_u[1].is_finite() && it.a_u.iter().all(|a| a.is_finite())),
-            ("effective stress", step.upd.stress.iter().all(|s| s.is_finite())),
-            ("pore pressure increment", it.dp.is_finite()),
-            ("volume ratio", j.is_finite()),
-        ];
-        if let Some((what, _)) = finite.iter().find(|f| !f.1) {
-            return Err(InadmissibleStep(format!(
-                "material point {} at ({:.4}, {:.4}) m: its {what} is not finite (NaN or Inf)",
-                ps.id[k], ps.x[k][0], ps.x[k][1]
-            )));
-        }
         let n_new = self.porosity_after(k, j);
         if j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
             return Err(InadmissibleStep(format!(
@@ -330,6 +319,27 @@ impl Model {
             )));
         }
         Ok(())
+    }
+
+    /// The first quantity of particle `k`'s step that is not finite (NaN or Inf), naming the
+    /// particle, if any.
+    pub fn nonfinite(&self, k: usize, step: &StepResult) -> Option<InadmissibleStep> {
+        let ps = &self.particles;
+        let it = &step.interp;
+        let j = step.jacobian;
+        let finite = [
+            ("displacement increment", it.du[0].is_finite() && it.du[1].is_finite()),
+            ("velocity", it.v_u[0].is_finite() && it.v_u[1].is_finite() && it.a_u.iter().all(|a| a.is_finite())),
+            ("effective stress", step.upd.stress.iter().all(|s| s.is_finite())),
+            ("pore pressure increment", it.dp.is_finite()),
+            ("volume ratio", j.is_finite()),
+        ];
+        finite.iter().find(|f| !f.1).map(|(what, _)| {
+            InadmissibleStep(format!(
+                "material point {} at ({:.4}, {:.4}) m: its {what} is not finite (NaN or Inf)",
+                ps.id[k], ps.x[k][0], ps.x[k][1]
+            ))
+        })
     }
 
     /// Updates particle `k` with the converged step ([003] Eq. 24, [000] Eq. 11): accelerations from
