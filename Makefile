@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study gold lint clean
+.PHONY: setup build run test study gold bench lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -24,10 +24,16 @@ test: setup
 # Long convergence studies (tables in target/studies/).
 study: build
 	cargo test --release --locked --test studies --test gold -- --ignored --nocapture --test-threads=1
+	python3 scripts/terzaghi_family.py
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
 gold: setup
 	PORO_GOLD_REFRESH=1 cargo test --release --locked --test gold
+
+# The peer footing benchmark (cases/footing_peer.toml) on 1 and 2 ranks, median of 3 runs each:
+# wall time, peak memory, Newton iterations, settlements at q = 3c and 4c, the time split.
+bench: build
+	python3 scripts/bench_footing_peer.py
 
 lint:
 	cargo fmt --check

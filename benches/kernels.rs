@@ -82,7 +82,7 @@ fn particle_kernels(c: &mut Criterion) {
     g.finish();
 
     let basis = bases(&model);
-    let nm = kernels::Newmark::new(model.beta, model.gamma, 1e-3);
+    let nm = kernels::Scheme::of(&model.integration, 1e-3, false);
     let states: Vec<Vec<NodeState>> = basis
         .iter()
         .enumerate()
@@ -118,7 +118,7 @@ fn particle_kernels(c: &mut Criterion) {
             for k in 0..n {
                 let m = basis[k].len() * 5;
                 let pt = kernels::Point::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
-                kernels::residual(&pt, &mut buf[..m]);
+                kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
             black_box(sum)

@@ -155,16 +155,14 @@ pub fn describe(case: &Case, label: &str) -> String {
         let a = model.active(st);
         let _ = writeln!(
             s,
-            "stage `{}`: {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]{}",
+            "stage `{}` ({}): {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]",
             st.name,
+            crate::analysis::StageAnalysis::of(case, st).describe(),
             st.duration,
             st.dt(),
             (st.duration / st.dt()).ceil() as usize,
             a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
             a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
-            st.time_integration
-                .as_ref()
-                .map_or(String::new(), |t| format!("; Newmark β = {}, γ = {}", t.beta, t.gamma))
         );
     }
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
@@ -181,7 +179,6 @@ pub fn describe(case: &Case, label: &str) -> String {
             (_, false) => "undeformed",
         }
     );
-    let _ = writeln!(s, "Newmark: β = {}, γ = {}", case.time_integration.beta, case.time_integration.gamma);
     let _ = writeln!(
         s,
         "solver: {}",

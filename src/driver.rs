@@ -18,6 +18,7 @@
 //! A restarted run (`--restart`) sets up as usual, then takes the particles, time, step, stage and
 //! step control from the checkpoint ([`crate::state`]) and continues in that stage.
 
+use crate::analysis::StageAnalysis;
 use crate::assembly::{self, GridSystem, Phase, StepForces};
 use crate::case::{Case, Stage};
 use crate::io::RunOutput;
@@ -136,6 +137,9 @@ pub struct Summary {
     /// `/proc/self/status`, absent where the system does not report it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_mib: Option<f64>,
+    /// The sum of every rank's peak resident memory [MiB] (equal to `peak_memory_mib` on one rank).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_memory_total_mib: Option<f64>,
     /// Largest checkerboard index of the pore pressures over the output steps (two-phase runs; see
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -222,6 +226,11 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
     let result = result.and_then(|_| indexed.map_err(RunError::Failed));
     summary.wall_time_s = start.elapsed().as_secs_f64();
     summary.peak_memory_mib = crate::io::peak_memory_mib();
+    // Collective: every rank reaches this point (a failed run's error was agreed by all ranks).
+    summary.peak_memory_total_mib = match summary.peak_memory_mib {
+        Some(m) => req.coll.sum(&[m]).ok().map(|v| v[0]),
+        None => None,
+    };
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
     let err = result.err();
     match &err {
@@ -267,6 +276,7 @@ impl Summary {
             petsc_options: assembly::petsc_options().unwrap_or_default(),
             timings: Timings::default(),
             peak_memory_mib: None,
+            peak_memory_total_mib: None,
             checkerboard_index_max: None,
             equilibrium_error: None,
             stopped: None,
@@ -294,6 +304,7 @@ pub fn test_jacobian(
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
+    sim.begin_stage(stage)?;
     for _ in 0..steps {
         sim.newton_solve(&active, stage.dt())?.map_err(RunError::Failed)?;
         sim.update_particles(stage.dt())?.map_err(RunError::Failed)?;
@@ -317,8 +328,8 @@ impl<'a> Simulation<'a> {
         let case = req.case;
         let coll = req.coll;
         let input = |e: String| RunError::Input(e);
-        let two_phase = case.analysis.formulation == crate::case::Formulation::TwoPhase;
-        let layout = crate::kernels::Layout::of(two_phase);
+        let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
+        let layout = StageAnalysis::of(case, &case.stages[first]).layout;
         let system = GridSystem::new(coll, &crate::model::grid_of(case), layout).map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
@@ -399,8 +410,7 @@ impl<'a> Simulation<'a> {
     /// The time-step loop of one stage.
     fn run_stage(&mut self, stage: &Stage) -> Result<(), RunError> {
         let active = self.model.active(stage);
-        let newmark = stage.time_integration.as_ref().unwrap_or(&self.case.time_integration);
-        (self.model.beta, self.model.gamma) = (newmark.beta, newmark.gamma);
+        let analysis = self.begin_stage(stage)?;
         let mut control = StepControl::new(stage, self.stage_end(stage));
         let stage_index = self.case.stages.iter().position(|s| std::ptr::eq(s, stage)).unwrap_or(0);
         if let Some((_, dt, successes)) = self.resume.take() {
@@ -408,8 +418,9 @@ impl<'a> Simulation<'a> {
             control.successes = successes;
         }
         self.progress(&format!(
-            "stage `{}`: t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
+            "stage `{}` ({}): t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
             stage.name,
+            analysis.describe(),
             self.t,
             control.t_end,
             stage.dt()
@@ -432,7 +443,7 @@ impl<'a> Simulation<'a> {
             match admitted {
                 Ok(()) => {
                     self.t = control.advance(self.t, dt);
-                    control.accepted();
+                    control.accepted(self.last_newton.0);
                     self.step += 1;
                     self.summary.steps = self.step;
                     self.summary.time_s = self.t;
@@ -470,6 +481,22 @@ impl<'a> Simulation<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Sets the stage's analysis type up: its time treatment on the model and, when its unknowns
+    /// per node differ from the last stage's, a new grid system (DMDA, matrix, SNES) for them.
+    fn begin_stage(&mut self, stage: &Stage) -> Result<StageAnalysis, RunError> {
+        let analysis = StageAnalysis::of(self.case, stage);
+        self.model.integration = analysis.integration;
+        if self.system.layout() != analysis.layout {
+            let grid = crate::model::grid_of(self.case);
+            let reused = self.system.reused_patterns;
+            self.system =
+                GridSystem::new(self.coll, &grid, analysis.layout).map_err(|e| RunError::Failed(e.to_string()))?;
+            self.system.reused_patterns = reused;
+            self.summary.grid_dofs = self.system.total_dofs();
+        }
+        Ok(analysis)
     }
 
     /// One Newton solve of the step t → t + dt. `Ok(Err(reason))` means it did not converge.
@@ -533,7 +560,7 @@ impl<'a> Simulation<'a> {
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
-        let recovered = if self.model.two_phase && self.model.patch_recovery {
+        let recovered = if self.model.two_phase && self.model.patch_recovery && self.system.layout().p.is_some() {
             Some(self.system.recovered_pressure_increments(&self.model))
         } else {
             None
@@ -760,10 +787,15 @@ impl<'a> Simulation<'a> {
 /// on the stage end.
 /// Accepted steps after which a cut Δt grows back by one factor.
 const GROW_AFTER: usize = 3;
+/// Newton iterations up to which a step counts as easy: after [`GROW_AFTER`] accepted steps, the
+/// last of them easy, Δt may grow beyond the stage's `dt` up to its `dt_max`.
+const EASY_NEWTON: usize = 3;
 
 #[derive(Debug, Clone)]
 struct StepControl {
     stage_dt: f64,
+    /// The largest Δt after easy steps.
+    dt_max: f64,
     dt: f64,
     cuts: usize,
     /// Accepted steps since Δt last changed.
@@ -777,6 +809,7 @@ impl StepControl {
     fn new(stage: &Stage, t_end: f64) -> StepControl {
         StepControl {
             stage_dt: stage.dt(),
+            dt_max: stage.dt_max.unwrap_or(stage.dt()),
             dt: stage.dt(),
             cuts: 0,
             successes: 0,
@@ -821,14 +854,17 @@ impl StepControl {
         }
     }
 
-    /// After an accepted step: reset the cut count, and after [`GROW_AFTER`] accepted steps at the
-    /// same Δt let it grow back towards the stage's (growing after every step would retry the Δt
-    /// that just failed at once, which costs a full failed Newton solve each time in a plastic run).
-    fn accepted(&mut self) {
+    /// After an accepted step that took `newton` iterations: reset the cut count, and after
+    /// [`GROW_AFTER`] accepted steps at the same Δt let it grow back towards the stage's (growing
+    /// after every step would retry the Δt that just failed at once, which costs a full failed
+    /// Newton solve each time in a plastic run), and beyond it up to `dt_max` when the last step
+    /// was easy.
+    fn accepted(&mut self, newton: usize) {
         self.cuts = 0;
         self.successes += 1;
         if self.successes >= GROW_AFTER {
-            self.dt = (self.dt / self.factor).min(self.stage_dt);
+            let cap = if newton <= EASY_NEWTON { self.dt_max } else { self.stage_dt };
+            self.dt = self.dt.max((self.dt / self.factor).min(cap));
             self.successes = 0;
         }
     }
@@ -936,6 +972,10 @@ mod tests {
             max_step_cuts: cuts,
             cut_factor: 0.5,
             time_integration: None,
+            analysis: Default::default(),
+            theta: None,
+            drainage: None,
+            dt_max: None,
         }
     }
 
@@ -963,15 +1003,39 @@ mod tests {
         assert!(c.clone().rejected(0.05).is_err());
         // Success resets the count; every GROW_AFTER successes double Δt back, never above the
         // stage's.
-        c.accepted();
+        c.accepted(1);
         assert!((c.dt - 0.05).abs() < 1e-15 && c.cuts == 0);
         for _ in 1..GROW_AFTER {
-            c.accepted();
+            c.accepted(1);
         }
         assert!((c.dt - 0.1).abs() < 1e-15);
         for _ in 0..3 * GROW_AFTER {
-            c.accepted();
+            c.accepted(1);
         }
         assert_eq!(c.dt, 0.2);
+    }
+
+    #[test]
+    fn easy_steps_grow_up_to_dt_max_and_hard_ones_do_not() {
+        let mut st = stage(0.1, 2);
+        st.dt_max = Some(0.4);
+        let mut c = StepControl::new(&st, 10.0);
+        for _ in 0..GROW_AFTER {
+            c.accepted(EASY_NEWTON + 1);
+        }
+        assert_eq!(c.dt, 0.1, "a hard step does not grow beyond the stage's dt");
+        for _ in 0..GROW_AFTER {
+            c.accepted(EASY_NEWTON);
+        }
+        assert!((c.dt - 0.2).abs() < 1e-15);
+        for _ in 0..4 * GROW_AFTER {
+            c.accepted(1);
+        }
+        assert!((c.dt - 0.4).abs() < 1e-15, "capped at dt_max");
+        // A hard step at a grown Δt keeps it (it converged); a failure cuts it.
+        for _ in 0..GROW_AFTER {
+            c.accepted(10);
+        }
+        assert!((c.dt - 0.4).abs() < 1e-15);
     }
 }

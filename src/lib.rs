@@ -5,6 +5,7 @@
 //! small dense block at a time); [`assembly`] is the only module that talks to PETSc; [`io`] is the
 //! only module that touches files; [`driver`] is the algorithm on one page.
 
+pub mod analysis;
 pub mod assembly;
 pub mod case;
 pub mod describe;

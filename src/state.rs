@@ -18,10 +18,10 @@ use crate::model::particles::Particles;
 use std::collections::HashMap;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 1;
+pub const FORMAT_VERSION: u64 = 2;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
-pub const PARTICLE_FIELDS: [(&str, usize); 20] = [
+pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
     ("id", 1),
     ("body", 1),
     ("material", 1),
@@ -42,10 +42,11 @@ pub const PARTICLE_FIELDS: [(&str, usize); 20] = [
     ("p", 1),
     ("p0", 1),
     ("eps_pd", 1),
+    ("grad_p", 2),
 ];
 
 /// Values per particle record (the sum of [`PARTICLE_FIELDS`]' components).
-pub const RECORD: usize = 35;
+pub const RECORD: usize = 37;
 
 /// `summary.json`'s `restarted_from`: the checkpoint a run continued from.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -138,7 +139,7 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
 pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
     let mut r = [0.0; RECORD];
     let f = &ps.def_grad[k];
-    let parts: [&[f64]; 20] = [
+    let parts: [&[f64]; 21] = [
         &[ps.id[k] as f64],
         &[ps.body[k] as f64],
         &[ps.material[k] as f64],
@@ -159,6 +160,7 @@ pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
         &[ps.p[k]],
         &[ps.p0[k]],
         &[ps.eps_pd[k]],
+        &ps.grad_p[k],
     ];
     let mut i = 0;
     for p in parts {
@@ -188,6 +190,7 @@ fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
     ps.p[k] = r[32];
     ps.p0[k] = r[33];
     ps.eps_pd[k] = r[34];
+    ps.grad_p[k] = two(35);
 }
 
 /// Records of all ranks' particles (concatenated by the caller), sorted by id.
@@ -298,6 +301,7 @@ mod tests {
         ps.p[k] = next();
         ps.p0[k] = next();
         ps.eps_pd[k] = next();
+        ps.grad_p[k] = [next(), next()];
         let flat: Vec<f64> = (0..ps.len()).rev().flat_map(|k| pack(&ps, k)).collect();
         let records = sorted_records(&flat);
         assert!(records.windows(2).all(|w| w[0][0] < w[1][0]), "sorted by id");

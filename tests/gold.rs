@@ -204,6 +204,7 @@ gold_tests!(
     elastic_column,
     footing_ld,
     footing_near_slope,
+    footing_peer,
     footing_sd,
     harmonic_column_zone1,
     harmonic_column_zone2,

@@ -18,11 +18,15 @@ fn fatal(e: petsc::Error) -> CallbackError {
     CallbackError::Fatal(e.to_string())
 }
 
-/// The kernel input of particle `k` for the prepared step.
+/// The kernel input of particle `k` for the prepared step. Without water dofs the u rows carry
+/// the mixture's mass (the water moves with the solid).
 pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
     let mut input = model.particle_input(k, &step.body_acc);
     if let Some(g) = step.grad_n.get(k) {
         input.grad_n = *g;
+    }
+    if step.layout.is_some_and(|l| l.w.is_none()) {
+        input.mass += input.water_mass;
     }
     let nm = step.nm.as_ref().expect("prepared");
     let s = &step.smooth[k];
@@ -116,8 +120,9 @@ impl<'a> Assembler<'a> {
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
     fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+        let nm = self.step.nm.expect("prepared");
         self.with_point(k, xl, |pt| {
-            kernels::residual(pt, buf);
+            kernels::residual(pt, &nm, buf);
             pt.size()
         })
     }
@@ -162,27 +167,92 @@ impl<'a> Assembler<'a> {
         }
     }
 
-    /// The kernel terms of the converged step summed per ghosted dof (this rank's particles): all
-    /// terms into `all`, the inertia term (with the body force) alone into `inertia`.
+    /// The kernel terms of the converged step summed per ghosted dof (this rank's particles), as
+    /// a balance at t_{n+1}. `all` holds the residual without the external loads: at a fixed dof
+    /// the terms at t_{n+1} unweighted (so that `all − f_ext` is the reaction at t_{n+1}); at a
+    /// free dof the scheme's weighted residual with its history divided by the weight 1 − α_f of
+    /// the forces at t_{n+1} (equal to f_ext,n+1 at convergence). `inertia` holds `all` minus the
+    /// internal forces at t_{n+1} (stress, pore pressure, porosity gradient, drag): the inertia
+    /// and body forces, and under the generalized-α method at a free dof the rest of the
+    /// weighted balance (its history of t_n). With these, Σ x ⊗ (f_ext + R − inertia) is exactly
+    /// the first moment of the internal forces at t_{n+1}, whatever the scheme.
     pub(super) fn nodal_terms(&self, xl: &[f64], all: &mut [f64], inertia: &mut [f64]) {
         let step = self.step;
+        let nm = step.nm.expect("prepared");
+        let plain = nm.unweighted();
         let mut buf = [0.0; MAX_LOCAL];
-        let mut ibuf = [0.0; MAX_LOCAL];
+        let mut ubuf = [0.0; MAX_LOCAL];
+        let mut fbuf = [0.0; MAX_LOCAL];
+        let mut forces = vec![0.0; all.len()];
+        let mut unweighted = vec![0.0; all.len()];
+        for k in 0..step.stencils.len() {
+            let m = self.with_point(k, xl, |pt| {
+                let m = pt.size();
+                kernels::residual(pt, &nm, &mut buf[..m]);
+                kernels::residual(pt, &plain, &mut ubuf[..m]);
+                kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
+                m
+            });
+            self.scatter(k, &buf[..m], all);
+            self.scatter(k, &ubuf[..m], &mut unweighted);
+            self.scatter(k, &fbuf[..m], &mut forces);
+        }
+        self.add_projection(xl, all);
+        for (a, h) in all.iter_mut().zip(&step.history) {
+            *a += h;
+        }
+        for (q, ((a, i), f)) in all.iter_mut().zip(inertia.iter_mut()).zip(&forces).enumerate() {
+            *a = if step.dofs.fixed[q] { unweighted[q] } else { *a / nm.w_force };
+            *i = *a - f;
+        }
+    }
+
+    /// The magnitude of the forces of the step per ghosted dof: Σ over particles of the absolute
+    /// values of their residual at Δd = 0 (stress, pore pressure, body force, inertia
+    /// predictors), plus the external loads at t_{n+1}. It scales the absolute tolerance of the
+    /// Newton solve, so that a step that starts in equilibrium (a body at rest) converges at the
+    /// round-off of its forces instead of chasing a relative decrease below it.
+    pub(super) fn force_magnitudes(&self) -> Vec<f64> {
+        let step = self.step;
+        let nm = step.nm.expect("prepared");
+        let xl = vec![0.0; step.fext.len()];
+        let mut out: Vec<f64> = step.fext.iter().map(|f| f.abs()).collect();
+        let mut buf = [0.0; MAX_LOCAL];
+        for k in 0..step.stencils.len() {
+            let m = self.residual_of(k, &xl, &mut buf);
+            for v in &mut buf[..m] {
+                *v = v.abs() * nm.w_force.max(nm.w_inertia);
+            }
+            self.scatter(k, &buf[..m], &mut out);
+        }
+        out
+    }
+
+    /// The generalized-α history of the step per ghosted dof: every particle's terms at t_n
+    /// (Δd = 0, its velocity and acceleration at t_n in place of the predictors, the body
+    /// acceleration `body_acc_old` of t_n) weighted by α_m (inertia) and α_f (forces), minus
+    /// α_f f_ext,n (`fext_old`). Constant over the step's Newton iterations.
+    pub(super) fn history(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        let step = self.step;
+        let hs = step.nm.and_then(|nm| nm.history()).expect("a scheme with a history");
+        let xl = vec![0.0; fext_old.len()];
+        let mut out: Vec<f64> = fext_old.iter().map(|f| -hs.w_force * f).collect();
+        let mut buf = [0.0; MAX_LOCAL];
         for k in 0..step.stencils.len() {
             let (nodes, basis) = step.stencils.get(k);
-            let states = node_states(step, k, xl);
-            let input = particle_input(self.model, step, k);
+            let states = node_states(step, k, &xl);
+            let mut input = particle_input(self.model, step, k);
+            let s = &step.smooth[k];
+            input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
+            input.body_acc = body_acc_old[self.model.particles.body[k] as usize];
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
             let pt =
                 kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
             let m = pt.size();
-            kernels::residual(&pt, &mut buf[..m]);
-            ibuf[..m].fill(0.0);
-            kernels::inertia::residual(&pt, &mut ibuf[..m]);
-            self.scatter(k, &buf[..m], all);
-            self.scatter(k, &ibuf[..m], inertia);
+            kernels::residual(&pt, &hs, &mut buf[..m]);
+            self.scatter(k, &buf[..m], &mut out);
         }
-        self.add_projection(xl, all);
+        out
     }
 
     /// −S Δp of the pressure projection in the continuity rows of `f`.
@@ -276,8 +346,12 @@ impl NonlinearProblem for Assembler<'_> {
         let t0 = Instant::now();
         let xl = self.gather(x)?;
         let mut fl = vec![0.0; xl.len()];
+        let wf = self.step.nm.expect("prepared").w_force;
         for (v, e) in fl.iter_mut().zip(&self.step.fext) {
-            *v = -e;
+            *v = -wf * e;
+        }
+        for (v, h) in fl.iter_mut().zip(&self.step.history) {
+            *v += h;
         }
         let mut buf = [0.0; MAX_LOCAL];
         for k in 0..self.step.stencils.len() {

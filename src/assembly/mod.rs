@@ -52,7 +52,7 @@ pub type Error = petsc::Error;
 /// Per-step data shared by the callbacks.
 #[derive(Debug, Default)]
 struct StepData {
-    nm: Option<kernels::Newmark>,
+    nm: Option<kernels::Scheme>,
     layout: Option<Layout>,
     /// Body acceleration at t_{n+1} per body.
     body_acc: Vec<[f64; 2]>,
@@ -60,12 +60,18 @@ struct StepData {
     dofs: DofMap,
     /// External nodal forces at t_{n+1} (tractions) per ghosted dof, on the nodes that carry them.
     fext: Vec<f64>,
+    /// The generalized-α history per ghosted dof: α_m M a_n + α_f (forces at t_n) − α_f f_ext,n
+    /// (empty for a scheme without one).
+    history: Vec<f64>,
     /// Δd at convergence, per ghosted dof (extended motion is not stored here).
     solution: Vec<f64>,
     /// Porosity gradient at each particle at t_n (two-phase).
     grad_n: Vec<[f64; 2]>,
     /// v_u, a_u, v_w, a_w at t_n at each particle, from the nodal projections.
     smooth: Vec<[[f64; 2]; 4]>,
+    /// The norm of the step's force magnitudes over the free dofs (see
+    /// `Assembler::force_magnitudes`), summed over ranks [N per m].
+    force_scale: f64,
     /// Pressure-projection blocks: a cell's four nodes and the 4 × 4 block S (see
     /// `kernels::pressure_projection`).
     projection: Vec<([u32; 4], [[f64; 4]; 4])>,
@@ -166,11 +172,20 @@ pub struct GridSystem {
     snes: Snes,
     jac: Option<Mat>,
     pattern: Option<Pattern>,
+    /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
+    /// per-step one.
+    user_atol: f64,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
     step: StepData,
     stages: Stages,
 }
+
+/// The absolute residual tolerance of a step relative to the norm of its force magnitudes: the
+/// round-off of a residual summed from forces of that size is about 1e-16 of it per dof, so 1e-10
+/// stops a step that starts in equilibrium (a body come to rest) well above the round-off, while
+/// still resolving the equilibrium to a ten-billionth of the forces involved.
+pub const FORCE_ATOL: f64 = 1e-10;
 
 /// Ghost width in nodes: a GIMP particle of a cell reaches at most one cell beyond it, so the
 /// nodes of a rank's cells plus two rows cover every node its particles touch, and the nodes its
@@ -186,7 +201,7 @@ impl GridSystem {
     /// (UMFPACK is sequential).
     pub fn new(coll: &Collective, grid: &crate::model::grid::Grid, layout: Layout) -> Result<GridSystem, Error> {
         let comm = Comm::from_raw(coll.communicator().as_raw());
-        let names = &crate::model::field_names(layout.w.is_some())[..layout.nd];
+        let names = layout.field_names();
         let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, names)?;
         let info = *dm.info();
         let x = dm.create_global_vector()?;
@@ -222,6 +237,7 @@ impl GridSystem {
             pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
+        let user_atol = snes.tolerances()?.0;
         let stages = Stages {
             run_setup: LogStage::register("porompm: setup")?,
             setup: LogStage::register("porompm: step setup")?,
@@ -247,6 +263,7 @@ impl GridSystem {
             snes,
             jac: None,
             pattern: None,
+            user_atol,
             reused_patterns: 0,
             step: StepData::default(),
             stages,
@@ -376,7 +393,12 @@ impl GridSystem {
         let (smooth, grad_n) = self.predictors(model, &st, &dofs, &nodal);
         let projection = self.projection_blocks(model);
         let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
-        let nm = kernels::Newmark::new(model.beta, model.gamma, dt);
+        let flow = self.layout.p.is_some() && self.layout.w.is_none();
+        let nm = kernels::Scheme::of(&model.integration, dt, flow);
+        let fext_old = match nm.history() {
+            Some(_) => Some(coll.agree(self.external_forces(model, active, t_new - dt, &dofs))?.0),
+            None => None,
+        };
         self.step = StepData {
             nm: Some(nm),
             layout: Some(self.layout),
@@ -391,6 +413,10 @@ impl GridSystem {
             ..StepData::default()
         };
         self.check_loads(&applied, t_new, coll)?;
+        if let Some(old) = fext_old {
+            self.step.history = self.history(model, &model.body_accelerations(active, t_new - dt), &old);
+        }
+        self.step.force_scale = self.force_scale(model, coll)?;
         // 5. The matrix pattern: kept if every rank finds every pair in it.
         let kept = self.pattern.as_ref().and_then(|p| p.slots(&self.step.stencils));
         let rebuild = coll.any(kept.is_none())?;
@@ -735,6 +761,9 @@ impl GridSystem {
                 x[o] = self.step.dofs.value[q];
             }
         }
+        // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.
+        let atol = self.user_atol.max(FORCE_ATOL * self.step.force_scale);
+        self.snes.set_tolerances(Some(atol), None, None, None)?;
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
         let (out, nonfinite) = {
@@ -773,7 +802,9 @@ impl GridSystem {
 
     /// The forces of the converged step (collective): the moment of the external, reaction and
     /// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
-    /// reaction.
+    /// reaction. Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia"
+    /// is then everything in it but the internal and external forces at t_{n+1} (see
+    /// `Assembler::nodal_terms`).
     pub fn step_forces(&mut self, model: &Model, coll: &Collective) -> Result<StepForces, String> {
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
@@ -859,7 +890,7 @@ impl GridSystem {
             return out;
         }
         let names = crate::model::field_names(true);
-        let own = crate::model::field_names(self.layout.w.is_some());
+        let own = self.layout.field_names();
         for &a in &self.owned_nodes {
             let l = a as usize;
             let (i, j) = self.ghost.ij(l);
@@ -871,6 +902,35 @@ impl GridSystem {
             }
         }
         out
+    }
+
+    /// The norm over the free dofs of the prepared step's force magnitudes (collective).
+    fn force_scale(&mut self, model: &Model, coll: &Collective) -> Result<f64, String> {
+        let mut mags = {
+            let mut seconds = 0.0;
+            let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
+            Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly).force_magnitudes()
+        };
+        self.sum_over_ranks(&mut mags).map_err(|e| e.to_string())?;
+        let nd = self.layout.nd;
+        let mut local = 0.0;
+        for &a in &self.owned_nodes {
+            for c in 0..nd {
+                let q = a as usize * nd + c;
+                if !self.step.dofs.fixed[q] {
+                    local += mags[q] * mags[q];
+                }
+            }
+        }
+        Ok(coll.sum(&[local])?[0].sqrt())
+    }
+
+    /// The generalized-α history of the prepared step (see `Assembler::history`).
+    fn history(&mut self, model: &Model, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        let mut seconds = 0.0;
+        let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
+        Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly)
+            .history(body_acc_old, fext_old)
     }
 
     /// The converged step at particle `k` for the particle update: exactly the point the converged

@@ -247,7 +247,7 @@ mod tests {
     fn a_minimal_case_parses_with_defaults() {
         let c = parse(MINIMAL, "t.toml", &[]).unwrap();
         assert_eq!(c.analysis.shape_functions, ShapeFunctions::Gimp);
-        assert_eq!(c.time_integration.beta, 0.25);
+        assert_eq!(c.time_integration.newmark().0, 0.25);
         assert_eq!(c.cell_size(), [0.1, 0.1]);
         assert!(c.materials[0].solid_bulk_modulus.unwrap().is_infinite());
     }

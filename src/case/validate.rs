@@ -370,11 +370,70 @@ pub fn validate(c: &Case) -> R {
             .filter_map(|s| s.time_integration.as_ref().map(|t| (format!("stages.{}.time_integration", s.name), t))),
     );
     for (key, ti) in newmarks {
-        let (beta, gamma) = (ti.beta, ti.gamma);
+        let (beta, gamma) = ti.newmark();
+        if let Some(r) = ti.rho_inf {
+            if !(0.0..=1.0).contains(&r) {
+                return Err(format!("key `{key}.rho_inf`: ρ∞ = {r} must lie in [0, 1]"));
+            }
+            if ti.is_newmark() {
+                return Err(format!(
+                    "key `{key}`: give either `rho_inf` (generalized-α, which sets β and γ) or `beta`/`gamma` (Newmark), not both"
+                ));
+            }
+        }
+        if ti.scheme == Some(super::TimeScheme::GeneralizedAlpha) && (ti.beta.is_some() || ti.gamma.is_some()) {
+            return Err(format!("key `{key}`: the generalized-α method takes `rho_inf`, not `beta`/`gamma`"));
+        }
+        if !ti.is_newmark() {
+            continue;
+        }
         if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta <= 1.0) {
             return Err(format!(
                 "key `{key}`: β = {beta}, γ = {gamma} is not unconditionally stable; use 2β ≥ γ ≥ 1/2 (default β = 1/4, γ = 1/2)"
             ));
+        }
+    }
+    // Analysis types.
+    for s in &c.stages {
+        let key = |k: &str| format!("stages.{}.{k}", s.name);
+        let two_phase = c.analysis.formulation == super::Formulation::TwoPhase;
+        match s.analysis {
+            super::AnalysisType::QuasiStatic if !two_phase => {
+                return Err(format!(
+                    "key `{}`: a quasi_static stage solves the water's flow and needs `analysis.formulation = \"two_phase\"`; use `static` for a one-phase case",
+                    key("analysis")
+                ))
+            }
+            super::AnalysisType::Static if two_phase && s.drainage.is_none() => {
+                return Err(format!(
+                    "key `{}`: a static stage of a two-phase case needs `drainage = \"drained\"` (the pore pressure is held) or `\"undrained\"` (no flow)",
+                    key("drainage")
+                ))
+            }
+            _ => {}
+        }
+        if s.drainage.is_some() && !(s.analysis == super::AnalysisType::Static && two_phase) {
+            return Err(format!("key `{}`: only a static stage of a two-phase case takes `drainage`", key("drainage")));
+        }
+        if let Some(th) = s.theta {
+            if s.analysis != super::AnalysisType::QuasiStatic {
+                return Err(format!("key `{}`: only a quasi_static stage takes `theta`", key("theta")));
+            }
+            if !(0.5..=1.0).contains(&th) {
+                return Err(format!("key `{}`: θ = {th} must lie in [1/2, 1] (1: backward Euler)", key("theta")));
+            }
+        }
+        if s.time_integration.is_some() && s.analysis != super::AnalysisType::Dynamic {
+            return Err(format!("key `{}`: only a dynamic stage takes `time_integration`", key("time_integration")));
+        }
+        if let Some(m) = s.dt_max {
+            if !(m.is_finite() && m >= s.dt()) {
+                return Err(format!(
+                    "key `{}`: {m} s must be finite and at least the stage's Δt = {} s",
+                    key("dt_max"),
+                    s.dt()
+                ));
+            }
         }
     }
     if c.output.history_every == 0 {
@@ -512,6 +571,7 @@ pub fn validate(c: &Case) -> R {
                 reference,
                 tolerance,
                 report_settlements,
+                report_loads,
                 stop_settlement,
             } => {
                 positive("verification.loaded_width", *loaded_width)?;
@@ -527,6 +587,9 @@ pub fn validate(c: &Case) -> R {
                 positive("verification.tolerance", *tolerance)?;
                 for (j, r) in report_settlements.iter().enumerate() {
                     positive(&format!("verification.report_settlements[{j}]"), *r)?;
+                }
+                for (j, r) in report_loads.iter().enumerate() {
+                    positive(&format!("verification.report_loads[{j}]"), *r)?;
                 }
                 if matches!(c.load(load), Some(Load::BodyForce { bodies: None, .. })) {
                     return Err(format!(

@@ -1,33 +1,49 @@
-//! The pore water's mass balance: the continuity equation ([`continuity`], [003] Eq. 23b) and the
-//! porosity-gradient terms that [003]'s uniform-porosity equations drop ([`porosity_gradient`]).
+//! The pore water's mass balance: the continuity equation ([`continuity`], [003] Eq. 23b), the
+//! Darcy flux of the u–p system ([`darcy`]) and the porosity-gradient terms that [003]'s
+//! uniform-porosity equations drop ([`porosity_gradient`]).
+
+use super::Point;
+
+/// The share of the solid's volumetric strain in the water's balance: 1 − n where the water's
+/// motion is an unknown (u–p–U, [003] Eq. 23b), 1 where the water follows the solid plus its Darcy
+/// flux (u–p, Biot's storage equation).
+fn solid_share(pt: &Point) -> f64 {
+    if pt.layout.w.is_some() {
+        1.0 - pt.part.porosity
+    } else {
+        1.0
+    }
+}
 
 /// Continuity ([003] Eq. 23b for the step's increments, on x_n):
-/// R_p,i = −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V; tangent −G₁ᵀ, −G₂ᵀ and −P.
+/// R_p,i = −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V (u–p–U) or −S_i [∇̄·Δu + Δp/Q] V (u–p);
+/// tangent −G₁ᵀ, −G₂ᵀ and −P, weighted by w_mass.
 pub mod continuity {
-    use super::super::Point;
+    use super::super::{Point, Scheme};
 
     /// Adds the continuity residual (layouts with a pressure).
-    pub fn residual(pt: &Point, out: &mut [f64]) {
+    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
         let n = part.porosity;
         let water = if pt.layout.w.is_some() { n * it.dvol_w } else { 0.0 };
-        let rate = (1.0 - n) * it.dvol_u + water + it.dp * part.inv_q;
+        let rate = super::solid_share(pt) * it.dvol_u + water + it.dp * part.inv_q;
         for (k, b) in pt.basis.iter().enumerate() {
-            out[k * nd + p] -= b.s * rate * part.volume;
+            out[k * nd + p] -= nm.w_mass * b.s * rate * part.volume;
         }
     }
 
     /// Adds −G₁ᵀ (p–u), −G₂ᵀ (p–U) and −P (p–p, [003] 16i with the sign of Eq. 23b).
-    pub fn tangent(pt: &Point, out: &mut [f64]) {
+    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
-        let (n, v) = (part.porosity, part.volume);
+        let (n, v) = (part.porosity, part.volume * nm.w_mass);
+        let fs = super::solid_share(pt);
         for (k, bk) in pt.basis.iter().enumerate() {
             let row = (k * nd + p) * m;
             for (l, bl) in pt.basis.iter().enumerate() {
                 for c in 0..2 {
-                    out[row + l * nd + c] -= (1.0 - n) * bk.s * bl.gv[c] * v;
+                    out[row + l * nd + c] -= fs * bk.s * bl.gv[c] * v;
                     if let Some(w) = pt.layout.w {
                         out[row + l * nd + w + c] -= n * bk.s * bl.gv[c] * v;
                     }
@@ -38,39 +54,79 @@ pub mod continuity {
     }
 }
 
-/// The porosity-gradient terms (see the kernels' documentation): R_u,i += S_i p ∇n V,
-/// R_U,i −= S_i p ∇n V, R_p,i −= S_i ∇n·(ΔU − Δu) V, with ∇n at t_n.
+/// The Darcy flux of the u–p system over the step, in the continuity rows (on x_n):
+/// R_p,i −= Δt V (k/γ_w) ∇S_i·(∇p_θ − ρ_w b), ∇p_θ = ∇p_n + θ Σ ∇S_j Δp_j,
+/// from ∇·u̇ + ∇·q + ṗ/Q = 0 with q = −(k/γ_w)(∇p − ρ_w b) integrated by parts (no flux across a
+/// boundary where p is free: impermeable). ∇p_n is the particle's (carried from step to step like
+/// p); b the body acceleration at t_{n+1}, so that a hydrostatic pressure drives no flow. Tangent
+/// −θΔt V (k/γ_w) ∇S_i·∇S_j (p–p): with −P the negative semi-definite H of Biot's equations.
+pub mod darcy {
+    use super::super::{Point, Scheme};
+
+    /// Adds the flux residual (u–p layouts under a scheme with flow).
+    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        let Some(p) = pt.layout.p else { return };
+        if nm.flow_dt == 0.0 {
+            return;
+        }
+        let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
+        let drive: [f64; 2] =
+            std::array::from_fn(|c| part.grad_p[c] + nm.theta * it.grad_dp[c] - part.water_density * part.body_acc[c]);
+        let f = nm.w_mass * nm.flow_dt * part.volume * part.mobility;
+        for (k, b) in pt.basis.iter().enumerate() {
+            out[k * nd + p] -= f * (b.g[0] * drive[0] + b.g[1] * drive[1]);
+        }
+    }
+
+    /// Adds −θΔt V (k/γ_w) ∇S_i·∇S_j in the p–p block.
+    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        let Some(p) = pt.layout.p else { return };
+        if nm.flow_dt == 0.0 {
+            return;
+        }
+        let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
+        let f = nm.w_mass * nm.flow_dt * nm.theta * part.volume * part.mobility;
+        for (k, bk) in pt.basis.iter().enumerate() {
+            for (l, bl) in pt.basis.iter().enumerate() {
+                out[(k * nd + p) * m + l * nd + p] -= f * (bk.g[0] * bl.g[0] + bk.g[1] * bl.g[1]);
+            }
+        }
+    }
+}
+
+/// The porosity-gradient terms (see the kernels' documentation): R_u,i += w_f S_i p ∇n V,
+/// R_U,i −= w_f S_i p ∇n V, R_p,i −= w_mass S_i ∇n·(ΔU − Δu) V, with ∇n at t_n.
 pub mod porosity_gradient {
-    use super::super::Point;
+    use super::super::{Point, Scheme};
 
     /// Adds the ∇n residual (u–p–U layouts only).
-    pub fn residual(pt: &Point, out: &mut [f64]) {
+    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let (Some(p), Some(w)) = (pt.layout.p, pt.layout.w) else { return };
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
         let gn = part.grad_n;
         let rel: f64 = (0..2).map(|c| gn[c] * (it.dw[c] - it.du[c])).sum();
         for (k, b) in pt.basis.iter().enumerate() {
             for c in 0..2 {
-                let f = b.s * pt.p * gn[c] * part.volume;
+                let f = nm.w_force * b.s * pt.p * gn[c] * part.volume;
                 out[k * nd + c] += f;
                 out[k * nd + w + c] -= f;
             }
-            out[k * nd + p] -= b.s * rel * part.volume;
+            out[k * nd + p] -= nm.w_mass * b.s * rel * part.volume;
         }
     }
 
-    /// Adds ±S_k S_l ∇n V in u–p, U–p and p–u, p–U.
-    pub fn tangent(pt: &Point, out: &mut [f64]) {
+    /// Adds ±S_k S_l ∇n V in u–p, U–p (weight w_f) and p–u, p–U (weight w_mass).
+    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let (Some(p), Some(w)) = (pt.layout.p, pt.layout.w) else { return };
         let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
         for (k, bk) in pt.basis.iter().enumerate() {
             for (l, bl) in pt.basis.iter().enumerate() {
                 for c in 0..2 {
                     let g = bk.s * bl.s * part.grad_n[c] * part.volume;
-                    out[(k * nd + c) * m + l * nd + p] += g;
-                    out[(k * nd + w + c) * m + l * nd + p] -= g;
-                    out[(k * nd + p) * m + l * nd + c] += g;
-                    out[(k * nd + p) * m + l * nd + w + c] -= g;
+                    out[(k * nd + c) * m + l * nd + p] += nm.w_force * g;
+                    out[(k * nd + w + c) * m + l * nd + p] -= nm.w_force * g;
+                    out[(k * nd + p) * m + l * nd + c] += nm.w_mass * g;
+                    out[(k * nd + p) * m + l * nd + w + c] -= nm.w_mass * g;
                 }
             }
         }

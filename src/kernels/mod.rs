@@ -90,16 +90,15 @@ pub struct Layout {
 impl Layout {
     /// u (one-phase: total stress or dry).
     pub const U: Layout = Layout { nd: 2, p: None, w: None };
+    /// u–p (the quasi-static Biot system, or undrained static): solid displacement and pore
+    /// pressure; the water follows the solid plus its Darcy flux.
+    pub const UP: Layout = Layout { nd: 3, p: Some(dof::P), w: None };
     /// u–p–U.
     pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX) };
 
-    /// The layout of a formulation.
-    pub fn of(two_phase: bool) -> Layout {
-        if two_phase {
-            Layout::UPU
-        } else {
-            Layout::U
-        }
+    /// The names of the layout's nodal fields, in dof order.
+    pub fn field_names(&self) -> &'static [&'static str] {
+        &["ux", "uy", "p", "Ux", "Uy"][..self.nd]
     }
 }
 
@@ -132,8 +131,8 @@ pub struct NodeState {
 }
 
 impl NodeState {
-    /// The state of a node with increments `d` under Newmark factors `nm`.
-    pub fn new(d: &[f64], nm: &Newmark) -> NodeState {
+    /// The state of a node with increments `d` under the time scheme `nm`.
+    pub fn new(d: &[f64], nm: &Scheme) -> NodeState {
         let mut s = NodeState::default();
         for (c, &x) in d.iter().enumerate() {
             s.d[c] = x;
@@ -159,6 +158,12 @@ pub struct ParticleInput {
     pub drag: f64,
     /// 1/Q [1/Pa] (two-phase).
     pub inv_q: f64,
+    /// Mobility k/γ_w of Darcy's law [m²/(Pa s)] (two-phase).
+    pub mobility: f64,
+    /// Water density ρ_w [kg/m³] (two-phase).
+    pub water_density: f64,
+    /// Pore-pressure gradient at t_n [Pa/m] (two-phase), carried by the particle.
+    pub grad_p: [f64; 2],
     /// Effective stress at t_n [Pa].
     pub stress: [f64; 4],
     /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
@@ -173,27 +178,146 @@ pub struct ParticleInput {
     pub pred: Predictors,
 }
 
-/// Newmark factors a₀ = 1/(βΔt²), a₁ = γ/(βΔt) of a step of length Δt.
+/// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integration {
+    /// Dynamics with the generalized-α method of Chung & Hulbert (1993): inertia at
+    /// t_{n+1−α_m}, every other force of the momentum balances at t_{n+1−α_f}, with the Newmark
+    /// updates of parameters β and γ. Newmark is α_m = α_f = 0.
+    Dynamic {
+        /// Newmark β.
+        beta: f64,
+        /// Newmark γ.
+        gamma: f64,
+        /// α_m.
+        alpha_m: f64,
+        /// α_f.
+        alpha_f: f64,
+    },
+    /// No inertia; the water's mass balance with Darcy's law, its flux at t_{n+θ} (θ-method;
+    /// θ = 1 is backward Euler).
+    QuasiStatic {
+        /// θ ∈ [1/2, 1].
+        theta: f64,
+    },
+    /// No inertia, no flow (drained with the pore pressure held, total stress, or undrained).
+    Static,
+}
+
+impl Integration {
+    /// Newmark's method with β and γ.
+    pub fn newmark(beta: f64, gamma: f64) -> Integration {
+        Integration::Dynamic { beta, gamma, alpha_m: 0.0, alpha_f: 0.0 }
+    }
+
+    /// The generalized-α method with the spectral radius ρ∞ ∈ [0, 1] at infinite frequency
+    /// (Chung & Hulbert 1993, Eqs. 25 and 17): α_m = (2ρ∞ − 1)/(ρ∞ + 1), α_f = ρ∞/(ρ∞ + 1),
+    /// γ = 1/2 − α_m + α_f, β = (1 − α_m + α_f)²/4; second-order accurate, unconditionally stable,
+    /// with the least low-frequency damping for the high-frequency damping ρ∞ asks for.
+    pub fn generalized_alpha(rho_inf: f64) -> Integration {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        Integration::Dynamic { beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2), gamma, alpha_m, alpha_f }
+    }
+
+    /// Whether the momentum balances carry inertia.
+    pub fn has_inertia(&self) -> bool {
+        matches!(self, Integration::Dynamic { .. })
+    }
+}
+
+/// One step of length Δt under an [`Integration`]: the factors a₀ = ∂a/∂Δd = 1/(βΔt²) and
+/// a₁ = ∂v/∂Δd = γ/(βΔt) (zero without inertia), and the weights of the terms at t_{n+1}.
 #[derive(Debug, Clone, Copy)]
-pub struct Newmark {
-    /// 1/(βΔt²).
+pub struct Scheme {
+    /// ∂a_{n+1}/∂Δd.
     pub a0: f64,
-    /// γ/(βΔt).
+    /// ∂v_{n+1}/∂Δd.
     pub a1: f64,
+    /// Weight of the inertia terms m a_{n+1}: 1 − α_m.
+    pub w_inertia: f64,
+    /// Weight of the other momentum terms at t_{n+1} (stress, pressure, drag, body force,
+    /// external loads): 1 − α_f.
+    pub w_force: f64,
+    /// Weight of the mass balance of the water (continuity and Darcy flux): 1 (0 in the
+    /// generalized-α history, which has none).
+    pub w_mass: f64,
+    /// Δt of the Darcy flux in the continuity rows (u–p), 0 where the water's motion is an unknown
+    /// or there is no flow.
+    pub flow_dt: f64,
+    /// θ of the Darcy flux.
+    pub theta: f64,
     beta: f64,
     gamma: f64,
     dt: f64,
 }
 
-impl Newmark {
-    /// Factors for step `dt`.
-    pub fn new(beta: f64, gamma: f64, dt: f64) -> Newmark {
-        Newmark { a0: 1.0 / (beta * dt * dt), a1: gamma / (beta * dt), beta, gamma, dt }
+impl Scheme {
+    /// Newmark factors for step `dt`.
+    pub fn newmark(beta: f64, gamma: f64, dt: f64) -> Scheme {
+        Scheme::of(&Integration::newmark(beta, gamma), dt, false)
+    }
+
+    /// The scheme of `integration` for a step `dt`; `flow` says whether the layout carries Darcy's
+    /// flux (u–p: a pressure and no water motion).
+    pub fn of(integration: &Integration, dt: f64, flow: bool) -> Scheme {
+        let mut s = Scheme {
+            a0: 0.0,
+            a1: 0.0,
+            w_inertia: 0.0,
+            w_force: 1.0,
+            w_mass: 1.0,
+            flow_dt: 0.0,
+            theta: 1.0,
+            beta: 0.25,
+            gamma: 0.5,
+            dt,
+        };
+        match *integration {
+            Integration::Dynamic { beta, gamma, alpha_m, alpha_f } => {
+                s.a0 = 1.0 / (beta * dt * dt);
+                s.a1 = gamma / (beta * dt);
+                s.w_inertia = 1.0 - alpha_m;
+                s.w_force = 1.0 - alpha_f;
+                (s.beta, s.gamma) = (beta, gamma);
+                if flow {
+                    s.flow_dt = dt;
+                }
+            }
+            Integration::QuasiStatic { theta } => {
+                s.theta = theta;
+                if flow {
+                    s.flow_dt = dt;
+                }
+            }
+            Integration::Static => {}
+        }
+        s
+    }
+
+    /// The weights of the generalized-α history: α_m on the inertia at t_n, α_f on the forces at
+    /// t_n, nothing on the mass balance; `None` for a scheme without one (Newmark, static).
+    pub fn history(&self) -> Option<Scheme> {
+        let (am, af) = (1.0 - self.w_inertia, 1.0 - self.w_force);
+        if self.a0 == 0.0 || (am == 0.0 && af == 0.0) {
+            return None;
+        }
+        Some(Scheme { a0: 0.0, a1: 0.0, w_inertia: am, w_force: af, w_mass: 0.0, flow_dt: 0.0, ..*self })
+    }
+
+    /// The same scheme with the terms at t_{n+1} unweighted (w_m = w_f = 1): the balance at t_{n+1}
+    /// for the equilibrium identity.
+    pub fn unweighted(&self) -> Scheme {
+        Scheme { w_inertia: 1.0, w_force: 1.0, ..*self }
     }
 
     /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
-    /// at Δd = 0).
+    /// at Δd = 0); zero without inertia.
     pub fn predict(&self, v: [f64; 2], a: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        if self.a0 == 0.0 {
+            return ([0.0; 2], [0.0; 2]);
+        }
         let (b, g, dt) = (self.beta, self.gamma, self.dt);
         let pa = |c: usize| -v[c] / (b * dt) - (0.5 / b - 1.0) * a[c];
         let pv = |c: usize| -(g / b - 1.0) * v[c] - (0.5 * g / b - 1.0) * dt * a[c];
@@ -218,7 +342,7 @@ pub struct Predictors {
 impl Predictors {
     /// The predictors for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and accelerations
     /// at t_n (the nodal values interpolated to the point).
-    pub fn new(nm: &Newmark, v_u: [f64; 2], a_u: [f64; 2], v_w: [f64; 2], a_w: [f64; 2]) -> Predictors {
+    pub fn new(nm: &Scheme, v_u: [f64; 2], a_u: [f64; 2], v_w: [f64; 2], a_w: [f64; 2]) -> Predictors {
         let (pa_u, pv_u) = nm.predict(v_u, a_u);
         let (pa_w, pv_w) = nm.predict(v_w, a_w);
         Predictors { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
@@ -252,6 +376,8 @@ pub struct Interp {
     pub dvol_u: f64,
     /// Volumetric strain increment of the water on x_n, ∇̄·ΔU.
     pub dvol_w: f64,
+    /// Gradient of the pressure increment on x_n, Σ ∇S Δp.
+    pub grad_dp: [f64; 2],
     /// Solid acceleration at t_{n+1}.
     pub a_u: [f64; 2],
     /// Water acceleration at t_{n+1}.
@@ -278,6 +404,8 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
         }
         if let Some(p) = layout.p {
             k.dp += b.s * st.d[p];
+            k.grad_dp[0] += b.g[0] * st.d[p];
+            k.grad_dp[1] += b.g[1] * st.d[p];
         }
         if let Some(w) = layout.w {
             for c in 0..2 {
@@ -346,36 +474,56 @@ impl<'a> Point<'a> {
     }
 }
 
-/// The residual block of the dynamic system (length `nn × nd`, node-major): the sum of every term
-/// of the layout (see the module documentation). `out` is overwritten.
-pub fn residual(pt: &Point, out: &mut [f64]) {
+/// Which groups of terms a residual evaluation takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Terms {
+    /// Every term of the layout.
+    All,
+    /// The internal forces of the momentum balances only: stress, pore pressure, porosity
+    /// gradient and drag (no inertia or body force, no mass balance), for the equilibrium identity.
+    Forces,
+}
+
+/// The residual block of one particle (length `nn × nd`, node-major): the sum of every term of the
+/// layout (see the module documentation), each weighted as the time scheme `nm` says. `out` is
+/// overwritten.
+pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    residual_terms(pt, nm, Terms::All, out);
+}
+
+/// The residual block of the chosen `terms` (see [`residual`]).
+pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
     out[..pt.size()].fill(0.0);
-    inertia::residual(pt, out);
-    stress::residual(pt, out);
-    if pt.layout.w.is_some() {
-        inertia::drag::residual(pt, out);
-        stress::pore_pressure::residual(pt, out);
-        flow::porosity_gradient::residual(pt, out);
+    if terms == Terms::All {
+        inertia::residual(pt, nm, out);
     }
-    if pt.layout.p.is_some() {
-        flow::continuity::residual(pt, out);
+    stress::residual(pt, nm, out);
+    stress::pore_pressure::residual(pt, nm, out);
+    if pt.layout.w.is_some() {
+        inertia::drag::residual(pt, nm, out);
+        flow::porosity_gradient::residual(pt, nm, out);
+    }
+    if pt.layout.p.is_some() && terms == Terms::All {
+        flow::continuity::residual(pt, nm, out);
+        flow::darcy::residual(pt, nm, out);
     }
 }
 
-/// The tangent block d(residual)/d(Δd) of the dynamic system, row-major `(nn·nd)²`. Every entry of
+/// The tangent block d(residual)/d(Δd) of one particle, row-major `(nn·nd)²`. Every entry of
 /// `out` is written (the zero couplings too), so the buffer may be reused from particle to particle.
-pub fn tangent(pt: &Point, nm: &Newmark, out: &mut [f64]) {
+pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let m = pt.size();
     out[..m * m].fill(0.0);
     inertia::tangent(pt, nm, out);
-    stress::tangent(pt, out);
+    stress::tangent(pt, nm, out);
+    stress::pore_pressure::tangent(pt, nm, out);
     if pt.layout.w.is_some() {
         inertia::drag::tangent(pt, nm, out);
-        stress::pore_pressure::tangent(pt, out);
-        flow::porosity_gradient::tangent(pt, out);
+        flow::porosity_gradient::tangent(pt, nm, out);
     }
     if pt.layout.p.is_some() {
-        flow::continuity::tangent(pt, out);
+        flow::continuity::tangent(pt, nm, out);
+        flow::darcy::tangent(pt, nm, out);
     }
 }
 

@@ -12,7 +12,7 @@
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
 
-use super::{bbar, kinematics, Point};
+use super::{bbar, kinematics, Point, Scheme};
 
 /// In-plane deviatoric stress and the mean stress of [xx, yy, xy, zz].
 fn split(s: &[f64; 4]) -> ([[f64; 2]; 2], f64) {
@@ -26,10 +26,10 @@ fn traction(dev: &[[f64; 2]; 2], pm: f64, g: [f64; 2], gv: [f64; 2]) -> [f64; 2]
     [dev[0][0] * g[0] + dev[0][1] * g[1] + pm * gv[0], dev[1][0] * g[0] + dev[1][1] * g[1] + pm * gv[1]]
 }
 
-/// Adds the effective-stress residual in the u rows.
-pub fn residual(pt: &Point, out: &mut [f64]) {
+/// Adds the effective-stress residual in the u rows (weight w_f = 1 − α_f).
+pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let nd = pt.layout.nd;
-    let v = pt.volume_new();
+    let v = pt.volume_new() * nm.w_force;
     let (dev, pm) = split(&pt.upd.stress);
     for k in 0..pt.basis.len() {
         let (g, gv) = pt.spatial[k];
@@ -40,9 +40,9 @@ pub fn residual(pt: &Point, out: &mut [f64]) {
 }
 
 /// Adds the u–u tangent of the effective-stress term (material, volume and geometric parts).
-pub fn tangent(pt: &Point, out: &mut [f64]) {
+pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let (nd, m) = (pt.layout.nd, pt.size());
-    let v = pt.volume_new();
+    let v = pt.volume_new() * nm.w_force;
     let s = &pt.upd.stress;
     let (dev, pm) = split(s);
     let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
@@ -80,9 +80,11 @@ pub fn tangent(pt: &Point, out: &mut [f64]) {
 }
 
 /// The pore pressure's forces: −(1 − n) p ∇̄'S_i V_{n+1} on the solid and −n p ∇̄'S_i V_{n+1} on the
-/// water ([003] Eqs. 23a, 23c on x_{n+1}); in a layout without water the solid carries p whole.
+/// water ([003] Eqs. 23a, 23c on x_{n+1}); in a layout without water the solid carries p whole (the
+/// momentum balance of the mixture). A layout without a pressure (a drained static stage of a
+/// two-phase model) keeps the particle's p_n, so that the total stress stays σ' − p m.
 pub mod pore_pressure {
-    use super::super::Point;
+    use super::super::{Point, Scheme};
 
     /// The fractions of p carried by the solid and the water equations.
     fn shares(pt: &Point) -> (f64, f64) {
@@ -94,14 +96,14 @@ pub mod pore_pressure {
         }
     }
 
-    /// Adds the pressure forces (layouts with a pressure).
-    pub fn residual(pt: &Point, out: &mut [f64]) {
-        if pt.layout.p.is_none() {
+    /// Adds the pressure forces (weight w_f).
+    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        if pt.layout.p.is_none() && pt.p == 0.0 {
             return;
         }
         let nd = pt.layout.nd;
         let (fs, fw) = shares(pt);
-        let pv = pt.p * pt.volume_new();
+        let pv = pt.p * pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
             let gv = pt.spatial[k].1;
             for c in 0..2 {
@@ -114,18 +116,22 @@ pub mod pore_pressure {
     }
 
     /// Adds the u–p and U–p couplings (−G₁, −G₂ on x_{n+1}) and their geometric u–u and U–u parts.
-    pub fn tangent(pt: &Point, out: &mut [f64]) {
-        let Some(p) = pt.layout.p else { return };
+    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        if pt.layout.p.is_none() && pt.p == 0.0 {
+            return;
+        }
         let (nd, m) = (pt.layout.nd, pt.size());
         let (fs, fw) = shares(pt);
-        let v = pt.volume_new();
+        let v = pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
             let gvk = pt.spatial[k].1;
             for (l, bl) in pt.basis.iter().enumerate() {
                 let gvl = pt.spatial[l].1;
                 for c in 0..2 {
                     let ru = (k * nd + c) * m;
-                    out[ru + l * nd + p] -= fs * v * gvk[c] * bl.s;
+                    if let Some(p) = pt.layout.p {
+                        out[ru + l * nd + p] -= fs * v * gvk[c] * bl.s;
+                    }
                     for d in 0..2 {
                         // ∂(J_v ∇̄'S_k,c)/∂Δu_l,d = J_v (∇̄'S_l,d ∇̄'S_k,c − ∇̄'S_l,c ∇̄'S_k,d).
                         let geo = pt.p * v * (gvl[d] * gvk[c] - gvl[c] * gvk[d]);
@@ -134,7 +140,7 @@ pub mod pore_pressure {
                             out[(k * nd + w + c) * m + l * nd + d] -= fw * geo;
                         }
                     }
-                    if let Some(w) = pt.layout.w {
+                    if let (Some(w), Some(p)) = (pt.layout.w, pt.layout.p) {
                         out[(k * nd + w + c) * m + l * nd + p] -= fw * v * gvk[c] * bl.s;
                     }
                 }

@@ -76,9 +76,14 @@ pub(crate) fn fd_blocks(
             .flat_map(|r| (0..m).map(move |c| (r, c)))
             .fold(0.0f64, |s, (r, c)| s.max(tangent[r * m + c].abs() * h[c % nd]))
     };
+    // And the round-off of the residual itself: a few ulps of its largest entry in the row field,
+    // divided by 2h_b.
+    let r0 = residual(d0);
+    let size = |a: usize| -> f64 { (0..m).filter(|r| r % nd == a).fold(0.0f64, |s, r| s.max(r0[r].abs())) };
     let mut out = Vec::new();
     for a in 0..nd {
         let ch = change(a);
+        let ulps = 8.0 * f64::EPSILON * size(a);
         for (b, &hb) in h.iter().enumerate().take(nd) {
             let (mut err, mut jmax, mut fdmax) = (0.0f64, 0.0f64, 0.0f64);
             for r in (0..m).filter(|r| r % nd == a) {
@@ -88,7 +93,7 @@ pub(crate) fn fd_blocks(
                     fdmax = fdmax.max(fd[r * m + c].abs());
                 }
             }
-            out.push(BlockError { row: a, col: b, err, jmax, fdmax, noise: 1e-8 * ch / hb });
+            out.push(BlockError { row: a, col: b, err, jmax, fdmax, noise: 1e-8 * ch / hb + ulps / (2.0 * hb) });
         }
     }
     out
@@ -115,6 +120,9 @@ fn part() -> ParticleInput {
         water_mass: 0.9,
         drag: 7.0e3,
         inv_q: 3.0e-9,
+        mobility: 2.0e-7,
+        water_density: 1000.0,
+        grad_p: [300.0, -9.0e3],
         stress: [-1.0e3, -2.0e3, 150.0, -1.2e3],
         eps_pd: 0.0,
         p: 500.0,
@@ -124,7 +132,7 @@ fn part() -> ParticleInput {
     }
 }
 
-fn states(d: &[f64], nd: usize, nm: &Newmark) -> Vec<NodeState> {
+fn states(d: &[f64], nd: usize, nm: &Scheme) -> Vec<NodeState> {
     d.chunks(nd).map(|c| NodeState::new(c, nm)).collect()
 }
 
@@ -146,18 +154,33 @@ fn steps(layout: Layout) -> Vec<f64> {
     (0..layout.nd).map(|c| if Some(c) == layout.p { 1e-3 } else { 1e-9 }).collect()
 }
 
-type Term = (&'static str, fn(&Point, &mut [f64]), fn(&Point, &Newmark, &mut [f64]));
+type Term = (&'static str, fn(&Point, &Scheme, &mut [f64]), fn(&Point, &Scheme, &mut [f64]));
 
 /// Every term with its residual and tangent.
 fn terms() -> Vec<Term> {
     vec![
         ("inertia", inertia::residual, inertia::tangent),
         ("drag", inertia::drag::residual, inertia::drag::tangent),
-        ("effective stress", stress::residual, |p, _, o| stress::tangent(p, o)),
-        ("pore pressure", stress::pore_pressure::residual, |p, _, o| stress::pore_pressure::tangent(p, o)),
-        ("porosity gradient", flow::porosity_gradient::residual, |p, _, o| flow::porosity_gradient::tangent(p, o)),
-        ("continuity", flow::continuity::residual, |p, _, o| flow::continuity::tangent(p, o)),
-        ("all", |p, o| residual(p, o), tangent),
+        ("effective stress", stress::residual, stress::tangent),
+        ("pore pressure", stress::pore_pressure::residual, stress::pore_pressure::tangent),
+        ("porosity gradient", flow::porosity_gradient::residual, flow::porosity_gradient::tangent),
+        ("continuity", flow::continuity::residual, flow::continuity::tangent),
+        ("darcy", flow::darcy::residual, flow::darcy::tangent),
+        ("all", residual, tangent),
+    ]
+}
+
+/// The layouts with the time schemes each is used with: u–p–U and u under Newmark and
+/// generalized-α, u–p quasi-static with Darcy's law (θ = 0.7) and static undrained, u static.
+fn layouts_and_schemes() -> Vec<(Layout, &'static str, Scheme)> {
+    let dt = 1e-3;
+    vec![
+        (Layout::UPU, "Newmark", Scheme::newmark(0.25, 0.5, dt)),
+        (Layout::UPU, "generalized-α", Scheme::of(&Integration::generalized_alpha(0.6), dt, false)),
+        (Layout::U, "Newmark", Scheme::newmark(0.25, 0.5, dt)),
+        (Layout::U, "static", Scheme::of(&Integration::Static, dt, false)),
+        (Layout::UP, "quasi-static", Scheme::of(&Integration::QuasiStatic { theta: 0.7 }, dt, true)),
+        (Layout::UP, "static undrained", Scheme::of(&Integration::Static, dt, true)),
     ]
 }
 
@@ -171,11 +194,11 @@ fn models() -> Vec<(&'static str, Constitutive, [f64; 4])> {
 }
 
 /// Runs the finite-difference check of one term; returns the blocks.
-fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layout) -> Vec<BlockError> {
+fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layout, nm: &Scheme) -> Vec<BlockError> {
     let basis = sample(6);
     let nd = layout.nd;
     let m = basis.len() * nd;
-    let nm = Newmark::new(0.25, 0.5, 1e-3);
+    let nm = *nm;
     let mut p = part();
     p.stress = stress;
     let d0 = increments(m, layout);
@@ -183,7 +206,7 @@ fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layou
         let st = states(d, nd, &nm);
         let pt = Point::new(&basis, &st, &p, model, layout);
         let mut r = vec![0.0; m];
-        (term.1)(&pt, &mut r);
+        (term.1)(&pt, &nm, &mut r);
         r
     };
     let st = states(&d0, nd, &nm);
@@ -196,13 +219,13 @@ fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layou
 #[test]
 fn every_term_matches_central_differences_block_by_block() {
     let names = ["ux", "uy", "p", "Ux", "Uy"];
-    for layout in [Layout::UPU, Layout::U] {
+    for (layout, sname, nm) in layouts_and_schemes() {
         for (mname, model, stress) in models() {
             for term in terms() {
-                for b in check_term(&term, &model, stress, layout) {
+                for b in check_term(&term, &model, stress, layout, &nm) {
                     assert!(
                         b.pass(),
-                        "{} ({mname}, nd = {}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
+                        "{} ({mname}, nd = {}, {sname}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
                         term.0,
                         layout.nd,
                         names[b.row],
@@ -222,7 +245,7 @@ fn every_term_matches_central_differences_block_by_block() {
 fn the_plastic_sample_really_returns() {
     let (_, model, stress) = models()[1];
     let basis = sample(6);
-    let nm = Newmark::new(0.25, 0.5, 1e-3);
+    let nm = Scheme::newmark(0.25, 0.5, 1e-3);
     let mut p = part();
     p.stress = stress;
     let d0 = increments(basis.len() * 5, Layout::UPU);
@@ -236,21 +259,20 @@ fn the_plastic_sample_really_returns() {
 /// entries against the rest of the tangent (p–p ≈ 1e-13, u–u ≈ 1e5 here), fails it.
 #[test]
 fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
-    let layout = Layout::UPU;
     let (_, model, stress) = models()[0];
     let basis = sample(6);
-    let nd = layout.nd;
-    let m = basis.len() * nd;
-    let nm = Newmark::new(0.25, 0.5, 1e-3);
     let p = ParticleInput { stress, ..part() };
-    let d0 = increments(m, layout);
     let mut flipped_blocks = 0;
-    for term in terms() {
+    let cases = [layouts_and_schemes()[1], layouts_and_schemes()[4]];
+    for (term, (layout, _, nm)) in terms().into_iter().flat_map(|t| cases.map(|c| (t, c))) {
+        let nd = layout.nd;
+        let m = basis.len() * nd;
+        let d0 = increments(m, layout);
         let res = |d: &[f64]| {
             let st = states(d, nd, &nm);
             let pt = Point::new(&basis, &st, &p, &model, layout);
             let mut r = vec![0.0; m];
-            (term.1)(&pt, &mut r);
+            (term.1)(&pt, &nm, &mut r);
             r
         };
         let st = states(&d0, nd, &nm);
@@ -273,11 +295,11 @@ fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
                 flipped_blocks += 1;
                 let blocks = fd_blocks(nd, &d0, &steps(layout), &res, &wrong);
                 let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
-                assert!(caught, "{}: a flipped {a}–{b} block passed", term.0);
+                assert!(caught, "{} (nd = {nd}): a flipped {a}–{b} block passed", term.0);
             }
         }
     }
-    assert!(flipped_blocks > 40, "only {flipped_blocks} blocks were flipped");
+    assert!(flipped_blocks > 60, "only {flipped_blocks} blocks were flipped");
 }
 
 #[test]
@@ -286,7 +308,7 @@ fn newmark_reproduces_a_uniformly_accelerated_motion() {
     // ([003] Eqs. 20–21) for any β, γ.
     for (beta, gamma) in [(0.25, 0.5), (0.3025, 0.6)] {
         let (dt, v, a) = (2e-3, [0.4, -1.1], [3.0, -9.81]);
-        let nm = Newmark::new(beta, gamma, dt);
+        let nm = Scheme::newmark(beta, gamma, dt);
         let pred = Predictors::new(&nm, v, a, v, a);
         let d = [v[0] * dt + 0.5 * a[0] * dt * dt, v[1] * dt + 0.5 * a[1] * dt * dt];
         let basis = [NodeBasis { s: 1.0, g: [0.0; 2], gv: [0.0; 2] }];
@@ -317,7 +339,7 @@ fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
     let pt = Point::new(&basis, &st, &p, &model, Layout::UPU);
     let mut r = vec![0.0; 20];
-    residual(&pt, &mut r);
+    residual(&pt, &Scheme::newmark(0.25, 0.5, 1e-3), &mut r);
     let fy: f64 = (0..4).map(|k| r[k * 5 + 1] + r[k * 5 + 4]).sum();
     assert!((fy - (p.mass + p.water_mass) * 9.81).abs() < 1e-12);
     assert!((0..4).all(|k| r[k * 5 + 2] == 0.0));
@@ -342,7 +364,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
     // Δu = (−0.01 x, −0.02 y): F = diag(0.99, 0.98); the mid-step strain is the exact
     // L = H (I + H/2)⁻¹, the volume ratio det F.
     let basis = unit_square([0.3, 0.6]);
-    let nm = Newmark::new(0.25, 0.5, 1.0);
+    let nm = Scheme::newmark(0.25, 0.5, 1.0);
     let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
     let st: Vec<NodeState> = pts.iter().map(|&(x, y)| NodeState::new(&[-0.01 * x, -0.02 * y], &nm)).collect();
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
@@ -367,7 +389,7 @@ fn a_rigid_rotation_turns_the_stress_with_the_material() {
             let alpha = std::f64::consts::FRAC_PI_2 / n as f64;
             let (c, sn) = (alpha.cos(), alpha.sin());
             let basis = unit_square([0.5, 0.5]);
-            let nm = Newmark::new(0.25, 0.5, 1.0);
+            let nm = Scheme::newmark(0.25, 0.5, 1.0);
             let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
             let st: Vec<NodeState> = pts
                 .iter()

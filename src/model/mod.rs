@@ -40,10 +40,8 @@ pub struct Model {
     pub boundaries: Vec<BoundaryDef>,
     /// g in Darcy's law [m/s²].
     pub g: f64,
-    /// Newmark β.
-    pub beta: f64,
-    /// Newmark γ.
-    pub gamma: f64,
+    /// How the current stage treats time (set by the driver at the start of each stage).
+    pub integration: crate::kernels::Integration,
     /// B̄ for GIMP ([000] §3).
     pub bbar: bool,
     /// MLSA patch recovery of the pore-pressure increments ([003] §3.3).
@@ -119,8 +117,7 @@ impl Model {
             loads,
             boundaries,
             g: case.analysis.g,
-            beta: case.time_integration.beta,
-            gamma: case.time_integration.gamma,
+            integration: case.time_integration.integration(),
             bbar: case.stabilisation.bbar,
             n_bodies: case.bodies.len(),
             pressure_projection: if case.analysis.formulation == Formulation::TwoPhase {
@@ -276,27 +273,31 @@ impl Model {
 
     /// The kernel input of particle `k` at the start of the step.
     #[inline]
-    pub fn particle_input(&self, k: usize, body_acc: &[[f64; 2]]) -> ParticleInput {
+    pub fn particle_input(&self, idx: usize, body_acc: &[[f64; 2]]) -> ParticleInput {
         let ps = &self.particles;
-        let mat = &self.materials[ps.material[k] as usize];
-        let (v, n) = (ps.volume[k], ps.porosity[k]);
-        let (water_mass, drag, inv_q) = if self.two_phase {
+        let mat = &self.materials[ps.material[idx] as usize];
+        let (v, n) = (ps.volume[idx], ps.porosity[idx]);
+        let (water_mass, drag, inv_q, mobility) = if self.two_phase {
             let gw = mat.water_density * self.g;
-            (self.water_mass(k), n * n * gw * v / mat.conductivity_at(n), mat.inv_q_at(n))
+            let k = mat.conductivity_at(n);
+            (self.water_mass(idx), n * n * gw * v / k, mat.inv_q_at(n), k / gw)
         } else {
-            (0.0, 0.0, 0.0)
+            (0.0, 0.0, 0.0, 0.0)
         };
         ParticleInput {
             volume: v,
             porosity: n,
-            mass: ps.mass[k],
+            mass: ps.mass[idx],
             water_mass,
             drag,
             inv_q,
-            stress: ps.stress[k],
-            eps_pd: ps.eps_pd[k],
-            p: ps.p[k],
-            body_acc: body_acc[ps.body[k] as usize],
+            mobility,
+            water_density: mat.water_density,
+            grad_p: ps.grad_p[idx],
+            stress: ps.stress[idx],
+            eps_pd: ps.eps_pd[idx],
+            p: ps.p[idx],
+            body_acc: body_acc[ps.body[idx] as usize],
             grad_n: [0.0; 2],
             pred: Default::default(),
         }
@@ -342,8 +343,8 @@ impl Model {
         })
     }
 
-    /// Updates particle `k` with the converged step ([003] Eq. 24, [000] Eq. 11): accelerations from
-    /// the nodal Newmark accelerations ([003] Eq. 24a), velocities by the Newmark rule
+    /// Updates particle `k` with the converged step ([003] Eq. 24, [000] Eq. 11): in a dynamic stage,
+    /// accelerations from the nodal Newmark accelerations ([003] Eq. 24a), velocities by the Newmark rule
     /// v_{n+1} = v_n + Δt((1 − γ)a_n + γ a_{n+1}) on the point (a FLIP update, where [003] Eq. 24b
     /// interpolates the nodal velocities: that PIC update damps the transients of the verification
     /// cases measurably, e.g. the Terzaghi settlement error rises from 2e-5 to 1.5e-3), the
@@ -352,21 +353,41 @@ impl Model {
     /// increment), position and displacement by the interpolated solid increment, deformation
     /// gradient by F_{n+1} = F̄ F_n, volume by J_v, porosity by conservation of solid mass:
     /// (1 − n_{n+1}) V_{n+1} = (1 − n_n) V_n, and (GIMP with stretching domains) the domain
-    /// half-widths by l_p = l_p0 ⊙ diag(sqrt(FᵀF)) (iGIMP), at most half a cell.
+    /// half-widths by l_p = l_p0 ⊙ diag(sqrt(FᵀF)) (iGIMP), at most half a cell. In a static or
+    /// quasi-static stage there is no acceleration: the velocity is the step's mean, Δu/Δt, for
+    /// both phases (the Darcy flux is not a particle quantity). The pore-pressure gradient follows
+    /// the pressure: ∇p += Σ ∇S Δp (interpolated; it drives the next step's Darcy flux).
     pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
         self.check_step(k, step)?;
         let j = step.jacobian;
         let n_new = self.porosity_after(k, j);
         let ps = &mut self.particles;
         let it = &step.interp;
-        let g = self.gamma;
-        for c in 0..2 {
-            ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.a_u[c]);
-            ps.acc[k][c] = it.a_u[c];
-            if self.two_phase {
-                ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * it.a_w[c]);
-                ps.acc_w[k][c] = it.a_w[c];
+        match self.integration {
+            crate::kernels::Integration::Dynamic { gamma: g, .. } => {
+                for c in 0..2 {
+                    ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.a_u[c]);
+                    ps.acc[k][c] = it.a_u[c];
+                    if self.two_phase {
+                        ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * it.a_w[c]);
+                        ps.acc_w[k][c] = it.a_w[c];
+                    }
+                }
             }
+            _ => {
+                for c in 0..2 {
+                    ps.vel[k][c] = it.du[c] / dt;
+                    ps.acc[k][c] = 0.0;
+                    if self.two_phase {
+                        ps.vel_w[k][c] = ps.vel[k][c];
+                        ps.acc_w[k][c] = 0.0;
+                    }
+                }
+            }
+        }
+        if self.two_phase {
+            ps.grad_p[k][0] += it.grad_dp[0];
+            ps.grad_p[k][1] += it.grad_dp[1];
         }
         for c in 0..2 {
             ps.x[k][c] += it.du[c];

@@ -51,6 +51,9 @@ pub struct Particles {
     pub p0: Vec<f64>,
     /// Deviatoric plastic strain ε_p^d = sqrt(2/3 e_p : e_p) [-].
     pub eps_pd: Vec<f64>,
+    /// Pore-pressure gradient [Pa/m] (two-phase), carried like p: it drives the Darcy flux of the
+    /// u–p system from the start of a step.
+    pub grad_p: Vec<[f64; 2]>,
 }
 
 impl Particles {
@@ -118,11 +121,12 @@ impl Particles {
                             ps.acc.push([0.0; 2]);
                             ps.vel_w.push([0.0; 2]);
                             ps.acc_w.push([0.0; 2]);
-                            let (stress, p) = match (&body.initial_stress, &body.uniform_stress) {
+                            let (stress, p, grad_p) = match (&body.initial_stress, &body.uniform_stress) {
                                 (Some(init), _) => geostatic(case, grid, init, x, two_phase),
-                                (None, Some(s)) => (*s, 0.0),
-                                (None, None) => ([0.0; 4], 0.0),
+                                (None, Some(s)) => (*s, 0.0, [0.0; 2]),
+                                (None, None) => ([0.0; 4], 0.0, [0.0; 2]),
                             };
+                            ps.grad_p.push(grad_p);
                             ps.stress.push(stress);
                             ps.p.push(p);
                             ps.p0.push(p);
@@ -146,18 +150,19 @@ fn jitter(id: u64, stream: u64) -> f64 {
     (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// The geostatic effective stress and pore pressure at `x` (see [`crate::case::InitialStress`]).
+/// The geostatic effective stress, pore pressure and pore-pressure gradient at `x` (see
+/// [`crate::case::InitialStress`]).
 fn geostatic(
     case: &Case,
     grid: &Grid,
     init: &crate::case::InitialStress,
     x: [f64; 2],
     two_phase: bool,
-) -> ([f64; 4], f64) {
+) -> ([f64; 4], f64, [f64; 2]) {
     let g = case.analysis.g;
     let (surface, mass) = case.column_above(x, grid.h[1] / 50.0);
     let sigma_v = -g * mass;
-    let p = if two_phase {
+    let (p, grad_p) = if two_phase {
         let rho_w = case
             .body_at(x)
             .map_or(1000.0, |b| case.materials[case.material_index(&b.material).expect("validated")].water_density);
@@ -165,12 +170,13 @@ fn geostatic(
             crate::case::WaterTable::Surface => surface,
             crate::case::WaterTable::Level(y) => y,
         };
-        rho_w * g * (level - x[1]).max(0.0)
+        let below = level > x[1];
+        (rho_w * g * (level - x[1]).max(0.0), [0.0, if below { -rho_w * g } else { 0.0 }])
     } else {
-        0.0
+        (0.0, [0.0; 2])
     };
     let sv = sigma_v + p;
-    ([init.k0 * sv, sv, 0.0, init.k0 * sv], p)
+    ([init.k0 * sv, sv, 0.0, init.k0 * sv], p, grad_p)
 }
 
 #[cfg(test)]

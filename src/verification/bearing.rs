@@ -13,7 +13,7 @@
 //! q_ult is the pressure at which d/B first reaches it (interpolated between steps), and the metric
 //! `bearing_capacity_ratio` = (q_ult/c)/reference, with reference 2 + π for Prandtl's undrained
 //! strip footing; c is the soil's cohesion. `results` gets q/c at each of `report_settlements`
-//! (interpolated) and the largest q/c reached. With `stop_settlement` the run ends (completed) once
+//! (interpolated), the settlement d [m] at each q/c of `report_loads` and the largest q/c reached. With `stop_settlement` the run ends (completed) once
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
 use super::{Check, Findings, Metric, Table};
@@ -32,6 +32,7 @@ pub struct BearingCheck {
     reference: f64,
     tolerance: f64,
     report: Vec<f64>,
+    report_loads: Vec<f64>,
     stop_at: Option<f64>,
     /// Downward displacement of the point while q = 0 [m].
     baseline: f64,
@@ -66,6 +67,8 @@ pub struct BearingSpec<'a> {
     pub tolerance: f64,
     /// d/B values at which q/c is reported.
     pub report_settlements: &'a [f64],
+    /// q/c values at which the settlement is reported.
+    pub report_loads: &'a [f64],
     /// d/B at which the run stops.
     pub stop_settlement: Option<f64>,
 }
@@ -134,6 +137,7 @@ impl BearingCheck {
             reference: spec.reference,
             tolerance: spec.tolerance,
             report: spec.report_settlements.to_vec(),
+            report_loads: spec.report_loads.to_vec(),
             stop_at: spec.stop_settlement,
             baseline: 0.0,
             curve: Vec::new(),
@@ -152,6 +156,14 @@ impl BearingCheck {
                     .sum();
                 coll.sum(&[local])?[0] * b * f / width
             }
+        })
+    }
+
+    /// d/B at the first crossing of q/c = `target` (interpolated), if reached.
+    fn settlement_at(&self, target: f64) -> Option<f64> {
+        self.curve.windows(2).find(|w| w[0][2] < target && w[1][2] >= target).map(|w| {
+            let s = (target - w[0][2]) / (w[1][2] - w[0][2]);
+            w[0][1] + s * (w[1][1] - w[0][1])
         })
     }
 
@@ -246,6 +258,11 @@ impl Check for BearingCheck {
     fn results(&self) -> Vec<(String, f64)> {
         let mut out: Vec<(String, f64)> =
             self.report.iter().filter_map(|&s| self.at(s).map(|qc| (format!("q_over_c_at_dB{s}"), qc))).collect();
+        for &q in &self.report_loads {
+            if let Some(d) = self.settlement_at(q) {
+                out.push((format!("settlement_at_qc{q}"), d * self.breadth));
+            }
+        }
         out.push(("q_over_c_max".into(), self.curve.iter().map(|r| r[2]).fold(f64::NEG_INFINITY, f64::max)));
         out.push(("d_over_B_final".into(), self.curve.last().map_or(0.0, |r| r[1])));
         out

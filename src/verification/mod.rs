@@ -264,6 +264,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
             reference,
             tolerance,
             report_settlements,
+            report_loads,
             stop_settlement,
         } => Box::new(bearing::BearingCheck::new(
             c,
@@ -279,6 +280,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                 reference: *reference,
                 tolerance: *tolerance,
                 report_settlements,
+                report_loads,
                 stop_settlement: *stop_settlement,
             },
         )?),
