@@ -245,7 +245,8 @@ fn test_jacobian(
     petsc_args: &[String],
 ) -> Result<(), Failure> {
     let c = load_case(case_path, sets)?;
-    let names = porompm::model::field_names(c.analysis.formulation == case::Formulation::TwoPhase);
+    // The fields of the first stage, whose tangent is checked.
+    let names = porompm::analysis::StageAnalysis::of(&c, &c.stages[0]).layout.field_names();
     let flip = match flip {
         None => None,
         Some(f) => {

@@ -2,43 +2,19 @@
 //! answer, the pressures of stiff consolidation without persistent oscillation, and the state handed
 //! from one analysis type to the next. Each run is the real binary in its own process.
 
+mod common;
+
+use common::{column, metric};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// Runs `case` (a path from the repository root) with `sets` into a fresh directory; returns the
-/// summary and the rows of history.csv as (header, rows). Panics unless the run completed.
+/// summary and history.csv's header and rows. Panics unless the run completed.
 fn run(case: &str, label: &str, sets: &[&str]) -> (Value, Vec<String>, Vec<Vec<f64>>) {
-    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("analysis").join(label);
-    let _ = std::fs::remove_dir_all(&out);
-    let mut args =
-        vec!["run".to_string(), case.to_string(), "--out".into(), out.display().to_string(), "--quiet".into()];
-    for s in sets {
-        args.push("--set".into());
-        args.push(s.to_string());
-    }
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm")).args(&args).current_dir(root()).output().expect("porompm runs");
-    let s: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).expect("summary.json")).expect("JSON");
-    assert!(o.status.success() && s["status"] == "completed", "{label}: {}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
-    (s, header, rows)
-}
-
-fn metric(s: &Value, name: &str) -> f64 {
-    s["verification"][name]["value"].as_f64().unwrap_or_else(|| panic!("no metric {name} in {}", s["verification"]))
-}
-
-fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
-    let i = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
-    rows.iter().map(|r| r[i]).collect()
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("analysis").join(label);
+    let r = common::run_case(case, &dir, &common::set_args(sets));
+    assert!(r.completed(), "{label}: {}", r.stderr());
+    (r.summary, r.header, r.rows)
 }
 
 /// The largest alternation |p_{k+1} − 2p_k + p_{k−1}| / q of the base pore pressure over the steps

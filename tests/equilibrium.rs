@@ -4,13 +4,12 @@
 //! on nodes the material does not fill; reactions of a displacement-controlled oedometer; a
 //! stressed body turned rigidly. Each run is the real binary in its own process.
 
+mod common;
+
+use common::{column, metric};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Output;
 
 fn out_dir(label: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("equilibrium").join(label)
@@ -24,35 +23,13 @@ fn run(case: &str, label: &str, sets: &[&str]) -> (Output, Value, Vec<String>, V
 
 /// [`run`] with PETSc options after `--`.
 fn run_with(case: &str, label: &str, sets: &[&str], petsc: &[&str]) -> (Output, Value, Vec<String>, Vec<Vec<f64>>) {
-    let out = out_dir(label);
-    let _ = std::fs::remove_dir_all(&out);
-    let mut args =
-        vec!["run".to_string(), case.to_string(), "--out".into(), out.display().to_string(), "--quiet".into()];
-    for s in sets {
-        args.push("--set".into());
-        args.push(s.to_string());
-    }
+    let mut args = common::set_args(sets);
     if !petsc.is_empty() {
         args.push("--".into());
         args.extend(petsc.iter().map(|s| s.to_string()));
     }
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm")).args(&args).current_dir(root()).output().expect("porompm runs");
-    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap_or_default())
-        .unwrap_or(Value::Null);
-    let text = std::fs::read_to_string(out.join("history.csv")).unwrap_or_default();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap_or("").split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
-    (o, s, header, rows)
-}
-
-fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
-    let i = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
-    rows.iter().map(|r| r[i]).collect()
-}
-
-fn metric(s: &Value, name: &str) -> f64 {
-    s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
+    let r = common::run_case(case, &out_dir(label), &args);
+    (r.output, r.summary, r.header, r.rows)
 }
 
 /// The kinematic patch test: every grid node follows a homogeneous stretch and shear, and every

@@ -3,14 +3,11 @@
 //! `fieldsplit-schur.opts`, meets its targets with each, and the strategies agree on every metric
 //! within solver tolerance. Each run is the real binary in its own process.
 
+mod common;
+
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn out_dir(label: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("verification").join(label)
@@ -18,28 +15,15 @@ fn out_dir(label: &str) -> PathBuf {
 
 /// Runs a case and returns its summary; panics with the run's error if it did not complete.
 fn run(case: &str, label: &str, options: Option<&str>, sets: &[&str]) -> Value {
-    let out = out_dir(label);
-    let _ = std::fs::remove_dir_all(&out);
-    let mut args = vec![
-        "run".to_string(),
-        format!("cases/{case}.toml"),
-        "--out".into(),
-        out.display().to_string(),
-        "--quiet".into(),
-    ];
+    let mut args = Vec::new();
     if let Some(o) = options {
         args.push("--options-file".into());
         args.push(format!("petsc_options/{o}.opts"));
     }
-    for s in sets {
-        args.push("--set".into());
-        args.push(s.to_string());
-    }
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm")).args(&args).current_dir(root()).output().expect("porompm runs");
-    let s: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).expect("summary.json")).expect("JSON");
-    assert!(o.status.success() && s["status"] == "completed", "{label}: {}", String::from_utf8_lossy(&o.stderr));
-    s
+    args.extend(common::set_args(sets));
+    let r = common::run_case(&format!("cases/{case}.toml"), &out_dir(label), &args);
+    assert!(r.completed(), "{label}: {}", r.stderr());
+    r.summary
 }
 
 fn metrics(s: &Value) -> BTreeMap<String, (f64, bool, f64)> {
@@ -160,16 +144,9 @@ fn large_strain_consolidation_meets_three_percent_at_ten_cells() {
 
 /// Column `name` of a run's history.csv with its time column.
 fn history(label: &str, name: &str) -> Vec<(f64, f64)> {
-    let text = std::fs::read_to_string(out_dir(label).join("history.csv")).expect("history.csv");
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
-    lines
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[0], v[col])
-        })
-        .collect()
+    let (header, rows) = common::read_history(&out_dir(label));
+    let (t, v) = (common::column(&header, &rows, "time"), common::column(&header, &rows, name));
+    t.into_iter().zip(v).collect()
 }
 
 #[test]
@@ -266,16 +243,13 @@ fn one_and_sixteen_points_per_cell_run() {
         &["bodies.block.particles_per_cell=4", "stages.slump.duration=0.05"],
     );
     assert_eq!(s["steps"], 50);
-    let dir = out_dir("slumping-ppc1");
-    let _ = std::fs::remove_dir_all(&dir);
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(["run", "cases/slumping_block.toml", "--out", dir.to_str().unwrap(), "--quiet"])
-        .args(["--set", "bodies.block.particles_per_cell=1", "--set", "stages.slump.duration=0.05"])
-        .current_dir(root())
-        .output()
-        .unwrap();
-    let s: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(o.status.code(), Some(1));
+    let r = common::run_case(
+        "cases/slumping_block.toml",
+        &out_dir("slumping-ppc1"),
+        &common::set_args(&["bodies.block.particles_per_cell=1", "stages.slump.duration=0.05"]),
+    );
+    let s = r.summary;
+    assert_eq!(r.output.status.code(), Some(1));
     let err = s["error"].as_str().unwrap();
     assert!(s["status"] == "failed" && err.contains("did not converge") && !err.contains("malloc"), "{err}");
     assert!(s["steps"].as_u64().unwrap() >= 10, "{}", s["steps"]);

@@ -110,10 +110,20 @@ impl<'a> Assembler<'a> {
 
     /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
     fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point) -> R) -> R {
+        self.with_point_of(k, xl, particle_input(self.model, self.step, k), f)
+    }
+
+    /// [`Self::with_point`] with the particle's kernel input given.
+    fn with_point_of<R>(
+        &self,
+        k: usize,
+        xl: &[f64],
+        input: kernels::ParticleInput,
+        f: impl FnOnce(&kernels::Point) -> R,
+    ) -> R {
         let step = self.step;
         let (nodes, basis) = step.stencils.get(k);
         let states = node_states(step, k, xl);
-        let input = particle_input(self.model, step, k);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         f(&kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared")))
     }
@@ -180,21 +190,28 @@ impl<'a> Assembler<'a> {
         let step = self.step;
         let nm = step.nm.expect("prepared");
         let plain = nm.unweighted();
+        // Without a history (Newmark, static, quasi-static) the weighted terms are the terms at
+        // t_{n+1}: one pass serves both.
+        let weighted = nm.history().is_some();
         let mut buf = [0.0; MAX_LOCAL];
         let mut ubuf = [0.0; MAX_LOCAL];
         let mut fbuf = [0.0; MAX_LOCAL];
         let mut forces = vec![0.0; all.len()];
-        let mut unweighted = vec![0.0; all.len()];
+        let mut unweighted = if weighted { vec![0.0; all.len()] } else { Vec::new() };
         for k in 0..step.stencils.len() {
             let m = self.with_point(k, xl, |pt| {
                 let m = pt.size();
                 kernels::residual(pt, &nm, &mut buf[..m]);
-                kernels::residual(pt, &plain, &mut ubuf[..m]);
+                if weighted {
+                    kernels::residual(pt, &plain, &mut ubuf[..m]);
+                }
                 kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
                 m
             });
             self.scatter(k, &buf[..m], all);
-            self.scatter(k, &ubuf[..m], &mut unweighted);
+            if weighted {
+                self.scatter(k, &ubuf[..m], &mut unweighted);
+            }
             self.scatter(k, &fbuf[..m], &mut forces);
         }
         self.add_projection(xl, all);
@@ -202,7 +219,9 @@ impl<'a> Assembler<'a> {
             *a += h;
         }
         for (q, ((a, i), f)) in all.iter_mut().zip(inertia.iter_mut()).zip(&forces).enumerate() {
-            *a = if step.dofs.fixed[q] { unweighted[q] } else { *a / nm.w_force };
+            if weighted {
+                *a = if step.dofs.fixed[q] { unweighted[q] } else { *a / nm.w_force };
+            }
             *i = *a - f;
         }
     }
@@ -239,17 +258,14 @@ impl<'a> Assembler<'a> {
         let mut out: Vec<f64> = fext_old.iter().map(|f| -hs.w_force * f).collect();
         let mut buf = [0.0; MAX_LOCAL];
         for k in 0..step.stencils.len() {
-            let (nodes, basis) = step.stencils.get(k);
-            let states = node_states(step, k, &xl);
             let mut input = particle_input(self.model, step, k);
             let s = &step.smooth[k];
             input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
             input.body_acc = body_acc_old[self.model.particles.body[k] as usize];
-            let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            let pt =
-                kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
-            let m = pt.size();
-            kernels::residual(&pt, &hs, &mut buf[..m]);
+            let m = self.with_point_of(k, &xl, input, |pt| {
+                kernels::residual(pt, &hs, &mut buf[..pt.size()]);
+                pt.size()
+            });
             self.scatter(k, &buf[..m], &mut out);
         }
         out

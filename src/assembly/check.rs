@@ -51,7 +51,7 @@ impl GridSystem {
         let nd = self.layout.nd;
         let p = self.layout.p;
         let h_cell = model.grid.h[0].min(model.grid.h[1]);
-        let names = &crate::model::field_names(self.layout.w.is_some())[..nd];
+        let names = self.layout.field_names();
         // A realistic iterate: part of this step's converged increment.
         self.solve(model)?;
         let mut x = self.x.duplicate()?;

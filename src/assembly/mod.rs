@@ -889,7 +889,7 @@ impl GridSystem {
         if self.step.solution.is_empty() {
             return out;
         }
-        let names = crate::model::field_names(true);
+        let names = Layout::UPU.field_names();
         let own = self.layout.field_names();
         for &a in &self.owned_nodes {
             let l = a as usize;

@@ -220,11 +220,6 @@ impl Integration {
         let gamma = 0.5 - alpha_m + alpha_f;
         Integration::Dynamic { beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2), gamma, alpha_m, alpha_f }
     }
-
-    /// Whether the momentum balances carry inertia.
-    pub fn has_inertia(&self) -> bool {
-        matches!(self, Integration::Dynamic { .. })
-    }
 }
 
 /// One step of length Δt under an [`Integration`]: the factors a₀ = ∂a/∂Δd = 1/(βΔt²) and

@@ -52,12 +52,13 @@ pub struct Model {
     pub pressure_projection: Option<f64>,
 }
 
-/// Names of the nodal fields, in dof order: ux, uy, p, Ux, Uy (two-phase) or ux, uy.
+/// Names of the nodal fields of a formulation's dynamic system, in dof order: ux, uy, p, Ux, Uy
+/// (two-phase) or ux, uy.
 pub fn field_names(two_phase: bool) -> &'static [&'static str] {
     if two_phase {
-        &["ux", "uy", "p", "Ux", "Uy"]
+        crate::kernels::Layout::UPU.field_names()
     } else {
-        &["ux", "uy"]
+        crate::kernels::Layout::U.field_names()
     }
 }
 

@@ -1,0 +1,78 @@
+//! What the integration tests share: running the real binary on a case into a fresh directory
+//! and reading back what it wrote.
+#![allow(dead_code)] // each test crate uses its own part
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The repository root (cases are named relative to it).
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A finished `porompm run`: the process output, summary.json (`Null` if none was written) and
+/// history.csv's header and rows (empty if none).
+pub struct Run {
+    pub output: Output,
+    pub summary: Value,
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Run {
+    /// Whether the process succeeded and the summary says `completed`.
+    pub fn completed(&self) -> bool {
+        self.output.status.success() && self.summary["status"] == "completed"
+    }
+
+    /// The process's standard error.
+    pub fn stderr(&self) -> String {
+        String::from_utf8_lossy(&self.output.stderr).into_owned()
+    }
+
+    /// Column `name` of history.csv.
+    pub fn column(&self, name: &str) -> Vec<f64> {
+        column(&self.header, &self.rows, name)
+    }
+}
+
+/// Runs `porompm run CASE --out DIR --quiet` with `args` after it (e.g. `--set` pairs, an options
+/// file, PETSc options after `--`) into `dir`, emptied first.
+pub fn run_case(case: &str, dir: &Path, args: &[String]) -> Run {
+    let _ = std::fs::remove_dir_all(dir);
+    let mut all =
+        vec!["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()];
+    all.extend(args.iter().cloned());
+    let output =
+        Command::new(env!("CARGO_BIN_EXE_porompm")).args(&all).current_dir(root()).output().expect("porompm runs");
+    let summary = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap_or_default())
+        .unwrap_or(Value::Null);
+    let (header, rows) = read_history(dir);
+    Run { output, summary, header, rows }
+}
+
+/// `--set` arguments for each of `sets`.
+pub fn set_args(sets: &[&str]) -> Vec<String> {
+    sets.iter().flat_map(|s| ["--set".to_string(), s.to_string()]).collect()
+}
+
+/// history.csv of a run directory: header and rows (empty if there is none).
+pub fn read_history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap_or_default();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap_or("").split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
+    (header, rows)
+}
+
+/// Column `name` of a history.
+pub fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+    let i = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    rows.iter().map(|r| r[i]).collect()
+}
+
+/// The value of verification metric `name` (NaN if the summary has none).
+pub fn metric(s: &Value, name: &str) -> f64 {
+    s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
+}
