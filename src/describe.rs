@@ -183,7 +183,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         s,
         "solver: {}",
         case.solver.options_file.as_deref().map_or(
-            "built-in default (Newton; sparse LU by UMFPACK on one rank up to 50 000 grid dofs, MUMPS beyond and on several)".to_string(),
+            "built-in default (Newton; sparse LU by UMFPACK on one rank up to 2 000 grid dofs, MUMPS beyond and on several)".to_string(),
             |f| format!("options file {f}")
         )
     );

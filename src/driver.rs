@@ -442,6 +442,7 @@ impl<'a> Simulation<'a> {
             };
             match admitted {
                 Ok(()) => {
+                    self.system.accept_increment(dt).map_err(|e| RunError::Failed(e.to_string()))?;
                     self.t = control.advance(self.t, dt);
                     control.accepted(self.last_newton.0);
                     self.step += 1;
@@ -488,6 +489,7 @@ impl<'a> Simulation<'a> {
     fn begin_stage(&mut self, stage: &Stage) -> Result<StageAnalysis, RunError> {
         let analysis = StageAnalysis::of(self.case, stage);
         self.model.integration = analysis.integration;
+        self.system.forget_increment();
         if self.system.layout() != analysis.layout {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;

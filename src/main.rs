@@ -44,6 +44,10 @@ enum Command {
         /// Continue from a checkpoint.h5 written by a run of the same case.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+        /// Threads per rank for the particle loops (default: this machine's cores divided by the
+        /// ranks running on it). The results do not depend on it.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=1024))]
+        threads: Option<u16>,
         /// PETSc options, after `--` (they reach PETSc's options database unchanged).
         #[arg(last = true, value_name = "PETSC_OPTIONS")]
         petsc: Vec<String>,
@@ -154,6 +158,8 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
 struct Continuation<'a> {
     checkpoint_every: usize,
     restart: Option<&'a Path>,
+    /// `--threads`, if given.
+    threads: Option<u16>,
 }
 
 fn run(
@@ -192,7 +198,10 @@ fn run(
         args.push(f.display().to_string());
     }
     args.extend(petsc_args.iter().cloned());
-    let (universe, coll, petsc) = start_mpi_and_petsc(&args)?;
+    let (universe, mut coll, petsc) = start_mpi_and_petsc(&args)?;
+    if let Some(n) = cont.threads {
+        coll.set_threads(n as usize);
+    }
     let mut output = RunOutput::create(out, coll.rank() == 0).map_err(input)?;
     let req = RunRequest {
         case: &c,
@@ -401,8 +410,9 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run { case, out, options_file, set, quiet, checkpoint_every, restart, petsc } => {
-            let cont = Continuation { checkpoint_every: *checkpoint_every, restart: restart.as_deref() };
+        Command::Run { case, out, options_file, set, quiet, checkpoint_every, restart, threads, petsc } => {
+            let cont =
+                Continuation { checkpoint_every: *checkpoint_every, restart: restart.as_deref(), threads: *threads };
             run(case, out, options_file, set, *quiet, cont, petsc)
         }
         Command::Sweep { case, out, options_file, vary, set, metric, quiet, petsc } => {

@@ -12,9 +12,11 @@ use mpi::datatype::PartitionMut;
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 
-/// The run's communicator (MPI_COMM_WORLD) and its reductions.
+/// The run's communicator (MPI_COMM_WORLD) and its reductions, and the threads each rank runs its
+/// particle loops on.
 pub struct Collective {
     world: SimpleCommunicator,
+    threads: usize,
 }
 
 impl Default for Collective {
@@ -25,8 +27,23 @@ impl Default for Collective {
 
 impl Collective {
     /// All ranks of the run. MPI must be initialised.
+    /// All ranks of the run, each with its share of this machine's cores as threads: the cores
+    /// divided by the ranks running on the same node (at least one).
     pub fn world() -> Collective {
-        Collective { world: SimpleCommunicator::world() }
+        let world = SimpleCommunicator::world();
+        let on_node = world.split_shared(world.rank()).size().max(1) as usize;
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Collective { world, threads: (cores / on_node).max(1) }
+    }
+
+    /// Sets the threads of this rank's particle loops (`--threads`; at least one).
+    pub fn set_threads(&mut self, n: usize) {
+        self.threads = n.max(1);
+    }
+
+    /// The threads of this rank's particle loops.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// The communicator (for PETSc and for point-to-point exchanges).

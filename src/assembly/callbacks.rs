@@ -2,6 +2,7 @@
 //! extensions (see [`super::stencils`]) onto the nodes that carry unknowns, added into a ghosted
 //! vector (summed over ranks by PETSc) and into the COO value array of the matrix.
 
+use super::stencils::Stencils;
 use super::StepData;
 use crate::kernels::{self, NodeState, MAX_LOCAL, MAX_NODES};
 use crate::model::Model;
@@ -75,6 +76,275 @@ fn transform(step: &StepData, k: usize, out: &mut Vec<Vec<(usize, f64)>>) -> usi
     step.stencils.effective(k).len() * nd
 }
 
+/// A range `lo..hi` of ghosted nodes (whole rows of the ghosted grid, so one range of the ghosted
+/// numbering) whose rows of the residual and of the matrix one thread assembles: its dofs
+/// `lo·nd..hi·nd` of a ghosted vector and its blocks `row_start(lo)..row_start(hi)` of the pattern
+/// (sorted by row). Every particle with an effective node in the band is evaluated by the band's
+/// thread, which adds only the rows of the band; particles near a band's edge are evaluated by both
+/// neighbours. Each entry thus receives the same contributions in the same (particle) order as on
+/// one thread: the sums do not depend on the number of threads, to the last bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Band {
+    pub lo: u32,
+    pub hi: u32,
+}
+
+impl Band {
+    fn holds(&self, a: u32) -> bool {
+        a >= self.lo && a < self.hi
+    }
+}
+
+/// `n` bands of whole rows of a ghosted grid of `nx × ny` nodes, cut where about equal numbers of
+/// the particles' first rows lie below (fewer bands if there are few rows).
+pub(super) fn bands(st: &Stencils, nx: usize, ny: usize, n: usize) -> Vec<Band> {
+    let total = (nx * ny) as u32;
+    let n = n.min(ny / 4).max(1);
+    if n == 1 || st.is_empty() {
+        return vec![Band { lo: 0, hi: total }];
+    }
+    let mut per_row = vec![0usize; ny + 1];
+    for k in 0..st.len() {
+        let first = st.effective(k).iter().min().copied().unwrap_or(0) as usize / nx;
+        per_row[first] += 1;
+    }
+    let mut out = Vec::with_capacity(n);
+    let (mut lo, mut seen, mut row) = (0u32, 0usize, 0usize);
+    for b in 1..n {
+        let goal = st.len() * b / n;
+        while row < ny && seen + per_row[row] <= goal {
+            seen += per_row[row];
+            row += 1;
+        }
+        let hi = ((row * nx) as u32).max(lo);
+        out.push(Band { lo, hi });
+        lo = hi;
+    }
+    out.push(Band { lo, hi: total });
+    out.retain(|b| b.hi > b.lo);
+    out
+}
+
+/// Runs `work` on every band on its own thread (the first on this one), each with its part of
+/// `data`: entries `start(band.lo)..start(band.hi)` (the bands cover `data` in order).
+fn run_bands<R: Send>(
+    bands: &[Band],
+    data: &mut [f64],
+    start: impl Fn(u32) -> usize,
+    work: impl Fn(Band, &mut [f64]) -> R + Sync,
+) -> Vec<R> {
+    let mut parts = Vec::with_capacity(bands.len());
+    let (mut rest, mut at) = (data, 0);
+    for b in bands {
+        let end = start(b.hi);
+        let (head, tail) = rest.split_at_mut(end - at);
+        parts.push((*b, head));
+        rest = tail;
+        at = end;
+    }
+    if parts.len() == 1 {
+        let (b, d) = parts.pop().expect("one band");
+        return vec![work(b, d)];
+    }
+    let work = &work;
+    std::thread::scope(|scope| {
+        let mut it = parts.into_iter();
+        let (b0, d0) = it.next().expect("a first band");
+        let handles: Vec<_> = it.map(|(b, d)| scope.spawn(move || work(b, d))).collect();
+        let mut out = vec![work(b0, d0)];
+        out.extend(handles.into_iter().map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p))));
+        out
+    })
+}
+
+/// The particle side of the callbacks: the model and the prepared step (shared by the threads).
+#[derive(Clone, Copy)]
+struct Particles<'a> {
+    model: &'a Model,
+    step: &'a StepData,
+}
+
+impl Particles<'_> {
+    /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
+    fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point) -> R) -> R {
+        self.with_point_of(k, xl, particle_input(self.model, self.step, k), f)
+    }
+
+    /// [`Self::with_point`] with the particle's kernel input given.
+    fn with_point_of<R>(
+        &self,
+        k: usize,
+        xl: &[f64],
+        input: kernels::ParticleInput,
+        f: impl FnOnce(&kernels::Point) -> R,
+    ) -> R {
+        let step = self.step;
+        let (nodes, basis) = step.stencils.get(k);
+        let states = node_states(step, k, xl);
+        let mat = &self.model.materials[self.model.particles.material[k] as usize];
+        f(&kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared")))
+    }
+
+    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
+    fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+        let nm = self.step.nm.expect("prepared");
+        self.with_point(k, xl, |pt| {
+            kernels::residual(pt, &nm, buf);
+            pt.size()
+        })
+    }
+
+    /// Whether particle `k` has an effective node in `band`.
+    fn touches(&self, k: usize, band: Band) -> bool {
+        self.step.stencils.effective(k).iter().any(|&a| band.holds(a))
+    }
+
+    /// Adds particle `k`'s raw residual block `r` (length m) through its extensions to the rows of
+    /// `band`, whose part of a ghosted array is `f`.
+    fn scatter(&self, k: usize, r: &[f64], f: &mut [f64], band: Band) {
+        let nd = self.step.dofs.nd;
+        let first = band.lo as usize * nd;
+        let (nodes, _) = self.step.stencils.get(k);
+        let eff = self.step.stencils.effective(k);
+        let mut moved = [false; MAX_LOCAL];
+        for e in self.step.stencils.extensions(k) {
+            for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
+                let a = e.slot as usize * nd + c;
+                moved[a] = true;
+                for m in 0..e.n as usize {
+                    let node = eff[e.masters[m].0 as usize];
+                    if band.holds(node) {
+                        f[node as usize * nd + c - first] += e.masters[m].1 * r[a];
+                    }
+                }
+            }
+        }
+        for (n, &node) in nodes.iter().enumerate() {
+            if !band.holds(node) {
+                continue;
+            }
+            for c in 0..nd {
+                if !moved[n * nd + c] {
+                    f[node as usize * nd + c - first] += r[n * nd + c];
+                }
+            }
+        }
+    }
+
+    /// The residual rows of `band` (its part `f` of a ghosted array) from every particle that
+    /// reaches it, each particle's block given by `block(k, buf) -> length`; returns the first
+    /// particle whose block was not finite.
+    fn residual_band(
+        &self,
+        band: Band,
+        f: &mut [f64],
+        block: &(impl Fn(usize, &mut [f64]) -> usize + Sync),
+    ) -> Option<usize> {
+        let mut buf = [0.0; MAX_LOCAL];
+        let mut nonfinite = None;
+        for k in (0..self.step.stencils.len()).filter(|&k| self.touches(k, band)) {
+            let m = block(k, &mut buf);
+            if nonfinite.is_none() && !buf[..m].iter().all(|r| r.is_finite()) {
+                nonfinite = Some(k);
+            }
+            self.scatter(k, &buf[..m], f, band);
+        }
+        nonfinite
+    }
+
+    /// The tangent blocks of every particle that reaches `band`, added into the band's part
+    /// `values` of the COO value array.
+    fn tangent_band(&self, band: Band, values: &mut [f64], xl: &[f64]) {
+        let step = self.step;
+        let nm = step.nm.expect("prepared");
+        let layout = step.layout.expect("prepared");
+        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
+        let mut eff_block = vec![0.0; MAX_EFF * kernels::MAX_DOF * MAX_EFF * kernels::MAX_DOF];
+        let mut tr = Vec::new();
+        let first = step.pattern.row_start(band.lo);
+        for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
+            let (nodes, basis) = step.stencils.get(k);
+            let input = particle_input(self.model, step, k);
+            let mat = &self.model.materials[self.model.particles.material[k] as usize];
+            let states = node_states(step, k, xl);
+            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout);
+            let m = pt.size();
+            kernels::tangent(&pt, &nm, &mut block[..m * m]);
+            self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);
+        }
+    }
+
+    /// Adds the rows of `band` of particle `k`'s tangent block to the band's part `values` of the
+    /// COO values, which starts at block `first`.
+    #[allow(clippy::too_many_arguments)]
+    fn add_tangent(
+        &self,
+        k: usize,
+        block: &[f64],
+        m: usize,
+        tr: &mut Vec<Vec<(usize, f64)>>,
+        eff_block: &mut [f64],
+        values: &mut [f64],
+        band: Band,
+        first: usize,
+    ) {
+        let step = self.step;
+        let nd = step.dofs.nd;
+        let has_ext = !step.stencils.extensions(k).is_empty();
+        let eff = step.stencils.effective(k);
+        let (me, kb): (usize, &[f64]) = if has_ext {
+            let me = transform(step, k, tr);
+            eff_block[..me * me].fill(0.0);
+            for a in 0..m {
+                for &(ea, wa) in &tr[a] {
+                    for b in 0..m {
+                        let v = block[a * m + b];
+                        if v == 0.0 {
+                            continue;
+                        }
+                        for &(eb, wb) in &tr[b] {
+                            eff_block[ea * me + eb] += wa * wb * v;
+                        }
+                    }
+                }
+            }
+            (me, &eff_block[..me * me])
+        } else {
+            (m, &block[..m * m])
+        };
+        let ne = me / nd;
+        let pattern = &step.pattern;
+        let mut ij = [(0i64, 0i64); MAX_EFF];
+        for (c, &a) in ij.iter_mut().zip(eff) {
+            *c = pattern.ij(a);
+        }
+        let fixed = &step.dofs.fixed;
+        for p in (0..ne).filter(|&p| band.holds(eff[p])) {
+            let rp = eff[p] as usize * nd;
+            for q in 0..ne {
+                let cq = eff[q] as usize * nd;
+                let base = (pattern.block_at(eff[p], ij[p], eff[q], ij[q]) as usize - first) * nd * nd;
+                for c1 in 0..nd {
+                    if fixed[rp + c1] {
+                        continue;
+                    }
+                    let row = &kb[(p * nd + c1) * me + q * nd..(p * nd + c1) * me + q * nd + nd];
+                    for c2 in 0..nd {
+                        if !fixed[cq + c2] {
+                            values[base + c1 * nd + c2] += row[c2];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The band of every node.
+    fn whole(&self) -> Band {
+        Band { lo: 0, hi: (self.step.dofs.fixed.len() / self.step.dofs.nd) as u32 }
+    }
+}
+
 /// The callbacks of one step.
 pub(super) struct Assembler<'a> {
     dm: &'a DmDa,
@@ -108,39 +378,15 @@ impl<'a> Assembler<'a> {
         Ok(self.x_local.read().map_err(fatal)?.to_vec())
     }
 
-    /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
-    fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point) -> R) -> R {
-        self.with_point_of(k, xl, particle_input(self.model, self.step, k), f)
-    }
-
-    /// [`Self::with_point`] with the particle's kernel input given.
-    fn with_point_of<R>(
-        &self,
-        k: usize,
-        xl: &[f64],
-        input: kernels::ParticleInput,
-        f: impl FnOnce(&kernels::Point) -> R,
-    ) -> R {
-        let step = self.step;
-        let (nodes, basis) = step.stencils.get(k);
-        let states = node_states(step, k, xl);
-        let mat = &self.model.materials[self.model.particles.material[k] as usize];
-        f(&kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared")))
-    }
-
-    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
-    fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
-        let nm = self.step.nm.expect("prepared");
-        self.with_point(k, xl, |pt| {
-            kernels::residual(pt, &nm, buf);
-            pt.size()
-        })
+    /// The particle side, for the threads.
+    fn particles(&self) -> Particles<'a> {
+        Particles { model: self.model, step: self.step }
     }
 
     /// Names particle `k`, whose residual at `xl` is not finite, and the first of its quantities
     /// that is not.
     fn describe_nonfinite(&self, k: usize, xl: &[f64]) -> String {
-        match self.with_point(k, xl, |pt| self.model.nonfinite(k, &kernels::StepResult::of(pt))) {
+        match self.particles().with_point(k, xl, |pt| self.model.nonfinite(k, &kernels::StepResult::of(pt))) {
             Some(e) => e.0,
             None => {
                 let ps = &self.model.particles;
@@ -148,31 +394,6 @@ impl<'a> Assembler<'a> {
                     "material point {} at ({:.4}, {:.4}) m: its residual (internal, inertia or flow terms) is not finite (NaN or Inf)",
                     ps.id[k], ps.x[k][0], ps.x[k][1]
                 )
-            }
-        }
-    }
-
-    /// Adds particle `k`'s raw residual block `r` (length m) to the ghosted array `f` through its
-    /// extensions.
-    fn scatter(&self, k: usize, r: &[f64], f: &mut [f64]) {
-        let nd = self.step.dofs.nd;
-        let (nodes, _) = self.step.stencils.get(k);
-        let eff = self.step.stencils.effective(k);
-        let mut moved = [false; MAX_LOCAL];
-        for e in self.step.stencils.extensions(k) {
-            for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
-                let a = e.slot as usize * nd + c;
-                moved[a] = true;
-                for m in 0..e.n as usize {
-                    f[eff[e.masters[m].0 as usize] as usize * nd + c] += e.masters[m].1 * r[a];
-                }
-            }
-        }
-        for (n, &node) in nodes.iter().enumerate() {
-            for c in 0..nd {
-                if !moved[n * nd + c] {
-                    f[node as usize * nd + c] += r[n * nd + c];
-                }
             }
         }
     }
@@ -198,8 +419,10 @@ impl<'a> Assembler<'a> {
         let mut fbuf = [0.0; MAX_LOCAL];
         let mut forces = vec![0.0; all.len()];
         let mut unweighted = if weighted { vec![0.0; all.len()] } else { Vec::new() };
+        let ps = self.particles();
+        let whole = ps.whole();
         for k in 0..step.stencils.len() {
-            let m = self.with_point(k, xl, |pt| {
+            let m = ps.with_point(k, xl, |pt| {
                 let m = pt.size();
                 kernels::residual(pt, &nm, &mut buf[..m]);
                 if weighted {
@@ -208,11 +431,11 @@ impl<'a> Assembler<'a> {
                 kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
                 m
             });
-            self.scatter(k, &buf[..m], all);
+            ps.scatter(k, &buf[..m], all, whole);
             if weighted {
-                self.scatter(k, &ubuf[..m], &mut unweighted);
+                ps.scatter(k, &ubuf[..m], &mut unweighted, whole);
             }
-            self.scatter(k, &fbuf[..m], &mut forces);
+            ps.scatter(k, &fbuf[..m], &mut forces, whole);
         }
         self.add_projection(xl, all);
         for (a, h) in all.iter_mut().zip(&step.history) {
@@ -236,14 +459,16 @@ impl<'a> Assembler<'a> {
         let nm = step.nm.expect("prepared");
         let xl = vec![0.0; step.fext.len()];
         let mut out: Vec<f64> = step.fext.iter().map(|f| f.abs()).collect();
-        let mut buf = [0.0; MAX_LOCAL];
-        for k in 0..step.stencils.len() {
-            let m = self.residual_of(k, &xl, &mut buf);
+        let ps = self.particles();
+        let weight = nm.w_force.max(nm.w_inertia);
+        let block = |k: usize, buf: &mut [f64]| {
+            let m = ps.residual_of(k, &xl, buf);
             for v in &mut buf[..m] {
-                *v = v.abs() * nm.w_force.max(nm.w_inertia);
+                *v = v.abs() * weight;
             }
-            self.scatter(k, &buf[..m], &mut out);
-        }
+            m
+        };
+        run_bands(&step.bands, &mut out, |a| a as usize * step.dofs.nd, |band, f| ps.residual_band(band, f, &block));
         out
     }
 
@@ -256,18 +481,18 @@ impl<'a> Assembler<'a> {
         let hs = step.nm.and_then(|nm| nm.history()).expect("a scheme with a history");
         let xl = vec![0.0; fext_old.len()];
         let mut out: Vec<f64> = fext_old.iter().map(|f| -hs.w_force * f).collect();
-        let mut buf = [0.0; MAX_LOCAL];
-        for k in 0..step.stencils.len() {
-            let mut input = particle_input(self.model, step, k);
+        let ps = self.particles();
+        let block = |k: usize, buf: &mut [f64]| {
+            let mut input = particle_input(ps.model, step, k);
             let s = &step.smooth[k];
             input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
-            input.body_acc = body_acc_old[self.model.particles.body[k] as usize];
-            let m = self.with_point_of(k, &xl, input, |pt| {
+            input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
+            ps.with_point_of(k, &xl, input, |pt| {
                 kernels::residual(pt, &hs, &mut buf[..pt.size()]);
                 pt.size()
-            });
-            self.scatter(k, &buf[..m], &mut out);
-        }
+            })
+        };
+        run_bands(&step.bands, &mut out, |a| a as usize * step.dofs.nd, |band, f| ps.residual_band(band, f, &block));
         out
     }
 
@@ -297,63 +522,6 @@ impl<'a> Assembler<'a> {
             }
         }
     }
-
-    /// Adds particle `k`'s tangent block to the COO values.
-    fn add_tangent(
-        &self,
-        k: usize,
-        block: &[f64],
-        m: usize,
-        tr: &mut Vec<Vec<(usize, f64)>>,
-        eff_block: &mut [f64],
-        values: &mut [f64],
-    ) {
-        let step = self.step;
-        let nd = step.dofs.nd;
-        let has_ext = !step.stencils.extensions(k).is_empty();
-        let eff = step.stencils.effective(k);
-        let (me, kb): (usize, &[f64]) = if has_ext {
-            let me = transform(step, k, tr);
-            eff_block[..me * me].fill(0.0);
-            for a in 0..m {
-                for &(ea, wa) in &tr[a] {
-                    for b in 0..m {
-                        let v = block[a * m + b];
-                        if v == 0.0 {
-                            continue;
-                        }
-                        for &(eb, wb) in &tr[b] {
-                            eff_block[ea * me + eb] += wa * wb * v;
-                        }
-                    }
-                }
-            }
-            (me, &eff_block[..me * me])
-        } else {
-            (m, &block[..m * m])
-        };
-        let ne = me / nd;
-        let slots = &step.slots[step.slot_offsets[k]..step.slot_offsets[k + 1]];
-        let fixed = &step.dofs.fixed;
-        for p in 0..ne {
-            let rp = eff[p] as usize * nd;
-            for q in 0..ne {
-                let cq = eff[q] as usize * nd;
-                let base = slots[p * ne + q] as usize * nd * nd;
-                for c1 in 0..nd {
-                    if fixed[rp + c1] {
-                        continue;
-                    }
-                    let row = &kb[(p * nd + c1) * me + q * nd..(p * nd + c1) * me + q * nd + nd];
-                    for c2 in 0..nd {
-                        if !fixed[cq + c2] {
-                            values[base + c1 * nd + c2] += row[c2];
-                        }
-                    }
-                }
-            }
-        }
-    }
 }
 
 impl NonlinearProblem for Assembler<'_> {
@@ -369,13 +537,15 @@ impl NonlinearProblem for Assembler<'_> {
         for (v, h) in fl.iter_mut().zip(&self.step.history) {
             *v += h;
         }
-        let mut buf = [0.0; MAX_LOCAL];
-        for k in 0..self.step.stencils.len() {
-            let m = self.residual_of(k, &xl, &mut buf);
-            if self.nonfinite.is_none() && !buf[..m].iter().all(|r| r.is_finite()) {
+        let ps = self.particles();
+        let nd = self.step.dofs.nd;
+        let block = |k: usize, buf: &mut [f64]| ps.residual_of(k, &xl, buf);
+        let bad =
+            run_bands(&self.step.bands, &mut fl, |a| a as usize * nd, |band, f| ps.residual_band(band, f, &block));
+        if let Some(k) = bad.into_iter().flatten().min() {
+            if self.nonfinite.is_none() {
                 self.nonfinite = Some(self.describe_nonfinite(k, &xl));
             }
-            self.scatter(k, &buf[..m], &mut fl);
         }
         self.add_projection(&xl, &mut fl);
         self.f_local.write().map_err(fatal)?.copy_from_slice(&fl);
@@ -399,24 +569,18 @@ impl NonlinearProblem for Assembler<'_> {
         let xl = self.gather(x)?;
         let step = self.step;
         let nd = step.dofs.nd;
-        let nm = step.nm.expect("prepared");
         let layout = step.layout.expect("prepared");
         let mut values = std::mem::take(&mut self.values);
         values.clear();
-        values.resize(step.pattern_blocks * nd * nd, 0.0);
-        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
-        let mut eff_block = vec![0.0; MAX_EFF * kernels::MAX_DOF * MAX_EFF * kernels::MAX_DOF];
-        let mut tr = Vec::new();
-        for k in 0..step.stencils.len() {
-            let (nodes, basis) = step.stencils.get(k);
-            let input = particle_input(self.model, step, k);
-            let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            let states = node_states(step, k, &xl);
-            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout);
-            let m = pt.size();
-            kernels::tangent(&pt, &nm, &mut block[..m * m]);
-            self.add_tangent(k, &block, m, &mut tr, &mut eff_block, &mut values);
-        }
+        values.resize(step.pattern.len() * nd * nd, 0.0);
+        let ps = self.particles();
+        let pattern = &step.pattern;
+        run_bands(
+            &step.bands,
+            &mut values,
+            |a| pattern.row_start(a) * nd * nd,
+            |band, v| ps.tangent_band(band, v, &xl),
+        );
         if let Some(p) = layout.p {
             for ((nodes, s), blocks) in step.projection.iter().zip(&step.projection_blocks) {
                 for (a, &na) in nodes.iter().enumerate() {

@@ -53,6 +53,8 @@ pub type Error = petsc::Error;
 #[derive(Debug, Default)]
 struct StepData {
     nm: Option<kernels::Scheme>,
+    /// The step's Δt [s].
+    dt: f64,
     layout: Option<Layout>,
     /// Body acceleration at t_{n+1} per body.
     body_acc: Vec<[f64; 2]>,
@@ -75,11 +77,10 @@ struct StepData {
     /// Pressure-projection blocks: a cell's four nodes and the 4 × 4 block S (see
     /// `kernels::pressure_projection`).
     projection: Vec<([u32; 4], [[f64; 4]; 4])>,
-    /// Each particle's COO slot map: offsets and blocks (see [`pattern::Pattern::slots`]).
-    slot_offsets: Vec<usize>,
-    slots: Vec<u32>,
-    /// Number of blocks of the pattern.
-    pattern_blocks: usize,
+    /// The matrix pattern (kept from step to step while it covers the particles' pairs).
+    pattern: Pattern,
+    /// The bands of node rows the threads assemble (see [`callbacks::Band`]).
+    bands: Vec<callbacks::Band>,
     /// The pattern block of every corner pair (a, b) of each pressure-projection cell, 4a + b.
     projection_blocks: Vec<[u32; 16]>,
     /// (diagonal block, component) of every owned fixed dof.
@@ -171,12 +172,14 @@ pub struct GridSystem {
     work_global: Vector,
     snes: Snes,
     jac: Option<Mat>,
-    pattern: Option<Pattern>,
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
+    /// The owned part of the last accepted step's Δd and its Δt, the predictor of the next step
+    /// when the analysis extrapolates (see [`kernels::Integration::extrapolates`]).
+    last_increment: Option<(Vec<f64>, f64)>,
     step: StepData,
     stages: Stages,
 }
@@ -262,9 +265,9 @@ impl GridSystem {
             work_global,
             snes,
             jac: None,
-            pattern: None,
             user_atol,
             reused_patterns: 0,
+            last_increment: None,
             step: StepData::default(),
             stages,
         })
@@ -337,6 +340,8 @@ impl GridSystem {
         body_names: &[String],
     ) -> Result<(), String> {
         let nd = self.layout.nd;
+        // The last step's maps go first, so that the new ones do not sit beside them.
+        let old_pattern = std::mem::take(&mut self.step).pattern;
         // 1. Stencils on x_n (B̄'s cells first: which cells the material fills, summed over ranks).
         let roots = if model.bbar {
             let mut phi = vec![0.0; self.ghost.len() * nd];
@@ -390,6 +395,7 @@ impl GridSystem {
         coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
         // 4. Effective stencils, predictors, porosity gradients, projection blocks, loads.
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
+        let bands = callbacks::bands(&st, self.ghost.count[0], self.ghost.count[1], coll.threads());
         let (smooth, grad_n) = self.predictors(model, &st, &dofs, &nodal);
         let projection = self.projection_blocks(model);
         let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
@@ -401,9 +407,11 @@ impl GridSystem {
         };
         self.step = StepData {
             nm: Some(nm),
+            dt,
             layout: Some(self.layout),
             body_acc: model.body_accelerations(active, t_new),
             stencils: st,
+            bands,
             dofs,
             fext,
             solution: Vec::new(),
@@ -418,24 +426,20 @@ impl GridSystem {
         }
         self.step.force_scale = self.force_scale(model, coll)?;
         // 5. The matrix pattern: kept if every rank finds every pair in it.
-        let kept = self.pattern.as_ref().and_then(|p| p.slots(&self.step.stencils));
-        let rebuild = coll.any(kept.is_none())?;
-        let (pattern_slots, pattern) = if rebuild {
+        let kept = !old_pattern.is_empty() && old_pattern.covers(&self.step.stencils);
+        let rebuild = coll.any(!kept)?;
+        let pattern = if rebuild {
             let [nx, ny] = self.ghost.count;
             let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
             let p = Pattern::build(&self.step.stencils, &self.owned_nodes, &groups, nx, ny);
-            let slots = p.slots(&self.step.stencils).expect("the new pattern holds every pair");
             let (rows, cols) = p.coo(nd, &self.l2g);
             let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());
             self.jac = Some(coll.agree(made)?);
-            (slots, p)
+            p
         } else {
             self.reused_patterns += 1;
-            (kept.expect("every rank kept the pattern"), self.pattern.take().expect("a pattern to keep"))
+            old_pattern
         };
-        self.step.slot_offsets = pattern_slots.0;
-        self.step.slots = pattern_slots.1;
-        self.step.pattern_blocks = pattern.len();
         let projection_blocks: Option<Vec<[u32; 16]>> = self
             .step
             .projection
@@ -461,7 +465,7 @@ impl GridSystem {
                 (pattern.block((q / nd) as u32, (q / nd) as u32).expect("owned diagonal blocks are listed"), q % nd)
             })
             .collect();
-        self.pattern = Some(pattern);
+        self.step.pattern = pattern;
         Ok(())
     }
 
@@ -750,13 +754,22 @@ impl GridSystem {
         Ok(())
     }
 
-    /// Solves the prepared step by Newton's method from Δd = 0 (with every fixed dof at its
-    /// prescribed increment).
+    /// Solves the prepared step by Newton's method from Δd = 0, or, when the analysis extrapolates,
+    /// from the last accepted increment scaled by Δt / Δt_last; every fixed dof starts at its
+    /// prescribed increment.
     pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
         let _stage = self.stages.solve.push()?;
         {
             let mut x = self.x.write()?;
-            x.fill(0.0);
+            match &self.last_increment {
+                Some((last, dt_last)) if model.integration.extrapolates() && last.len() == x.len() => {
+                    let ratio = self.step.dt / dt_last;
+                    for (xi, li) in x.iter_mut().zip(last) {
+                        *xi = ratio * li;
+                    }
+                }
+                _ => x.fill(0.0),
+            }
             for &(o, q) in &self.step.dofs.owned_fixed {
                 x[o] = self.step.dofs.value[q];
             }
@@ -785,6 +798,19 @@ impl GridSystem {
             assembly_seconds,
             solve_seconds,
         })
+    }
+
+    /// Keeps the increment of the step just accepted (of length `dt`) as the next step's
+    /// predictor.
+    pub fn accept_increment(&mut self, dt: f64) -> Result<(), Error> {
+        self.last_increment = Some((self.x.read()?.to_vec(), dt));
+        Ok(())
+    }
+
+    /// Forgets the last increment: the next step starts from Δd = 0 (a new stage changes the loads
+    /// or the analysis, so the last rate says nothing about the next step).
+    pub fn forget_increment(&mut self) {
+        self.last_increment = None;
     }
 
     /// Splits the system into the SNES, its solution vector and matrix, and the callbacks of the
@@ -984,10 +1010,12 @@ fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
     }
 }
 
-/// Grid dofs above which the default LU is MUMPS also on one rank: Debian's UMFPACK (32-bit
-/// indices) failed in its numeric factorisation on the slumping block at 1.04e5 unknowns (grid
-/// 216 × 162, 1.8e5 grid dofs), where MUMPS factorised it; at 2e4 unknowns both took the same time.
-pub const UMFPACK_MAX_GRID_DOFS: usize = 50_000;
+/// Grid dofs above which the default LU is MUMPS also on one rank. Measured factorisation times
+/// (MatLUFactorNum, whole runs): terzaghi (110 grid dofs) UMFPACK 0.086 s vs MUMPS 0.153 s;
+/// slumping_block (2 375) 6.30 vs 5.91 s; footing_peer at h = 0.1 (5 406) 2.96 vs 1.97 s and at
+/// h = 0.05 (20 806) 15.8 vs 12.2 s. Debian's UMFPACK (32-bit indices) also failed in its numeric
+/// factorisation on the slumping block at 1.8e5 grid dofs, where MUMPS factorised it.
+pub const UMFPACK_MAX_GRID_DOFS: usize = 2_000;
 
 /// The factorisation package of the default solver: UMFPACK on one rank for grids up to
 /// [`UMFPACK_MAX_GRID_DOFS`], MUMPS otherwise.

@@ -6,8 +6,9 @@
 //! diagonal). Each particle keeps a slot map: the block of every pair of its effective nodes. A
 //! Jacobian then adds every particle's dense block into one value array in list order and hands it
 //! to PETSc at once (`MatSetValuesCOO`), which is several times faster than inserting the blocks
-//! one by one (../shared/solver-findings.md §3). Listing the blocks, not the particles' entries,
-//! keeps the memory at a few hundred bytes per particle.
+//! one by one (../shared/solver-findings.md §3). A particle finds the block of a pair through a
+//! dense table indexed by the first node and the pair's offset on the grid (no per-particle map:
+//! that map cost more memory than the particles themselves on the peer footing).
 //!
 //! The pattern is kept from step to step while every pair a particle needs is already in it (the
 //! matrix then keeps its structure, and a direct solver its symbolic factorisation); otherwise a
@@ -35,6 +36,9 @@ pub struct Pattern {
     far: HashMap<(u32, u32), u32>,
     /// Columns of the ghosted node grid (to turn node indices into (i, j)).
     nx: usize,
+    /// The blocks of row node a are `row_start[a]..row_start[a + 1]` (the list is sorted by
+    /// (a, b), so that the blocks of a range of row nodes are one range of the list).
+    row_start: Vec<u32>,
 }
 
 impl Pattern {
@@ -45,6 +49,24 @@ impl Pattern {
             return None;
         }
         Some(a as usize * WIDTH * WIDTH + ((dj + REACH) as usize) * WIDTH + (di + REACH) as usize)
+    }
+
+    /// The grid coordinates (i, j) of ghosted node `a`.
+    pub fn ij(&self, a: u32) -> (i64, i64) {
+        let a = a as i64;
+        (a % self.nx as i64, a / self.nx as i64)
+    }
+
+    /// The block of pair (a, b) with the nodes' grid coordinates given (see [`Pattern::ij`]);
+    /// `u32::MAX` if the pattern lacks it.
+    #[inline]
+    pub fn block_at(&self, a: u32, ija: (i64, i64), b: u32, ijb: (i64, i64)) -> u32 {
+        let (di, dj) = (ijb.0 - ija.0, ijb.1 - ija.1);
+        if di.abs() <= REACH && dj.abs() <= REACH {
+            self.near[a as usize * WIDTH * WIDTH + ((dj + REACH) as usize) * WIDTH + (di + REACH) as usize]
+        } else {
+            *self.far.get(&(a, b)).unwrap_or(&NONE)
+        }
     }
 
     /// The block of pair (a, b), if the pattern has it.
@@ -75,7 +97,13 @@ impl Pattern {
     /// pairs of each of the node `groups` (tied faces, pressure-projection cells), on a ghosted grid
     /// of `nx × ny` nodes.
     pub fn build(st: &Stencils, owned: &[u32], groups: &[Vec<u32>], nx: usize, ny: usize) -> Pattern {
-        let mut p = Pattern { pairs: Vec::new(), near: vec![NONE; nx * ny * WIDTH * WIDTH], far: HashMap::new(), nx };
+        let mut p = Pattern {
+            pairs: Vec::new(),
+            near: vec![NONE; nx * ny * WIDTH * WIDTH],
+            far: HashMap::new(),
+            nx,
+            row_start: Vec::new(),
+        };
         for &a in owned {
             p.insert(a, a);
         }
@@ -94,25 +122,42 @@ impl Pattern {
                 }
             }
         }
+        p.sort(nx * ny);
         p
     }
 
-    /// Every particle's slot map (the block of each pair of its effective nodes, row-major), or
-    /// `None` if some pair is missing from this pattern.
-    pub fn slots(&self, st: &Stencils) -> Option<(Vec<usize>, Vec<u32>)> {
-        let mut offsets = Vec::with_capacity(st.len() + 1);
-        offsets.push(0);
-        let mut slots = Vec::new();
-        for k in 0..st.len() {
-            let eff = st.effective(k);
-            for &a in eff {
-                for &b in eff {
-                    slots.push(self.block(a, b)?);
+    /// Sorts the list by (a, b) and renumbers the blocks accordingly.
+    fn sort(&mut self, nodes: usize) {
+        self.pairs.sort_unstable();
+        self.far.clear();
+        for (v, &(a, b)) in self.pairs.iter().enumerate() {
+            match self.offset(a, b) {
+                Some(o) => self.near[o] = v as u32,
+                None => {
+                    self.far.insert((a, b), v as u32);
                 }
             }
-            offsets.push(slots.len());
         }
-        Some((offsets, slots))
+        self.row_start = vec![0; nodes + 1];
+        for &(a, _) in &self.pairs {
+            self.row_start[a as usize + 1] += 1;
+        }
+        for a in 0..nodes {
+            self.row_start[a + 1] += self.row_start[a];
+        }
+    }
+
+    /// The first block of row node `a` (`a` may be one past the last node).
+    pub fn row_start(&self, a: u32) -> usize {
+        self.row_start[a as usize] as usize
+    }
+
+    /// Whether the pattern holds every pair of every particle's effective nodes.
+    pub fn covers(&self, st: &Stencils) -> bool {
+        (0..st.len()).all(|k| {
+            let eff = st.effective(k);
+            eff.iter().all(|&a| eff.iter().all(|&b| self.block(a, b).is_some()))
+        })
     }
 
     /// Number of blocks.
@@ -166,14 +211,20 @@ mod tests {
         let p = Pattern::build(&st, &[11], &[], 10, 10);
         // 16 + 16 − 4 shared + 4 for the far particle; (11, 11) is already a particle pair.
         assert_eq!(p.len(), 16 + 16 - 4 + 4);
-        let (offsets, slots) = p.slots(&st).unwrap();
-        assert_eq!(offsets, vec![0, 16, 32, 36]);
-        assert!(slots.iter().all(|&s| (s as usize) < p.len()));
-        assert_eq!(p.pairs[slots[16 + 1] as usize], (12, 13));
-        assert_eq!(p.pairs[slots[32 + 1] as usize], (30, 35));
+        assert!(p.covers(&st));
+        // Sorted by (a, b), with the rows' ranges.
+        assert!(p.pairs.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(p.row_start(12) - p.row_start(11), 4);
+        assert_eq!(p.pairs[p.row_start(30)], (30, 30));
+        assert_eq!(p.row_start(100), p.len());
+        assert_eq!(p.pairs[p.block(12, 13).unwrap() as usize], (12, 13));
+        assert_eq!(p.block_at(12, p.ij(12), 13, p.ij(13)), p.block(12, 13).unwrap());
+        assert_eq!(p.pairs[p.block(30, 35).unwrap() as usize], (30, 35));
+        assert_eq!(p.block_at(30, p.ij(30), 35, p.ij(35)), p.block(30, 35).unwrap());
+        assert_eq!(p.block_at(30, p.ij(30), 36, p.ij(36)), NONE);
         // A particle needing a pair the pattern lacks.
         let other = stencils(&[&[11, 44]]);
-        assert!(p.slots(&other).is_none());
+        assert!(!p.covers(&other));
         let (rows, cols) = p.coo(2, &(0..200).collect::<Vec<i32>>());
         assert_eq!(rows.len(), p.len() * 4);
         assert_eq!((rows[1], cols[1]), (22, 23));

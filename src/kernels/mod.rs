@@ -205,6 +205,15 @@ pub enum Integration {
 }
 
 impl Integration {
+    /// Whether a step starts from the last increment scaled to its Δt (a constant-rate predictor,
+    /// as static and consolidation codes do) rather than from Δd = 0. Without inertia the path is
+    /// smooth in the load, and the extrapolated increment leaves only the change of the rate to
+    /// Newton: an elastic load step then converges in one iteration instead of two. The dynamic
+    /// schemes start from Δd = 0, which is their own (Newmark) predictor of the motion.
+    pub fn extrapolates(&self) -> bool {
+        !matches!(self, Integration::Dynamic { .. })
+    }
+
     /// Newmark's method with β and γ.
     pub fn newmark(beta: f64, gamma: f64) -> Integration {
         Integration::Dynamic { beta, gamma, alpha_m: 0.0, alpha_f: 0.0 }
@@ -529,8 +538,11 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 pub struct StepResult {
     /// Interpolated increments, velocities and accelerations.
     pub interp: Interp,
-    /// The soil model's update (effective stress and ε̄ at t_{n+1}).
-    pub upd: StressUpdate,
+    /// The effective stress at t_{n+1} from the soil model [Pa] (its tangents are not kept: a
+    /// step's results are held for every particle at once).
+    pub stress: [f64; 4],
+    /// The accumulated deviatoric plastic strain ε̄ at t_{n+1} [-].
+    pub eps_pd: f64,
     /// Incremental deformation gradient the particle keeps, F̄ = (J_v/J)^{1/2} F.
     pub f_inc: [[f64; 2]; 2],
     /// Volume ratio of the step, J_v.
@@ -540,7 +552,13 @@ pub struct StepResult {
 impl StepResult {
     /// The result of the converged point.
     pub fn of(pt: &Point) -> StepResult {
-        StepResult { interp: pt.interp, upd: pt.upd, f_inc: pt.kin.f_bar(), jacobian: pt.kin.jv }
+        StepResult {
+            interp: pt.interp,
+            stress: pt.upd.stress,
+            eps_pd: pt.upd.eps_pd,
+            f_inc: pt.kin.f_bar(),
+            jacobian: pt.kin.jv,
+        }
     }
 }
 

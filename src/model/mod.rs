@@ -332,7 +332,7 @@ impl Model {
         let finite = [
             ("displacement increment", it.du[0].is_finite() && it.du[1].is_finite()),
             ("velocity", it.v_u[0].is_finite() && it.v_u[1].is_finite() && it.a_u.iter().all(|a| a.is_finite())),
-            ("effective stress", step.upd.stress.iter().all(|s| s.is_finite())),
+            ("effective stress", step.stress.iter().all(|s| s.is_finite())),
             ("pore pressure increment", it.dp.is_finite()),
             ("volume ratio", j.is_finite()),
         ];
@@ -394,8 +394,8 @@ impl Model {
             ps.x[k][c] += it.du[c];
             ps.disp[k][c] += it.du[c];
         }
-        ps.stress[k] = step.upd.stress;
-        ps.eps_pd[k] = step.upd.eps_pd;
+        ps.stress[k] = step.stress;
+        ps.eps_pd[k] = step.eps_pd;
         ps.p[k] += dp;
         ps.volume[k] *= j;
         ps.porosity[k] = n_new;
