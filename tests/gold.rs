@@ -201,6 +201,7 @@ macro_rules! gold_tests {
 }
 
 gold_tests!(
+    consolidation_layer,
     elastic_column,
     footing_ld,
     footing_near_slope,

@@ -3,17 +3,22 @@
 //! A DMDA holds the background grid (dofs of the layout interlaced per node), so that the
 //! distribution of nodes over ranks, ghost nodes and the global numbering come from PETSc. Every
 //! step ([`GridSystem::prepare_step`]) runs the same named steps, whatever the analysis:
-//! 1. [`stencils::build`]: each particle's stencil (nodes, S, ∇S, ∇̄S) on x_n, once per step; a
-//!    support reaching past the grid is an error;
-//! 2. [`GridSystem::project`]: masses, momenta, mass-weighted accelerations, porosities and filled
-//!    fractions mapped to the nodes ([003] Eq. 19) and summed over ranks;
-//! 3. [`dofs::build`]: the dof map — free dofs, dofs fixed by the active boundaries (with their
-//!    prescribed increments) and the dofs of nodes the material barely fills;
-//! 4. [`stencils::extend`]: each particle's effective stencil, extending the motion of barely
-//!    filled nodes from well-filled ones (see [`stencils`]), then its Newmark predictors and
-//!    porosity gradient, the pressure-projection blocks and the external forces at t_{n+1}, with
-//!    the check that every applied force reaches a node that carries it;
-//! 5. [`pattern`]: the COO pattern of the matrix, kept while it holds every pair the particles need.
+//! 1. `stencils_on_xn` ([`stencils::build`]): each particle's stencil (nodes, S, ∇S, ∇̄S) on x_n,
+//!    once per step; a support reaching past the grid is an error;
+//! 2. `project`: masses, momenta, mass-weighted accelerations, porosities and filled fractions
+//!    mapped to the nodes ([003] Eq. 19) and summed over ranks;
+//! 3. `dof_map` ([`dofs::build`]): the dof map — free dofs, dofs fixed by the active boundaries
+//!    (with their prescribed increments) and the dofs of nodes the material barely fills; then the
+//!    grid-edge check and [`stencils::extend`]: each particle's effective stencil, extending the
+//!    motion of barely filled nodes from well-filled ones (see [`stencils`]);
+//! 4. `step_data`: the threads' bands, the Newmark predictors and porosity gradients, the
+//!    pressure-projection blocks and the external forces at t_{n+1}, with the check that every
+//!    applied force reaches a node that carries it, the generalized-α history and the force scale;
+//! 5. `matrix_pattern` ([`pattern`]): the COO pattern of the matrix, kept while it holds every
+//!    pair the particles need.
+//!
+//! The analysis type enters only through the layout (which fields a node carries) and the
+//! [`kernels::Scheme`] of the step.
 //!
 //! [`GridSystem::solve`] then runs PETSc SNES with residual and Jacobian callbacks
 //! ([`callbacks`]) that loop over particles, call the pure kernels of [`crate::kernels`], map their
@@ -44,7 +49,7 @@ use pattern::Pattern;
 use petsc::ksp::KspOps;
 use petsc::{Comm, DmDa, GhostedRange, LogStage, Mat, Options, Snes, StageGuard, VecOps, Vector};
 use std::time::Instant;
-use stencils::Stencils;
+use stencils::{Crossing, Stencils};
 
 /// Errors of the global system.
 pub type Error = petsc::Error;
@@ -329,7 +334,8 @@ impl GridSystem {
     }
 
     /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
-    /// boundaries (see the module documentation). Collective; every rank returns the same outcome.
+    /// boundaries (see the module documentation), in the named steps every analysis type shares.
+    /// Collective; every rank returns the same outcome.
     pub fn prepare_step(
         &mut self,
         model: &Model,
@@ -339,10 +345,21 @@ impl GridSystem {
         coll: &Collective,
         body_names: &[String],
     ) -> Result<(), String> {
-        let nd = self.layout.nd;
         // The last step's maps go first, so that the new ones do not sit beside them.
         let old_pattern = std::mem::take(&mut self.step).pattern;
-        // 1. Stencils on x_n (B̄'s cells first: which cells the material fills, summed over ranks).
+        let (mut st, crossings) = self.stencils_on_xn(model, coll)?;
+        let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
+        let dofs = self.dof_map(model, active, (t_new - dt, t_new), &nodal, coll)?;
+        coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
+        stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
+        self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
+        self.matrix_pattern(old_pattern, coll)
+    }
+
+    /// Step 1: the stencils on x_n (B̄'s cells first: which cells the material fills, summed over
+    /// ranks), and the particles whose support crosses a side of the grid.
+    fn stencils_on_xn(&mut self, model: &Model, coll: &Collective) -> Result<(Stencils, Vec<Crossing>), String> {
+        let nd = self.layout.nd;
         let roots = if model.bbar {
             let mut phi = vec![0.0; self.ghost.len() * nd];
             for (l, f) in stencils::cell_fractions(model, &self.ghost).into_iter().enumerate() {
@@ -354,12 +371,21 @@ impl GridSystem {
         } else {
             stencils::CellRoots::identity()
         };
-        let (mut st, crossings) = coll.agree(stencils::build(model, &self.ghost, &roots))?;
-        // 2. Projections to the nodes, summed over ranks.
-        let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
-        // 3. The dof map.
-        // Moving surfaces: per surface boundary, the dofs any rank's particles fix, summed over ranks;
-        // a dof takes the first such boundary in case order.
+        coll.agree(stencils::build(model, &self.ghost, &roots))
+    }
+
+    /// Step 3: the dof map of the step `(t_n, t_{n+1})`. Moving surfaces: per surface boundary, the
+    /// dofs any rank's particles fix, summed over ranks; a dof takes the first such boundary in
+    /// case order.
+    fn dof_map(
+        &mut self,
+        model: &Model,
+        active: &Active,
+        times: (f64, f64),
+        nodal: &Nodal,
+        coll: &Collective,
+    ) -> Result<DofMap, String> {
+        let nd = self.layout.nd;
         let fixes = model.surface_fixes(active);
         let mut surface = vec![0.0; self.ghost.len() * nd];
         for &bi in active.boundaries.iter().filter(|&&b| model.boundaries[b].surface.is_some()) {
@@ -381,7 +407,7 @@ impl GridSystem {
         let mut dofs = dofs::build(
             model,
             active,
-            (t_new - dt, t_new),
+            times,
             &self.ghost,
             self.owned_start,
             self.owned_count,
@@ -392,22 +418,37 @@ impl GridSystem {
             self.layout.w,
         );
         dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
-        coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
-        // 4. Effective stencils, predictors, porosity gradients, projection blocks, loads.
-        stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
+        Ok(dofs)
+    }
+
+    /// Step 4: the data the callbacks use (`self.step`), from the effective stencils `st` and the dof map: the
+    /// threads' bands, the predictors, porosity gradients, pressure-projection blocks, external
+    /// loads (checked against what the nodes carry), the generalized-α history and the force
+    /// scale of the Newton floor.
+    #[allow(clippy::too_many_arguments)]
+    fn step_data(
+        &mut self,
+        model: &Model,
+        active: &Active,
+        (t_old, t_new): (f64, f64),
+        st: Stencils,
+        dofs: DofMap,
+        nodal: &Nodal,
+        coll: &Collective,
+    ) -> Result<(), String> {
         let bands = callbacks::bands(&st, self.ghost.count[0], self.ghost.count[1], coll.threads());
-        let (smooth, grad_n) = self.predictors(model, &st, &dofs, &nodal);
+        let (smooth, grad_n) = self.predictors(model, &st, &dofs, nodal);
         let projection = self.projection_blocks(model);
         let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
-        let nm = kernels::Scheme::of(&model.integration, dt, flow);
+        let nm = kernels::Scheme::of(&model.integration, t_new - t_old, flow);
         let fext_old = match nm.history() {
-            Some(_) => Some(coll.agree(self.external_forces(model, active, t_new - dt, &dofs))?.0),
+            Some(_) => Some(coll.agree(self.external_forces(model, active, t_old, &dofs))?.0),
             None => None,
         };
         self.step = StepData {
             nm: Some(nm),
-            dt,
+            dt: t_new - t_old,
             layout: Some(self.layout),
             body_acc: model.body_accelerations(active, t_new),
             stencils: st,
@@ -422,13 +463,18 @@ impl GridSystem {
         };
         self.check_loads(&applied, t_new, coll)?;
         if let Some(old) = fext_old {
-            self.step.history = self.history(model, &model.body_accelerations(active, t_new - dt), &old);
+            self.step.history = self.history(model, &model.body_accelerations(active, t_old), &old);
         }
         self.step.force_scale = self.force_scale(model, coll)?;
-        // 5. The matrix pattern: kept if every rank finds every pair in it.
-        let kept = !old_pattern.is_empty() && old_pattern.covers(&self.step.stencils);
-        let rebuild = coll.any(!kept)?;
-        let pattern = if rebuild {
+        Ok(())
+    }
+
+    /// Step 5: the matrix pattern, kept (`old`) if every rank finds every pair in it, and where the
+    /// pressure-projection cells and the fixed dofs' diagonals lie in it.
+    fn matrix_pattern(&mut self, old: Pattern, coll: &Collective) -> Result<(), String> {
+        let nd = self.layout.nd;
+        let kept = !old.is_empty() && old.covers(&self.step.stencils);
+        let pattern = if coll.any(!kept)? {
             let [nx, ny] = self.ghost.count;
             let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
             let p = Pattern::build(&self.step.stencils, &self.owned_nodes, &groups, nx, ny);
@@ -438,7 +484,7 @@ impl GridSystem {
             p
         } else {
             self.reused_patterns += 1;
-            old_pattern
+            old
         };
         let projection_blocks: Option<Vec<[u32; 16]>> = self
             .step

@@ -6,7 +6,8 @@
 //!
 //! * Terzaghi ([003] §4.1.1): `e_p_Tv<T>` is [003] Eq. 33, sqrt(Σ (P*−P)²)/N over the particles of
 //!   the column (note: divided by N, not √N), with P = p/q; `p_rms_error_Tv<T>` is the plain RMS
-//!   sqrt(Σ (P*−P)²/N); `settlement_rel_error_Tv<T>` compares the settlement with Terzaghi's. The
+//!   sqrt(Σ (P*−P)²/N) at every T_v; `settlement_rel_error_Tv<T>` (at the last T_v) compares the
+//!   settlement with Terzaghi's. The
 //!   settlement of the laterally confined column is its loss of volume per unit width,
 //!   (Σ V₀ − Σ V)/w, which follows every particle's J. The analytical P* is evaluated at each
 //!   particle's initial depth below the drained top, at the time the run reaches T_v (the time
@@ -481,8 +482,10 @@ impl Check for ConsolidationCheck {
                 ),
             };
             out.push((format!("e_p_{}", tg.label), e_p));
+            // The RMS over the particles (not divided by their number) beside e_p at every time:
+            // e_p falls as 1/√N with the particle count for the same pointwise error.
+            out.push((format!("p_rms_error_{}", tg.label), rms));
             if tg.full {
-                out.push((format!("p_rms_error_{}", tg.label), rms));
                 out.push((format!("settlement_rel_error_{}", tg.label), se));
             }
         }
