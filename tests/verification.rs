@@ -67,8 +67,12 @@ fn family(case: &str, sets: &[&str], expected: &[&str], agree: f64) -> BTreeMap<
 
 #[test]
 fn terzaghi_consolidation_meets_its_targets_with_every_strategy() {
-    let m =
-        family("terzaghi", &[], &["e_p_Tv0.1", "e_p_Tv0.5", "p_rms_error_Tv0.5", "settlement_rel_error_Tv0.5"], 1e-6);
+    let m = family(
+        "terzaghi",
+        &[],
+        &["e_p_Tv0.1", "e_p_Tv0.5", "p_rms_error_Tv0.1", "p_rms_error_Tv0.5", "settlement_rel_error_Tv0.5"],
+        1e-6,
+    );
     // The target at 10 cells and Δt = 1e-3 s.
     assert!(m["e_p_Tv0.1"].0 <= 1e-2 && m["e_p_Tv0.5"].0 <= 1e-2);
 }
