@@ -172,7 +172,11 @@ pub fn describe(case: &Case, label: &str) -> String {
         if gravity { "on" } else { "off" },
         if model.materials.iter().all(|m| m.model.is_linear()) { "never called (elastic)" } else { "on" },
         if model.bbar { "on" } else { "off" },
-        if model.patch_recovery { "on" } else { "off" },
+        match (model.patch_recovery, model.pressure_update) {
+            (_, crate::case::PressureUpdate::ProjectedTotal) => "off (pressure from the projected total field)",
+            (true, _) => "on",
+            (false, _) => "off",
+        },
         match (model.basis, model.stretch_domains) {
             (crate::model::shape::Basis::Linear, _) => "none (linear basis)",
             (_, true) => "follow the stretch",

@@ -562,10 +562,14 @@ impl<'a> Simulation<'a> {
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
-        let recovered = if self.model.two_phase && self.model.patch_recovery && self.system.layout().p.is_some() {
-            Some(self.system.recovered_pressure_increments(&self.model))
-        } else {
-            None
+        let recovered = match (self.model.pressure_update, self.system.layout().p.is_some()) {
+            (crate::case::PressureUpdate::ProjectedTotal, true) => Some(
+                self.system.projected_pressure_increments(&self.model).map_err(|e| RunError::Failed(e.to_string()))?,
+            ),
+            (_, true) if self.model.two_phase && self.model.patch_recovery => {
+                Some(self.system.recovered_pressure_increments(&self.model))
+            }
+            _ => None,
         };
         for (k, r) in results.iter().enumerate() {
             let dp = recovered.as_ref().map_or(r.interp.dp, |v| v[k]);

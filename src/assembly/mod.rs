@@ -47,7 +47,8 @@ use dofs::DofMap;
 use mpi::raw::AsRaw;
 use pattern::Pattern;
 use petsc::ksp::KspOps;
-use petsc::{Comm, DmDa, GhostedRange, LogStage, Mat, Options, Snes, StageGuard, VecOps, Vector};
+use petsc::mat::MatOps;
+use petsc::{Comm, DmDa, GhostedRange, Ksp, LogStage, Mat, Options, Snes, StageGuard, VecOps, Vector};
 use std::time::Instant;
 use stencils::{Crossing, Stencils};
 
@@ -180,6 +181,8 @@ pub struct GridSystem {
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
+    /// The one-field DMDA and CG solver of the pressure's L² projection (built on first use).
+    l2_projection: Option<(DmDa, Ksp)>,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
     /// The owned part of the last accepted step's Δd and its Δt, the predictor of the next step
@@ -273,6 +276,7 @@ impl GridSystem {
             user_atol,
             reused_patterns: 0,
             last_increment: None,
+            l2_projection: None,
             step: StepData::default(),
             stages,
         })
@@ -950,6 +954,82 @@ impl GridSystem {
         (0..model.particles.len())
             .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).interp.dp))
             .collect()
+    }
+
+    /// Pore-pressure increments that make each particle's pressure the interpolation of the total
+    /// nodal field, p_{n+1} = Σ S_i (P_i + Δp_i) (`stabilisation.pressure_update =
+    /// "projected_total"`). P is the consistent L² projection of the particles' pressures p_n onto
+    /// the nodal functions: M P = b with M_ij = Σ_p V_p S_ip S_jp and b_i = Σ_p V_p S_ip p_p, solved
+    /// by CG with Jacobi (options prefix `pressure_projection_`, relative tolerance 1e-12). A
+    /// pressure field the nodes represent comes back unchanged (no smoothing, unlike a lumped
+    /// projection), and what they cannot represent is dropped instead of accumulating on the
+    /// particles. Nodes no particle reaches get P = 0 (a regularisation of 1e-12 of a cell's area
+    /// on every diagonal). Collective.
+    pub fn projected_pressure_increments(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
+        let nd = self.layout.nd;
+        let pc = self.layout.p.expect("a pressure");
+        if self.l2_projection.is_none() {
+            let dm = DmDa::new_2d(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"])?;
+            let mut ksp = Ksp::new(self.comm)?;
+            ksp.set_prefix("pressure_projection_")?;
+            ksp.set_type("cg")?;
+            ksp.pc()?.set_type("jacobi")?;
+            ksp.set_tolerances(Some(1e-12), Some(0.0), Some(10_000))?;
+            ksp.set_from_options()?;
+            self.l2_projection = Some((dm, ksp));
+        }
+        let (dm1, ksp) = self.l2_projection.as_mut().expect("built above");
+        let pattern = &self.step.pattern;
+        let (rows, cols) = pattern.coo(1, dm1.local_to_global());
+        let mut mat = dm1.create_matrix_coo(&rows, &cols)?;
+        let mut values = vec![0.0; pattern.len()];
+        let ng = self.ghost.len();
+        let mut b = vec![0.0; ng];
+        let ps = &model.particles;
+        let st = &self.step.stencils;
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
+            for (&a, ba) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
+                let w = ps.volume[k] * ba.s;
+                b[a as usize] += w * ps.p[k];
+                let ija = pattern.ij(a);
+                for (&c, bc) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
+                    values[pattern.block_at(a, ija, c, pattern.ij(c)) as usize] += w * bc.s;
+                }
+            }
+        }
+        let eps = 1e-12 * model.grid.h[0] * model.grid.h[1];
+        for &a in &self.owned_nodes {
+            values[pattern.block(a, a).expect("owned diagonal blocks are listed") as usize] += eps;
+        }
+        mat.set_values_coo(&values, false)?;
+        let mut b_local = dm1.create_local_vector()?;
+        b_local.write()?.copy_from_slice(&b);
+        let mut b_global = dm1.create_global_vector()?;
+        b_global.set_all(0.0)?;
+        dm1.local_to_global_add(&b_local, &mut b_global)?;
+        let mut p_global = dm1.create_global_vector()?;
+        ksp.set_operators(&mat, &mat)?;
+        let out = ksp.solve(&b_global, &mut p_global)?;
+        if out.reason <= 0 {
+            return Err(Error::new(format!(
+                "the L² projection of the pore pressure (stabilisation.pressure_update = \"projected_total\") did not \
+                 converge: {} after {} CG iterations",
+                out.reason_text, out.iterations
+            )));
+        }
+        let mut p_local = dm1.create_local_vector()?;
+        dm1.global_to_local(&p_global, &mut p_local)?;
+        let total: Vec<f64> = {
+            let pl = p_local.read()?;
+            (0..ng).map(|l| pl[l] + self.step.solution[l * nd + pc]).collect()
+        };
+        Ok((0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                nodes.iter().zip(basis).map(|(&n, nb)| nb.s * total[n as usize]).sum::<f64>() - ps.p[k]
+            })
+            .collect())
     }
 
     /// The nodes this rank owns after the last solve, as records of 7 values: global node index

@@ -615,6 +615,24 @@ pub struct Stabilisation {
     /// none.
     #[serde(default)]
     pub pressure_projection: Option<f64>,
+    /// How a particle's pore pressure follows a converged step (two-phase): `increments` (the
+    /// default: p += the interpolated, or patch-recovered, increment) or `projected_total` (p is
+    /// the interpolation of the total nodal field P + Δp, P the consistent L² projection of the
+    /// particles' pressures onto the nodal functions, so that whatever the nodes cannot represent
+    /// does not accumulate on the particles). Not with `patch_recovery`.
+    #[serde(default)]
+    pub pressure_update: PressureUpdate,
+}
+
+/// How a particle's pore pressure follows a converged step (see [`Stabilisation::pressure_update`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PressureUpdate {
+    /// p_{n+1} = p_n + Σ S_i Δp_i (or its MLSA recovery).
+    #[default]
+    Increments,
+    /// p_{n+1} = Σ S_i (P_i + Δp_i), M P = Σ_p V_p S p_n with the consistent M.
+    ProjectedTotal,
 }
 
 /// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none

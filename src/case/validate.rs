@@ -72,6 +72,19 @@ pub fn validate(c: &Case) -> R {
     let two_phase = c.analysis.formulation == Formulation::TwoPhase;
     positive("analysis.g", c.analysis.g)?;
 
+    if c.stabilisation.pressure_update == PressureUpdate::ProjectedTotal {
+        if !two_phase {
+            return Err("key `stabilisation.pressure_update`: `projected_total` needs a two-phase case".into());
+        }
+        if c.stabilisation.patch_recovery == Some(true) {
+            return Err(
+                "keys `stabilisation.pressure_update = \"projected_total\"` and `stabilisation.patch_recovery = \
+                        true` exclude each other: choose one way to update the particles' pressure"
+                    .into(),
+            );
+        }
+    }
+
     // Grid.
     finite2("grid.origin", c.grid.origin)?;
     positive("grid.size[0]", c.grid.size[0])?;

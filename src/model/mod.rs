@@ -46,6 +46,8 @@ pub struct Model {
     pub bbar: bool,
     /// MLSA patch recovery of the pore-pressure increments ([003] §3.3).
     pub patch_recovery: bool,
+    /// How the particles' pressure follows a converged step (two-phase).
+    pub pressure_update: crate::case::PressureUpdate,
     /// Number of bodies of the case.
     pub n_bodies: usize,
     /// Factor α of the pressure-projection stabilisation τ = α/G (two-phase), if on.
@@ -126,6 +128,7 @@ impl Model {
             } else {
                 None
             },
+            pressure_update: case.stabilisation.pressure_update,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
