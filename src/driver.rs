@@ -51,6 +51,8 @@ pub struct RunRequest<'a> {
     pub checkpoint_every: usize,
     /// Continue from this checkpoint (its path as given, and its content).
     pub restart: Option<(String, Checkpoint)>,
+    /// Set by `main`'s SIGINT/SIGTERM handler: stop after the current step.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Why a run stopped early.
@@ -60,13 +62,15 @@ pub enum RunError {
     Input(String),
     /// The run could not continue (e.g. a step that does not converge after the allowed cuts).
     Failed(String),
+    /// SIGINT or SIGTERM: the run stopped after a complete step, with its fields and a checkpoint.
+    Interrupted(String),
 }
 
 impl RunError {
     /// The message.
     pub fn message(&self) -> &str {
         match self {
-            RunError::Input(m) | RunError::Failed(m) => m,
+            RunError::Input(m) | RunError::Failed(m) | RunError::Interrupted(m) => m,
         }
     }
 }
@@ -198,6 +202,8 @@ struct Simulation<'a> {
     /// Step of the last field output.
     fields_step: Option<usize>,
     checkpoint_every: usize,
+    /// `main`'s SIGINT/SIGTERM flag.
+    interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Names of the bodies (for messages).
     body_names: Vec<String>,
     /// The last converged step's equilibrium error and boundary reactions.
@@ -235,6 +241,13 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
     let err = result.err();
     match &err {
         None => summary.status = "completed".into(),
+        Some(RunError::Interrupted(m)) => {
+            summary.status = "interrupted".into();
+            summary.error = Some(m.clone());
+            if summary.verification_passed.is_some() {
+                summary.verification_passed = Some(false);
+            }
+        }
         Some(e) => {
             summary.status = "failed".into();
             summary.error = Some(e.message().to_string());
@@ -381,6 +394,7 @@ impl<'a> Simulation<'a> {
             resume: None,
             fields_step: None,
             checkpoint_every: req.checkpoint_every,
+            interrupt: req.interrupt.clone(),
             body_names: case.bodies.iter().map(|b| b.name.clone()).collect(),
             equilibrium: (0.0, vec![[0.0; 2]; case.boundaries.len()]),
         };
@@ -462,6 +476,7 @@ impl<'a> Simulation<'a> {
                     if self.checkpoint_every > 0 && self.step.is_multiple_of(self.checkpoint_every) {
                         self.write_checkpoint(stage_index, &control)?;
                     }
+                    self.stop_if_interrupted(stage_index, &control)?;
                     if stopping {
                         if !control.finished(self.t) && !self.step.is_multiple_of(self.case.output.history_every) {
                             self.record_step(dt)?;
@@ -715,6 +730,32 @@ impl<'a> Simulation<'a> {
     }
 
     /// Writes `checkpoint.h5` after an accepted step in stage `stage_index`.
+    /// After a complete step: if any rank was sent SIGINT or SIGTERM (agreed across ranks), write
+    /// the step's history row and fields and a checkpoint to restart from, and stop. Otherwise
+    /// keep the running summary's counts up to date (rank 0 rewrites summary.json atomically
+    /// every history row).
+    fn stop_if_interrupted(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
+        let local = self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst));
+        if !self.coll.any(local).map_err(RunError::Failed)? {
+            if self.step.is_multiple_of(self.case.output.history_every) {
+                self.out.write_summary(&*self.summary).map_err(RunError::Failed)?;
+            }
+            return Ok(());
+        }
+        if !self.step.is_multiple_of(self.case.output.history_every) {
+            self.record_step(control.dt)?;
+        }
+        self.write_fields()?;
+        self.write_checkpoint(stage_index, control)?;
+        Err(RunError::Interrupted(format!(
+            "interrupted (SIGINT or SIGTERM) at t = {:.6e} s after {} complete steps; the fields of the last step and \
+             checkpoint.h5 are written: continue with `porompm run ... --restart {}`",
+            self.t,
+            self.step,
+            self.out.path_of("checkpoint.h5")
+        )))
+    }
+
     fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
         let t0 = Instant::now();
         let ps = &self.model.particles;

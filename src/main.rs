@@ -11,6 +11,8 @@ use porompm::io::{self, RunOutput};
 use porompm::parallel::Collective;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 #[derive(Parser)]
 #[command(name = "porompm", version = porompm::VERSION_LONG, about = "Implicit u–p–U GIMP material point method for saturated soils, on PETSc")]
@@ -191,6 +193,7 @@ fn run(
         if !f.is_file() {
             return Err(input(format!("PETSc options file {} does not exist", f.display())));
         }
+        io::check_petsc_options_file(f).map_err(input)?;
     }
     let mut args: Vec<String> = Vec::new();
     for f in &files {
@@ -198,6 +201,14 @@ fn run(
         args.push(f.display().to_string());
     }
     args.extend(petsc_args.iter().cloned());
+    // SIGINT and SIGTERM: the first asks the run to stop after its current step (with fields and a
+    // checkpoint); a second one exits at once (code 130).
+    let interrupt = Arc::new(AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&interrupt))
+            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&interrupt)))
+            .map_err(|e| input(format!("cannot install the signal handler: {e}")))?;
+    }
     let (universe, mut coll, petsc) = start_mpi_and_petsc(&args)?;
     if let Some(n) = cont.threads {
         coll.set_threads(n as usize);
@@ -212,6 +223,7 @@ fn run(
         coll: &coll,
         checkpoint_every: cont.checkpoint_every,
         restart,
+        interrupt: Some(interrupt),
     };
     let (summary, err) = driver::run(&req, &mut output);
     drop(output);
@@ -242,6 +254,7 @@ fn run(
         None => Ok(()),
         Some(RunError::Input(m)) => Err(input(m)),
         Some(RunError::Failed(m)) => Err(Failure { code: 1, message: m }),
+        Some(RunError::Interrupted(m)) => Err(Failure { code: 130, message: m }),
     }
 }
 
@@ -280,6 +293,7 @@ fn test_jacobian(
         coll: &coll,
         checkpoint_every: 0,
         restart: None,
+        interrupt: None,
     };
     let result = driver::test_jacobian(&req, steps, flip);
     drop(petsc);

@@ -110,6 +110,17 @@ fn an_out_of_range_value_is_named_with_its_range() {
     assert_one_line_error(&o, "hydraulic_conductivity`: must be a positive number");
     let o = porompm(&["check", "cases/terzaghi.toml", "--set", "time_integration.gamma=0.4"]);
     assert_one_line_error(&o, "not unconditionally stable");
+    // Absurd magnitudes: each named with its bound.
+    for (set, needle) in [
+        ("materials.soil.model.young_modulus=1e308", "young_modulus`: must be at most 1e13 Pa"),
+        ("materials.soil.water_bulk_modulus=1e20", "water_bulk_modulus`: must be at most 1e13 Pa"),
+        ("materials.soil.solid_bulk_modulus=1e14", "solid_bulk_modulus`: must be at most 1e13 Pa"),
+        ("materials.soil.hydraulic_conductivity=5", "hydraulic_conductivity`: must be at most 1e0 m/s"),
+        ("materials.soil.solid_density=1e6", "solid_density`: must be at most 1e5 kg/m³"),
+    ] {
+        let o = porompm(&["check", "cases/terzaghi.toml", "--set", set]);
+        assert_one_line_error(&o, needle);
+    }
 }
 
 #[test]
@@ -513,4 +524,103 @@ fn a_nan_in_the_solve_ends_every_rank_failed() {
     let err = stderr(&o);
     assert_eq!(err.lines().filter(|l| l.starts_with("error:")).count(), 1, "{err}");
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// Sends `signal` (`INT` or `TERM`) to a `porompm run` once its running summary counts `after`
+/// steps, and returns its exit status.
+fn interrupt_run(args: &[&str], dir: &Path, signal: &str, after: u64) -> std::process::ExitStatus {
+    let mut child = Command::new(bin())
+        .args(args)
+        .current_dir(root())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("the porompm binary runs");
+    let t0 = std::time::Instant::now();
+    loop {
+        let steps = std::fs::read_to_string(dir.join("summary.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .and_then(|s| s["steps"].as_u64())
+            .unwrap_or(0);
+        if steps >= after {
+            break;
+        }
+        assert!(t0.elapsed().as_secs() < 120, "the run never reached {after} steps");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let sent = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+    assert!(sent.success());
+    child.wait().unwrap()
+}
+
+/// SIGINT (and SIGTERM) stop a run after a complete step: exit code 130, `summary.json` says
+/// `interrupted` with the steps done and how to continue, the last step's fields and a checkpoint
+/// are written, and `--restart` from it ends with the metrics of an uninterrupted run; the running
+/// summary counts the steps while the run goes.
+#[test]
+fn an_interrupted_run_leaves_a_checkpoint_and_its_restart_matches_the_uninterrupted_run() {
+    let full = out_dir("interrupt-full");
+    let base =
+        ["run", "cases/terzaghi.toml", "--quiet", "--set", "stages.0.duration=2", "--set", "output.history_every=1"];
+    let o = porompm(&[&base[..], &["--out", full.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    for signal in ["INT", "TERM"] {
+        let dir = out_dir(&format!("interrupt-{signal}"));
+        let args = [&base[..], &["--out", dir.to_str().unwrap()]].concat();
+        let status = interrupt_run(&args, &dir, signal, 50);
+        assert_eq!(status.code(), Some(130), "SIG{signal}: exit status {status:?}");
+        let s = summary(&dir);
+        assert_eq!(s["status"], "interrupted", "SIG{signal}: {s}");
+        let steps = s["steps"].as_u64().unwrap();
+        assert!((50..2000).contains(&steps), "SIG{signal}: {steps} steps");
+        assert!(s["error"].as_str().unwrap().contains("--restart"), "{s}");
+        for f in ["checkpoint.h5", "fields.h5", "fields.xdmf", "history.csv"] {
+            assert!(dir.join(f).is_file(), "SIG{signal}: {f} missing");
+        }
+        let cp = dir.join("checkpoint.h5");
+        let o = porompm(&[&args[..], &["--restart", cp.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "restart after SIG{signal}: {}", stderr(&o));
+        let (a, b) = (summary(&dir), summary(&full));
+        assert_eq!(a["steps"], b["steps"]);
+        for (name, m) in b["verification"].as_object().unwrap() {
+            let (x, y) = (a["verification"][name]["value"].as_f64().unwrap(), m["value"].as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 1e-9 * y.abs(),
+                "SIG{signal}: {name} {x:e} after the restart, {y:e} uninterrupted"
+            );
+        }
+    }
+}
+
+/// Garbage in a PETSc options file is one clear porompm error naming the file and line, never
+/// PETSc's traceback: text that is not an option, binary content, an incomplete `alias`, and a
+/// nested `-options_file` that does not exist. Every shipped options file passes the same check.
+#[test]
+fn garbage_in_an_options_file_is_one_clear_error() {
+    let dir = out_dir("garbage-options");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, &[u8], &str); 4] = [
+        ("text.opts", b"# a comment\n-ksp_type preonly\nthis is not an option\n", "line 3: `this` is not an option"),
+        ("binary.opts", &[0xff, 0xfe, 0x00, 0x13, 0x37, 0x80], "is not a text file"),
+        ("alias.opts", b"alias -only_one\n", "line 1: `alias` needs two option names"),
+        ("nested.opts", b"-options_file /nonexistent/porompm.opts\n", "/nonexistent/porompm.opts does not exist"),
+    ];
+    for (name, content, needle) in cases {
+        let f = dir.join(name);
+        std::fs::write(&f, content).unwrap();
+        let out = dir.join(format!("run-{name}"));
+        let o = porompm(&[
+            "run",
+            "cases/terzaghi.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--options-file",
+            f.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, needle);
+    }
+    for entry in std::fs::read_dir(root().join("petsc_options")).unwrap() {
+        let f = entry.unwrap().path();
+        porompm::io::check_petsc_options_file(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+    }
 }

@@ -128,18 +128,19 @@ pub struct Material {
     pub name: String,
     /// Initial porosity n [-].
     pub porosity: f64,
-    /// Density of the solid grains ρ_s [kg/m³].
+    /// Density of the solid grains ρ_s [kg/m³], in (0, 1e5].
     pub solid_density: f64,
-    /// Density of the pore water ρ_w [kg/m³].
+    /// Density of the pore water ρ_w [kg/m³], in (0, 1e5].
     #[serde(default = "default_rho_w")]
     pub water_density: f64,
-    /// Bulk modulus of the pore water K_w [Pa] (two-phase).
+    /// Bulk modulus of the pore water K_w [Pa] (two-phase), in (0, 1e13].
     #[serde(default)]
     pub water_bulk_modulus: Option<f64>,
-    /// Bulk modulus of the solid grains K_s [Pa]; `inf` for incompressible grains (two-phase).
+    /// Bulk modulus of the solid grains K_s [Pa], in (0, 1e13]; `inf` for incompressible grains
+    /// (two-phase).
     #[serde(default)]
     pub solid_bulk_modulus: Option<f64>,
-    /// Hydraulic conductivity k [m/s] (two-phase) at the initial porosity.
+    /// Hydraulic conductivity k [m/s] (two-phase) at the initial porosity, in (0, 1].
     #[serde(default)]
     pub hydraulic_conductivity: Option<f64>,
     /// How the conductivity changes with the void ratio (default: constant).
@@ -172,7 +173,7 @@ fn default_rho_w() -> f64 {
 pub enum SoilModel {
     /// Isotropic linear elasticity, plane strain.
     LinearElastic {
-        /// Young's modulus E [Pa].
+        /// Young's modulus E [Pa], in (0, 1e13].
         young_modulus: f64,
         /// Poisson's ratio ν [-].
         poisson_ratio: f64,
@@ -181,7 +182,7 @@ pub enum SoilModel {
     /// plastic strain and an optional tension cut-off ([000] §4; Tresca with `friction_angle = 0`,
     /// the cohesion being the undrained strength).
     MohrCoulomb {
-        /// Young's modulus E [Pa].
+        /// Young's modulus E [Pa], in (0, 1e13].
         young_modulus: f64,
         /// Poisson's ratio ν [-].
         poisson_ratio: f64,
@@ -210,7 +211,7 @@ pub enum SoilModel {
     },
     /// Von Mises with linear softening ([001] §3.2): q ≤ √3 c(ε̄), c = max(c_p + H_s ε̄, c_r).
     VonMises {
-        /// Young's modulus E [Pa].
+        /// Young's modulus E [Pa], in (0, 1e13].
         young_modulus: f64,
         /// Poisson's ratio ν [-].
         poisson_ratio: f64,

@@ -14,6 +14,28 @@ fn positive(key: &str, v: f64) -> R {
     }
 }
 
+/// Largest modulus accepted [Pa]: ten times diamond's Young's modulus. Beyond it a soil tangent
+/// holds no digits of the load (E = 1e308 overflowed to NaN before the run failed).
+pub const MAX_MODULUS: f64 = 1e13;
+/// Largest hydraulic conductivity accepted [m/s] (open gravel is about 1e-1).
+pub const MAX_CONDUCTIVITY: f64 = 1.0;
+/// Largest density accepted [kg/m³] (osmium is 22 590).
+pub const MAX_DENSITY: f64 = 1e5;
+
+/// A positive physical magnitude of at most `hi` (in `unit`), with the reason for the bound.
+fn magnitude(key: &str, v: f64, hi: f64, unit: &str, why: &str) -> R {
+    positive(key, v)?;
+    if v > hi {
+        return Err(format!("key `{key}`: must be at most {hi:e} {unit} ({why}), got {v:e}"));
+    }
+    Ok(())
+}
+
+/// A modulus in (0, MAX_MODULUS] Pa.
+fn modulus(key: &str, v: f64) -> R {
+    magnitude(key, v, MAX_MODULUS, "Pa", "stiffer than any geomaterial: the tangent would hold no digits of the load")
+}
+
 fn positive_or_inf(key: &str, v: f64) -> R {
     if v > 0.0 && !v.is_nan() {
         Ok(())
@@ -108,20 +130,23 @@ pub fn validate(c: &Case) -> R {
     for (i, m) in c.materials.iter().enumerate() {
         let k = |f: &str| format!("materials[{i}].{f}");
         in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
-        positive(&k("solid_density"), m.solid_density)?;
-        positive(&k("water_density"), m.water_density)?;
+        for (f, v) in [("solid_density", m.solid_density), ("water_density", m.water_density)] {
+            magnitude(&k(f), v, MAX_DENSITY, "kg/m³", "denser than any material")?;
+        }
         soil_model(&k("model"), &m.model)?;
         if two_phase {
             for (f, v) in
                 [("water_bulk_modulus", m.water_bulk_modulus), ("hydraulic_conductivity", m.hydraulic_conductivity)]
             {
                 match v {
-                    Some(v) => positive(&k(f), v)?,
+                    Some(v) if f == "water_bulk_modulus" => modulus(&k(f), v)?,
+                    Some(v) => magnitude(&k(f), v, MAX_CONDUCTIVITY, "m/s", "more permeable than open gravel")?,
                     None => return Err(format!("key `{}`: required in a two_phase analysis", k(f))),
                 }
             }
             match m.solid_bulk_modulus {
-                Some(v) => positive_or_inf(&k("solid_bulk_modulus"), v)?,
+                Some(v) if v.is_infinite() => positive_or_inf(&k("solid_bulk_modulus"), v)?,
+                Some(v) => modulus(&k("solid_bulk_modulus"), v)?,
                 None => {
                     return Err(format!(
                         "key `{}`: required in a two_phase analysis (inf for incompressible grains)",
@@ -654,7 +679,7 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
     let k = |f: &str| format!("{prefix}.{f}");
     match model {
         SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-            positive(&k("young_modulus"), *young_modulus)?;
+            modulus(&k("young_modulus"), *young_modulus)?;
             in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
         }
         SoilModel::MohrCoulomb {
@@ -669,7 +694,7 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
             dilation_decay,
             tension_cutoff,
         } => {
-            positive(&k("young_modulus"), *young_modulus)?;
+            modulus(&k("young_modulus"), *young_modulus)?;
             in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
             in_closed_open(&k("friction_angle"), *friction_angle, 0.0, 90.0)?;
             non_negative(&k("cohesion"), *cohesion)?;
@@ -709,7 +734,7 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
             }
         }
         SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
-            positive(&k("young_modulus"), *young_modulus)?;
+            modulus(&k("young_modulus"), *young_modulus)?;
             in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
             positive(&k("cohesion"), *cohesion)?;
             if let Some(r) = residual_cohesion {

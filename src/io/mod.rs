@@ -108,7 +108,13 @@ impl RunOutput {
         self.dir.is_some()
     }
 
-    /// Writes (replaces) `summary.json`.
+    /// The path of the output file `name` (as given on the command line; on a rank that writes
+    /// nothing, `name` alone).
+    pub fn path_of(&self, name: &str) -> String {
+        self.dir.as_ref().map_or(name.to_string(), |d| d.join(name).display().to_string())
+    }
+
+    /// Writes (replaces) `summary.json`, atomically.
     pub fn write_summary<T: Serialize>(&self, summary: &T) -> Result<(), String> {
         let Some(dir) = &self.dir else { return Ok(()) };
         let text = serde_json::to_string_pretty(summary).map_err(|e| format!("cannot serialise the summary: {e}"))?;
@@ -176,6 +182,63 @@ impl RunOutput {
         }
         write_atomic(&dir.join(name), text.as_bytes())
     }
+}
+
+/// Checks a PETSc options file against the grammar PETSc reads it with
+/// (`PetscOptionsInsertFilePetsc`), so that a bad file is one clear error rather than PETSc's
+/// traceback: text after `#` is a comment; a non-empty line starts with an option name (`-...`,
+/// its value the rest of the line) or is `alias -new -old`. Files named `*.yml`/`*.yaml` are
+/// PETSc's YAML form and only checked to be text. An `-options_file F` line is followed (F relative
+/// to the working directory, as PETSc reads it), up to 8 levels deep.
+pub fn check_petsc_options_file(path: &Path) -> Result<(), String> {
+    check_options_file_at(path, 0)
+}
+
+fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
+    let name = path.display();
+    if depth > 8 {
+        return Err(format!("PETSc options file {name}: `-options_file` nested more than 8 levels deep"));
+    }
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read the PETSc options file {name}: {e}"))?;
+    let text = String::from_utf8(bytes)
+        .ok()
+        .filter(|t| !t.contains('\0'))
+        .ok_or_else(|| format!("PETSc options file {name} is not a text file"))?;
+    let yaml = matches!(path.extension().and_then(|e| e.to_str()), Some("yml" | "yaml"));
+    if yaml {
+        return Ok(());
+    }
+    for (i, line) in text.lines().enumerate() {
+        let content = line.split('#').next().unwrap_or("");
+        let tokens: Vec<&str> = content.split_whitespace().collect();
+        let Some(&first) = tokens.first() else { continue };
+        if first.eq_ignore_ascii_case("alias") {
+            if tokens.len() < 3 {
+                return Err(format!("PETSc options file {name} line {}: `alias` needs two option names", i + 1));
+            }
+        } else if !first.starts_with('-') || first.len() < 2 {
+            let shown: String = first.chars().take(40).collect();
+            return Err(format!(
+                "PETSc options file {name} line {}: `{shown}` is not an option (an option name begins with `-`; \
+                 comments begin with `#`)",
+                i + 1
+            ));
+        } else if first == "-options_file" {
+            let Some(&nested) = tokens.get(1) else {
+                return Err(format!("PETSc options file {name} line {}: `-options_file` without a file", i + 1));
+            };
+            let nested = Path::new(nested);
+            if !nested.is_file() {
+                return Err(format!(
+                    "PETSc options file {name} line {}: the options file {} does not exist",
+                    i + 1,
+                    nested.display()
+                ));
+            }
+            check_options_file_at(nested, depth + 1)?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
