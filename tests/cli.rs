@@ -624,3 +624,23 @@ fn garbage_in_an_options_file_is_one_clear_error() {
         porompm::io::check_petsc_options_file(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
     }
 }
+
+/// Bad settings of the analysis types and of the run: each one error naming the key or flag.
+#[test]
+fn bad_analysis_settings_are_named() {
+    for (case, set, needle) in [
+        ("cases/terzaghi.toml", "stages.0.theta=0.3", "key `stages.consolidation.theta`: only a quasi_static stage"),
+        ("cases/elastic_column.toml", "stages.0.analysis=quasi_static", "needs `analysis.formulation = \"two_phase\"`"),
+        ("cases/terzaghi.toml", "stages.0.analysis=static", "key `stages.consolidation.drainage`"),
+        ("cases/terzaghi.toml", "stages.0.dt_max=-1", "key `stages.consolidation.dt_max`"),
+        ("cases/terzaghi.toml", "time_integration.rho_inf=1.5", "key `time_integration.rho_inf`"),
+        ("cases/terzaghi.toml", "stabilisation.pressure_update=bogus", "expected `increments` or `projected_total`"),
+    ] {
+        let o = porompm(&["check", case, "--set", set]);
+        assert_one_line_error(&o, needle);
+    }
+    let out = out_dir("threads-zero");
+    let o = porompm(&["run", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--threads", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--threads"), "{}", stderr(&o));
+}
