@@ -23,7 +23,7 @@ test: setup
 
 # Long convergence studies (tables in target/studies/).
 study: build
-	cargo test --release --locked --test studies --test gold -- --ignored --nocapture --test-threads=1
+	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1
 	python3 scripts/terzaghi_family.py
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.

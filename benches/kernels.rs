@@ -199,7 +199,7 @@ fn global_assembly(c: &mut Criterion) {
     let case = load("cases/slumping_block.toml", &[]);
     let coll = porompm::parallel::Collective::world();
     let layout = kernels::Layout::UPU;
-    let system = porompm::assembly::GridSystem::new(&coll, &porompm::model::grid_of(&case), layout);
+    let system = porompm::assembly::GridSystem::new(&coll, &porompm::model::grid_of(&case), layout, None);
     let mut system = system.expect("the grid system is created");
     let model = Model::build(&case, |i, j| system.owns_cell(i, j));
     let stage = &case.stages[0];

@@ -191,6 +191,9 @@ pub fn describe(case: &Case, label: &str) -> String {
             |f| format!("options file {f}")
         )
     );
+    for w in crate::diagnostics::physics::warnings(case, &model) {
+        let _ = writeln!(s, "warning [{}]: {}", w.kind, w.message);
+    }
     match &case.verification {
         Some(v) => {
             let _ = writeln!(s, "verification: {}", crate::verification::describe(v));

@@ -21,8 +21,9 @@
 use crate::analysis::StageAnalysis;
 use crate::assembly::{self, GridSystem, Phase, StepForces};
 use crate::case::{Case, Stage};
+use crate::diagnostics::{energy, Monitor, Warning};
 use crate::io::RunOutput;
-use crate::kernels::StepResult;
+use crate::kernels::{Integration, StepResult};
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::progress::Progress;
@@ -49,6 +50,8 @@ pub struct RunRequest<'a> {
     pub coll: &'a Collective,
     /// Write `checkpoint.h5` every this many steps (0: never).
     pub checkpoint_every: usize,
+    /// Repartition when the load imbalance passes this ratio (see [`crate::distribution`]).
+    pub balance_threshold: f64,
     /// Continue from this checkpoint (its path as given, and its content).
     pub restart: Option<(String, Checkpoint)>,
     /// Set by `main`'s SIGINT/SIGTERM handler: stop after the current step.
@@ -116,6 +119,12 @@ pub struct Summary {
     pub steps: usize,
     /// Step cuts (retries with smaller Δt).
     pub step_cuts: usize,
+    /// Material points that moved to another rank over the run (since the restart, if restarted).
+    pub migrated_particles: usize,
+    /// Repartitions of the grid over the ranks to balance the material points.
+    pub repartitions: usize,
+    /// The largest load imbalance at a history row (the busiest rank's points over the mean).
+    pub load_imbalance_max: f64,
     /// Newton iterations over the run.
     pub snes_iterations: usize,
     /// Krylov iterations over the run.
@@ -148,6 +157,20 @@ pub struct Summary {
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub checkerboard_index_max: Option<f64>,
+    /// Largest pressure oscillation index over the output steps (two-phase runs; see
+    /// `diagnostics::Monitor::row`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pressure_oscillation_index_max: Option<f64>,
+    /// Smallest and largest particle pore pressure over the output steps [Pa] (two-phase runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pore_pressure_range: Option<[f64; 2]>,
+    /// The relative energy imbalance of the dynamic stages at the last history row (see
+    /// `diagnostics::energy`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy_balance_error: Option<f64>,
+    /// Warnings: parameter combinations known to lock or oscillate (before the run) and
+    /// diagnostics past their thresholds (during it), each with what to change.
+    pub warnings: Vec<Warning>,
     /// The worst relative error of the equilibrium identity ∫σ dV = Σ x ⊗ (F_ext + R − F_inertia)
     /// over the converged steps (see `Simulation::record_equilibrium`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -208,6 +231,11 @@ struct Simulation<'a> {
     body_names: Vec<String>,
     /// The last converged step's equilibrium error and boundary reactions.
     equilibrium: (f64, Vec<[f64; 2]>),
+    /// The stability diagnostics.
+    monitor: Monitor,
+    /// `--balance-threshold`, and the imbalance after the last attempt to repartition (a new
+    /// attempt waits until the imbalance has grown by [`crate::distribution::BALANCE_GAIN`]).
+    balance: (f64, Option<f64>),
 }
 
 /// Runs a case and returns its summary (also written to `summary.json`).
@@ -278,6 +306,9 @@ impl Summary {
             end_time_s: req.case.end_time(),
             steps: 0,
             step_cuts: 0,
+            migrated_particles: 0,
+            repartitions: 0,
+            load_imbalance_max: 1.0,
             snes_iterations: 0,
             ksp_iterations: 0,
             matrix_structure_reuses: 0,
@@ -291,6 +322,10 @@ impl Summary {
             peak_memory_mib: None,
             peak_memory_total_mib: None,
             checkerboard_index_max: None,
+            pressure_oscillation_index_max: None,
+            pore_pressure_range: None,
+            energy_balance_error: None,
+            warnings: Vec::new(),
             equilibrium_error: None,
             stopped: None,
             verification: BTreeMap::new(),
@@ -320,7 +355,7 @@ pub fn test_jacobian(
     sim.begin_stage(stage)?;
     for _ in 0..steps {
         sim.newton_solve(&active, stage.dt())?.map_err(RunError::Failed)?;
-        sim.update_particles(stage.dt())?.map_err(RunError::Failed)?;
+        sim.update_particles(&active, stage.dt())?.map_err(RunError::Failed)?;
         sim.t += stage.dt();
     }
     let names = sim.body_names.clone();
@@ -343,7 +378,8 @@ impl<'a> Simulation<'a> {
         let input = |e: String| RunError::Input(e);
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
         let layout = StageAnalysis::of(case, &case.stages[first]).layout;
-        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout).map_err(|e| input(e.to_string()))?;
+        let system =
+            GridSystem::new(coll, &crate::model::grid_of(case), layout, None).map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
         let check = verification::for_case(case, &model, coll).map_err(|e| input(format!("verification: {e}")))?;
@@ -355,9 +391,10 @@ impl<'a> Simulation<'a> {
         for p in &probes {
             columns.extend(probe_fields(model.two_phase).iter().map(|f| format!("{}.{f}", p.name)));
         }
-        if model.two_phase {
-            columns.push("checkerboard_index".into());
-        }
+        let dynamic = case.stages.iter().any(|s| s.analysis == crate::case::AnalysisType::Dynamic);
+        let monitor = Monitor::new(model.two_phase, dynamic);
+        columns.extend(monitor.columns());
+        columns.push("load_imbalance".into());
         columns.push("equilibrium_error".into());
         for b in &case.boundaries {
             columns.push(format!("{}.reaction_x", b.name));
@@ -384,7 +421,7 @@ impl<'a> Simulation<'a> {
             probes,
             out,
             coll,
-            display: Progress::new(!req.quiet && coll.rank() == 0, case.end_time()),
+            display: Progress::new(!req.quiet && coll.rank() == 0, coll.rank() == 0, case.end_time()),
             t: 0.0,
             step: 0,
             summary,
@@ -397,7 +434,11 @@ impl<'a> Simulation<'a> {
             interrupt: req.interrupt.clone(),
             body_names: case.bodies.iter().map(|b| b.name.clone()).collect(),
             equilibrium: (0.0, vec![[0.0; 2]; case.boundaries.len()]),
+            monitor,
+            balance: (req.balance_threshold, None),
         };
+        let warnings = crate::diagnostics::physics::warnings(case, &sim.model);
+        sim.warn(warnings);
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
         }
@@ -446,7 +487,7 @@ impl<'a> Simulation<'a> {
             let admitted = match outcome {
                 Ok(()) => {
                     let forces = self.system.step_forces(&self.model, self.coll).map_err(RunError::Failed)?;
-                    let updated = self.update_particles(dt)?;
+                    let updated = self.update_particles(&active, dt)?;
                     if updated.is_ok() {
                         self.record_equilibrium(&forces)?;
                     }
@@ -457,6 +498,8 @@ impl<'a> Simulation<'a> {
             match admitted {
                 Ok(()) => {
                     self.system.accept_increment(dt).map_err(|e| RunError::Failed(e.to_string()))?;
+                    self.migrate_particles()?;
+                    self.balance_load()?;
                     self.t = control.advance(self.t, dt);
                     control.accepted(self.last_newton.0);
                     self.step += 1;
@@ -508,8 +551,9 @@ impl<'a> Simulation<'a> {
         if self.system.layout() != analysis.layout {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;
-            self.system =
-                GridSystem::new(self.coll, &grid, analysis.layout).map_err(|e| RunError::Failed(e.to_string()))?;
+            let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
+            self.system = GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners))
+                .map_err(|e| RunError::Failed(e.to_string()))?;
             self.system.reused_patterns = reused;
             self.summary.grid_dofs = self.system.total_dofs();
         }
@@ -566,7 +610,7 @@ impl<'a> Simulation<'a> {
 
     /// The particle update of a converged step; `Ok(Err(..))` if a particle would become
     /// inadmissible (the step is then cut), in which case no particle is changed.
-    fn update_particles(&mut self, dt: f64) -> Result<Result<(), String>, RunError> {
+    fn update_particles(&mut self, active: &crate::model::Active, dt: f64) -> Result<Result<(), String>, RunError> {
         let t0 = Instant::now();
         let _stage = self.system.phase(Phase::ParticleUpdate).map_err(|e| RunError::Failed(e.to_string()))?;
         let n = self.model.particles.len();
@@ -586,12 +630,104 @@ impl<'a> Simulation<'a> {
             }
             _ => None,
         };
+        // The energy terms of a dynamic step need the particles' state at t_n.
+        let dynamic = matches!(self.model.integration, Integration::Dynamic { .. });
+        let before: Vec<_> = if dynamic {
+            let body_acc = self.model.body_accelerations(active, self.t + dt);
+            let ps = &self.model.particles;
+            (0..n).map(|k| (self.model.particle_input(k, &body_acc), ps.vel[k], ps.vel_w[k])).collect()
+        } else {
+            Vec::new()
+        };
+        let mut terms = [0.0; 5];
         for (k, r) in results.iter().enumerate() {
             let dp = recovered.as_ref().map_or(r.interp.dp, |v| v[k]);
             self.model.update_particle(k, r, dp, dt).map_err(|e| RunError::Failed(e.0))?;
+            if let Some((input, v, vw)) = before.get(k) {
+                let ps = &self.model.particles;
+                let e = energy::particle_step(input, r, dp, ps.volume[k]);
+                let k_old = energy::kinetic(input.mass, input.water_mass, *v, *vw);
+                let k_new = energy::kinetic(ps.mass[k], self.model.water_mass(k), ps.vel[k], ps.vel_w[k]);
+                let d = if input.water_mass > 0.0 { energy::darcy(input.drag, dt, r) } else { 0.0 };
+                terms[0] += e.body;
+                terms[1] += e.internal;
+                terms[2] += k_new - k_old;
+                terms[3] += d;
+                terms[4] += k_new;
+            }
+        }
+        if dynamic {
+            self.monitor.ledger.add_particles(terms[0], terms[1], terms[2], terms[3], terms[4]);
         }
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(Ok(()))
+    }
+
+    /// Moves the material points whose centre left this rank's cells to their new owner
+    /// ([`crate::distribution::migrate`]); counted in summary.json.
+    fn migrate_particles(&mut self) -> Result<(), RunError> {
+        if self.coll.size() == 1 {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
+        let moved = crate::distribution::migrate(&mut self.model, self.case, &owners, self.coll);
+        self.summary.migrated_particles += self.coll.sum_count(moved.sent as u64) as usize;
+        self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The busiest rank's material points over the mean (1 on one rank); collective.
+    fn load_imbalance(&self) -> Result<f64, RunError> {
+        if self.coll.size() == 1 {
+            return Ok(1.0);
+        }
+        let counts = self.coll.gather(&[self.model.particles.len() as f64]).map_err(RunError::Failed)?;
+        Ok(crate::distribution::imbalance(&counts))
+    }
+
+    /// Repartitions the grid over the ranks when the load imbalance passes the threshold and a
+    /// better distribution exists ([`crate::distribution::balanced`]): a new grid system on the new
+    /// distribution, and the points moved to their new owners. Counted in summary.json.
+    fn balance_load(&mut self) -> Result<(), RunError> {
+        let (threshold, last) = self.balance;
+        if self.coll.size() == 1 || !threshold.is_finite() {
+            return Ok(());
+        }
+        let now = self.load_imbalance()?;
+        if now <= threshold || last.is_some_and(|l| now < l * crate::distribution::BALANCE_GAIN) {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let grid = &self.model.grid;
+        let [nx, ny] = grid.cells;
+        let mut hist = vec![0.0; nx * ny];
+        for x in &self.model.particles.x {
+            if let Some((i, j)) = grid.cell_of(*x) {
+                hist[i + j * nx] += 1.0;
+            }
+        }
+        let hist = self.coll.sum(&hist).map_err(RunError::Failed)?;
+        let proposal = crate::distribution::balanced(&hist, grid.cells, self.coll.size(), assembly::STENCIL_WIDTH);
+        let Some((owners, predicted)) = proposal.filter(|(_, p)| *p * crate::distribution::BALANCE_GAIN <= now) else {
+            self.balance.1 = Some(now);
+            return Ok(());
+        };
+        let reused = self.system.reused_patterns;
+        let layout = self.system.layout();
+        self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners))
+            .map_err(|e| RunError::Failed(e.to_string()))?;
+        self.system.reused_patterns = reused;
+        let moved = crate::distribution::migrate(&mut self.model, self.case, &owners, self.coll);
+        self.summary.migrated_particles += self.coll.sum_count(moved.sent as u64) as usize;
+        self.summary.repartitions += 1;
+        self.balance.1 = Some(predicted);
+        self.progress(&format!(
+            "  t = {:.6e} s: load imbalance {now:.2} > {threshold}: grid repartitioned, imbalance now {predicted:.2}",
+            self.t
+        ));
+        self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// The equilibrium identity of the converged step ([`StepForces`]): the volume integral of the
@@ -613,6 +749,9 @@ impl<'a> Simulation<'a> {
             local[3] += (s[1] - p) * v;
         }
         let lhs = self.coll.sum(&local).map_err(RunError::Failed)?;
+        if matches!(self.model.integration, Integration::Dynamic { .. }) {
+            self.monitor.ledger.external += forces.work;
+        }
         let m = &forces.moment;
         let diff = [lhs[0] - m[0][0], lhs[1] - m[0][1], lhs[2] - m[1][0], lhs[3] - m[1][1]];
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -631,13 +770,13 @@ impl<'a> Simulation<'a> {
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
         row.extend(update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?);
-        if self.model.two_phase {
-            let ci =
-                verification::checkerboard::checkerboard_index(&self.model, self.coll).map_err(RunError::Failed)?;
-            self.summary.checkerboard_index_max =
-                Some(self.summary.checkerboard_index_max.map_or(ci, |m: f64| m.max(ci)));
-            row.push(ci);
-        }
+        let (values, warnings) = self.monitor.row(&self.model, self.coll, self.t).map_err(RunError::Failed)?;
+        row.extend(values);
+        let imbalance = self.load_imbalance()?;
+        self.summary.load_imbalance_max = self.summary.load_imbalance_max.max(imbalance);
+        row.push(imbalance);
+        self.worst_to_summary();
+        self.warn(warnings);
         row.push(self.equilibrium.0);
         for r in &self.equilibrium.1 {
             row.extend(r);
@@ -668,6 +807,8 @@ impl<'a> Simulation<'a> {
     /// Results of the probes, metrics, results and tables of the check, and the figures.
     fn finish(mut self) -> Result<(), RunError> {
         let t0 = Instant::now();
+        let warnings = self.monitor.finish(self.t);
+        self.warn(warnings);
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         for pr in &self.probes {
             if pr.last.len() >= 4 {
@@ -713,6 +854,25 @@ impl<'a> Simulation<'a> {
 
     fn progress(&self, msg: &str) {
         self.display.message(msg);
+    }
+
+    /// Gives warnings: in the terminal (rank 0, also with `--quiet`) and in summary.json.
+    fn warn(&mut self, warnings: Vec<Warning>) {
+        for w in warnings {
+            let at = w.time_s.map(|t| format!(" (t = {t:.6e} s)")).unwrap_or_default();
+            self.display.warning(&format!("warning [{}]{at}: {}", w.kind, w.message));
+            self.summary.warnings.push(w);
+        }
+    }
+
+    /// The diagnostics' worst values into the summary.
+    fn worst_to_summary(&mut self) {
+        let w = self.monitor.worst;
+        let some = |v: f64| (!v.is_nan()).then_some(v);
+        self.summary.checkerboard_index_max = some(w.checkerboard);
+        self.summary.pressure_oscillation_index_max = some(w.oscillation);
+        self.summary.pore_pressure_range = (!w.p_range[0].is_nan()).then_some(w.p_range);
+        self.summary.energy_balance_error = some(w.energy);
     }
 
     /// One output time of `fields.h5`/`fields.xdmf` (once per step at most).
@@ -774,7 +934,7 @@ impl<'a> Simulation<'a> {
             dt: control.dt,
             successes: control.successes as u64,
             counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
-            checkerboard_max: s.checkerboard_index_max.unwrap_or(f64::NAN),
+            diagnostics: self.monitor.state(self.coll).map_err(RunError::Failed)?,
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
             check_state,
             particles: state::sorted_records(&all),
@@ -789,20 +949,28 @@ impl<'a> Simulation<'a> {
     fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
         let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
         state::check_case(cp, self.case).map_err(refuse)?;
-        let restored = cp.restore_particles(&mut self.model.particles, self.summary.particles);
+        let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
+        let (grid, me) = (&self.model.grid, self.coll.rank());
+        let restored =
+            cp.restore_particles(&self.model.particles, self.summary.particles, |x| owners.rank_of(grid, x) == me);
         if self.coll.any(restored.is_err()).map_err(RunError::Failed)? {
             return Err(refuse(
                 restored.err().unwrap_or_else(|| "another rank could not take its material points".into()),
             ));
         }
+        self.model.particles = restored.map_err(RunError::Failed)?;
+        self.model.resolve_targets(self.case);
         self.t = cp.time;
         self.step = cp.step as usize;
         let s = &mut *self.summary;
         s.time_s = cp.time;
         s.steps = self.step;
         [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses] = cp.counters.map(|c| c as usize);
-        s.checkerboard_index_max = (!cp.checkerboard_max.is_nan()).then_some(cp.checkerboard_max);
+        self.monitor
+            .restore_state(&cp.diagnostics, self.coll.rank() == 0)
+            .map_err(|e| refuse(format!("diagnostics: {e}")))?;
         self.system.reused_patterns = s.matrix_structure_reuses;
+        self.worst_to_summary();
         for (p, &e) in self.probes.iter_mut().zip(&cp.probe_extremes) {
             p.excess_extreme = e;
         }

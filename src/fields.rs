@@ -5,7 +5,8 @@
 //! (3 components, z = 0), the effective stress components `stress_xx`, `stress_yy`, `stress_xy`,
 //! `stress_zz` [Pa] (tension positive; total stress in one-phase runs), the mean effective stress
 //! `mean_stress` = −(σ'_xx + σ'_yy + σ'_zz)/3 [Pa] (compression positive), the deviatoric stress
-//! `q` = sqrt(3/2 s:s) [Pa], the deviatoric plastic strain `eps_pd` [-], `material_id`, `body_id`,
+//! `q` = sqrt(3/2 s:s) [Pa], the deviatoric plastic strain `eps_pd` [-], the `mass` [kg] (per metre of thickness) and `volume`
+//! [m²] each point carries, `material_id`, `body_id`,
 //! `particle_id`, and in two-phase runs the pore pressure `p` and the excess pore pressure
 //! `p_excess` = p − p₀ [Pa].
 //!
@@ -18,7 +19,7 @@ use crate::model::Model;
 use crate::parallel::Collective;
 
 /// Values per particle record in the gather.
-const PREC: usize = 16;
+const PREC: usize = 18;
 
 /// The grid's geometry for the field files.
 pub fn grid_geometry(model: &Model) -> GridGeometry {
@@ -53,6 +54,8 @@ pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> 
                 ps.p[k],
                 ps.p0[k],
                 ps.eps_pd[k],
+                ps.mass[k],
+                ps.volume[k],
             ]
         })
         .collect();
@@ -80,6 +83,8 @@ pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> 
             }),
         ),
         scalar("eps_pd", real(&|r| r[15])),
+        scalar("mass", real(&|r| r[16])),
+        scalar("volume", real(&|r| r[17])),
         scalar("material_id", int(2)),
         scalar("body_id", int(1)),
         scalar("particle_id", Values::Real(all.iter().map(|r| r[0]).collect())),

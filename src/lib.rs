@@ -9,6 +9,8 @@ pub mod analysis;
 pub mod assembly;
 pub mod case;
 pub mod describe;
+pub mod diagnostics;
+pub mod distribution;
 pub mod driver;
 pub mod element_test;
 pub mod fields;

@@ -46,6 +46,10 @@ enum Command {
         /// Continue from a checkpoint.h5 written by a run of the same case.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
+        /// Repartition the grid over the ranks when the busiest rank holds more than this many times
+        /// the mean number of material points per rank (≥ 1; `inf`: never). Ignored on one rank.
+        #[arg(long = "balance-threshold", value_name = "RATIO", default_value_t = porompm::distribution::DEFAULT_BALANCE_THRESHOLD, value_parser = parse_balance_threshold)]
+        balance_threshold: f64,
         /// Threads per rank for the particle loops (default: this machine's cores divided by the
         /// ranks running on it). The results do not depend on it.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=1024))]
@@ -156,12 +160,22 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
     case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
 
-/// Checkpointing and restart of `porompm run`.
+/// Checkpointing, restart and distribution settings of `porompm run`.
 struct Continuation<'a> {
     checkpoint_every: usize,
     restart: Option<&'a Path>,
     /// `--threads`, if given.
     threads: Option<u16>,
+    /// `--balance-threshold`.
+    balance_threshold: f64,
+}
+
+/// `--balance-threshold`: a ratio of at least 1 (or `inf`).
+fn parse_balance_threshold(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v >= 1.0 => Ok(v),
+        _ => Err(format!("must be a number ≥ 1 (the busiest rank's points over the mean; `inf`: never), got `{text}`")),
+    }
 }
 
 fn run(
@@ -222,6 +236,7 @@ fn run(
         quiet,
         coll: &coll,
         checkpoint_every: cont.checkpoint_every,
+        balance_threshold: cont.balance_threshold,
         restart,
         interrupt: Some(interrupt),
     };
@@ -292,6 +307,7 @@ fn test_jacobian(
         quiet: true,
         coll: &coll,
         checkpoint_every: 0,
+        balance_threshold: f64::INFINITY,
         restart: None,
         interrupt: None,
     };
@@ -424,9 +440,24 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run { case, out, options_file, set, quiet, checkpoint_every, restart, threads, petsc } => {
-            let cont =
-                Continuation { checkpoint_every: *checkpoint_every, restart: restart.as_deref(), threads: *threads };
+        Command::Run {
+            case,
+            out,
+            options_file,
+            set,
+            quiet,
+            checkpoint_every,
+            restart,
+            threads,
+            balance_threshold,
+            petsc,
+        } => {
+            let cont = Continuation {
+                checkpoint_every: *checkpoint_every,
+                restart: restart.as_deref(),
+                threads: *threads,
+                balance_threshold: *balance_threshold,
+            };
             run(case, out, options_file, set, *quiet, cont, petsc)
         }
         Command::Sweep { case, out, options_file, vary, set, metric, quiet, petsc } => {

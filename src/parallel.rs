@@ -8,7 +8,7 @@
 //! same `Ok` or the same error (that of the lowest failing rank).
 
 use mpi::collective::SystemOperation;
-use mpi::datatype::PartitionMut;
+use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 
@@ -117,6 +117,37 @@ impl Collective {
             self.world.all_gather_varcount_into(v, &mut part);
         }
         out
+    }
+
+    /// A personalised all-to-all exchange: `outgoing[r]` goes to rank r (the entry for this rank is
+    /// sent to itself); returns what every rank sent here, concatenated in rank order. Counts are
+    /// exchanged first, so any rank may send to any other in one exchange (a particle that moved
+    /// several subdomains in one step reaches its owner at once).
+    pub fn exchange(&self, outgoing: &[Vec<f64>]) -> Vec<f64> {
+        let size = self.size();
+        assert_eq!(outgoing.len(), size, "one buffer per rank");
+        let send_counts: Vec<i32> = outgoing.iter().map(|v| v.len() as i32).collect();
+        let mut recv_counts = vec![0i32; size];
+        self.world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
+        let offsets = |c: &[i32]| -> Vec<i32> {
+            c.iter()
+                .scan(0i32, |acc, &n| {
+                    let d = *acc;
+                    *acc += n;
+                    Some(d)
+                })
+                .collect()
+        };
+        let send: Vec<f64> = outgoing.concat();
+        let send_displs = offsets(&send_counts);
+        let recv_displs = offsets(&recv_counts);
+        let mut recv = vec![0.0; recv_counts.iter().sum::<i32>() as usize];
+        {
+            let part = Partition::new(&send[..], &send_counts[..], &send_displs[..]);
+            let mut into = PartitionMut::new(&mut recv[..], &recv_counts[..], &recv_displs[..]);
+            self.world.all_to_all_varcount_into(&part, &mut into);
+        }
+        recv
     }
 
     /// Whether any rank reports `flag`.

@@ -15,13 +15,14 @@ const TICKS: u64 = 10_000;
 pub struct Progress {
     bar: Option<ProgressBar>,
     lines: bool,
+    rank0: bool,
     end: f64,
 }
 
 impl Progress {
     /// A display for a run up to simulated time `end` [s]; `speak` is false on ranks other than 0
-    /// and with `--quiet`.
-    pub fn new(speak: bool, end: f64) -> Progress {
+    /// and with `--quiet`, `rank0` only on ranks other than 0.
+    pub fn new(speak: bool, rank0: bool, end: f64) -> Progress {
         let bar = (speak && std::io::stderr().is_terminal()).then(|| {
             let b = ProgressBar::with_draw_target(Some(TICKS), ProgressDrawTarget::stderr_with_hz(4));
             let style = ProgressStyle::with_template("{elapsed:>4} {bar:16} {percent:>3}% {msg} ETA {eta}")
@@ -30,7 +31,16 @@ impl Progress {
             b.set_message("starting,");
             b
         });
-        Progress { bar, lines: speak, end }
+        Progress { bar, lines: speak, rank0, end }
+    }
+
+    /// A warning line: printed on rank 0 also with `--quiet` (through the bar when there is one).
+    pub fn warning(&self, msg: &str) {
+        match &self.bar {
+            Some(b) => b.println(msg),
+            None if self.rank0 => eprintln!("{msg}"),
+            None => {}
+        }
     }
 
     /// An event line.

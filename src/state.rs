@@ -5,7 +5,7 @@
 //! the stress and ε_p^d, and the Newmark velocities and accelerations of both phases), the time,
 //! the step count, the index of the stage, the step control's Δt and its count of accepted steps
 //! since Δt last changed, the run's counters, the probes' excess-pressure extremes, the largest
-//! checkerboard index so far, and what the verification check has gathered (if the check can keep
+//! diagnostics so far, and what the verification check has gathered (if the check can keep
 //! it; see [`crate::verification::Check::checkpoint_state`]). Everything else (grid, loads,
 //! boundaries, matrices) is rebuilt from the case.
 //!
@@ -18,7 +18,7 @@ use crate::model::particles::Particles;
 use std::collections::HashMap;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 2;
+pub const FORMAT_VERSION: u64 = 3;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
 pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
@@ -79,8 +79,8 @@ pub struct Checkpoint {
     pub successes: u64,
     /// Step cuts, Newton iterations, Krylov iterations and matrix-structure reuses so far.
     pub counters: [u64; 4],
-    /// Largest checkerboard index so far (NaN: none yet).
-    pub checkerboard_max: f64,
+    /// The stability diagnostics' state ([`crate::diagnostics::Monitor::state`]).
+    pub diagnostics: Vec<f64>,
     /// The probes' signed excess-pressure extremes, in case order.
     pub probe_extremes: Vec<f64>,
     /// The verification check's own state (`None`: the check keeps none).
@@ -193,6 +193,17 @@ fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
     ps.grad_p[k] = two(35);
 }
 
+/// The points of `records`, in their order (every array from its record).
+pub fn particles_from_records(records: &[[f64; RECORD]]) -> Particles {
+    let mut ps = Particles::default();
+    for r in records {
+        ps.push_blank(r[0] as u64, r[1] as u16, r[2] as u16);
+        let k = ps.len() - 1;
+        unpack(&mut ps, k, r);
+    }
+    ps
+}
+
 /// Records of all ranks' particles (concatenated by the caller), sorted by id.
 pub fn sorted_records(flat: &[f64]) -> Vec<[f64; RECORD]> {
     let mut out: Vec<[f64; RECORD]> = flat.chunks_exact(RECORD).map(|c| c.try_into().expect("RECORD values")).collect();
@@ -214,7 +225,10 @@ impl Checkpoint {
         for c in self.counters {
             h.u64(c);
         }
-        h.f64(self.checkerboard_max);
+        h.u64(self.diagnostics.len() as u64);
+        for &v in &self.diagnostics {
+            h.f64(v);
+        }
         h.u64(self.probe_extremes.len() as u64);
         for &v in &self.probe_extremes {
             h.f64(v);
@@ -237,9 +251,16 @@ impl Checkpoint {
         h.0
     }
 
-    /// Overwrites this rank's particles with their records. Every local particle must be in the
-    /// checkpoint with the same body and material; `total` is the particle count over all ranks.
-    pub fn restore_particles(&self, ps: &mut Particles, total: usize) -> Result<(), String> {
+    /// The points this rank takes from the checkpoint: those whose centre `owned` says lie in its
+    /// cells (whatever the number of ranks that wrote the file), sorted by id. The case's points
+    /// `ps` (this rank's share of them, as generated) must all be in the checkpoint with the same
+    /// body and material, and `total` (the case's count over all ranks) must be its count.
+    pub fn restore_particles(
+        &self,
+        ps: &Particles,
+        total: usize,
+        owned: impl Fn([f64; 2]) -> bool,
+    ) -> Result<Particles, String> {
         if total != self.particles.len() {
             return Err(format!(
                 "it holds {} material points but this case has {total} (a different case or grid)",
@@ -255,9 +276,9 @@ impl Checkpoint {
             if r[1] as u16 != ps.body[k] || r[2] as u16 != ps.material[k] {
                 return Err(format!("material point {} belongs to another body or material in it", ps.id[k]));
             }
-            unpack(ps, k, r);
         }
-        Ok(())
+        let mine: Vec<[f64; RECORD]> = self.particles.iter().filter(|r| owned([r[3], r[4]])).copied().collect();
+        Ok(particles_from_records(&mine))
     }
 }
 
@@ -313,15 +334,23 @@ mod tests {
             dt: 1e-3,
             successes: 2,
             counters: [1, 2, 3, 4],
-            checkerboard_max: f64::NAN,
+            diagnostics: vec![f64::NAN, 1.0],
             probe_extremes: vec![],
             check_state: None,
             particles: records,
         };
-        let (_, mut fresh) = particles();
-        cp.restore_particles(&mut fresh, ps.len()).unwrap();
-        assert_eq!(format!("{fresh:?}"), format!("{ps:?}"));
-        assert!(cp.restore_particles(&mut fresh, ps.len() + 1).unwrap_err().contains("holds 40 material points"));
+        let (_, fresh) = particles();
+        let back = cp.restore_particles(&fresh, ps.len(), |_| true).unwrap();
+        assert_eq!(format!("{back:?}"), format!("{ps:?}"));
+        // A rank takes the points whose centre lies in its cells, whoever wrote the file.
+        let lower = cp.restore_particles(&fresh, ps.len(), |x| x[1] < 0.5).unwrap();
+        assert_eq!(lower.len(), ps.x.iter().filter(|x| x[1] < 0.5).count());
+        assert!(lower.len() >= 19 && lower.len() < ps.len());
+        assert!(lower.x.iter().all(|x| x[1] < 0.5) && lower.id.windows(2).all(|w| w[0] < w[1]));
+        assert!(cp.restore_particles(&fresh, ps.len() + 1, |_| true).unwrap_err().contains("holds 40 material points"));
+        let mut other = fresh.clone();
+        other.body[3] = 1;
+        assert!(cp.restore_particles(&other, ps.len(), |_| true).unwrap_err().contains("another body"));
     }
 
     #[test]
@@ -335,7 +364,7 @@ mod tests {
             dt: 1e-3,
             successes: 2,
             counters: [1, 2, 3, 4],
-            checkerboard_max: 0.1,
+            diagnostics: vec![0.1],
             probe_extremes: vec![1.0],
             check_state: Some(vec![2.0]),
             particles: (0..ps.len()).map(|k| pack(&ps, k)).collect(),

@@ -282,23 +282,6 @@ fn the_slumping_block_on_two_ranks_matches_one_rank() {
     }
 }
 
-/// An error raised on one rank between collectives (a particle leaving its rank's ghost region,
-/// before particles migrate) ends the run on every rank with that rank's message: no hang, one
-/// error line, summary.json `failed`.
-#[test]
-fn an_error_on_one_rank_ends_every_rank_with_its_message() {
-    let dir = out_dir("falling_2ranks");
-    let o = mpirun(2, &["run", "tests/cases/falling_block.toml", "--out", dir.to_str().unwrap(), "--quiet"])
-        .expect("mpirun");
-    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
-    let s = summary(&dir);
-    let err = s["error"].as_str().unwrap();
-    assert_eq!(s["status"], "failed");
-    assert!(err.contains("outside this rank's ghost region") && err.contains("(rank 1)"), "{err}");
-    let lines = stderr(&o).lines().filter(|l| l.starts_with("error:")).count();
-    assert_eq!(lines, 1, "{}", stderr(&o));
-}
-
 #[test]
 fn terzaghi_on_two_ranks_matches_one_rank() {
     let one = out_dir("terzaghi_1rank");
@@ -643,4 +626,66 @@ fn bad_analysis_settings_are_named() {
     let o = porompm(&["run", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--threads", "0"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--threads"), "{}", stderr(&o));
+}
+
+/// More bad values, each one error naming its key: the grid, bodies, stages, probes, the
+/// verification, the time integration, the output, the stabilisation and the loads.
+#[test]
+fn bad_values_across_the_case_are_named() {
+    for (set, needle) in [
+        ("grid.size=[-1.0,1.0]", "key `grid.size[0]`: must be a positive number"),
+        ("grid.origin=[nan,0.0]", "key `grid.origin`: must be finite"),
+        ("bodies.0.particles_per_cell=0", "key `bodies[0].particles_per_cell`: must be between 1 and 8"),
+        ("bodies.0.material=nonesuch", "key `bodies[0].material`: no material named `nonesuch`"),
+        ("bodies.0.perturbation=-1", "key `bodies[0].perturbation`: must be in [0, 0.5)"),
+        ("stages.0.duration=0", "key `stages[0].duration`: must be a positive number"),
+        ("stages.0.dt=-1", "key `stages[0].dt`: must be a positive number"),
+        ("stages.0.cut_factor=1.5", "key `stages[0].cut_factor`: must be in (0, 1)"),
+        ("stages.0.max_step_cuts=1000", "key `stages[0].max_step_cuts`: at most 30"),
+        ("stages.0.loads=[\"nonesuch\"]", "key `stages[0].loads`: no load named `nonesuch`"),
+        ("stages.0.boundaries=[\"nonesuch\"]", "key `stages[0].boundaries`: no boundary named `nonesuch`"),
+        ("probes.0.point=[5.0,5.0]", "key `probes[0].point`: [5.0, 5.0] is outside the grid"),
+        ("verification.time_factors=[-1.0]", "key `verification.time_factors`: give positive time factors"),
+        ("verification.body=nonesuch", "key `verification.body`: no body named `nonesuch`"),
+        ("verification.load=nonesuch", "key `verification.load`: no load named `nonesuch`"),
+        ("time_integration.beta=0.1", "key `time_integration`: β = 0.1, γ = 0.5 is not unconditionally stable"),
+        ("output.history_every=0", "key `output.history_every`: must be at least 1"),
+        ("materials.0.model.poisson_ratio=0.5", "key `materials[0].model.poisson_ratio`: must be in (-1, 0.5)"),
+        ("materials.0.water_density=0", "key `materials[0].water_density`: must be a positive number"),
+        ("stabilisation.pressure_projection=-1", "key `stabilisation.pressure_projection`: must be a positive number"),
+        ("stabilisation.pressure_projection=1e9", "key `stabilisation.pressure_projection`: must be at most 1e3"),
+        ("boundaries.0.side=nowhere", "--set boundaries.0.side: unknown variant `nowhere`"),
+        ("boundaries.0.fix=[\"uz\"]", "--set boundaries.0.fix: unknown variant `uz`"),
+        ("loads.0.face=top", "key `loads[0]`: unknown variant `top`"),
+        ("loads.0.traction=[nan,0.0]", "key `loads[0].traction`: must be finite"),
+        ("analysis.g=-1", "key `analysis.g`: must be a positive number"),
+    ] {
+        let o = porompm(&["check", "cases/terzaghi.toml", "--set", set]);
+        assert_one_line_error(&o, needle);
+    }
+}
+
+/// `porompm check` lists the physics warnings of a case (what would lock or oscillate), and a
+/// shipped case has none.
+#[test]
+fn check_lists_the_physics_warnings() {
+    let o = porompm(&["check", "cases/terzaghi.toml"]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("warning"), "{}", String::from_utf8_lossy(&o.stdout));
+    for (sets, kind) in [
+        (&["materials.0.model.poisson_ratio=0.495"][..], "warning [locking]"),
+        (&["materials.0.hydraulic_conductivity=1e-12"][..], "warning [equal_order_near_undrained]"),
+        (
+            &["time_integration.rho_inf=1.0", "time.dt=1e-2", "stages.0.duration=1.0"][..],
+            "warning [undamped_large_step]",
+        ),
+    ] {
+        let mut args = vec!["check", "cases/terzaghi.toml"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let o = porompm(&args);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success() && out.contains(kind), "{sets:?}: {out}");
+    }
 }

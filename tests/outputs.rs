@@ -206,6 +206,8 @@ fn paraview_reads_the_fields_as_written() {
         ("mean_stress", 1),
         ("q", 1),
         ("eps_pd", 1),
+        ("mass", 1),
+        ("volume", 1),
         ("p", 1),
         ("p_excess", 1),
         ("material_id", 1),

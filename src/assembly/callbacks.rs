@@ -373,9 +373,21 @@ impl<'a> Assembler<'a> {
         Assembler { dm, model, step, x_local, f_local, seconds, stage, values: Vec::new(), nonfinite: None }
     }
 
+    /// The physical increments of the ghosted dofs at PETSc's `x` (pressures times the step's
+    /// scale, see `assembly::pressure_scale`).
     fn gather(&mut self, x: &VecRef) -> Result<Vec<f64>, CallbackError> {
         self.dm.global_to_local(x, self.x_local).map_err(fatal)?;
-        Ok(self.x_local.read().map_err(fatal)?.to_vec())
+        let mut xl = self.x_local.read().map_err(fatal)?.to_vec();
+        self.for_pressures(&mut xl, |v, s| *v *= s);
+        Ok(xl)
+    }
+
+    /// Applies `f(value, s)` to the pressure component of every ghosted node of `v`.
+    fn for_pressures(&self, v: &mut [f64], f: impl Fn(&mut f64, f64)) {
+        if let Some(p) = self.step.layout.and_then(|l| l.p) {
+            let (nd, s) = (self.step.dofs.nd, self.step.p_scale);
+            v.iter_mut().skip(p).step_by(nd).for_each(|x| f(x, s));
+        }
     }
 
     /// The particle side, for the threads.
@@ -548,6 +560,8 @@ impl NonlinearProblem for Assembler<'_> {
             }
         }
         self.add_projection(&xl, &mut fl);
+        // The continuity rows in PETSc's scaling (see `assembly::pressure_scale`).
+        self.for_pressures(&mut fl, |v, s| *v *= s);
         self.f_local.write().map_err(fatal)?.copy_from_slice(&fl);
         f.set_all(0.0).map_err(fatal)?;
         self.dm.local_to_global_add(self.f_local, f).map_err(fatal)?;
@@ -556,7 +570,7 @@ impl NonlinearProblem for Assembler<'_> {
             let xo = x.read().map_err(fatal)?;
             let mut fo = f.write().map_err(fatal)?;
             for &(o, q) in &self.step.dofs.owned_fixed {
-                fo[o] = xo[o] - self.step.dofs.value[q];
+                fo[o] = xo[o] - self.step.dofs.value[q] / self.step.unit(q);
             }
         }
         *self.seconds += t0.elapsed().as_secs_f64();
@@ -590,6 +604,16 @@ impl NonlinearProblem for Assembler<'_> {
                             values[blocks[a * 4 + b] as usize * nd * nd + p * nd + p] -= s[a][b];
                         }
                     }
+                }
+            }
+        }
+        // PETSc's scaling: the continuity rows and the pressure columns times s.
+        if let Some(p) = layout.p {
+            let s = step.p_scale;
+            for block in values.chunks_exact_mut(nd * nd) {
+                for c in 0..nd {
+                    block[p * nd + c] *= s;
+                    block[c * nd + p] *= s;
                 }
             }
         }

@@ -68,6 +68,8 @@ struct StepData {
     dofs: DofMap,
     /// External nodal forces at t_{n+1} (tractions) per ghosted dof, on the nodes that carry them.
     fext: Vec<f64>,
+    /// The same at t_n (for the generalized-α history and the work of the step).
+    fext_old: Vec<f64>,
     /// The generalized-α history per ghosted dof: α_m M a_n + α_f (forces at t_n) − α_f f_ext,n
     /// (empty for a scheme without one).
     history: Vec<f64>,
@@ -91,6 +93,40 @@ struct StepData {
     projection_blocks: Vec<[u32; 16]>,
     /// (diagonal block, component) of every owned fixed dof.
     fixed_diagonals: Vec<(u32, usize)>,
+    /// The pressure unknown's scale s [Pa/m] (see [`pressure_scale`]): PETSc sees Δp / s, and the
+    /// continuity rows multiplied by s; 0 until the step is prepared.
+    p_scale: f64,
+}
+
+impl StepData {
+    /// The physical increment of ghosted dof `q` per unit of its PETSc unknown: s for a pressure
+    /// dof, 1 for the others.
+    fn unit(&self, q: usize) -> f64 {
+        match self.layout.and_then(|l| l.p) {
+            Some(p) if q % self.dofs.nd == p => self.p_scale,
+            _ => 1.0,
+        }
+    }
+}
+
+/// The scale s of the pressure unknowns [Pa/m]: the largest constrained modulus of the skeleton
+/// over the smallest cell size, M/h. PETSc solves for Δp / s, and the continuity rows are
+/// multiplied by s (a symmetric diagonal scaling, so a symmetric tangent stays symmetric). A
+/// momentum row's entries are of order M (stiffness) and its coupling to the pressure of order h,
+/// so after scaling the coupling block is of order M as well, and a volume imbalance δV of a
+/// continuity row weighs s δV, as much as the force M δV / h it would take to close it. Without
+/// it the continuity rows are 1e-9…1e-20 of the momentum rows, and Newton's residual norm (and
+/// its absolute tolerance) cannot see an unsolved pressure equation: a quasi-static step that
+/// starts from the extrapolated increment was accepted with no iteration while its pore pressure
+/// drifted by 0.1 % of the load per step (Terzaghi, Δt = 0.1 s).
+pub fn pressure_scale(model: &Model) -> f64 {
+    let m = model.materials.iter().map(|m| m.model.elastic().constrained_modulus()).fold(0.0, f64::max);
+    let h = model.grid.h[0].min(model.grid.h[1]);
+    if m > 0.0 && h > 0.0 {
+        m / h
+    } else {
+        1.0
+    }
 }
 
 /// Outcome of one nonlinear step solve.
@@ -132,6 +168,10 @@ pub struct StepForces {
     /// The reaction of each boundary (index into `Model::boundaries`) on the material: the force
     /// the fixed dofs of both phases exert [N per m].
     pub reactions: Vec<[f64; 2]>,
+    /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
+    /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
+    /// (trapezoidal; the reactions at t_n are the last step's, none after a new grid system) [J per m].
+    pub work: f64,
 }
 
 /// The PETSc log stages of a run (shown by `-log_view`).
@@ -178,6 +218,8 @@ pub struct GridSystem {
     work_global: Vector,
     snes: Snes,
     jac: Option<Mat>,
+    /// The reactions per ghosted dof of the last converged step (for the work of the next).
+    last_reactions: Vec<f64>,
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
@@ -198,10 +240,13 @@ pub struct GridSystem {
 /// still resolving the equilibrium to a ten-billionth of the forces involved.
 pub const FORCE_ATOL: f64 = 1e-10;
 
-/// Ghost width in nodes: a GIMP particle of a cell reaches at most one cell beyond it, so the
-/// nodes of a rank's cells plus two rows cover every node its particles touch, and the nodes its
-/// barely filled nodes are extended from (they lie towards the particle).
-const STENCIL_WIDTH: usize = 2;
+/// Ghost width in nodes: a GIMP particle of a cell reaches at most one cell beyond it, and with B̄
+/// a barely filled cell takes its volumetric strain from a neighbour (`stencils::CellRoots`), so a
+/// particle's stencil reaches at most two cells beyond its own: node e + 3 for a particle in cell
+/// e. Three rows of ghost nodes cover every node a rank's particles touch, and the nodes its
+/// barely filled nodes are extended from (they lie towards the particle). (Two were once used: the
+/// footing near a slope on three ranks reached past them at a B̄ root.)
+pub const STENCIL_WIDTH: usize = 3;
 
 impl GridSystem {
     /// Creates the DMDA for the grid and dof layout on the run's communicator, and the SNES with
@@ -210,10 +255,20 @@ impl GridSystem {
     /// one rank (the fastest of the measured strategies on the verification cases, see
     /// docs/solvers.md) up to [`UMFPACK_MAX_GRID_DOFS`], and by MUMPS beyond and on several ranks
     /// (UMFPACK is sequential).
-    pub fn new(coll: &Collective, grid: &crate::model::grid::Grid, layout: Layout) -> Result<GridSystem, Error> {
+    ///
+    /// `partition` distributes the nodes over the ranks (None: PETSc's even split); see
+    /// [`crate::distribution::balanced`].
+    pub fn new(
+        coll: &Collective,
+        grid: &crate::model::grid::Grid,
+        layout: Layout,
+        partition: Option<&crate::distribution::Owners>,
+    ) -> Result<GridSystem, Error> {
         let comm = Comm::from_raw(coll.communicator().as_raw());
         let names = layout.field_names();
-        let dm = DmDa::new_2d(comm, grid.nodes(), STENCIL_WIDTH, names)?;
+        let counts = partition.map(|o| o.counts());
+        let ranges = counts.as_ref().map(|(x, y)| (&x[..], &y[..]));
+        let dm = DmDa::new_2d_partitioned(comm, grid.nodes(), STENCIL_WIDTH, names, ranges)?;
         let info = *dm.info();
         let x = dm.create_global_vector()?;
         let x_local = dm.create_local_vector()?;
@@ -274,12 +329,19 @@ impl GridSystem {
             snes,
             jac: None,
             user_atol,
+            last_reactions: Vec::new(),
             reused_patterns: 0,
             last_increment: None,
             l2_projection: None,
             step: StepData::default(),
             stages,
         })
+    }
+
+    /// Which rank owns which cells (from the DMDA's ownership ranges).
+    pub fn owners(&self) -> Result<crate::distribution::Owners, Error> {
+        let (x, y) = self.dm.ownership_ranges()?;
+        Ok(crate::distribution::Owners::new(&x, &y))
     }
 
     /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
@@ -446,10 +508,7 @@ impl GridSystem {
         let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
         let nm = kernels::Scheme::of(&model.integration, t_new - t_old, flow);
-        let fext_old = match nm.history() {
-            Some(_) => Some(coll.agree(self.external_forces(model, active, t_old, &dofs))?.0),
-            None => None,
-        };
+        let fext_old = coll.agree(self.external_forces(model, active, t_old, &dofs))?.0;
         self.step = StepData {
             nm: Some(nm),
             dt: t_new - t_old,
@@ -463,12 +522,14 @@ impl GridSystem {
             grad_n,
             smooth,
             projection,
+            p_scale: pressure_scale(model),
             ..StepData::default()
         };
         self.check_loads(&applied, t_new, coll)?;
-        if let Some(old) = fext_old {
-            self.step.history = self.history(model, &model.body_accelerations(active, t_old), &old);
+        if nm.history().is_some() {
+            self.step.history = self.history(model, &model.body_accelerations(active, t_old), &fext_old);
         }
+        self.step.fext_old = fext_old;
         self.step.force_scale = self.force_scale(model, coll)?;
         Ok(())
     }
@@ -821,7 +882,7 @@ impl GridSystem {
                 _ => x.fill(0.0),
             }
             for &(o, q) in &self.step.dofs.owned_fixed {
-                x[o] = self.step.dofs.value[q];
+                x[o] = self.step.dofs.value[q] / self.step.unit(q);
             }
         }
         // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.
@@ -836,7 +897,11 @@ impl GridSystem {
         };
         let solve_seconds = t0.elapsed().as_secs_f64();
         self.dm.global_to_local(&self.x, &mut self.x_local)?;
-        self.step.solution = self.x_local.read()?.to_vec();
+        let mut solution = self.x_local.read()?.to_vec();
+        for (q, v) in solution.iter_mut().enumerate() {
+            *v *= self.step.unit(q);
+        }
+        self.step.solution = solution;
         Ok(StepSolve {
             converged: out.converged,
             reason: out.reason_text,
@@ -893,15 +958,18 @@ impl GridSystem {
             asm.nodal_terms(&xl, &mut all, &mut inertia);
         }
         let mut fext = self.step.fext.clone();
-        for v in [&mut all, &mut inertia, &mut fext] {
+        let mut fext_old = self.step.fext_old.clone();
+        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old] {
             self.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
         let g = &model.grid;
         let hi = g.extent_max();
         let origin = [0.5 * (g.origin[0] + hi[0]), 0.5 * (g.origin[1] + hi[1])];
         let nb = model.boundaries.len();
-        // [total moment (4), external (4), reaction (4), inertia (4), reactions per boundary (2 nb)]
-        let mut local = vec![0.0; 16 + 2 * nb];
+        // [total moment (4), external (4), reaction (4), inertia (4), work, reactions per boundary (2 nb)]
+        let mut local = vec![0.0; 17 + 2 * nb];
+        let last = std::mem::take(&mut self.last_reactions);
+        let mut reactions = vec![0.0; ng];
         // (dof component, in-plane direction) of the solid and water motion.
         let motion: Vec<(usize, usize)> =
             self.motion().into_iter().map(|c| (c, if c < 2 { c } else { c - self.layout.w.unwrap_or(0) })).collect();
@@ -916,8 +984,11 @@ impl GridSystem {
                 let b = self.step.dofs.boundary[q];
                 let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
                 if (b as usize) < nb {
-                    local[16 + 2 * b as usize + dir] += reaction;
+                    local[17 + 2 * b as usize + dir] += reaction;
                 }
+                reactions[q] = reaction;
+                let reaction_old = last.get(q).copied().unwrap_or(reaction);
+                local[16] += 0.5 * (fext_old[q] + fext[q] + reaction_old + reaction) * self.step.solution[q];
                 for (row, x) in xr.iter().enumerate() {
                     let k = row * 2 + dir;
                     local[k] += x * (fext[q] + reaction - inertia[q]);
@@ -927,13 +998,15 @@ impl GridSystem {
                 }
             }
         }
+        self.last_reactions = reactions;
         let s = coll.sum(&local)?;
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         Ok(StepForces {
             moment: [[s[0], s[1]], [s[2], s[3]]],
             scale: norm(&s[4..8]).max(norm(&s[8..12])).max(norm(&s[12..16])),
             origin,
-            reactions: (0..nb).map(|b| [s[16 + 2 * b], s[17 + 2 * b]]).collect(),
+            reactions: (0..nb).map(|b| [s[17 + 2 * b], s[18 + 2 * b]]).collect(),
+            work: s[16],
         })
     }
 
@@ -969,7 +1042,9 @@ impl GridSystem {
         let nd = self.layout.nd;
         let pc = self.layout.p.expect("a pressure");
         if self.l2_projection.is_none() {
-            let dm = DmDa::new_2d(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"])?;
+            // The same distribution of the nodes as the system's DMDA.
+            let (x, y) = self.dm.ownership_ranges()?;
+            let dm = DmDa::new_2d_partitioned(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"], Some((&x, &y)))?;
             let mut ksp = Ksp::new(self.comm)?;
             ksp.set_prefix("pressure_projection_")?;
             ksp.set_type("cg")?;
@@ -1070,7 +1145,8 @@ impl GridSystem {
             for c in 0..nd {
                 let q = a as usize * nd + c;
                 if !self.step.dofs.fixed[q] {
-                    local += mags[q] * mags[q];
+                    let m = mags[q] * self.step.unit(q);
+                    local += m * m;
                 }
             }
         }

@@ -256,7 +256,7 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
             let l = ghost.node(i as usize, j as usize).ok_or_else(|| {
                 format!(
                     "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \
-                     (particle migration between ranks is not implemented yet)",
+                     (its support is wider than the ghost nodes around its cell allow)",
                     ps.id[k], x[0], x[1]
                 )
             })?;

@@ -19,6 +19,8 @@ fn positive(key: &str, v: f64) -> R {
 pub const MAX_MODULUS: f64 = 1e13;
 /// Largest hydraulic conductivity accepted [m/s] (open gravel is about 1e-1).
 pub const MAX_CONDUCTIVITY: f64 = 1.0;
+/// Largest pressure-projection factor α accepted (τ = α/G; the values that work are of order 1).
+pub const MAX_PROJECTION: f64 = 1e3;
 /// Largest density accepted [kg/m³] (osmium is 22 590).
 pub const MAX_DENSITY: f64 = 1e5;
 
@@ -94,6 +96,15 @@ pub fn validate(c: &Case) -> R {
     let two_phase = c.analysis.formulation == Formulation::TwoPhase;
     positive("analysis.g", c.analysis.g)?;
 
+    if let Some(alpha) = c.stabilisation.pressure_projection {
+        magnitude(
+            "stabilisation.pressure_projection",
+            alpha,
+            MAX_PROJECTION,
+            "times 1/G",
+            "beyond it the penalty swamps the coupling it stabilises",
+        )?;
+    }
     if c.stabilisation.pressure_update == PressureUpdate::ProjectedTotal {
         if !two_phase {
             return Err("key `stabilisation.pressure_update`: `projected_total` needs a two-phase case".into());

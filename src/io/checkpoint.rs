@@ -1,9 +1,10 @@
 //! `checkpoint.h5`: reading and writing a [`Checkpoint`] (see [`crate::state`] for what it holds).
 //!
 //! Layout: root attributes `format` ("porompm-checkpoint"), `version`, `case_fingerprint`, `time`
-//! [s], `step`, `stage`, `dt` [s], `successes`, `checkerboard_max`, `has_check_state`, then
+//! [s], `step`, `stage`, `dt` [s], `successes`, `has_check_state`, then
 //! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
-//! iterations, matrix-structure reuses), `probe_extremes` [Pa], `check_state`, and one dataset per
+//! iterations, matrix-structure reuses), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
+//! `check_state`, and one dataset per
 //! particle array under `/particles` (n × components, SI units, sorted by id).
 //!
 //! Atomicity: the file is written as `<name>.tmp`, closed, synced to disk, and renamed over the
@@ -50,9 +51,9 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), String> {
         attr_u64(loc, "stage", cp.stage).map_err(fail)?;
         attr_f64(loc, "dt", cp.dt).map_err(fail)?;
         attr_u64(loc, "successes", cp.successes).map_err(fail)?;
-        attr_f64(loc, "checkerboard_max", cp.checkerboard_max).map_err(fail)?;
         attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64).map_err(fail)?;
         f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..])).map_err(fail)?;
+        dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics).map_err(fail)?;
         dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes).map_err(fail)?;
         let state = cp.check_state.clone().unwrap_or_default();
         dataset_f64(&f, "check_state", &[state.len()], &state).map_err(fail)?;
@@ -140,7 +141,7 @@ pub fn read(path: &Path) -> Result<Checkpoint, String> {
         dt: x("dt").map_err(corrupt)?,
         successes: u("successes").map_err(corrupt)?,
         counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 4 values"))?,
-        checkerboard_max: x("checkerboard_max").map_err(corrupt)?,
+        diagnostics: vec_f64("diagnostics").map_err(corrupt)?,
         probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
         check_state: has_state.then_some(state),
         particles,
@@ -171,7 +172,7 @@ mod tests {
             dt: 1e-3 / 3.0,
             successes: 2,
             counters: [1, 301, 302, 7],
-            checkerboard_max: f64::NAN,
+            diagnostics: vec![f64::NAN, 0.5],
             probe_extremes: vec![-12.5, 3.0],
             check_state: Some(vec![1.0, 2.0]),
             particles: vec![r, r2],
@@ -190,7 +191,7 @@ mod tests {
         assert_eq!(back.checksum(), cp.checksum());
         assert_eq!(back.particles, cp.particles);
         assert_eq!(back.time.to_bits(), cp.time.to_bits());
-        assert!(back.checkerboard_max.is_nan() && back.check_state == cp.check_state);
+        assert!(back.diagnostics[0].is_nan() && back.diagnostics[1] == 0.5 && back.check_state == cp.check_state);
 
         // Change one particle value behind the checksum's back.
         {

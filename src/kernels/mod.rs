@@ -547,6 +547,11 @@ pub struct StepResult {
     pub f_inc: [[f64; 2]; 2],
     /// Volume ratio of the step, J_v.
     pub jacobian: f64,
+    /// The objective strain increment Δε [xx, yy, γxy, zz] the stress update used (zero for a
+    /// rigid rotation).
+    pub deps: [f64; 4],
+    /// The porosity gradient ∇n at t_n the step used (two-phase u–p–U; zero otherwise).
+    pub grad_n: [f64; 2],
 }
 
 impl StepResult {
@@ -558,6 +563,8 @@ impl StepResult {
             eps_pd: pt.upd.eps_pd,
             f_inc: pt.kin.f_bar(),
             jacobian: pt.kin.jv,
+            deps: pt.kin.deps,
+            grad_n: pt.part.grad_n,
         }
     }
 }

@@ -104,7 +104,7 @@ impl LoadDef {
                         let in_body = body.as_ref().is_none_or(|b| c.bodies[particles.body[k] as usize].name == *b);
                         in_body
                             && region.contains(particles.x0[k])
-                            && face_is_exposed(c, particles.x0[k], particles.lp[k], *face)
+                            && face_is_exposed(c, particles.x0[k], particles.lp0[k], *face)
                     })
                     .collect(),
                 face: *face,
@@ -310,7 +310,7 @@ impl BoundaryDef {
                     continue;
                 }
                 for &f in &sf.faces {
-                    if face_is_exposed(c, particles.x0[k], particles.lp[k], f) {
+                    if face_is_exposed(c, particles.x0[k], particles.lp0[k], f) {
                         v.push((k, f));
                     }
                 }

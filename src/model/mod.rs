@@ -134,6 +134,22 @@ impl Model {
         }
     }
 
+    /// Resolves the case's point-wise loads (face tractions) and moving surfaces again on this
+    /// rank's points, after points moved between ranks. Both depend only on what travels with a
+    /// point (its body, and its position and domain at t = 0), so every point keeps its loads.
+    pub fn resolve_targets(&mut self, case: &Case) {
+        for (l, c) in self.loads.iter_mut().zip(&case.loads) {
+            if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
+                *l = LoadDef::from_case(c, case, &self.grid, &self.particles);
+            }
+        }
+        for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
+            if b.surface.is_some() {
+                *b = BoundaryDef::from_case(c, case, &self.particles);
+            }
+        }
+    }
+
     /// Dofs per node.
     pub fn ndof(&self) -> usize {
         if self.two_phase {

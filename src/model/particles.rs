@@ -67,6 +67,32 @@ impl Particles {
         self.x.is_empty()
     }
 
+    /// Appends a point with the given id, body and material and every other array zero (to be
+    /// filled by the caller).
+    pub fn push_blank(&mut self, id: u64, body: u16, material: u16) {
+        self.id.push(id);
+        self.body.push(body);
+        self.material.push(material);
+        self.x.push([0.0; 2]);
+        self.x0.push([0.0; 2]);
+        self.disp.push([0.0; 2]);
+        self.lp.push([0.0; 2]);
+        self.lp0.push([0.0; 2]);
+        self.def_grad.push([[0.0; 2]; 2]);
+        self.volume.push(0.0);
+        self.porosity.push(0.0);
+        self.mass.push(0.0);
+        self.vel.push([0.0; 2]);
+        self.acc.push([0.0; 2]);
+        self.vel_w.push([0.0; 2]);
+        self.acc_w.push([0.0; 2]);
+        self.stress.push([0.0; 4]);
+        self.p.push(0.0);
+        self.p0.push(0.0);
+        self.eps_pd.push(0.0);
+        self.grad_p.push([0.0; 2]);
+    }
+
     /// Fills the bodies of the case with `n × n` points per cell, keeping those whose cell
     /// satisfies `owned(cell_i, cell_j)` (the cells of this rank). Points are placed at the centres
     /// of the n × n sub-cells; a point belongs to the first body that contains it.

@@ -15,30 +15,55 @@ use crate::model::Model;
 use crate::parallel::Collective;
 use std::collections::HashMap;
 
-/// The checkerboard index of the current pore pressures (0 when there is no pressure).
-pub fn checkerboard_index(model: &Model, coll: &Collective) -> Result<f64, String> {
-    let ps = &model.particles;
-    let local: Vec<f64> = (0..ps.len()).flat_map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k]]).collect();
-    let all = coll.gather(&local)?;
-    let points: Vec<[f64; 3]> = all.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
-    Ok(index_of(&points, model.grid.origin, model.grid.h))
+/// How the pore pressures deviate from their local smooth fit.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Fit {
+    /// The checkerboard index I (see the module's documentation).
+    pub index: f64,
+    /// The largest deviation |p_k − s_k| of a particle's pressure from its smooth part [Pa].
+    pub max_deviation: f64,
 }
 
-/// The index of point values `[x, y, p]` binned on cells of size `h` from `origin`.
+/// The checkerboard fit of the current pore pressures (zero when there is no pressure). Each
+/// body is fitted on its own: a jump of the pressure between bodies (a footing on saturated soil)
+/// is not an oscillation.
+pub fn pressure_fit(model: &Model, coll: &Collective) -> Result<Fit, String> {
+    let ps = &model.particles;
+    let local: Vec<f64> = (0..ps.len()).flat_map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k], ps.body[k] as f64]).collect();
+    let all = coll.gather(&local)?;
+    let points: Vec<[f64; 4]> = all.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    Ok(fit_of(&points, model.grid.origin, model.grid.h))
+}
+
+/// The index of point values `[x, y, p]` (one body) binned on cells of size `h` from `origin`.
 pub fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
-    let cell = |p: &[f64; 3]| (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64);
-    let mut bins: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    fit_of3(points, origin, h).index
+}
+
+/// The fit of point values `[x, y, p]` of one body.
+fn fit_of3(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> Fit {
+    let with_body: Vec<[f64; 4]> = points.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
+    fit_of(&with_body, origin, h)
+}
+
+/// The fit of point values `[x, y, p, body]` binned on cells of size `h` from `origin`, each
+/// body's points apart.
+pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
+    let cell = |p: &[f64; 4]| {
+        (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64, p[3] as i64)
+    };
+    let mut bins: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
     for (k, p) in points.iter().enumerate() {
         bins.entry(cell(p)).or_default().push(k);
     }
-    let (mut r2, mut s2) = (0.0, 0.0);
-    for (&(i, j), members) in &bins {
+    let (mut r2, mut s2, mut worst) = (0.0, 0.0, 0.0f64);
+    for (&(i, j, body), members) in &bins {
         let centre = [origin[0] + (i as f64 + 0.5) * h[0], origin[1] + (j as f64 + 0.5) * h[1]];
-        let local = |p: &[f64; 3]| [(p[0] - centre[0]) / h[0], (p[1] - centre[1]) / h[1]];
+        let local = |p: &[f64; 4]| [(p[0] - centre[0]) / h[0], (p[1] - centre[1]) / h[1]];
         let mut nb: Vec<usize> = Vec::new();
         for dj in -1..=1 {
             for di in -1..=1 {
-                if let Some(v) = bins.get(&(i + di, j + dj)) {
+                if let Some(v) = bins.get(&(i + di, j + dj, body)) {
                     nb.extend(v);
                 }
             }
@@ -81,13 +106,10 @@ pub fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
             let s: f64 = basis(local(&points[k])).iter().zip(&coef).map(|(q, c)| q * c).sum();
             r2 += (points[k][2] - s).powi(2);
             s2 += s * s;
+            worst = worst.max((points[k][2] - s).abs());
         }
     }
-    if s2 <= 0.0 {
-        0.0
-    } else {
-        (r2 / s2).sqrt()
-    }
+    Fit { index: if s2 <= 0.0 { 0.0 } else { (r2 / s2).sqrt() }, max_deviation: worst }
 }
 
 /// Solves the m × m system by Gaussian elimination with partial pivoting; `None` if singular.
@@ -145,6 +167,29 @@ mod tests {
         let cb = index_of(&points(|_, _, i, j| 10.0 + if (i + j) % 2 == 0 { 1.0 } else { -1.0 }), o, h);
         assert!((cb - 0.1).abs() < 0.01, "{cb}");
         assert_eq!(index_of(&[], o, h), 0.0);
+    }
+
+    #[test]
+    fn the_largest_deviation_is_the_amplitude_of_the_pattern() {
+        let (o, h) = ([0.0, 0.0], [0.5, 0.25]);
+        let smooth = fit_of3(&points(|x, y, _, _| 5.0 + 2.0 * x - 3.0 * y), o, h);
+        assert!(smooth.max_deviation < 1e-12, "{smooth:?}");
+        // ±1 alternating on 10 + x: the interior points deviate by about 1 from their fit (a fit
+        // over 3 × 3 cells takes up a little of the pattern at the edges).
+        let cb = fit_of3(&points(|x, _, i, j| 10.0 + x + if (i + j) % 2 == 0 { 1.0 } else { -1.0 }), o, h);
+        assert!(cb.max_deviation > 0.9 && cb.max_deviation < 1.5, "{cb:?}");
+        // One particle off by 3 in a smooth field stands out.
+        let spike = fit_of3(&points(|_, _, i, j| 10.0 + if (i, j) == (9, 7) { 3.0 } else { 0.0 }), o, h);
+        assert!(spike.max_deviation > 2.0 && spike.max_deviation <= 3.0, "{spike:?}");
+        // Two bodies with different uniform pressures side by side: no oscillation.
+        let two: Vec<[f64; 4]> = points(|x, _, _, _| if x < 2.5 { 10.0 } else { 0.0 })
+            .iter()
+            .map(|p| [p[0], p[1], p[2], if p[0] < 2.5 { 0.0 } else { 1.0 }])
+            .collect();
+        assert!(fit_of(&two, o, h).max_deviation < 1e-12);
+        // The same jump inside one body is one.
+        let one: Vec<[f64; 4]> = two.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
+        assert!(fit_of(&one, o, h).max_deviation > 1.0);
     }
 
     #[test]

@@ -76,3 +76,30 @@ pub fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
 pub fn metric(s: &Value, name: &str) -> f64 {
     s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
 }
+
+/// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`; one rank
+/// runs the binary directly), with a 600 s limit so that a hang fails the test instead of holding it.
+pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run {
+    if ranks == 1 {
+        return run_case(case, dir, args);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+    let np = ranks.to_string();
+    let mut all: Vec<String> = ["600", "mpirun", "--oversubscribe", "-n", np.as_str(), env!("CARGO_BIN_EXE_porompm")]
+        .map(String::from)
+        .to_vec();
+    all.extend(["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()]);
+    all.extend(args.iter().cloned());
+    let output = Command::new("timeout")
+        .args(&all)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .current_dir(root())
+        .output()
+        .expect("mpirun runs");
+    assert_ne!(output.status.code(), Some(124), "{case} on {ranks} ranks: no end within 600 s (a hang)");
+    let summary = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap_or_default())
+        .unwrap_or(Value::Null);
+    let (header, rows) = read_history(dir);
+    Run { output, summary, header, rows }
+}

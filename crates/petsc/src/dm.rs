@@ -84,9 +84,28 @@ impl DmDa {
     /// a box stencil of width `stencil_width`, and non-periodic boundaries. Matrices created from it
     /// are only preallocated (no zeros are stored), so their structure is what assembly puts in.
     pub fn new_2d(comm: Comm, nodes: [usize; 2], stencil_width: usize, field_names: &[&str]) -> Result<DmDa> {
+        DmDa::new_2d_partitioned(comm, nodes, stencil_width, field_names, None)
+    }
+
+    /// As [`DmDa::new_2d`], with the nodes distributed as `ranges` says: the number of node columns
+    /// of each of the m process columns and of node rows of each of the n process rows (m n must be
+    /// the communicator's size; rank a + b m owns column slab a and row slab b). `None`: PETSc decides.
+    pub fn new_2d_partitioned(
+        comm: Comm,
+        nodes: [usize; 2],
+        stencil_width: usize,
+        field_names: &[&str],
+        ranges: Option<(&[usize], &[usize])>,
+    ) -> Result<DmDa> {
         if field_names.is_empty() {
             return Err(Error::new("a DMDA needs at least one field"));
         }
+        let lx: Option<Vec<Int>> = ranges.map(|r| r.0.iter().map(|&v| v as Int).collect());
+        let ly: Option<Vec<Int>> = ranges.map(|r| r.1.iter().map(|&v| v as Int).collect());
+        let (m, n) = match (&lx, &ly) {
+            (Some(x), Some(y)) => (x.len() as Int, y.len() as Int),
+            _ => (sys::PETSC_DECIDE as Int, sys::PETSC_DECIDE as Int),
+        };
         let mut raw = std::ptr::null_mut();
         call!(DMDACreate2d(
             comm.raw(),
@@ -95,12 +114,12 @@ impl DmDa {
             sys::DMDAStencilType::DMDA_STENCIL_BOX,
             nodes[0] as Int,
             nodes[1] as Int,
-            sys::PETSC_DECIDE as Int,
-            sys::PETSC_DECIDE as Int,
+            m,
+            n,
             field_names.len() as Int,
             stencil_width as Int,
-            std::ptr::null(),
-            std::ptr::null(),
+            lx.as_ref().map_or(std::ptr::null(), |v| v.as_ptr()),
+            ly.as_ref().map_or(std::ptr::null(), |v| v.as_ptr()),
             &mut raw
         ))?;
         let mut dm = DmDa {

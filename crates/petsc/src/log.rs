@@ -11,11 +11,15 @@ pub struct LogStage(sys::PetscLogStage);
 pub struct StageGuard(());
 
 impl LogStage {
-    /// Registers a stage (the name appears in `-log_view`).
+    /// Registers a stage (the name appears in `-log_view`), or returns the stage already
+    /// registered under that name (PETSc refuses a second registration).
     pub fn register(name: &str) -> Result<LogStage> {
         let c = cstring(name)?;
-        let mut s: sys::PetscLogStage = 0;
-        call!(PetscLogStageRegister(c.as_ptr(), &mut s))?;
+        let mut s: sys::PetscLogStage = -1;
+        call!(PetscLogStageGetId(c.as_ptr(), &mut s))?;
+        if s < 0 {
+            call!(PetscLogStageRegister(c.as_ptr(), &mut s))?;
+        }
         Ok(LogStage(s))
     }
 

@@ -1,0 +1,266 @@
+//! Which rank holds which material point, and the migration of points to their owner after each
+//! particle update.
+//!
+//! A material point belongs to the rank that owns the cell holding its centre, and a rank owns
+//! cell (i, j) when it owns node (i, j) of the DMDA (the cell's lower-left node). The DMDA
+//! distributes the nodes in a tensor grid of subdomains: `m` slabs along x and `n` along y, rank
+//! r = a + b m holding slab a along x and slab b along y (PETSc's ordering). A point's stencil
+//! (GIMP: the nodes within h + l_p of its centre; with B̄ the nodes of a neighbouring root cell) then
+//! lies in its rank's ghost region of width three.
+//!
+//! After every accepted step the points whose centre left this rank's cells are packed into
+//! records ([`crate::state::pack`]: every per-point array, so stress, internal variables, F,
+//! volumes, pressures and velocities move with them) and sent directly to their new owner in one
+//! personalised all-to-all exchange, however far they moved. A rank's points are kept sorted by
+//! id, so the order (and with it every sum over a rank's points) does not depend on how the
+//! points arrived. The loads and moving surfaces that act on particular points are resolved again
+//! from the case on the new set ([`crate::model::Model::resolve_targets`]): they depend only on
+//! quantities that travel with the point (its body, its position and domain at t = 0).
+
+use crate::case::Case;
+use crate::model::grid::Grid;
+use crate::model::Model;
+use crate::parallel::Collective;
+use crate::state::{pack, particles_from_records, RECORD};
+
+/// The load imbalance (the busiest rank's points over the mean) beyond which a run repartitions
+/// the grid (`porompm run --balance-threshold`).
+pub const DEFAULT_BALANCE_THRESHOLD: f64 = 1.2;
+
+/// A repartition is made only if it lowers the imbalance by at least this factor; after one that
+/// could not, the next attempt waits until the imbalance has grown by this factor.
+pub const BALANCE_GAIN: f64 = 1.1;
+
+/// The distribution of the grid's cells over ranks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Owners {
+    /// First node column of each slab along x, and one past the last (length m + 1).
+    x: Vec<usize>,
+    /// First node row of each slab along y, and one past the last (length n + 1).
+    y: Vec<usize>,
+}
+
+impl Owners {
+    /// From the number of node columns and rows each slab owns (`DMDAGetOwnershipRanges`).
+    pub fn new(counts_x: &[usize], counts_y: &[usize]) -> Owners {
+        let starts = |c: &[usize]| {
+            let mut v = vec![0];
+            for &n in c {
+                v.push(v.last().copied().unwrap_or(0) + n);
+            }
+            v
+        };
+        Owners { x: starts(counts_x), y: starts(counts_y) }
+    }
+
+    /// The number of node columns and rows of each slab (the inverse of [`Owners::new`]).
+    pub fn counts(&self) -> (Vec<usize>, Vec<usize>) {
+        let c = |s: &[usize]| s.windows(2).map(|w| w[1] - w[0]).collect();
+        (c(&self.x), c(&self.y))
+    }
+
+    /// One rank owning everything.
+    pub fn single(nodes: [usize; 2]) -> Owners {
+        Owners::new(&[nodes[0]], &[nodes[1]])
+    }
+
+    /// Number of ranks.
+    pub fn ranks(&self) -> usize {
+        (self.x.len() - 1) * (self.y.len() - 1)
+    }
+
+    /// The rank owning cell (i, j).
+    pub fn rank_of_cell(&self, i: usize, j: usize) -> usize {
+        let slab = |s: &[usize], k: usize| s[1..].partition_point(|&end| end <= k).min(s.len() - 2);
+        slab(&self.x, i) + slab(&self.y, j) * (self.x.len() - 1)
+    }
+
+    /// The rank owning the cell that holds `x` (a centre outside the grid counts with the nearest
+    /// cell: the grid-edge check stops such a run before it is mapped).
+    pub fn rank_of(&self, grid: &Grid, x: [f64; 2]) -> usize {
+        let mut c = [0usize; 2];
+        for d in 0..2 {
+            let s = (x[d] - grid.origin[d]) / grid.h[d];
+            c[d] = if s.is_finite() { (s.floor().max(0.0) as usize).min(grid.cells[d] - 1) } else { 0 };
+        }
+        self.rank_of_cell(c[0], c[1])
+    }
+}
+
+/// The load imbalance of a distribution of points: the largest count of a rank over the mean
+/// (1 when balanced; 1 when there are no points).
+pub fn imbalance(counts: &[f64]) -> f64 {
+    let total: f64 = counts.iter().sum();
+    if total <= 0.0 || counts.is_empty() {
+        return 1.0;
+    }
+    counts.iter().copied().fold(0.0, f64::max) / (total / counts.len() as f64)
+}
+
+/// A distribution of the cells over `ranks` ranks that balances the points: `hist` holds the
+/// number of points per cell (i + j nx, summed over ranks). Every tensor grid of slabs m × n = ranks
+/// is tried, its x cuts balancing the points per cell column and its y cuts the points per cell
+/// row, and the one whose busiest rank holds the fewest points is returned with its imbalance.
+/// Every slab keeps at least `min_width` node columns or rows (the DMDA's stencil width).
+pub fn balanced(hist: &[f64], cells: [usize; 2], ranks: usize, min_width: usize) -> Option<(Owners, f64)> {
+    let (nx, ny) = (cells[0], cells[1]);
+    let mut columns = vec![0.0; nx];
+    let mut rows = vec![0.0; ny];
+    for j in 0..ny {
+        for i in 0..nx {
+            columns[i] += hist[i + j * nx];
+            rows[j] += hist[i + j * nx];
+        }
+    }
+    let mut best: Option<(Owners, f64)> = None;
+    for m in (1..=ranks).filter(|m| ranks.is_multiple_of(*m)) {
+        let n = ranks / m;
+        let (Some(cx), Some(cy)) = (cuts(&columns, m, min_width), cuts(&rows, n, min_width)) else { continue };
+        let owners = Owners::new(&cx, &cy);
+        let mut per_rank = vec![0.0; ranks];
+        for j in 0..ny {
+            for i in 0..nx {
+                per_rank[owners.rank_of_cell(i, j)] += hist[i + j * nx];
+            }
+        }
+        let im = imbalance(&per_rank);
+        if best.as_ref().is_none_or(|b| im < b.1) {
+            best = Some((owners, im));
+        }
+    }
+    best
+}
+
+/// Node counts of `k` slabs along one direction (cells `w.len()`, nodes one more) whose shares of
+/// the weights `w` per cell are as equal as the cells allow, each at least `min_width` nodes; None
+/// if the nodes are too few.
+fn cuts(w: &[f64], k: usize, min_width: usize) -> Option<Vec<usize>> {
+    let nodes = w.len() + 1;
+    if k * min_width > nodes {
+        return None;
+    }
+    let total: f64 = w.iter().sum();
+    let mut cum = vec![0.0; w.len() + 1];
+    for (i, x) in w.iter().enumerate() {
+        cum[i + 1] = cum[i] + x;
+    }
+    let mut starts = vec![0usize];
+    for a in 1..k {
+        let target = total * a as f64 / k as f64;
+        let lo = starts[a - 1] + min_width;
+        let hi = nodes - (k - a) * min_width;
+        // The cut (first node of slab a) whose cumulative weight is nearest the target.
+        let c = (lo..=hi.min(w.len()))
+            .min_by(|&p, &q| (cum[p] - target).abs().total_cmp(&(cum[q] - target).abs()).then(p.cmp(&q)))
+            .unwrap_or(lo);
+        starts.push(c);
+    }
+    starts.push(nodes);
+    Some(starts.windows(2).map(|s| s[1] - s[0]).collect())
+}
+
+/// What one migration did on this rank.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Migration {
+    /// Points that left this rank.
+    pub sent: usize,
+    /// Points that arrived.
+    pub received: usize,
+}
+
+/// Sends every point of this rank whose centre lies in another rank's cells to that rank and takes
+/// in the points sent here; collective (every rank calls it after the same step). The points stay
+/// sorted by id and the case's point-wise loads and surfaces are resolved again on the new set.
+pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collective) -> Migration {
+    let me = coll.rank();
+    let size = coll.size();
+    if size == 1 {
+        return Migration::default();
+    }
+    let ps = &model.particles;
+    let dest: Vec<usize> = (0..ps.len()).map(|k| owners.rank_of(&model.grid, ps.x[k])).collect();
+    let mut outgoing = vec![Vec::new(); size];
+    let mut sent = 0;
+    for (k, &r) in dest.iter().enumerate() {
+        if r != me {
+            outgoing[r].extend_from_slice(&pack(ps, k));
+            sent += 1;
+        }
+    }
+    let arrived = coll.exchange(&outgoing);
+    let received = arrived.len() / RECORD;
+    if sent == 0 && received == 0 {
+        return Migration::default();
+    }
+    let mut records: Vec<[f64; RECORD]> = (0..ps.len()).filter(|&k| dest[k] == me).map(|k| pack(ps, k)).collect();
+    records.extend(arrived.chunks_exact(RECORD).map(|c| <[f64; RECORD]>::try_from(c).expect("RECORD values")));
+    records.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    model.particles = particles_from_records(&records);
+    model.resolve_targets(case);
+    Migration { sent, received }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cells_belong_to_the_slab_of_their_lower_left_node() {
+        // 3 × 2 ranks over 10 × 7 nodes (9 × 6 cells).
+        let o = Owners::new(&[4, 3, 3], &[4, 3]);
+        assert_eq!(o.ranks(), 6);
+        assert_eq!(o.rank_of_cell(0, 0), 0);
+        assert_eq!(o.rank_of_cell(3, 3), 0);
+        assert_eq!(o.rank_of_cell(4, 3), 1);
+        assert_eq!(o.rank_of_cell(7, 0), 2);
+        assert_eq!(o.rank_of_cell(8, 5), 5);
+        assert_eq!(o.rank_of_cell(3, 4), 3);
+        let g = Grid::new([0.0, 0.0], [1.0, 1.0], [9, 6]);
+        assert_eq!(o.rank_of(&g, [4.5, 0.5]), 1);
+        assert_eq!(o.rank_of(&g, [8.99, 6.0]), 5, "the top edge counts with the last cell");
+        assert_eq!(o.rank_of(&g, [-0.5, -3.0]), 0, "outside: the nearest cell");
+        assert_eq!(Owners::single([10, 7]).rank_of(&g, [8.5, 5.5]), 0);
+        assert_eq!(o.counts(), (vec![4, 3, 3], vec![4, 3]));
+    }
+
+    #[test]
+    fn a_crowded_corner_is_shared_out() {
+        // 12 × 12 cells, every point in the 4 × 4 cells of the lower-left corner, 4 ranks.
+        let cells = [12, 12];
+        let mut hist = vec![0.0; 144];
+        for j in 0..4 {
+            for i in 0..4 {
+                hist[i + 12 * j] = 4.0;
+            }
+        }
+        let (o, im) = balanced(&hist, cells, 4, 2).unwrap();
+        // PETSc's even split (7, 6 nodes each way) would put all 64 points on rank 0: imbalance 4.
+        assert_eq!(imbalance(&[64.0, 0.0, 0.0, 0.0]), 4.0);
+        assert!(im <= 1.0 + 1e-12, "imbalance {im} with {:?}", o.counts());
+        let mut per = [0.0; 4];
+        for j in 0..12 {
+            for i in 0..12 {
+                per[o.rank_of_cell(i, j)] += hist[i + 12 * j];
+            }
+        }
+        assert_eq!(per, [16.0; 4]);
+        let (cx, cy) = o.counts();
+        assert_eq!(cx.iter().sum::<usize>(), 13);
+        assert_eq!(cy.iter().sum::<usize>(), 13);
+        assert!(cx.iter().chain(&cy).all(|&c| c >= 2));
+    }
+
+    #[test]
+    fn slabs_keep_the_stencil_width_and_too_few_nodes_give_none() {
+        // All the weight in one cell: the cuts cannot split it, every slab keeps two nodes.
+        let w = [0.0, 0.0, 9.0, 0.0, 0.0, 0.0];
+        let c = cuts(&w, 3, 2).unwrap();
+        assert_eq!(c.iter().sum::<usize>(), 7);
+        assert!(c.iter().all(|&n| n >= 2), "{c:?}");
+        assert!(cuts(&w, 4, 2).is_none(), "4 slabs of 2 nodes need 8 nodes");
+        // Uniform weights over 9 cells: 4 and 5 cells (the last slab also holds the last node).
+        let even = cuts(&[1.0; 9], 2, 2).unwrap();
+        assert!(even == vec![4, 6] || even == vec![5, 5], "{even:?}");
+        assert_eq!(imbalance(&[]), 1.0);
+    }
+}
