@@ -78,12 +78,8 @@ impl Owners {
     /// The rank owning the cell that holds `x` (a centre outside the grid counts with the nearest
     /// cell: the grid-edge check stops such a run before it is mapped).
     pub fn rank_of(&self, grid: &Grid, x: [f64; 2]) -> usize {
-        let mut c = [0usize; 2];
-        for d in 0..2 {
-            let s = (x[d] - grid.origin[d]) / grid.h[d];
-            c[d] = if s.is_finite() { (s.floor().max(0.0) as usize).min(grid.cells[d] - 1) } else { 0 };
-        }
-        self.rank_of_cell(c[0], c[1])
+        let (i, j) = grid.nearest_cell(x);
+        self.rank_of_cell(i, j)
     }
 }
 
@@ -159,23 +155,15 @@ fn cuts(w: &[f64], k: usize, min_width: usize) -> Option<Vec<usize>> {
     Some(starts.windows(2).map(|s| s[1] - s[0]).collect())
 }
 
-/// What one migration did on this rank.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Migration {
-    /// Points that left this rank.
-    pub sent: usize,
-    /// Points that arrived.
-    pub received: usize,
-}
-
 /// Sends every point of this rank whose centre lies in another rank's cells to that rank and takes
 /// in the points sent here; collective (every rank calls it after the same step). The points stay
 /// sorted by id and the case's point-wise loads and surfaces are resolved again on the new set.
-pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collective) -> Migration {
+/// Returns the number of points that left this rank.
+pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collective) -> usize {
     let me = coll.rank();
     let size = coll.size();
     if size == 1 {
-        return Migration::default();
+        return 0;
     }
     let ps = &model.particles;
     let dest: Vec<usize> = (0..ps.len()).map(|k| owners.rank_of(&model.grid, ps.x[k])).collect();
@@ -188,16 +176,15 @@ pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collectiv
         }
     }
     let arrived = coll.exchange(&outgoing);
-    let received = arrived.len() / RECORD;
-    if sent == 0 && received == 0 {
-        return Migration::default();
+    if sent == 0 && arrived.is_empty() {
+        return 0;
     }
     let mut records: Vec<[f64; RECORD]> = (0..ps.len()).filter(|&k| dest[k] == me).map(|k| pack(ps, k)).collect();
     records.extend(arrived.chunks_exact(RECORD).map(|c| <[f64; RECORD]>::try_from(c).expect("RECORD values")));
     records.sort_by(|a, b| a[0].total_cmp(&b[0]));
     model.particles = particles_from_records(&records);
     model.resolve_targets(case);
-    Migration { sent, received }
+    sent
 }
 
 #[cfg(test)]

@@ -551,7 +551,7 @@ impl<'a> Simulation<'a> {
         if self.system.layout() != analysis.layout {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;
-            let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
+            let owners = self.system.owners().clone();
             self.system = GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners))
                 .map_err(|e| RunError::Failed(e.to_string()))?;
             self.system.reused_patterns = reused;
@@ -670,9 +670,8 @@ impl<'a> Simulation<'a> {
             return Ok(());
         }
         let t0 = Instant::now();
-        let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
-        let moved = crate::distribution::migrate(&mut self.model, self.case, &owners, self.coll);
-        self.summary.migrated_particles += self.coll.sum_count(moved.sent as u64) as usize;
+        let sent = crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
+        self.summary.migrated_particles += self.coll.sum_count(sent as u64) as usize;
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -703,9 +702,9 @@ impl<'a> Simulation<'a> {
         let [nx, ny] = grid.cells;
         let mut hist = vec![0.0; nx * ny];
         for x in &self.model.particles.x {
-            if let Some((i, j)) = grid.cell_of(*x) {
-                hist[i + j * nx] += 1.0;
-            }
+            // The cell that decides the point's owner (`Owners::rank_of`).
+            let (i, j) = grid.nearest_cell(*x);
+            hist[i + j * nx] += 1.0;
         }
         let hist = self.coll.sum(&hist).map_err(RunError::Failed)?;
         let proposal = crate::distribution::balanced(&hist, grid.cells, self.coll.size(), assembly::STENCIL_WIDTH);
@@ -718,15 +717,14 @@ impl<'a> Simulation<'a> {
         self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners))
             .map_err(|e| RunError::Failed(e.to_string()))?;
         self.system.reused_patterns = reused;
-        let moved = crate::distribution::migrate(&mut self.model, self.case, &owners, self.coll);
-        self.summary.migrated_particles += self.coll.sum_count(moved.sent as u64) as usize;
+        self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
+        self.migrate_particles()?;
         self.summary.repartitions += 1;
         self.balance.1 = Some(predicted);
         self.progress(&format!(
             "  t = {:.6e} s: load imbalance {now:.2} > {threshold}: grid repartitioned, imbalance now {predicted:.2}",
             self.t
         ));
-        self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -949,8 +947,7 @@ impl<'a> Simulation<'a> {
     fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
         let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
         state::check_case(cp, self.case).map_err(refuse)?;
-        let owners = self.system.owners().map_err(|e| RunError::Failed(e.to_string()))?;
-        let (grid, me) = (&self.model.grid, self.coll.rank());
+        let (owners, grid, me) = (self.system.owners(), &self.model.grid, self.coll.rank());
         let restored =
             cp.restore_particles(&self.model.particles, self.summary.particles, |x| owners.rank_of(grid, x) == me);
         if self.coll.any(restored.is_err()).map_err(RunError::Failed)? {

@@ -102,14 +102,7 @@ impl Collective {
         let n = v.len() as i32;
         let mut counts = vec![0i32; size];
         self.world.all_gather_into(&n, &mut counts[..]);
-        let displs: Vec<i32> = counts
-            .iter()
-            .scan(0i32, |acc, &c| {
-                let d = *acc;
-                *acc += c;
-                Some(d)
-            })
-            .collect();
+        let displs = displacements(&counts);
         let total: i32 = counts.iter().sum();
         let mut out = vec![T::default(); total as usize];
         {
@@ -129,18 +122,9 @@ impl Collective {
         let send_counts: Vec<i32> = outgoing.iter().map(|v| v.len() as i32).collect();
         let mut recv_counts = vec![0i32; size];
         self.world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
-        let offsets = |c: &[i32]| -> Vec<i32> {
-            c.iter()
-                .scan(0i32, |acc, &n| {
-                    let d = *acc;
-                    *acc += n;
-                    Some(d)
-                })
-                .collect()
-        };
         let send: Vec<f64> = outgoing.concat();
-        let send_displs = offsets(&send_counts);
-        let recv_displs = offsets(&recv_counts);
+        let send_displs = displacements(&send_counts);
+        let recv_displs = displacements(&recv_counts);
         let mut recv = vec![0.0; recv_counts.iter().sum::<i32>() as usize];
         {
             let part = Partition::new(&send[..], &send_counts[..], &send_displs[..]);
@@ -180,4 +164,16 @@ impl Collective {
         let msg = String::from_utf8_lossy(&bytes).into_owned();
         Err(if self.size() > 1 { format!("{msg} (rank {first})") } else { msg })
     }
+}
+
+/// The offset of each part in a buffer of parts of `counts` values laid end to end.
+fn displacements(counts: &[i32]) -> Vec<i32> {
+    counts
+        .iter()
+        .scan(0i32, |acc, &n| {
+            let d = *acc;
+            *acc += n;
+            Some(d)
+        })
+        .collect()
 }

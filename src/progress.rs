@@ -21,7 +21,8 @@ pub struct Progress {
 
 impl Progress {
     /// A display for a run up to simulated time `end` [s]; `speak` is false on ranks other than 0
-    /// and with `--quiet`, `rank0` only on ranks other than 0.
+    /// and with `--quiet`; `rank0` is true on rank 0 only (warnings are printed there even with
+    /// `--quiet`).
     pub fn new(speak: bool, rank0: bool, end: f64) -> Progress {
         let bar = (speak && std::io::stderr().is_terminal()).then(|| {
             let b = ProgressBar::with_draw_target(Some(TICKS), ProgressDrawTarget::stderr_with_hz(4));

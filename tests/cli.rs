@@ -39,6 +39,14 @@ fn assert_one_line_error(o: &Output, needle: &str) {
     assert!(!err.contains("panicked") && !err.contains("PETSC ERROR") && !err.contains("[0]PETSC"), "{err}");
 }
 
+/// `porompm check CASE --set SET` refuses each `(SET, needle)` pair with one error line naming it.
+fn assert_sets_refused(case: &str, pairs: &[(&str, &str)]) {
+    for (set, needle) in pairs {
+        let o = porompm(&["check", case, "--set", set]);
+        assert_one_line_error(&o, needle);
+    }
+}
+
 fn summary(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json exists");
     serde_json::from_str(&text).expect("summary.json is valid JSON")
@@ -111,16 +119,16 @@ fn an_out_of_range_value_is_named_with_its_range() {
     let o = porompm(&["check", "cases/terzaghi.toml", "--set", "time_integration.gamma=0.4"]);
     assert_one_line_error(&o, "not unconditionally stable");
     // Absurd magnitudes: each named with its bound.
-    for (set, needle) in [
-        ("materials.soil.model.young_modulus=1e308", "young_modulus`: must be at most 1e13 Pa"),
-        ("materials.soil.water_bulk_modulus=1e20", "water_bulk_modulus`: must be at most 1e13 Pa"),
-        ("materials.soil.solid_bulk_modulus=1e14", "solid_bulk_modulus`: must be at most 1e13 Pa"),
-        ("materials.soil.hydraulic_conductivity=5", "hydraulic_conductivity`: must be at most 1e0 m/s"),
-        ("materials.soil.solid_density=1e6", "solid_density`: must be at most 1e5 kg/m³"),
-    ] {
-        let o = porompm(&["check", "cases/terzaghi.toml", "--set", set]);
-        assert_one_line_error(&o, needle);
-    }
+    assert_sets_refused(
+        "cases/terzaghi.toml",
+        &[
+            ("materials.soil.model.young_modulus=1e308", "young_modulus`: must be at most 1e13 Pa"),
+            ("materials.soil.water_bulk_modulus=1e20", "water_bulk_modulus`: must be at most 1e13 Pa"),
+            ("materials.soil.solid_bulk_modulus=1e14", "solid_bulk_modulus`: must be at most 1e13 Pa"),
+            ("materials.soil.hydraulic_conductivity=5", "hydraulic_conductivity`: must be at most 1e0 m/s"),
+            ("materials.soil.solid_density=1e6", "solid_density`: must be at most 1e5 kg/m³"),
+        ],
+    );
 }
 
 #[test]
@@ -632,37 +640,40 @@ fn bad_analysis_settings_are_named() {
 /// verification, the time integration, the output, the stabilisation and the loads.
 #[test]
 fn bad_values_across_the_case_are_named() {
-    for (set, needle) in [
-        ("grid.size=[-1.0,1.0]", "key `grid.size[0]`: must be a positive number"),
-        ("grid.origin=[nan,0.0]", "key `grid.origin`: must be finite"),
-        ("bodies.0.particles_per_cell=0", "key `bodies[0].particles_per_cell`: must be between 1 and 8"),
-        ("bodies.0.material=nonesuch", "key `bodies[0].material`: no material named `nonesuch`"),
-        ("bodies.0.perturbation=-1", "key `bodies[0].perturbation`: must be in [0, 0.5)"),
-        ("stages.0.duration=0", "key `stages[0].duration`: must be a positive number"),
-        ("stages.0.dt=-1", "key `stages[0].dt`: must be a positive number"),
-        ("stages.0.cut_factor=1.5", "key `stages[0].cut_factor`: must be in (0, 1)"),
-        ("stages.0.max_step_cuts=1000", "key `stages[0].max_step_cuts`: at most 30"),
-        ("stages.0.loads=[\"nonesuch\"]", "key `stages[0].loads`: no load named `nonesuch`"),
-        ("stages.0.boundaries=[\"nonesuch\"]", "key `stages[0].boundaries`: no boundary named `nonesuch`"),
-        ("probes.0.point=[5.0,5.0]", "key `probes[0].point`: [5.0, 5.0] is outside the grid"),
-        ("verification.time_factors=[-1.0]", "key `verification.time_factors`: give positive time factors"),
-        ("verification.body=nonesuch", "key `verification.body`: no body named `nonesuch`"),
-        ("verification.load=nonesuch", "key `verification.load`: no load named `nonesuch`"),
-        ("time_integration.beta=0.1", "key `time_integration`: β = 0.1, γ = 0.5 is not unconditionally stable"),
-        ("output.history_every=0", "key `output.history_every`: must be at least 1"),
-        ("materials.0.model.poisson_ratio=0.5", "key `materials[0].model.poisson_ratio`: must be in (-1, 0.5)"),
-        ("materials.0.water_density=0", "key `materials[0].water_density`: must be a positive number"),
-        ("stabilisation.pressure_projection=-1", "key `stabilisation.pressure_projection`: must be a positive number"),
-        ("stabilisation.pressure_projection=1e9", "key `stabilisation.pressure_projection`: must be at most 1e3"),
-        ("boundaries.0.side=nowhere", "--set boundaries.0.side: unknown variant `nowhere`"),
-        ("boundaries.0.fix=[\"uz\"]", "--set boundaries.0.fix: unknown variant `uz`"),
-        ("loads.0.face=top", "key `loads[0]`: unknown variant `top`"),
-        ("loads.0.traction=[nan,0.0]", "key `loads[0].traction`: must be finite"),
-        ("analysis.g=-1", "key `analysis.g`: must be a positive number"),
-    ] {
-        let o = porompm(&["check", "cases/terzaghi.toml", "--set", set]);
-        assert_one_line_error(&o, needle);
-    }
+    assert_sets_refused(
+        "cases/terzaghi.toml",
+        &[
+            ("grid.size=[-1.0,1.0]", "key `grid.size[0]`: must be a positive number"),
+            ("grid.origin=[nan,0.0]", "key `grid.origin`: must be finite"),
+            ("bodies.0.particles_per_cell=0", "key `bodies[0].particles_per_cell`: must be between 1 and 8"),
+            ("bodies.0.material=nonesuch", "key `bodies[0].material`: no material named `nonesuch`"),
+            ("bodies.0.perturbation=-1", "key `bodies[0].perturbation`: must be in [0, 0.5)"),
+            ("stages.0.duration=0", "key `stages[0].duration`: must be a positive number"),
+            ("stages.0.dt=-1", "key `stages[0].dt`: must be a positive number"),
+            ("stages.0.cut_factor=1.5", "key `stages[0].cut_factor`: must be in (0, 1)"),
+            ("stages.0.max_step_cuts=1000", "key `stages[0].max_step_cuts`: at most 30"),
+            ("stages.0.loads=[\"nonesuch\"]", "key `stages[0].loads`: no load named `nonesuch`"),
+            ("stages.0.boundaries=[\"nonesuch\"]", "key `stages[0].boundaries`: no boundary named `nonesuch`"),
+            ("probes.0.point=[5.0,5.0]", "key `probes[0].point`: [5.0, 5.0] is outside the grid"),
+            ("verification.time_factors=[-1.0]", "key `verification.time_factors`: give positive time factors"),
+            ("verification.body=nonesuch", "key `verification.body`: no body named `nonesuch`"),
+            ("verification.load=nonesuch", "key `verification.load`: no load named `nonesuch`"),
+            ("time_integration.beta=0.1", "key `time_integration`: β = 0.1, γ = 0.5 is not unconditionally stable"),
+            ("output.history_every=0", "key `output.history_every`: must be at least 1"),
+            ("materials.0.model.poisson_ratio=0.5", "key `materials[0].model.poisson_ratio`: must be in (-1, 0.5)"),
+            ("materials.0.water_density=0", "key `materials[0].water_density`: must be a positive number"),
+            (
+                "stabilisation.pressure_projection=-1",
+                "key `stabilisation.pressure_projection`: must be a positive number",
+            ),
+            ("stabilisation.pressure_projection=1e9", "key `stabilisation.pressure_projection`: must be at most 1e3"),
+            ("boundaries.0.side=nowhere", "--set boundaries.0.side: unknown variant `nowhere`"),
+            ("boundaries.0.fix=[\"uz\"]", "--set boundaries.0.fix: unknown variant `uz`"),
+            ("loads.0.face=top", "key `loads[0]`: unknown variant `top`"),
+            ("loads.0.traction=[nan,0.0]", "key `loads[0].traction`: must be finite"),
+            ("analysis.g=-1", "key `analysis.g`: must be a positive number"),
+        ],
+    );
 }
 
 /// `porompm check` lists the physics warnings of a case (what would lock or oscillate), and a

@@ -209,6 +209,8 @@ pub struct GridSystem {
     owned_count: [usize; 2],
     /// Ghosted indices of the owned nodes, row by row.
     owned_nodes: Vec<u32>,
+    /// Which rank owns which cells (the DMDA's ownership ranges).
+    owners: crate::distribution::Owners,
     /// Global index of every ghosted dof.
     l2g: Vec<i32>,
     x: Vector,
@@ -283,6 +285,8 @@ impl GridSystem {
                 info.ghosted.len() * layout.nd
             )));
         }
+        let (counts_x, counts_y) = dm.ownership_ranges()?;
+        let owners = crate::distribution::Owners::new(&counts_x, &counts_y);
         let mut owned_nodes = Vec::new();
         for j in info.owned_start[1]..info.owned_start[1] + info.owned_count[1] {
             for i in info.owned_start[0]..info.owned_start[0] + info.owned_count[0] {
@@ -320,6 +324,7 @@ impl GridSystem {
             owned_start: info.owned_start,
             owned_count: info.owned_count,
             owned_nodes,
+            owners,
             l2g,
             x,
             x_local,
@@ -338,10 +343,9 @@ impl GridSystem {
         })
     }
 
-    /// Which rank owns which cells (from the DMDA's ownership ranges).
-    pub fn owners(&self) -> Result<crate::distribution::Owners, Error> {
-        let (x, y) = self.dm.ownership_ranges()?;
-        Ok(crate::distribution::Owners::new(&x, &y))
+    /// Which rank owns which cells (the DMDA's ownership ranges).
+    pub fn owners(&self) -> &crate::distribution::Owners {
+        &self.owners
     }
 
     /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
@@ -1043,7 +1047,7 @@ impl GridSystem {
         let pc = self.layout.p.expect("a pressure");
         if self.l2_projection.is_none() {
             // The same distribution of the nodes as the system's DMDA.
-            let (x, y) = self.dm.ownership_ranges()?;
+            let (x, y) = self.owners.counts();
             let dm = DmDa::new_2d_partitioned(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"], Some((&x, &y)))?;
             let mut ksp = Ksp::new(self.comm)?;
             ksp.set_prefix("pressure_projection_")?;

@@ -35,15 +35,22 @@ impl Grid {
     /// The cell (i, j) containing `x`, or `None` outside the grid (points on the upper boundary
     /// belong to the last cell).
     pub fn cell_of(&self, x: [f64; 2]) -> Option<(usize, usize)> {
+        let inside = (0..2).all(|d| {
+            let s = (x[d] - self.origin[d]) / self.h[d];
+            s >= -1e-9 && s <= self.cells[d] as f64 + 1e-9
+        });
+        inside.then(|| self.nearest_cell(x))
+    }
+
+    /// The cell (i, j) containing `x`, or the nearest cell outside the grid (cell (0, 0) for a
+    /// position that is not finite).
+    pub fn nearest_cell(&self, x: [f64; 2]) -> (usize, usize) {
         let mut c = [0usize; 2];
         for d in 0..2 {
             let s = (x[d] - self.origin[d]) / self.h[d];
-            if !(s >= -1e-9 && s <= self.cells[d] as f64 + 1e-9) {
-                return None;
-            }
-            c[d] = (s.floor().max(0.0) as usize).min(self.cells[d] - 1);
+            c[d] = if s.is_finite() { (s.floor().max(0.0) as usize).min(self.cells[d] - 1) } else { 0 };
         }
-        Some((c[0], c[1]))
+        (c[0], c[1])
     }
 
     /// Centre of cell (i, j) [m].

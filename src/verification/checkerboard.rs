@@ -35,17 +35,6 @@ pub fn pressure_fit(model: &Model, coll: &Collective) -> Result<Fit, String> {
     Ok(fit_of(&points, model.grid.origin, model.grid.h))
 }
 
-/// The index of point values `[x, y, p]` (one body) binned on cells of size `h` from `origin`.
-pub fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
-    fit_of3(points, origin, h).index
-}
-
-/// The fit of point values `[x, y, p]` of one body.
-fn fit_of3(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> Fit {
-    let with_body: Vec<[f64; 4]> = points.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
-    fit_of(&with_body, origin, h)
-}
-
 /// The fit of point values `[x, y, p, body]` binned on cells of size `h` from `origin`, each
 /// body's points apart.
 pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
@@ -143,6 +132,17 @@ fn solve(a: &mut [f64], b: &mut [f64], m: usize) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fit of point values `[x, y, p]` of one body.
+    fn fit_of3(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> Fit {
+        let with_body: Vec<[f64; 4]> = points.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
+        fit_of(&with_body, origin, h)
+    }
+
+    /// The index of point values `[x, y, p]` of one body.
+    fn index_of(points: &[[f64; 3]], origin: [f64; 2], h: [f64; 2]) -> f64 {
+        fit_of3(points, origin, h).index
+    }
 
     /// 2 × 2 points per cell on 10 × 8 cells of 0.5 × 0.25, values from `f`.
     fn points(f: impl Fn(f64, f64, i64, i64) -> f64) -> Vec<[f64; 3]> {
