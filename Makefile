@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study gold bench lint clean
+.PHONY: setup build run test study gold bench bench-scaling lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -34,6 +34,12 @@ gold: setup
 # wall time, peak memory, Newton iterations, settlements at q = 3c and 4c, the time split.
 bench: build
 	python3 scripts/bench_footing_peer.py
+
+# Strong scaling 1 -> 2 ranks at 1.04e5 unknowns (slumping block, field split and MUMPS; median of
+# RUNS=3) and the communication per step at 2 and 4 ranks for the weak-scaling model
+# (target/bench/scaling.md; about 30 minutes; COMM=0 skips the second part).
+bench-scaling: build
+	python3 scripts/bench_scaling.py
 
 lint:
 	cargo fmt --check

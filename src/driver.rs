@@ -125,6 +125,9 @@ pub struct Summary {
     pub repartitions: usize,
     /// The largest load imbalance at a history row (the busiest rank's points over the mean).
     pub load_imbalance_max: f64,
+    /// porompm's own collective operations on rank 0 over the run (reductions, gathers, the
+    /// migration and output exchanges; PETSc's own messages are in its `-log_view`).
+    pub collectives: crate::parallel::Traffic,
     /// Newton iterations over the run.
     pub snes_iterations: usize,
     /// Krylov iterations over the run.
@@ -266,6 +269,7 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         None => None,
     };
     summary.petsc_options = assembly::petsc_options().unwrap_or_default();
+    summary.collectives = req.coll.traffic();
     let err = result.err();
     match &err {
         None => summary.status = "completed".into(),
@@ -309,6 +313,7 @@ impl Summary {
             migrated_particles: 0,
             repartitions: 0,
             load_imbalance_max: 1.0,
+            collectives: Default::default(),
             snes_iterations: 0,
             ksp_iterations: 0,
             matrix_structure_reuses: 0,
@@ -348,7 +353,7 @@ pub fn test_jacobian(
     flip: Option<(usize, usize)>,
 ) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
     let mut summary = Summary::new(req);
-    let mut out = RunOutput::create(&req.out_dir, false).map_err(RunError::Input)?;
+    let mut out = RunOutput::silent();
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
@@ -409,7 +414,7 @@ impl<'a> Simulation<'a> {
         }
         out.start_history(&columns).map_err(input)?;
         if case.output.fields_every > 0 {
-            out.start_fields(crate::fields::grid_geometry(&model)).map_err(input)?;
+            out.start_fields(crate::fields::grid_geometry(&model), coll.communicator()).map_err(input)?;
         }
         drop(setup_stage);
         summary.timings.setup_s = t0.elapsed().as_secs_f64();
@@ -768,7 +773,8 @@ impl<'a> Simulation<'a> {
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         let mut row = vec![self.t, self.step as f64, dt, self.last_newton.0 as f64, self.last_newton.1 as f64];
         row.extend(update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?);
-        let (values, warnings) = self.monitor.row(&self.model, self.coll, self.t).map_err(RunError::Failed)?;
+        let (values, warnings) =
+            self.monitor.row(&self.model, self.system.owners(), self.coll, self.t).map_err(RunError::Failed)?;
         row.extend(values);
         let imbalance = self.load_imbalance()?;
         self.summary.load_imbalance_max = self.summary.load_imbalance_max.max(imbalance);
@@ -879,8 +885,8 @@ impl<'a> Simulation<'a> {
             return Ok(());
         }
         let t0 = Instant::now();
-        let nodes = self.system.owned_node_records();
-        let frame = crate::fields::frame(&self.model, &nodes, self.coll, self.t).map_err(RunError::Failed)?;
+        let nodes = self.system.owned_node_block();
+        let frame = crate::fields::frame(&self.model, &nodes, self.coll, self.t);
         self.out.write_fields(&frame).map_err(RunError::Failed)?;
         self.fields_step = Some(self.step);
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();

@@ -1,7 +1,9 @@
-//! The fields written to `fields.h5`/`fields.xdmf` at an output time, gathered from all ranks (the
-//! file itself is written by rank 0 through [`crate::io::fields`]).
+//! The fields written to `fields.h5`/`fields.xdmf` at an output time, each rank's share of them
+//! (all ranks write the file together through [`crate::io::fields`]).
 //!
-//! Particle fields (sorted by particle id): `position` and `displacement` [m], `velocity` [m/s]
+//! Particle fields, sorted by particle id: the records are redistributed so that each rank holds
+//! one slab of the sorted list ([`Collective::sorted_slab`]), which it writes at its place in the
+//! file; the file does not depend on the number of ranks. The fields: `position` and `displacement` [m], `velocity` [m/s]
 //! (3 components, z = 0), the effective stress components `stress_xx`, `stress_yy`, `stress_xy`,
 //! `stress_zz` [Pa] (tension positive; total stress in one-phase runs), the mean effective stress
 //! `mean_stress` = −(σ'_xx + σ'_yy + σ'_zz)/3 [Pa] (compression positive), the deviatoric stress
@@ -10,15 +12,17 @@
 //! `particle_id`, and in two-phase runs the pore pressure `p` and the excess pore pressure
 //! `p_excess` = p − p₀ [Pa].
 //!
-//! Grid fields: `active` (1 where the node took part in the last step) and the nodal increments of
-//! the last step, `du` [m] (and in two-phase runs `dp` [Pa] and `dU` [m]); all zero before the
-//! first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's geometry.
+//! Grid fields, each rank writing the block of nodes it owns: `active` (1 where the node took part
+//! in the last step) and the nodal increments of the last step, `du` [m] (and in two-phase runs `dp`
+//! [Pa] and `dU` [m]); all zero before the first step (e.g. at t = 0 and at the restart time). Node
+//! coordinates are the grid's geometry.
 
+use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::io::fields::{Field, Frame, GridGeometry, Values};
 use crate::model::Model;
 use crate::parallel::Collective;
 
-/// Values per particle record in the gather.
+/// Values per particle record in the redistribution.
 const PREC: usize = 18;
 
 /// The grid's geometry for the field files.
@@ -30,9 +34,9 @@ fn vec3(v: impl Iterator<Item = [f64; 2]>) -> Vec<f64> {
     v.flat_map(|a| [a[0], a[1], 0.0]).collect()
 }
 
-/// The fields at time `t`, on every rank. `node_records` are this rank's
-/// [`crate::assembly::GridSystem::owned_node_records`].
-pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> Result<Frame, String> {
+/// This rank's share of the fields at time `t` (collective). `nodes` is this rank's
+/// [`crate::assembly::GridSystem::owned_node_block`].
+pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Frame {
     let ps = &model.particles;
     let local: Vec<f64> = (0..ps.len())
         .flat_map(|k| {
@@ -59,9 +63,8 @@ pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> 
             ]
         })
         .collect();
-    let mut all: Vec<[f64; PREC]> =
-        coll.gather(&local)?.chunks_exact(PREC).map(|c| c.try_into().expect("PREC values")).collect();
-    all.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let slab = coll.sorted_slab(&local, PREC);
+    let all: Vec<[f64; PREC]> = slab.values.chunks_exact(PREC).map(|c| c.try_into().expect("PREC values")).collect();
     let real = |f: &dyn Fn(&[f64; PREC]) -> f64| Values::Real(all.iter().map(f).collect());
     let int = |i: usize| Values::Int(all.iter().map(|r| r[i] as i32).collect());
     let scalar = |name, values| Field { name, components: 1, values };
@@ -94,23 +97,22 @@ pub fn frame(model: &Model, node_records: &[f64], coll: &Collective, t: f64) -> 
         pf.push(scalar("p_excess", real(&|r| r[13] - r[14])));
     }
 
-    let n_nodes = model.grid.node_count();
-    let mut active = vec![0; n_nodes];
-    let mut d = vec![[0.0; 5]; n_nodes];
-    for r in coll.gather(node_records)?.chunks_exact(7) {
-        let n = r[0] as usize;
-        if n < n_nodes {
-            active[n] = (r[1] > 0.5) as i32;
-            d[n].copy_from_slice(&r[2..7]);
-        }
-    }
+    let d: Vec<&[f64]> = nodes.values.chunks_exact(NODE_VALUES).collect();
+    let active = d.iter().map(|v| (v[0] > 0.5) as i32).collect();
     let mut gf = vec![
         Field { name: "active", components: 1, values: Values::Int(active) },
-        Field { name: "du", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[0], v[1]]))) },
+        Field { name: "du", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[1], v[2]]))) },
     ];
     if model.two_phase {
-        gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[2]).collect()) });
-        gf.push(Field { name: "dU", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[3], v[4]]))) });
+        gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[3]).collect()) });
+        gf.push(Field { name: "dU", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[4], v[5]]))) });
     }
-    Ok(Frame { time: t, particles: all.len(), particle_fields: pf, grid_fields: gf })
+    Frame {
+        time: t,
+        particles: slab.total,
+        first_particle: slab.offset,
+        particle_fields: pf,
+        node_block: (nodes.start, nodes.count),
+        grid_fields: gf,
+    }
 }

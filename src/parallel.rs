@@ -17,6 +17,17 @@ use mpi::traits::*;
 pub struct Collective {
     world: SimpleCommunicator,
     threads: usize,
+    /// The collective operations this rank took part in, and the bytes they brought it.
+    traffic: std::cell::Cell<Traffic>,
+}
+
+/// Counts of porompm's own collective operations on one rank (PETSc's are in its `-log_view`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Traffic {
+    /// Collective calls (reductions, gathers, exchanges, agreements).
+    pub calls: u64,
+    /// Bytes they delivered to this rank.
+    pub bytes: u64,
 }
 
 impl Default for Collective {
@@ -33,12 +44,22 @@ impl Collective {
         let world = SimpleCommunicator::world();
         let on_node = world.split_shared(world.rank()).size().max(1) as usize;
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        Collective { world, threads: (cores / on_node).max(1) }
+        Collective { world, threads: (cores / on_node).max(1), traffic: Default::default() }
     }
 
     /// Sets the threads of this rank's particle loops (`--threads`; at least one).
     pub fn set_threads(&mut self, n: usize) {
         self.threads = n.max(1);
+    }
+
+    /// This rank's collective traffic so far.
+    pub fn traffic(&self) -> Traffic {
+        self.traffic.get()
+    }
+
+    fn count(&self, bytes: usize) {
+        let t = self.traffic.get();
+        self.traffic.set(Traffic { calls: t.calls + 1, bytes: t.bytes + bytes as u64 });
     }
 
     /// The threads of this rank's particle loops.
@@ -63,6 +84,7 @@ impl Collective {
 
     fn reduce(&self, v: &[f64], op: SystemOperation) -> Vec<f64> {
         let mut out = vec![0.0; v.len()];
+        self.count(8 * v.len());
         if !v.is_empty() {
             self.world.all_reduce_into(v, &mut out[..], op);
         }
@@ -87,6 +109,7 @@ impl Collective {
     /// Exact sum of counts over ranks.
     pub fn sum_count(&self, v: u64) -> u64 {
         let mut out = 0u64;
+        self.count(8);
         self.world.all_reduce_into(&v, &mut out, SystemOperation::sum());
         out
     }
@@ -104,6 +127,7 @@ impl Collective {
         self.world.all_gather_into(&n, &mut counts[..]);
         let displs = displacements(&counts);
         let total: i32 = counts.iter().sum();
+        self.count(4 * size + total as usize * std::mem::size_of::<T>());
         let mut out = vec![T::default(); total as usize];
         {
             let mut part = PartitionMut::new(&mut out[..], counts, displs);
@@ -126,6 +150,7 @@ impl Collective {
         let send_displs = displacements(&send_counts);
         let recv_displs = displacements(&recv_counts);
         let mut recv = vec![0.0; recv_counts.iter().sum::<i32>() as usize];
+        self.count(4 * size + 8 * recv.len());
         {
             let part = Partition::new(&send[..], &send_counts[..], &send_displs[..]);
             let mut into = PartitionMut::new(&mut recv[..], &recv_counts[..], &recv_displs[..]);
@@ -134,10 +159,38 @@ impl Collective {
         recv
     }
 
+    /// Records of `stride` values whose first value is a unique non-negative integer key (a
+    /// particle id), redistributed so that rank r holds the r-th slab of the list of all ranks'
+    /// records sorted by key: keys in [r K/P, (r + 1) K/P) with K one more than the largest key, so
+    /// every rank receives a share of about n/P records and no rank the whole list. Returns this
+    /// rank's slab (sorted), its first position in the global list, and the number of records of
+    /// all ranks. Collective; the global list does not depend on the number of ranks.
+    pub fn sorted_slab(&self, records: &[f64], stride: usize) -> Slab {
+        let size = self.size();
+        let largest = records.chunks_exact(stride).map(|r| r[0]).fold(-1.0f64, f64::max);
+        let keys = self.reduce(&[largest + 1.0], SystemOperation::max())[0].max(1.0);
+        let mut outgoing = vec![Vec::new(); size];
+        for r in records.chunks_exact(stride) {
+            let to = ((r[0] / keys * size as f64) as usize).min(size - 1);
+            outgoing[to].extend_from_slice(r);
+        }
+        let received = self.exchange(&outgoing);
+        let mut rows: Vec<&[f64]> = received.chunks_exact(stride).collect();
+        rows.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        let values: Vec<f64> = rows.concat();
+        let n = (values.len() / stride) as u64;
+        let mut counts = vec![0u64; size];
+        self.count(8 * size);
+        self.world.all_gather_into(&n, &mut counts[..]);
+        let offset = counts[..self.rank()].iter().sum::<u64>() as usize;
+        Slab { values, offset, total: counts.iter().sum::<u64>() as usize }
+    }
+
     /// Whether any rank reports `flag`.
     pub fn any(&self, flag: bool) -> Result<bool, String> {
         let mine = flag as i32;
         let mut out = 0i32;
+        self.count(4);
         self.world.all_reduce_into(&mine, &mut out, SystemOperation::max());
         Ok(out > 0)
     }
@@ -147,6 +200,7 @@ impl Collective {
     pub fn agree<T>(&self, local: Result<T, String>) -> Result<T, String> {
         let mine = if local.is_err() { self.rank() as i32 } else { i32::MAX };
         let mut first = i32::MAX;
+        self.count(4);
         self.world.all_reduce_into(&mine, &mut first, SystemOperation::min());
         if first == i32::MAX {
             return local;
@@ -164,6 +218,17 @@ impl Collective {
         let msg = String::from_utf8_lossy(&bytes).into_owned();
         Err(if self.size() > 1 { format!("{msg} (rank {first})") } else { msg })
     }
+}
+
+/// One rank's part of a list distributed over the ranks ([`Collective::sorted_slab`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Slab {
+    /// This rank's records, laid end to end.
+    pub values: Vec<f64>,
+    /// The position of its first record in the whole list.
+    pub offset: usize,
+    /// The number of records of all ranks.
+    pub total: usize,
 }
 
 /// The offset of each part in a buffer of parts of `counts` values laid end to end.

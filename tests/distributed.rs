@@ -22,6 +22,9 @@ struct Frame {
     position: Vec<[f64; 2]>,
     velocity: Vec<[f64; 2]>,
     stress: Vec<f64>,
+    /// The grid fields: the active flag and the last step's displacement increment of every node.
+    active: Vec<i32>,
+    du: Vec<f64>,
 }
 
 /// Every output time of a run's fields.h5, in time order.
@@ -49,6 +52,8 @@ fn frames(dir: &Path) -> Vec<Frame> {
                 position: pairs(read(n, "position")),
                 velocity: pairs(read(n, "velocity")),
                 stress: sxx.iter().zip(&syy).zip(&sxy).map(|((a, b), c)| a.abs().max(b.abs()).max(c.abs())).collect(),
+                active: f.dataset(&format!("grid/{n}/active")).unwrap().read_raw::<i32>().unwrap(),
+                du: f.dataset(&format!("grid/{n}/du")).unwrap().read_raw::<f64>().unwrap(),
             }
         })
         .collect()
@@ -127,6 +132,11 @@ fn a_block_carried_across_every_rank_boundary_and_back_keeps_its_points_mass_and
             worst = (worst.0.max(dp), worst.1.max(dx), worst.2.max(dv / (a / w)));
             assert!(dp <= 1e-9, "{n} ranks at t = {}: momentum {p:?} against one rank's {q:?}", f.time);
             assert!(dx <= 1e-9 && dv <= 1e-9 * a / w, "{n} ranks at t = {}: positions {dx}, velocities {dv}", f.time);
+            // Each rank writes the block of nodes it owns: the grid fields are one rank's.
+            assert_eq!(f.active, g.active, "{n} ranks at t = {}: active nodes", f.time);
+            let ddu = f.du.iter().zip(&g.du).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(f.active.contains(&1) || f.time == 0.0, "t = {}: no active node", f.time);
+            assert!(ddu <= 1e-9, "{n} ranks at t = {}: nodal increments differ by {ddu} m", f.time);
             // Against the exact swing: the dynamic stage starts from a₀ = 0 under the load A, which
             // leaves the velocity behind by about A Δt/3 (0.15 m/s of 14 m/s) for the whole run.
             assert!((p[0] - exact).abs() <= 2e-2 * m0 * a / w, "t = {}: momentum {} against {exact}", f.time, p[0]);

@@ -109,6 +109,21 @@ impl StepData {
     }
 }
 
+/// Values per node of a [`NodeBlock`].
+pub const NODE_VALUES: usize = 6;
+
+/// The nodes a rank owns: the rectangle of grid nodes `start .. start + count` (i, j) and
+/// [`NODE_VALUES`] values per node, x fastest (see [`GridSystem::owned_node_block`]).
+#[derive(Debug, Clone, Default)]
+pub struct NodeBlock {
+    /// The first owned node (i, j).
+    pub start: [usize; 2],
+    /// The owned nodes along x and y.
+    pub count: [usize; 2],
+    /// The values, node by node.
+    pub values: Vec<f64>,
+}
+
 /// The scale s of the pressure unknowns [Pa/m]: the largest constrained modulus of the skeleton
 /// over the smallest cell size, M/h. PETSc solves for Δp / s, and the continuity rows are
 /// multiplied by s (a symmetric diagonal scaling, so a symmetric tangent stays symmetric). A
@@ -1111,28 +1126,27 @@ impl GridSystem {
             .collect())
     }
 
-    /// The nodes this rank owns after the last solve, as records of 7 values: global node index
-    /// j·n_x + i, active (well-filled) flag (1 or 0), and the nodal increments Δd of the step (ux,
-    /// uy, p, Ux, Uy; zeros beyond the dofs of the layout). Empty before the first solve.
-    pub fn owned_node_records(&self) -> Vec<f64> {
-        let (nd, nx) = (self.layout.nd, self.dm.info().nodes[0]);
-        let mut out = Vec::new();
-        if self.step.solution.is_empty() {
-            return out;
-        }
+    /// The block of nodes this rank owns and, per node (x fastest), 6 values: the active
+    /// (well-filled) flag (1 or 0) of the last solve and its nodal increments Δd (ux, uy, p, Ux,
+    /// Uy; zeros beyond the dofs of the layout); all zero before the first solve.
+    pub fn owned_node_block(&self) -> NodeBlock {
+        let nd = self.layout.nd;
         let names = Layout::UPU.field_names();
         let own = self.layout.field_names();
+        let mut values = Vec::with_capacity(self.owned_nodes.len() * NODE_VALUES);
         for &a in &self.owned_nodes {
             let l = a as usize;
-            let (i, j) = self.ghost.ij(l);
-            out.push((j * nx + i) as f64);
-            out.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
+            if self.step.solution.is_empty() {
+                values.extend([0.0; NODE_VALUES]);
+                continue;
+            }
+            values.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
             for name in names {
                 let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| self.step.solution[l * nd + c]);
-                out.push(v);
+                values.push(v);
             }
         }
-        out
+        NodeBlock { start: self.owned_start, count: self.owned_count, values }
     }
 
     /// The norm over the free dofs of the prepared step's force magnitudes (collective).

@@ -140,11 +140,17 @@ impl Monitor {
     /// principal total stress magnitude |σ' − p I| over the particles (the load a footing or a
     /// column carries, the overburden of a slope), so a spurious pressure is measured against what
     /// the soil carries and not against itself.
-    pub fn row(&mut self, model: &Model, coll: &Collective, t: f64) -> Result<(Vec<f64>, Vec<Warning>), String> {
+    pub fn row(
+        &mut self,
+        model: &Model,
+        owners: &crate::distribution::Owners,
+        coll: &Collective,
+        t: f64,
+    ) -> Result<(Vec<f64>, Vec<Warning>), String> {
         let mut values = Vec::new();
         let mut warnings = Vec::new();
         if self.two_phase {
-            let fit = crate::verification::checkerboard::pressure_fit(model, coll)?;
+            let fit = crate::verification::checkerboard::pressure_fit(model, owners, coll)?;
             let ps = &model.particles;
             let (mut lo, mut hi, mut scale) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
             for k in 0..ps.len() {

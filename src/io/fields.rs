@@ -2,7 +2,11 @@
 //!
 //! Every output time `i` adds the HDF5 groups `/particles/<i>` (one dataset per particle field,
 //! n or n × 3 values) and `/grid/<i>` (one dataset per nodal field, n_y × n_x or n_y × n_x × 3
-//! values, x fastest); `/grid/x` and `/grid/y` hold the node coordinates [m]. `fields.xdmf` is a
+//! values, x fastest); `/grid/x` and `/grid/y` hold the node coordinates [m]. All ranks write the
+//! HDF5 file together (HDF5's MPI-I/O driver): they create its groups and datasets together, and
+//! each writes its own rows: its slab of the particles sorted by id and the block of grid nodes it
+//! owns (see [`Frame`]). No rank holds the fields of all particles, and the file written on any
+//! number of ranks is the one written on one. `fields.xdmf` is a
 //! temporal collection with one spatial collection per output time, holding the particles as a
 //! `Polyvertex` point set and the grid as a `3DCoRectMesh` of one layer of nodes (z = 0) with
 //! `ORIGIN_DXDYDZ` geometry: ParaView 5.11's XDMF reader reads scalars on a `2DCoRectMesh` but
@@ -14,6 +18,8 @@
 //! quadratic in their number (measured: 601 output times of Terzaghi took 7.7 s that way).
 
 use hdf5_metno as h5;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::{AsRaw, CommunicatorCollectives};
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -63,27 +69,43 @@ pub struct GridGeometry {
     pub nodes: [usize; 2],
 }
 
-/// The fields of one output time.
+/// One rank's share of the fields of one output time.
 #[derive(Debug, Clone)]
 pub struct Frame {
     /// Simulated time [s].
     pub time: f64,
-    /// Number of particles.
+    /// Number of particles of all ranks.
     pub particles: usize,
-    /// Particle fields (the first must be `position`, 3 components).
+    /// The place of this rank's first particle in the list of all particles sorted by id; its
+    /// particle fields hold the next rows of that list.
+    pub first_particle: usize,
+    /// This rank's rows of the particle fields (the first must be `position`, 3 components).
     pub particle_fields: Vec<Field>,
-    /// Nodal fields on the grid.
+    /// The block of grid nodes this rank writes: its first node (i, j) and its nodes along x and y.
+    pub node_block: ([usize; 2], [usize; 2]),
+    /// This rank's nodal fields on its block of nodes, x fastest.
     pub grid_fields: Vec<Field>,
+}
+
+impl Frame {
+    /// This rank's number of particle rows.
+    fn rows(&self) -> usize {
+        self.particle_fields.first().map_or(0, |f| f.values.len() / f.components.max(1))
+    }
 }
 
 /// Shortest wall time between two rewrites of the XDMF file during a run.
 pub const INDEX_INTERVAL: Duration = Duration::from_secs(2);
 
-/// The field files of a run.
+/// The field files of a run (every rank holds one; only the writing rank writes the XDMF index).
 pub struct FieldFiles {
     h5: PathBuf,
     xdmf: PathBuf,
     grid: GridGeometry,
+    /// The ranks writing the HDF5 file (MPI_COMM_WORLD's handle; MPI outlives the run).
+    comm: mpi::ffi::MPI_Comm,
+    /// Whether this rank writes the XDMF index.
+    writer: bool,
     /// Output times written to the HDF5 file.
     frames: usize,
     /// Their XDMF grids.
@@ -93,45 +115,117 @@ pub struct FieldFiles {
     dirty: bool,
 }
 
-fn write_field(g: &h5::Group, f: &Field, shape: &[usize]) -> h5::Result<()> {
-    let mut shape = shape.to_vec();
+/// Creates the dataset `f.name` of `shape` (times the field's components) in `g` (collective) and
+/// writes this rank's values at `start` along the leading dimensions, `count` long.
+fn write_field(g: &h5::Group, f: &Field, shape: &[usize], start: &[usize], count: &[usize]) -> h5::Result<()> {
+    let mut full = shape.to_vec();
+    let mut local = count.to_vec();
     if f.components > 1 {
-        shape.push(f.components);
+        full.push(f.components);
+        local.push(f.components);
     }
+    let empty = local.contains(&0);
     match &f.values {
-        Values::Real(v) => g.new_dataset::<f64>().shape(shape).create(f.name)?.write_raw(&v[..]),
-        Values::Int(v) => g.new_dataset::<i32>().shape(shape).create(f.name)?.write_raw(&v[..]),
+        Values::Real(v) => {
+            let ds = g.new_dataset::<f64>().shape(full).create(f.name)?;
+            if !empty {
+                write_block(&ds, v, start, &local)?;
+            }
+        }
+        Values::Int(v) => {
+            let ds = g.new_dataset::<i32>().shape(full).create(f.name)?;
+            if !empty {
+                write_block(&ds, v, start, &local)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes `v` (row-major, `local` long in each dimension) into `ds` at `start` along its first
+/// one or two dimensions.
+fn write_block<T: h5::H5Type>(ds: &h5::Dataset, v: &[T], start: &[usize], local: &[usize]) -> h5::Result<()> {
+    let view =
+        ndarray::ArrayView::from_shape(local.to_vec(), v).map_err(|e| h5::Error::from(e.to_string().as_str()))?;
+    match (start, local.len()) {
+        ([a], 1) => ds.write_slice(view, (*a..*a + local[0],)),
+        ([a], 2) => ds.write_slice(view, (*a..*a + local[0], ..)),
+        ([a, b], 2) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1])),
+        ([a, b], 3) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1], ..)),
+        _ => Err(h5::Error::from("unexpected field shape")),
     }
 }
 
 impl FieldFiles {
     /// Starts `fields.h5` (replacing an old one) in `dir`, with the grid's node coordinates.
-    pub fn create(dir: &Path, grid: GridGeometry) -> Result<FieldFiles, String> {
+    /// Collective over `comm`; `writer` is the rank that writes the XDMF index (and removes old
+    /// files first).
+    pub fn create(
+        dir: &Path,
+        grid: GridGeometry,
+        comm: &SimpleCommunicator,
+        writer: bool,
+    ) -> Result<FieldFiles, String> {
         let h5 = dir.join("fields.h5");
         let xdmf = dir.join("fields.xdmf");
-        for p in [&h5, &xdmf] {
-            if p.exists() {
-                fs::remove_file(p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
-            }
-        }
-        let fail = |e: h5::Error| format!("cannot write {}: {e}", h5.display());
-        let f = h5::File::create(&h5).map_err(fail)?;
-        let g = f.create_group("grid").map_err(fail)?;
-        let coords = |d: usize| -> Vec<f64> {
-            (0..grid.nodes[d]).map(|i| grid.origin[d] + i as f64 * grid.spacing[d]).collect()
+        let removed = if writer {
+            [&h5, &xdmf]
+                .into_iter()
+                .filter(|p| p.exists())
+                .try_for_each(|p| fs::remove_file(p).map_err(|e| format!("cannot remove old {}: {e}", p.display())))
+        } else {
+            Ok(())
         };
-        for (d, name) in ["x", "y"].iter().enumerate() {
-            g.new_dataset::<f64>()
-                .shape(grid.nodes[d])
-                .create(*name)
-                .and_then(|ds| ds.write_raw(&coords(d)[..]))
-                .map_err(fail)?;
+        // The other ranks open the file only once the writing rank has made the directory and
+        // removed the old files.
+        comm.barrier();
+        removed?;
+        let files = FieldFiles {
+            h5,
+            xdmf,
+            grid,
+            comm: comm.as_raw(),
+            writer,
+            frames: 0,
+            body: String::new(),
+            last_index: None,
+            dirty: false,
+        };
+        let fail = |e: h5::Error| format!("cannot write {}: {e}", files.h5.display());
+        {
+            // Every handle closes before the file does (at the end of this block).
+            let f = files.open(true).map_err(fail)?;
+            let coords = |d: usize| -> Vec<f64> {
+                (0..grid.nodes[d]).map(|i| grid.origin[d] + i as f64 * grid.spacing[d]).collect()
+            };
+            {
+                let g = f.create_group("grid").map_err(fail)?;
+                for (d, name) in ["x", "y"].iter().enumerate() {
+                    let ds = g.new_dataset::<f64>().shape(grid.nodes[d]).create(*name).map_err(fail)?;
+                    if writer {
+                        ds.write_raw(&coords(d)[..]).map_err(fail)?;
+                    }
+                }
+                f.create_group("particles").map_err(fail)?;
+            }
+            f.flush().map_err(fail)?;
         }
-        f.create_group("particles").map_err(fail)?;
-        Ok(FieldFiles { h5, xdmf, grid, frames: 0, body: String::new(), last_index: None, dirty: false })
+        Ok(files)
     }
 
-    /// Appends one output time and rewrites the XDMF file.
+    /// Opens the HDF5 file on all ranks (MPI-I/O), new or to append to.
+    fn open(&self, create: bool) -> h5::Result<h5::File> {
+        let comm = self.comm;
+        let mut b = h5::File::with_options();
+        b.with_fapl(|p| p.mpio(comm, None));
+        if create {
+            b.create(&self.h5)
+        } else {
+            b.append(&self.h5)
+        }
+    }
+
+    /// Appends one output time (collective) and, on the writing rank, rewrites the XDMF file.
     pub fn write(&mut self, frame: &Frame) -> Result<(), String> {
         let i = self.frames;
         let fail = |e: h5::Error| format!("cannot write {}: {e}", self.h5.display());
@@ -139,25 +233,30 @@ impl FieldFiles {
         if frame.particle_fields.first().map(|f| (f.name, f.components)) != Some(("position", 3)) {
             return Err("the first particle field must be `position` with 3 components".into());
         }
+        let rows = frame.rows();
         for f in &frame.particle_fields {
-            if f.values.len() != frame.particles * f.components {
+            if f.values.len() != rows * f.components {
                 return Err(format!("particle field `{}` has {} values", f.name, f.values.len()));
             }
         }
+        let ([i0, j0], [ni, nj]) = frame.node_block;
+        if i0 + ni > nx || j0 + nj > ny || frame.first_particle + rows > frame.particles {
+            return Err("this rank's block of the fields lies outside the grid or the particle list".into());
+        }
         for f in &frame.grid_fields {
-            if f.values.len() != nx * ny * f.components {
+            if f.values.len() != ni * nj * f.components {
                 return Err(format!("grid field `{}` has {} values", f.name, f.values.len()));
             }
         }
         {
-            let file = h5::File::append(&self.h5).map_err(fail)?;
+            let file = self.open(false).map_err(fail)?;
             let pg = file.group("particles").and_then(|g| g.create_group(&i.to_string())).map_err(fail)?;
             for f in &frame.particle_fields {
-                write_field(&pg, f, &[frame.particles]).map_err(fail)?;
+                write_field(&pg, f, &[frame.particles], &[frame.first_particle], &[rows]).map_err(fail)?;
             }
             let gg = file.group("grid").and_then(|g| g.create_group(&i.to_string())).map_err(fail)?;
             for f in &frame.grid_fields {
-                write_field(&gg, f, &[ny, nx]).map_err(fail)?;
+                write_field(&gg, f, &[ny, nx], &[j0, i0], &[nj, ni]).map_err(fail)?;
             }
             file.flush().map_err(fail)?;
         }
@@ -173,7 +272,7 @@ impl FieldFiles {
 
     /// Writes the XDMF file with every output time so far (if it lacks any).
     pub fn finish(&mut self) -> Result<(), String> {
-        if !self.dirty {
+        if !self.dirty || !self.writer {
             return Ok(());
         }
         let head = "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n  <Domain>\n    <Grid Name=\"porompm\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
@@ -251,21 +350,26 @@ impl Drop for FieldFiles {
 mod tests {
     use super::*;
 
+    /// The only unit test of the library that needs MPI (a singleton run; MPI is finalised when
+    /// `universe` drops, so no other unit test may initialise it).
     #[test]
     fn frames_are_appended_and_listed_in_the_xdmf_file() {
+        let universe = mpi::initialize().expect("MPI initialises once per test process");
         let dir = std::env::temp_dir().join(format!("porompm-fields-test-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
         let grid = GridGeometry { origin: [0.0, -1.0], spacing: [0.5, 0.25], nodes: [3, 5] };
-        let mut files = FieldFiles::create(&dir, grid).unwrap();
+        let mut files = FieldFiles::create(&dir, grid, &universe.world(), true).unwrap();
         for t in [0.0, 0.5] {
             let frame = Frame {
                 time: t,
                 particles: 2,
+                first_particle: 0,
                 particle_fields: vec![
                     Field { name: "position", components: 3, values: Values::Real(vec![0.1, 0.2, 0.0, 0.3, 0.4, 0.0]) },
                     Field { name: "p", components: 1, values: Values::Real(vec![t, 2.0 * t]) },
                     Field { name: "material_id", components: 1, values: Values::Int(vec![0, 1]) },
                 ],
+                node_block: ([0, 0], [3, 5]),
                 grid_fields: vec![Field { name: "active", components: 1, values: Values::Int(vec![1; 15]) }],
             };
             files.write(&frame).unwrap();
@@ -280,18 +384,29 @@ mod tests {
         assert_eq!(f.dataset("particles/1/p").unwrap().read_raw::<f64>().unwrap(), vec![0.5, 1.0]);
         assert_eq!(f.dataset("grid/y").unwrap().read_raw::<f64>().unwrap(), vec![-1.0, -0.75, -0.5, -0.25, 0.0]);
         // A wrong length is an error, not a broken file.
-        let bad = Frame { time: 1.0, particles: 3, particle_fields: vec![], grid_fields: vec![] };
+        let bad = Frame {
+            time: 1.0,
+            particles: 3,
+            first_particle: 0,
+            particle_fields: vec![],
+            node_block: ([0, 0], [3, 5]),
+            grid_fields: vec![],
+        };
         assert!(files.write(&bad).unwrap_err().contains("`position`"));
         let bad = Frame {
             time: 1.0,
             particles: 3,
+            first_particle: 0,
             particle_fields: vec![
                 Field { name: "position", components: 3, values: Values::Real(vec![0.0; 9]) },
                 Field { name: "p", components: 1, values: Values::Real(vec![1.0]) },
             ],
+            node_block: ([0, 0], [3, 5]),
             grid_fields: vec![],
         };
         assert!(files.write(&bad).unwrap_err().contains("`p` has 1 values"));
+        let bad = Frame { first_particle: 2, particle_fields: bad.particle_fields[..1].to_vec(), ..bad.clone() };
+        assert!(files.write(&bad).unwrap_err().contains("outside"), "rows 2..5 of 3 particles");
         files.finish().unwrap();
         assert_eq!(fs::read_to_string(dir.join("fields.xdmf")).unwrap(), text, "the XDMF file lists complete frames");
         fs::remove_dir_all(&dir).unwrap();

@@ -10,6 +10,7 @@ pub mod checkpoint;
 pub mod fields;
 pub mod plot;
 
+use mpi::topology::SimpleCommunicator;
 use serde::Serialize;
 use std::fs::{self, File};
 use std::io::{BufWriter, Write};
@@ -62,7 +63,11 @@ pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf, String>
 
 /// The output directory of a run.
 pub struct RunOutput {
+    /// The directory, on the writing rank.
     dir: Option<PathBuf>,
+    /// The directory, on every rank (the field files are written by all ranks); `None` when
+    /// nothing is written ([`RunOutput::silent`]).
+    shared: Option<PathBuf>,
     history: Option<BufWriter<File>>,
     fields: Option<fields::FieldFiles>,
 }
@@ -76,12 +81,13 @@ pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
 }
 
 impl RunOutput {
-    /// Prepares `dir` (created if needed) on the writing rank; a no-op on the others. Results of
+    /// Prepares `dir` (created if needed) on the writing rank; the others only keep its name, for
+    /// the field files all ranks write. Results of
     /// an earlier run in the same directory are removed first so that they cannot be mistaken
     /// for this run's.
     pub fn create(dir: &Path, writer: bool) -> Result<RunOutput, String> {
         if !writer {
-            return Ok(RunOutput { dir: None, history: None, fields: None });
+            return Ok(RunOutput { dir: None, shared: Some(dir.to_path_buf()), history: None, fields: None });
         }
         fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
         for old in ["summary.json", "history.csv", "amplitude_profile.csv", "fields.h5", "fields.xdmf"] {
@@ -94,7 +100,12 @@ impl RunOutput {
         if plots.is_dir() {
             fs::remove_dir_all(&plots).map_err(|e| format!("cannot remove old {}: {e}", plots.display()))?;
         }
-        Ok(RunOutput { dir: Some(dir.to_path_buf()), history: None, fields: None })
+        Ok(RunOutput { dir: Some(dir.to_path_buf()), shared: Some(dir.to_path_buf()), history: None, fields: None })
+    }
+
+    /// An output that writes nothing on any rank (the tangent check).
+    pub fn silent() -> RunOutput {
+        RunOutput { dir: None, shared: None, history: None, fields: None }
     }
 
     /// Draws the figures as PNG files into `plots/` (created if needed) and returns the paths.
@@ -142,14 +153,15 @@ impl RunOutput {
         writeln!(w, "{}", line.join(",")).and_then(|_| w.flush()).map_err(|e| format!("cannot write history.csv: {e}"))
     }
 
-    /// Starts `fields.h5`/`fields.xdmf` for a grid.
-    pub fn start_fields(&mut self, grid: fields::GridGeometry) -> Result<(), String> {
-        let Some(dir) = &self.dir else { return Ok(()) };
-        self.fields = Some(fields::FieldFiles::create(dir, grid)?);
+    /// Starts `fields.h5`/`fields.xdmf` for a grid, on all ranks of `comm` together.
+    pub fn start_fields(&mut self, grid: fields::GridGeometry, comm: &SimpleCommunicator) -> Result<(), String> {
+        if let Some(shared) = &self.shared {
+            self.fields = Some(fields::FieldFiles::create(shared, grid, comm, self.dir.is_some())?);
+        }
         Ok(())
     }
 
-    /// Appends one output time to the field files (if started).
+    /// Appends one output time to the field files (if started; collective).
     pub fn write_fields(&mut self, frame: &fields::Frame) -> Result<(), String> {
         match self.fields.as_mut() {
             Some(f) => f.write(frame),

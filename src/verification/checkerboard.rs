@@ -11,6 +11,7 @@
 //! over all particles whose neighbourhood has enough points for the fit. A field that is locally
 //! quadratic scores 0, a smooth field O(h³ p‴/p), an alternating pattern of amplitude A about A/|p|.
 
+use crate::distribution::Owners;
 use crate::model::Model;
 use crate::parallel::Collective;
 use std::collections::HashMap;
@@ -26,27 +27,64 @@ pub struct Fit {
 
 /// The checkerboard fit of the current pore pressures (zero when there is no pressure). Each
 /// body is fitted on its own: a jump of the pressure between bodies (a footing on saturated soil)
-/// is not an oscillation.
-pub fn pressure_fit(model: &Model, coll: &Collective) -> Result<Fit, String> {
+/// is not an oscillation. Collective and distributed: a rank fits the cells it owns (`owners`),
+/// for which it receives the points of the neighbouring cells other ranks hold (a halo one cell
+/// wide), and the sums are added over the ranks; no rank gathers the points of all.
+pub fn pressure_fit(model: &Model, owners: &Owners, coll: &Collective) -> Result<Fit, String> {
     let ps = &model.particles;
-    let local: Vec<f64> = (0..ps.len()).flat_map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k], ps.body[k] as f64]).collect();
-    let all = coll.gather(&local)?;
-    let points: Vec<[f64; 4]> = all.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-    Ok(fit_of(&points, model.grid.origin, model.grid.h))
+    let (origin, h, [nx, ny]) = (model.grid.origin, model.grid.h, model.grid.cells);
+    let owner =
+        |i: i64, j: i64| owners.rank_of_cell(i.clamp(0, nx as i64 - 1) as usize, j.clamp(0, ny as i64 - 1) as usize);
+    let me = coll.rank();
+    let mut points: Vec<[f64; 4]> =
+        (0..ps.len()).map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k], ps.body[k] as f64]).collect();
+    if coll.size() > 1 {
+        let mut outgoing = vec![Vec::new(); coll.size()];
+        let mut to = Vec::with_capacity(9);
+        for p in &points {
+            let (i, j, _) = cell_of(p, origin, h);
+            to.clear();
+            for (di, dj) in (-1..=1).flat_map(|dj| (-1..=1).map(move |di| (di, dj))) {
+                let (a, b) = (i + di, j + dj);
+                if a >= 0 && b >= 0 && a < nx as i64 && b < ny as i64 {
+                    let r = owner(a, b);
+                    if r != me && !to.contains(&r) {
+                        to.push(r);
+                    }
+                }
+            }
+            for &r in &to {
+                outgoing[r].extend_from_slice(p);
+            }
+        }
+        points.extend(coll.exchange(&outgoing).chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+    }
+    let local = sums_of(&points, origin, h, |i, j| owner(i, j) == me);
+    let sums = coll.sum(&[local.0, local.1])?;
+    let worst = coll.max(&[local.2])?[0];
+    Ok(Fit { index: if sums[1] <= 0.0 { 0.0 } else { (sums[0] / sums[1]).sqrt() }, max_deviation: worst })
+}
+
+/// The cell (i, j) of point `p` = `[x, y, p, body]`, and its body.
+fn cell_of(p: &[f64; 4], origin: [f64; 2], h: [f64; 2]) -> (i64, i64, i64) {
+    (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64, p[3] as i64)
 }
 
 /// The fit of point values `[x, y, p, body]` binned on cells of size `h` from `origin`, each
 /// body's points apart.
 pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
-    let cell = |p: &[f64; 4]| {
-        (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64, p[3] as i64)
-    };
+    let (r2, s2, worst) = sums_of(points, origin, h, |_, _| true);
+    Fit { index: if s2 <= 0.0 { 0.0 } else { (r2 / s2).sqrt() }, max_deviation: worst }
+}
+
+/// Σ r_k², Σ s_k² and max |r_k| over the points of the cells (i, j) for which `evaluate` holds.
+fn sums_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2], evaluate: impl Fn(i64, i64) -> bool) -> (f64, f64, f64) {
     let mut bins: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
     for (k, p) in points.iter().enumerate() {
-        bins.entry(cell(p)).or_default().push(k);
+        bins.entry(cell_of(p, origin, h)).or_default().push(k);
     }
     let (mut r2, mut s2, mut worst) = (0.0, 0.0, 0.0f64);
-    for (&(i, j, body), members) in &bins {
+    for (&(i, j, body), members) in bins.iter().filter(|((i, j, _), _)| evaluate(*i, *j)) {
         let centre = [origin[0] + (i as f64 + 0.5) * h[0], origin[1] + (j as f64 + 0.5) * h[1]];
         let local = |p: &[f64; 4]| [(p[0] - centre[0]) / h[0], (p[1] - centre[1]) / h[1]];
         let mut nb: Vec<usize> = Vec::new();
@@ -98,7 +136,7 @@ pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
             worst = worst.max((points[k][2] - s).abs());
         }
     }
-    Fit { index: if s2 <= 0.0 { 0.0 } else { (r2 / s2).sqrt() }, max_deviation: worst }
+    (r2, s2, worst)
 }
 
 /// Solves the m × m system by Gaussian elimination with partial pivoting; `None` if singular.

@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""`make bench-scaling`: strong scaling from one to two ranks at 10^5 unknowns, and the communication
+a step costs, for the weak-scaling model of docs/distributed.md.
+
+Part 1, strong scaling. The slumping block (cases/slumping_block.toml) on a 216 x 162 grid: 104 112
+u-p-U unknowns under the block, 82 944 material points, stabilised by the pressure projection
+(alpha = 1), 20 steps of 1e-3 s. Two solver strategies (petsc_options/fieldsplit-schur-amg.opts and
+petsc_options/direct-lu.opts), each run as: one rank with one thread, one rank with two threads
+(the default on this 2-core machine: the particle loops on both cores, PETSc on one), two ranks
+with one thread each (STRATEGIES="..." chooses the option files). RUNS runs of each (default 3), one at a time; the median wall time and its
+phases. Speed-up = wall time of one rank with one thread / wall time of two ranks (and of one rank
+with two threads / two ranks, what a user of the default gains).
+
+Part 2, communication per step (COMM=1, the default). The same problem at three sizes per rank on
+two and four ranks (four oversubscribe the 2 cores: only counts are read there, not times), 5 steps
+with `-log_view`: PETSc's messages, bytes and reductions per rank and step (ghost updates of the
+residual and tangent assembly, off-rank COO entries, the Krylov solver's mat-vecs and dot products),
+and the points migrated (summary.json). Writes target/bench/scaling.md and scaling.json.
+"""
+import json, os, re, statistics, subprocess, sys
+
+RUNS = int(os.environ.get("RUNS", "3"))
+COMM = os.environ.get("COMM", "1") != "0"
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXE = os.path.join(ROOT, "target", "release", "porompm")
+OUT = os.path.join(ROOT, "target", "bench")
+CASE = "cases/slumping_block.toml"
+BASE = ["--set", "stabilisation.pressure_projection=1.0"]
+STRATEGIES = os.environ.get("STRATEGIES", "fieldsplit-schur-amg direct-lu").split()
+CONFIGS = [(1, 1), (1, 2), (2, 1)]  # (ranks, threads per rank)
+PHASES = ["step_setup_s", "assembly_s", "linear_solve_s", "particle_update_s", "output_s"]
+
+
+def run(name, ranks, threads, cells, duration, extra=()):
+    out = os.path.join(OUT, "scaling", name)
+    cmd = [EXE, "run", CASE, "--out", out, "--quiet", "--threads", str(threads),
+           "--set", f"grid.cells=[{cells[0]},{cells[1]}]", "--set", f"stages.slump.duration={duration}"] + BASE
+    cmd += list(extra)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    if ranks > 1:
+        cmd = ["mpirun", "--oversubscribe", "-n", str(ranks)] + cmd
+    p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    s = json.load(open(os.path.join(out, "summary.json")))
+    if p.returncode != 0 or s["status"] != "completed":
+        sys.exit(f"bench-scaling: {' '.join(cmd)} did not complete: {s.get('error')}\n{p.stderr[-2000:]}")
+    return s, p.stdout
+
+
+def strong():
+    rows = {}
+    for strategy in STRATEGIES:
+        opts = ["--options-file", f"petsc_options/{strategy}.opts"]
+        for ranks, threads in CONFIGS:
+            runs = [run(f"{strategy}-{ranks}r{threads}t-{k}", ranks, threads, (216, 162), 0.02, opts)[0]
+                    for k in range(RUNS)]
+            med = sorted(runs, key=lambda s: s["wall_time_s"])[len(runs) // 2]
+            rows[(strategy, ranks, threads)] = (med, [s["wall_time_s"] for s in runs])
+    lines = ["| strategy | ranks x threads | wall time [s] (median; all runs) | speed-up vs 1x1 | vs 1x2 | "
+             "Newton | Krylov | step setup [s] | assembly [s] | linear solve [s] | particle update [s] | "
+             "output [s] | peak memory, all ranks [MiB] |", "|" + "---|" * 13]
+    table = []
+    for strategy in STRATEGIES:
+        w11 = statistics.median(rows[(strategy, 1, 1)][1])
+        w12 = statistics.median(rows[(strategy, 1, 2)][1])
+        for ranks, threads in CONFIGS:
+            s, alls = rows[(strategy, ranks, threads)]
+            w = statistics.median(alls)
+            t = s["timings"]
+            lines.append(
+                f"| {strategy} | {ranks} x {threads} | {w:.1f} ({', '.join(f'{a:.1f}' for a in alls)}) | "
+                f"{w11 / w:.2f} | {w12 / w:.2f} | {s['snes_iterations']} | {s['ksp_iterations']} | "
+                + " | ".join(f"{t[p]:.2f}" for p in PHASES)
+                + f" | {s['peak_memory_total_mib']:.0f} |")
+            table.append({"strategy": strategy, "ranks": ranks, "threads": threads, "wall_s": w, "runs": alls,
+                          "dofs": s["dofs"], "particles": s["particles"], "newton": s["snes_iterations"],
+                          "krylov": s["ksp_iterations"], "timings": t, "memory_mib": s["peak_memory_total_mib"]})
+    s = rows[(STRATEGIES[0], 1, 1)][0]
+    head = f"Strong scaling: {s['dofs']} unknowns, {s['particles']} material points, {s['steps']} steps."
+    return head + "\n\n" + "\n".join(lines), table
+
+
+LOG = {"messages": r"^MPI Msg Count:\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)", "bytes": r"^MPI Msg Len \(bytes\):\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)",
+       "reductions": r"^MPI Reductions:\s+(\S+)"}
+
+
+def comm():
+    """Messages, bytes and reductions per rank and step from -log_view, with the migrated points."""
+    lines = ["| cells | ranks | unknowns | points per rank | steps | Newton | Krylov | messages / rank / step | "
+             "kB / rank / step | reductions / step | migrated points / step |", "|" + "---|" * 11]
+    table = []
+    for cells in [(108, 81), (216, 162), (432, 324)]:
+        for ranks in (2, 4):
+            s, log = run(f"comm-{cells[0]}-{ranks}", ranks, 1, cells, 0.005,
+                         ["--balance-threshold", "1.2", "--options-file", "petsc_options/fieldsplit-schur-amg.opts",
+                          "--", "-log_view"])
+            found = {}
+            for key, pat in LOG.items():
+                m = re.search(pat, log, re.M)
+                found[key] = [float(v) for v in m.groups()] if m else None
+            if not all(found.values()):
+                sys.exit("bench-scaling: -log_view printed no MPI message summary")
+            steps = s["steps"]
+            # PETSc 3.18 prints Max, Max/Min, Avg and Total per rank; the regular expressions keep Max, Avg
+            # and Total. Messages: the average per rank. Bytes: the Avg column is the mean message
+            # length, so the bytes per rank are the total over the ranks.
+            msgs = found["messages"][1] / steps
+            kbytes = found["bytes"][2] / ranks / steps / 1e3
+            red = found["reductions"][0] / steps
+            row = {"cells": cells, "ranks": ranks, "dofs": s["dofs"], "points_per_rank": s["particles"] / ranks,
+                   "steps": steps, "newton": s["snes_iterations"], "krylov": s["ksp_iterations"],
+                   "messages_per_rank_step": msgs, "kbytes_per_rank_step": kbytes, "reductions_per_step": red,
+                   "migrated_per_step": s["migrated_particles"] / steps, "repartitions": s["repartitions"]}
+            table.append(row)
+            lines.append(f"| {cells[0]} x {cells[1]} | {ranks} | {s['dofs']} | {row['points_per_rank']:.0f} | {steps} | "
+                         f"{s['snes_iterations']} | {s['ksp_iterations']} | {msgs:.0f} | {kbytes:.0f} | {red:.0f} | "
+                         f"{row['migrated_per_step']:.0f} |")
+    return "\n".join(lines), table
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    text, strong_rows = strong()
+    print(text, flush=True)
+    result = {"strong": strong_rows}
+    if COMM:
+        ctext, comm_rows = comm()
+        print("\n" + ctext)
+        text += "\n\nCommunication per step (fieldsplit-schur-amg, -log_view; 4 ranks oversubscribe 2 cores):\n\n" + ctext
+        result["comm"] = comm_rows
+    open(os.path.join(OUT, "scaling.md"), "w").write(text + "\n")
+    json.dump(result, open(os.path.join(OUT, "scaling.json"), "w"), indent=1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
