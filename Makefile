@@ -37,7 +37,7 @@ bench: build
 
 # Strong scaling 1 -> 2 ranks at 1.04e5 unknowns (slumping block, field split and MUMPS; median of
 # RUNS=3) and the communication per step at 2 and 4 ranks for the weak-scaling model
-# (target/bench/scaling.md; about 30 minutes; COMM=0 skips the second part).
+# (target/bench/scaling.md; about 40 minutes; STRONG=0 or COMM=0 skips a part).
 bench-scaling: build
 	python3 scripts/bench_scaling.py
 

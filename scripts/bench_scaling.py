@@ -11,16 +11,18 @@ with one thread each (STRATEGIES="..." chooses the option files). RUNS runs of e
 phases. Speed-up = wall time of one rank with one thread / wall time of two ranks (and of one rank
 with two threads / two ranks, what a user of the default gains).
 
-Part 2, communication per step (COMM=1, the default). The same problem at three sizes per rank on
-two and four ranks (four oversubscribe the 2 cores: only counts are read there, not times), 5 steps
-with `-log_view`: PETSc's messages, bytes and reductions per rank and step (ghost updates of the
-residual and tangent assembly, off-rank COO entries, the Krylov solver's mat-vecs and dot products),
-and the points migrated (summary.json). Writes target/bench/scaling.md and scaling.json.
+Part 2, communication per step (COMM=1, the default). The same problem at three sizes on two and
+four ranks (four oversubscribe the 2 cores: only counts are read there, not times) with `-log_view`:
+PETSc's messages, bytes and reductions per rank and step (ghost updates of the residual and tangent
+assembly, off-rank COO entries, the Krylov solver's mat-vecs and dot products), porompm's own
+collectives (summary.json.collectives, rank 0) and the points migrated; each the difference of a
+10-step and a 5-step run over 5 steps, so that the set-up (first matrix, repartition) drops out. Writes target/bench/scaling.md and scaling.json.
 """
 import json, os, re, statistics, subprocess, sys
 
 RUNS = int(os.environ.get("RUNS", "3"))
 COMM = os.environ.get("COMM", "1") != "0"
+STRONG = os.environ.get("STRONG", "1") != "0"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXE = os.path.join(ROOT, "target", "release", "porompm")
 OUT = os.path.join(ROOT, "target", "bench")
@@ -79,53 +81,63 @@ def strong():
     return head + "\n\n" + "\n".join(lines), table
 
 
-LOG = {"messages": r"^MPI Msg Count:\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)", "bytes": r"^MPI Msg Len \(bytes\):\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)",
+LOG = {"messages": r"^MPI Msg Count:\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)",
+       "bytes": r"^MPI Msg Len \(bytes\):\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)",
        "reductions": r"^MPI Reductions:\s+(\S+)"}
 
 
+def counts(cells, ranks, duration):
+    """One run with -log_view: its summary and PETSc's message counts (per rank: messages, bytes;
+    reductions)."""
+    s, log = run(f"comm-{cells[0]}-{ranks}-{duration}", ranks, 1, cells, duration,
+                 ["--options-file", "petsc_options/fieldsplit-schur-amg.opts", "--", "-log_view"])
+    found = {}
+    for key, pat in LOG.items():
+        m = re.search(pat, log, re.M)
+        if not m:
+            sys.exit("bench-scaling: -log_view printed no MPI message summary")
+        found[key] = [float(v) for v in m.groups()]
+    # PETSc 3.18 prints Max, Max/Min, Avg and Total; the regular expressions keep Max, Avg and
+    # Total. Messages: the average per rank. Bytes: the Avg column is the mean message length, so
+    # the bytes per rank are the total over the ranks.
+    return s, {"messages": found["messages"][1], "bytes": found["bytes"][2] / ranks,
+               "reductions": found["reductions"][0], "own_calls": s["collectives"]["calls"],
+               "own_bytes": s["collectives"]["bytes"], "krylov": s["ksp_iterations"], "newton": s["snes_iterations"],
+               "migrated": s["migrated_particles"] / ranks}
+
+
 def comm():
-    """Messages, bytes and reductions per rank and step from -log_view, with the migrated points."""
-    lines = ["| cells | ranks | unknowns | points per rank | steps | Newton | Krylov | messages / rank / step | "
-             "kB / rank / step | reductions / step | migrated points / step |", "|" + "---|" * 11]
+    """Messages, bytes and reductions per rank and step: the difference of a 10-step and a 5-step run
+    over 5 steps, so that the set-up (the first matrix, the repartition after the first step) drops out."""
+    lines = ["| cells | ranks | unknowns | points per rank | Krylov / Newton | PETSc messages / rank / step | "
+             "PETSc kB / rank / step | PETSc reductions / step | porompm collectives / step | porompm kB / step | "
+             "migrated points / rank / step |", "|" + "---|" * 11]
     table = []
     for cells in [(108, 81), (216, 162), (432, 324)]:
         for ranks in (2, 4):
-            s, log = run(f"comm-{cells[0]}-{ranks}", ranks, 1, cells, 0.005,
-                         ["--balance-threshold", "1.2", "--options-file", "petsc_options/fieldsplit-schur-amg.opts",
-                          "--", "-log_view"])
-            found = {}
-            for key, pat in LOG.items():
-                m = re.search(pat, log, re.M)
-                found[key] = [float(v) for v in m.groups()] if m else None
-            if not all(found.values()):
-                sys.exit("bench-scaling: -log_view printed no MPI message summary")
-            steps = s["steps"]
-            # PETSc 3.18 prints Max, Max/Min, Avg and Total per rank; the regular expressions keep Max, Avg
-            # and Total. Messages: the average per rank. Bytes: the Avg column is the mean message
-            # length, so the bytes per rank are the total over the ranks.
-            msgs = found["messages"][1] / steps
-            kbytes = found["bytes"][2] / ranks / steps / 1e3
-            red = found["reductions"][0] / steps
-            row = {"cells": cells, "ranks": ranks, "dofs": s["dofs"], "points_per_rank": s["particles"] / ranks,
-                   "steps": steps, "newton": s["snes_iterations"], "krylov": s["ksp_iterations"],
-                   "messages_per_rank_step": msgs, "kbytes_per_rank_step": kbytes, "reductions_per_step": red,
-                   "migrated_per_step": s["migrated_particles"] / steps, "repartitions": s["repartitions"]}
+            s5, a = counts(cells, ranks, 0.005)
+            s10, b = counts(cells, ranks, 0.010)
+            d = {k: (b[k] - a[k]) / 5 for k in a}
+            row = {"cells": cells, "ranks": ranks, "dofs": s10["dofs"], "points_per_rank": s10["particles"] / ranks,
+                   "krylov_per_newton": d["krylov"] / d["newton"], **{f"{k}_per_step": v for k, v in d.items()}}
             table.append(row)
-            lines.append(f"| {cells[0]} x {cells[1]} | {ranks} | {s['dofs']} | {row['points_per_rank']:.0f} | {steps} | "
-                         f"{s['snes_iterations']} | {s['ksp_iterations']} | {msgs:.0f} | {kbytes:.0f} | {red:.0f} | "
-                         f"{row['migrated_per_step']:.0f} |")
+            lines.append(f"| {cells[0]} x {cells[1]} | {ranks} | {s10['dofs']} | {row['points_per_rank']:.0f} | "
+                         f"{row['krylov_per_newton']:.1f} | {d['messages']:.0f} | {d['bytes'] / 1e3:.0f} | "
+                         f"{d['reductions']:.0f} | {d['own_calls']:.0f} | {d['own_bytes'] / 1e3:.1f} | {d['migrated']:.1f} |")
     return "\n".join(lines), table
 
 
 def main():
     os.makedirs(OUT, exist_ok=True)
-    text, strong_rows = strong()
-    print(text, flush=True)
-    result = {"strong": strong_rows}
+    text, result = "", {}
+    if STRONG:
+        text, result["strong"] = strong()
+        print(text, flush=True)
     if COMM:
         ctext, comm_rows = comm()
         print("\n" + ctext)
-        text += "\n\nCommunication per step (fieldsplit-schur-amg, -log_view; 4 ranks oversubscribe 2 cores):\n\n" + ctext
+        text += ("\n\nCommunication per step (fieldsplit-schur-amg, -log_view, steps 6-10; 4 ranks oversubscribe "
+                 "2 cores):\n\n" + ctext)
         result["comm"] = comm_rows
     open(os.path.join(OUT, "scaling.md"), "w").write(text + "\n")
     json.dump(result, open(os.path.join(OUT, "scaling.json"), "w"), indent=1)
