@@ -343,10 +343,35 @@ fn test_jacobian(
 fn start_mpi_and_petsc(args: &[String]) -> Result<(mpi::environment::Universe, Collective, petsc::Petsc), Failure> {
     let universe = mpi::initialize().ok_or_else(|| input("MPI could not be initialised (already initialised?)"))?;
     let coll = Collective::world();
+    if coll.size() > 1 {
+        abort_all_ranks_on_panic();
+    }
     let comm = petsc::Comm::from_raw(coll.communicator().as_raw());
     let petsc = petsc::Petsc::initialize_on(comm, args, None, "porompm")
         .map_err(|e| input(format!("cannot initialise PETSc: {e}")))?;
+    // Fault injection for the test of `abort_all_ranks_on_panic` (tests/distributed.rs): the rank
+    // named by PORO_FAULT_PANIC_RANK panics here, with PETSc running and the others going on.
+    if std::env::var("PORO_FAULT_PANIC_RANK").ok().and_then(|r| r.parse::<usize>().ok()) == Some(coll.rank()) {
+        panic!("fault injected by PORO_FAULT_PANIC_RANK on rank {}", coll.rank());
+    }
     Ok((universe, coll, petsc))
+}
+
+/// A panic on one rank of a parallel run (a bug: every expected failure is an agreed error) would
+/// leave the other ranks waiting in their next collective operation for ever, and unwinding it
+/// would drop PETSc objects, whose destruction is collective too. So after the usual panic message
+/// the whole run is ended with MPI_Abort (exit code 70). A panic inside a residual or Jacobian
+/// callback is not a reason: the callback catches it and every rank agrees on the error.
+fn abort_all_ranks_on_panic() {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        previous(info);
+        if !petsc::snes::in_callback() {
+            eprintln!("porompm: a rank panicked (a bug, please report it); ending every rank of the run");
+            use mpi::traits::Communicator;
+            mpi::topology::SimpleCommunicator::world().abort(70);
+        }
+    }));
 }
 
 fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure> {

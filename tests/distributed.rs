@@ -245,3 +245,29 @@ fn the_grid_is_repartitioned_when_the_points_crowd_onto_some_ranks() {
         assert!((a - b).abs() <= 1e-6 * scale, "{name}: {a} without, {b} with repartitioning");
     }
 }
+
+/// A panic on one rank (a bug; injected here by PORO_FAULT_PANIC_RANK right after PETSc starts)
+/// ends every rank of the run at once through MPI_Abort, with the panic's message, instead of
+/// leaving the other ranks waiting in their next collective operation for ever.
+#[test]
+fn a_panic_on_one_rank_ends_every_rank() {
+    let dir = out_dir("panic");
+    let _ = std::fs::remove_dir_all(&dir);
+    let started = std::time::Instant::now();
+    let output = std::process::Command::new("timeout")
+        .args(["120", "mpirun", "--oversubscribe", "-n", "2", env!("CARGO_BIN_EXE_porompm"), "run", SLIDING, "--out"])
+        .arg(&dir)
+        .arg("--quiet")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("PORO_FAULT_PANIC_RANK", "1")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("mpirun runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_ne!(output.status.code(), Some(124), "the run hung after the panic:\n{stderr}");
+    assert!(!output.status.success(), "a run with a panicking rank must fail");
+    assert!(stderr.contains("fault injected by PORO_FAULT_PANIC_RANK on rank 1"), "{stderr}");
+    assert!(stderr.contains("ending every rank of the run"), "{stderr}");
+    println!("ended after {:.1} s with {:?}", started.elapsed().as_secs_f64(), output.status.code());
+}

@@ -13,6 +13,25 @@ use crate::{cstring, error, Comm, Int, Real, Result};
 use petsc_sys as sys;
 use std::ffi::{c_char, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Callbacks running now in this process (their panics are caught and become SNES errors).
+static IN_CALLBACK: AtomicUsize = AtomicUsize::new(0);
+
+/// Whether a residual or Jacobian callback is running in this process (on any thread, so also
+/// on the worker threads a callback starts): a panic then is caught and becomes an error that
+/// every rank agrees on, and a panic hook must not end the process for it.
+pub fn in_callback() -> bool {
+    IN_CALLBACK.load(Ordering::SeqCst) > 0
+}
+
+/// Runs `f` counted as a callback (see [`in_callback`]), catching its panic.
+fn guarded<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+    IN_CALLBACK.fetch_add(1, Ordering::SeqCst);
+    let r = catch_unwind(AssertUnwindSafe(f));
+    IN_CALLBACK.fetch_sub(1, Ordering::SeqCst);
+    r
+}
 
 /// Why a callback could not produce its result.
 #[derive(Debug, Clone)]
@@ -119,7 +138,7 @@ unsafe extern "C" fn residual_trampoline(
     }
     // SAFETY: `ctx` points to the Context living on the stack of `Snes::solve` during the solve.
     let ctx = unsafe { &mut *(ctx as *mut Context) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.residual(&VecRef::new(x), &mut VecRef::new(f))));
+    let outcome = guarded(|| ctx.problem.residual(&VecRef::new(x), &mut VecRef::new(f)));
     finish(outcome, "residual evaluation", ctx, || {
         // SAFETY: valid SNES handle passed by PETSc.
         unsafe { sys::SNESSetFunctionDomainError(snes) };
@@ -139,7 +158,7 @@ unsafe extern "C" fn jacobian_trampoline(
     }
     // SAFETY: as in `residual_trampoline`.
     let ctx = unsafe { &mut *(ctx as *mut Context) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a))));
+    let outcome = guarded(|| ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a)));
     finish(outcome, "Jacobian assembly", ctx, || {
         // SAFETY: valid SNES handle passed by PETSc.
         unsafe { sys::SNESSetJacobianDomainError(snes) };
