@@ -924,7 +924,7 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         let ps = &self.model.particles;
         let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
-        let all = self.coll.gather(&local).map_err(RunError::Failed)?;
+        let slab = self.coll.sorted_slab(&local, state::RECORD);
         let check_state = match self.check.as_ref() {
             Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
             None => None,
@@ -941,9 +941,11 @@ impl<'a> Simulation<'a> {
             diagnostics: self.monitor.state(self.coll).map_err(RunError::Failed)?,
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
             check_state,
-            particles: state::sorted_records(&all),
+            particles: state::records_of(&slab.values),
+            first: slab.offset as u64,
+            total: slab.total as u64,
         };
-        self.out.write_checkpoint(&cp).map_err(RunError::Failed)?;
+        self.out.write_checkpoint(&cp, self.coll.communicator()).map_err(RunError::Failed)?;
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -953,15 +955,24 @@ impl<'a> Simulation<'a> {
     fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
         let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
         state::check_case(cp, self.case).map_err(refuse)?;
-        let (owners, grid, me) = (self.system.owners(), &self.model.grid, self.coll.rank());
-        let restored =
-            cp.restore_particles(&self.model.particles, self.summary.particles, |x| owners.rank_of(grid, x) == me);
-        if self.coll.any(restored.is_err()).map_err(RunError::Failed)? {
-            return Err(refuse(
-                restored.err().unwrap_or_else(|| "another rank could not take its material points".into()),
-            ));
+        // The checkpoint's records and the case's points as generated, each redistributed to the
+        // same slabs of ids, must match; then every point goes to the rank owning its cell.
+        if cp.total as usize != self.summary.particles {
+            return Err(refuse(format!(
+                "it holds {} material points but this case has {} (a different case or grid)",
+                cp.total, self.summary.particles
+            )));
         }
-        self.model.particles = restored.map_err(RunError::Failed)?;
+        let ps = &self.model.particles;
+        let generated: Vec<f64> =
+            (0..ps.len()).flat_map(|k| [ps.id[k] as f64, ps.body[k] as f64, ps.material[k] as f64]).collect();
+        let generated = self.coll.sorted_slab(&generated, 3).values;
+        let generated: Vec<[f64; 3]> = generated.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let flat: Vec<f64> = cp.particles.iter().flatten().copied().collect();
+        let records = state::records_of(&self.coll.sorted_slab(&flat, state::RECORD).values);
+        self.coll.agree(state::check_points(&records, &generated)).map_err(refuse)?;
+        self.model.particles = state::particles_from_records(&records);
+        crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
         self.model.resolve_targets(self.case);
         self.t = cp.time;
         self.step = cp.step as usize;

@@ -188,14 +188,6 @@ fn run(
     petsc_args: &[String],
 ) -> Result<(), Failure> {
     let c = load_case(case_path, sets)?;
-    let restart = match cont.restart {
-        Some(p) => {
-            let cp = io::checkpoint::read(p).map_err(input)?;
-            porompm::state::check_case(&cp, &c).map_err(|e| input(format!("checkpoint {}: {e}", p.display())))?;
-            Some((p.display().to_string(), cp))
-        }
-        None => None,
-    };
     // Options files: the case's own (relative to the case file), then the command line's.
     let mut files: Vec<PathBuf> = Vec::new();
     if let Some(f) = &c.solver.options_file {
@@ -227,6 +219,15 @@ fn run(
     if let Some(n) = cont.threads {
         coll.set_threads(n as usize);
     }
+    // Every rank reads its share of the checkpoint (MPI-I/O); all get the same outcome.
+    let restart = match cont.restart {
+        Some(p) => {
+            let cp = io::checkpoint::read(p, coll.communicator()).map_err(input)?;
+            porompm::state::check_case(&cp, &c).map_err(|e| input(format!("checkpoint {}: {e}", p.display())))?;
+            Some((p.display().to_string(), cp))
+        }
+        None => None,
+    };
     let mut output = RunOutput::create(out, coll.rank() == 0).map_err(input)?;
     let req = RunRequest {
         case: &c,

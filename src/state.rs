@@ -15,10 +15,9 @@
 
 use crate::case::Case;
 use crate::model::particles::Particles;
-use std::collections::HashMap;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 3;
+pub const FORMAT_VERSION: u64 = 4;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
 pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
@@ -85,8 +84,13 @@ pub struct Checkpoint {
     pub probe_extremes: Vec<f64>,
     /// The verification check's own state (`None`: the check keeps none).
     pub check_state: Option<Vec<f64>>,
-    /// Particle records ([`pack`]) of all ranks, sorted by id.
+    /// This rank's slab of the particle records ([`pack`]) of all ranks sorted by id: records
+    /// `first .. first + particles.len()` of `total` (every rank writes and reads its own slab).
     pub particles: Vec<[f64; RECORD]>,
+    /// The position of this rank's first record in the id-sorted list.
+    pub first: u64,
+    /// The number of records of all ranks.
+    pub total: u64,
 }
 
 /// FNV-1a, 64 bit.
@@ -204,16 +208,48 @@ pub fn particles_from_records(records: &[[f64; RECORD]]) -> Particles {
     ps
 }
 
-/// Records of all ranks' particles (concatenated by the caller), sorted by id.
-pub fn sorted_records(flat: &[f64]) -> Vec<[f64; RECORD]> {
-    let mut out: Vec<[f64; RECORD]> = flat.chunks_exact(RECORD).map(|c| c.try_into().expect("RECORD values")).collect();
-    out.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    out
+/// Records laid end to end, as arrays.
+pub fn records_of(flat: &[f64]) -> Vec<[f64; RECORD]> {
+    flat.chunks_exact(RECORD).map(|c| c.try_into().expect("RECORD values")).collect()
+}
+
+/// Whether the records of a checkpoint (a slab of the id-sorted list) are the case's points
+/// `generated` (`[id, body, material]`, the same slab of the case's points as generated): the same
+/// ids, each of the same body and material.
+pub fn check_points(records: &[[f64; RECORD]], generated: &[[f64; 3]]) -> Result<(), String> {
+    for (r, g) in records.iter().zip(generated) {
+        if r[0] != g[0] {
+            let id = r[0].min(g[0]) as u64;
+            return Err(format!("material point {id} is in only one of the case and the checkpoint"));
+        }
+        if r[1] != g[1] || r[2] != g[2] {
+            return Err(format!("material point {} belongs to another body or material in it", g[0] as u64));
+        }
+    }
+    if records.len() != generated.len() {
+        return Err("its material points are not those of this case".into());
+    }
+    Ok(())
 }
 
 impl Checkpoint {
-    /// The checksum of the content (stored with the file and verified on reading).
-    pub fn checksum(&self) -> u64 {
+    /// This rank's share of the particles' checksum: the wrapping sum over its records of a hash of
+    /// each record's position in the id-sorted list and its values. The shares of all ranks add up
+    /// (wrapping) to the same sum whatever the number of ranks; a swapped or changed record changes it.
+    pub fn records_hash(&self) -> u64 {
+        self.particles.iter().enumerate().fold(0u64, |sum, (k, r)| {
+            let mut h = Fnv::new();
+            h.u64(self.first + k as u64);
+            for &v in r {
+                h.f64(v);
+            }
+            sum.wrapping_add(h.0)
+        })
+    }
+
+    /// The checksum of the content (stored with the file and verified on reading), given the
+    /// [`Checkpoint::records_hash`] summed over all ranks.
+    pub fn checksum(&self, records_hash: u64) -> u64 {
         let mut h = Fnv::new();
         h.u64(FORMAT_VERSION);
         h.u64(self.case_fingerprint);
@@ -242,43 +278,9 @@ impl Checkpoint {
                 }
             }
         }
-        h.u64(self.particles.len() as u64);
-        for r in &self.particles {
-            for &v in r {
-                h.f64(v);
-            }
-        }
+        h.u64(self.total);
+        h.u64(records_hash);
         h.0
-    }
-
-    /// The points this rank takes from the checkpoint: those whose centre `owned` says lie in its
-    /// cells (whatever the number of ranks that wrote the file), sorted by id. The case's points
-    /// `ps` (this rank's share of them, as generated) must all be in the checkpoint with the same
-    /// body and material, and `total` (the case's count over all ranks) must be its count.
-    pub fn restore_particles(
-        &self,
-        ps: &Particles,
-        total: usize,
-        owned: impl Fn([f64; 2]) -> bool,
-    ) -> Result<Particles, String> {
-        if total != self.particles.len() {
-            return Err(format!(
-                "it holds {} material points but this case has {total} (a different case or grid)",
-                self.particles.len()
-            ));
-        }
-        let index: HashMap<u64, usize> = self.particles.iter().enumerate().map(|(i, r)| (r[0] as u64, i)).collect();
-        for k in 0..ps.len() {
-            let r = index
-                .get(&ps.id[k])
-                .map(|&i| &self.particles[i])
-                .ok_or_else(|| format!("material point {} of this case is not in it", ps.id[k]))?;
-            if r[1] as u16 != ps.body[k] || r[2] as u16 != ps.material[k] {
-                return Err(format!("material point {} belongs to another body or material in it", ps.id[k]));
-            }
-        }
-        let mine: Vec<[f64; RECORD]> = self.particles.iter().filter(|r| owned([r[3], r[4]])).copied().collect();
-        Ok(particles_from_records(&mine))
     }
 }
 
@@ -323,34 +325,22 @@ mod tests {
         ps.p0[k] = next();
         ps.eps_pd[k] = next();
         ps.grad_p[k] = [next(), next()];
-        let flat: Vec<f64> = (0..ps.len()).rev().flat_map(|k| pack(&ps, k)).collect();
-        let records = sorted_records(&flat);
-        assert!(records.windows(2).all(|w| w[0][0] < w[1][0]), "sorted by id");
-        let cp = Checkpoint {
-            case_fingerprint: 1,
-            time: 0.25,
-            step: 7,
-            stage: 0,
-            dt: 1e-3,
-            successes: 2,
-            counters: [1, 2, 3, 4],
-            diagnostics: vec![f64::NAN, 1.0],
-            probe_extremes: vec![],
-            check_state: None,
-            particles: records,
-        };
-        let (_, fresh) = particles();
-        let back = cp.restore_particles(&fresh, ps.len(), |_| true).unwrap();
+        let mut records: Vec<[f64; RECORD]> = (0..ps.len()).rev().map(|k| pack(&ps, k)).collect();
+        records.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        let flat: Vec<f64> = records.iter().flatten().copied().collect();
+        assert_eq!(records_of(&flat), records);
+        let back = particles_from_records(&records);
         assert_eq!(format!("{back:?}"), format!("{ps:?}"));
-        // A rank takes the points whose centre lies in its cells, whoever wrote the file.
-        let lower = cp.restore_particles(&fresh, ps.len(), |x| x[1] < 0.5).unwrap();
-        assert_eq!(lower.len(), ps.x.iter().filter(|x| x[1] < 0.5).count());
-        assert!(lower.len() >= 19 && lower.len() < ps.len());
-        assert!(lower.x.iter().all(|x| x[1] < 0.5) && lower.id.windows(2).all(|w| w[0] < w[1]));
-        assert!(cp.restore_particles(&fresh, ps.len() + 1, |_| true).unwrap_err().contains("holds 40 material points"));
-        let mut other = fresh.clone();
-        other.body[3] = 1;
-        assert!(cp.restore_particles(&other, ps.len(), |_| true).unwrap_err().contains("another body"));
+        // The case's points, as generated, against the checkpoint's.
+        let (_, fresh) = particles();
+        let generated: Vec<[f64; 3]> =
+            (0..fresh.len()).map(|k| [fresh.id[k] as f64, fresh.body[k] as f64, fresh.material[k] as f64]).collect();
+        check_points(&records, &generated).unwrap();
+        assert!(check_points(&records, &generated[1..]).unwrap_err().contains("material point 0 is in only one"));
+        assert!(check_points(&records[..39], &generated).unwrap_err().contains("not those of this case"));
+        let mut other = generated.clone();
+        other[3][1] = 1.0;
+        assert!(check_points(&records, &other).unwrap_err().contains("another body"));
     }
 
     #[test]
@@ -368,13 +358,25 @@ mod tests {
             probe_extremes: vec![1.0],
             check_state: Some(vec![2.0]),
             particles: (0..ps.len()).map(|k| pack(&ps, k)).collect(),
+            first: 0,
+            total: ps.len() as u64,
         };
+        let sum = |c: &Checkpoint| c.checksum(c.records_hash());
         let mut other = cp.clone();
         other.particles[5][32] += 1e-12;
-        assert_ne!(cp.checksum(), other.checksum());
+        assert_ne!(sum(&cp), sum(&other));
+        let mut other = cp.clone();
+        other.particles.swap(3, 4);
+        assert_ne!(sum(&cp), sum(&other), "records in another order");
         let mut other = cp.clone();
         other.check_state = None;
-        assert_ne!(cp.checksum(), other.checksum());
+        assert_ne!(sum(&cp), sum(&other));
+        // Split into two slabs (two ranks), the shares add up to the whole's.
+        let (mut a, mut b) = (cp.clone(), cp.clone());
+        a.particles.truncate(15);
+        b.particles.drain(..15);
+        b.first = 15;
+        assert_eq!(a.records_hash().wrapping_add(b.records_hash()), cp.records_hash());
         // The output table does not change the fingerprint; the physics does.
         let mut c2 = c.clone();
         c2.output.history_every = 5;

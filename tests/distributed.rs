@@ -170,11 +170,29 @@ fn a_checkpoint_written_on_n_ranks_restarts_on_m() {
     let reference = reference.last().unwrap();
     let mut every = fixed_partition();
     every.extend(["--checkpoint-every".to_string(), "110".to_string()]);
-    for (n, m) in [(3, 2), (3, 1), (1, 3), (2, 3)] {
+    // The particle arrays of a checkpoint, read whole.
+    let arrays = |cp: &Path| -> Vec<Vec<f64>> {
+        let f = h5::File::open(cp).expect("checkpoint.h5 opens");
+        ["id", "x", "vel", "stress"]
+            .iter()
+            .map(|a| f.dataset(&format!("particles/{a}")).unwrap().read_raw().unwrap())
+            .collect()
+    };
+    let mut one_rank: Option<Vec<Vec<f64>>> = None;
+    for (n, m) in [(1, 3), (3, 2), (3, 1), (2, 3)] {
         let first = out_dir(&format!("restart-{n}-to-{m}-first"));
         let r = run_case_on(n, SLIDING, &first, &every);
         assert!(r.completed(), "{n} ranks: {}", r.stderr());
         let cp = first.join("checkpoint.h5");
+        // All ranks write their slabs of the id-sorted records: the file is the one-rank file.
+        let a = arrays(&cp);
+        let base = one_rank.get_or_insert_with(|| a.clone());
+        assert_eq!(a[0], base[0], "{n} ranks: the checkpoint's ids");
+        // Positions [m], velocities [m/s] and stresses (round-off of the 1e7 Pa modulus) [Pa].
+        for (k, tol) in [(1, 1e-9), (2, 1e-9), (3, 1e-6)] {
+            let diff = a[k].iter().zip(&base[k]).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+            assert!(diff <= tol, "{n} ranks: checkpoint array {k} differs from one rank's by {diff}");
+        }
         let again = out_dir(&format!("restart-{n}-to-{m}"));
         let args = ["--restart".to_string(), cp.display().to_string()];
         let args: Vec<String> = args.into_iter().chain(fixed_partition()).collect();

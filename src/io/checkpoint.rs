@@ -7,14 +7,23 @@
 //! `check_state`, and one dataset per
 //! particle array under `/particles` (n × components, SI units, sorted by id).
 //!
+//! All ranks write and read the file together (HDF5's MPI-I/O driver): each writes the slab of the
+//! id-sorted particle records it holds and reads back an equal share of the rows; no rank holds the
+//! records of all. The particles' checksum is a sum over the records of a hash of each record's
+//! position and values ([`Checkpoint::records_hash`]), added over the ranks, so it is the same for
+//! any number of ranks.
+//!
 //! Atomicity: the file is written as `<name>.tmp`, closed, synced to disk, and renamed over the
-//! old checkpoint (then the directory is synced). A run killed while writing leaves the previous
+//! old checkpoint by the writing rank (then the directory is synced). A run killed while writing leaves the previous
 //! checkpoint in place and at most a stray `.tmp`. On reading, a file without `complete`, of
 //! another format version, or whose content does not match its checksum is refused.
 
 use crate::state::{Checkpoint, PARTICLE_FIELDS, RECORD};
 use hdf5_metno as h5;
 use hdf5_metno::types::VarLenUnicode;
+use mpi::collective::SystemOperation;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::{AsRaw, Communicator, CommunicatorCollectives};
 use std::fs;
 use std::path::Path;
 
@@ -32,60 +41,129 @@ fn dataset_f64(g: &h5::Group, name: &str, shape: &[usize], data: &[f64]) -> h5::
     g.new_dataset::<f64>().shape(shape.to_vec()).create(name)?.write_raw(data)
 }
 
-/// Writes `cp` to `path` atomically (see the module documentation).
-pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), String> {
-    let tmp = path.with_extension("h5.tmp");
-    let fail = |e: h5::Error| format!("cannot write checkpoint {}: {e}", tmp.display());
-    if tmp.exists() {
-        fs::remove_file(&tmp).map_err(|e| format!("cannot remove {}: {e}", tmp.display()))?;
+/// The same outcome on every rank of `comm`: `Ok` if every rank's is, else this rank's error or,
+/// on the ranks that succeeded, a note that another failed.
+fn agree<T>(comm: &SimpleCommunicator, local: Result<T, String>) -> Result<T, String> {
+    let mine = local.is_err() as i32;
+    let mut any = 0i32;
+    comm.all_reduce_into(&mine, &mut any, SystemOperation::max());
+    match local {
+        Ok(_) if any > 0 => Err("another rank could not read or write the checkpoint".into()),
+        other => other,
     }
-    {
-        let f = h5::File::create(&tmp).map_err(fail)?;
-        let format: VarLenUnicode = FORMAT.parse().expect("ASCII");
-        f.new_attr::<VarLenUnicode>().create("format").and_then(|a| a.write_scalar(&format)).map_err(fail)?;
-        let loc: &h5::Location = &f;
-        attr_u64(loc, "version", crate::state::FORMAT_VERSION).map_err(fail)?;
-        attr_u64(loc, "case_fingerprint", cp.case_fingerprint).map_err(fail)?;
-        attr_f64(loc, "time", cp.time).map_err(fail)?;
-        attr_u64(loc, "step", cp.step).map_err(fail)?;
-        attr_u64(loc, "stage", cp.stage).map_err(fail)?;
-        attr_f64(loc, "dt", cp.dt).map_err(fail)?;
-        attr_u64(loc, "successes", cp.successes).map_err(fail)?;
-        attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64).map_err(fail)?;
-        f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..])).map_err(fail)?;
-        dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics).map_err(fail)?;
-        dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes).map_err(fail)?;
-        let state = cp.check_state.clone().unwrap_or_default();
-        dataset_f64(&f, "check_state", &[state.len()], &state).map_err(fail)?;
-        let g = f.create_group("particles").map_err(fail)?;
-        let n = cp.particles.len();
-        let mut offset = 0;
-        for (name, comps) in PARTICLE_FIELDS {
-            let data: Vec<f64> = cp.particles.iter().flat_map(|r| r[offset..offset + comps].to_vec()).collect();
-            dataset_f64(&g, name, &[n, comps], &data).map_err(fail)?;
-            offset += comps;
-        }
-        attr_u64(loc, "checksum", cp.checksum()).map_err(fail)?;
-        attr_u64(loc, "complete", 1).map_err(fail)?;
-        f.flush().map_err(fail)?;
-        f.close().map_err(fail)?;
-    }
-    let sync = |p: &Path| fs::File::open(p).and_then(|f| f.sync_all());
-    sync(&tmp).map_err(|e| format!("cannot sync {}: {e}", tmp.display()))?;
-    fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        sync(dir).map_err(|e| format!("cannot sync {}: {e}", dir.display()))?;
-    }
-    Ok(())
 }
 
-/// Reads and verifies a checkpoint (format, version, completeness, checksum).
-pub fn read(path: &Path) -> Result<Checkpoint, String> {
+/// The particles' checksum share of every rank, added (wrapping).
+fn hash_over_ranks(comm: &SimpleCommunicator, mine: u64) -> u64 {
+    let mut sum = 0u64;
+    comm.all_reduce_into(&mine, &mut sum, SystemOperation::sum());
+    sum
+}
+
+fn open_mpio(path: &Path, comm: &SimpleCommunicator, create: bool) -> h5::Result<h5::File> {
+    let raw = comm.as_raw();
+    let mut b = h5::File::with_options();
+    b.with_fapl(|p| p.mpio(raw, None));
+    if create {
+        b.create(path)
+    } else {
+        b.open(path)
+    }
+}
+
+/// Writes `cp` (this rank's slab of the particles) to `path` atomically, on all ranks of `comm`
+/// together; `writer` is the rank that renames the finished file (see the module documentation).
+pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bool) -> Result<(), String> {
+    let tmp = path.with_extension("h5.tmp");
+    let fail = |e: h5::Error| format!("cannot write checkpoint {}: {e}", tmp.display());
+    let removed = match writer && tmp.exists() {
+        true => fs::remove_file(&tmp).map_err(|e| format!("cannot remove {}: {e}", tmp.display())),
+        false => Ok(()),
+    };
+    agree(comm, removed)?;
+    let hash = hash_over_ranks(comm, cp.records_hash());
+    let written = (|| -> h5::Result<()> {
+        let f = open_mpio(&tmp, comm, true)?;
+        let format: VarLenUnicode = FORMAT.parse().expect("ASCII");
+        f.new_attr::<VarLenUnicode>().create("format").and_then(|a| a.write_scalar(&format))?;
+        let loc: &h5::Location = &f;
+        attr_u64(loc, "version", crate::state::FORMAT_VERSION)?;
+        attr_u64(loc, "case_fingerprint", cp.case_fingerprint)?;
+        attr_f64(loc, "time", cp.time)?;
+        attr_u64(loc, "step", cp.step)?;
+        attr_u64(loc, "stage", cp.stage)?;
+        attr_f64(loc, "dt", cp.dt)?;
+        attr_u64(loc, "successes", cp.successes)?;
+        attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64)?;
+        f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..]))?;
+        dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics)?;
+        dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes)?;
+        let state = cp.check_state.clone().unwrap_or_default();
+        dataset_f64(&f, "check_state", &[state.len()], &state)?;
+        {
+            let g = f.create_group("particles")?;
+            let (n, rows, first) = (cp.total as usize, cp.particles.len(), cp.first as usize);
+            let mut offset = 0;
+            for (name, comps) in PARTICLE_FIELDS {
+                let ds = g.new_dataset::<f64>().shape([n, comps]).create(name)?;
+                if rows > 0 {
+                    let data: Vec<f64> = cp.particles.iter().flat_map(|r| r[offset..offset + comps].to_vec()).collect();
+                    super::fields::write_block(&ds, &data, &[first], &[rows, comps])?;
+                }
+                offset += comps;
+            }
+        }
+        attr_u64(loc, "checksum", cp.checksum(hash))?;
+        attr_u64(loc, "complete", 1)?;
+        f.flush()?;
+        f.close()
+    })();
+    agree(comm, written.map_err(fail))?;
+    let renamed = if writer {
+        let sync = |p: &Path| fs::File::open(p).and_then(|f| f.sync_all());
+        sync(&tmp)
+            .map_err(|e| format!("cannot sync {}: {e}", tmp.display()))
+            .and_then(|_| {
+                fs::rename(&tmp, path)
+                    .map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
+            })
+            .and_then(|_| match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                Some(dir) => sync(dir).map_err(|e| format!("cannot sync {}: {e}", dir.display())),
+                None => Ok(()),
+            })
+    } else {
+        Ok(())
+    };
+    agree(comm, renamed)
+}
+
+/// Reads and verifies a checkpoint (format, version, completeness, checksum), on all ranks of
+/// `comm` together: each rank gets an equal share of the id-sorted particle records (rows
+/// [r n/P, (r + 1) n/P) of n on P ranks). Every rank returns the same outcome.
+pub fn read(path: &Path, comm: &SimpleCommunicator) -> Result<Checkpoint, String> {
+    let read = read_share(path, comm);
+    let hash = hash_over_ranks(comm, read.as_ref().map_or(0, |(cp, _)| cp.records_hash()));
+    let cp = agree(comm, read)?;
+    let (cp, stored) = cp;
+    if stored != cp.checksum(hash) {
+        return Err(format!("checkpoint {} is corrupt: its content does not match its checksum", path.display()));
+    }
+    Ok(cp)
+}
+
+/// This rank's share of the checkpoint and the stored checksum.
+fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64), String> {
     let name = path.display();
     if !path.is_file() {
         return Err(format!("checkpoint {name} does not exist"));
     }
-    let f = h5::File::open(path)
+    // Not an HDF5 file: every rank sees it the same way before the collective open.
+    let mut signature = [0u8; 8];
+    let read = fs::File::open(path).and_then(|mut f| std::io::Read::read_exact(&mut f, &mut signature));
+    if read.is_err() || &signature != b"\x89HDF\r\n\x1a\n" {
+        return Err(format!("checkpoint {name} cannot be opened (not an HDF5 file, or truncated)"));
+    }
+    let f = open_mpio(path, comm, false)
         .map_err(|_| format!("checkpoint {name} cannot be opened (not an HDF5 file, or truncated)"))?;
     let bad = |what: &str| format!("checkpoint {name} is not a porompm checkpoint ({what})");
     let format = f.attr("format").and_then(|a| a.read_scalar::<VarLenUnicode>()).map_err(|_| bad("no `format`"))?;
@@ -110,7 +188,7 @@ pub fn read(path: &Path) -> Result<Checkpoint, String> {
     let has_state = u("has_check_state").map_err(corrupt)? == 1;
     let state = vec_f64("check_state").map_err(corrupt)?;
     let g = f.group("particles").map_err(corrupt)?;
-    let mut columns = Vec::new();
+    let mut datasets = Vec::new();
     let mut n = None;
     for (field, comps) in PARTICLE_FIELDS {
         let d = g.dataset(field).map_err(corrupt)?;
@@ -119,10 +197,20 @@ pub fn read(path: &Path) -> Result<Checkpoint, String> {
             return Err(format!("checkpoint {name}: particle array `{field}` has shape {shape:?}"));
         }
         n = Some(shape[0]);
-        columns.push(d.read_raw::<f64>().map_err(corrupt)?);
+        datasets.push(d);
     }
     let n = n.unwrap_or(0);
-    let particles = (0..n)
+    let (rank, size) = (comm.rank() as usize, comm.size() as usize);
+    let (a, b) = (rank * n / size, (rank + 1) * n / size);
+    let mut columns = Vec::new();
+    for d in &datasets {
+        let column = match b > a {
+            true => d.read_slice_2d::<f64, _>((a..b, ..)).map_err(corrupt)?.iter().copied().collect(),
+            false => Vec::new(),
+        };
+        columns.push(column);
+    }
+    let particles = (0..b - a)
         .map(|k| {
             let mut r = [0.0; RECORD];
             let mut o = 0;
@@ -145,12 +233,11 @@ pub fn read(path: &Path) -> Result<Checkpoint, String> {
         probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
         check_state: has_state.then_some(state),
         particles,
+        first: a as u64,
+        total: n as u64,
     };
     let stored = u("checksum").map_err(corrupt)?;
-    if stored != cp.checksum() {
-        return Err(format!("checkpoint {name} is corrupt: its content does not match its checksum"));
-    }
-    Ok(cp)
+    Ok((cp, stored))
 }
 
 #[cfg(test)]
@@ -176,19 +263,23 @@ mod tests {
             probe_extremes: vec![-12.5, 3.0],
             check_state: Some(vec![1.0, 2.0]),
             particles: vec![r, r2],
+            first: 0,
+            total: 2,
         }
     }
 
     #[test]
     fn a_checkpoint_round_trips_exactly_and_a_tampered_or_partial_one_is_refused() {
+        let (_lock, world) = crate::io::test_world();
         let dir = std::env::temp_dir().join(format!("porompm-cp-test-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
         let path = dir.join("checkpoint.h5");
         let cp = sample();
-        write(&path, &cp).unwrap();
+        write(&path, &cp, &world, true).unwrap();
         assert!(!dir.join("checkpoint.h5.tmp").exists());
-        let back = read(&path).unwrap();
-        assert_eq!(back.checksum(), cp.checksum());
+        let back = read(&path, &world).unwrap();
+        assert_eq!(back.checksum(back.records_hash()), cp.checksum(cp.records_hash()));
+        assert_eq!((back.first, back.total), (0, 2));
         assert_eq!(back.particles, cp.particles);
         assert_eq!(back.time.to_bits(), cp.time.to_bits());
         assert!(back.diagnostics[0].is_nan() && back.diagnostics[1] == 0.5 && back.check_state == cp.check_state);
@@ -199,19 +290,19 @@ mod tests {
             let d = f.dataset("particles/p").unwrap();
             d.write_raw(&[1.0, 2.0][..]).unwrap();
         }
-        assert!(read(&path).unwrap_err().contains("does not match its checksum"));
+        assert!(read(&path, &world).unwrap_err().contains("does not match its checksum"));
 
         // A file whose writing stopped before `complete`.
-        write(&path, &cp).unwrap();
+        write(&path, &cp, &world, true).unwrap();
         {
             let f = h5::File::open_rw(&path).unwrap();
             f.delete_attr("complete").unwrap();
         }
-        assert!(read(&path).unwrap_err().contains("incomplete"));
+        assert!(read(&path, &world).unwrap_err().contains("incomplete"));
 
         fs::write(&path, "not hdf5").unwrap();
-        assert!(read(&path).unwrap_err().contains("not an HDF5 file, or truncated"));
-        assert!(read(&dir.join("none.h5")).unwrap_err().contains("does not exist"));
+        assert!(read(&path, &world).unwrap_err().contains("not an HDF5 file, or truncated"));
+        assert!(read(&dir.join("none.h5"), &world).unwrap_err().contains("does not exist"));
         fs::remove_dir_all(&dir).unwrap();
     }
 }

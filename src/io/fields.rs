@@ -144,7 +144,12 @@ fn write_field(g: &h5::Group, f: &Field, shape: &[usize], start: &[usize], count
 
 /// Writes `v` (row-major, `local` long in each dimension) into `ds` at `start` along its first
 /// one or two dimensions.
-fn write_block<T: h5::H5Type>(ds: &h5::Dataset, v: &[T], start: &[usize], local: &[usize]) -> h5::Result<()> {
+pub(super) fn write_block<T: h5::H5Type>(
+    ds: &h5::Dataset,
+    v: &[T],
+    start: &[usize],
+    local: &[usize],
+) -> h5::Result<()> {
     let view =
         ndarray::ArrayView::from_shape(local.to_vec(), v).map_err(|e| h5::Error::from(e.to_string().as_str()))?;
     match (start, local.len()) {
@@ -350,15 +355,13 @@ impl Drop for FieldFiles {
 mod tests {
     use super::*;
 
-    /// The only unit test of the library that needs MPI (a singleton run; MPI is finalised when
-    /// `universe` drops, so no other unit test may initialise it).
     #[test]
     fn frames_are_appended_and_listed_in_the_xdmf_file() {
-        let universe = mpi::initialize().expect("MPI initialises once per test process");
+        let (_lock, world) = crate::io::test_world();
         let dir = std::env::temp_dir().join(format!("porompm-fields-test-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
         let grid = GridGeometry { origin: [0.0, -1.0], spacing: [0.5, 0.25], nodes: [3, 5] };
-        let mut files = FieldFiles::create(&dir, grid, &universe.world(), true).unwrap();
+        let mut files = FieldFiles::create(&dir, grid, &world, true).unwrap();
         for t in [0.0, 0.5] {
             let frame = Frame {
                 time: t,

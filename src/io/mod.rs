@@ -177,10 +177,11 @@ impl RunOutput {
         }
     }
 
-    /// Writes `checkpoint.h5` atomically (see [`checkpoint`]).
-    pub fn write_checkpoint(&self, cp: &crate::state::Checkpoint) -> Result<(), String> {
-        let Some(dir) = &self.dir else { return Ok(()) };
-        checkpoint::write(&dir.join("checkpoint.h5"), cp)
+    /// Writes `checkpoint.h5` atomically, on all ranks of `comm` together (see [`checkpoint`]);
+    /// nothing on a silent output.
+    pub fn write_checkpoint(&self, cp: &crate::state::Checkpoint, comm: &SimpleCommunicator) -> Result<(), String> {
+        let Some(dir) = &self.shared else { return Ok(()) };
+        checkpoint::write(&dir.join("checkpoint.h5"), cp, comm, self.dir.is_some())
     }
 
     /// Writes a CSV table `name` (header, rows) atomically.
@@ -251,6 +252,22 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// MPI for the unit tests that write HDF5 files through MPI-I/O (a singleton run): initialised once
+/// and never finalised (the test process ends without it), with a lock so that one test at a
+/// time uses it.
+#[cfg(test)]
+pub(crate) fn test_world() -> (std::sync::MutexGuard<'static, ()>, SimpleCommunicator) {
+    static INIT: std::sync::Once = std::sync::Once::new();
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    INIT.call_once(|| {
+        let (universe, _) =
+            mpi::initialize_with_threading(mpi::Threading::Multiple).expect("MPI initialises once per test process");
+        std::mem::forget(universe);
+    });
+    let guard = LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    (guard, SimpleCommunicator::world())
 }
 
 #[cfg(test)]
