@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study gold bench bench-scaling lint clean
+.PHONY: setup build run test study gold bench bench-scaling bench-solvers lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -40,6 +40,11 @@ bench: build
 # (target/bench/scaling.md; about 40 minutes; STRONG=0 or COMM=0 skips a part).
 bench-scaling: build
 	python3 scripts/bench_scaling.py
+
+# The linear solvers from 1e4 to 1e6 unknowns on 1 and 2 ranks: the iterative field split against MUMPS
+# (target/bench/solvers.md; about 90 minutes; SIZES, RANKS, STRATEGIES, RUNS, STEPS choose; docs/solvers.md).
+bench-solvers: build
+	python3 scripts/bench_solvers.py
 
 lint:
 	cargo fmt --check

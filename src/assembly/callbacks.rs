@@ -419,7 +419,11 @@ impl<'a> Assembler<'a> {
     /// and body forces, and under the generalized-α method at a free dof the rest of the
     /// weighted balance (its history of t_n). With these, Σ x ⊗ (f_ext + R − inertia) is exactly
     /// the first moment of the internal forces at t_{n+1}, whatever the scheme.
-    pub(super) fn nodal_terms(&self, xl: &[f64], all: &mut [f64], inertia: &mut [f64]) {
+    ///
+    /// `magnitude` receives Σ over particles of the absolute values of their weighted residual
+    /// blocks, plus the absolute external loads: the scale of each dof's equation at the
+    /// converged state (see `StepForces::field_scales`).
+    pub(super) fn nodal_terms(&self, xl: &[f64], all: &mut [f64], inertia: &mut [f64], magnitude: &mut [f64]) {
         let step = self.step;
         let nm = step.nm.expect("prepared");
         let plain = nm.unweighted();
@@ -444,12 +448,19 @@ impl<'a> Assembler<'a> {
                 m
             });
             ps.scatter(k, &buf[..m], all, whole);
+            for v in &mut buf[..m] {
+                *v = v.abs();
+            }
+            ps.scatter(k, &buf[..m], magnitude, whole);
             if weighted {
                 ps.scatter(k, &ubuf[..m], &mut unweighted, whole);
             }
             ps.scatter(k, &fbuf[..m], &mut forces, whole);
         }
         self.add_projection(xl, all);
+        for (m, e) in magnitude.iter_mut().zip(&step.fext) {
+            *m += e.abs();
+        }
         for (a, h) in all.iter_mut().zip(&step.history) {
             *a += h;
         }

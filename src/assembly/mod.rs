@@ -31,6 +31,7 @@ mod callbacks;
 mod check;
 pub mod dofs;
 pub mod pattern;
+mod splits;
 pub mod stencils;
 
 pub use check::BlockCheck;
@@ -96,6 +97,9 @@ struct StepData {
     /// The pressure unknown's scale s [Pa/m] (see [`pressure_scale`]): PETSc sees Δp / s, and the
     /// continuity rows multiplied by s; 0 until the step is prepared.
     p_scale: f64,
+    /// The norm of the force magnitudes of each field (`Layout::fields`) over its free dofs, in
+    /// PETSc's scaling: the scale of the field's residual.
+    field_scales: Vec<f64>,
 }
 
 impl StepData {
@@ -144,6 +148,11 @@ pub fn pressure_scale(model: &Model) -> f64 {
     }
 }
 
+/// The PETSc option that turns the field-wise Krylov convergence test off (`false`): by default
+/// a Krylov solve converges only when the residual of every field (u, p, U), relative to its own
+/// equations' terms, is within `-ksp_rtol` (see `petsc::fields::FieldTest`).
+pub const FIELD_TEST_OPTION: &str = "-porompm_ksp_field_test";
+
 /// Outcome of one nonlinear step solve.
 #[derive(Debug, Clone)]
 pub struct StepSolve {
@@ -166,6 +175,14 @@ pub struct StepSolve {
     pub assembly_seconds: f64,
     /// Wall time of the whole SNES solve [s].
     pub solve_seconds: f64,
+    /// The norm of the final Newton residual of each field (`Layout::fields`), in PETSc's scaling.
+    pub field_residuals: Vec<f64>,
+    /// The norm of each field's force magnitudes at the start of the step (Δd = 0), in PETSc's
+    /// scaling (see `Assembler::force_magnitudes`).
+    pub field_scales: Vec<f64>,
+    /// The largest relative residual of each field over the step's linear solves (see
+    /// `petsc::fields::relative_field_residuals`; empty when not measured).
+    pub linear_field_residuals: Vec<f64>,
 }
 
 /// The forces of a converged step, summed over ranks, for the equilibrium identity and the
@@ -187,6 +204,11 @@ pub struct StepForces {
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
     /// (trapezoidal; the reactions at t_n are the last step's, none after a new grid system) [J per m].
     pub work: f64,
+    /// The norm of each field's equation magnitudes at the converged state (Σ over particles of
+    /// their absolute residual blocks plus the absolute loads, over the free dofs, in PETSc's
+    /// scaling): with the magnitudes at the step's start, the scale of the field's final
+    /// residual (a step that starts at rest has no continuity terms before it moves).
+    pub field_scales: Vec<f64>,
 }
 
 /// The PETSc log stages of a run (shown by `-log_view`).
@@ -322,6 +344,18 @@ impl GridSystem {
             pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
+        // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
+        // post-solve hook it would replace).
+        let positions: Vec<[f64; 2]> = (info.owned_start[1]..info.owned_start[1] + info.owned_count[1])
+            .flat_map(|j| (info.owned_start[0]..info.owned_start[0] + info.owned_count[0]).map(move |i| (i, j)))
+            .map(|(i, j)| grid.node_position(i, j))
+            .collect();
+        let first_dof = x.ownership_range()?.0;
+        splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
+        if !snes.uses_eisenstat_walker()? {
+            let test = petsc::Options::global().get_bool(FIELD_TEST_OPTION)?.unwrap_or(true);
+            snes.monitor_fields(layout.fields().into_iter().map(|(_, c)| c).collect(), test)?;
+        }
         let user_atol = snes.tolerances()?.0;
         let stages = Stages {
             run_setup: LogStage::register("porompm: setup")?,
@@ -921,6 +955,13 @@ impl GridSystem {
             *v *= self.step.unit(q);
         }
         self.step.solution = solution;
+        let components = &out.final_residual_components;
+        let field_residuals = if components.len() == self.layout.nd {
+            let norm = |cs: &[usize]| cs.iter().map(|&c| components[c] * components[c]).sum::<f64>().sqrt();
+            self.layout.fields().iter().map(|(_, cs)| norm(cs)).collect()
+        } else {
+            Vec::new()
+        };
         Ok(StepSolve {
             converged: out.converged,
             reason: out.reason_text,
@@ -931,6 +972,9 @@ impl GridSystem {
             nonfinite,
             assembly_seconds,
             solve_seconds,
+            field_residuals,
+            field_scales: self.step.field_scales.clone(),
+            linear_field_residuals: out.linear_field_residuals,
         })
     }
 
@@ -968,19 +1012,20 @@ impl GridSystem {
     pub fn step_forces(&mut self, model: &Model, coll: &Collective) -> Result<StepForces, String> {
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
-        let (mut all, mut inertia) = (vec![0.0; ng], vec![0.0; ng]);
+        let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         {
             let xl = self.step.solution.clone();
             let mut seconds = 0.0;
             let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
             let asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
-            asm.nodal_terms(&xl, &mut all, &mut inertia);
+            asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
         }
         let mut fext = self.step.fext.clone();
         let mut fext_old = self.step.fext_old.clone();
-        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old] {
+        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
             self.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
+        let field_scales = self.field_norms(&magnitude, coll)?;
         let g = &model.grid;
         let hi = g.extent_max();
         let origin = [0.5 * (g.origin[0] + hi[0]), 0.5 * (g.origin[1] + hi[1])];
@@ -1026,7 +1071,26 @@ impl GridSystem {
             origin,
             reactions: (0..nb).map(|b| [s[17 + 2 * b], s[18 + 2 * b]]).collect(),
             work: s[16],
+            field_scales,
         })
+    }
+
+    /// The norm of each field (`Layout::fields`) of the ghosted, rank-summed dof values `v` over
+    /// the free owned dofs, in PETSc's scaling (pressure rows times s) (collective).
+    fn field_norms(&self, v: &[f64], coll: &Collective) -> Result<Vec<f64>, String> {
+        let nd = self.layout.nd;
+        let mut local = vec![0.0; nd];
+        for &a in &self.owned_nodes {
+            for (c, l) in local.iter_mut().enumerate() {
+                let q = a as usize * nd + c;
+                if !self.step.dofs.fixed[q] {
+                    let m = v[q] * self.step.unit(q);
+                    *l += m * m;
+                }
+            }
+        }
+        let squares = coll.sum(&local)?;
+        Ok(self.layout.fields().iter().map(|(_, cs)| cs.iter().map(|&c| squares[c]).sum::<f64>().sqrt()).collect())
     }
 
     /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
@@ -1157,18 +1221,8 @@ impl GridSystem {
             Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly).force_magnitudes()
         };
         self.sum_over_ranks(&mut mags).map_err(|e| e.to_string())?;
-        let nd = self.layout.nd;
-        let mut local = 0.0;
-        for &a in &self.owned_nodes {
-            for c in 0..nd {
-                let q = a as usize * nd + c;
-                if !self.step.dofs.fixed[q] {
-                    let m = mags[q] * self.step.unit(q);
-                    local += m * m;
-                }
-            }
-        }
-        Ok(coll.sum(&[local])?[0].sqrt())
+        self.step.field_scales = self.field_norms(&mags, coll)?;
+        Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
     }
 
     /// The generalized-α history of the prepared step (see `Assembler::history`).
@@ -1261,6 +1315,17 @@ pub fn petsc_options() -> Result<Vec<String>, Error> {
 }
 
 /// The solver configuration (KSP and PC types and the factorisation package), for the summary.
+/// The mat-vecs with the whole tangent timed after the linear solves (see `petsc::fields`) and
+/// their total wall time [s] on this rank.
+pub fn timed_matvecs(sys: &GridSystem) -> (usize, f64) {
+    sys.snes.timed_matvecs()
+}
+
+/// Whether the linear solver iterates (any KSP but `preonly`).
+pub fn is_iterative(sys: &mut GridSystem) -> Result<bool, Error> {
+    Ok(sys.snes.ksp()?.type_name()? != "preonly")
+}
+
 pub fn describe_solver(sys: &mut GridSystem) -> Result<String, Error> {
     let snes_type = sys.snes.type_name()?;
     let lag = sys.snes.lag_jacobian()?;

@@ -100,6 +100,19 @@ impl Layout {
     pub fn field_names(&self) -> &'static [&'static str] {
         &["ux", "uy", "p", "Ux", "Uy"][..self.nd]
     }
+
+    /// The physical fields and their dof offsets: the solid displacement u, then the pore
+    /// pressure p and the water displacement U where the system has them.
+    pub fn fields(&self) -> Vec<(&'static str, Vec<usize>)> {
+        let mut out = vec![("u", vec![dof::UX, dof::UY])];
+        if let Some(p) = self.p {
+            out.push(("p", vec![p]));
+        }
+        if let Some(w) = self.w {
+            out.push(("U", vec![w, w + 1]));
+        }
+        out
+    }
 }
 
 /// Basis values of one stencil node for one particle.

@@ -47,7 +47,28 @@ impl IndexSet {
         Ok(v)
     }
 
-    #[allow(dead_code)]
+    /// Declares that the indices come in blocks of `bs` consecutive entries of one node (the
+    /// block size reaches the sub-matrix a field split extracts with it, and from there
+    /// BoomerAMG's number of functions).
+    pub fn set_block_size(&mut self, bs: usize) -> Result<()> {
+        call!(ISSetBlockSize(self.raw, bs as Int))
+    }
+
+    /// Attaches the near-null space spanned by `vectors` (laid out like the rows this index set
+    /// selects; orthonormal) under the name a field split looks for, so that the split's
+    /// sub-matrix carries it to its preconditioner (GAMG's aggregates; BoomerAMG's interpolation
+    /// with nodal coarsening).
+    pub fn compose_near_null_space(&mut self, comm: Comm, vectors: &[crate::Vector]) -> Result<()> {
+        let raw: Vec<sys::Vec> = vectors.iter().map(|v| v.raw).collect();
+        let mut sp: sys::MatNullSpace = std::ptr::null_mut();
+        call!(MatNullSpaceCreate(comm.raw(), sys::PetscBool::PETSC_FALSE, raw.len() as Int, raw.as_ptr(), &mut sp))?;
+        let name = crate::cstring("nearnullspace")?;
+        let composed = call!(PetscObjectCompose(self.raw as sys::PetscObject, name.as_ptr(), sp as sys::PetscObject));
+        // The index set holds its own reference now.
+        call!(MatNullSpaceDestroy(&mut sp))?;
+        composed
+    }
+
     pub(crate) fn raw(&self) -> sys::IS {
         self.raw
     }

@@ -168,6 +168,13 @@ impl PcRef<'_> {
         call!(PCFactorSetMatSolverType(self.raw, c.as_ptr()))
     }
 
+    /// For a field split: defines the split `name` (options prefix `-fieldsplit_<name>_`) as the
+    /// rows of `is`. Splits are added in call order.
+    pub fn field_split_set_is(&mut self, name: &str, is: &crate::IndexSet) -> Result<()> {
+        let c = cstring(name)?;
+        call!(PCFieldSplitSetIS(self.raw, c.as_ptr(), is.raw()))
+    }
+
     /// For factorisation preconditioners: the package doing it (`"mumps"`, `"petsc"`, ...).
     pub fn factor_solver_type(&self) -> Result<Option<String>> {
         let mut t: sys::MatSolverType = std::ptr::null();

@@ -20,6 +20,7 @@ macro_rules! call {
 pub mod comm;
 pub mod dm;
 pub mod error;
+pub mod fields;
 pub mod init;
 pub mod is;
 pub mod ksp;
@@ -33,6 +34,7 @@ pub mod viewer;
 pub use comm::Comm;
 pub use dm::{DmDa, DmDaInfo, GhostedRange};
 pub use error::{Error, Result};
+pub use fields::{FieldMonitor, Fields};
 pub use init::{Petsc, PetscBuild};
 pub use is::IndexSet;
 pub use ksp::{Ksp, KspRef, PcRef};

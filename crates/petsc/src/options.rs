@@ -104,6 +104,16 @@ impl Options {
         Ok(c_text(buf.as_ptr()))
     }
 
+    /// The boolean value of an option (`name` with its leading dash), if set (a bare name means
+    /// true); a value that is not a boolean is an error.
+    pub fn get_bool(&self, name: &str) -> Result<Option<bool>> {
+        let n = cstring(name)?;
+        let mut value = sys::PetscBool::PETSC_FALSE;
+        let mut set = sys::PetscBool::PETSC_FALSE;
+        call!(PetscOptionsGetBool(self.raw, std::ptr::null(), n.as_ptr(), &mut value, &mut set))?;
+        Ok(from_bool(set).then(|| from_bool(value)))
+    }
+
     /// Every option currently in the database, in insertion order.
     pub fn all(&self) -> Result<Vec<OptionEntry>> {
         let mut p: *mut c_char = std::ptr::null_mut();

@@ -6,6 +6,7 @@
 //! trial state as inadmissible (`SNESSetFunctionDomainError`), which makes the solve end as diverged
 //! instead of failing, so the caller can cut the step.
 
+use crate::fields::{FieldMonitor, FieldTest, Fields};
 use crate::ksp::KspRef;
 use crate::mat::{Mat, MatRef};
 use crate::vector::{VecOps, VecRef, Vector};
@@ -26,7 +27,7 @@ pub fn in_callback() -> bool {
 }
 
 /// Runs `f` counted as a callback (see [`in_callback`]), catching its panic.
-fn guarded<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+pub(crate) fn guarded<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
     IN_CALLBACK.fetch_add(1, Ordering::SeqCst);
     let r = catch_unwind(AssertUnwindSafe(f));
     IN_CALLBACK.fetch_sub(1, Ordering::SeqCst);
@@ -68,6 +69,12 @@ pub struct SolveOutcome {
     pub residual_history: Vec<Real>,
     /// The message of a [`CallbackError::Domain`] raised during the solve, if any.
     pub domain_error: Option<String>,
+    /// The 2-norm of each component of the final residual (empty unless the residual vector has
+    /// a block size above one).
+    pub final_residual_components: Vec<Real>,
+    /// The largest relative residual of each field over the linear solves (see
+    /// [`crate::fields::relative_field_residuals`]; empty without [`Snes::monitor_fields`]).
+    pub linear_field_residuals: Vec<Real>,
 }
 
 /// An owned SNES, destroyed on drop.
@@ -75,6 +82,11 @@ pub struct Snes {
     raw: sys::SNES,
     history: Box<[Real]>,
     history_its: Box<[Int]>,
+    /// The per-field measurement of the linear solves (its address is the KSP's post-solve
+    /// context, so it lives, boxed, as long as the SNES).
+    fields: Option<Box<FieldMonitor>>,
+    /// The field-wise Krylov convergence test (its address is the KSP's convergence context).
+    field_test: Option<Box<FieldTest>>,
 }
 
 impl Drop for Snes {
@@ -170,8 +182,13 @@ impl Snes {
     pub fn new(comm: Comm) -> Result<Snes> {
         let mut raw = std::ptr::null_mut();
         call!(SNESCreate(comm.raw(), &mut raw))?;
-        let mut s =
-            Snes { raw, history: vec![0.0; 1000].into_boxed_slice(), history_its: vec![0; 1000].into_boxed_slice() };
+        let mut s = Snes {
+            raw,
+            history: vec![0.0; 1000].into_boxed_slice(),
+            history_its: vec![0; 1000].into_boxed_slice(),
+            fields: None,
+            field_test: None,
+        };
         call!(SNESSetConvergenceHistory(
             s.raw,
             s.history.as_mut_ptr(),
@@ -250,6 +267,42 @@ impl Snes {
         call!(SNESSetFromOptions(self.raw))
     }
 
+    /// Whether the linear tolerance follows Eisenstat–Walker (`-snes_ksp_ew`).
+    pub fn uses_eisenstat_walker(&self) -> Result<bool> {
+        let mut flg = sys::PetscBool::PETSC_FALSE;
+        call!(SNESKSPGetUseEW(self.raw, &mut flg))?;
+        Ok(crate::from_bool(flg))
+    }
+
+    /// Measures every linear solve field by field from now on (`fields`: the components of each
+    /// field in the vectors' blocks); each [`Snes::solve`] reports the largest relative residual
+    /// of each field over its linear solves in [`SolveOutcome::linear_field_residuals`]. With
+    /// `test`, a Krylov solve also converges only when every field's relative residual is within
+    /// the KSP's relative tolerance (see [`FieldTest`]). Call after [`Snes::set_from_options`].
+    pub fn monitor_fields(&mut self, fields: Fields, test: bool) -> Result<()> {
+        let mut monitor = Box::new(FieldMonitor::new(fields.clone()));
+        let ctx = monitor.as_mut() as *mut FieldMonitor as *mut c_void;
+        let mut k = std::ptr::null_mut();
+        call!(SNESGetKSP(self.raw, &mut k))?;
+        call!(KSPSetPostSolve(k, Some(crate::fields::post_solve), ctx))?;
+        self.fields = Some(monitor);
+        if test {
+            self.field_test = Some(FieldTest::install(k, fields)?);
+        }
+        Ok(())
+    }
+
+    /// Mat-vecs with the whole operator timed by the field monitor over the SNES's life, and their
+    /// total wall time [s] (on this rank; PETSc's own mat-vecs inside the solvers are not counted).
+    pub fn timed_matvecs(&self) -> (usize, f64) {
+        self.fields.as_ref().map_or((0, 0.0), |m| m.matvecs)
+    }
+
+    /// Krylov iterations that went on because a field's residual lagged, over the SNES's life.
+    pub fn field_test_extensions(&self) -> usize {
+        self.field_test.as_ref().map_or(0, |t| t.extensions)
+    }
+
     /// The linear solver inside the SNES.
     pub fn ksp(&mut self) -> Result<KspRef<'_>> {
         let mut k = std::ptr::null_mut();
@@ -270,11 +323,32 @@ impl Snes {
         call!(SNESView(self.raw, viewer.raw()))
     }
 
+    /// The 2-norm of each component of the SNES's residual vector (empty if it has none yet or
+    /// its block size is one).
+    fn residual_components(&self) -> Result<Vec<Real>> {
+        let mut f: sys::Vec = std::ptr::null_mut();
+        call!(SNESGetFunction(self.raw, &mut f, std::ptr::null_mut(), std::ptr::null_mut()))?;
+        if f.is_null() {
+            return Ok(Vec::new());
+        }
+        let mut bs: Int = 0;
+        call!(VecGetBlockSize(f, &mut bs))?;
+        if bs <= 1 {
+            return Ok(Vec::new());
+        }
+        let mut n = vec![0.0; bs as usize];
+        call!(VecStrideNormAll(f, sys::NormType::NORM_2, n.as_mut_ptr()))?;
+        Ok(n)
+    }
+
     /// Solves `F(x) = 0` starting from `x`, with `jac` as Jacobian (and preconditioning) matrix.
     ///
     /// Solver failures that PETSc reports as divergence (line search, iteration limit, domain
     /// error) come back as `Ok` with `converged == false`; only genuine errors are `Err`.
     pub fn solve(&mut self, x: &mut Vector, jac: &mut Mat, problem: &mut dyn NonlinearProblem) -> Result<SolveOutcome> {
+        if let Some(m) = self.fields.as_mut() {
+            m.reset();
+        }
         let mut ctx = Context { problem, domain_error: None };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
         call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), ctx_ptr))?;
@@ -305,6 +379,7 @@ impl Snes {
         let mut nhist: Int = 0;
         call!(SNESGetConvergenceHistory(self.raw, &mut hist, &mut hist_its, &mut nhist))?;
         let n = (nhist.max(0) as usize).min(self.history.len());
+        let final_residual_components = self.residual_components()?;
         Ok(SolveOutcome {
             converged: reason.0 > 0,
             reason: reason.0,
@@ -313,6 +388,8 @@ impl Snes {
             linear_iterations: lits as usize,
             residual_history: self.history[..n].to_vec(),
             domain_error: ctx.domain_error,
+            final_residual_components,
+            linear_field_residuals: self.fields.as_ref().map(|m| m.worst.clone()).unwrap_or_default(),
         })
     }
 }

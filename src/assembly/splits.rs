@@ -1,0 +1,90 @@
+//! The named field splits of the block preconditioners.
+//!
+//! When the PETSc options choose `-pc_type fieldsplit` and define no splits of their own
+//! (`-pc_fieldsplit_<n>_fields`), porompm defines two, by index sets, whatever the system:
+//!
+//! * `u`: every displacement dof, the solid's (ux, uy) and, in the u–p–U system, the water's
+//!   (Ux, Uy) — kept in one block because the drag couples them strongly; the index set carries
+//!   the node's displacement components as its block size (4 or 2), so BoomerAMG treats the
+//!   components of a node together, and the rigid-body modes of the grid (two translations and
+//!   the rotation, solid and water moving together) as its near-null space, which GAMG uses for
+//!   its aggregates and BoomerAMG with nodal coarsening;
+//! * `p`: the pore pressures.
+//!
+//! One options file (`-fieldsplit_u_*`, `-fieldsplit_p_*`) thus serves the u–p and the u–p–U
+//! systems alike. PETSc 3.18's own DM splits lose the block size (see docs/solvers.md).
+
+use crate::kernels::Layout;
+use crate::parallel::Collective;
+use petsc::ksp::KspOps;
+use petsc::{Comm, IndexSet, Options, Snes, VecOps, Vector};
+
+/// The splits porompm defined, by name, or `None` when the preconditioner is not a field split
+/// or the options define the splits themselves.
+pub(super) fn define(
+    snes: &mut Snes,
+    comm: Comm,
+    coll: &Collective,
+    layout: Layout,
+    first_dof: usize,
+    positions: &[[f64; 2]],
+) -> Result<Option<Vec<&'static str>>, petsc::Error> {
+    let Some(p) = layout.p else { return Ok(None) };
+    let mut ksp = snes.ksp()?;
+    let mut pc = ksp.pc()?;
+    if pc.type_name()? != "fieldsplit" || user_defines_splits()? {
+        return Ok(None);
+    }
+    let nd = layout.nd;
+    let displacement: Vec<usize> = (0..nd).filter(|&c| c != p).collect();
+    let index = |cs: &[usize]| -> Vec<petsc::Int> {
+        (0..positions.len()).flat_map(|a| cs.iter().map(move |&c| (first_dof + a * nd + c) as petsc::Int)).collect()
+    };
+    let mut u = IndexSet::new_general(comm, &index(&displacement))?;
+    u.set_block_size(displacement.len())?;
+    let modes = rigid_body_modes(comm, coll, displacement.len(), positions)?;
+    u.compose_near_null_space(comm, &modes)?;
+    let pressure = IndexSet::new_general(comm, &index(&[p]))?;
+    pc.field_split_set_is("u", &u)?;
+    pc.field_split_set_is("p", &pressure)?;
+    Ok(Some(vec!["u", "p"]))
+}
+
+/// Whether the options database defines field splits by component lists.
+fn user_defines_splits() -> Result<bool, petsc::Error> {
+    Ok(Options::global().all()?.iter().any(|o| o.name.starts_with("pc_fieldsplit_") && o.name.ends_with("_fields")))
+}
+
+/// The orthonormal rigid-body modes of the grid for a block of `components` displacement dofs per
+/// node (pairs (x, y), solid then water): the translations along x and y and the rotation about
+/// the nodes' centroid, every pair moving alike (collective).
+fn rigid_body_modes(
+    comm: Comm,
+    coll: &Collective,
+    components: usize,
+    positions: &[[f64; 2]],
+) -> Result<Vec<Vector>, petsc::Error> {
+    let local = [positions.len() as f64, positions.iter().map(|x| x[0]).sum(), positions.iter().map(|x| x[1]).sum()];
+    let sums = coll.sum(&local).map_err(petsc::Error::new)?;
+    let centre = [sums[1] / sums[0].max(1.0), sums[2] / sums[0].max(1.0)];
+    let n = positions.len() * components;
+    let pairs = components / 2;
+    let mode = |f: &dyn Fn([f64; 2]) -> [f64; 2]| -> Result<Vector, petsc::Error> {
+        let mut values = vec![0.0; n];
+        for (a, x) in positions.iter().enumerate() {
+            let d = f([x[0] - centre[0], x[1] - centre[1]]);
+            for k in 0..pairs {
+                values[a * components + 2 * k] = d[0];
+                values[a * components + 2 * k + 1] = d[1];
+            }
+        }
+        // Translations and the rotation about the centroid are orthogonal: only normalise.
+        let norm = coll.sum(&[values.iter().map(|v| v * v).sum()]).map_err(petsc::Error::new)?[0].sqrt();
+        let mut v = Vector::new_mpi(comm, n as petsc::Int, petsc::DETERMINE)?;
+        for (w, x) in v.write()?.iter_mut().zip(&values) {
+            *w = x / norm;
+        }
+        Ok(v)
+    };
+    Ok(vec![mode(&|_| [1.0, 0.0])?, mode(&|_| [0.0, 1.0])?, mode(&|r| [-r[1], r[0]])?])
+}
