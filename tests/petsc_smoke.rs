@@ -12,7 +12,7 @@
 use petsc::ksp::KspOps;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
-use petsc::{CallbackError, Comm, DmDa, Mat, MatRef, Options, Petsc, Snes, VecOps, VecRef, Vector};
+use petsc::{CallbackError, Comm, DmDa, IndexSet, Mat, MatRef, Options, Petsc, Snes, VecOps, VecRef, Vector};
 use std::path::{Path, PathBuf};
 
 type TestResult = Result<(), String>;
@@ -81,6 +81,27 @@ impl NonlinearProblem for SaddleSystem<'_> {
     }
 }
 
+/// As porompm does (`assembly::splits`): a field split gets the splits `u` (ux, uy, Ux, Uy; block
+/// size 4) and `p`, by index sets.
+fn define_splits(snes: &mut Snes, dm: &DmDa, comm: Comm) -> TestResult {
+    let mut ksp = snes.ksp().map_err(e)?;
+    let mut pc = ksp.pc().map_err(e)?;
+    if pc.type_name().map_err(e)? != "fieldsplit" {
+        return Ok(());
+    }
+    let v = dm.create_global_vector().map_err(e)?;
+    let (lo, hi) = v.ownership_range().map_err(e)?;
+    let pick = |cs: &[usize]| -> Vec<petsc::Int> {
+        (lo..hi).filter(|q| cs.contains(&((q - lo) % 5))).map(|q| q as petsc::Int).collect()
+    };
+    let mut u = IndexSet::new_general(comm, &pick(&[0, 1, 3, 4])).map_err(e)?;
+    u.set_block_size(4).map_err(e)?;
+    let p = IndexSet::new_general(comm, &pick(&[2])).map_err(e)?;
+    pc.field_split_set_is("u", &u).map_err(e)?;
+    pc.field_split_set_is("p", &p).map_err(e)?;
+    Ok(())
+}
+
 fn solve_with_options_file(path: &Path) -> TestResult {
     let comm = Comm::world();
     let mut opts = Options::new().map_err(e)?;
@@ -114,6 +135,7 @@ fn solve_with_options_file(path: &Path) -> TestResult {
     }
     snes.set_tolerances(None, Some(1e-10), None, Some(50)).map_err(e)?;
     snes.set_from_options().map_err(e)?;
+    define_splits(&mut snes, &dm, comm)?;
     let mut x = dm.create_global_vector().map_err(e)?;
     x.set_all(0.0).map_err(e)?;
     let mut jac = dm.create_matrix().map_err(e)?;
