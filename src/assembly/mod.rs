@@ -344,14 +344,14 @@ impl GridSystem {
             pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
-        // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
-        // post-solve hook it would replace).
         let positions: Vec<[f64; 2]> = (info.owned_start[1]..info.owned_start[1] + info.owned_count[1])
             .flat_map(|j| (info.owned_start[0]..info.owned_start[0] + info.owned_count[0]).map(move |i| (i, j)))
             .map(|(i, j)| grid.node_position(i, j))
             .collect();
         let first_dof = x.ownership_range()?.0;
         splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
+        // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
+        // post-solve hook it would replace).
         if !snes.uses_eisenstat_walker()? {
             let test = petsc::Options::global().get_bool(FIELD_TEST_OPTION)?.unwrap_or(true);
             snes.monitor_fields(layout.fields().into_iter().map(|(_, c)| c).collect(), test)?;

@@ -19,8 +19,8 @@ use crate::parallel::Collective;
 use petsc::ksp::KspOps;
 use petsc::{Comm, IndexSet, Options, Snes, VecOps, Vector};
 
-/// The splits porompm defined, by name, or `None` when the preconditioner is not a field split
-/// or the options define the splits themselves.
+/// Defines the splits `u` and `p` when the preconditioner is a field split of a system with a
+/// pressure and the options define no splits themselves; otherwise does nothing.
 pub(super) fn define(
     snes: &mut Snes,
     comm: Comm,
@@ -28,12 +28,12 @@ pub(super) fn define(
     layout: Layout,
     first_dof: usize,
     positions: &[[f64; 2]],
-) -> Result<Option<Vec<&'static str>>, petsc::Error> {
-    let Some(p) = layout.p else { return Ok(None) };
+) -> Result<(), petsc::Error> {
+    let Some(p) = layout.p else { return Ok(()) };
     let mut ksp = snes.ksp()?;
     let mut pc = ksp.pc()?;
     if pc.type_name()? != "fieldsplit" || user_defines_splits()? {
-        return Ok(None);
+        return Ok(());
     }
     let nd = layout.nd;
     let displacement: Vec<usize> = (0..nd).filter(|&c| c != p).collect();
@@ -46,8 +46,7 @@ pub(super) fn define(
     u.compose_near_null_space(comm, &modes)?;
     let pressure = IndexSet::new_general(comm, &index(&[p]))?;
     pc.field_split_set_is("u", &u)?;
-    pc.field_split_set_is("p", &pressure)?;
-    Ok(Some(vec!["u", "p"]))
+    pc.field_split_set_is("p", &pressure)
 }
 
 /// Whether the options database defines field splits by component lists.

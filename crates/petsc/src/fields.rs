@@ -53,8 +53,6 @@ pub struct FieldMonitor {
     fields: Fields,
     /// The largest η of each field since the last reset.
     pub worst: Vec<Real>,
-    /// Linear solves measured since the last reset.
-    pub solves: usize,
     /// Mat-vecs with the whole operator timed over the monitor's life, and their total wall time [s]
     /// (the first product of each measurement: the cost of one mat-vec of the system).
     pub matvecs: (usize, f64),
@@ -64,13 +62,12 @@ impl FieldMonitor {
     /// A monitor of `fields` (components of the vectors' blocks).
     pub fn new(fields: Fields) -> FieldMonitor {
         let n = fields.len();
-        FieldMonitor { fields, worst: vec![0.0; n], solves: 0, matvecs: (0, 0.0) }
+        FieldMonitor { fields, worst: vec![0.0; n], matvecs: (0, 0.0) }
     }
 
     /// Forgets the solves measured so far.
     pub fn reset(&mut self) {
         self.worst.iter_mut().for_each(|w| *w = 0.0);
-        self.solves = 0;
     }
 
     /// Measures the solve `A x = b` of `ksp` just finished.
@@ -81,7 +78,6 @@ impl FieldMonitor {
         for (w, e) in self.worst.iter_mut().zip(eta) {
             *w = w.max(e);
         }
-        self.solves += 1;
         Ok(())
     }
 }
@@ -105,21 +101,21 @@ fn measure(fields: &[Vec<usize>], ksp: sys::KSP, b: sys::Vec, x: sys::Vec) -> Re
         call!(VecStrideNormAll(v, sys::NormType::NORM_2, n.as_mut_ptr()))?;
         Ok(n.into_iter().map(|x| x * x).collect())
     };
-    let work = Work::new(b)?;
+    let (r, t, y) = (duplicate(b)?, duplicate(b)?, duplicate(b)?);
     let t0 = std::time::Instant::now();
-    call!(MatMult(a, x, work.r))?;
+    call!(MatMult(a, x, r.raw))?;
     let seconds = t0.elapsed().as_secs_f64();
-    call!(VecAYPX(work.r, -1.0, b))?;
-    let residual = squares(work.r)?;
+    call!(VecAYPX(r.raw, -1.0, b))?;
+    let residual = squares(r.raw)?;
     let rhs = squares(b)?;
     let mut terms = Vec::with_capacity(fields.len());
     for g in fields {
-        call!(VecCopy(x, work.t))?;
+        call!(VecCopy(x, t.raw))?;
         for c in (0..nc).filter(|c| !g.contains(c)) {
-            call!(VecStrideScale(work.t, c as Int, 0.0))?;
+            call!(VecStrideScale(t.raw, c as Int, 0.0))?;
         }
-        call!(MatMult(a, work.t, work.y))?;
-        terms.push(squares(work.y)?);
+        call!(MatMult(a, t.raw, y.raw))?;
+        terms.push(squares(y.raw)?);
     }
     Ok((relative_field_residuals(fields, &residual, &rhs, &terms), seconds))
 }
@@ -134,8 +130,6 @@ pub struct FieldTest {
     inner: ConvergenceTest,
     /// PETSc's norm below which the next field check is made (after a failed one).
     next_check: Option<Real>,
-    /// Field checks that sent the iteration on, over the KSP's life.
-    pub extensions: usize,
 }
 
 type ConvergenceFn =
@@ -160,11 +154,11 @@ impl Drop for ConvergenceTest {
 
 impl FieldTest {
     /// Replaces the convergence test of `ksp` by the field-wise one (boxed: its address is the
-    /// test's context; keep the box alive as long as the KSP, or call [`FieldTest::remove`]).
+    /// test's context; keep the box alive as long as the KSP).
     pub(crate) fn install(ksp: sys::KSP, fields: Fields) -> Result<Box<FieldTest>> {
         let mut inner = ConvergenceTest { test: None, ctx: std::ptr::null_mut(), destroy: None };
         call!(KSPGetAndClearConvergenceTest(ksp, &mut inner.test, &mut inner.ctx, &mut inner.destroy))?;
-        let mut t = Box::new(FieldTest { fields, inner, next_check: None, extensions: 0 });
+        let mut t = Box::new(FieldTest { fields, inner, next_check: None });
         let ctx = t.as_mut() as *mut FieldTest as *mut c_void;
         call!(KSPSetConvergenceTest(ksp, Some(field_converged), ctx, None))?;
         Ok(t)
@@ -188,14 +182,13 @@ impl FieldTest {
         call!(KSPGetTolerances(ksp, &mut rtol, &mut atol, &mut dtol, &mut maxits))?;
         let mut b: sys::Vec = std::ptr::null_mut();
         call!(KSPGetRhs(ksp, &mut b))?;
-        let work = Work::new(b)?;
-        let mut x = work.r;
-        call!(KSPBuildSolution(ksp, work.r, &mut x))?;
+        let solution = duplicate(b)?;
+        let mut x = solution.raw;
+        call!(KSPBuildSolution(ksp, solution.raw, &mut x))?;
         let worst = measure(&self.fields, ksp, b, x)?.0.into_iter().fold(0.0, Real::max);
         if worst > rtol {
             *reason = sys::KSPConvergedReason::KSP_CONVERGED_ITERATING;
             self.next_check = Some(rnorm * 0.5 * rtol / worst);
-            self.extensions += 1;
         } else {
             self.next_check = None;
         }
@@ -233,32 +226,11 @@ fn code(outcome: std::thread::Result<Result<()>>, what: &str) -> sys::PetscError
     }
 }
 
-/// Three work vectors shaped like the right-hand side, destroyed on drop.
-struct Work {
-    r: sys::Vec,
-    t: sys::Vec,
-    y: sys::Vec,
-}
-
-impl Work {
-    fn new(like: sys::Vec) -> Result<Work> {
-        let mut w = Work { r: std::ptr::null_mut(), t: std::ptr::null_mut(), y: std::ptr::null_mut() };
-        call!(VecDuplicate(like, &mut w.r))?;
-        call!(VecDuplicate(like, &mut w.t))?;
-        call!(VecDuplicate(like, &mut w.y))?;
-        Ok(w)
-    }
-}
-
-impl Drop for Work {
-    fn drop(&mut self) {
-        for v in [&mut self.r, &mut self.t, &mut self.y] {
-            if !v.is_null() {
-                // SAFETY: created by VecDuplicate above and destroyed once.
-                unsafe { sys::VecDestroy(v) };
-            }
-        }
-    }
+/// A new vector shaped like `like` (owned: destroyed on drop).
+fn duplicate(like: sys::Vec) -> Result<crate::Vector> {
+    let mut raw = std::ptr::null_mut();
+    call!(VecDuplicate(like, &mut raw))?;
+    Ok(crate::Vector { raw })
 }
 
 /// `KSPSetPostSolve` callback: `ctx` is the `FieldMonitor` boxed inside the owning `Snes`.

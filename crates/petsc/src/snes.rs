@@ -298,11 +298,6 @@ impl Snes {
         self.fields.as_ref().map_or((0, 0.0), |m| m.matvecs)
     }
 
-    /// Krylov iterations that went on because a field's residual lagged, over the SNES's life.
-    pub fn field_test_extensions(&self) -> usize {
-        self.field_test.as_ref().map_or(0, |t| t.extensions)
-    }
-
     /// The linear solver inside the SNES.
     pub fn ksp(&mut self) -> Result<KspRef<'_>> {
         let mut k = std::ptr::null_mut();
