@@ -5,14 +5,15 @@
 #   hdf5-metno), clang/libclang for bindgen, pkg-config, the serial OpenBLAS (Debian's reference
 #   BLAS is several times slower inside the direct solvers), for the PNG plots (plotters' text
 #   through font-kit) the fontconfig and FreeType development files and the DejaVu fonts, and
-#   ParaView with its Python (`pvbatch`), with which the tests read fields.xdmf back.
+#   ParaView with its Python (`pvbatch`), with which the tests read fields.xdmf back, and SciPy for
+#   the study script scripts/schur_spectrum.py.
 #   Rust: cargo and rustc through rustup, if no cargo is found.
 # Run as root or with sudo available.
 set -euo pipefail
 
 packages=(petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev clang libclang-dev pkg-config
           libopenblas0-serial libfontconfig1-dev libfreetype-dev fonts-dejavu-core
-          make git ca-certificates curl paraview python3-paraview)
+          make git ca-certificates curl paraview python3-paraview python3-scipy)
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
