@@ -7,7 +7,7 @@
 //! (`KSPSetPostSolve`), so that a run can report, and a test can check, that each field's
 //! equation was solved to the tolerance asked for.
 
-use crate::{Int, Real, Result};
+use crate::{Int, Real, Result, VecOps};
 use petsc_sys as sys;
 use std::ffi::c_void;
 
@@ -228,9 +228,7 @@ fn code(outcome: std::thread::Result<Result<()>>, what: &str) -> sys::PetscError
 
 /// A new vector shaped like `like` (owned: destroyed on drop).
 fn duplicate(like: sys::Vec) -> Result<crate::Vector> {
-    let mut raw = std::ptr::null_mut();
-    call!(VecDuplicate(like, &mut raw))?;
-    Ok(crate::Vector { raw })
+    crate::VecRef::new(like).duplicate()
 }
 
 /// `KSPSetPostSolve` callback: `ctx` is the `FieldMonitor` boxed inside the owning `Snes`.
