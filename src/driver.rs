@@ -629,8 +629,8 @@ impl<'a> Simulation<'a> {
                     kind: "iterative_unstabilised".into(),
                     message: format!(
                         "the Krylov solver ({}) runs an equal-order two-phase case without pressure projection: its \
-                         checkerboard pressure modes are nearly singular for the pressure block's preconditioner, and the \
-                         iterations grow with the grid (slumping block: 39 -> 92 per Newton step from 1.3e3 to 1.0e5 unknowns, docs/solvers.md); \
+                         checkerboard pressure modes are nearly singular for the pressure block's preconditioner, whose \
+                         iterations may then grow with the grid (docs/solvers.md, \"Which strategy for which case\"); \
                          set stabilisation.pressure_projection = 1.0 or use a direct strategy",
                         self.summary.solver
                     ),

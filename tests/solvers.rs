@@ -89,3 +89,68 @@ fn a_direct_solve_leaves_every_field_at_round_off() {
         }
     }
 }
+
+/// Krylov iterations per Newton iteration of the consolidating layer's first three steps (u–p,
+/// stabilised) on an n × n grid, under `opts` and the extra PETSc options.
+fn krylov_per_newton(name: &str, n: usize, opts: &str, petsc: &[&str]) -> f64 {
+    let cells = format!("grid.cells=[{n},{n}]");
+    let sets = ["stages.consolidation.duration=0.0003", cells.as_str(), "stabilisation.pressure_projection=1.0"];
+    let mut args = set_args(&sets);
+    args.extend(["--options-file".into(), opts.into(), "--".into()]);
+    args.extend(petsc.iter().map(|s| s.to_string()));
+    let run = run_case("cases/consolidation_layer.toml", &dir(&format!("{name}-{n}")), &args);
+    assert!(run.completed(), "{name} at {n} x {n}: {}", run.stderr());
+    let newton = run.summary["snes_iterations"].as_f64().expect("snes_iterations");
+    run.summary["ksp_iterations"].as_f64().expect("ksp_iterations") / newton
+}
+
+#[test]
+fn the_fixed_stress_schur_preconditioner_keeps_the_iterations_flat_where_selfp_grows() {
+    // Measured per Newton iteration at 20 × 20, 40 × 40, 80 × 80 cells (1.2e3 to 1.9e4 unknowns):
+    // fixed stress 28.0, 22.6, 17.4; selfp with the same blocks otherwise 33.6 at 20 × 20, 51.6 at 80 × 80.
+    let fixed = "petsc_options/fieldsplit-fixed-stress.opts";
+    let selfp = ["-pc_fieldsplit_schur_precondition", "selfp"];
+    let f: Vec<f64> = [20, 80].iter().map(|&n| krylov_per_newton("fixed-stress", n, fixed, &[])).collect();
+    let s: Vec<f64> = [20, 80].iter().map(|&n| krylov_per_newton("selfp", n, fixed, &selfp)).collect();
+    eprintln!("Krylov per Newton at 20 x 20 and 80 x 80: fixed stress {f:?}, selfp {s:?}");
+    assert!(f[1] <= 1.1 * f[0], "fixed stress grows: {f:?}");
+    assert!(f[1] <= 25.0, "fixed stress needs {} Krylov iterations per Newton at 80 x 80", f[1]);
+    assert!(s[1] >= 1.3 * s[0], "selfp does not grow, so this grid sequence proves nothing: {s:?}");
+}
+
+#[test]
+fn the_fixed_stress_schur_preconditioner_is_refused_for_the_dynamic_system() {
+    let (case, mut args) = upu();
+    args.extend(["--options-file".into(), "petsc_options/fieldsplit-fixed-stress.opts".into()]);
+    let run = run_case(case, &dir("upu-fixed-stress"), &args);
+    assert!(!run.output.status.success(), "the u–p–U run accepted the fixed-stress Schur preconditioner");
+    let err = run.stderr();
+    assert!(err.contains("pc_fieldsplit_schur_precondition") && err.contains("u–p–U"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// Whether a run's summary carries a warning of `kind`.
+fn warns(run: &Run, kind: &str) -> bool {
+    run.summary["warnings"].as_array().expect("warnings").iter().any(|w| w["kind"] == kind)
+}
+
+#[test]
+fn an_iterative_strategy_on_an_unstabilised_case_warns_and_only_then() {
+    let short = "stages.consolidation.duration=0.0002";
+    let opts = |file: &str| vec!["--options-file".to_string(), format!("petsc_options/{file}.opts")];
+    for (name, stabilised, file, expected) in [
+        ("warn-iterative", false, "fieldsplit-fixed-stress", true),
+        ("warn-stabilised", true, "fieldsplit-fixed-stress", false),
+        ("warn-direct", false, "direct-lu", false),
+    ] {
+        let mut sets = vec![short, "grid.cells=[16,16]"];
+        if stabilised {
+            sets.push("stabilisation.pressure_projection=1.0");
+        }
+        let mut args = set_args(&sets);
+        args.extend(opts(file));
+        let run = run_case("cases/consolidation_layer.toml", &dir(name), &args);
+        assert!(run.completed(), "{name}: {}", run.stderr());
+        assert_eq!(warns(&run, "iterative_unstabilised"), expected, "{name}: {}", run.summary["warnings"]);
+    }
+}

@@ -355,6 +355,8 @@ pub(super) struct Assembler<'a> {
     seconds: &'a mut f64,
     stage: &'a LogStage,
     values: Vec<f64>,
+    /// The fixed-stress Schur preconditioner, refilled after every Jacobian.
+    schur: Option<&'a mut petsc::SchurUser>,
     /// The first material point whose residual block was not finite in this solve (on this
     /// rank), with the quantity that was not.
     pub(super) nonfinite: Option<String>,
@@ -370,7 +372,25 @@ impl<'a> Assembler<'a> {
         seconds: &'a mut f64,
         stage: &'a LogStage,
     ) -> Assembler<'a> {
-        Assembler { dm, model, step, x_local, f_local, seconds, stage, values: Vec::new(), nonfinite: None }
+        Assembler {
+            dm,
+            model,
+            step,
+            x_local,
+            f_local,
+            seconds,
+            stage,
+            values: Vec::new(),
+            schur: None,
+            nonfinite: None,
+        }
+    }
+
+    /// The callbacks, also refilling the fixed-stress Schur preconditioner `schur` after each
+    /// Jacobian.
+    pub(super) fn with_schur(mut self, schur: Option<&'a mut petsc::SchurUser>) -> Assembler<'a> {
+        self.schur = schur;
+        self
     }
 
     /// The physical increments of the ghosted dofs at PETSc's `x` (pressures times the step's
@@ -634,6 +654,9 @@ impl NonlinearProblem for Assembler<'_> {
         }
         j.set_values_coo(&values, false).map_err(fatal)?;
         self.values = values;
+        if let Some(schur) = self.schur.as_deref_mut() {
+            schur.update(j, &step.fixed_stress).map_err(fatal)?;
+        }
         *self.seconds += t0.elapsed().as_secs_f64();
         Ok(())
     }

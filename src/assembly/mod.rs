@@ -100,6 +100,9 @@ struct StepData {
     /// The norm of the force magnitudes of each field (`Layout::fields`) over its free dofs, in
     /// PETSc's scaling: the scale of the field's residual.
     field_scales: Vec<f64>,
+    /// The diagonal the fixed-stress Schur preconditioner adds to A_pp, per owned pressure row
+    /// (see [`GridSystem::fixed_stress_diagonal`]; empty without that preconditioner).
+    fixed_stress: Vec<f64>,
 }
 
 impl StepData {
@@ -257,6 +260,8 @@ pub struct GridSystem {
     work_global: Vector,
     snes: Snes,
     jac: Option<Mat>,
+    /// The fixed-stress Schur preconditioner, when the options ask for one (see [`splits`]).
+    schur: Option<petsc::SchurUser>,
     /// The reactions per ghosted dof of the last converged step (for the work of the next).
     last_reactions: Vec<f64>,
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
@@ -349,7 +354,7 @@ impl GridSystem {
             .map(|(i, j)| grid.node_position(i, j))
             .collect();
         let first_dof = x.ownership_range()?.0;
-        splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
+        let schur = splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
         // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
         // post-solve hook it would replace).
         if !snes.uses_eisenstat_walker()? {
@@ -382,6 +387,7 @@ impl GridSystem {
             work_global,
             snes,
             jac: None,
+            schur,
             user_atol,
             last_reactions: Vec::new(),
             reused_patterns: 0,
@@ -472,7 +478,39 @@ impl GridSystem {
         coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
+        self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
         self.matrix_pattern(old_pattern, coll)
+    }
+
+    /// Step 4: the diagonal of the fixed-stress Schur preconditioner Sp = A_pp + diag(d) of the
+    /// u–p system (see [`splits`]), per owned pressure row in the `p` split's order:
+    /// d_i = −s² Σ_k N_i(x_k) V_k / K_dr,k, the lumped pressure mass of the points over their
+    /// skeleton's drained (plane-strain) bulk modulus, in PETSc's scaling (s the pressure scale);
+    /// 0 on fixed pressures, whose rows stay the unit diagonal. It is the volume change of the
+    /// fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible grains, as the
+    /// continuity equation assumes), with the sign of A_pp's storage term. Empty without that
+    /// preconditioner.
+    fn fixed_stress_diagonal(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
+        let (Some(p), true) = (self.layout.p, self.schur.is_some()) else { return Ok(Vec::new()) };
+        let nd = self.layout.nd;
+        let mut mass = vec![0.0; self.ghost.len() * nd];
+        let (st, ps) = (&self.step.stencils, &model.particles);
+        for k in 0..st.len() {
+            let drained = model.materials[ps.material[k] as usize].model.elastic().plane_bulk_modulus();
+            let (nodes, basis) = st.get(k);
+            for (&node, nb) in nodes.iter().zip(basis) {
+                mass[node as usize * nd + p] += nb.s * ps.volume[k] / drained;
+            }
+        }
+        self.sum_over_ranks(&mut mass)?;
+        let s2 = self.step.p_scale * self.step.p_scale;
+        let fixed = &self.step.dofs.fixed;
+        Ok(self
+            .owned_nodes
+            .iter()
+            .map(|&a| a as usize * nd + p)
+            .map(|q| if fixed[q] { 0.0 } else { -s2 * mass[q] })
+            .collect())
     }
 
     /// Step 1: the stencils on x_n (B̄'s cells first: which cells the material fills, summed over
@@ -599,6 +637,9 @@ impl GridSystem {
             let (rows, cols) = p.coo(nd, &self.l2g);
             let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());
             self.jac = Some(coll.agree(made)?);
+            if let Some(schur) = &mut self.schur {
+                schur.forget();
+            }
             p
         } else {
             self.reused_patterns += 1;
@@ -998,9 +1039,10 @@ impl GridSystem {
         model: &'a Model,
         seconds: &'a mut f64,
     ) -> Result<(&'a mut Snes, &'a mut Vector, &'a mut Mat, Assembler<'a>), Error> {
-        let GridSystem { dm, x, x_local, f_local, snes, jac, step, stages, .. } = self;
+        let GridSystem { dm, x, x_local, f_local, snes, jac, schur, step, stages, .. } = self;
         let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("the step was not prepared"))?;
-        let asm = Assembler::new(dm, model, step, x_local, f_local, seconds, &stages.assembly);
+        let asm =
+            Assembler::new(dm, model, step, x_local, f_local, seconds, &stages.assembly).with_schur(schur.as_mut());
         Ok((snes, x, jac, asm))
     }
 

@@ -13,14 +13,26 @@
 //!
 //! One options file (`-fieldsplit_u_*`, `-fieldsplit_p_*`) thus serves the u–p and the u–p–U
 //! systems alike. PETSc 3.18's own DM splits lose the block size (see docs/solvers.md).
+//!
+//! A Schur-complement split of the u–p system whose options ask for a user-built Schur
+//! preconditioner (`-pc_fieldsplit_schur_precondition user`) gets porompm's fixed-stress
+//! approximation, Sp = A_pp − s² M_L / K_dr (see `GridSystem::fixed_stress_diagonal`): the
+//! pressure block of the tangent plus the lumped pressure mass over the skeleton's drained bulk
+//! modulus, the volume change a pressure increment causes when the mean total stress is held
+//! fixed. PETSc's `selfp` (A_pp − A_pu diag(A_uu)⁻¹ A_up) approximates that volume change through
+//! the diagonal of the stiffness, which shrinks as h² under refinement, and its spectrum spreads
+//! with the grid; the fixed-stress one does not (docs/solvers.md).
 
 use crate::kernels::Layout;
 use crate::parallel::Collective;
 use petsc::ksp::KspOps;
-use petsc::{Comm, IndexSet, Options, Snes, VecOps, Vector};
+use petsc::{Comm, IndexSet, Options, SchurUser, Snes, VecOps, Vector};
 
 /// Defines the splits `u` and `p` when the preconditioner is a field split of a system with a
-/// pressure and the options define no splits themselves; otherwise does nothing.
+/// pressure and the options define no splits themselves; otherwise does nothing. Returns the
+/// user-built Schur preconditioner when the options ask for one (the caller fills it after each
+/// Jacobian); that needs porompm's splits and the u–p system, and asking for it otherwise is an
+/// error naming the option.
 pub(super) fn define(
     snes: &mut Snes,
     comm: Comm,
@@ -28,12 +40,24 @@ pub(super) fn define(
     layout: Layout,
     first_dof: usize,
     positions: &[[f64; 2]],
-) -> Result<(), petsc::Error> {
-    let Some(p) = layout.p else { return Ok(()) };
+) -> Result<Option<SchurUser>, petsc::Error> {
     let mut ksp = snes.ksp()?;
     let mut pc = ksp.pc()?;
+    let user_schur = SchurUser::requested(&pc)?;
+    let Some(p) = layout.p else { return Ok(None) };
+    if user_schur && (layout.w.is_some() || user_defines_splits()?) {
+        return Err(petsc::Error::new(format!(
+            "-{SCHUR_USER_OPTION} user (porompm's fixed-stress Schur preconditioner) applies to the u–p system of \
+             quasi-static stages with porompm's own splits; this run {}: use selfp",
+            if layout.w.is_some() {
+                "solves the dynamic u–p–U system"
+            } else {
+                "defines its own -pc_fieldsplit_<n>_fields"
+            }
+        )));
+    }
     if pc.type_name()? != "fieldsplit" || user_defines_splits()? {
-        return Ok(());
+        return Ok(None);
     }
     let nd = layout.nd;
     let displacement: Vec<usize> = (0..nd).filter(|&c| c != p).collect();
@@ -46,8 +70,15 @@ pub(super) fn define(
     u.compose_near_null_space(comm, &modes)?;
     let pressure = IndexSet::new_general(comm, &index(&[p]))?;
     pc.field_split_set_is("u", &u)?;
-    pc.field_split_set_is("p", &pressure)
+    pc.field_split_set_is("p", &pressure)?;
+    if user_schur {
+        return Ok(Some(SchurUser::new(&pc, pressure)?));
+    }
+    Ok(None)
 }
+
+/// The PETSc option that chooses the Schur preconditioner (`user`: porompm's fixed-stress one).
+const SCHUR_USER_OPTION: &str = "pc_fieldsplit_schur_precondition";
 
 /// Whether the options database defines field splits by component lists.
 fn user_defines_splits() -> Result<bool, petsc::Error> {

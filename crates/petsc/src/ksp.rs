@@ -20,7 +20,7 @@ pub struct KspRef<'a> {
 
 /// A borrowed preconditioner (always owned by its KSP).
 pub struct PcRef<'a> {
-    raw: sys::PC,
+    pub(crate) raw: sys::PC,
     _life: PhantomData<&'a mut ()>,
 }
 

@@ -122,6 +122,12 @@ impl LinearElastic {
         self.d[0][1]
     }
 
+    /// Drained bulk modulus of the skeleton in plane strain, K_dr = λ + μ [Pa]: the in-plane mean
+    /// stress (σ_xx + σ_yy)/2 per unit of the in-plane volumetric strain ε_xx + ε_yy.
+    pub fn plane_bulk_modulus(&self) -> f64 {
+        self.lame() + self.shear_modulus()
+    }
+
     /// σ + D Δε.
     pub fn trial(&self, stress: &[f64; 4], deps: &[f64; 4]) -> [f64; 4] {
         let mut s = *stress;
