@@ -27,7 +27,8 @@ against the bandwidth bound of an AIJ mat-vec (12 bytes per nonzero, 20 bytes pe
 bandwidth of one core measured by scripts/triad.c.
 
 RUNS runs of each configuration up to 10^5 unknowns (default 3, median by wall time) and RUNS_LARGE at
-10^6 (default 1). SIZES="small medium large" chooses sizes, RANKS="1 2" the rank counts. Writes
+10^6 (default 1). SIZES="small medium large" chooses sizes, RANKS="1 2" the rank counts, STRATEGIES (a
+list of option files' names) keeps only those of each problem's strategies. Writes
 target/bench/solvers.md and solvers.json.
 """
 import json, os, re, statistics, subprocess, sys
@@ -58,6 +59,7 @@ PROBLEMS = {
 SELECTED = os.environ.get("PROBLEMS", "consolidation slumping").split()
 SIZES = os.environ.get("SIZES", "small medium large").split()
 RANKS = [int(r) for r in os.environ.get("RANKS", "1 2").split()]
+ONLY = os.environ.get("STRATEGIES", "").split()
 MUMPS_LARGE = os.environ.get("MUMPS_LARGE", "0") != "0"
 EVENTS = ["KSPSolve", "PCSetUp", "SNESSolve"]
 
@@ -128,6 +130,8 @@ def measure(key, problem, bandwidth):
     for size in SIZES:
         cells = problem["grids"][size]
         for strategy in problem["strategies"]:
+            if ONLY and strategy not in ONLY:
+                continue
             if strategy.startswith("direct") and size == "large" and not MUMPS_LARGE:
                 continue
             for ranks in RANKS:

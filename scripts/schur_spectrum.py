@@ -9,7 +9,9 @@ pressure at component `--pressure`), forms the exact Schur complement S = A_pp -
 the 1 %/99 % eigenvalues of Sp^-1 S for
 
 * selfp: Sp = A_pp - A_pu diag(A_uu)^-1 A_up (PETSc's `-pc_fieldsplit_schur_precondition selfp`);
-* fixed stress (with `--drained-bulk-modulus`): selfp - beta M_L, beta = 1/K_dr, M_L the lumped
+* A_pp alone;
+* fixed stress (with `--drained-bulk-modulus`): selfp - beta M_L and A_pp - beta M_L (the one porompm builds
+  for `-pc_fieldsplit_schur_precondition user`), beta = 1/K_dr, M_L the lumped
   pressure mass in PETSc's scaled units. M_L is recovered from the rows of A_pp: where the Darcy flux and
   the pressure projection rows sum to zero, a row of A_pp sums to -c M_L with c = `--storage` (n/K_w +
   (1-n)/K_s, 1/Pa); near drained boundaries the flux rows do not, so M_L is capped at `--mass-cap`
@@ -67,12 +69,13 @@ def main():
     S = (App.toarray() - Apu @ sla.splu(Auu).solve(Aup.toarray()))[keep]
     selfp = (App - Apu @ sp.diags(1.0 / Auu.diagonal()) @ Aup).toarray()[keep]
     print(f"{A.shape[0]} unknowns, {len(u)} displacement, {len(p)} pressure ({len(live)} coupled)")
-    cases = [("selfp", selfp)]
+    cases = [("selfp", selfp), ("A_pp", App.toarray()[keep])]
     if a.drained_bulk_modulus:
         mass = -np.asarray(App.sum(axis=1)).ravel()[live] / a.storage
         if a.mass_cap:
             mass = np.minimum(mass, a.mass_cap)
-        cases.append(("fixed stress", selfp - np.diag(mass / a.drained_bulk_modulus)))
+        cases.append(("selfp - bM", selfp - np.diag(mass / a.drained_bulk_modulus)))
+        cases.append(("A_pp - bM", App.toarray()[keep] - np.diag(mass / a.drained_bulk_modulus)))
     for name, Sp in cases:
         w, imag = spectrum(S, Sp)
         lo, hi = w[int(0.01 * len(w))], w[int(0.99 * len(w))]
