@@ -36,14 +36,19 @@ fn krylov(name: &str, system: (&str, Vec<String>), petsc: &[&str]) -> Run {
     run
 }
 
-/// (field, linear_max) of a run's summary.
-fn linear(run: &Run) -> Vec<(String, f64)> {
+/// (field, value of `key`) of each entry of a run's summary's `field_residuals`.
+fn per_field(run: &Run, key: &str) -> Vec<(String, f64)> {
     run.summary["field_residuals"]
         .as_array()
         .expect("field_residuals")
         .iter()
-        .map(|r| (r["field"].as_str().unwrap().to_string(), r["linear_max"].as_f64().expect("measured")))
+        .map(|r| (r["field"].as_str().unwrap().to_string(), r[key].as_f64().expect("measured")))
         .collect()
+}
+
+/// (field, linear_max) of a run's summary.
+fn linear(run: &Run) -> Vec<(String, f64)> {
+    per_field(run, "linear_max")
 }
 
 const RIGHT: [&str; 6] = ["-ksp_type", "fgmres", "-ksp_pc_side", "right", "-ksp_norm_type", "unpreconditioned"];
@@ -155,16 +160,6 @@ fn an_iterative_strategy_on_an_unstabilised_case_warns_and_only_then() {
     }
 }
 
-/// (field, newton_final_max) of a run's summary.
-fn newton_final(run: &Run) -> Vec<(String, f64)> {
-    run.summary["field_residuals"]
-        .as_array()
-        .expect("field_residuals")
-        .iter()
-        .map(|r| (r["field"].as_str().unwrap().to_string(), r["newton_final_max"].as_f64().expect("measured")))
-        .collect()
-}
-
 #[test]
 fn the_final_newton_residual_of_each_field_shows_what_newton_left() {
     // The slumping block with one lagged-Jacobian Newton iteration per step, then with four
@@ -179,7 +174,7 @@ fn the_final_newton_residual_of_each_field_shows_what_newton_left() {
             args.extend(["-snes_max_it".into(), its.to_string(), "-snes_convergence_test".into(), "skip".into()]);
             let run = run_case("cases/slumping_block.toml", &dir(&format!("newton-final-{its}")), &args);
             assert!(run.completed(), "{its} iteration(s): {}", run.stderr());
-            newton_final(&run)
+            per_field(&run, "newton_final_max")
         })
         .collect();
     eprintln!("one Newton iteration per step: {:?}; four: {:?}", runs[0], runs[1]);
