@@ -56,6 +56,10 @@ def main():
     ap.add_argument("--drained-bulk-modulus", type=float, help="K_dr [Pa]: also try fixed stress, beta = 1/K_dr")
     ap.add_argument("--storage", type=float, default=0.3 / 2.2e9, help="n/K_w + (1-n)/K_s [1/Pa]")
     ap.add_argument("--mass-cap", type=float, help="cap of the recovered lumped pressure mass (M^2 for s = M/h)")
+    ap.add_argument("--drop-layers", type=int, default=0,
+                    help="leave out the pressure nodes of the outermost K layers of live nodes along the largest i and j "
+                         "(the Schur complement were those pressures fixed); needs --cells-x")
+    ap.add_argument("--cells-x", type=int, help="cells along x of the grid the matrix came from")
     a = ap.parse_args()
 
     A = PetscBinaryIO.PetscBinaryIO().readBinaryFile(a.matrix, mattype="scipy.sparse")[-1].tocsr()
@@ -65,6 +69,12 @@ def main():
     Auu, Aup = A[u][:, u].tocsc(), A[u][:, p].tocsc()
     Apu, App = A[p][:, u].tocsr(), A[p][:, p]
     live = np.where(np.asarray(abs(Apu).sum(axis=1)).ravel() > 0)[0]
+    if a.drop_layers:
+        if not a.cells_x:
+            sys.exit("--drop-layers needs --cells-x")
+        node = p[live] // a.dofs_per_node
+        i, j = node % (a.cells_x + 1), node // (a.cells_x + 1)
+        live = live[(i <= i.max() - a.drop_layers) & (j <= j.max() - a.drop_layers)]
     keep = np.ix_(live, live)
     S = (App.toarray() - Apu @ sla.splu(Auu).solve(Aup.toarray()))[keep]
     selfp = (App - Apu @ sp.diags(1.0 / Auu.diagonal()) @ Aup).toarray()[keep]
