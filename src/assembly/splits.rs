@@ -45,7 +45,8 @@ pub(super) fn define(
     let mut pc = ksp.pc()?;
     let user_schur = SchurUser::requested(&pc)?;
     let Some(p) = layout.p else { return Ok(None) };
-    if user_schur && (layout.w.is_some() || user_defines_splits()?) {
+    let own_splits = !user_defines_splits()?;
+    if user_schur && (layout.w.is_some() || !own_splits) {
         return Err(petsc::Error::new(format!(
             "-{SCHUR_USER_OPTION} user (porompm's fixed-stress Schur preconditioner) applies to the u–p system of \
              quasi-static stages with porompm's own splits; this run {}: use selfp",
@@ -56,7 +57,7 @@ pub(super) fn define(
             }
         )));
     }
-    if pc.type_name()? != "fieldsplit" || user_defines_splits()? {
+    if pc.type_name()? != "fieldsplit" || !own_splits {
         return Ok(None);
     }
     let nd = layout.nd;

@@ -19,10 +19,9 @@ pub struct SchurUser {
     pc: sys::PC,
     /// The rows (and columns) of the Schur split.
     rows: IndexSet,
-    /// Sp, once built from the current operator's pattern.
-    sp: Option<Mat>,
-    /// The diagonal added to the sub-matrix, laid out like Sp's rows.
-    diagonal: Option<Vector>,
+    /// Sp, once built from the current operator's pattern, with the vector holding the diagonal
+    /// added to it (laid out like Sp's rows).
+    built: Option<(Mat, Vector)>,
 }
 
 impl Drop for SchurUser {
@@ -54,27 +53,18 @@ impl SchurUser {
     /// has the rows `rows`. Nothing is built before the first [`SchurUser::update`].
     pub fn new(pc: &PcRef, rows: IndexSet) -> Result<SchurUser> {
         call!(PetscObjectReference(pc.raw as sys::PetscObject))?;
-        Ok(SchurUser { pc: pc.raw, rows, sp: None, diagonal: None })
-    }
-
-    /// Number of the Schur split's rows on this rank (the length [`SchurUser::update`] expects).
-    pub fn local_rows(&self) -> Result<usize> {
-        self.rows.local_len()
+        Ok(SchurUser { pc: pc.raw, rows, built: None })
     }
 
     /// Forgets Sp: the operator's nonzero pattern changed, so the next update extracts a new one.
     pub fn forget(&mut self) {
-        self.sp = None;
-        self.diagonal = None;
+        self.built = None;
     }
 
     /// Sets Sp = A[rows, rows] + diag(`add`) from the assembled operator `a` (`add`: this rank's
     /// rows, in the index set's order) and, when Sp is new, gives it to the field split.
     pub fn update(&mut self, a: &dyn MatOps, add: &[Real]) -> Result<()> {
-        let old = match (self.sp.take(), self.diagonal.take()) {
-            (Some(sp), Some(d)) => Some((sp, d)),
-            _ => None,
-        };
+        let old = self.built.take();
         let fresh = old.is_none();
         let reuse = if fresh { sys::MatReuse::MAT_INITIAL_MATRIX } else { sys::MatReuse::MAT_REUSE_MATRIX };
         let mut raw = old.as_ref().map_or(std::ptr::null_mut(), |(sp, _)| sp.raw);
@@ -106,8 +96,7 @@ impl SchurUser {
                 sp.raw
             ))?;
         }
-        self.sp = Some(sp);
-        self.diagonal = Some(d);
+        self.built = Some((sp, d));
         Ok(())
     }
 }
