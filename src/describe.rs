@@ -127,7 +127,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         if let Some(list) = &b.surface {
             // Resolved per step; at t = 0 from the particles' faces.
             let only = crate::model::Active { loads: Vec::new(), boundaries: vec![bi] };
-            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only).into_iter().map(|(n, _, _)| n).collect();
+            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only, false).into_iter().map(|(n, _, _)| n).collect();
             nodes.sort_unstable();
             nodes.dedup();
             let _ = writeln!(

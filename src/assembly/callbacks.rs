@@ -182,7 +182,8 @@ impl Particles<'_> {
         let (nodes, basis) = step.stencils.get(k);
         let states = node_states(step, k, xl);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
-        f(&kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared")))
+        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
+        f(&pt.with_faces(step.faces_of(k), &states[..nodes.len()]))
     }
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
@@ -267,7 +268,8 @@ impl Particles<'_> {
             let input = particle_input(self.model, step, k);
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
             let states = node_states(step, k, xl);
-            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout);
+            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout)
+                .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             kernels::tangent(&pt, &nm, &mut block[..m * m]);
             self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);

@@ -132,3 +132,65 @@ pub mod porosity_gradient {
         }
     }
 }
+
+/// A drained surface of the u–p system imposed on the material's own faces by Nitsche's method
+/// (the non-symmetric, penalty-stabilised variant: Burman 2012, SIAM J. Numer. Anal. 50(4)), in the
+/// continuity rows, for each exposed face of the particle on a drained moving surface:
+/// R_p,i −= w_mass Δt κ A [−N_i (∇p_θ − ρ_w b)·n + (∇N_i·n + γ/h N_i) p_θ(x_f)],
+/// the flux across the face that the integration by parts of [`darcy`] leaves out (consistency),
+/// plus the weak condition p = 0 at the face (its antisymmetric and penalty terms). N_i and ∇N_i are
+/// the grid's bilinear shape functions at the face point x_f, A the face's length, n its outward
+/// normal, κ = k/γ_w, ∇p_θ the particle's gradient as in [`darcy`] and
+/// p_θ(x_f) = p_n + ∇p_n·(x_f − x_p) + θ Σ N_j(x_f) Δp_j. With the boundary terms of the
+/// non-symmetric variant the flux form stays coercive, ∫κ|∇v|², for any γ ≥ 0, so that a face
+/// that cuts a node's support to a sliver needs no larger penalty. Fixing the pressure at the
+/// nodes beyond the face instead puts the drained boundary up to a cell above the material, and
+/// its drainage vanishes as the surface comes near a grid line. Tangent
+/// −w_mass θΔt κ A [−N_i ∇S_j·n + (∇N_i·n + γ/h N_i) N_j] (p–p).
+pub mod drained_face {
+    use super::super::{Point, Scheme};
+
+    /// Adds the Nitsche terms of the particle's drained faces (u–p layouts under a scheme with flow).
+    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        let Some(p) = pt.layout.p else { return };
+        if nm.flow_dt == 0.0 || pt.faces.is_empty() {
+            return;
+        }
+        let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
+        let drive: [f64; 2] =
+            std::array::from_fn(|c| part.grad_p[c] + nm.theta * it.grad_dp[c] - part.water_density * part.body_acc[c]);
+        for (face, &dp_face) in pt.faces.iter().zip(&pt.face_dp) {
+            let n = face.normal;
+            let flux = drive[0] * n[0] + drive[1] * n[1];
+            let off = face.offset;
+            let p_face = part.p + part.grad_p[0] * off[0] + part.grad_p[1] * off[1] + nm.theta * dp_face;
+            let f = nm.w_mass * nm.flow_dt * part.mobility * face.area;
+            for (k, (s, g)) in face.basis.iter().take(pt.basis.len()).enumerate() {
+                let dn = g[0] * n[0] + g[1] * n[1];
+                out[k * nd + p] -= f * (-s * flux + (dn + face.penalty * s) * p_face);
+            }
+        }
+    }
+
+    /// Adds the p–p tangent of the Nitsche terms.
+    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+        let Some(p) = pt.layout.p else { return };
+        if nm.flow_dt == 0.0 || pt.faces.is_empty() {
+            return;
+        }
+        let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
+        let nn = pt.basis.len();
+        for face in pt.faces {
+            let n = face.normal;
+            let f = nm.w_mass * nm.flow_dt * nm.theta * part.mobility * face.area;
+            for (k, (sk, gk)) in face.basis.iter().take(nn).enumerate() {
+                let dn = gk[0] * n[0] + gk[1] * n[1];
+                for (l, bl) in pt.basis.iter().enumerate() {
+                    let gn = bl.g[0] * n[0] + bl.g[1] * n[1];
+                    let sl = face.basis[l].0;
+                    out[(k * nd + p) * m + l * nd + p] -= f * (-sk * gn + (dn + face.penalty * sk) * sl);
+                }
+            }
+        }
+    }
+}

@@ -23,6 +23,8 @@
 //! | [`stress::pore_pressure`] | u, U | −(1 − n) p ∇̄'S_i V_{n+1}, −n p ∇̄'S_i V_{n+1} ([003] 23a, c) |
 //! | [`flow::porosity_gradient`] | u, U, p | ±S_i p ∇n V, −S_i ∇n·(ΔU − Δu) V |
 //! | [`flow::continuity`] | p | −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V ([003] 23b) |
+//! | [`flow::darcy`] | p | −Δt V (k/γ_w) ∇S_i·(∇p_θ − ρ_w b) (u–p with flow) |
+//! | [`flow::drained_face`] | p | Nitsche's terms of p = 0 on the particle's drained faces (u–p with flow) |
 //!
 //! with m_s = (1 − n)ρ_s V (the mixture's mass in one-phase runs), m_w = nρ_w V, p = p_n + Σ S_j Δp_j,
 //! σ' the effective stress after the soil model's objective update (see [`kinematics`]) and ∇̄'
@@ -458,6 +460,31 @@ pub struct Point<'a> {
     pub spatial: [([f64; 2], [f64; 2]); MAX_NODES],
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
+    /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
+    /// particles have none).
+    pub faces: &'a [DrainedFace],
+    /// Σ N_j(x_f) Δp_j at each of `faces`.
+    pub face_dp: [f64; MAX_FACES],
+}
+
+/// Largest number of drained faces of one particle (all four sides of its domain).
+pub const MAX_FACES: usize = 4;
+
+/// One exposed face of a particle on a drained surface imposed weakly (see
+/// [`flow::drained_face`]), on x_n.
+#[derive(Debug, Clone, Copy)]
+pub struct DrainedFace {
+    /// The face point minus the particle's centre, x_f − x_p [m].
+    pub offset: [f64; 2],
+    /// The outward unit normal.
+    pub normal: [f64; 2],
+    /// The face's length (its area per unit thickness) [m].
+    pub area: f64,
+    /// Nitsche's penalty γ/h [1/m].
+    pub penalty: f64,
+    /// The grid's bilinear shape function N_i and its gradient at the face point, per stencil slot
+    /// (in the order of the particle's basis).
+    pub basis: [(f64, [f64; 2]); MAX_NODES],
 }
 
 impl<'a> Point<'a> {
@@ -477,7 +504,31 @@ impl<'a> Point<'a> {
         for (s, b) in spatial.iter_mut().zip(basis) {
             *s = kin.spatial(b);
         }
-        Point { basis, part, layout, interp, kin, rotated, upd, spatial, p: part.p + interp.dp }
+        Point {
+            basis,
+            part,
+            layout,
+            interp,
+            kin,
+            rotated,
+            upd,
+            spatial,
+            p: part.p + interp.dp,
+            faces: &[],
+            face_dp: [0.0; MAX_FACES],
+        }
+    }
+
+    /// The point with its drained `faces` (at most [`MAX_FACES`]), their pressure increments
+    /// interpolated from the same nodal `states`.
+    pub fn with_faces(mut self, faces: &'a [DrainedFace], states: &[NodeState]) -> Point<'a> {
+        let Some(p) = self.layout.p else { return self };
+        let faces = &faces[..faces.len().min(MAX_FACES)];
+        for (dp, face) in self.face_dp.iter_mut().zip(faces) {
+            *dp = face.basis.iter().zip(states.iter().take(self.basis.len())).map(|((s, _), st)| s * st.d[p]).sum();
+        }
+        self.faces = faces;
+        self
     }
 
     /// Number of local dofs (stencil nodes × dofs per node).
@@ -523,6 +574,7 @@ pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
     if pt.layout.p.is_some() && terms == Terms::All {
         flow::continuity::residual(pt, nm, out);
         flow::darcy::residual(pt, nm, out);
+        flow::drained_face::residual(pt, nm, out);
     }
 }
 
@@ -541,6 +593,7 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     if pt.layout.p.is_some() {
         flow::continuity::tangent(pt, nm, out);
         flow::darcy::tangent(pt, nm, out);
+        flow::drained_face::tangent(pt, nm, out);
     }
 }
 

@@ -112,6 +112,23 @@ fn sample(nn: usize) -> Vec<NodeBasis> {
         .collect()
 }
 
+/// Two drained faces of a sample particle (a corner: top and right), with bilinear-like values
+/// and gradients that differ from the particle's basis.
+fn sample_faces(nn: usize) -> Vec<DrainedFace> {
+    [([0.0, 0.02], [0.1, 0.995]), ([0.03, 0.0], [0.98, -0.2])]
+        .iter()
+        .map(|&(offset, n)| {
+            let len = f64::hypot(n[0], n[1]);
+            let mut basis = [(0.0, [0.0; 2]); crate::kernels::MAX_NODES];
+            for (k, b) in basis.iter_mut().take(nn).enumerate() {
+                let x = k as f64 + offset[1] * 10.0;
+                *b = (0.1 + 0.08 * (x * 0.9).cos().abs(), [(x * 0.8).sin() * 4.0, (x * 1.7).cos() * 3.0]);
+            }
+            DrainedFace { offset, normal: [n[0] / len, n[1] / len], area: 0.05, penalty: 20.0, basis }
+        })
+        .collect()
+}
+
 fn part() -> ParticleInput {
     ParticleInput {
         volume: 2.5e-3,
@@ -166,6 +183,7 @@ fn terms() -> Vec<Term> {
         ("porosity gradient", flow::porosity_gradient::residual, flow::porosity_gradient::tangent),
         ("continuity", flow::continuity::residual, flow::continuity::tangent),
         ("darcy", flow::darcy::residual, flow::darcy::tangent),
+        ("drained face", flow::drained_face::residual, flow::drained_face::tangent),
         ("all", residual, tangent),
     ]
 }
@@ -202,15 +220,16 @@ fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layou
     let mut p = part();
     p.stress = stress;
     let d0 = increments(m, layout);
+    let faces = sample_faces(basis.len());
     let res = |d: &[f64]| {
         let st = states(d, nd, &nm);
-        let pt = Point::new(&basis, &st, &p, model, layout);
+        let pt = Point::new(&basis, &st, &p, model, layout).with_faces(&faces, &st);
         let mut r = vec![0.0; m];
         (term.1)(&pt, &nm, &mut r);
         r
     };
     let st = states(&d0, nd, &nm);
-    let pt = Point::new(&basis, &st, &p, model, layout);
+    let pt = Point::new(&basis, &st, &p, model, layout).with_faces(&faces, &st);
     let mut t = vec![0.0; m * m];
     (term.2)(&pt, &nm, &mut t);
     fd_blocks(nd, &d0, &steps(layout), &res, &t)
@@ -268,15 +287,16 @@ fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
         let nd = layout.nd;
         let m = basis.len() * nd;
         let d0 = increments(m, layout);
+        let faces = sample_faces(basis.len());
         let res = |d: &[f64]| {
             let st = states(d, nd, &nm);
-            let pt = Point::new(&basis, &st, &p, &model, layout);
+            let pt = Point::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
             let mut r = vec![0.0; m];
             (term.1)(&pt, &nm, &mut r);
             r
         };
         let st = states(&d0, nd, &nm);
-        let pt = Point::new(&basis, &st, &p, &model, layout);
+        let pt = Point::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
         let mut t = vec![0.0; m * m];
         (term.2)(&pt, &nm, &mut t);
         for a in 0..nd {

@@ -206,7 +206,7 @@ impl Model {
     ///   side of the particle, (x_i − x_p)·n ≥ 0: they include the well-filled node just inside a
     ///   face that has moved past a grid line, which carries the boundary's reaction (the nodes
     ///   beyond the face alone are barely filled and cannot).
-    pub fn surface_fixes(&self, active: &Active) -> Vec<((u32, u32), usize, [bool; 5])> {
+    pub fn surface_fixes(&self, active: &Active, weak_drainage: bool) -> Vec<((u32, u32), usize, [bool; 5])> {
         let mut out = Vec::new();
         let tol = 1e-9 * self.grid.h[0].min(self.grid.h[1]);
         for &bi in &active.boundaries {
@@ -216,18 +216,10 @@ impl Model {
             for d in &b.fix {
                 comps[dof_index(*d)] = true;
             }
+            comps[dof_index(crate::case::Dof::P)] &= !weak_drainage;
             for &(k, face) in list {
-                let (x, lp, f) = (self.particles.x[k], self.particles.lp[k], self.particles.def_grad[k]);
-                let n0 = match face {
-                    Side::XMin => [-1.0, 0.0],
-                    Side::XMax => [1.0, 0.0],
-                    Side::YMin => [0.0, -1.0],
-                    Side::YMax => [0.0, 1.0],
-                };
-                // F⁻ᵀ n₀ up to the factor 1/det F.
-                let m = [f[1][1] * n0[0] - f[1][0] * n0[1], -f[0][1] * n0[0] + f[0][0] * n0[1]];
-                let len = m[0].hypot(m[1]);
-                let n = if len > 0.0 { [m[0] / len, m[1] / len] } else { n0 };
+                let (x, lp) = (self.particles.x[k], self.particles.lp[k]);
+                let n = self.face_normal(k, face);
                 let extent = n[0].abs() * lp[0] + n[1].abs() * lp[1];
                 let st = shape::stencil(self.basis, &self.grid, x, lp);
                 for ((i, j), w, _) in st.iter() {
@@ -246,6 +238,42 @@ impl Model {
                 }
             }
         }
+        out
+    }
+
+    /// The outward unit normal of particle `k`'s exposed `face` on the current configuration:
+    /// the reference normal n₀ turned with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson).
+    pub fn face_normal(&self, k: usize, face: Side) -> [f64; 2] {
+        let f = self.particles.def_grad[k];
+        let n0 = match face {
+            Side::XMin => [-1.0, 0.0],
+            Side::XMax => [1.0, 0.0],
+            Side::YMin => [0.0, -1.0],
+            Side::YMax => [0.0, 1.0],
+        };
+        // F⁻ᵀ n₀ up to the factor 1/det F.
+        let m = [f[1][1] * n0[0] - f[1][0] * n0[1], -f[0][1] * n0[0] + f[0][0] * n0[1]];
+        let len = m[0].hypot(m[1]);
+        if len > 0.0 {
+            [m[0] / len, m[1] / len]
+        } else {
+            n0
+        }
+    }
+
+    /// The exposed faces of the particles on the active moving surfaces that drain (fix `p`),
+    /// each once, ordered by particle.
+    pub fn drained_faces(&self, active: &Active) -> Vec<(usize, Side)> {
+        let mut out: Vec<(usize, Side)> = active
+            .boundaries
+            .iter()
+            .map(|&bi| &self.boundaries[bi])
+            .filter(|b| b.fix.contains(&crate::case::Dof::P))
+            .filter_map(|b| b.surface.as_ref())
+            .flat_map(|list| list.iter().copied())
+            .collect();
+        out.sort_by_key(|&(k, face)| (k, face as u8));
+        out.dedup();
         out
     }
 
@@ -376,7 +404,8 @@ impl Model {
     /// half-widths by l_p = l_p0 ⊙ diag(sqrt(FᵀF)) (iGIMP), at most half a cell. In a static or
     /// quasi-static stage there is no acceleration: the velocity is the step's mean, Δu/Δt, for
     /// both phases (the Darcy flux is not a particle quantity). The pore-pressure gradient follows
-    /// the pressure: ∇p += Σ ∇S Δp (interpolated; it drives the next step's Darcy flux).
+    /// the pressure and the material: ∇p ← ΔF⁻ᵀ(∇p + Σ ∇S Δp) (interpolated on x_n, then carried
+    /// to x_{n+1}; it drives the next step's Darcy flux).
     pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
         self.check_step(k, step)?;
         let j = step.jacobian;
@@ -406,8 +435,12 @@ impl Model {
             }
         }
         if self.two_phase {
-            ps.grad_p[k][0] += it.grad_dp[0];
-            ps.grad_p[k][1] += it.grad_dp[1];
+            // The gradient on x_n, Σ ∇S Δp added, then carried to x_{n+1} with the material:
+            // ∇_{n+1} p = ΔF⁻ᵀ ∇_n p (the pressure is a material field between steps).
+            let g = [ps.grad_p[k][0] + it.grad_dp[0], ps.grad_p[k][1] + it.grad_dp[1]];
+            let fi = &step.f_inc;
+            let det = fi[0][0] * fi[1][1] - fi[0][1] * fi[1][0];
+            ps.grad_p[k] = [(fi[1][1] * g[0] - fi[1][0] * g[1]) / det, (-fi[0][1] * g[0] + fi[0][0] * g[1]) / det];
         }
         for c in 0..2 {
             ps.x[k][c] += it.du[c];

@@ -254,6 +254,23 @@ pub fn volumetric_gradients(
     gv
 }
 
+/// The grid's bilinear shape function of the node at `node` and its gradient at the point `x`, the
+/// gradient taken on the side of grid lines through `x` where `side` lies (a point next to `x`):
+/// N = Π_d max(0, 1 − |x_d − x_i,d|/h_d). A gradient component on a grid line itself with `side`
+/// on it too is the mean of the two sides, 0.
+pub fn bilinear(node: [f64; 2], x: [f64; 2], side: [f64; 2], h: [f64; 2]) -> (f64, [f64; 2]) {
+    let n: [f64; 2] = std::array::from_fn(|d| (1.0 - (x[d] - node[d]).abs() / h[d]).max(0.0));
+    let dn: [f64; 2] = std::array::from_fn(|d| {
+        let r = side[d] - node[d];
+        if r.abs() < h[d] && r != 0.0 {
+            -r.signum() / h[d]
+        } else {
+            0.0
+        }
+    });
+    (n[0] * n[1], [dn[0] * n[1], n[0] * dn[1]])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -429,5 +446,28 @@ mod tests {
         let s = stencil(Basis::Gimp, &g, [0.75, 0.375], [0.25, 0.125]);
         assert_eq!(s.len, 16);
         assert!((s.iter().map(|(_, w, _)| w).sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    /// The bilinear functions of a cell's four nodes sum to one with gradients summing to zero at
+    /// any point, and on a grid line the gradient is the one of the side asked for.
+    #[test]
+    fn bilinear_functions_are_a_partition_of_unity_with_one_sided_gradients() {
+        let h = [0.1, 0.05];
+        let nodes = [[0.0, 0.0], [0.1, 0.0], [0.0, 0.05], [0.1, 0.05]];
+        let x = [0.037, 0.021];
+        let (mut s, mut g) = (0.0, [0.0; 2]);
+        for n in nodes {
+            let (v, d) = bilinear(n, x, x, h);
+            s += v;
+            g[0] += d[0];
+            g[1] += d[1];
+        }
+        assert!((s - 1.0).abs() < 1e-14 && g[0].abs() < 1e-12 && g[1].abs() < 1e-12, "{s} {g:?}");
+        // On the line y = 0.05 the node at (0, 0.05) falls below it and rises above it.
+        let on = [0.0, 0.05];
+        let below = bilinear([0.0, 0.05], on, [0.0, 0.05 - 1e-9], h);
+        let above = bilinear([0.0, 0.05], on, [0.0, 0.05 + 1e-9], h);
+        assert_eq!(below.0, 1.0);
+        assert!((below.1[1] - 20.0).abs() < 1e-12 && (above.1[1] + 20.0).abs() < 1e-12, "{below:?} {above:?}");
     }
 }
