@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{column, metric};
+use common::{column, has_warning, metric};
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -264,10 +264,16 @@ fn quasi_static_large_strain_consolidation_drains_through_the_moving_surface() {
                 "output.fields_every=0",
             ];
             let (s, _, _) = run("cases/large_strain_consolidation.toml", &format!("large-strain-qs-{n}"), &sets);
+            assert!(!has_warning(&s, "patch_recovery_quasi_static"), "{n} cells: {}", s["warnings"]);
             (metric(&s, "settlement_rel_error_Us0.5"), metric(&s, "p_rms_error_Us0.5"))
         })
         .collect();
     eprintln!("quasi-static large strain, 10 and 20 cells: (settlement, p RMS) {errors:?}");
     assert!(errors.iter().all(|e| e.0 <= 0.02 && e.1 <= 0.015), "errors {errors:?}");
     assert!(errors[1].0 < errors[0].0 && errors[1].1 < errors[0].1, "no convergence: {errors:?}");
+    // The case's own patch recovery in a quasi-static stage is warned about.
+    let sets =
+        ["stages.consolidation.analysis=quasi_static", "stages.consolidation.duration=0.01", "output.fields_every=0"];
+    let (s, _, _) = run("cases/large_strain_consolidation.toml", "large-strain-qs-patch", &sets);
+    assert!(has_warning(&s, "patch_recovery_quasi_static"), "{}", s["warnings"]);
 }

@@ -134,11 +134,6 @@ fn the_fixed_stress_schur_preconditioner_is_refused_for_the_dynamic_system() {
     assert!(!err.contains("panicked"), "{err}");
 }
 
-/// Whether a run's summary carries a warning of `kind`.
-fn warns(run: &Run, kind: &str) -> bool {
-    run.summary["warnings"].as_array().expect("warnings").iter().any(|w| w["kind"] == kind)
-}
-
 #[test]
 fn an_iterative_strategy_on_an_unstabilised_case_warns_and_only_then() {
     let short = "stages.consolidation.duration=0.0002";
@@ -156,7 +151,12 @@ fn an_iterative_strategy_on_an_unstabilised_case_warns_and_only_then() {
         args.extend(opts(file));
         let run = run_case("cases/consolidation_layer.toml", &dir(name), &args);
         assert!(run.completed(), "{name}: {}", run.stderr());
-        assert_eq!(warns(&run, "iterative_unstabilised"), expected, "{name}: {}", run.summary["warnings"]);
+        assert_eq!(
+            common::has_warning(&run.summary, "iterative_unstabilised"),
+            expected,
+            "{name}: {}",
+            run.summary["warnings"]
+        );
     }
 }
 

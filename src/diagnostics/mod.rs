@@ -19,7 +19,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Warning {
     /// What it is about: `pressure_oscillation`, `energy_balance` (from the run), or
-    /// `equal_order_near_undrained`, `locking`, `undamped_large_step` (from the case).
+    /// `equal_order_near_undrained`, `locking`, `single_point_cells`, `unresolved_consolidation`,
+    /// `undamped_large_step`, `patch_recovery_quasi_static` (from the case).
     pub kind: String,
     /// What was seen, and what to change.
     pub message: String,
