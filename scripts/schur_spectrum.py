@@ -10,6 +10,9 @@ the 1 %/99 % eigenvalues of Sp^-1 S for
 
 * selfp: Sp = A_pp - A_pu diag(A_uu)^-1 A_up (PETSc's `-pc_fieldsplit_schur_precondition selfp`);
 * A_pp alone;
+* with `--strip K`: selfp with the exact inverse of A_uu over the displacement dofs of a free-surface strip
+  (the nodes beyond the outermost K - 1 layers of live pressure nodes) in place of its diagonal, and with
+  `--fixed-stress-share c` that minus c (1-n)^2 M_L/K_dr (the solid's share of the fixed-stress term);
 * fixed stress (with `--drained-bulk-modulus`): selfp - beta M_L and A_pp - beta M_L (the one porompm builds
   for `-pc_fieldsplit_schur_precondition user`), beta = 1/K_dr, M_L the lumped
   pressure mass in PETSc's scaled units. M_L is recovered from the rows of A_pp: where the Darcy flux and
@@ -60,6 +63,14 @@ def main():
                     help="leave out the pressure nodes of the outermost K layers of live nodes along the largest i and j "
                          "(the Schur complement were those pressures fixed); needs --cells-x")
     ap.add_argument("--cells-x", type=int, help="cells along x of the grid the matrix came from")
+    ap.add_argument("--strip", type=int, default=0,
+                    help="also try selfp with the exact inverse of A_uu over the displacement dofs of the nodes "
+                         "beyond the outermost K - 1 layers of live pressure nodes (a free-surface strip along the "
+                         "largest i and j; dense, small grids only) instead of its diagonal there; needs --cells-x")
+    ap.add_argument("--fixed-stress-share", type=float, action="append", default=[],
+                    help="with --strip and --drained-bulk-modulus: subtract this share c of (1-n)^2 M_L/K_dr "
+                         "(n = --porosity) from the strip-corrected selfp (repeatable)")
+    ap.add_argument("--porosity", type=float, default=0.3, help="n for --fixed-stress-share")
     a = ap.parse_args()
 
     A = PetscBinaryIO.PetscBinaryIO().readBinaryFile(a.matrix, mattype="scipy.sparse")[-1].tocsr()
@@ -86,6 +97,24 @@ def main():
             mass = np.minimum(mass, a.mass_cap)
         cases.append(("selfp - bM", selfp - np.diag(mass / a.drained_bulk_modulus)))
         cases.append(("A_pp - bM", App.toarray()[keep] - np.diag(mass / a.drained_bulk_modulus)))
+    if a.strip:
+        if not a.cells_x:
+            sys.exit("--strip needs --cells-x")
+        pnode = p[live] // a.dofs_per_node
+        pi, pj = pnode % (a.cells_x + 1), pnode // (a.cells_x + 1)
+        unode = u // a.dofs_per_node
+        ui, uj = unode % (a.cells_x + 1), unode // (a.cells_x + 1)
+        strip = np.where((ui >= pi.max() + 1 - a.strip) | (uj >= pj.max() + 1 - a.strip))[0]
+        inner = np.setdiff1d(np.arange(len(u)), strip)
+        d = 1.0 / Auu.diagonal()
+        corrected = (App - Apu[:, inner] @ sp.diags(d[inner]) @ Aup[inner]).toarray()
+        corrected -= Apu[:, strip].toarray() @ la.solve(Auu[strip][:, strip].toarray(), Aup[strip].toarray())
+        corrected = corrected[keep]
+        cases.append((f"strip {a.strip}", corrected))
+        if a.drained_bulk_modulus:
+            for c in a.fixed_stress_share:
+                beta = c * (1.0 - a.porosity) ** 2 / a.drained_bulk_modulus
+                cases.append((f"strip {a.strip} - {c}(1-n)^2 M/K", corrected - np.diag(mass * beta)))
     for name, Sp in cases:
         w, imag = spectrum(S, Sp)
         lo, hi = w[int(0.01 * len(w))], w[int(0.99 * len(w))]
