@@ -147,6 +147,80 @@ pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil 
     s
 }
 
+/// How an axisymmetric analysis (x ≡ r ≥ 0, y the axis) weights a GIMP particle in r
+/// (`../shared/seeds-001-002.md` Part A2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisymmetricWeights {
+    /// Option A: the planar GIMP functions S_i, ∇S_i, and the hoop operator T_i = S_i / r_p.
+    Planar,
+    /// Option B: the particle's characteristic function integrated with the axisymmetric measure
+    /// r dr: S^r_i = (1/2l r_p) ∫ N_i r dr, G^r_i = (1/2l r_p) ∫ N_i′ r dr over [r_p − l, r_p + l],
+    /// T^r_i = S^{r,planar}_i / r_p; mass and volume then carry the 2πr weight consistently, which
+    /// matters near the axis.
+    RWeighted,
+}
+
+/// ∫_{−∞}^{s} t N(t) dt for the hat N of spacing h (zero outside (−h, h)).
+#[inline]
+fn hat_first_moment(s: f64, h: f64) -> f64 {
+    if s <= -h || s >= h {
+        0.0
+    } else if s <= 0.0 {
+        s * s / 2.0 + s * s * s / (3.0 * h) - h * h / 6.0
+    } else {
+        -h * h / 6.0 + s * s / 2.0 - s * s * s / (3.0 * h)
+    }
+}
+
+/// The r-direction functions of Option B ([`AxisymmetricWeights::RWeighted`]) of the node at `ri` for
+/// a particle at `rp` > 0 with half-width `lp` < `rp`: (S^r, G^r, T^r) with
+/// S^r = (1/2l r_p) ∫ N_i r dr, G^r = (1/2l r_p) ∫ N_i′ r dr = (1/2l r_p)([N_i r] − ∫ N_i dr) and
+/// T^r = (1/2l r_p) ∫ N_i dr over the domain. They satisfy Σ S^r = 1, Σ G^r = 0 and, for
+/// u_r = α + βr, Σ G^r u_i = β and Σ T^r u_i = α/r_p + β.
+pub fn axisymmetric_gimp_r(rp: f64, lp: f64, ri: f64, h: f64) -> (f64, f64, f64) {
+    let (a, b) = (rp - lp - ri, rp + lp - ri);
+    let scale = 1.0 / (2.0 * lp * rp);
+    let plain = hat_integral(b, h) - hat_integral(a, h);
+    let moment = hat_first_moment(b, h) - hat_first_moment(a, h) + ri * plain;
+    let edges = hat(b, h) * (rp + lp) - hat(a, h) * (rp - lp);
+    (scale * moment, scale * (edges - plain), scale * plain)
+}
+
+/// The stencil of a particle at `x` = (r, y) in an axisymmetric analysis, with the hoop operator
+/// T_i of each node (ε_θθ = Σ T_i u_r,i): S_i = S^r_i S^y_i, ∇S_i = (G^r_i S^y_i, S^r_i G^y_i),
+/// T_i = T^r_i S^y_i. The linear basis and [`AxisymmetricWeights::Planar`] keep the planar
+/// functions with T_i = S_i / r_p; [`AxisymmetricWeights::RWeighted`] replaces the r-direction
+/// GIMP functions by [`axisymmetric_gimp_r`]. The particle must lie off the axis, r_p > 0.
+pub fn axisymmetric_stencil(
+    basis: Basis,
+    weights: AxisymmetricWeights,
+    grid: &Grid,
+    x: [f64; 2],
+    lp: [f64; 2],
+) -> (Stencil, [f64; MAX_STENCIL]) {
+    let (wx, nx) = weights_1d(basis, x[0], lp[0], grid.origin[0], grid.h[0], grid.cells[0]);
+    let (wy, ny) = weights_1d(basis, x[1], lp[1], grid.origin[1], grid.h[1], grid.cells[1]);
+    let mut s = Stencil::default();
+    let mut hoop = [0.0; MAX_STENCIL];
+    for &(j, sy, gy) in &wy[..ny] {
+        for &(i, sx, gx) in &wx[..nx] {
+            let (sr, gr, tr) = match (basis, weights) {
+                (Basis::Gimp, AxisymmetricWeights::RWeighted) => {
+                    axisymmetric_gimp_r(x[0], lp[0], grid.origin[0] + i as f64 * grid.h[0], grid.h[0])
+                }
+                _ => (sx, gx, sx / x[0]),
+            };
+            let k = s.len;
+            s.nodes[k] = (i, j);
+            s.w[k] = sr * sy;
+            s.dw[k] = [gr * sy, sr * gy];
+            hoop[k] = tr * sy;
+            s.len += 1;
+        }
+    }
+    (s, hoop)
+}
+
 /// Weights for a force acting at `point` on the face of a particle: the bilinear hat functions
 /// N_i(point) of the cell holding the point (points on the grid's edge belong to its last cell).
 /// They are consistent with GIMP's internal force when the particle domain ends at the material's
@@ -469,5 +543,75 @@ mod tests {
         let above = bilinear([0.0, 0.05], on, [0.0, 0.05 + 1e-9], h);
         assert_eq!(below.0, 1.0);
         assert!((below.1[1] - 20.0).abs() < 1e-12 && (above.1[1] + 20.0).abs() < 1e-12, "{below:?} {above:?}");
+    }
+
+    /// [`axisymmetric_stencil`] on a grid whose first node column is the axis, particles near
+    /// the axis and away from it, one and two per cell.
+    fn axisymmetric_samples() -> Vec<(Basis, AxisymmetricWeights, [f64; 2], [f64; 2])> {
+        let mut out = Vec::new();
+        for (basis, weights) in [
+            (Basis::Gimp, AxisymmetricWeights::Planar),
+            (Basis::Gimp, AxisymmetricWeights::RWeighted),
+            (Basis::Linear, AxisymmetricWeights::Planar),
+        ] {
+            for (x, lp) in [
+                ([0.025, 0.31], [0.025, 0.025]),
+                ([0.075, 0.62], [0.025, 0.025]),
+                ([0.55, 0.4], [0.05, 0.05]),
+                ([1.237, 0.77], [0.025, 0.0125]),
+            ] {
+                out.push((basis, weights, x, lp));
+            }
+        }
+        out
+    }
+
+    /// Part E item 5 of `../shared/seeds-001-002.md`: for u_r = α + βr, u_y = γy the particle's
+    /// strains are exact, ε_rr = β, ε_yy = γ, ε_θθ = α/r_p + β, and Σ S_i = 1, for both GIMP options
+    /// and the linear basis.
+    #[test]
+    fn axisymmetric_strains_of_a_linear_field_are_exact() {
+        let grid = Grid { origin: [0.0, 0.0], h: [0.1, 0.1], cells: [20, 20] };
+        let (alpha, beta, gamma) = (3.0e-3, -2.0e-3, 5.0e-4);
+        for (basis, weights, x, lp) in axisymmetric_samples() {
+            let (st, hoop) = axisymmetric_stencil(basis, weights, &grid, x, lp);
+            let (mut sum, mut err, mut eyy, mut ett) = (0.0, 0.0, 0.0, 0.0);
+            for (k, t) in hoop.iter().enumerate().take(st.len) {
+                let (i, j) = st.nodes[k];
+                let (r, y) = (i as f64 * grid.h[0], j as f64 * grid.h[1]);
+                let ur = alpha + beta * r;
+                sum += st.w[k];
+                err += st.dw[k][0] * ur;
+                eyy += st.dw[k][1] * gamma * y;
+                ett += t * ur;
+            }
+            let what = format!("{basis:?} {weights:?} at {x:?}");
+            assert!((sum - 1.0).abs() < 1e-13, "{what}: Σ S = {sum}");
+            assert!((err - beta).abs() < 1e-15, "{what}: ε_rr = {err:e}");
+            assert!((eyy - gamma).abs() < 1e-15, "{what}: ε_yy = {eyy:e}");
+            assert!((ett - (alpha / x[0] + beta)).abs() < 1e-14, "{what}: ε_θθ = {ett:e}");
+        }
+    }
+
+    /// Option B's r-functions against the closed forms of Part A2: Σ G^r = 0, the same hoop operator
+    /// as Option A, and S^r = N_i(r_p) + n₁ l²/(3 r_p) for a domain inside one cell (n₁ = ±1/h the hat's
+    /// slope there).
+    #[test]
+    fn r_weighted_gimp_matches_its_closed_forms() {
+        let h = 0.1;
+        let (rp, lp) = (0.55, 0.025);
+        let (mut gsum, mut ssum) = (0.0, 0.0);
+        for i in 0..12 {
+            let ri = i as f64 * h;
+            let (s, g, t) = axisymmetric_gimp_r(rp, lp, ri, h);
+            let (planar, _) = gimp_1d(rp - ri, lp, h);
+            assert!((t - planar / rp).abs() < 1e-15, "node {i}: T = {t}, planar S/r_p = {}", planar / rp);
+            let slope = if (rp - ri).abs() < h { -(rp - ri).signum() / h } else { 0.0 };
+            let expected = if (rp - ri).abs() < h { hat(rp - ri, h) + slope * lp * lp / (3.0 * rp) } else { 0.0 };
+            assert!((s - expected).abs() < 1e-15, "node {i}: S^r = {s}, closed form {expected}");
+            gsum += g;
+            ssum += s;
+        }
+        assert!(gsum.abs() < 1e-13 && (ssum - 1.0).abs() < 1e-14, "Σ G^r = {gsum}, Σ S^r = {ssum}");
     }
 }
