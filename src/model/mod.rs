@@ -2,6 +2,7 @@
 //! conditions, and the particle update after a converged step. Pure Rust; the global system lives in
 //! [`crate::assembly`].
 
+pub mod cmpm;
 pub mod grid;
 pub mod linalg;
 pub mod loads;

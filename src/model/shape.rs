@@ -221,6 +221,47 @@ pub fn axisymmetric_stencil(
     (s, hoop)
 }
 
+/// Up to four cells (their lower-left node) with the local GIMP weights of their four nodes.
+pub type LocalGimp = [((u32, u32), [f64; 4]); 4];
+
+/// The local GIMP weights of [001] §5.4 (double mapping with local GIMP functions, DM-G): for
+/// each cell e the particle's domain overlaps, S*^e_ip = (1/V_p) ∫_{Ω_p ∩ Ω_e} N^e_i dx for the
+/// cell's four nodes, in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1) of the cell's
+/// lower-left node (i, j). Separable closed form (`../shared/seeds-001-002.md` Part A6): per
+/// direction the overlap [s, t] of the domain with the cell [a, a + h] gives the right node
+/// I_R = ((t − a)² − (s − a)²)/2h and the left node I_L = (t − s) − I_R, over 2l. Summed over the
+/// cells, the weights of a node are its planar GIMP weight. At most 2 × 2 cells (l ≤ h/2); cells
+/// outside the grid are dropped. Not yet used by the kernels (issue «Seed [001]»).
+pub fn local_gimp(grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (LocalGimp, usize) {
+    let mut per_dir = [[(0u32, 0.0, 0.0); 2]; 2];
+    let mut count = [0usize; 2];
+    for d in 0..2 {
+        let (o, h) = (grid.origin[d], grid.h[d]);
+        let (lo, hi) = (x[d] - lp[d], x[d] + lp[d]);
+        let first = (((lo - o) / h).floor() as i64).max(0);
+        let last = (((hi - o) / h).floor() as i64).min(grid.cells[d] as i64 - 1);
+        for c in first..=last {
+            let a = o + c as f64 * h;
+            let (s, t) = (lo.max(a), hi.min(a + h));
+            if t > s && count[d] < 2 {
+                let right = ((t - a).powi(2) - (s - a).powi(2)) / (2.0 * h);
+                let left = (t - s) - right;
+                per_dir[d][count[d]] = (c as u32, left / (2.0 * lp[d]), right / (2.0 * lp[d]));
+                count[d] += 1;
+            }
+        }
+    }
+    let mut out = [((0u32, 0u32), [0.0; 4]); 4];
+    let mut n = 0;
+    for &(cj, yl, yr) in &per_dir[1][..count[1]] {
+        for &(ci, xl, xr) in &per_dir[0][..count[0]] {
+            out[n] = ((ci, cj), [xl * yl, xr * yl, xl * yr, xr * yr]);
+            n += 1;
+        }
+    }
+    (out, n)
+}
+
 /// Weights for a force acting at `point` on the face of a particle: the bilinear hat functions
 /// N_i(point) of the cell holding the point (points on the grid's edge belong to its last cell).
 /// They are consistent with GIMP's internal force when the particle domain ends at the material's
@@ -613,5 +654,35 @@ mod tests {
             ssum += s;
         }
         assert!(gsum.abs() < 1e-13 && (ssum - 1.0).abs() < 1e-14, "Σ G^r = {gsum}, Σ S^r = {ssum}");
+    }
+
+    /// Part E item 2 of `../shared/seeds-001-002.md`: the local GIMP weights of all cells sum to 1
+    /// for a domain inside the grid, and a node's weights summed over the cells are its planar GIMP
+    /// weight (so a domain inside one cell has the planar weights there), to 1e-14.
+    #[test]
+    fn local_gimp_weights_add_up_to_the_planar_ones() {
+        let grid = Grid { origin: [0.0, -1.0], h: [0.1, 0.05], cells: [20, 40] };
+        for (x, lp) in [
+            ([0.537, -0.512], [0.025, 0.0125]),
+            ([0.5, -0.5], [0.05, 0.025]),
+            ([0.612, -0.27], [0.0125, 0.0125]),
+            ([1.2, 0.3], [0.05, 0.02]),
+        ] {
+            let (cells, n) = local_gimp(&grid, x, lp);
+            let total: f64 = cells[..n].iter().flat_map(|c| c.1).sum();
+            assert!((total - 1.0).abs() < 1e-14, "{x:?}: Σ S* = {total}");
+            let planar = stencil(Basis::Gimp, &grid, x, lp);
+            for (node, w, _) in planar.iter() {
+                let sum: f64 = cells[..n]
+                    .iter()
+                    .flat_map(|&((ci, cj), s)| {
+                        [((ci, cj), s[0]), ((ci + 1, cj), s[1]), ((ci, cj + 1), s[2]), ((ci + 1, cj + 1), s[3])]
+                    })
+                    .filter(|&(m, _)| m == node)
+                    .map(|(_, v)| v)
+                    .sum();
+                assert!((sum - w).abs() < 1e-14, "{x:?}, node {node:?}: Σ_e S* = {sum}, GIMP {w}");
+            }
+        }
     }
 }
