@@ -47,6 +47,7 @@
 //! Each node carries the gradient ∇S_i used for the deviatoric part of B and a gradient ∇̄S_i for the
 //! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B.
 
+pub mod cell;
 pub mod flow;
 pub mod inertia;
 pub mod kinematics;
