@@ -14,8 +14,11 @@
 //!
 //! Grid fields, each rank writing the block of nodes it owns: `active` (1 where the node took part
 //! in the last step) and the nodal increments of the last step, `du` [m] (and in two-phase runs `dp`
-//! [Pa] and `dU` [m]); all zero before the first step (e.g. at t = 0 and at the restart time). Node
-//! coordinates are the grid's geometry.
+//! [Pa] and `dU` [m]), and [001]'s nodal diagnostics `K_mag` = √(K_x² + K_y²) (Eq. 25, the diagonal
+//! of the skeleton's stiffness at the node's x and y dofs [N/m per m]) and `Fint_mag` (Eq. 26 with its
+//! squares, the skeleton's internal force [N/m per m]) from the particles that reach the node; all zero
+//! before the first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's
+//! geometry.
 
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::io::fields::{Field, Frame, GridGeometry, Values};
@@ -107,6 +110,8 @@ pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Fra
         gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[3]).collect()) });
         gf.push(Field { name: "dU", components: 3, values: Values::Real(vec3(d.iter().map(|v| [v[4], v[5]]))) });
     }
+    gf.push(Field { name: "K_mag", components: 1, values: Values::Real(d.iter().map(|v| v[6]).collect()) });
+    gf.push(Field { name: "Fint_mag", components: 1, values: Values::Real(d.iter().map(|v| v[7]).collect()) });
     Frame {
         time: t,
         particles: slab.total,

@@ -217,7 +217,7 @@ fn paraview_reads_the_fields_as_written() {
     }
     let g = &v["blocks"]["grid"];
     assert_eq!(g["points"], 22, "2 × 11 nodes");
-    for (name, comps) in [("active", 1), ("du", 3), ("dp", 1), ("dU", 3)] {
+    for (name, comps) in [("active", 1), ("du", 3), ("dp", 1), ("dU", 3), ("K_mag", 1), ("Fint_mag", 1)] {
         assert_eq!(g["arrays"][name], serde_json::json!([comps, 22]), "grid array {name}");
     }
     let b: Vec<f64> = g["bounds"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
@@ -280,4 +280,54 @@ fn a_quiet_run_prints_nothing_and_a_piped_one_draws_no_bar() {
     let err = stderr(&o);
     assert!(err.contains("stage `consolidation`") && err.contains("completed: 601 steps"), "{err}");
     assert!(!err.contains("ETA") && !err.contains('\r'), "no progress bar when stderr is not a terminal:\n{err}");
+}
+
+/// The nodal diagnostic `K_mag` of [001] Eq. 25 in fields.h5: on [001] §6's unrotated block
+/// (`tests/cases/stiffness_block.toml`, 2 × 2 quarter-point particles per 1 m cell, E = 1000 kN/m²,
+/// ν = 0.3), every interior node carries the particle-integrated value 3059.60 kN/m with the linear
+/// basis and with GIMP (`seeds-001-002.md` B2; 1e-10 relative), on one rank and on two; a node on
+/// the block's edge, half of whose cells are empty, carries about half of it; `Fint_mag` is zero
+/// (no load, no stress); both are zero at t = 0.
+#[test]
+fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
+    let (e, nu) = (1.0e6, 0.3);
+    let f = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let expected = (15.0 / 16.0) * (4.0 / 3.0) * (f * (1.0 - nu) + e / (2.0 * (1.0 + nu))) * 2f64.sqrt();
+    assert!((expected / 1e3 - 3059.60).abs() < 5e-3, "{expected}");
+    for (basis, ranks) in [("linear", 1), ("gimp", 1), ("gimp", 2)] {
+        let dir = out_dir(&format!("stiffness-block-{basis}-{ranks}"));
+        let set = format!("analysis.shape_functions={basis}");
+        let mut args =
+            vec!["run", "tests/cases/stiffness_block.toml", "--out", dir.to_str().unwrap(), "--quiet", "--set", &set];
+        let np = ranks.to_string();
+        let o = if ranks == 1 {
+            porompm(&args)
+        } else {
+            let mut all = vec!["--oversubscribe", "-n", &np, bin()];
+            all.append(&mut args);
+            Command::new("mpirun")
+                .args(&all)
+                .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+                .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+                .current_dir(root())
+                .output()
+                .expect("mpirun runs")
+        };
+        assert!(o.status.success(), "{basis}, {ranks} ranks: {}", stderr(&o));
+        let h = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
+        let read =
+            |frame: usize, name: &str| h.dataset(&format!("grid/{frame}/{name}")).unwrap().read_raw::<f64>().unwrap();
+        let (k0, k, fint) = (read(0, "K_mag"), read(1, "K_mag"), read(1, "Fint_mag"));
+        assert!(k0.iter().all(|&x| x == 0.0), "K_mag at t = 0: {k0:?}");
+        let node = |i: usize, j: usize| j * 9 + i;
+        for j in 1..8 {
+            for i in 1..8 {
+                let v = k[node(i, j)];
+                assert!((v / expected - 1.0).abs() < 1e-10, "{basis}, {ranks} ranks: K_mag at ({i}, {j}) = {v}");
+            }
+        }
+        let edge = k[node(0, 4)] / expected;
+        assert!((edge - 0.5).abs() < 0.05, "{basis}: K_mag on the edge / interior = {edge}");
+        assert!(fint.iter().all(|&x| x.abs() < 1e-6 * expected), "Fint_mag without a load: {fint:?}");
+    }
 }

@@ -494,6 +494,37 @@ impl<'a> Assembler<'a> {
         }
     }
 
+    /// The nodal diagnostics of [001] Eqs. 25–26 per ghosted dof of the solid's motion: the diagonal
+    /// of the skeleton's stiffness (`k`, the stress term's tangent) and its internal force (`f`, the
+    /// effective-stress and pore-pressure terms, unweighted) at the increments `xl`, from every
+    /// particle that reaches the node, not mapped through the extensions (what the node itself sees).
+    pub(super) fn nodal_stiffness_and_force(&self, xl: &[f64], k: &mut [f64], f: &mut [f64]) {
+        let step = self.step;
+        let plain = step.nm.expect("prepared").unweighted();
+        let nd = step.dofs.nd;
+        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
+        let mut buf = [0.0; MAX_LOCAL];
+        let ps = self.particles();
+        for p in 0..step.stencils.len() {
+            let (nodes, _) = step.stencils.get(p);
+            ps.with_point(p, xl, |pt| {
+                let m = pt.size();
+                block[..m * m].fill(0.0);
+                buf[..m].fill(0.0);
+                kernels::stress::tangent(pt, &plain, &mut block[..m * m]);
+                kernels::stress::residual(pt, &plain, &mut buf[..m]);
+                kernels::stress::pore_pressure::residual(pt, &plain, &mut buf[..m]);
+                for (n, &node) in nodes.iter().enumerate() {
+                    for c in 0..2 {
+                        let a = n * nd + c;
+                        k[node as usize * nd + c] += block[a * m + a];
+                        f[node as usize * nd + c] += buf[a];
+                    }
+                }
+            });
+        }
+    }
+
     /// The magnitude of the forces of the step per ghosted dof: Σ over particles of the absolute
     /// values of their residual at Δd = 0 (stress, pore pressure, body force, inertia
     /// predictors), plus the external loads at t_{n+1}. It scales the absolute tolerance of the

@@ -127,8 +127,9 @@ impl StepData {
     }
 }
 
-/// Values per node of a [`NodeBlock`].
-pub const NODE_VALUES: usize = 6;
+/// Values per node of a [`NodeBlock`]: whether it is well filled, the step's increments of ux, uy,
+/// p, Ux, Uy (0 where the layout has none), K_mag and F^int_mag.
+pub const NODE_VALUES: usize = 8;
 
 /// The nodes a rank owns: the rectangle of grid nodes `start .. start + count` (i, j) and
 /// [`NODE_VALUES`] values per node, x fastest (see [`GridSystem::owned_node_block`]).
@@ -275,6 +276,12 @@ pub struct GridSystem {
     schur: Option<petsc::SchurUser>,
     /// The reactions per ghosted dof of the last converged step (for the work of the next).
     last_reactions: Vec<f64>,
+    /// K_mag and F^int_mag ([001] Eqs. 25–26) per owned node of the last step whose forces were
+    /// asked for them (see [`GridSystem::step_forces`]).
+    node_diagnostics: Vec<[f64; 2]>,
+    /// The nodal values of the last step of a system this one replaced, over the whole grid, and
+    /// the grid's nodes along x (see [`GridSystem::carry_node_values`]).
+    carried: (Vec<f64>, usize),
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
@@ -407,6 +414,8 @@ impl GridSystem {
             schur,
             user_atol,
             last_reactions: Vec::new(),
+            node_diagnostics: Vec::new(),
+            carried: (Vec::new(), 0),
             reused_patterns: 0,
             last_increment: None,
             l2_projection: None,
@@ -489,6 +498,7 @@ impl GridSystem {
     ) -> Result<(), String> {
         // The last step's maps go first, so that the new ones do not sit beside them.
         let old_pattern = std::mem::take(&mut self.step).pattern;
+        self.carried = (Vec::new(), 0);
         let (mut st, crossings) = self.stencils_on_xn(model, coll)?;
         let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
         let weak = self.drains_weakly(model, dt);
@@ -1117,16 +1127,28 @@ impl GridSystem {
     /// reaction. Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia"
     /// is then everything in it but the internal and external forces at t_{n+1} (see
     /// `Assembler::nodal_terms`).
-    pub fn step_forces(&mut self, model: &Model, coll: &Collective) -> Result<StepForces, String> {
+    pub fn step_forces(&mut self, model: &Model, coll: &Collective, diagnostics: bool) -> Result<StepForces, String> {
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
         let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
+        let (mut stiffness, mut internal) = (vec![0.0; ng], vec![0.0; ng]);
         {
             let xl = self.step.solution.clone();
             let mut seconds = 0.0;
             let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
             let asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
             asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
+            if diagnostics {
+                asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
+            }
+        }
+        if diagnostics {
+            for v in [&mut stiffness, &mut internal] {
+                self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+            }
+            let mag = |v: &[f64], l: usize| v[l * nd].hypot(v[l * nd + 1]);
+            self.node_diagnostics =
+                self.owned_nodes.iter().map(|&a| [mag(&stiffness, a as usize), mag(&internal, a as usize)]).collect();
         }
         let mut fext = self.step.fext.clone();
         let mut fext_old = self.step.fext_old.clone();
@@ -1306,10 +1328,12 @@ impl GridSystem {
         let names = Layout::UPU.field_names();
         let own = self.layout.field_names();
         let mut values = Vec::with_capacity(self.owned_nodes.len() * NODE_VALUES);
-        for &a in &self.owned_nodes {
+        for (o, &a) in self.owned_nodes.iter().enumerate() {
             let l = a as usize;
             if self.step.solution.is_empty() {
-                values.extend([0.0; NODE_VALUES]);
+                let (i, j) = self.ghost.ij(l);
+                let g = (j * self.carried.1 + i) * NODE_VALUES;
+                values.extend(self.carried.0.get(g..g + NODE_VALUES).unwrap_or(&[0.0; NODE_VALUES]));
                 continue;
             }
             values.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
@@ -1317,8 +1341,30 @@ impl GridSystem {
                 let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| self.step.solution[l * nd + c]);
                 values.push(v);
             }
+            values.extend(self.node_diagnostics.get(o).copied().unwrap_or([0.0; 2]));
         }
         NodeBlock { start: self.owned_start, count: self.owned_count, values }
+    }
+
+    /// The nodal values of [`Self::owned_node_block`] of every node of `grid` (x fastest), summed
+    /// over ranks: what a system that replaces this one on another distribution of the nodes
+    /// carries over ([`Self::carry_node_values`]; collective).
+    pub fn global_node_values(&self, grid: &crate::model::grid::Grid, coll: &Collective) -> Result<Vec<f64>, String> {
+        let nx = grid.cells[0] + 1;
+        let mut all = vec![0.0; nx * (grid.cells[1] + 1) * NODE_VALUES];
+        let block = self.owned_node_block();
+        for (o, v) in block.values.chunks_exact(NODE_VALUES).enumerate() {
+            let (i, j) = (block.start[0] + o % block.count[0], block.start[1] + o / block.count[0]);
+            let g = (j * nx + i) * NODE_VALUES;
+            all[g..g + NODE_VALUES].copy_from_slice(v);
+        }
+        coll.sum(&all)
+    }
+
+    /// Takes over the nodal values of the last step of the system this one replaced (from
+    /// [`Self::global_node_values`] on `grid`), for the field output until its own first step.
+    pub fn carry_node_values(&mut self, grid: &crate::model::grid::Grid, values: Vec<f64>) {
+        self.carried = (values, grid.cells[0] + 1);
     }
 
     /// The norm over the free dofs of the prepared step's force magnitudes (collective).
