@@ -287,7 +287,8 @@ fn a_quiet_run_prints_nothing_and_a_piped_one_draws_no_bar() {
 /// ν = 0.3), every interior node carries the particle-integrated value 3059.60 kN/m with the linear
 /// basis and with GIMP (`seeds-001-002.md` B2; 1e-10 relative), on one rank and on two; a node on
 /// the block's edge, half of whose cells are empty, carries about half of it; `Fint_mag` is zero
-/// (no load, no stress); both are zero at t = 0.
+/// (no load, no stress), and under gravity it balances each interior node's weight ρ g h² (1e-8);
+/// both are zero at t = 0.
 #[test]
 fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
     let (e, nu) = (1.0e6, 0.3);
@@ -329,5 +330,29 @@ fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
         let edge = k[node(0, 4)] / expected;
         assert!((edge - 0.5).abs() < 0.05, "{basis}: K_mag on the edge / interior = {edge}");
         assert!(fint.iter().all(|&x| x.abs() < 1e-6 * expected), "Fint_mag without a load: {fint:?}");
+    }
+    // Under gravity each free node's internal force balances its weight, ρ g h² in the interior
+    // (ρ = (1 − n)ρ_s + nρ_w = 1400 kg/m³, h = 1 m).
+    let dir = out_dir("stiffness-block-gravity");
+    let o = porompm(&[
+        "run",
+        "tests/cases/stiffness_block.toml",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "loads.0.acceleration=[0.0,-9.81]",
+        "--set",
+        "materials.0.solid_density=2000.0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let h = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
+    let fint = h.dataset("grid/1/Fint_mag").unwrap().read_raw::<f64>().unwrap();
+    let weight = (0.7 * 2000.0 + 0.3 * 1.0e-3) * 9.81;
+    for j in 1..8 {
+        for i in 1..8 {
+            let v = fint[j * 9 + i];
+            assert!((v / weight - 1.0).abs() < 1e-8, "F^int_mag at ({i}, {j}) = {v}, weight {weight}");
+        }
     }
 }
