@@ -130,9 +130,14 @@ pub fn describe(case: &Case, label: &str) -> String {
             let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only, false).into_iter().map(|(n, _, _)| n).collect();
             nodes.sort_unstable();
             nodes.dedup();
+            let weak = if b.fix.contains(&crate::case::Dof::P) {
+                "; in quasi-static stages p = 0 on the faces themselves (Nitsche), not at the nodes"
+            } else {
+                ""
+            };
             let _ = writeln!(
                 s,
-                "boundary `{}`: {} fixed on a moving surface of {} particle faces ({} nodes at t = 0)",
+                "boundary `{}`: {} fixed on a moving surface of {} particle faces ({} nodes at t = 0{weak})",
                 b.name,
                 fix.join(", "),
                 list.len(),

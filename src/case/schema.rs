@@ -392,7 +392,8 @@ pub struct Boundary {
     #[serde(default)]
     pub region: Option<Region>,
     /// The moving surface of a body: the nodes on or beyond the exposed faces of its boundary
-    /// particles, found again every step (a drained free surface: `fix = ["p"]`).
+    /// particles, found again every step (a drained free surface: `fix = ["p"]`; in the
+    /// quasi-static u–p system p = 0 is imposed on the faces themselves, by Nitsche's method).
     #[serde(default)]
     pub surface: Option<Surface>,
     /// Components fixed: `ux`, `uy`, `Ux`, `Uy`, and `p` (drained). In a one_phase analysis the
