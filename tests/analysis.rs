@@ -246,7 +246,7 @@ fn the_terzaghi_family_subset_converges_in_both_analysis_types() {
 /// The quasi-static u–p system drains through a moving surface: the large-strain column (settling
 /// by 18 % of its height, so that its top passes grid lines) at 10 and 20 cells, Δt = 1e-3 s,
 /// without patch recovery, settles within 2 % of Xie & Leo's answer at U_s = 0.5, and closer on the
-/// finer grid (measured 1.6 % and 1.0 %; p RMS 9.2e-3 and 6.7e-3). With the pressure fixed at the
+/// finer grid (measured 0.83 % and 0.57 %; p RMS 5.4e-3 and 4.7e-3). With the pressure fixed at the
 /// nodes beyond the surface instead of Nitsche's weak condition on the particles' faces, the
 /// drainage vanished each time the surface neared a grid line: 20 % and 46 %, worse under
 /// refinement.

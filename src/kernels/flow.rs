@@ -138,7 +138,8 @@ pub mod porosity_gradient {
 /// continuity rows, for each exposed face of the particle on a drained moving surface:
 /// R_p,i −= w_mass Δt κ A [−N_i (∇p_θ − ρ_w b)·n + (∇N_i·n + γ/h N_i) p_θ(x_f)],
 /// the flux across the face that the integration by parts of [`darcy`] leaves out (consistency),
-/// plus the weak condition p = 0 at the face (its antisymmetric and penalty terms). N_i and ∇N_i are
+/// plus the weak condition p = 0 at the face (its antisymmetric and penalty terms; γ in
+/// `assembly::NITSCHE_PENALTY`). N_i and ∇N_i are
 /// the grid's bilinear shape functions at the face point x_f, A the face's length, n its outward
 /// normal, κ = k/γ_w, ∇p_θ the particle's gradient as in [`darcy`] and
 /// p_θ(x_f) = p_n + ∇p_n·(x_f − x_p) + θ Σ N_j(x_f) Δp_j. With the boundary terms of the
