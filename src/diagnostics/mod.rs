@@ -209,7 +209,7 @@ impl Monitor {
             format!(
                 "the pore pressure oscillates from particle to particle: a particle deviates from its local smooth fit by {v:.2} of the largest total stress (limit {OSCILLATION_LIMIT}), \
                  for {OSCILLATION_ROWS} history rows in a row or at the end; equal-order pressures need stabilisation near undrained conditions: set stabilisation.pressure_projection = 2.0 \
-                 (or patch_recovery = true), or take larger steps"
+                 (or, in a dynamic stage, patch_recovery = true), or take larger steps"
             )
         })
     }
