@@ -799,11 +799,11 @@ impl<'a> Simulation<'a> {
         let reused = self.system.reused_patterns;
         let layout = self.system.layout();
         // The last step's nodal values, for the field output of this step on the new distribution.
-        let carried = self.system.global_node_values(&self.model.grid, self.coll).map_err(RunError::Failed)?;
+        let carried = self.system.global_node_values(self.coll).map_err(RunError::Failed)?;
         self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners))
             .map_err(|e| RunError::Failed(e.to_string()))?;
         self.system.reused_patterns = reused;
-        self.system.carry_node_values(&self.model.grid, carried);
+        self.system.carry_node_values(carried);
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         self.migrate_particles()?;
         self.summary.repartitions += 1;

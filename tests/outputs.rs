@@ -2,6 +2,8 @@
 //! back by ParaView's own XDMF reader (pvbatch, installed by scripts/setup.sh), `porompm report`,
 //! and the quiet progress display. Every test runs the real binary.
 
+mod common;
+
 use hdf5_metno as h5;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -298,23 +300,8 @@ fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
     for (basis, ranks) in [("linear", 1), ("gimp", 1), ("gimp", 2)] {
         let dir = out_dir(&format!("stiffness-block-{basis}-{ranks}"));
         let set = format!("analysis.shape_functions={basis}");
-        let mut args =
-            vec!["run", "tests/cases/stiffness_block.toml", "--out", dir.to_str().unwrap(), "--quiet", "--set", &set];
-        let np = ranks.to_string();
-        let o = if ranks == 1 {
-            porompm(&args)
-        } else {
-            let mut all = vec!["--oversubscribe", "-n", &np, bin()];
-            all.append(&mut args);
-            Command::new("mpirun")
-                .args(&all)
-                .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-                .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-                .current_dir(root())
-                .output()
-                .expect("mpirun runs")
-        };
-        assert!(o.status.success(), "{basis}, {ranks} ranks: {}", stderr(&o));
+        let r = common::run_case_on(ranks, "tests/cases/stiffness_block.toml", &dir, &common::set_args(&[&set]));
+        assert!(r.completed(), "{basis}, {ranks} ranks: {}", r.stderr());
         let h = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
         let read =
             |frame: usize, name: &str| h.dataset(&format!("grid/{frame}/{name}")).unwrap().read_raw::<f64>().unwrap();
@@ -334,18 +321,9 @@ fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
     // Under gravity each free node's internal force balances its weight, ρ g h² in the interior
     // (ρ = (1 − n)ρ_s + nρ_w = 1400 kg/m³, h = 1 m).
     let dir = out_dir("stiffness-block-gravity");
-    let o = porompm(&[
-        "run",
-        "tests/cases/stiffness_block.toml",
-        "--out",
-        dir.to_str().unwrap(),
-        "--quiet",
-        "--set",
-        "loads.0.acceleration=[0.0,-9.81]",
-        "--set",
-        "materials.0.solid_density=2000.0",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let sets = ["loads.0.acceleration=[0.0,-9.81]", "materials.0.solid_density=2000.0"];
+    let r = common::run_case("tests/cases/stiffness_block.toml", &dir, &common::set_args(&sets));
+    assert!(r.completed(), "{}", r.stderr());
     let h = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
     let fint = h.dataset("grid/1/Fint_mag").unwrap().read_raw::<f64>().unwrap();
     let weight = (0.7 * 2000.0 + 0.3 * 1.0e-3) * 9.81;

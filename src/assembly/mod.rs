@@ -279,9 +279,9 @@ pub struct GridSystem {
     /// K_mag and F^int_mag ([001] Eqs. 25–26) per owned node of the last step whose forces were
     /// asked for them (see [`GridSystem::step_forces`]).
     node_diagnostics: Vec<[f64; 2]>,
-    /// The nodal values of the last step of a system this one replaced, over the whole grid, and
-    /// the grid's nodes along x (see [`GridSystem::carry_node_values`]).
-    carried: (Vec<f64>, usize),
+    /// The nodal values of the last step of a system this one replaced, over the whole grid (see
+    /// [`GridSystem::carry_node_values`]).
+    carried: Vec<f64>,
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
@@ -418,7 +418,7 @@ impl GridSystem {
             user_atol,
             last_reactions: Vec::new(),
             node_diagnostics: Vec::new(),
-            carried: (Vec::new(), 0),
+            carried: Vec::new(),
             reused_patterns: 0,
             last_increment: None,
             l2_projection: None,
@@ -501,7 +501,7 @@ impl GridSystem {
     ) -> Result<(), String> {
         // The last step's maps go first, so that the new ones do not sit beside them.
         let old_pattern = std::mem::take(&mut self.step).pattern;
-        self.carried = (Vec::new(), 0);
+        self.carried = Vec::new();
         let (mut st, crossings) = self.stencils_on_xn(model, coll)?;
         let nodal = self.project(model, &st).map_err(|e| e.to_string())?;
         let weak = self.drains_weakly(model, dt);
@@ -1335,8 +1335,8 @@ impl GridSystem {
             let l = a as usize;
             if self.step.solution.is_empty() {
                 let (i, j) = self.ghost.ij(l);
-                let g = (j * self.carried.1 + i) * NODE_VALUES;
-                values.extend(self.carried.0.get(g..g + NODE_VALUES).unwrap_or(&[0.0; NODE_VALUES]));
+                let g = (j * self.dm.info().nodes[0] + i) * NODE_VALUES;
+                values.extend(self.carried.get(g..g + NODE_VALUES).unwrap_or(&[0.0; NODE_VALUES]));
                 continue;
             }
             values.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
@@ -1349,12 +1349,12 @@ impl GridSystem {
         NodeBlock { start: self.owned_start, count: self.owned_count, values }
     }
 
-    /// The nodal values of [`Self::owned_node_block`] of every node of `grid` (x fastest), summed
+    /// The nodal values of [`Self::owned_node_block`] of every node of the grid (x fastest), summed
     /// over ranks: what a system that replaces this one on another distribution of the nodes
     /// carries over ([`Self::carry_node_values`]; collective).
-    pub fn global_node_values(&self, grid: &crate::model::grid::Grid, coll: &Collective) -> Result<Vec<f64>, String> {
-        let nx = grid.cells[0] + 1;
-        let mut all = vec![0.0; nx * (grid.cells[1] + 1) * NODE_VALUES];
+    pub fn global_node_values(&self, coll: &Collective) -> Result<Vec<f64>, String> {
+        let [nx, ny] = self.dm.info().nodes;
+        let mut all = vec![0.0; nx * ny * NODE_VALUES];
         let block = self.owned_node_block();
         for (o, v) in block.values.chunks_exact(NODE_VALUES).enumerate() {
             let (i, j) = (block.start[0] + o % block.count[0], block.start[1] + o / block.count[0]);
@@ -1365,9 +1365,10 @@ impl GridSystem {
     }
 
     /// Takes over the nodal values of the last step of the system this one replaced (from
-    /// [`Self::global_node_values`] on `grid`), for the field output until its own first step.
-    pub fn carry_node_values(&mut self, grid: &crate::model::grid::Grid, values: Vec<f64>) {
-        self.carried = (values, grid.cells[0] + 1);
+    /// [`Self::global_node_values`] on the same grid), for the field output until its own first
+    /// step.
+    pub fn carry_node_values(&mut self, values: Vec<f64>) {
+        self.carried = values;
     }
 
     /// The norm over the free dofs of the prepared step's force magnitudes (collective).

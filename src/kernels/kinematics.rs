@@ -48,6 +48,12 @@ fn mul(a: &M2, b: &M2) -> M2 {
     c
 }
 
+/// det(a) a⁻ᵀ v, the cofactor matrix of `a` times `v`: a gradient pushed forward by `a` up to the
+/// factor 1/det a (Nanson's normal, a material field's gradient on the new configuration).
+pub fn cofactor_mul(a: &M2, v: [f64; 2]) -> [f64; 2] {
+    [a[1][1] * v[0] - a[1][0] * v[1], -a[0][1] * v[0] + a[0][0] * v[1]]
+}
+
 /// aᵀ v.
 fn mul_t(a: &M2, v: [f64; 2]) -> [f64; 2] {
     [a[0][0] * v[0] + a[1][0] * v[1], a[0][1] * v[0] + a[1][1] * v[1]]

@@ -253,7 +253,7 @@ impl Model {
             Side::YMax => [0.0, 1.0],
         };
         // F⁻ᵀ n₀ up to the factor 1/det F.
-        let m = [f[1][1] * n0[0] - f[1][0] * n0[1], -f[0][1] * n0[0] + f[0][0] * n0[1]];
+        let m = crate::kernels::kinematics::cofactor_mul(&f, n0);
         let len = m[0].hypot(m[1]);
         if len > 0.0 {
             [m[0] / len, m[1] / len]
@@ -441,7 +441,8 @@ impl Model {
             let g = [ps.grad_p[k][0] + it.grad_dp[0], ps.grad_p[k][1] + it.grad_dp[1]];
             let fi = &step.f_inc;
             let det = fi[0][0] * fi[1][1] - fi[0][1] * fi[1][0];
-            ps.grad_p[k] = [(fi[1][1] * g[0] - fi[1][0] * g[1]) / det, (-fi[0][1] * g[0] + fi[0][0] * g[1]) / det];
+            let m = crate::kernels::kinematics::cofactor_mul(fi, g);
+            ps.grad_p[k] = [m[0] / det, m[1] / det];
         }
         for c in 0..2 {
             ps.x[k][c] += it.du[c];
