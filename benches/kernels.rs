@@ -43,7 +43,7 @@ fn bases(model: &Model) -> Vec<Vec<NodeBasis>> {
         .map(|k| {
             let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
             let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j));
-            (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n] }).collect()
+            (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n], t: 0.0, tv: 0.0 }).collect()
         })
         .collect()
 }

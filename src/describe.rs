@@ -22,6 +22,21 @@ pub fn describe(case: &Case, label: &str) -> String {
     let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
     let _ = writeln!(
         s,
+        "geometry: {}",
+        match model.geometry {
+            shape::Geometry::PlaneStrain => "plane strain (volumes per metre of thickness)".to_string(),
+            shape::Geometry::Axisymmetric(w) => format!(
+                "axisymmetric about the y axis (x ≡ r; ring volumes 2πrA; hoop strain u_r/r; GIMP weights in r: {w:?}){}",
+                if model.boundaries.iter().any(|b| b.is_axis()) {
+                    "; u_r = 0 on the axis (boundary `axis`)"
+                } else {
+                    ""
+                }
+            ),
+        }
+    );
+    let _ = writeln!(
+        s,
         "grid: {} × {} cells of {:.4} × {:.4} m from ({}, {}); {} nodes, {} grid dofs",
         g.cells[0],
         g.cells[1],
@@ -90,7 +105,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     for k in 0..model.particles.len() {
         let st = shape::stencil(model.basis, g, model.particles.x[k], model.particles.lp[k]);
         for ((i, j), w, _) in st.iter() {
-            filled[j as usize * g.nodes()[0] + i as usize] += w * model.particles.volume[k] / (g.h[0] * g.h[1]);
+            filled[j as usize * g.nodes()[0] + i as usize] += w * model.area(k) / (g.h[0] * g.h[1]);
         }
     }
     let active_nodes = filled.iter().filter(|&&f| f > WELL_FILLED_FRACTION).count();

@@ -415,6 +415,7 @@ impl<'a> Simulation<'a> {
             GridSystem::new(coll, &crate::model::grid_of(case), layout, None).map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
+        let n_boundaries = model.boundaries.len();
         let check = verification::for_case(case, &model, coll).map_err(|e| input(format!("verification: {e}")))?;
         let probes = find_probes(case, &model, coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
@@ -429,7 +430,7 @@ impl<'a> Simulation<'a> {
         columns.extend(monitor.columns());
         columns.push("load_imbalance".into());
         columns.push("equilibrium_error".into());
-        for b in &case.boundaries {
+        for b in &model.boundaries {
             columns.push(format!("{}.reaction_x", b.name));
             columns.push(format!("{}.reaction_y", b.name));
         }
@@ -467,7 +468,7 @@ impl<'a> Simulation<'a> {
             checkpoint_every: req.checkpoint_every,
             interrupt: req.interrupt.clone(),
             body_names: case.bodies.iter().map(|b| b.name.clone()).collect(),
-            equilibrium: (0.0, vec![[0.0; 2]; case.boundaries.len()]),
+            equilibrium: (0.0, vec![[0.0; 2]; n_boundaries]),
             monitor,
             balance: (req.balance_threshold, None),
         };
@@ -820,9 +821,14 @@ impl<'a> Simulation<'a> {
     /// first moment of the external forces, the reactions and the inertia forces about the same
     /// point, Σ_i x_i ⊗ (F_ext + R − F_inertia)_i on the nodes at t_{n+1}. The relative error (in the
     /// Frobenius norm, against the largest of the moments) is kept for the history row and its
-    /// worst for summary.json, with the boundaries' reactions.
+    /// worst for summary.json, with the boundaries' reactions. In axial symmetry the moments are
+    /// taken about the axis (r = 0) and the hoop stress takes part: Σ r_i f_r,i = ∫(σ_rr + σ_θθ) dV
+    /// and Σ (y_i − y_o) f_r,i = ∫(σ_ry + (y − y_o) σ_θθ / r) dV (virtual displacements r e_r and
+    /// (y − y_o) e_r), exact for the planar weights without B̄ and up to the discretisation of
+    /// the hoop operator otherwise.
     fn record_equilibrium(&mut self, forces: &StepForces) -> Result<(), RunError> {
         let ps = &self.model.particles;
+        let axisymmetric = self.model.geometry.axisymmetric();
         let mut local = [0.0; 4];
         for k in 0..ps.len() {
             let s = ps.stress[k];
@@ -832,6 +838,10 @@ impl<'a> Simulation<'a> {
             local[1] += s[2] * v;
             local[2] += s[2] * v;
             local[3] += (s[1] - p) * v;
+            if axisymmetric {
+                local[0] += (s[3] - p) * v;
+                local[2] += (ps.x[k][1] - forces.origin[1]) * (s[3] - p) * v / ps.x[k][0];
+            }
         }
         let lhs = self.coll.sum(&local).map_err(RunError::Failed)?;
         if matches!(self.model.integration, Integration::Dynamic { .. }) {

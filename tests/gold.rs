@@ -213,6 +213,7 @@ gold_tests!(
     harmonic_column_zone1,
     harmonic_column_zone2,
     harmonic_column_zone3,
+    hollow_cylinder,
     lame_cylinder,
     large_strain_consolidation,
     patch_test,

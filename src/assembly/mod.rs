@@ -339,7 +339,25 @@ impl GridSystem {
         let names = layout.field_names();
         let counts = partition.map(|o| o.counts());
         let ranges = counts.as_ref().map(|(x, y)| (&x[..], &y[..]));
-        let dm = DmDa::new_2d_partitioned(comm, grid.nodes(), STENCIL_WIDTH, names, ranges)?;
+        let dm = DmDa::new_2d_partitioned(comm, grid.nodes(), STENCIL_WIDTH, names, ranges).map_err(|e| {
+            if e.message.contains("smaller than stencil width") {
+                Error {
+                    message: format!(
+                        "the grid of {} × {} nodes cannot be split over {} ranks: each rank needs at least \
+                         {STENCIL_WIDTH} node columns and rows along every direction the grid is split in (the \
+                         ghost width a GIMP point's support needs); run on fewer ranks or refine the grid \
+                         (PETSc: {})",
+                        grid.nodes()[0],
+                        grid.nodes()[1],
+                        coll.size(),
+                        e.message
+                    ),
+                    ..e
+                }
+            } else {
+                e
+            }
+        })?;
         let info = *dm.info();
         let x = dm.create_global_vector()?;
         let x_local = dm.create_local_vector()?;
@@ -587,7 +605,8 @@ impl GridSystem {
             .into_iter()
             .map(|(k, face)| {
                 let normal = model.face_normal(k, face);
-                let (xf, area) = face_point(face, ps.x[k], ps.lp[k]);
+                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
+                let area = length * model.geometry.measure(xf[0]);
                 let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
                 let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
                 let (nodes, _) = self.step.stencils.get(k);
@@ -768,7 +787,7 @@ impl GridSystem {
             for (&node, nb) in nodes.iter().zip(basis) {
                 let b = node as usize * nd;
                 let s = nb.s;
-                phi[b] += s * ps.volume[k] / cell_area;
+                phi[b] += s * model.area(k) / cell_area;
                 porosity[b] += s * ps.mass[k] * ps.porosity[k];
                 for c in 0..2 {
                     mass[b + c] += s * ps.mass[k];
@@ -954,6 +973,8 @@ impl GridSystem {
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
                         let (point, length) = face_point(*face, x, lp);
+                        // The face's area: its length times the ring's 2πr in axial symmetry.
+                        let length = length * model.geometry.measure(point[0]);
                         applied.add([traction[0] * f * length, traction[1] * f * length]);
                         let w = shape::face_weights(g, point);
                         for ((i, j), s, _) in w.iter() {
@@ -970,6 +991,7 @@ impl GridSystem {
                 LoadTarget::NodalTraction { nodes, traction } => {
                     for &(i, j, trib) in nodes.iter().filter(|&&(i, j, _)| self.owns_cell(i, j)) {
                         let l = self.ghost.node(i, j).expect("owned");
+                        let trib = trib * model.geometry.measure(g.node_position(i, j)[0]);
                         let force = [traction[0] * f * trib, traction[1] * f * trib];
                         applied.add(force);
                         add(l, force, g.node_position(i, j));
@@ -981,6 +1003,8 @@ impl GridSystem {
                         if !g.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
                             continue;
                         }
+                        let ring = model.geometry.measure(point[0]);
+                        let force = [force[0] * ring, force[1] * ring];
                         applied.add([force[0] * pressure * f, force[1] * pressure * f]);
                         // Shares on unfilled nodes are extended from the material's side.
                         let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
@@ -1161,7 +1185,10 @@ impl GridSystem {
         let field_scales = self.field_norms(&magnitude, coll)?;
         let g = &model.grid;
         let hi = g.extent_max();
-        let origin = [0.5 * (g.origin[0] + hi[0]), 0.5 * (g.origin[1] + hi[1])];
+        // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
+        // stress is only defined there).
+        let centre_x = if model.geometry.axisymmetric() { 0.0 } else { 0.5 * (g.origin[0] + hi[0]) };
+        let origin = [centre_x, 0.5 * (g.origin[1] + hi[1])];
         let nb = model.boundaries.len();
         // [total moment (4), external (4), reaction (4), inertia (4), work, reactions per boundary (2 nb)]
         let mut local = vec![0.0; 17 + 2 * nb];

@@ -176,7 +176,7 @@ pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
         let (x, lp) = (ps.x[k], ps.lp[k]);
         if model.basis == Basis::Linear {
             if let Some(l) = g.cell_of(x).and_then(|(i, j)| ghost.node(i, j)) {
-                out[l] += ps.volume[k] / area;
+                out[l] += model.area(k) / area;
             }
             continue;
         }
@@ -193,7 +193,7 @@ pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
                 .collect()
         };
         // The domain's area is scaled to the particle's volume.
-        let scale = ps.volume[k] / (4.0 * lp[0] * lp[1]);
+        let scale = model.area(k) / (4.0 * lp[0] * lp[1]);
         for (cy, ly) in span(1) {
             for &(cx, lx) in &span(0) {
                 if let Some(l) = ghost.node(cx, cy) {
@@ -246,9 +246,11 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
                 crossings.push(Crossing { k, side });
             }
         }
-        let mut st = shape::stencil(model.basis, g, x, lp);
-        let gv =
-            model.bbar.then(|| shape::volumetric_gradients(model.basis, g, x, lp, &mut st, &|i, j| roots.root(i, j)));
+        let (mut st, hoop) = model.geometry.stencil(model.basis, g, x, lp);
+        let axisymmetric = model.geometry.axisymmetric();
+        let gv = model.bbar.then(|| {
+            shape::volumetric_operators(model.basis, g, x, lp, &mut st, &|i, j| roots.root(i, j), axisymmetric)
+        });
         if st.len == 0 {
             return Err(format!("material point {} at ({:.4}, {:.4}) m has left the grid", ps.id[k], x[0], x[1]));
         }
@@ -263,10 +265,11 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
             out.nodes.push(l as u32);
         }
         let first = out.basis.len();
-        kernels::plain_basis(&st, &mut out.basis);
-        if let Some(gv) = gv {
-            for (b, v) in out.basis[first..].iter_mut().zip(gv) {
+        kernels::plain_basis(&st, &hoop, &mut out.basis);
+        if let Some((gv, tv)) = gv {
+            for ((b, v), t) in out.basis[first..].iter_mut().zip(gv).zip(tv) {
                 b.gv = v;
+                b.tv = t;
             }
         }
         out.offsets.push(out.nodes.len());
@@ -389,7 +392,7 @@ pub fn extend(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &Dof
         for (slot, idx) in raw.clone().enumerate() {
             let l = st.nodes[idx] as usize;
             let b = st.basis[idx];
-            if dofs.well[l] || (b.s == 0.0 && b.g == [0.0; 2] && b.gv == [0.0; 2]) {
+            if dofs.well[l] || (b.s == 0.0 && b.g == [0.0; 2] && b.gv == [0.0; 2] && b.tv == 0.0) {
                 continue;
             }
             let mask = motion.iter().filter(|&&c| !dofs.boundary_fixed(l, c)).fold(0u8, |m, &c| m | (1 << c));

@@ -70,6 +70,41 @@ pub struct Analysis {
     /// constant here; gravity as a load is a `body_force` load.
     #[serde(default = "default_g")]
     pub g: f64,
+    /// `plane_strain` (the default) or `axisymmetric`: x is then the radius r ≥ 0 and y the axis of
+    /// revolution; the hoop strain u_r/r enters every strain and divergence, and volumes, masses
+    /// and loads are those of the full ring (2πr times the area in the (r, y) plane). Nodes on the
+    /// axis (r = 0) have u_r = 0 (and U_r = 0) without a boundary saying so.
+    #[serde(default)]
+    pub geometry: Geometry,
+    /// How an axisymmetric GIMP analysis weights a particle in r (`../shared/seeds-001-002.md` Part
+    /// A2): `r_weighted` (the default; the particle's characteristic function integrated with the
+    /// measure r dr, Option B, which distributes mass and volume with the ring's weight and is exact
+    /// next to the axis) or `planar` (the planar GIMP functions with the hoop operator S_i/r_p,
+    /// Option A). Both reproduce the strains of u_r = α + βr exactly; the linear basis has one form.
+    #[serde(default)]
+    pub axisymmetric_weights: AxisymmetricWeights,
+}
+
+/// The geometry of the (x, y) plane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Geometry {
+    /// Plane strain: ε_zz = 0, volumes per metre of thickness.
+    #[default]
+    PlaneStrain,
+    /// Axial symmetry about the y axis: x ≡ r ≥ 0, hoop strain u_r/r, ring volumes 2πrA.
+    Axisymmetric,
+}
+
+/// How an axisymmetric GIMP analysis weights a particle in r.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisymmetricWeights {
+    /// Option A: planar GIMP functions, hoop operator S_i / r_p.
+    Planar,
+    /// Option B: GIMP functions integrated with the measure r dr.
+    #[default]
+    RWeighted,
 }
 
 fn default_shape() -> ShapeFunctions {
@@ -992,6 +1027,28 @@ pub enum Verification {
         #[serde(default = "default_lame_tol")]
         stress_tolerance: f64,
     },
+    /// A thick-walled hollow cylinder under internal pressure in axial symmetry, its outer wall held
+    /// radially and plane strain along the axis ([001] §3.1; `../shared/seeds-001-002.md` Part B1):
+    /// Lamé's closed form with u_r(b) = 0, compared after the first load step (the first increment
+    /// of [001]).
+    HollowCylinder {
+        /// The cylinder's body (linear elastic, one phase).
+        body: String,
+        /// The internal pressure (a `nodal_traction` or `particle_traction` whose x component is
+        /// the pressure on the inner face, times its time function).
+        load: String,
+        /// Inner radius a [m].
+        inner_radius: f64,
+        /// Outer radius b [m] (held radially).
+        outer_radius: f64,
+        /// Largest accepted relative error of u_r at the inner radius.
+        #[serde(default = "default_lame_tol")]
+        displacement_tolerance: f64,
+        /// Largest accepted relative error of Δσ_rr at the innermost points (mp1) and volume-weighted
+        /// RMS of the relative error of Δσ_rr over the body.
+        #[serde(default = "default_hollow_stress_tol")]
+        stress_tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1009,8 +1066,28 @@ pub enum Verification {
     },
 }
 
+impl Verification {
+    /// The `kind` the case file names.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Verification::Terzaghi { .. } => "terzaghi",
+            Verification::HarmonicColumn { .. } => "harmonic_column",
+            Verification::ElasticColumn { .. } => "elastic_column",
+            Verification::BearingCapacity { .. } => "bearing_capacity",
+            Verification::LargeStrainConsolidation { .. } => "large_strain_consolidation",
+            Verification::Patch { .. } => "patch",
+            Verification::Lame { .. } => "lame",
+            Verification::HollowCylinder { .. } => "hollow_cylinder",
+            Verification::ShockWave { .. } => "shock_wave",
+        }
+    }
+}
+
 fn default_lame_tol() -> f64 {
     0.05
+}
+fn default_hollow_stress_tol() -> f64 {
+    0.25
 }
 fn default_spread_tol() -> f64 {
     1e-9

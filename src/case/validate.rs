@@ -92,6 +92,38 @@ fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> R {
 }
 
 /// Checks every range and reference of the case.
+/// The conditions of an axisymmetric case: x is the radius, so the grid starts at r ≥ 0 (the
+/// material then lies at r > 0, and nodes on the axis get u_r = 0 from the model's own `axis`
+/// boundary, a name no case boundary may take); the verification references that assume plane
+/// strain are refused.
+fn axisymmetry(c: &Case, tol: f64) -> R {
+    if c.analysis.geometry != crate::case::Geometry::Axisymmetric {
+        return Ok(());
+    }
+    if c.grid.origin[0] < -tol {
+        return Err(format!(
+            "key `grid.origin`: an axisymmetric analysis has x ≡ r ≥ 0, so the grid must start at x ≥ 0 (got {})",
+            c.grid.origin[0]
+        ));
+    }
+    if let Some(b) = c.boundaries.iter().find(|b| b.name == crate::model::AXIS) {
+        return Err(format!(
+            "key `boundaries`: the name `{}` is taken by the axis of an axisymmetric analysis (u_r = 0 at r = 0,              added by the program); rename the boundary",
+            b.name
+        ));
+    }
+    match &c.verification {
+        None
+        | Some(Verification::Terzaghi { .. })
+        | Some(Verification::ElasticColumn { .. })
+        | Some(Verification::HollowCylinder { .. }) => Ok(()),
+        Some(v) => Err(format!(
+            "key `verification`: the `{}` reference is a plane-strain solution and cannot check an axisymmetric              analysis (the one-dimensional columns `terzaghi` and `elastic_column` and the `hollow_cylinder` can)",
+            v.kind()
+        )),
+    }
+}
+
 pub fn validate(c: &Case) -> R {
     let two_phase = c.analysis.formulation == Formulation::TwoPhase;
     positive("analysis.g", c.analysis.g)?;
@@ -132,6 +164,7 @@ pub fn validate(c: &Case) -> R {
     let h = c.cell_size();
     let tol = [1e-9 * h[0], 1e-9 * h[1]];
     let inside_grid = |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] - tol[d] && p[d] <= hi[d] + tol[d]);
+    axisymmetry(c, tol[0])?;
 
     // Materials.
     if c.materials.is_empty() {
@@ -532,6 +565,41 @@ pub fn validate(c: &Case) -> R {
                 }
                 (body, load)
             }
+            Verification::HollowCylinder {
+                body,
+                load,
+                inner_radius,
+                outer_radius,
+                displacement_tolerance,
+                stress_tolerance,
+            } => {
+                positive("verification.inner_radius", *inner_radius)?;
+                if outer_radius <= inner_radius {
+                    return Err("key `verification.outer_radius`: must exceed `inner_radius`".into());
+                }
+                positive("verification.displacement_tolerance", *displacement_tolerance)?;
+                positive("verification.stress_tolerance", *stress_tolerance)?;
+                if !matches!(c.load(load), Some(Load::NodalTraction { .. } | Load::ParticleTraction { .. })) {
+                    return Err(format!(
+                        "key `verification.load`: `{load}` must be a nodal_traction or particle_traction load"
+                    ));
+                }
+                if let Some(b) = c.body(body) {
+                    let mat = &c.materials[c.material_index(&b.material).expect("validated")];
+                    if !matches!(mat.model, SoilModel::LinearElastic { .. }) {
+                        return Err(format!("key `verification.body`: the hollow cylinder's reference needs a linear elastic body, and `{body}` is not"));
+                    }
+                }
+                if two_phase {
+                    return Err(
+                        "key `verification`: the hollow cylinder's reference is for a one_phase analysis".into()
+                    );
+                }
+                if c.analysis.geometry != crate::case::Geometry::Axisymmetric {
+                    return Err("key `verification`: the hollow cylinder's reference needs `analysis.geometry = \"axisymmetric\"`".into());
+                }
+                (body, load)
+            }
             Verification::Patch { body, boundary, spread_tolerance, tolerance } => {
                 positive("verification.spread_tolerance", *spread_tolerance)?;
                 positive("verification.tolerance", *tolerance)?;
@@ -672,7 +740,7 @@ pub fn validate(c: &Case) -> R {
                     return Err("key `verification`: the elastic column reference is for a one_phase analysis".into());
                 }
             }
-            Verification::BearingCapacity { .. } | Verification::Lame { .. } => {}
+            Verification::BearingCapacity { .. } | Verification::Lame { .. } | Verification::HollowCylinder { .. } => {}
             _ => {
                 if !two_phase {
                     return Err(

@@ -17,7 +17,8 @@ fn solid_share(pt: &Point) -> f64 {
 
 /// Continuity ([003] Eq. 23b for the step's increments, on x_n):
 /// R_p,i = −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V (u–p–U) or −S_i [∇̄·Δu + Δp/Q] V (u–p);
-/// tangent −G₁ᵀ, −G₂ᵀ and −P, weighted by w_mass.
+/// tangent −G₁ᵀ, −G₂ᵀ and −P, weighted by w_mass. In axial symmetry the divergences include the
+/// hoop term, ∇̄·Δu + Σ T̄_j Δu_r,j ([`super::super::Interp::dvol_u`]).
 pub mod continuity {
     use super::super::{Point, Scheme};
 
@@ -42,10 +43,11 @@ pub mod continuity {
         for (k, bk) in pt.basis.iter().enumerate() {
             let row = (k * nd + p) * m;
             for (l, bl) in pt.basis.iter().enumerate() {
+                let div = [bl.gv[0] + bl.tv, bl.gv[1]];
                 for c in 0..2 {
-                    out[row + l * nd + c] -= fs * bk.s * bl.gv[c] * v;
+                    out[row + l * nd + c] -= fs * bk.s * div[c] * v;
                     if let Some(w) = pt.layout.w {
-                        out[row + l * nd + w + c] -= n * bk.s * bl.gv[c] * v;
+                        out[row + l * nd + w + c] -= n * bk.s * div[c] * v;
                     }
                 }
                 out[row + l * nd + p] -= bk.s * bl.s * v * part.inv_q;

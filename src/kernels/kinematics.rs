@@ -21,6 +21,14 @@
 //!   ω = ½(L_yx − L_xy),  R = (I − ½W)⁻¹(I + ½W), a rotation by θ = 2 atan(ω/2),
 //! and the soil model starts from the rotated stress R σ_n Rᵀ. A rigid rotation by α gives
 //! sym L = 0 and θ = α exactly, so the stress turns with the material to round-off.
+//!
+//! **Axial symmetry** (x ≡ r, `../shared/seeds-001-002.md` Part A2): F is block diagonal with the
+//! hoop stretch F_θθ = 1 + H_θθ, H_θθ = Σ T_i Δu_r,i (T_i the node's hoop operator, S_i/r_p for the
+//! planar weights: F_θθ = r_{n+1}/r_n), and F_v,θθ likewise with B̄'s T̄_i. Then J = det F_rz F_θθ,
+//! J_v = det F_v,rz F_v,θθ, the mid-step hoop rate L_θθ = H_θθ/(1 + H_θθ/2) is the fourth strain
+//! component (the zz slot of plane strain) and enters the traces of L and L_v; on x_{n+1} the hoop
+//! operators are T'_i = T_i/F_θθ and T̄'_i = T̄_i/F_v,θθ. The rotation stays in the (r, y) plane. In
+//! plane strain T = 0 and every hoop quantity drops out.
 
 use super::NodeBasis;
 
@@ -88,12 +96,17 @@ pub struct Kinematics {
     pub omega: f64,
     /// Rotation angle of the step θ = 2 atan(ω/2) [rad].
     pub theta: f64,
+    /// The hoop stretch F_θθ = 1 + Σ T_i Δu_r,i (1 in plane strain).
+    pub f_hoop: f64,
+    /// B̄'s hoop stretch F_v,θθ = 1 + Σ T̄_i Δu_r,i.
+    pub fv_hoop: f64,
 }
 
 impl Kinematics {
     /// The kinematics for displacement increments `du[k]` at the nodes of `basis`.
     pub fn new(basis: &[NodeBasis], du: impl Iterator<Item = [f64; 2]>) -> Kinematics {
         let (mut h, mut hv) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+        let (mut ht, mut hvt) = (0.0, 0.0);
         for (b, u) in basis.iter().zip(du) {
             for a in 0..2 {
                 for c in 0..2 {
@@ -101,22 +114,27 @@ impl Kinematics {
                     hv[a][c] += u[a] * b.gv[c];
                 }
             }
+            ht += b.t * u[0];
+            hvt += b.tv * u[0];
         }
         let add = |a: &M2, s: f64| [[1.0 + s * a[0][0], s * a[0][1]], [s * a[1][0], 1.0 + s * a[1][1]]];
         let (f, fv) = (add(&h, 1.0), add(&hv, 1.0));
         let (fh_inv, fvh_inv) = (inverse(&add(&h, 0.5)), inverse(&add(&hv, 0.5)));
         let l = mul(&h, &fh_inv);
         let lv = mul(&hv, &fvh_inv);
-        let tr = l[0][0] + l[1][1];
-        let trv = lv[0][0] + lv[1][1];
+        let (lt, lvt) = (ht / (1.0 + 0.5 * ht), hvt / (1.0 + 0.5 * hvt));
+        let tr = l[0][0] + l[1][1] + lt;
+        let trv = lv[0][0] + lv[1][1] + lvt;
         let vol = (trv - tr) / 3.0;
-        let deps = [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol];
+        let deps = [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], lt + vol];
         let omega = 0.5 * (l[1][0] - l[0][1]);
         Kinematics {
             f,
-            j: det(&f),
+            j: det(&f) * (1.0 + ht),
             fv,
-            jv: det(&fv),
+            jv: det(&fv) * (1.0 + hvt),
+            f_hoop: 1.0 + ht,
+            fv_hoop: 1.0 + hvt,
             f_inv: inverse(&f),
             fv_inv: inverse(&fv),
             fh_inv,
@@ -145,7 +163,15 @@ impl Kinematics {
             deps: [0.0; 4],
             omega: 0.0,
             theta: 0.0,
+            f_hoop: 1.0,
+            fv_hoop: 1.0,
         }
+    }
+
+    /// The hoop operators of a node on x_{n+1}: (T', T̄') = (T/F_θθ, T̄/F_v,θθ).
+    #[inline]
+    pub fn hoop(&self, b: &NodeBasis) -> (f64, f64) {
+        (b.t / self.f_hoop, b.tv / self.fv_hoop)
     }
 
     /// The gradients of a node's basis function on x_{n+1}: (∇'S, ∇̄'S) = (F⁻ᵀ∇S, F_v⁻ᵀ∇̄S).
@@ -157,19 +183,23 @@ impl Kinematics {
     /// ∂Δε/∂Δu_l (4 strain components × 2 displacement components) for a node with basis `b`.
     ///
     /// dL = (I − L/2) dH F_h⁻¹ with dH = e_d ⊗ ∇S_l, so dL_ab = (I − L/2)_ad (F_h⁻ᵀ∇S_l)_b; the
-    /// same for L_v with ∇̄S_l.
+    /// same for L_v with ∇̄S_l. The hoop rate L_θθ = H_θθ/(1 + H_θθ/2) has
+    /// dL_θθ/dΔu_l,r = T_l/(1 + H_θθ/2)², and L_v,θθ likewise with T̄_l.
     pub fn deps_derivative(&self, b: &NodeBasis) -> [[f64; 2]; 4] {
         let gh = mul_t(&self.fh_inv, b.g);
         let gvh = mul_t(&self.fvh_inv, b.gv);
+        let mid = |f: f64| 1.0 / (0.5 * (1.0 + f)).powi(2);
+        let (dlt, dlvt) = (b.t * mid(self.f_hoop), b.tv * mid(self.fv_hoop));
         // Column d: the strain increment of a unit increment of component d.
         let column = |d: usize| -> [f64; 4] {
             // dL[a][c] = (I − L/2)[a][d] gh[c].
             let dl = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
             let dlv = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.lv[a][d]) * gvh[c];
-            let tr = dl(0, 0) + dl(1, 1);
-            let trv = dlv(0, 0) + dlv(1, 1);
+            let (lt, lvt) = if d == 0 { (dlt, dlvt) } else { (0.0, 0.0) };
+            let tr = dl(0, 0) + dl(1, 1) + lt;
+            let trv = dlv(0, 0) + dlv(1, 1) + lvt;
             let vol = (trv - tr) / 3.0;
-            [dl(0, 0) + vol, dl(1, 1) + vol, dl(0, 1) + dl(1, 0), vol]
+            [dl(0, 0) + vol, dl(1, 1) + vol, dl(0, 1) + dl(1, 0), lt + vol]
         };
         let (c0, c1) = (column(0), column(1));
         std::array::from_fn(|r| [c0[r], c1[r]])
@@ -188,7 +218,9 @@ impl Kinematics {
     }
 
     /// The incremental deformation gradient the particle keeps: F̄ = (J_v/J)^{1/2} F, whose
-    /// determinant is J_v (so that the domain and the volume follow the same volume change).
+    /// determinant is J_v (so that the domain and the volume follow the same volume change; in
+    /// axial symmetry its in-plane determinant is J_v/F_θθ, the area change of a ring whose
+    /// radius grew by F_θθ).
     pub fn f_bar(&self) -> M2 {
         let s = if self.j > 0.0 && self.jv > 0.0 { (self.jv / self.j).sqrt() } else { 1.0 };
         [[self.f[0][0] * s, self.f[0][1] * s], [self.f[1][0] * s, self.f[1][1] * s]]
@@ -226,6 +258,8 @@ mod tests {
                     s: 0.2,
                     g: [(x * 1.3).cos() * 3.0, (x * 0.9).sin() * 2.0],
                     gv: [(x * 1.1).cos() * 2.5, (x * 0.4).sin() * 1.5],
+                    t: 0.2 + 0.1 * x,
+                    tv: 0.3 - 0.05 * x,
                 }
             })
             .collect()
@@ -275,7 +309,7 @@ mod tests {
             .iter()
             .map(|&(x, y): &(f64, f64)| {
                 let g = [if x == 0.0 { -0.5 } else { 0.5 }, if y == 0.0 { -0.5 } else { 0.5 }];
-                NodeBasis { s: 0.25, g, gv: g }
+                NodeBasis { s: 0.25, g, gv: g, t: 0.0, tv: 0.0 }
             })
             .collect();
         for alpha in [0.1f64, 0.9, -1.4] {

@@ -127,11 +127,17 @@ pub struct NodeBasis {
     pub g: [f64; 2],
     /// ∇̄S_i (volumetric part of B̄; equals `g` without B̄), on x_n.
     pub gv: [f64; 2],
+    /// The hoop operator T_i of an axisymmetric analysis (ε_θθ = Σ T_i u_r,i; S_i/r_p for the
+    /// planar weights), on x_n; zero in plane strain.
+    pub t: f64,
+    /// The hoop operator of B̄'s volumetric part (equals `t` without B̄).
+    pub tv: f64,
 }
 
-/// The basis of a whole stencil without B̄, appended to `out`.
-pub fn plain_basis(st: &Stencil, out: &mut Vec<NodeBasis>) {
-    out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k] }));
+/// The basis of a whole stencil without B̄, with the hoop operators `hoop` (zero in plane
+/// strain), appended to `out`.
+pub fn plain_basis(st: &Stencil, hoop: &[f64], out: &mut Vec<NodeBasis>) {
+    out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k], t: hoop[k], tv: hoop[k] }));
 }
 
 /// Nodal values seen by a particle: the increment Δd and its parts a₀Δd, a₁Δd of the acceleration
@@ -369,18 +375,18 @@ impl Predictors {
     }
 }
 
-/// B̄ of one node from its deviatoric gradient `g` and volumetric gradient `gv`: 4 strain rows ×
-/// 2 displacement components ([000] Eq. 16).
+/// B̄ of one node from its deviatoric gradient `g` and volumetric gradient `gv` and, in axial
+/// symmetry, its hoop operators `hoop` = (T, T̄) (zero in plane strain): 4 strain rows
+/// [rr, yy, ry, θθ] × 2 displacement components ([000] Eq. 16): B̄ = B − ⅓ m mᵀB + ⅓ m mᵀB̄_v with
+/// m = [1, 1, 0, 1], the hoop row of B being [T, 0] (`../shared/seeds-001-002.md` Part A2).
 #[inline]
-pub fn bbar(g: [f64; 2], gv: [f64; 2]) -> [[f64; 2]; 4] {
+pub fn bbar(g: [f64; 2], gv: [f64; 2], hoop: (f64, f64)) -> [[f64; 2]; 4] {
     let (gx, gy, vx, vy) = (g[0], g[1], gv[0], gv[1]);
+    let (tt, tv) = hoop;
     let t = 1.0 / 3.0;
-    [
-        [2.0 * t * gx + t * vx, -t * gy + t * vy],
-        [-t * gx + t * vx, 2.0 * t * gy + t * vy],
-        [gy, gx],
-        [-t * gx + t * vx, -t * gy + t * vy],
-    ]
+    // ⅓(mᵀB̄_v − mᵀB): the volumetric correction of every normal row.
+    let corr = [t * (vx + tv - gx - tt), t * (vy - gy)];
+    [[gx + corr[0], corr[1]], [corr[0], gy + corr[1]], [gy, gx], [tt + corr[0], corr[1]]]
 }
 
 /// Values interpolated to a particle from the nodal increments, with its Newmark predictors.
@@ -392,7 +398,8 @@ pub struct Interp {
     pub dw: [f64; 2],
     /// Pressure increment Σ S Δp.
     pub dp: f64,
-    /// Volumetric strain increment of the solid on x_n, ∇̄·Δu = Σ ∇̄S·Δu.
+    /// Volumetric strain increment of the solid on x_n, ∇̄·Δu = Σ ∇̄S·Δu (+ Σ T̄ Δu_r in axial
+    /// symmetry).
     pub dvol_u: f64,
     /// Volumetric strain increment of the water on x_n, ∇̄·ΔU.
     pub dvol_w: f64,
@@ -416,6 +423,7 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
         k.v_w = pred.v_w;
     }
     for (b, st) in basis.iter().zip(states) {
+        k.dvol_u += b.tv * st.d[0];
         for c in 0..2 {
             k.a_u[c] += b.s * st.a[c];
             k.v_u[c] += b.s * st.v[c];
@@ -428,6 +436,7 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
             k.grad_dp[1] += b.g[1] * st.d[p];
         }
         if let Some(w) = layout.w {
+            k.dvol_w += b.tv * st.d[w];
             for c in 0..2 {
                 k.dvol_w += b.gv[c] * st.d[w + c];
                 k.a_w[c] += b.s * st.a[w + c];
@@ -459,6 +468,8 @@ pub struct Point<'a> {
     pub upd: StressUpdate,
     /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}.
     pub spatial: [([f64; 2], [f64; 2]); MAX_NODES],
+    /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain).
+    pub hoop: [(f64, f64); MAX_NODES],
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
@@ -502,8 +513,10 @@ impl<'a> Point<'a> {
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         let upd = model.update(&rotated, part.eps_pd, &kin.deps);
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
-        for (s, b) in spatial.iter_mut().zip(basis) {
+        let mut hoop = [(0.0, 0.0); MAX_NODES];
+        for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
             *s = kin.spatial(b);
+            *t = kin.hoop(b);
         }
         Point {
             basis,
@@ -514,6 +527,7 @@ impl<'a> Point<'a> {
             rotated,
             upd,
             spatial,
+            hoop,
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],

@@ -11,6 +11,11 @@
 //! * volume: f_i,c (∇̄'S_l)_d, from ∂J_v/∂Δu_l,d = J_v (∇̄'S_l)_d;
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
+//!
+//! Axial symmetry adds the hoop stress to the radial force, f_i,r += V_{n+1}(dev σ'_θθ T'_i +
+//! σ'_m T̄'_i) (B̄'ᵀσ' with the hoop row of [`super::bbar`]), ∂J_v/∂Δu_l,r gains J_v T̄'_l, and
+//! ∂T'_i/∂Δu_l,r = −T'_i T'_l (T' = T/F_θθ) gives the geometric part
+//! −V_{n+1} (dev σ'_θθ T'_i T'_l + σ'_m T̄'_i T̄'_l) in the r–r entry.
 
 use super::{bbar, kinematics, Point, Scheme};
 
@@ -26,6 +31,13 @@ fn traction(dev: &[[f64; 2]; 2], pm: f64, g: [f64; 2], gv: [f64; 2]) -> [f64; 2]
     [dev[0][0] * g[0] + dev[0][1] * g[1] + pm * gv[0], dev[1][0] * g[0] + dev[1][1] * g[1] + pm * gv[1]]
 }
 
+/// The radial force of the hoop stress on a node with hoop operators (T', T̄') on x_{n+1}, per
+/// unit volume: dev σ_θθ T' + σ_m T̄' (zero in plane strain).
+#[inline]
+fn hoop_force(s: &[f64; 4], pm: f64, hoop: (f64, f64)) -> f64 {
+    (s[3] - pm) * hoop.0 + pm * hoop.1
+}
+
 /// Adds the effective-stress residual in the u rows (weight w_f = 1 − α_f).
 pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let nd = pt.layout.nd;
@@ -34,7 +46,7 @@ pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     for k in 0..pt.basis.len() {
         let (g, gv) = pt.spatial[k];
         let t = traction(&dev, pm, g, gv);
-        out[k * nd] += t[0] * v;
+        out[k * nd] += (t[0] + hoop_force(&pt.upd.stress, pm, pt.hoop[k])) * v;
         out[k * nd + 1] += t[1] * v;
     }
 }
@@ -60,18 +72,27 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
             }
         }
     }
+    let dev_tt = s[3] - pm;
     for k in 0..pt.basis.len() {
         let (gk, gvk) = pt.spatial[k];
-        let bk = bbar(gk, gvk);
-        let tk = traction(&dev, pm, gk, gvk);
+        let hk = pt.hoop[k];
+        let bk = bbar(gk, gvk, hk);
+        let mut tk = traction(&dev, pm, gk, gvk);
+        tk[0] += hoop_force(s, pm, hk);
         for l in 0..pt.basis.len() {
             let (gl, gvl) = pt.spatial[l];
+            let hl = pt.hoop[l];
             let dev_gl = [dev[0][0] * gl[0] + dev[0][1] * gl[1], dev[1][0] * gl[0] + dev[1][1] * gl[1]];
+            // ∂J_v/∂Δu_l / J_v: the in-plane divergence and, radially, the hoop term.
+            let djv = [gvl[0] + hl.1, gvl[1]];
             for c in 0..2 {
                 for d in 0..2 {
                     let material: f64 = (0..4).map(|r| bk[r][c] * a[l][r][d]).sum();
-                    let volume = tk[c] * gvl[d];
-                    let geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
+                    let volume = tk[c] * djv[d];
+                    let mut geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
+                    if c == 0 && d == 0 {
+                        geometric -= dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1;
+                    }
                     out[(k * nd + c) * m + l * nd + d] += v * (material + volume + geometric);
                 }
             }
@@ -105,7 +126,9 @@ pub mod pore_pressure {
         let (fs, fw) = shares(pt);
         let pv = pt.p * pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
-            let gv = pt.spatial[k].1;
+            let (g, tv) = (pt.spatial[k].1, pt.hoop[k].1);
+            // The divergence operator on x_{n+1}: ∇̄'S and, radially, the hoop term T̄'.
+            let gv = [g[0] + tv, g[1]];
             for c in 0..2 {
                 out[k * nd + c] -= fs * pv * gv[c];
                 if let Some(w) = pt.layout.w {
@@ -124,24 +147,34 @@ pub mod pore_pressure {
         let (fs, fw) = shares(pt);
         let v = pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
-            let gvk = pt.spatial[k].1;
+            let (gvk, tk) = (pt.spatial[k].1, pt.hoop[k].1);
+            let divk = [gvk[0] + tk, gvk[1]];
             for (l, bl) in pt.basis.iter().enumerate() {
-                let gvl = pt.spatial[l].1;
+                let (gvl, tl) = (pt.spatial[l].1, pt.hoop[l].1);
                 for c in 0..2 {
                     let ru = (k * nd + c) * m;
                     if let Some(p) = pt.layout.p {
-                        out[ru + l * nd + p] -= fs * v * gvk[c] * bl.s;
+                        out[ru + l * nd + p] -= fs * v * divk[c] * bl.s;
                     }
                     for d in 0..2 {
-                        // ∂(J_v ∇̄'S_k,c)/∂Δu_l,d = J_v (∇̄'S_l,d ∇̄'S_k,c − ∇̄'S_l,c ∇̄'S_k,d).
-                        let geo = pt.p * v * (gvl[d] * gvk[c] - gvl[c] * gvk[d]);
+                        // ∂(J_v ∇̄'S_k,c)/∂Δu_l,d = J_v (∇̄'S_l,d ∇̄'S_k,c − ∇̄'S_l,c ∇̄'S_k,d); in
+                        // axial symmetry the divergence gains T̄' (radially) and J_v's derivative
+                        // T̄'_l (radially), whose hoop–hoop parts cancel.
+                        let mut geo = gvl[d] * gvk[c] - gvl[c] * gvk[d];
+                        if d == 0 {
+                            geo += tl * gvk[c];
+                        }
+                        if c == 0 {
+                            geo += tk * gvl[d];
+                        }
+                        let geo = pt.p * v * geo;
                         out[ru + l * nd + d] -= fs * geo;
                         if let Some(w) = pt.layout.w {
                             out[(k * nd + w + c) * m + l * nd + d] -= fw * geo;
                         }
                     }
                     if let (Some(w), Some(p)) = (pt.layout.w, pt.layout.p) {
-                        out[(k * nd + w + c) * m + l * nd + p] -= fw * v * gvk[c] * bl.s;
+                        out[(k * nd + w + c) * m + l * nd + p] -= fw * v * divk[c] * bl.s;
                     }
                 }
             }

@@ -100,13 +100,23 @@ pub(crate) fn fd_blocks(
 }
 
 fn sample(nn: usize) -> Vec<NodeBasis> {
+    sample_in(nn, false)
+}
+
+/// A sample basis; with `hoop` the hoop operators of a point at r ≈ 0.2 m of an axisymmetric
+/// analysis (T ≈ S/r, and B̄'s T̄ different from it).
+fn sample_in(nn: usize, hoop: bool) -> Vec<NodeBasis> {
     (0..nn)
         .map(|k| {
             let x = k as f64;
+            let s = 0.05 + 0.1 * (x * 0.7).sin().abs();
+            let (t, tv) = if hoop { (s / 0.2, 0.04 + 0.5 * (x * 0.3).cos().abs()) } else { (0.0, 0.0) };
             NodeBasis {
-                s: 0.05 + 0.1 * (x * 0.7).sin().abs(),
+                s,
                 g: [(x * 1.3).cos() * 3.0, (x * 0.9).sin() * 2.0],
                 gv: [(x * 1.1).cos() * 2.5, (x * 0.4).sin() * 1.5],
+                t,
+                tv,
             }
         })
         .collect()
@@ -211,9 +221,17 @@ fn models() -> Vec<(&'static str, Constitutive, [f64; 4])> {
     ]
 }
 
-/// Runs the finite-difference check of one term; returns the blocks.
-fn check_term(term: &Term, model: &Constitutive, stress: [f64; 4], layout: Layout, nm: &Scheme) -> Vec<BlockError> {
-    let basis = sample(6);
+/// Runs the finite-difference check of one term (with the hoop operators of an axisymmetric
+/// point if `hoop`); returns the blocks.
+fn check_term(
+    term: &Term,
+    model: &Constitutive,
+    stress: [f64; 4],
+    layout: Layout,
+    nm: &Scheme,
+    hoop: bool,
+) -> Vec<BlockError> {
+    let basis = sample_in(6, hoop);
     let nd = layout.nd;
     let m = basis.len() * nd;
     let nm = *nm;
@@ -240,11 +258,11 @@ fn every_term_matches_central_differences_block_by_block() {
     let names = ["ux", "uy", "p", "Ux", "Uy"];
     for (layout, sname, nm) in layouts_and_schemes() {
         for (mname, model, stress) in models() {
-            for term in terms() {
-                for b in check_term(&term, &model, stress, layout, &nm) {
+            for (term, hoop) in terms().into_iter().flat_map(|t| [(t, false), (t, true)]) {
+                for b in check_term(&term, &model, stress, layout, &nm, hoop) {
                     assert!(
                         b.pass(),
-                        "{} ({mname}, nd = {}, {sname}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
+                        "{} ({mname}, nd = {}, {sname}, axisymmetric {hoop}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
                         term.0,
                         layout.nd,
                         names[b.row],
@@ -279,11 +297,12 @@ fn the_plastic_sample_really_returns() {
 #[test]
 fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
     let (_, model, stress) = models()[0];
-    let basis = sample(6);
     let p = ParticleInput { stress, ..part() };
     let mut flipped_blocks = 0;
     let cases = [layouts_and_schemes()[1], layouts_and_schemes()[4]];
-    for (term, (layout, _, nm)) in terms().into_iter().flat_map(|t| cases.map(|c| (t, c))) {
+    let all = terms().into_iter().flat_map(|t| cases.map(|c| (t, c))).flat_map(|(t, c)| [(t, c, false), (t, c, true)]);
+    for (term, (layout, _, nm), hoop) in all {
+        let basis = sample_in(6, hoop);
         let nd = layout.nd;
         let m = basis.len() * nd;
         let d0 = increments(m, layout);
@@ -315,11 +334,11 @@ fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
                 flipped_blocks += 1;
                 let blocks = fd_blocks(nd, &d0, &steps(layout), &res, &wrong);
                 let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
-                assert!(caught, "{} (nd = {nd}): a flipped {a}–{b} block passed", term.0);
+                assert!(caught, "{} (nd = {nd}, axisymmetric {hoop}): a flipped {a}–{b} block passed", term.0);
             }
         }
     }
-    assert!(flipped_blocks > 60, "only {flipped_blocks} blocks were flipped");
+    assert!(flipped_blocks > 120, "only {flipped_blocks} blocks were flipped");
 }
 
 #[test]
@@ -331,7 +350,7 @@ fn newmark_reproduces_a_uniformly_accelerated_motion() {
         let nm = Scheme::newmark(beta, gamma, dt);
         let pred = Predictors::new(&nm, v, a, v, a);
         let d = [v[0] * dt + 0.5 * a[0] * dt * dt, v[1] * dt + 0.5 * a[1] * dt * dt];
-        let basis = [NodeBasis { s: 1.0, g: [0.0; 2], gv: [0.0; 2] }];
+        let basis = [NodeBasis { s: 1.0, ..NodeBasis::default() }];
         let st = states(&[d[0], d[1], 0.0, d[0], d[1]], 5, &nm);
         let k = interpolate(&basis, &st, &pred, Layout::UPU);
         for c in 0..2 {
@@ -374,7 +393,7 @@ fn unit_square(x: [f64; 2]) -> Vec<NodeBasis> {
             let sy = if ny == 0.0 { 1.0 - x[1] } else { x[1] };
             let gx = if nx == 0.0 { -1.0 } else { 1.0 };
             let gy = if ny == 0.0 { -1.0 } else { 1.0 };
-            NodeBasis { s: sx * sy, g: [gx * sy, sx * gy], gv: [gx * sy, sx * gy] }
+            NodeBasis { s: sx * sy, g: [gx * sy, sx * gy], gv: [gx * sy, sx * gy], t: 0.0, tv: 0.0 }
         })
         .collect()
 }

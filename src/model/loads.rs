@@ -299,6 +299,24 @@ pub struct BoundaryDef {
 }
 
 impl BoundaryDef {
+    /// The axis of an axisymmetric model: u_r = 0 and U_r = 0 on the grid side r = 0 (named
+    /// [`super::AXIS`]; it is not a case boundary and holds in every stage).
+    pub fn axis() -> BoundaryDef {
+        BoundaryDef {
+            name: super::AXIS.to_string(),
+            side: Some(Side::XMin),
+            region: None,
+            surface: None,
+            fix: vec![Dof::Ux, Dof::WUx],
+            motion: None,
+        }
+    }
+
+    /// Whether this is the axis of an axisymmetric model.
+    pub fn is_axis(&self) -> bool {
+        self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()
+    }
+
     /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
     /// surface's region if it has one, whose face in a listed direction is exposed at t = 0).
     pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles) -> BoundaryDef {

@@ -53,7 +53,25 @@ pub struct Model {
     pub n_bodies: usize,
     /// Factor α of the pressure-projection stabilisation τ = α/G (two-phase), if on.
     pub pressure_projection: Option<f64>,
+    /// Plane strain or axial symmetry (with its particle weights).
+    pub geometry: shape::Geometry,
 }
+
+/// The geometry of a case.
+pub fn geometry_of(case: &Case) -> shape::Geometry {
+    match case.analysis.geometry {
+        crate::case::Geometry::PlaneStrain => shape::Geometry::PlaneStrain,
+        crate::case::Geometry::Axisymmetric => {
+            shape::Geometry::Axisymmetric(match case.analysis.axisymmetric_weights {
+                crate::case::AxisymmetricWeights::Planar => shape::AxisymmetricWeights::Planar,
+                crate::case::AxisymmetricWeights::RWeighted => shape::AxisymmetricWeights::RWeighted,
+            })
+        }
+    }
+}
+
+/// The name of the boundary an axisymmetric model adds on the axis (u_r = 0, U_r = 0 at r = 0).
+pub const AXIS: &str = "axis";
 
 /// Names of the nodal fields of a formulation's dynamic system, in dof order: ux, uy, p, Ux, Uy
 /// (two-phase) or ux, uy.
@@ -107,7 +125,12 @@ impl Model {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
         let loads = case.loads.iter().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
-        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
+        let mut boundaries: Vec<BoundaryDef> =
+            case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
+        let geometry = geometry_of(case);
+        if geometry.axisymmetric() && grid.origin[0].abs() <= 1e-12 * grid.h[0] {
+            boundaries.push(BoundaryDef::axis());
+        }
         Model {
             two_phase: case.analysis.formulation == Formulation::TwoPhase,
             basis: match case.analysis.shape_functions {
@@ -130,6 +153,7 @@ impl Model {
                 None
             },
             pressure_update: case.stabilisation.pressure_update,
+            geometry,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
@@ -173,10 +197,14 @@ impl Model {
                 Some(ns) => (0..all.len()).filter(|&i| ns.iter().any(|n| n == all[i])).collect(),
             }
         };
-        Active {
-            loads: pick(&stage.loads, self.loads.iter().map(|l| l.name.as_str()).collect()),
-            boundaries: pick(&stage.boundaries, self.boundaries.iter().map(|b| b.name.as_str()).collect()),
+        let mut boundaries = pick(&stage.boundaries, self.boundaries.iter().map(|b| b.name.as_str()).collect());
+        // The axis holds in every stage.
+        if let Some(axis) = self.boundaries.iter().position(|b| b.is_axis()) {
+            if !boundaries.contains(&axis) {
+                boundaries.push(axis);
+            }
         }
+        Active { loads: pick(&stage.loads, self.loads.iter().map(|l| l.name.as_str()).collect()), boundaries }
     }
 
     /// For each dof component (ux, uy, p, Ux, Uy) at node (i, j), the first active side or region
@@ -295,6 +323,13 @@ impl Model {
             }
         }
         out
+    }
+
+    /// The area of particle `k` in the (x, y) plane: its volume over the geometry's measure at its
+    /// radius (the volume itself in plane strain) [m²].
+    #[inline]
+    pub fn area(&self, k: usize) -> f64 {
+        self.particles.volume[k] / self.geometry.measure(self.particles.x[k][0])
     }
 
     /// The pore water's mass n ρ_w V carried by particle `k` (zero in a one-phase run) [kg].

@@ -107,7 +107,8 @@ impl Particles {
             let c0 = grid.cell_of(lo).unwrap_or((0, 0));
             let c1 = grid.cell_of(hi).unwrap_or((grid.cells[0] - 1, grid.cells[1] - 1));
             let lp = [grid.h[0] / (2.0 * n as f64), grid.h[1] / (2.0 * n as f64)];
-            let vol = grid.h[0] * grid.h[1] / (n * n) as f64;
+            let area = grid.h[0] * grid.h[1] / (n * n) as f64;
+            let geometry = super::geometry_of(case);
             for cj in c0.1..=c1.1 {
                 for ci in c0.0..=c1.0 {
                     for sj in 0..n {
@@ -126,6 +127,8 @@ impl Particles {
                             if !body.shape.contains(x) || earlier || !owned(ci, cj) {
                                 continue;
                             }
+                            // The ring's volume 2πr A in axial symmetry.
+                            let vol = area * geometry.measure(x[0]);
                             let mass = if two_phase {
                                 (1.0 - mat.porosity) * mat.solid_density * vol
                             } else {

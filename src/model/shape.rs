@@ -147,6 +147,53 @@ pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil 
     s
 }
 
+/// The geometry of an analysis: plane strain, or axial symmetry about the y axis (x ≡ r ≥ 0) with
+/// the particle weights of [`AxisymmetricWeights`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Geometry {
+    /// Plane strain: volumes per metre of thickness, no hoop strain.
+    PlaneStrain,
+    /// Axial symmetry: ring volumes 2πrA and the hoop strain u_r/r.
+    Axisymmetric(AxisymmetricWeights),
+}
+
+impl Geometry {
+    /// The measure of a unit of (x, y) area or length at radius `r`: 1 in plane strain (per metre
+    /// of thickness), 2πr in axial symmetry (the full ring).
+    #[inline]
+    pub fn measure(&self, r: f64) -> f64 {
+        match self {
+            Geometry::PlaneStrain => 1.0,
+            Geometry::Axisymmetric(_) => std::f64::consts::TAU * r,
+        }
+    }
+
+    /// The measure of the strip x ∈ [lo, hi] (its width, or the area π(hi² − lo²) of the annulus it
+    /// sweeps about the axis): what a one-dimensional column's volume change is divided by to give
+    /// its settlement.
+    pub fn plan_area(&self, lo: f64, hi: f64) -> f64 {
+        match self {
+            Geometry::PlaneStrain => hi - lo,
+            Geometry::Axisymmetric(_) => std::f64::consts::PI * (hi * hi - lo * lo),
+        }
+    }
+
+    /// Whether the analysis is axisymmetric.
+    #[inline]
+    pub fn axisymmetric(&self) -> bool {
+        matches!(self, Geometry::Axisymmetric(_))
+    }
+
+    /// The particle's stencil with the hoop operator T_i of each node (zero in plane strain; see
+    /// [`axisymmetric_stencil`]).
+    pub fn stencil(&self, basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (Stencil, [f64; MAX_STENCIL]) {
+        match *self {
+            Geometry::PlaneStrain => (stencil(basis, grid, x, lp), [0.0; MAX_STENCIL]),
+            Geometry::Axisymmetric(w) => axisymmetric_stencil(basis, w, grid, x, lp),
+        }
+    }
+}
+
 /// How an axisymmetric analysis (x ≡ r ≥ 0, y the axis) weights a GIMP particle in r
 /// (`../shared/seeds-001-002.md` Part A2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -308,7 +355,24 @@ pub fn volumetric_gradients(
     st: &mut Stencil,
     root: &dyn Fn(usize, usize) -> (usize, usize),
 ) -> [[f64; 2]; MAX_STENCIL] {
+    volumetric_operators(basis, grid, x, lp, st, root, false).0
+}
+
+/// [`volumetric_gradients`] with, in axial symmetry (`hoop`), the volumetric hoop operator of
+/// each node: the cell-centre values N_i(x_c)/r_c = 1/(4 r_c) of the same cells with the same
+/// weights, so that B̄'s volumetric strain ∇̄·u + ū_r/r is the cell-centre one of the whole
+/// divergence (zero without `hoop`).
+pub fn volumetric_operators(
+    basis: Basis,
+    grid: &Grid,
+    x: [f64; 2],
+    lp: [f64; 2],
+    st: &mut Stencil,
+    root: &dyn Fn(usize, usize) -> (usize, usize),
+    hoop: bool,
+) -> ([[f64; 2]; MAX_STENCIL], [f64; MAX_STENCIL]) {
     let mut gv = [[0.0; 2]; MAX_STENCIL];
+    let mut tv = [0.0; MAX_STENCIL];
     // Cells overlapped in each direction, with the length of the overlap.
     let overlaps = |d: usize| -> ([(usize, f64); 3], usize) {
         let mut out = [(0usize, 0.0); 3];
@@ -340,12 +404,13 @@ pub fn volumetric_gradients(
     let (oy, ny) = overlaps(1);
     let total: f64 = ox[..nx].iter().map(|a| a.1).sum::<f64>() * oy[..ny].iter().map(|a| a.1).sum::<f64>();
     if total <= 0.0 {
-        return gv;
+        return (gv, tv);
     }
     for &(cy, ly) in &oy[..ny] {
         for &(cx, lx) in &ox[..nx] {
             let f = lx * ly / total;
             let (rx, ry) = root(cx, cy);
+            let centre_hoop = if hoop { 0.25 / (grid.origin[0] + (rx as f64 + 0.5) * grid.h[0]) } else { 0.0 };
             for (di, sx) in [(0u32, -1.0), (1u32, 1.0)] {
                 for (dj, sy) in [(0u32, -1.0), (1u32, 1.0)] {
                     let node = (rx as u32 + di, ry as u32 + dj);
@@ -362,11 +427,12 @@ pub fn volumetric_gradients(
                     };
                     gv[k][0] += f * sx / (2.0 * grid.h[0]);
                     gv[k][1] += f * sy / (2.0 * grid.h[1]);
+                    tv[k] += f * centre_hoop;
                 }
             }
         }
     }
-    gv
+    (gv, tv)
 }
 
 /// The grid's bilinear shape function of the node at `node` and its gradient at the point `x`, the

@@ -11,7 +11,7 @@
 //! there), at the end of the run.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Load, SoilModel, Verification};
+use crate::case::{Case, Load, Verification};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -67,20 +67,11 @@ impl LameCheck {
         else {
             return Err("not a Lamé verification".into());
         };
-        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-        let mat = &c.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
-        let (e, nu) = match mat.model {
-            SoilModel::LinearElastic { young_modulus, poisson_ratio } => (young_modulus, poisson_ratio),
-            _ => return Err(format!("body `{body}` is not linear elastic")),
-        };
+        let (bi, e, nu) = super::elastic_body(c, body)?;
         let Some(Load::LinePressure { pressure, time_function, .. }) = c.load(load) else {
             return Err(format!("`{load}` is not a line_pressure load"));
         };
-        let time_fn = time_function
-            .as_ref()
-            .and_then(|n| c.time_function(n))
-            .map(TimeFn::from_case)
-            .unwrap_or(TimeFn::Constant(1.0));
+        let time_fn = super::load_time_fn(c, time_function);
         Ok(LameCheck {
             body: bi as u16,
             center: *center,

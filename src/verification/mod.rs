@@ -24,6 +24,7 @@ pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
 pub mod figures;
+pub mod hollow_cylinder;
 pub mod lame;
 pub mod patch;
 pub mod shock;
@@ -109,6 +110,27 @@ pub trait Check {
     }
 }
 
+/// The index of a linear elastic `body` of the case with its Young's modulus [Pa] and Poisson's
+/// ratio, for the elastic closed forms.
+pub(crate) fn elastic_body(c: &Case, body: &str) -> Result<(usize, f64, f64), String> {
+    let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
+    let mat = &c.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
+    match mat.model {
+        crate::case::SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+            Ok((bi, young_modulus, poisson_ratio))
+        }
+        _ => Err(format!("body `{body}` is not linear elastic")),
+    }
+}
+
+/// The time function a load names (a constant 1 if none).
+pub(crate) fn load_time_fn(c: &Case, name: &Option<String>) -> crate::model::loads::TimeFn {
+    name.as_ref()
+        .and_then(|n| c.time_function(n))
+        .map(crate::model::loads::TimeFn::from_case)
+        .unwrap_or(crate::model::loads::TimeFn::Constant(1.0))
+}
+
 /// Geometry and soil of a loaded one-dimensional column, taken from the case.
 #[derive(Debug, Clone)]
 pub(crate) struct Column {
@@ -143,7 +165,7 @@ impl Column {
             body: bi as u16,
             top: hi[1],
             height: hi[1] - lo[1],
-            width: hi[0] - lo[0],
+            width: model.geometry.plan_area(lo[0], hi[0]),
             x_centre: 0.5 * (lo[0] + hi[0]),
             load: traction[1].abs(),
             constrained_modulus: mat.model.elastic().constrained_modulus(),
@@ -172,6 +194,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
     Ok(Some(match v {
         Verification::Patch { .. } => Box::new(patch::PatchCheck::new(c, model)?),
         Verification::Lame { .. } => Box::new(lame::LameCheck::new(c)?),
+        Verification::HollowCylinder { .. } => Box::new(hollow_cylinder::HollowCylinderCheck::new(c)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -782,7 +805,7 @@ impl ElasticColumnCheck {
         Ok(ElasticColumnCheck {
             body: bi as u16,
             top: hi[1],
-            width: hi[0] - lo[0],
+            width: model.geometry.plan_area(lo[0], hi[0]),
             density,
             gravity: g,
             surcharge: q,
@@ -904,6 +927,10 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::Lame { inner_radius, outer_radius, .. } => {
             format!("Lamé cylinder, a = {inner_radius} m, b = {outer_radius} m: u_r, σ_rr, σ_θθ")
         }
+        Verification::HollowCylinder { inner_radius, outer_radius, .. } => format!(
+            "axisymmetric hollow cylinder with a fixed outer wall ([001] §3.1), a = {inner_radius} m, \
+             b = {outer_radius} m: u_r(a) and Δσ_rr after the first load step"
+        ),
         Verification::Patch { boundary, .. } => {
             format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")
         }

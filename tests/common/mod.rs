@@ -72,12 +72,12 @@ pub fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
     rows.iter().map(|r| r[i]).collect()
 }
 
-/// The value of verification metric `name` (NaN if the summary has none).
 /// Whether a run's summary lists a warning of `kind`.
 pub fn has_warning(s: &Value, kind: &str) -> bool {
     s["warnings"].as_array().is_some_and(|w| w.iter().any(|w| w["kind"] == kind))
 }
 
+/// The value of verification metric `name` (NaN if the summary has none).
 pub fn metric(s: &Value, name: &str) -> f64 {
     s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
 }

@@ -1,0 +1,291 @@
+//! The hollow cylinder of [001] §3.1 in axial symmetry: a thick-walled cylinder under internal
+//! pressure with its outer wall held radially and plane strain along the axis
+//! (`../shared/seeds-001-002.md` Part B1, which reconstructs these boundary conditions from [001]'s
+//! constants A = 19.56 kN and C = 10.87 kPa).
+//!
+//! With inner radius a, outer radius b, pressure p, shear modulus μ, Poisson's ratio ν and
+//! κ = 1/(1 − 2ν), compression positive:
+//!   A = p/(1/a² + κ/b²),  C = κA/(2b²),
+//!   Δσ_rr = A/r² + 2C,  Δσ_θθ = −A/r² + 2C,  Δσ_yy = 4νC,  Δσ_m = 4C(1 + ν)/3 (constant),
+//!   u_r = (A/2μ)(1/r − r/b²).
+//! Metrics after the first load step (the first increment of [001]), from the run: u_r at r = a
+//! extrapolated linearly from the two innermost columns of points (exact for the linear basis,
+//! whose displacement is linear between the nodes), Δσ_rr averaged over the innermost column
+//! (the point mp1 of [001]) and the volume-weighted RMS over the body of the relative error of
+//! Δσ_rr (weighted by volume, so that it does not shrink because more points are counted). The
+//! reference is small-strain: a load of [001]'s 100 kPa strains the inner wall by 9 % and the
+//! geometrically nonlinear answer differs by 3.6 % in u_r(a); the case applies a small
+//! increment.
+
+use super::{Check, Findings, Metric};
+use crate::case::{Case, Load, Verification};
+use crate::model::loads::TimeFn;
+use crate::model::Model;
+use crate::parallel::Collective;
+
+/// The closed-form solution (compression positive).
+#[derive(Debug, Clone, Copy)]
+pub struct FixedWallLame {
+    /// Inner radius a [m].
+    pub a: f64,
+    /// Outer radius b [m].
+    pub b: f64,
+    /// Internal pressure p [Pa].
+    pub p: f64,
+    /// Young's modulus [Pa].
+    pub e: f64,
+    /// Poisson's ratio.
+    pub nu: f64,
+}
+
+impl FixedWallLame {
+    /// The constants (A [N/m… Pa m²], C [Pa]).
+    pub fn constants(&self) -> (f64, f64) {
+        let kappa = 1.0 / (1.0 - 2.0 * self.nu);
+        let a = self.p / (1.0 / (self.a * self.a) + kappa / (self.b * self.b));
+        (a, kappa * a / (2.0 * self.b * self.b))
+    }
+
+    /// (u_r, Δσ_rr, Δσ_θθ, Δσ_yy) at radius r, stresses compression positive.
+    pub fn at(&self, r: f64) -> (f64, f64, f64, f64) {
+        let (a, c) = self.constants();
+        let mu = self.e / (2.0 * (1.0 + self.nu));
+        (
+            a / (2.0 * mu) * (1.0 / r - r / (self.b * self.b)),
+            a / (r * r) + 2.0 * c,
+            -a / (r * r) + 2.0 * c,
+            4.0 * self.nu * c,
+        )
+    }
+
+    /// The mean stress Δσ_m, the same at every radius (compression positive).
+    pub fn mean_stress(&self) -> f64 {
+        4.0 * self.constants().1 * (1.0 + self.nu) / 3.0
+    }
+}
+
+/// What the first increment gave.
+#[derive(Debug, Clone, Copy, Default)]
+struct Increment {
+    /// u_r at r = a [m].
+    u_inner: f64,
+    /// Δσ_rr, Δσ_m and Δq at the innermost points (compression positive) [Pa], and their radius [m].
+    mp1: [f64; 4],
+    /// Volume-weighted RMS of the relative error of Δσ_rr over the body.
+    rms: f64,
+    /// The pressure of the increment [Pa] and its time [s].
+    p: f64,
+    t: f64,
+}
+
+/// The hollow-cylinder check of a case.
+pub struct HollowCylinderCheck {
+    body: u16,
+    theory: FixedWallLame,
+    time_fn: TimeFn,
+    tolerances: (f64, f64),
+    first: Option<Increment>,
+}
+
+impl HollowCylinderCheck {
+    /// The check of a `hollow_cylinder` verification.
+    pub fn new(c: &Case) -> Result<HollowCylinderCheck, String> {
+        let Some(Verification::HollowCylinder {
+            body,
+            load,
+            inner_radius,
+            outer_radius,
+            displacement_tolerance,
+            stress_tolerance,
+        }) = &c.verification
+        else {
+            return Err("not a hollow-cylinder verification".into());
+        };
+        let (bi, young_modulus, poisson_ratio) = super::elastic_body(c, body)?;
+        let (traction, time_function) = match c.load(load) {
+            Some(Load::NodalTraction { traction, time_function, .. })
+            | Some(Load::ParticleTraction { traction, time_function, .. }) => (traction[0], time_function),
+            _ => return Err(format!("`{load}` is not a nodal_traction or particle_traction load")),
+        };
+        let time_fn = super::load_time_fn(c, time_function);
+        Ok(HollowCylinderCheck {
+            body: bi as u16,
+            theory: FixedWallLame {
+                a: *inner_radius,
+                b: *outer_radius,
+                p: traction.abs(),
+                e: young_modulus,
+                nu: poisson_ratio,
+            },
+            time_fn,
+            tolerances: (*displacement_tolerance, *stress_tolerance),
+            first: None,
+        })
+    }
+
+    /// The increment of the state at time `t` (collective).
+    fn increment(&self, t: f64, model: &Model, coll: &Collective) -> Result<Increment, String> {
+        let ps = &model.particles;
+        let theory = FixedWallLame { p: self.theory.p * self.time_fn.eval(t), ..self.theory };
+        let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
+        let tol = 1e-9 * theory.b;
+        // The two innermost columns of points (by their radius at t = 0).
+        let first = -coll.max(&[mine.iter().map(|&k| -ps.x0[k][0]).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        let beyond = mine.iter().map(|&k| ps.x0[k][0]).filter(|&r| r > first + tol);
+        let second = -coll.max(&[beyond.map(|r| -r).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        // [n₁, Σu₁, n₂, Σu₂, Σσ_rr, Σσ_m, Σq over column 1, Σ V e², Σ V]
+        let mut local = [0.0; 9];
+        for &k in &mine {
+            let r0 = ps.x0[k][0];
+            let s = ps.stress[k];
+            let (rr, yy, tt) = (-s[0], -s[1], -s[3]);
+            for (col, at) in [(0, first), (2, second)] {
+                if (r0 - at).abs() <= tol {
+                    local[col] += 1.0;
+                    local[col + 1] += ps.disp[k][0];
+                }
+            }
+            if (r0 - first).abs() <= tol {
+                let m = (rr + yy + tt) / 3.0;
+                let q = (0.5 * ((rr - tt).powi(2) + (tt - yy).powi(2) + (yy - rr).powi(2)) + 3.0 * s[2] * s[2]).sqrt();
+                local[4] += rr;
+                local[5] += m;
+                local[6] += q;
+            }
+            let (_, srr, _, _) = theory.at(r0);
+            local[7] += ps.volume[k] * ((rr - srr) / srr).powi(2);
+            local[8] += ps.volume[k];
+        }
+        let s = coll.sum(&local)?;
+        if s[0] == 0.0 || s[2] == 0.0 {
+            return Err("the hollow cylinder's check needs two columns of points in its body".into());
+        }
+        let (u1, u2) = (s[1] / s[0], s[3] / s[2]);
+        let u_inner = u1 + (u2 - u1) * (theory.a - first) / (second - first);
+        Ok(Increment {
+            u_inner,
+            mp1: [s[4] / s[0], s[5] / s[0], s[6] / s[0], first],
+            rms: (s[7] / s[8]).sqrt(),
+            p: theory.p,
+            t,
+        })
+    }
+}
+
+impl Check for HollowCylinderCheck {
+    fn columns(&self) -> Vec<String> {
+        vec!["cylinder.u_inner".into(), "cylinder.sigma_rr_mp1".into()]
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+        let inc = self.increment(t, model, coll)?;
+        // The initial state (t = 0) is observed too; the first increment is the first step's.
+        if t > 0.0 {
+            self.first.get_or_insert(inc);
+        }
+        Ok(vec![inc.u_inner, inc.mp1[0]])
+    }
+
+    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+        let Some(inc) = self.first else {
+            return Err("the hollow cylinder's check saw no load step".into());
+        };
+        let theory = FixedWallLame { p: inc.p, ..self.theory };
+        let (u_star, ..) = theory.at(theory.a);
+        let (_, srr_star, ..) = theory.at(inc.mp1[3]);
+        let where_ = format!(
+            "after the first load step (t = {:.4e} s, p = {:.4e} Pa; a = {} m, b = {} m, ν = {})",
+            inc.t, inc.p, theory.a, theory.b, theory.nu
+        );
+        let rel = |x: f64, star: f64| (x - star).abs() / star.abs().max(f64::MIN_POSITIVE);
+        Ok((
+            vec![
+                (
+                    "u_inner_rel_error".into(),
+                    Metric::error(
+                        rel(inc.u_inner, u_star),
+                        self.tolerances.0,
+                        format!("u_r(a) = {:.6e} m vs Lamé {u_star:.6e} m {where_}", inc.u_inner),
+                    ),
+                ),
+                (
+                    "sigma_rr_mp1_rel_error".into(),
+                    Metric::error(
+                        rel(inc.mp1[0], srr_star),
+                        self.tolerances.1,
+                        format!(
+                            "Δσ_rr at the innermost points (r = {:.4} m) {:.6e} Pa vs Lamé {srr_star:.6e} Pa {where_}",
+                            inc.mp1[3], inc.mp1[0]
+                        ),
+                    ),
+                ),
+                (
+                    "sigma_rr_rms_rel_error".into(),
+                    Metric::error(inc.rms, self.tolerances.1, format!("volume-weighted RMS over the body {where_}")),
+                ),
+            ],
+            Vec::new(),
+        ))
+    }
+
+    fn results(&self) -> Vec<(String, f64)> {
+        let Some(inc) = self.first else { return Vec::new() };
+        let theory = FixedWallLame { p: inc.p, ..self.theory };
+        let per_100kpa = 1.0e5 / inc.p;
+        vec![
+            ("u_inner_per_100kPa".into(), inc.u_inner * per_100kpa),
+            ("sigma_rr_mp1_per_100kPa".into(), inc.mp1[0] * per_100kpa),
+            ("sigma_m_mp1_per_100kPa".into(), inc.mp1[1] * per_100kpa),
+            ("q_mp1_per_100kPa".into(), inc.mp1[2] * per_100kpa),
+            ("sigma_m_exact_per_100kPa".into(), theory.mean_stress() * per_100kpa),
+        ]
+    }
+
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(match self.first {
+            Some(i) => vec![i.u_inner, i.mp1[0], i.mp1[1], i.mp1[2], i.mp1[3], i.rms, i.p, i.t],
+            None => Vec::new(),
+        }))
+    }
+
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+        self.first = match state {
+            [] => None,
+            [u, a, b, c, d, rms, p, t] => {
+                Some(Increment { u_inner: *u, mp1: [*a, *b, *c, *d], rms: *rms, p: *p, t: *t })
+            }
+            _ => return Err("the hollow cylinder's check state has 8 values".into()),
+        };
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [001]'s constants and `../shared/seeds-001-002.md` Part B1's values follow, and the solution
+    /// meets its boundary conditions and Hooke's law in axial symmetry with ε_yy = 0.
+    #[test]
+    fn the_closed_form_has_the_paper_s_constants_and_meets_its_conditions() {
+        let l = FixedWallLame { a: 0.5, b: 1.5, p: 100.0, e: 1000.0, nu: 0.3 };
+        let (a, c) = l.constants();
+        assert!((a - 19.5652).abs() < 1e-4 && (c - 10.8696).abs() < 1e-4, "A = {a}, C = {c}");
+        assert!((l.at(0.5).0 - 0.045217).abs() < 1e-6);
+        assert!((l.at(0.5).1 - 100.0).abs() < 1e-9 && l.at(1.5).0.abs() < 1e-12);
+        assert!((l.mean_stress() - 18.841).abs() < 1e-3);
+        let lam = l.e * l.nu / ((1.0 + l.nu) * (1.0 - 2.0 * l.nu));
+        let g = l.e / (2.0 * (1.0 + l.nu));
+        let (r, h) = (0.8, 1e-6);
+        let (u, srr, stt, syy) = l.at(r);
+        let dudr = (l.at(r + h).0 - l.at(r - h).0) / (2.0 * h);
+        // Compression positive: σ = −(λ tr ε I + 2μ ε).
+        assert!((-(lam * (dudr + u / r) + 2.0 * g * dudr) - srr).abs() < 1e-6);
+        assert!((-(lam * (dudr + u / r) + 2.0 * g * u / r) - stt).abs() < 1e-6);
+        assert!((-(lam * (dudr + u / r)) - syy).abs() < 1e-6);
+    }
+}
