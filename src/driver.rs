@@ -380,6 +380,15 @@ pub fn test_jacobian(
     steps: usize,
     flip: Option<(usize, usize)>,
 ) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
+    let stiffness = req.case.stabilisation.stiffness;
+    if stiffness != crate::case::Stiffness::Particle {
+        return Err(RunError::Input(format!(
+            "key `stabilisation.stiffness`: test-jacobian checks the exact tangent, and `{}` replaces its material \
+             block by [001]'s approximate stiffness (Newton then converges linearly, by design); check the case \
+             with `--set stabilisation.stiffness=particle`",
+            serde_json::to_value(stiffness).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
+        )));
+    }
     let mut summary = Summary::new(req);
     let mut out = RunOutput::silent();
     let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;

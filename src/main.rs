@@ -315,7 +315,10 @@ fn test_jacobian(
     let result = driver::test_jacobian(&req, steps, flip);
     drop(petsc);
     drop(universe);
-    let (blocks, yielded) = result.map_err(|e| Failure { code: 1, message: e.message().to_string() })?;
+    let (blocks, yielded) = result.map_err(|e| Failure {
+        code: if matches!(e, driver::RunError::Input(_)) { 2 } else { 1 },
+        message: e.message().to_string(),
+    })?;
     println!("material points that have yielded: {yielded}");
     println!(
         "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps, scaled by D^-1/2 · D^-1/2)",

@@ -271,7 +271,8 @@ impl Particles<'_> {
             let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout)
                 .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
-            kernels::tangent(&pt, &nm, &mut block[..m * m]);
+            kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
+            step.stiffness.add(k, &pt, nm.w_force, &mut block[..m * m], m, layout.nd);
             self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);
         }
     }
@@ -511,7 +512,8 @@ impl<'a> Assembler<'a> {
                 let m = pt.size();
                 block[..m * m].fill(0.0);
                 buf[..m].fill(0.0);
-                kernels::stress::tangent(pt, &plain, &mut block[..m * m]);
+                kernels::stress::tangent_with(pt, &plain, &mut block[..m * m], step.stiffness.material(p));
+                step.stiffness.add(p, pt, 1.0, &mut block[..m * m], m, nd);
                 kernels::stress::residual(pt, &plain, &mut buf[..m]);
                 kernels::stress::pore_pressure::residual(pt, &plain, &mut buf[..m]);
                 for (n, &node) in nodes.iter().enumerate() {

@@ -33,6 +33,7 @@ pub mod dofs;
 pub mod pattern;
 mod splits;
 pub mod stencils;
+mod stiffness;
 
 pub use check::BlockCheck;
 pub use stencils::WELL_FILLED_FRACTION;
@@ -107,6 +108,8 @@ struct StepData {
     /// each, in increasing order.
     faces: Vec<kernels::DrainedFace>,
     face_owner: Vec<usize>,
+    /// The material stiffness of the Newton matrix (`stabilisation.stiffness`).
+    stiffness: stiffness::MappedStiffness,
 }
 
 impl StepData {
@@ -531,6 +534,8 @@ impl GridSystem {
             (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
         }
         self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
+        self.step.stiffness =
+            coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
         self.matrix_pattern(old_pattern, coll)
     }
 

@@ -659,6 +659,33 @@ pub struct Stabilisation {
     /// does not accumulate on the particles). Not with `patch_recovery`.
     #[serde(default)]
     pub pressure_update: PressureUpdate,
+    /// How the skeleton's material stiffness enters the Newton matrix ([001] §5,
+    /// `../shared/seeds-001-002.md` Parts A4–A6, docs/axisymmetry.md): `particle` (the default:
+    /// the exact tangent, integrated at the points), `w_star` (points weighted as if their cell
+    /// were exactly full, [001] Eq. 15), `gauss_mapping` (the points' moduli mapped to the cell's
+    /// nodes and from there to its 2 × 2 Gauss points, Eq. 19 with W), `double_mapping` (the same
+    /// with W*, Eq. 19) or `double_mapping_gimp` (with the local GIMP weights, Eq. 20). Every
+    /// option but `particle` is an approximate Jacobian: Newton converges to the same answer, at a
+    /// linear rate; with `-snes_type ksponly` a step is [001]'s single linear solve.
+    #[serde(default)]
+    pub stiffness: Stiffness,
+}
+
+/// The material stiffness of the Newton matrix (see [`Stabilisation::stiffness`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stiffness {
+    /// The exact tangent, integrated at the material points.
+    #[default]
+    Particle,
+    /// Particle integration with the weights W* = W omp/cmp ([001] Eq. 15).
+    WStar,
+    /// Gauss mapping GM ([001] Eq. 19 with W_p).
+    GaussMapping,
+    /// Double mapping DM ([001] Eq. 19 with W*_p).
+    DoubleMapping,
+    /// Double mapping with local GIMP weights DM-G ([001] Eq. 20).
+    DoubleMappingGimp,
 }
 
 /// How a particle's pore pressure follows a converged step (see [`Stabilisation::pressure_update`]).

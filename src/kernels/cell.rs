@@ -2,14 +2,40 @@
 //! Parts A5, A6): the particles' moduli mapped to the cell's nodes (D_i^e, [001] Eqs. 16 and 20),
 //! from there to the cell's 2 × 2 Gauss points (D_g, Eq. 17), and the cell's stiffness integrated at
 //! those points as in the finite element method (K_e, Eqs. 19 and 20). Pure functions on one cell of
-//! size h_x × h_y, nodes in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1); plane strain,
-//! moduli as 3 × 3 matrices on (ε_xx, ε_yy, γ_xy).
+//! size h_x × h_y, nodes in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1); moduli as
+//! 4 × 4 matrices on porompm's strain vector (ε_xx, ε_yy, γ_xy, ε_zz), ε_zz the hoop strain in axial
+//! symmetry (zero in plane strain). With B̄ the Gauss points' B takes its volumetric part from the
+//! cell centre (selective integration, `../shared/seeds-001-002.md` Part A8); in axial symmetry each
+//! Gauss point is weighted by 2πr_g and the hoop row of B is N_i(x_g)/r_g.
 //!
-//! Not yet used by the assembly (issue «Seed [001]»): this module holds the kernels and the
-//! checks of Part E items 3 and 4 (`tests` below).
+//! The assembly uses them one material point at a time (`stabilisation.stiffness`): the mapped
+//! stiffness is linear in the nodal moduli, so a cell's K_e is the sum of its points' shares.
+//! `tests` below hold the checks of Part E items 3 and 4.
 
-/// A 3 × 3 tangent on (ε_xx, ε_yy, γ_xy).
-pub type Moduli = [[f64; 3]; 3];
+use super::bbar;
+
+/// A 4 × 4 tangent on (ε_xx, ε_yy, γ_xy, ε_zz).
+pub type Moduli = [[f64; 4]; 4];
+
+/// One cell of the grid as the mapped stiffness sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct CellGeometry {
+    /// The cell's size [m].
+    pub h: [f64; 2],
+    /// The position of its lower-left node [m].
+    pub lo: [f64; 2],
+    /// B̄: the volumetric part of B from the cell centre.
+    pub bbar: bool,
+    /// Axial symmetry about x = 0 (x ≡ r).
+    pub axisymmetric: bool,
+}
+
+impl CellGeometry {
+    /// A plane-strain cell of size `h` without B̄ (its position does not matter).
+    pub fn plane(h: [f64; 2]) -> CellGeometry {
+        CellGeometry { h, lo: [0.0; 2], bbar: false, axisymmetric: false }
+    }
+}
 
 /// One particle's share of a cell in [`nodal_moduli`]: its weights of the cell's four nodes, its
 /// moduli and its integration weight.
@@ -39,7 +65,7 @@ pub fn q4(xi: [f64; 2], h: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
 /// `(weights of the four nodes, moduli, integration weight)`: the bilinear values N_i(x_p) with the
 /// weight W_p or W*_p (DM, GM), or the local GIMP weights S*^e_ip with W_p (DM-G).
 pub fn nodal_moduli(particles: impl IntoIterator<Item = CellShare>) -> [Moduli; 4] {
-    let mut d = [[[0.0; 3]; 3]; 4];
+    let mut d = [[[0.0; 4]; 4]; 4];
     for (w, dp, wp) in particles {
         for (di, wi) in d.iter_mut().zip(w) {
             for (row, prow) in di.iter_mut().zip(&dp) {
@@ -52,37 +78,47 @@ pub fn nodal_moduli(particles: impl IntoIterator<Item = CellShare>) -> [Moduli; 
     d
 }
 
-/// [001] Eqs. 17 and 19: the stiffness of a cell of size `h` (8 × 8 on (u_x, u_y) of its four
-/// nodes) from its nodal moduli, K_e = Σ_g B_gᵀ D_g B_g |J| with D_g = Σ_i N_i(x_g) D_i^e and
-/// |J| = h_x h_y / 4 (the Gauss weights are 1).
-pub fn mapped_stiffness(h: [f64; 2], d_nodes: &[Moduli; 4]) -> [[f64; 8]; 8] {
+/// [001] Eqs. 17 and 19: the stiffness of a cell (8 × 8 on (u_x, u_y) of its four nodes) from its
+/// nodal moduli, K_e = Σ_g B_gᵀ D_g B_g |J| m(r_g) with D_g = Σ_i N_i(x_g) D_i^e, |J| = h_x h_y / 4
+/// (the Gauss weights are 1) and m the geometry's measure (1, or 2πr_g in axial symmetry).
+pub fn mapped_stiffness(cell: &CellGeometry, d_nodes: &[Moduli; 4]) -> [[f64; 8]; 8] {
+    let h = cell.h;
     let det = h[0] * h[1] / 4.0;
     let mut k = [[0.0; 8]; 8];
+    let rc = cell.lo[0] + 0.5 * h[0];
+    let (_, gc) = q4([0.0, 0.0], h);
     for xi in GAUSS_2X2 {
         let (n, g) = q4(xi, h);
-        let mut dg = [[0.0; 3]; 3];
+        let rg = cell.lo[0] + 0.5 * h[0] * (1.0 + xi[0]);
+        let (measure, hoop, hoop_c) =
+            if cell.axisymmetric { (std::f64::consts::TAU * rg, 1.0 / rg, 0.25 / rc) } else { (1.0, 0.0, 0.0) };
+        let mut dg = [[0.0; 4]; 4];
         for (ni, di) in n.iter().zip(d_nodes) {
-            for r in 0..3 {
-                for c in 0..3 {
+            for r in 0..4 {
+                for c in 0..4 {
                     dg[r][c] += ni * di[r][c];
                 }
             }
         }
-        // B_i = [[g_x, 0], [0, g_y], [g_y, g_x]].
-        let b = |i: usize| -> [[f64; 2]; 3] { [[g[i][0], 0.0], [0.0, g[i][1]], [g[i][1], g[i][0]]] };
-        for i in 0..4 {
-            let bi = b(i);
-            for j in 0..4 {
-                let bj = b(j);
+        let b: [[[f64; 2]; 4]; 4] = std::array::from_fn(|i| {
+            let t = n[i] * hoop;
+            if cell.bbar {
+                bbar(g[i], gc[i], (t, hoop_c))
+            } else {
+                bbar(g[i], g[i], (t, t))
+            }
+        });
+        for (i, bi) in b.iter().enumerate() {
+            for (j, bj) in b.iter().enumerate() {
                 for a in 0..2 {
                     for c in 0..2 {
                         let mut s = 0.0;
-                        for r in 0..3 {
-                            for q in 0..3 {
+                        for r in 0..4 {
+                            for q in 0..4 {
                                 s += bi[r][a] * dg[r][q] * bj[q][c];
                             }
                         }
-                        k[2 * i + a][2 * j + c] += s * det;
+                        k[2 * i + a][2 * j + c] += s * det * measure;
                     }
                 }
             }
@@ -102,7 +138,8 @@ mod tests {
     fn moduli() -> Moduli {
         let (e, nu) = (1000.0, 0.3);
         let f = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
-        [[f * (1.0 - nu), f * nu, 0.0], [f * nu, f * (1.0 - nu), 0.0], [0.0, 0.0, e / (2.0 * (1.0 + nu))]]
+        let (d11, d12, g) = (f * (1.0 - nu), f * nu, e / (2.0 * (1.0 + nu)));
+        [[d11, d12, 0.0, d12], [d12, d11, 0.0, d12], [0.0, 0.0, g, 0.0], [d12, d12, 0.0, d11]]
     }
 
     /// The finite-element value: an interior node of a uniform Q4 mesh, (4/3)(D₁₁ + G) √2.
@@ -185,7 +222,7 @@ mod tests {
                     }
                 }
                 for ((ci, cj), list) in cells {
-                    let ke = mapped_stiffness(h, &nodal_moduli(list));
+                    let ke = mapped_stiffness(&CellGeometry::plane(h), &nodal_moduli(list));
                     for (a, node) in [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)].into_iter().enumerate() {
                         let e = diag.entry(node).or_default();
                         e[0] += ke[2 * a][2 * a];

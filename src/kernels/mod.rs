@@ -596,10 +596,16 @@ pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
 /// The tangent block d(residual)/d(Δd) of one particle, row-major `(nn·nd)²`. Every entry of
 /// `out` is written (the zero couplings too), so the buffer may be reused from particle to particle.
 pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    tangent_with(pt, nm, out, 1.0);
+}
+
+/// [`tangent`] with the skeleton's material stiffness scaled by `material` (see
+/// [`stress::tangent_with`]).
+pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
     let m = pt.size();
     out[..m * m].fill(0.0);
     inertia::tangent(pt, nm, out);
-    stress::tangent(pt, nm, out);
+    stress::tangent_with(pt, nm, out, material);
     stress::pore_pressure::tangent(pt, nm, out);
     if pt.layout.w.is_some() {
         inertia::drag::tangent(pt, nm, out);

@@ -53,6 +53,14 @@ pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 
 /// Adds the u–u tangent of the effective-stress term (material, volume and geometric parts).
 pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    tangent_with(pt, nm, out, 1.0);
+}
+
+/// [`tangent`] with the material part V B̄'ᵀ D_alg ∂Δε/∂Δu scaled by `material`: 1 is the exact
+/// tangent; [001]'s modified weights W* scale it by omp/cmp, and its mapped stiffnesses replace
+/// it (0) by their cell kernels ([`super::cell`]). The rotation of the objective update and the
+/// volume and geometric parts are kept.
+pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
     let (nd, m) = (pt.layout.nd, pt.size());
     let v = pt.volume_new() * nm.w_force;
     let s = &pt.upd.stress;
@@ -68,7 +76,7 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let dt = pt.kin.theta_derivative(bl);
         for r in 0..4 {
             for d in 0..2 {
-                a[l][r][d] = t_drot[r] * dt[d] + (0..4).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+                a[l][r][d] = t_drot[r] * dt[d] + material * (0..4).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
             }
         }
     }

@@ -55,6 +55,8 @@ pub struct Model {
     pub pressure_projection: Option<f64>,
     /// Plane strain or axial symmetry (with its particle weights).
     pub geometry: shape::Geometry,
+    /// The material stiffness of the Newton matrix ([001] §5).
+    pub stiffness: crate::case::Stiffness,
 }
 
 /// The geometry of a case.
@@ -154,6 +156,7 @@ impl Model {
             },
             pressure_update: case.stabilisation.pressure_update,
             geometry,
+            stiffness: case.stabilisation.stiffness,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }

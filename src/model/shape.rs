@@ -290,7 +290,7 @@ pub fn local_gimp(grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (LocalGimp, usize) 
         for c in first..=last {
             let a = o + c as f64 * h;
             let (s, t) = (lo.max(a), hi.min(a + h));
-            if t > s && count[d] < 2 {
+            if t - s > 1e-12 * h && count[d] < 2 {
                 let right = ((t - a).powi(2) - (s - a).powi(2)) / (2.0 * h);
                 let left = (t - s) - right;
                 per_dir[d][count[d]] = (c as u32, left / (2.0 * lp[d]), right / (2.0 * lp[d]));

@@ -1,0 +1,161 @@
+//! The skeleton's material stiffness in the Newton matrix, as `stabilisation.stiffness` asks
+//! ([001] §5; `../shared/seeds-001-002.md` Parts A4–A6, A8): each material point's share of the
+//! cells it maps to, prepared once per step on x_n.
+//!
+//! * `particle`: the exact tangent (share: none, material factor 1).
+//! * `w_star`: particle integration with W*_p = W_p omp/cmp ([001] Eq. 15): the point's material
+//!   tangent scaled by omp/cmp, omp the nominal number of points of a full cell (n² for n × n per
+//!   cell, from the point's initial half-widths) and cmp the number of points whose centre is in
+//!   its cell now.
+//! * `gauss_mapping`, `double_mapping`: the point's moduli go to the four nodes of the cell holding
+//!   its centre with the bilinear weights N_i(x_p) and the integration weight W_p = A_p/|J| (GM)
+//!   or W*_p (DM), [001] Eqs. 16 and 19.
+//! * `double_mapping_gimp`: to the nodes of every cell its domain overlaps, with the local GIMP
+//!   weights S*^e_ip of `shape::local_gimp` and W_p, Eq. 20.
+//!
+//! K_e = Σ_g B_gᵀ (Σ_i N_i(x_g) Σ_p w_ip D_p) B_g |J| is linear in the points' shares, so each point
+//! adds its own K_e^p into its own tangent block (`kernels::cell::mapped_stiffness` with
+//! D_i = w_ip D_p), and extensions, bands and fixed dofs treat it like the rest of the block. A
+//! point's cell is on its rank (points belong to the rank that owns the cell holding their
+//! centre), so cmp needs no communication. A_p is the area in the (x, y) plane, so that in axial
+//! symmetry r enters once, through the Gauss points' 2πr_g.
+//!
+//! D_p is the point's consistent tangent (the paper uses the elastic one). Every option but
+//! `particle` gives an approximate Jacobian: Newton converges at a linear rate to the answer of
+//! the residual, which is unchanged; `-snes_type ksponly` makes each step the single linear solve
+//! of [001].
+
+use super::stencils::Stencils;
+use crate::case::Stiffness;
+use crate::kernels::cell::{mapped_stiffness, q4, CellGeometry, Moduli};
+use crate::kernels::Point;
+use crate::model::{shape, Model};
+use petsc::GhostedRange;
+
+/// A cell (its lower-left node) and a point's weights w_i W_p of its four nodes.
+type CellWeights = ((usize, usize), [f64; 4]);
+
+/// One point's share of one cell.
+#[derive(Debug, Clone, Copy)]
+struct Share {
+    /// The cell's four nodes as slots of the point's stencil, in `kernels::cell`'s order.
+    slots: [u8; 4],
+    /// w_i W_p: the point's weights of the nodes times its integration weight.
+    weights: [f64; 4],
+    /// The cell.
+    cell: CellGeometry,
+}
+
+/// The mapped-stiffness shares of a step's points.
+#[derive(Debug, Default)]
+pub(super) struct MappedStiffness {
+    /// The factor of each point's own material tangent (1, omp/cmp or 0).
+    material: Vec<f64>,
+    shares: Vec<Share>,
+    /// Point k's shares are `shares[offsets[k]..offsets[k + 1]]`.
+    offsets: Vec<usize>,
+}
+
+impl MappedStiffness {
+    /// The shares of this rank's points for the model's option (empty for `particle`).
+    pub(super) fn prepare(model: &Model, ghost: &GhostedRange, st: &Stencils) -> Result<MappedStiffness, String> {
+        let mut out = MappedStiffness::default();
+        if model.stiffness == Stiffness::Particle {
+            return Ok(out);
+        }
+        let (g, ps) = (&model.grid, &model.particles);
+        let jac = g.h[0] * g.h[1] / 4.0;
+        // cmp: the points whose centre is in each cell, keyed by the cell's lower-left node.
+        let mut count = vec![0u32; ghost.len()];
+        let cell_key = |k: usize| g.cell_of(ps.x[k]).and_then(|(i, j)| ghost.node(i, j));
+        for k in 0..ps.len() {
+            if let Some(l) = cell_key(k) {
+                count[l] += 1;
+            }
+        }
+        let w_star = |k: usize| -> f64 {
+            let omp = (g.h[0] * g.h[1] / (4.0 * ps.lp0[k][0] * ps.lp0[k][1])).round();
+            cell_key(k).map_or(1.0, |l| omp / count[l].max(1) as f64)
+        };
+        let geometry = |i: usize, j: usize| CellGeometry {
+            h: g.h,
+            lo: g.node_position(i, j),
+            bbar: model.bbar,
+            axisymmetric: model.geometry.axisymmetric(),
+        };
+        out.offsets.push(0);
+        for k in 0..ps.len() {
+            let w_p = model.area(k) / jac;
+            let (factor, cells): (f64, Vec<CellWeights>) = match model.stiffness {
+                Stiffness::Particle => unreachable!("handled above"),
+                Stiffness::WStar => (w_star(k), Vec::new()),
+                Stiffness::GaussMapping | Stiffness::DoubleMapping => {
+                    let (i, j) = g.cell_of(ps.x[k]).ok_or_else(|| outside(model, k))?;
+                    let lo = g.node_position(i, j);
+                    let xi = [2.0 * (ps.x[k][0] - lo[0]) / g.h[0] - 1.0, 2.0 * (ps.x[k][1] - lo[1]) / g.h[1] - 1.0];
+                    let w = if model.stiffness == Stiffness::DoubleMapping { w_star(k) * w_p } else { w_p };
+                    (0.0, vec![((i, j), q4(xi, g.h).0.map(|n| n * w))])
+                }
+                Stiffness::DoubleMappingGimp => {
+                    let (list, n) = shape::local_gimp(g, ps.x[k], ps.lp[k]);
+                    let cells = list[..n].iter().map(|&((i, j), w)| ((i as usize, j as usize), w.map(|s| s * w_p)));
+                    (0.0, cells.collect())
+                }
+            };
+            out.material.push(factor);
+            let (nodes, _) = st.get(k);
+            for ((i, j), weights) in cells {
+                let mut slots = [0u8; 4];
+                for (s, (di, dj)) in slots.iter_mut().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {
+                    let l = ghost.node(i + di, j + dj).ok_or_else(|| outside(model, k))?;
+                    *s = nodes.iter().position(|&n| n as usize == l).ok_or_else(|| {
+                        format!(
+                            "material point {}: node ({}, {}) of a cell it maps its stiffness to is not in its stencil",
+                            ps.id[k],
+                            i + di,
+                            j + dj
+                        )
+                    })? as u8;
+                }
+                out.shares.push(Share { slots, weights, cell: geometry(i, j) });
+            }
+            out.offsets.push(out.shares.len());
+        }
+        Ok(out)
+    }
+
+    /// The factor of point `k`'s own material tangent (1 for the exact tangent).
+    pub(super) fn material(&self, k: usize) -> f64 {
+        self.material.get(k).copied().unwrap_or(1.0)
+    }
+
+    /// Adds point `k`'s mapped stiffness, times `weight` (the scheme's w_f), to the u–u entries of
+    /// its tangent `block` (m × m, `nd` dofs per node), with the moduli of `pt`'s stress update.
+    pub(super) fn add(&self, k: usize, pt: &Point, weight: f64, block: &mut [f64], m: usize, nd: usize) {
+        let Some(shares) = self.offsets.get(k + 1).map(|&hi| &self.shares[self.offsets[k]..hi]) else { return };
+        let d: Moduli = pt.upd.tangent;
+        for share in shares {
+            let d_nodes: [Moduli; 4] = std::array::from_fn(|i| d.map(|row| row.map(|v| v * share.weights[i])));
+            let ke = mapped_stiffness(&share.cell, &d_nodes);
+            for (a, &sa) in share.slots.iter().enumerate() {
+                for (b, &sb) in share.slots.iter().enumerate() {
+                    for c in 0..2 {
+                        for e in 0..2 {
+                            block[(sa as usize * nd + c) * m + sb as usize * nd + e] +=
+                                weight * ke[2 * a + c][2 * b + e];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The error of a point whose cell is not on this rank's grid.
+fn outside(model: &Model, k: usize) -> String {
+    let ps = &model.particles;
+    format!(
+        "material point {} at ({:.4}, {:.4}) m: its cell is outside this rank's ghost region",
+        ps.id[k], ps.x[k][0], ps.x[k][1]
+    )
+}
