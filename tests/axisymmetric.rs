@@ -176,15 +176,18 @@ fn the_hollow_cylinder_gives_the_same_answers_on_two_ranks() {
 }
 
 /// Bad axisymmetric input stops before the run with a message naming the key: a grid reaching
-/// r < 0, a boundary taking the axis's name, a plane-strain reference on an axisymmetric case and
-/// the hollow cylinder's reference on a plane-strain one.
+/// r < 0, a boundary taking the axis's name, a plane-strain reference on an axisymmetric case, the
+/// hollow cylinder's reference on a plane-strain one, and [001]'s CMPM recovery with B̄ or in a
+/// two-phase case.
 #[test]
 fn bad_axisymmetric_input_is_refused_with_a_clear_message() {
-    let cases: [(&str, &[&str], &str); 4] = [
+    let cases: [(&str, &[&str], &str); 6] = [
         (CYLINDER, &["grid.origin=[-0.1,0.0]"], "grid must start at x ≥ 0"),
         (CYLINDER, &["boundaries.0.name=axis"], "the name `axis` is taken"),
         (CYLINDER, &["analysis.geometry=plane_strain"], "needs `analysis.geometry = \"axisymmetric\"`"),
         ("cases/lame_cylinder.toml", &["analysis.geometry=axisymmetric"], "is a plane-strain solution"),
+        (CYLINDER, &["stabilisation.stress_recovery=cmpm", "stabilisation.bbar=true"], "exclude each other"),
+        ("cases/terzaghi.toml", &["stabilisation.stress_recovery=cmpm"], "`cmpm` is for one_phase analyses"),
     ];
     for (i, (case, sets, message)) in cases.iter().enumerate() {
         let r = run_case(case, &out_dir(&format!("bad-{i}")), &set_args(sets));

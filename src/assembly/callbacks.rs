@@ -182,7 +182,9 @@ impl Particles<'_> {
         let (nodes, basis) = step.stencils.get(k);
         let states = node_states(step, k, xl);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
-        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, step.layout.expect("prepared"));
+        let strain = step.stencils.strain_of(k);
+        let layout = step.layout.expect("prepared");
+        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
         f(&pt.with_faces(step.faces_of(k), &states[..nodes.len()]))
     }
 
@@ -268,7 +270,8 @@ impl Particles<'_> {
             let input = particle_input(self.model, step, k);
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
             let states = node_states(step, k, xl);
-            let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, layout)
+            let strain = step.stencils.strain_of(k);
+            let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout)
                 .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));

@@ -528,6 +528,9 @@ impl GridSystem {
         let weak = self.drains_weakly(model, dt);
         let dofs = self.dof_map(model, active, (t_new - dt, t_new), &nodal, weak, coll)?;
         coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
+        if model.stress_recovery == crate::case::StressRecovery::Cmpm {
+            coll.agree(stencils::cmpm_patches(&mut st, model, &self.ghost, &dofs))?;
+        }
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
         if weak {
@@ -1430,7 +1433,8 @@ impl GridSystem {
         let states = callbacks::node_states(&self.step, k, &self.step.solution);
         let input = callbacks::particle_input(model, &self.step, k);
         let mat = &model.materials[model.particles.material[k] as usize];
-        let pt = kernels::Point::new(basis, &states[..nodes.len()], &input, &mat.model, self.layout)
+        let strain = self.step.stencils.strain_of(k);
+        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
         StepResult::of(&pt)
     }

@@ -25,7 +25,7 @@
 
 use super::dofs::DofMap;
 use crate::kernels::{self, NodeBasis};
-use crate::model::shape::{self, Basis};
+use crate::model::shape::{self, Basis, MAX_STENCIL};
 use crate::model::Model;
 use petsc::GhostedRange;
 
@@ -66,6 +66,9 @@ pub struct Stencils {
     pub eff_nodes: Vec<u32>,
     pub ext_offsets: Vec<usize>,
     pub ext: Vec<Extension>,
+    /// The strain-recovery operators of each raw slot (`kernels::Point::with_recovery`), flat
+    /// like `basis`; empty when the strain is recovered with the basis itself.
+    pub strain: Vec<NodeBasis>,
 }
 
 impl Stencils {
@@ -83,6 +86,17 @@ impl Stencils {
     pub fn get(&self, k: usize) -> (&[u32], &[NodeBasis]) {
         let r = self.offsets[k]..self.offsets[k + 1];
         (&self.nodes[r.clone()], &self.basis[r])
+    }
+
+    /// The strain-recovery operators of particle `k`'s raw slots: its CMPM patch functions
+    /// ([`cmpm_patches`]) or, by default, its basis.
+    pub fn strain_of(&self, k: usize) -> &[NodeBasis] {
+        let r = self.offsets[k]..self.offsets[k + 1];
+        if self.strain.is_empty() {
+            &self.basis[r]
+        } else {
+            &self.strain[r]
+        }
     }
 
     /// Effective nodes of particle `k` (its raw nodes first).
@@ -365,6 +379,110 @@ pub fn extension(
         }
     }
     None
+}
+
+/// [001]'s CMPM strain recovery (`stabilisation.stress_recovery = "cmpm"`, [001] Eqs. 21–24,
+/// `../shared/seeds-001-002.md` Part A7; step 4 of a step, before the extensions): for each point,
+/// the patch of its centre's cell in each direction is cubic when the node columns (rows) on both
+/// sides of the cell are well filled, quadratic when one side is, linear otherwise (a neighbour
+/// that is outside the grid or barely filled would pull the strain towards its extended or absent
+/// motion); a corner of the tensor-product patch that is not well filled drops the y side of the
+/// patch on its side first, then the x side. The patch's nodes join the point's raw stencil (with
+/// zero basis: they carry no force or mass) and `strain` holds the patch functions' gradients
+/// ∇N²_j(x_p) = (2/h) dN/dξ and, in axial symmetry, the hoop operators N²_j(x_p)/r_p.
+pub fn cmpm_patches(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &DofMap) -> Result<(), String> {
+    use crate::model::cmpm::{functions, Patch1d};
+    let (g, ps) = (&model.grid, &model.particles);
+    let well = |i: i64, j: i64| -> bool {
+        i >= 0 && j >= 0 && ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
+    };
+    let mut out = Stencils { offsets: vec![0], ..Default::default() };
+    for k in 0..st.len() {
+        let x = ps.x[k];
+        let (ci, cj) =
+            g.cell_of(x).ok_or_else(|| format!("material point {}: its centre has left the grid", ps.id[k]))?;
+        let (ci, cj) = (ci as i64, cj as i64);
+        let col = |i: i64| well(i, cj) && well(i, cj + 1);
+        let row = |j: i64| well(ci, j) && well(ci + 1, j);
+        let (mut left, mut right, mut below, mut above) = (col(ci - 1), col(ci + 2), row(cj - 1), row(cj + 2));
+        // Corners of the tensor product: each must be well filled too.
+        for _ in 0..4 {
+            let xs: Vec<i64> = [(left, ci - 1), (true, ci), (true, ci + 1), (right, ci + 2)]
+                .iter()
+                .filter_map(|&(on, i)| on.then_some(i))
+                .collect();
+            let ys: Vec<i64> = [(below, cj - 1), (true, cj), (true, cj + 1), (above, cj + 2)]
+                .iter()
+                .filter_map(|&(on, j)| on.then_some(j))
+                .collect();
+            let Some(&(bi, bj)) =
+                xs.iter().flat_map(|&i| ys.iter().map(move |&j| (i, j))).find(|&(i, j)| !well(i, j)).as_ref()
+            else {
+                break;
+            };
+            if bj == cj - 1 && below {
+                below = false;
+            } else if bj == cj + 2 && above {
+                above = false;
+            } else if bi == ci - 1 {
+                left = false;
+            } else {
+                right = false;
+            }
+        }
+        let patch = |minus: bool, plus: bool| match (minus, plus) {
+            (true, true) => Patch1d::Cubic,
+            (false, true) => Patch1d::QuadraticPlus,
+            (true, false) => Patch1d::QuadraticMinus,
+            (false, false) => Patch1d::Linear,
+        };
+        let (px, py) = (patch(left, right), patch(below, above));
+        let lo = g.node_position(ci as usize, cj as usize);
+        let xi = [2.0 * (x[0] - lo[0]) / g.h[0] - 1.0, 2.0 * (x[1] - lo[1]) / g.h[1] - 1.0];
+        let ((nx, dx), (ny, dy)) = (functions(px, xi[0]), functions(py, xi[1]));
+        // The patch's first node: one cell to the − side where the patch reaches there.
+        let (ix0, jy0) = (ci - i64::from(left), cj - i64::from(below));
+        let hoop = if model.geometry.axisymmetric() { 1.0 / x[0] } else { 0.0 };
+        let (nodes, basis) = st.get(k);
+        let mut nodes = nodes.to_vec();
+        let mut basis = basis.to_vec();
+        let mut strain = vec![NodeBasis::default(); nodes.len()];
+        for b in 0..py.nodes().len() {
+            for a in 0..px.nodes().len() {
+                let (i, j) = (ix0 + a as i64, jy0 + b as i64);
+                let l = ghost.node(i as usize, j as usize).ok_or_else(|| {
+                    format!(
+                        "material point {}: node ({i}, {j}) of its CMPM patch is outside this rank's ghost region",
+                        ps.id[k]
+                    )
+                })? as u32;
+                let slot = match nodes.iter().position(|&n| n == l) {
+                    Some(s) => s,
+                    None if nodes.len() < MAX_STENCIL => {
+                        nodes.push(l);
+                        basis.push(NodeBasis::default());
+                        strain.push(NodeBasis::default());
+                        nodes.len() - 1
+                    }
+                    None => {
+                        return Err(format!(
+                            "material point {}: its CMPM patch and stencil exceed {MAX_STENCIL} nodes",
+                            ps.id[k]
+                        ))
+                    }
+                };
+                let e = [dx[a] * 2.0 / g.h[0] * ny[b], nx[a] * dy[b] * 2.0 / g.h[1]];
+                let t = nx[a] * ny[b] * hoop;
+                strain[slot] = NodeBasis { s: 0.0, g: e, gv: e, t, tv: t };
+            }
+        }
+        out.nodes.extend(nodes);
+        out.basis.extend(basis);
+        out.strain.extend(strain);
+        out.offsets.push(out.nodes.len());
+    }
+    *st = out;
+    Ok(())
 }
 
 /// Adds the effective stencils and extensions (step 4 of a step) for the dof map `dofs` and the

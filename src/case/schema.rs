@@ -669,6 +669,25 @@ pub struct Stabilisation {
     /// linear rate; with `-snes_type ksponly` a step is [001]'s single linear solve.
     #[serde(default)]
     pub stiffness: Stiffness,
+    /// How a point's strain increment is recovered from the nodal displacements ([001] §5.5):
+    /// `basis` (the default: with the gradients of the point's basis functions, as its forces are
+    /// integrated) or `cmpm` (composite MPM: the higher-order Lagrange patch functions of [001]
+    /// Eqs. 22–23 (corrected) over the point's cell and its well-filled neighbours, cubic, quadratic
+    /// or linear per direction; one-phase, without B̄). The residual keeps the basis for the forces
+    /// and its tangent stays exact.
+    #[serde(default)]
+    pub stress_recovery: StressRecovery,
+}
+
+/// How a point's strain is recovered (see [`Stabilisation::stress_recovery`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StressRecovery {
+    /// With the gradients of the point's basis functions.
+    #[default]
+    Basis,
+    /// With [001]'s CMPM patch functions.
+    Cmpm,
 }
 
 /// The material stiffness of the Newton matrix (see [`Stabilisation::stiffness`]).

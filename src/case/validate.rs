@@ -150,6 +150,22 @@ pub fn validate(c: &Case) -> R {
         }
     }
 
+    if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
+        if two_phase {
+            return Err("key `stabilisation.stress_recovery`: `cmpm` is for one_phase analyses ([001] is one-phase; \
+                        in the coupled systems the continuity equation's divergence would no longer be the \
+                        transpose of the pressure's force)"
+                .into());
+        }
+        if c.stabilisation.bbar {
+            return Err(
+                "keys `stabilisation.stress_recovery = \"cmpm\"` and `stabilisation.bbar = true` exclude each \
+                        other: the CMPM patch recovers the whole strain, B̄ would replace its volumetric part"
+                    .into(),
+            );
+        }
+    }
+
     // Grid.
     finite2("grid.origin", c.grid.origin)?;
     positive("grid.size[0]", c.grid.size[0])?;

@@ -470,6 +470,14 @@ pub struct Point<'a> {
     pub spatial: [([f64; 2], [f64; 2]); MAX_NODES],
     /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain).
     pub hoop: [(f64, f64); MAX_NODES],
+    /// The operators the strain is recovered with (see [`Point::with_recovery`]): the basis
+    /// itself, or [001]'s CMPM patch functions; the kinematics and every derivative of them use
+    /// these, the forces use `basis`.
+    pub strain: &'a [NodeBasis],
+    /// `spatial` of the strain operators.
+    pub strain_spatial: [([f64; 2], [f64; 2]); MAX_NODES],
+    /// `hoop` of the strain operators.
+    pub strain_hoop: [(f64, f64); MAX_NODES],
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
@@ -508,8 +516,25 @@ impl<'a> Point<'a> {
         model: &Constitutive,
         layout: Layout,
     ) -> Point<'a> {
+        Point::with_recovery(basis, basis, states, part, model, layout)
+    }
+
+    /// [`Point::new`] with the strain recovered by the operators `strain` (one per node of
+    /// `basis`, in its order; its `g`, `gv`, `t`, `tv` are used, its `s` is not): the step's
+    /// deformation gradient is F = I + Σ Δu_i ⊗ e_i, e_i = `strain[i].g`, and so the strain
+    /// increment the soil model sees, the rotation and the volume change; the forces keep the
+    /// basis, f_i = B̄'_iᵀσ V. [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
+    /// passes its patch functions; `strain = basis` is the usual point.
+    pub fn with_recovery(
+        basis: &'a [NodeBasis],
+        strain: &'a [NodeBasis],
+        states: &[NodeState],
+        part: &'a ParticleInput,
+        model: &Constitutive,
+        layout: Layout,
+    ) -> Point<'a> {
         let interp = interpolate(basis, states, &part.pred, layout);
-        let kin = Kinematics::new(basis, states.iter().map(|s| [s.d[0], s.d[1]]));
+        let kin = Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]));
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         let upd = model.update(&rotated, part.eps_pd, &kin.deps);
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
@@ -517,6 +542,13 @@ impl<'a> Point<'a> {
         for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
             *s = kin.spatial(b);
             *t = kin.hoop(b);
+        }
+        let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
+        if !std::ptr::eq(strain, basis) {
+            for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
+                *s = kin.spatial(b);
+                *t = kin.hoop(b);
+            }
         }
         Point {
             basis,
@@ -528,6 +560,9 @@ impl<'a> Point<'a> {
             upd,
             spatial,
             hoop,
+            strain,
+            strain_spatial,
+            strain_hoop,
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],

@@ -12,6 +12,10 @@
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
 //!
+//! Every derivative with respect to Δu_l goes through node l's strain operators
+//! ([`super::Point::strain`], `strain_spatial`, `strain_hoop`): the basis itself, or [001]'s CMPM
+//! patch functions, which recover the strain while the forces keep the basis.
+//!
 //! Axial symmetry adds the hoop stress to the radial force, f_i,r += V_{n+1}(dev σ'_θθ T'_i +
 //! σ'_m T̄'_i) (B̄'ᵀσ' with the hoop row of [`super::bbar`]), ∂J_v/∂Δu_l,r gains J_v T̄'_l, and
 //! ∂T'_i/∂Δu_l,r = −T'_i T'_l (T' = T/F_θθ) gives the geometric part
@@ -71,7 +75,7 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
     let t_drot: [f64; 4] = std::array::from_fn(|r| (0..4).map(|q| t_mat[r][q] * drot[q]).sum());
     // A_l = ∂σ'/∂Δu_l (4 × 2) for every node.
     let mut a = [[[0.0; 2]; 4]; super::MAX_NODES];
-    for (l, bl) in pt.basis.iter().enumerate() {
+    for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
         let de = pt.kin.deps_derivative(bl);
         let dt = pt.kin.theta_derivative(bl);
         for r in 0..4 {
@@ -88,8 +92,9 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
         let mut tk = traction(&dev, pm, gk, gvk);
         tk[0] += hoop_force(s, pm, hk);
         for l in 0..pt.basis.len() {
-            let (gl, gvl) = pt.spatial[l];
-            let hl = pt.hoop[l];
+            // Derivatives with respect to Δu_l go through the strain operators of node l.
+            let (gl, gvl) = pt.strain_spatial[l];
+            let hl = pt.strain_hoop[l];
             let dev_gl = [dev[0][0] * gl[0] + dev[0][1] * gl[1], dev[1][0] * gl[0] + dev[1][1] * gl[1]];
             // ∂J_v/∂Δu_l / J_v: the in-plane divergence and, radially, the hoop term.
             let djv = [gvl[0] + hl.1, gvl[1]];
@@ -158,7 +163,7 @@ pub mod pore_pressure {
             let (gvk, tk) = (pt.spatial[k].1, pt.hoop[k].1);
             let divk = [gvk[0] + tk, gvk[1]];
             for (l, bl) in pt.basis.iter().enumerate() {
-                let (gvl, tl) = (pt.spatial[l].1, pt.hoop[l].1);
+                let (gvl, tl) = (pt.strain_spatial[l].1, pt.strain_hoop[l].1);
                 for c in 0..2 {
                     let ru = (k * nd + c) * m;
                     if let Some(p) = pt.layout.p {

@@ -221,17 +221,32 @@ fn models() -> Vec<(&'static str, Constitutive, [f64; 4])> {
     ]
 }
 
+/// Strain operators that differ from [`sample_in`]'s basis (standing for [001]'s CMPM patch
+/// functions, see [`Point::with_recovery`]), with hoop operators if `hoop`.
+fn sample_strain(nn: usize, hoop: bool) -> Vec<NodeBasis> {
+    (0..nn)
+        .map(|k| {
+            let x = k as f64 + 0.5;
+            let g = [(x * 0.8).sin() * 2.5, (x * 1.6).cos() * 1.8];
+            let t = if hoop { 0.3 + 0.2 * (x * 0.5).sin() } else { 0.0 };
+            NodeBasis { s: 0.0, g, gv: g, t, tv: t }
+        })
+        .collect()
+}
+
 /// Runs the finite-difference check of one term (with the hoop operators of an axisymmetric
-/// point if `hoop`); returns the blocks.
+/// point if `hoop`, and with the strain recovered by other operators than the basis if
+/// `recovery`); returns the blocks.
 fn check_term(
     term: &Term,
     model: &Constitutive,
     stress: [f64; 4],
     layout: Layout,
     nm: &Scheme,
-    hoop: bool,
+    (hoop, recovery): (bool, bool),
 ) -> Vec<BlockError> {
     let basis = sample_in(6, hoop);
+    let strain = if recovery { sample_strain(6, hoop) } else { basis.clone() };
     let nd = layout.nd;
     let m = basis.len() * nd;
     let nm = *nm;
@@ -239,15 +254,15 @@ fn check_term(
     p.stress = stress;
     let d0 = increments(m, layout);
     let faces = sample_faces(basis.len());
-    let res = |d: &[f64]| {
-        let st = states(d, nd, &nm);
-        let pt = Point::new(&basis, &st, &p, model, layout).with_faces(&faces, &st);
+    let point = |st: &[NodeState]| -> Vec<f64> {
+        let pt = Point::with_recovery(&basis, &strain, st, &p, model, layout).with_faces(&faces, st);
         let mut r = vec![0.0; m];
         (term.1)(&pt, &nm, &mut r);
         r
     };
+    let res = |d: &[f64]| point(&states(d, nd, &nm));
     let st = states(&d0, nd, &nm);
-    let pt = Point::new(&basis, &st, &p, model, layout).with_faces(&faces, &st);
+    let pt = Point::with_recovery(&basis, &strain, &st, &p, model, layout).with_faces(&faces, &st);
     let mut t = vec![0.0; m * m];
     (term.2)(&pt, &nm, &mut t);
     fd_blocks(nd, &d0, &steps(layout), &res, &t)
@@ -258,11 +273,12 @@ fn every_term_matches_central_differences_block_by_block() {
     let names = ["ux", "uy", "p", "Ux", "Uy"];
     for (layout, sname, nm) in layouts_and_schemes() {
         for (mname, model, stress) in models() {
-            for (term, hoop) in terms().into_iter().flat_map(|t| [(t, false), (t, true)]) {
-                for b in check_term(&term, &model, stress, layout, &nm, hoop) {
+            let modes = [(false, false), (true, false), (false, true), (true, true)];
+            for (term, mode) in terms().into_iter().flat_map(|t| modes.map(|m| (t, m))) {
+                for b in check_term(&term, &model, stress, layout, &nm, mode) {
                     assert!(
                         b.pass(),
-                        "{} ({mname}, nd = {}, {sname}, axisymmetric {hoop}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
+                        "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain) {mode:?}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
                         term.0,
                         layout.nd,
                         names[b.row],

@@ -6,8 +6,8 @@
 //! corrected [001] Eq. 23) or linear (none). The functions are negative in places: they recover
 //! strains, they never map mass or momentum.
 //!
-//! Not yet used by the kernels (issue «Seed [001]»): this module holds the functions and their
-//! checks (Part E item 1).
+//! `assembly::stencils::cmpm_patches` builds each point's patch from them
+//! (`stabilisation.stress_recovery = "cmpm"`); the tests below are Part E item 1.
 
 /// Which 1D patch a direction uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -57,6 +57,8 @@ pub struct Model {
     pub geometry: shape::Geometry,
     /// The material stiffness of the Newton matrix ([001] §5).
     pub stiffness: crate::case::Stiffness,
+    /// How a point's strain increment is recovered ([001] §5.5).
+    pub stress_recovery: crate::case::StressRecovery,
 }
 
 /// The geometry of a case.
@@ -157,6 +159,7 @@ impl Model {
             pressure_update: case.stabilisation.pressure_update,
             geometry,
             stiffness: case.stabilisation.stiffness,
+            stress_recovery: case.stabilisation.stress_recovery,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
