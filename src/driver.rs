@@ -530,9 +530,14 @@ impl<'a> Simulation<'a> {
             let outcome = self.newton_solve(&active, dt)?;
             let admitted = match outcome {
                 Ok(()) => {
-                    let diagnostics = self.case.output.fields_every > 0;
+                    let nodes_checked = self.check.as_ref().is_some_and(|c| c.needs_nodes());
+                    let diagnostics = self.case.output.fields_every > 0 || nodes_checked;
                     let forces =
                         self.system.step_forces(&self.model, self.coll, diagnostics).map_err(RunError::Failed)?;
+                    if let (Some(c), true) = (self.check.as_mut(), nodes_checked) {
+                        let block = self.system.owned_node_block();
+                        c.observe_nodes(&block, &self.model, self.coll).map_err(RunError::Failed)?;
+                    }
                     let updated = self.update_particles(&active, dt)?;
                     if updated.is_ok() {
                         self.record_equilibrium(&forces)?;

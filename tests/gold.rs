@@ -218,6 +218,7 @@ gold_tests!(
     large_strain_consolidation,
     patch_test,
     rigid_rotation,
+    rotated_stiffness,
     shock_wave,
     slope_clay,
     slope_sand,

@@ -1095,6 +1095,21 @@ pub enum Verification {
         #[serde(default = "default_hollow_stress_tol")]
         stress_tolerance: f64,
     },
+    /// The nodal stiffness diagnostic K_mag = √(K_x² + K_y²) ([001] Eq. 25, §6) of a block of
+    /// material points in plane strain against the finite-element value of an interior node of a
+    /// uniform Q4 mesh of square cells, (4/3)(D₁₁ + G)√2, over the nodes within `radius` of
+    /// `center`, after the last step (`../shared/seeds-001-002.md` Part B2).
+    StiffnessMap {
+        /// The block (linear elastic).
+        body: String,
+        /// The centre of the evaluated nodes [m].
+        center: [f64; 2],
+        /// The radius within which nodes are evaluated [m].
+        radius: f64,
+        /// Largest accepted relative deviation of K_mag at any of those nodes.
+        #[serde(default = "default_stiffness_map_tol")]
+        tolerance: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1124,6 +1139,7 @@ impl Verification {
             Verification::Patch { .. } => "patch",
             Verification::Lame { .. } => "lame",
             Verification::HollowCylinder { .. } => "hollow_cylinder",
+            Verification::StiffnessMap { .. } => "stiffness_map",
             Verification::ShockWave { .. } => "shock_wave",
         }
     }
@@ -1131,6 +1147,9 @@ impl Verification {
 
 fn default_lame_tol() -> f64 {
     0.05
+}
+fn default_stiffness_map_tol() -> f64 {
+    0.01
 }
 fn default_hollow_stress_tol() -> f64 {
     0.25

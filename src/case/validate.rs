@@ -150,6 +150,16 @@ pub fn validate(c: &Case) -> R {
         }
     }
 
+    if c.stabilisation.stiffness == crate::case::Stiffness::DoubleMappingGimp
+        && c.analysis.shape_functions == crate::case::ShapeFunctions::Linear
+    {
+        return Err(
+            "key `stabilisation.stiffness`: `double_mapping_gimp` maps with the points' GIMP domains and needs \
+                    `analysis.shape_functions = \"gimp\"` or `\"ugimp\"` (a linear basis's stencil does not reach \
+                    every cell a domain overlaps)"
+                .into(),
+        );
+    }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         if two_phase {
             return Err("key `stabilisation.stress_recovery`: `cmpm` is for one_phase analyses ([001] is one-phase; \
@@ -616,6 +626,31 @@ pub fn validate(c: &Case) -> R {
                 }
                 (body, load)
             }
+            Verification::StiffnessMap { body, center, radius, tolerance } => {
+                finite2("verification.center", *center)?;
+                positive("verification.radius", *radius)?;
+                positive("verification.tolerance", *tolerance)?;
+                if let Some(b) = c.body(body) {
+                    let mat = &c.materials[c.material_index(&b.material).expect("validated")];
+                    if !matches!(mat.model, SoilModel::LinearElastic { .. }) {
+                        return Err(format!("key `verification.body`: the stiffness map's reference needs a linear elastic body, and `{body}` is not"));
+                    }
+                }
+                let h = c.cell_size();
+                if (h[0] - h[1]).abs() > 1e-9 * h[0] {
+                    return Err(format!(
+                        "key `grid`: the stiffness map's reference is for square cells, got {} × {} m",
+                        h[0], h[1]
+                    ));
+                }
+                if c.body(body).is_none() {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                }
+                if c.analysis.geometry != crate::case::Geometry::PlaneStrain {
+                    return Err("key `verification`: the stiffness map's reference is for plane strain".into());
+                }
+                return Ok(());
+            }
             Verification::Patch { body, boundary, spread_tolerance, tolerance } => {
                 positive("verification.spread_tolerance", *spread_tolerance)?;
                 positive("verification.tolerance", *tolerance)?;
@@ -756,7 +791,10 @@ pub fn validate(c: &Case) -> R {
                     return Err("key `verification`: the elastic column reference is for a one_phase analysis".into());
                 }
             }
-            Verification::BearingCapacity { .. } | Verification::Lame { .. } | Verification::HollowCylinder { .. } => {}
+            Verification::BearingCapacity { .. }
+            | Verification::Lame { .. }
+            | Verification::HollowCylinder { .. }
+            | Verification::StiffnessMap { .. } => {}
             _ => {
                 if !two_phase {
                     return Err(

@@ -28,6 +28,7 @@ pub mod hollow_cylinder;
 pub mod lame;
 pub mod patch;
 pub mod shock;
+pub mod stiffness_map;
 pub mod terzaghi;
 pub mod waves;
 pub mod xie_leo;
@@ -83,6 +84,22 @@ pub trait Check {
     fn observe(&mut self, t: f64, dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String>;
     /// The metrics (name, metric) and tables at the end of the run.
     fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String>;
+    /// Whether the check reads the nodal diagnostics K_mag and F^int_mag
+    /// ([`Check::observe_nodes`]); the run then computes them after every step.
+    fn needs_nodes(&self) -> bool {
+        false
+    }
+    /// Called after every converged step, before the particle update, with this rank's owned
+    /// nodes (`crate::assembly::NodeBlock`, values per node as `crate::assembly::NODE_VALUES`
+    /// says) when [`Check::needs_nodes`]; collective.
+    fn observe_nodes(
+        &mut self,
+        _block: &crate::assembly::NodeBlock,
+        _model: &Model,
+        _coll: &Collective,
+    ) -> Result<(), String> {
+        Ok(())
+    }
     /// Some(reason) once the run has shown what the check needs and should end (completed).
     fn stop(&self) -> Option<String> {
         None
@@ -195,6 +212,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::Patch { .. } => Box::new(patch::PatchCheck::new(c, model)?),
         Verification::Lame { .. } => Box::new(lame::LameCheck::new(c)?),
         Verification::HollowCylinder { .. } => Box::new(hollow_cylinder::HollowCylinderCheck::new(c)?),
+        Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -930,6 +948,10 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::HollowCylinder { inner_radius, outer_radius, .. } => format!(
             "axisymmetric hollow cylinder with a fixed outer wall ([001] §3.1), a = {inner_radius} m, \
              b = {outer_radius} m: u_r(a) and Δσ_rr after the first load step"
+        ),
+        Verification::StiffnessMap { center, radius, .. } => format!(
+            "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",
+            center[0], center[1]
         ),
         Verification::Patch { boundary, .. } => {
             format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")

@@ -1,0 +1,135 @@
+//! [001] §6's stiffness test (`../shared/seeds-001-002.md` Part B2): the nodal diagnostic
+//! K_mag = √(K_x² + K_y²) ([001] Eq. 25; `K_x`, `K_y` the diagonal entries of the assembled
+//! material stiffness, field `K_mag`) of a block of material points, against the value of an
+//! interior node of a uniform finite-element mesh of square Q4 cells with 2 × 2 Gauss points,
+//! K_FEM = (4/3)(D₁₁ + G)√2 (plane strain, D₁₁ = E(1 − ν)/((1 + ν)(1 − 2ν)), G = E/(2(1 + ν));
+//! independent of the cell size). Metrics after the last step over the grid nodes within
+//! `radius` of `center`: the largest and the RMS relative deviation |K_mag/K_FEM − 1| (each node
+//! counted once, so that neither shrinks with more points); `results` has the smallest and largest
+//! ratio and the number of nodes.
+
+use super::{Check, Findings, Metric};
+use crate::assembly::{NodeBlock, NODE_VALUES};
+use crate::case::{Case, Verification};
+use crate::model::Model;
+use crate::parallel::Collective;
+
+/// The stiffness-map check of a case.
+pub struct StiffnessMapCheck {
+    center: [f64; 2],
+    radius: f64,
+    reference: f64,
+    tolerance: f64,
+    /// [max |dev|, Σ dev², count, min ratio, max ratio] of the last step.
+    last: Option<[f64; 5]>,
+}
+
+impl StiffnessMapCheck {
+    /// The check of a `stiffness_map` verification.
+    pub fn new(c: &Case) -> Result<StiffnessMapCheck, String> {
+        let Some(Verification::StiffnessMap { body, center, radius, tolerance }) = &c.verification else {
+            return Err("not a stiffness-map verification".into());
+        };
+        let (_, e, nu) = super::elastic_body(c, body)?;
+        Ok(StiffnessMapCheck {
+            center: *center,
+            radius: *radius,
+            reference: fem_k_mag(e, nu),
+            tolerance: *tolerance,
+            last: None,
+        })
+    }
+}
+
+/// K_mag of an interior node of a uniform plane-strain Q4 mesh of square cells (2 × 2 Gauss
+/// points), per metre of thickness: (4/3)(D₁₁ + G)√2.
+pub fn fem_k_mag(e: f64, nu: f64) -> f64 {
+    let d11 = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    (4.0 / 3.0) * (d11 + e / (2.0 * (1.0 + nu))) * std::f64::consts::SQRT_2
+}
+
+impl Check for StiffnessMapCheck {
+    fn columns(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn observe(&mut self, _t: f64, _dt: f64, _model: &Model, _coll: &Collective) -> Result<Vec<f64>, String> {
+        Ok(Vec::new())
+    }
+
+    fn needs_nodes(&self) -> bool {
+        true
+    }
+
+    fn observe_nodes(&mut self, block: &NodeBlock, model: &Model, coll: &Collective) -> Result<(), String> {
+        let mut local = [0.0, 0.0, 0.0];
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (o, v) in block.values.chunks_exact(NODE_VALUES).enumerate() {
+            let (i, j) = (block.start[0] + o % block.count[0], block.start[1] + o / block.count[0]);
+            let x = model.grid.node_position(i, j);
+            if (x[0] - self.center[0]).hypot(x[1] - self.center[1]) > self.radius {
+                continue;
+            }
+            let ratio = v[6] / self.reference;
+            local[0] = f64::max(local[0], (ratio - 1.0).abs());
+            local[1] += (ratio - 1.0).powi(2);
+            local[2] += 1.0;
+            lo = lo.min(ratio);
+            hi = hi.max(ratio);
+        }
+        let worst = coll.max(&[local[0], hi, -lo])?;
+        let sums = coll.sum(&local[1..])?;
+        self.last = Some([worst[0], sums[0], sums[1], -worst[2], worst[1]]);
+        Ok(())
+    }
+
+    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+        let Some([max, sq, n, _, _]) = self.last else {
+            return Err("the stiffness map saw no step".into());
+        };
+        if n == 0.0 {
+            return Err("the stiffness map found no grid node within its radius".into());
+        }
+        let detail = format!(
+            "over {n} nodes within {} m of ({}, {}), against K_FEM = {:.6e} N/m",
+            self.radius, self.center[0], self.center[1], self.reference
+        );
+        Ok((
+            vec![
+                ("k_mag_max_rel_deviation".into(), Metric::error(max, self.tolerance, detail.clone())),
+                ("k_mag_rms_rel_deviation".into(), Metric::error((sq / n).sqrt(), self.tolerance, detail)),
+            ],
+            Vec::new(),
+        ))
+    }
+
+    fn results(&self) -> Vec<(String, f64)> {
+        let Some([_, _, n, lo, hi]) = self.last else { return Vec::new() };
+        vec![("k_mag_min_ratio".into(), lo), ("k_mag_max_ratio".into(), hi), ("nodes".into(), n)]
+    }
+
+    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(self.last.map(|l| l.to_vec()).unwrap_or_default()))
+    }
+
+    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+        self.last = match state {
+            [] => None,
+            s => Some(s.try_into().map_err(|_| "the stiffness map's state has 5 values".to_string())?),
+        };
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// [001] §6's value for E = 1000 kN/m², ν = 0.3.
+    #[test]
+    fn the_finite_element_reference_is_the_papers() {
+        assert!((super::fem_k_mag(1000.0, 0.3) - 3263.57).abs() < 5e-3);
+    }
+}
