@@ -224,6 +224,7 @@ gold_tests!(
     slope_sand,
     slumping_block,
     terzaghi,
+    vertical_cut,
 );
 
 #[test]

@@ -184,3 +184,24 @@ fn the_rotated_lattice_keeps_the_papers_order_of_stiffness_errors() {
     let (dm0, _, _) = run("dm-unrotated", &["parameters.angle=0", "stabilisation.stiffness=double_mapping"]);
     assert!(dm0 < 1e-10, "DM on the unrotated lattice: largest deviation {dm0}");
 }
+
+/// Part E items 10 and 12 (cases/vertical_cut.toml, [001] §7.2) with regular MPM: the cut fails
+/// and runs to 1.0 m of toe displacement, every point stays on or inside its softened yield
+/// surface at every step (q ≤ √3 c(ε̄)(1 + 1e-8)), the residual strength is reached somewhere
+/// (ε̄ > 0.30), and the smoothness of K_mag and F^int_mag is measured at 0.1 and 1.0 m (DM-GC
+/// against MPM, item 11, is a study: `make study`).
+#[test]
+fn the_vertical_cut_runs_to_a_metre_of_toe_displacement() {
+    let r = run_case("cases/vertical_cut.toml", &out_dir("cut"), &[]);
+    assert!(r.completed(), "{}", r.stderr());
+    let result = |k: &str| r.summary["results"][k].as_f64().unwrap_or(f64::NAN);
+    assert!(result("toe_displacement") >= 1.0, "toe {}", result("toe_displacement"));
+    assert_eq!(r.summary["verification"]["yield_excess"]["pass"], true, "{}", r.summary["verification"]);
+    assert!(result("eps_pd_max") > 0.30, "ε̄ max {}", result("eps_pd_max"));
+    for s in ["0.1", "1"] {
+        for f in ["k_mag", "fint_mag"] {
+            let v = result(&format!("{f}_roughness_at_{s}"));
+            assert!(v.is_finite() && v > 0.0, "{f} roughness at {s} m: {v}");
+        }
+    }
+}

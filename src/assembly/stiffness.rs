@@ -20,15 +20,16 @@
 //! centre), so cmp needs no communication. A_p is the area in the (x, y) plane, so that in axial
 //! symmetry r enters once, through the Gauss points' 2πr_g.
 //!
-//! D_p is the point's consistent tangent (the paper uses the elastic one). Every option but
-//! `particle` gives an approximate Jacobian: Newton converges at a linear rate to the answer of
-//! the residual, which is unchanged; `-snes_type ksponly` makes each step the single linear solve
-//! of [001].
+//! D_p is the point's elastic matrix, as in [001] (Eq. 5, and its initial-stiffness iteration for
+//! plasticity): with the consistent tangent of softening points mapped to the Gauss points, Newton
+//! diverged on the vertical cut at its first dynamic step (30 iterations, four cuts), with the
+//! elastic one it converges. Every option but `particle` gives an approximate Jacobian: Newton
+//! converges at a linear rate to the answer of the residual, which is unchanged;
+//! `-snes_type ksponly` makes each step the single linear solve of [001].
 
 use super::stencils::Stencils;
 use crate::case::Stiffness;
 use crate::kernels::cell::{mapped_stiffness, q4, CellGeometry, Moduli};
-use crate::kernels::Point;
 use crate::model::{shape, Model};
 use petsc::GhostedRange;
 
@@ -130,10 +131,9 @@ impl MappedStiffness {
     }
 
     /// Adds point `k`'s mapped stiffness, times `weight` (the scheme's w_f), to the u–u entries of
-    /// its tangent `block` (m × m, `nd` dofs per node), with the moduli of `pt`'s stress update.
-    pub(super) fn add(&self, k: usize, pt: &Point, weight: f64, block: &mut [f64], m: usize, nd: usize) {
+    /// its tangent `block` (m × m, `nd` dofs per node), with the elastic moduli `d` of its material.
+    pub(super) fn add(&self, k: usize, d: &Moduli, weight: f64, block: &mut [f64], m: usize, nd: usize) {
         let Some(shares) = self.offsets.get(k + 1).map(|&hi| &self.shares[self.offsets[k]..hi]) else { return };
-        let d: Moduli = pt.upd.tangent;
         for share in shares {
             let d_nodes: [Moduli; 4] = std::array::from_fn(|i| d.map(|row| row.map(|v| v * share.weights[i])));
             let ke = mapped_stiffness(&share.cell, &d_nodes);

@@ -1110,6 +1110,25 @@ pub enum Verification {
         #[serde(default = "default_stiffness_map_tol")]
         tolerance: f64,
     },
+    /// The vertical cut of [001] §3.2 and §7.2 (`../shared/seeds-001-002.md` Part B3, Part E items
+    /// 10–12): no closed form; the run stops when the toe has moved `stop_displacement`, and reports
+    /// the constitutive check q ≤ √3 c(ε̄) at every point and step, the largest ε̄, the smoothness of
+    /// the nodal K_mag and F^int_mag when the toe passes each of `snapshots`, and the total
+    /// variation of σ_m at the points `b` and `c`.
+    VerticalCut {
+        /// The soil (von Mises).
+        body: String,
+        /// The toe's point at t = 0 (the nearest material point is followed) [m].
+        toe: [f64; 2],
+        /// The points B (shear band) and C (sliding block) at t = 0 [m].
+        b: [f64; 2],
+        c: [f64; 2],
+        /// The toe's horizontal displacement that ends the run [m].
+        stop_displacement: f64,
+        /// Toe displacements at which the nodal fields' smoothness is measured [m].
+        #[serde(default)]
+        snapshots: Vec<f64>,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1140,6 +1159,7 @@ impl Verification {
             Verification::Lame { .. } => "lame",
             Verification::HollowCylinder { .. } => "hollow_cylinder",
             Verification::StiffnessMap { .. } => "stiffness_map",
+            Verification::VerticalCut { .. } => "vertical_cut",
             Verification::ShockWave { .. } => "shock_wave",
         }
     }

@@ -626,6 +626,25 @@ pub fn validate(c: &Case) -> R {
                 }
                 (body, load)
             }
+            Verification::VerticalCut { body, toe, b, c: cpoint, stop_displacement, snapshots } => {
+                for (k, v) in [("toe", toe), ("b", b), ("c", cpoint)] {
+                    finite2(&format!("verification.{k}"), *v)?;
+                }
+                positive("verification.stop_displacement", *stop_displacement)?;
+                for (j, s) in snapshots.iter().enumerate() {
+                    positive(&format!("verification.snapshots[{j}]"), *s)?;
+                }
+                let Some(bd) = c.body(body) else {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                };
+                let mat = &c.materials[c.material_index(&bd.material).expect("validated")];
+                if !matches!(mat.model, SoilModel::VonMises { .. }) {
+                    return Err(format!(
+                        "key `verification.body`: the vertical cut's checks need a von_mises body, and `{body}` is not"
+                    ));
+                }
+                return Ok(());
+            }
             Verification::StiffnessMap { body, center, radius, tolerance } => {
                 finite2("verification.center", *center)?;
                 positive("verification.radius", *radius)?;
@@ -794,7 +813,8 @@ pub fn validate(c: &Case) -> R {
             Verification::BearingCapacity { .. }
             | Verification::Lame { .. }
             | Verification::HollowCylinder { .. }
-            | Verification::StiffnessMap { .. } => {}
+            | Verification::StiffnessMap { .. }
+            | Verification::VerticalCut { .. } => {}
             _ => {
                 if !two_phase {
                     return Err(

@@ -30,6 +30,7 @@ pub mod patch;
 pub mod shock;
 pub mod stiffness_map;
 pub mod terzaghi;
+pub mod vertical_cut;
 pub mod waves;
 pub mod xie_leo;
 
@@ -213,6 +214,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::Lame { .. } => Box::new(lame::LameCheck::new(c)?),
         Verification::HollowCylinder { .. } => Box::new(hollow_cylinder::HollowCylinderCheck::new(c)?),
         Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
+        Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -952,6 +954,9 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::StiffnessMap { center, radius, .. } => format!(
             "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",
             center[0], center[1]
+        ),
+        Verification::VerticalCut { stop_displacement, .. } => format!(
+            "vertical cut ([001] §7.2) to a toe displacement of {stop_displacement} m: yield check, smoothness of K_mag and F^int_mag"
         ),
         Verification::Patch { boundary, .. } => {
             format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")
