@@ -199,7 +199,13 @@ fn global_assembly(c: &mut Criterion) {
     let case = load("cases/slumping_block.toml", &[]);
     let coll = porompm::parallel::Collective::world();
     let layout = kernels::Layout::UPU;
-    let system = porompm::assembly::GridSystem::new(&coll, &porompm::model::grid_of(&case), layout, None);
+    let system = porompm::assembly::GridSystem::new(
+        &coll,
+        &porompm::model::grid_of(&case),
+        layout,
+        None,
+        case.stabilisation.stiffness,
+    );
     let mut system = system.expect("the grid system is created");
     let model = Model::build(&case, |i, j| system.owns_cell(i, j));
     let stage = &case.stages[0];

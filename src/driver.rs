@@ -420,8 +420,8 @@ impl<'a> Simulation<'a> {
         let input = |e: String| RunError::Input(e);
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
         let layout = StageAnalysis::of(case, &case.stages[first]).layout;
-        let system =
-            GridSystem::new(coll, &crate::model::grid_of(case), layout, None).map_err(|e| input(e.to_string()))?;
+        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout, None, case.stabilisation.stiffness)
+            .map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
         let n_boundaries = model.boundaries.len();
@@ -604,7 +604,7 @@ impl<'a> Simulation<'a> {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;
             let owners = self.system.owners().clone();
-            self.system = GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners))
+            self.system = GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners), self.model.stiffness)
                 .map_err(|e| RunError::Failed(e.to_string()))?;
             self.system.reused_patterns = reused;
             self.summary.grid_dofs = self.system.total_dofs();
@@ -815,7 +815,7 @@ impl<'a> Simulation<'a> {
         let layout = self.system.layout();
         // The last step's nodal values, for the field output of this step on the new distribution.
         let carried = self.system.global_node_values(self.coll).map_err(RunError::Failed)?;
-        self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners))
+        self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners), self.model.stiffness)
             .map_err(|e| RunError::Failed(e.to_string()))?;
         self.system.reused_patterns = reused;
         self.system.carry_node_values(carried);

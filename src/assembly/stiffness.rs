@@ -23,7 +23,7 @@
 //! D_p is the point's elastic matrix, as in [001] (Eq. 5, and its initial-stiffness iteration for
 //! plasticity), which stays positive definite while points soften. (With either the elastic or
 //! the consistent moduli mapped, Newton needed more than its default 30 iterations at the vertical
-//! cut's first dynamic step; with the elastic ones and `-snes_max_it 300` it converges, about 200
+//! cut's first dynamic step; with the elastic ones and 300 (`super::newton_iterations`) it converges, about 200
 //! iterations a step.) Every option but `particle` gives an approximate Jacobian: Newton
 //! converges at a linear rate to the answer of the residual, which is unchanged;
 //! `-snes_type ksponly` makes each step the single linear solve of [001].
