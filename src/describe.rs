@@ -205,6 +205,23 @@ pub fn describe(case: &Case, label: &str) -> String {
     );
     let _ = writeln!(
         s,
+        "stiffness in the Newton matrix: {}; strain recovery: {}",
+        match model.stiffness {
+            crate::case::Stiffness::Particle => "the exact tangent".to_string(),
+            other => format!(
+                "{} ([001]'s mapped stiffness: an approximate Jacobian, Newton converges linearly; up to {} \
+                 iterations a step)",
+                other.name(),
+                crate::assembly::newton_iterations(other)
+            ),
+        },
+        match model.stress_recovery {
+            crate::case::StressRecovery::Basis => "the basis functions' gradients",
+            crate::case::StressRecovery::Cmpm => "CMPM patch functions ([001] Eqs. 22–23, corrected)",
+        }
+    );
+    let _ = writeln!(
+        s,
         "solver: {}",
         case.solver.options_file.as_deref().map_or(
             "built-in default (Newton; sparse LU by UMFPACK on one rank up to 2 000 grid dofs, MUMPS beyond and on several)".to_string(),

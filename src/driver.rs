@@ -386,7 +386,7 @@ pub fn test_jacobian(
             "key `stabilisation.stiffness`: test-jacobian checks the exact tangent, and `{}` replaces its material \
              block by [001]'s approximate stiffness (Newton then converges linearly, by design); check the case \
              with `--set stabilisation.stiffness=particle`",
-            serde_json::to_value(stiffness).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
+            stiffness.name()
         )));
     }
     let mut summary = Summary::new(req);

@@ -243,6 +243,20 @@ mod tests {
     use super::tests_support::MINIMAL;
     use super::*;
 
+    /// The names the messages use are the case file's.
+    #[test]
+    fn stiffness_names_are_the_case_file_s() {
+        for s in [
+            Stiffness::Particle,
+            Stiffness::WStar,
+            Stiffness::GaussMapping,
+            Stiffness::DoubleMapping,
+            Stiffness::DoubleMappingGimp,
+        ] {
+            assert_eq!(serde_json::to_value(s).unwrap(), s.name());
+        }
+    }
+
     #[test]
     fn a_minimal_case_parses_with_defaults() {
         let c = parse(MINIMAL, "t.toml", &[]).unwrap();

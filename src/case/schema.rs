@@ -679,6 +679,19 @@ pub struct Stabilisation {
     pub stress_recovery: StressRecovery,
 }
 
+impl Stiffness {
+    /// The name the case file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stiffness::Particle => "particle",
+            Stiffness::WStar => "w_star",
+            Stiffness::GaussMapping => "gauss_mapping",
+            Stiffness::DoubleMapping => "double_mapping",
+            Stiffness::DoubleMappingGimp => "double_mapping_gimp",
+        }
+    }
+}
+
 /// How a point's strain is recovered (see [`Stabilisation::stress_recovery`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
