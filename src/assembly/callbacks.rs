@@ -275,7 +275,7 @@ impl Particles<'_> {
                 .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
-            step.stiffness.add(k, &mat.model.elastic().d, nm.w_force, &mut block[..m * m], m, layout.nd);
+            step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
             self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);
         }
     }
@@ -516,8 +516,7 @@ impl<'a> Assembler<'a> {
                 block[..m * m].fill(0.0);
                 buf[..m].fill(0.0);
                 kernels::stress::tangent_with(pt, &plain, &mut block[..m * m], step.stiffness.material(p));
-                let mat = &self.model.materials[self.model.particles.material[p] as usize];
-                step.stiffness.add(p, &mat.model.elastic().d, 1.0, &mut block[..m * m], m, nd);
+                step.stiffness.add(p, 1.0, &mut block[..m * m], m, nd);
                 kernels::stress::residual(pt, &plain, &mut buf[..m]);
                 kernels::stress::pore_pressure::residual(pt, &plain, &mut buf[..m]);
                 for (n, &node) in nodes.iter().enumerate() {

@@ -42,10 +42,10 @@ type CellWeights = ((usize, usize), [f64; 4]);
 struct Share {
     /// The cell's four nodes as slots of the point's stencil, in `kernels::cell`'s order.
     slots: [u8; 4],
-    /// w_i W_p: the point's weights of the nodes times its integration weight.
-    weights: [f64; 4],
-    /// The cell.
-    cell: CellGeometry,
+    /// The point's share K_e^p of the cell's stiffness (8 × 8 on the four nodes' u_x, u_y): the
+    /// moduli are elastic and the weights fixed on x_n, so it is the same for every Newton
+    /// iteration of the step and is computed once, here.
+    ke: [[f64; 8]; 8],
 }
 
 /// The mapped-stiffness shares of a step's points.
@@ -106,6 +106,7 @@ impl MappedStiffness {
             };
             out.material.push(factor);
             let (nodes, _) = st.get(k);
+            let d: &Moduli = &model.materials[ps.material[k] as usize].model.elastic().d;
             for ((i, j), weights) in cells {
                 let mut slots = [0u8; 4];
                 for (s, (di, dj)) in slots.iter_mut().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {
@@ -119,7 +120,8 @@ impl MappedStiffness {
                         )
                     })? as u8;
                 }
-                out.shares.push(Share { slots, weights, cell: geometry(i, j) });
+                let d_nodes: [Moduli; 4] = std::array::from_fn(|n| d.map(|row| row.map(|v| v * weights[n])));
+                out.shares.push(Share { slots, ke: mapped_stiffness(&geometry(i, j), &d_nodes) });
             }
             out.offsets.push(out.shares.len());
         }
@@ -132,12 +134,11 @@ impl MappedStiffness {
     }
 
     /// Adds point `k`'s mapped stiffness, times `weight` (the scheme's w_f), to the u–u entries of
-    /// its tangent `block` (m × m, `nd` dofs per node), with the elastic moduli `d` of its material.
-    pub(super) fn add(&self, k: usize, d: &Moduli, weight: f64, block: &mut [f64], m: usize, nd: usize) {
+    /// its tangent `block` (m × m, `nd` dofs per node).
+    pub(super) fn add(&self, k: usize, weight: f64, block: &mut [f64], m: usize, nd: usize) {
         let Some(shares) = self.offsets.get(k + 1).map(|&hi| &self.shares[self.offsets[k]..hi]) else { return };
         for share in shares {
-            let d_nodes: [Moduli; 4] = std::array::from_fn(|i| d.map(|row| row.map(|v| v * share.weights[i])));
-            let ke = mapped_stiffness(&share.cell, &d_nodes);
+            let ke = &share.ke;
             for (a, &sa) in share.slots.iter().enumerate() {
                 for (b, &sb) in share.slots.iter().enumerate() {
                     for c in 0..2 {
