@@ -437,8 +437,7 @@ pub fn cmpm_patches(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs
             (false, false) => Patch1d::Linear,
         };
         let (px, py) = (patch(left, right), patch(below, above));
-        let lo = g.node_position(ci as usize, cj as usize);
-        let xi = [2.0 * (x[0] - lo[0]) / g.h[0] - 1.0, 2.0 * (x[1] - lo[1]) / g.h[1] - 1.0];
+        let xi = g.local_coordinates((ci as usize, cj as usize), x);
         let ((nx, dx), (ny, dy)) = (functions(px, xi[0]), functions(py, xi[1]));
         // The patch's first node: one cell to the − side where the patch reaches there.
         let (ix0, jy0) = (ci - i64::from(left), cj - i64::from(below));

@@ -93,8 +93,7 @@ impl MappedStiffness {
                 Stiffness::WStar => (w_star(k), Vec::new()),
                 Stiffness::GaussMapping | Stiffness::DoubleMapping => {
                     let (i, j) = g.cell_of(ps.x[k]).ok_or_else(|| outside(model, k))?;
-                    let lo = g.node_position(i, j);
-                    let xi = [2.0 * (ps.x[k][0] - lo[0]) / g.h[0] - 1.0, 2.0 * (ps.x[k][1] - lo[1]) / g.h[1] - 1.0];
+                    let xi = g.local_coordinates((i, j), ps.x[k]);
                     let w = if model.stiffness == Stiffness::DoubleMapping { w_star(k) * w_p } else { w_p };
                     (0.0, vec![((i, j), q4(xi, g.h).0.map(|n| n * w))])
                 }

@@ -32,6 +32,12 @@ impl Grid {
         [self.origin[0] + i as f64 * self.h[0], self.origin[1] + j as f64 * self.h[1]]
     }
 
+    /// The local coordinates ξ ∈ [−1, 1]² of `x` in cell (i, j) (its lower-left node).
+    pub fn local_coordinates(&self, (i, j): (usize, usize), x: [f64; 2]) -> [f64; 2] {
+        let lo = self.node_position(i, j);
+        [2.0 * (x[0] - lo[0]) / self.h[0] - 1.0, 2.0 * (x[1] - lo[1]) / self.h[1] - 1.0]
+    }
+
     /// The cell (i, j) containing `x`, or `None` outside the grid (points on the upper boundary
     /// belong to the last cell).
     pub fn cell_of(&self, x: [f64; 2]) -> Option<(usize, usize)> {
