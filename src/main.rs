@@ -147,10 +147,16 @@ enum Command {
 struct Failure {
     code: u8,
     message: String,
+    /// Whether rank 0 has printed the message already (before MPI was finalised).
+    reported: bool,
+}
+
+fn failed(message: impl Into<String>) -> Failure {
+    Failure { code: 1, message: message.into(), reported: false }
 }
 
 fn input(message: impl Into<String>) -> Failure {
-    Failure { code: 2, message: message.into() }
+    Failure { code: 2, message: message.into(), reported: false }
 }
 
 fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
@@ -219,23 +225,40 @@ fn run(
     if let Some(n) = cont.threads {
         coll.set_threads(n as usize);
     }
+    let result = run_started(&c, case_path, out, sets, quiet, cont, interrupt, &coll);
+    finish(universe, coll, petsc, result)
+}
+
+/// The part of `run` that needs MPI and PETSc: everything after they start.
+#[allow(clippy::too_many_arguments)]
+fn run_started(
+    c: &case::Case,
+    case_path: &Path,
+    out: &Path,
+    sets: &[String],
+    quiet: bool,
+    cont: Continuation,
+    interrupt: Arc<AtomicBool>,
+    coll: &Collective,
+) -> Result<(), Failure> {
     // Every rank reads its share of the checkpoint (MPI-I/O); all get the same outcome.
     let restart = match cont.restart {
         Some(p) => {
             let cp = io::checkpoint::read(p, coll.communicator()).map_err(input)?;
-            porompm::state::check_case(&cp, &c).map_err(|e| input(format!("checkpoint {}: {e}", p.display())))?;
+            porompm::state::check_case(&cp, c).map_err(|e| input(format!("checkpoint {}: {e}", p.display())))?;
             Some((p.display().to_string(), cp))
         }
         None => None,
     };
-    let mut output = RunOutput::create(out, coll.rank() == 0).map_err(input)?;
+    // Rank 0 alone creates the output directory; every rank learns whether it could.
+    let mut output = coll.agree(RunOutput::create(out, coll.rank() == 0)).map_err(input)?;
     let req = RunRequest {
-        case: &c,
+        case: c,
         case_label: case_path.display().to_string(),
         overrides: sets.to_vec(),
         out_dir: out.to_path_buf(),
         quiet,
-        coll: &coll,
+        coll,
         checkpoint_every: cont.checkpoint_every,
         balance_threshold: cont.balance_threshold,
         restart,
@@ -264,13 +287,11 @@ fn run(
             summary.wall_time_s
         );
     }
-    drop(petsc);
-    drop(universe);
     match err {
         None => Ok(()),
         Some(RunError::Input(m)) => Err(input(m)),
-        Some(RunError::Failed(m)) => Err(Failure { code: 1, message: m }),
-        Some(RunError::Interrupted(m)) => Err(Failure { code: 130, message: m }),
+        Some(RunError::Failed(m)) => Err(failed(m)),
+        Some(RunError::Interrupted(m)) => Err(Failure { code: 130, message: m, reported: false }),
     }
 }
 
@@ -312,34 +333,70 @@ fn test_jacobian(
         restart: None,
         interrupt: None,
     };
-    let result = driver::test_jacobian(&req, steps, flip);
-    drop(petsc);
-    drop(universe);
-    let (blocks, yielded) = result.map_err(|e| Failure {
-        code: if matches!(e, driver::RunError::Input(_)) { 2 } else { 1 },
-        message: e.message().to_string(),
-    })?;
-    println!("material points that have yielded: {yielded}");
-    println!(
-        "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps, scaled by D^-1/2 · D^-1/2)",
+    let result = driver::test_jacobian(&req, steps, flip)
+        .map_err(|e| Failure {
+            code: if matches!(e, driver::RunError::Input(_)) { 2 } else { 1 },
+            message: e.message().to_string(),
+            reported: false,
+        })
+        .and_then(|(blocks, yielded)| jacobian_table(&blocks, yielded, steps, tolerance, coll.rank() == 0));
+    finish(universe, coll, petsc, result)
+}
+
+/// Prints (on rank 0) the blocks of a Jacobian test and fails if one differs by more than `tolerance`.
+fn jacobian_table(
+    blocks: &[porompm::assembly::BlockCheck],
+    yielded: usize,
+    steps: usize,
+    tolerance: f64,
+    print: bool,
+) -> Result<(), Failure> {
+    let mut table = format!("material points that have yielded: {yielded}\n");
+    table += &format!(
+        "{:>4} {:>4} {:>14} {:>14} {:>12}  (tangent vs central differences after {steps} steps, scaled by D^-1/2 · D^-1/2)\n",
         "row", "col", "max|J-Jfd|", "max|J|", "relative"
     );
     let mut worst: f64 = 0.0;
-    for b in &blocks {
-        println!(
-            "{:>4} {:>4} {:>14.4e} {:>14.4e} {:>12.3e}",
+    for b in blocks {
+        table += &format!(
+            "{:>4} {:>4} {:>14.4e} {:>14.4e} {:>12.3e}\n",
             b.row, b.col, b.max_abs_error, b.max_abs_entry, b.relative_error
         );
         worst = worst.max(b.relative_error);
     }
-    if worst > tolerance {
-        return Err(Failure {
-            code: 1,
-            message: format!("the tangent differs from finite differences by {worst:.3e} > {tolerance:.1e}"),
-        });
+    if worst <= tolerance {
+        table += &format!("all blocks agree within {tolerance:.1e} (worst {worst:.3e})\n");
     }
-    println!("all blocks agree within {tolerance:.1e} (worst {worst:.3e})");
+    if print {
+        print!("{table}");
+    }
+    if worst > tolerance {
+        return Err(failed(format!("the tangent differs from finite differences by {worst:.3e} > {tolerance:.1e}")));
+    }
     Ok(())
+}
+
+/// Ends a command that started MPI and PETSc. mpirun ends the whole job as soon as one rank exits
+/// with a non-zero code, so an error is printed by rank 0 while MPI still runs, and every rank
+/// waits at a barrier for that before any of them finalises and exits.
+fn finish(
+    universe: mpi::environment::Universe,
+    coll: Collective,
+    petsc: petsc::Petsc,
+    result: Result<(), Failure>,
+) -> Result<(), Failure> {
+    use mpi::collective::CommunicatorCollectives;
+    let result = result.map_err(|f| {
+        if coll.rank() == 0 {
+            eprintln!("error: {}", f.message);
+        }
+        Failure { reported: true, ..f }
+    });
+    coll.communicator().barrier();
+    drop(petsc);
+    drop(coll);
+    drop(universe);
+    result
 }
 
 /// Initialises MPI (rsmpi) and then PETSc on its world communicator; the caller drops them in
@@ -384,7 +441,7 @@ fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure>
     let ptext = io::read_text(path).map_err(input)?;
     let p = case::element::parse_path(&ptext, &path.display().to_string()).map_err(|e| input(e.to_string()))?;
     let model = porompm::model::material::soil_model(&m.model);
-    let rows = porompm::element_test::run(&model, &p).map_err(|e| Failure { code: 1, message: e })?;
+    let rows = porompm::element_test::run(&model, &p).map_err(failed)?;
     let file =
         io::write_csv(out, "element_test.csv", &porompm::element_test::HEADER, &porompm::element_test::table(&rows))
             .map_err(input)?;
@@ -443,14 +500,14 @@ fn sweep(
             Ok(())
         }
         Err(SweepError::Input(m)) => Err(input(m)),
-        Err(SweepError::AllFailed(m)) => Err(Failure { code: 1, message: m }),
+        Err(SweepError::AllFailed(m)) => Err(failed(m)),
     }
 }
 
 fn info(petsc_args: &[String]) -> Result<(), Failure> {
     let (universe, coll, petsc) = start_mpi_and_petsc(petsc_args)?;
-    let total = coll.sum(&[1.0]).map_err(|e| Failure { code: 1, message: e })?[0];
-    let ranks = coll.gather(&[coll.rank() as f64]).map_err(|e| Failure { code: 1, message: e })?;
+    let total = coll.sum(&[1.0]).map_err(failed)?[0];
+    let ranks = coll.gather(&[coll.rank() as f64]).map_err(failed)?;
     if coll.rank() == 0 {
         let b = petsc::PetscBuild::get();
         println!("porompm {}", porompm::VERSION);
@@ -458,12 +515,12 @@ fn info(petsc_args: &[String]) -> Result<(), Failure> {
         println!("ranks: {}", coll.size());
         println!("collective sum over ranks: {total} (ranks reporting: {ranks:?})");
     }
-    drop(petsc);
-    drop(universe);
-    if total as usize != ranks.len() {
-        return Err(Failure { code: 1, message: "the collective sum does not match the number of ranks".into() });
-    }
-    Ok(())
+    let result = if total as usize != ranks.len() {
+        Err(failed("the collective sum does not match the number of ranks"))
+    } else {
+        Ok(())
+    };
+    finish(universe, coll, petsc, result)
 }
 
 fn main() -> ExitCode {
@@ -505,13 +562,14 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            // Under mpirun every rank ends with the same, agreed error: rank 0 prints it.
+            // Under mpirun every rank ends with the same, agreed error: rank 0 prints it (`finish`
+            // has, for a command that ran MPI).
             let rank = ["OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"]
                 .iter()
                 .find_map(|v| std::env::var(v).ok())
                 .and_then(|r| r.parse::<usize>().ok())
                 .unwrap_or(0);
-            if rank == 0 {
+            if rank == 0 && !f.reported {
                 eprintln!("error: {}", f.message);
             }
             ExitCode::from(f.code)
