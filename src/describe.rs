@@ -123,8 +123,11 @@ pub fn describe(case: &Case, label: &str) -> String {
 
     for l in &model.loads {
         let kind = match case.load(&l.name) {
-            Some(Load::ParticleTraction { .. }) => {
-                format!("particle traction on {} material points", l.size())
+            Some(Load::ParticleTraction { increment_factor, .. }) => {
+                let follows = increment_factor.as_deref().map_or(String::new(), |e| {
+                    format!(", each increment scaled by `{e}` at the loaded faces' mean centre at the step's start")
+                });
+                format!("particle traction on {} material points{follows}", l.size())
             }
             Some(Load::NodalTraction { .. }) => format!("nodal traction on {} nodes", l.size()),
             Some(Load::LinePressure { pressure, .. }) => {
@@ -201,6 +204,16 @@ pub fn describe(case: &Case, label: &str) -> String {
             (crate::model::shape::Basis::Linear, _) => "none (linear basis)",
             (_, true) => "follow the stretch",
             (_, false) => "undeformed",
+        }
+    );
+    let _ = writeln!(
+        s,
+        "kinematics: {}",
+        if model.linear_increments {
+            "geometrically linear steps on the configuration at each step's start ([001]: K Δu = ΔF, the residual \
+             of the step's start taken off)"
+        } else {
+            "finite strain on the configuration at each step's end (objective update, exact tangent)"
         }
     );
     let _ = writeln!(

@@ -24,6 +24,7 @@ use crate::case::{Case, Stage};
 use crate::diagnostics::{energy, Monitor, Warning};
 use crate::io::RunOutput;
 use crate::kernels::{Integration, StepResult};
+use crate::model::loads::IncrementsFrom;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::progress::Progress;
@@ -485,6 +486,8 @@ impl<'a> Simulation<'a> {
         sim.warn(warnings);
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
+        } else {
+            sim.set_load_increments(|_| IncrementsFrom::Start)?;
         }
         sim.record_step(0.0)?;
         sim.write_fields()?;
@@ -553,6 +556,7 @@ impl<'a> Simulation<'a> {
                     self.migrate_particles()?;
                     self.balance_load()?;
                     self.t = control.advance(self.t, dt);
+                    self.set_load_increments(|_| IncrementsFrom::Accepted)?;
                     control.accepted(self.last_newton.0);
                     self.step += 1;
                     self.summary.steps = self.step;
@@ -1046,6 +1050,7 @@ impl<'a> Simulation<'a> {
             counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
             diagnostics: self.monitor.state(self.coll).map_err(RunError::Failed)?,
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
+            load_totals: self.model.loads.iter().map(|l| l.increments.as_ref().map_or(0.0, |s| s.total)).collect(),
             check_state,
             particles: state::records_of(&slab.values),
             first: slab.offset as u64,
@@ -1053,6 +1058,28 @@ impl<'a> Simulation<'a> {
         };
         self.out.write_checkpoint(&cp, self.coll.communicator()).map_err(RunError::Failed)?;
         self.summary.timings.output_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Sets every load whose increments follow its loaded faces at the current time
+    /// ([`crate::model::loads::LoadDef::set_increments`]), at the faces' mean centre over all ranks.
+    fn set_load_increments(&mut self, from: impl Fn(usize) -> IncrementsFrom) -> Result<(), RunError> {
+        for li in 0..self.model.loads.len() {
+            // Whether a load has increments is the case's: every rank takes the same branch.
+            if self.model.loads[li].increments.is_none() {
+                continue;
+            }
+            let local = self.model.loads[li].face_moments(&self.model.particles, &self.model.geometry);
+            let m = self.coll.sum(&local).map_err(RunError::Failed)?;
+            let load = &mut self.model.loads[li];
+            if m[2] <= 0.0 {
+                return Err(RunError::Failed(format!(
+                    "load `{}`: no loaded face is left to evaluate its increment_factor at",
+                    load.name
+                )));
+            }
+            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from(li)).map_err(RunError::Failed)?;
+        }
         Ok(())
     }
 
@@ -1081,6 +1108,7 @@ impl<'a> Simulation<'a> {
         crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
         self.model.resolve_targets(self.case);
         self.t = cp.time;
+        self.set_load_increments(|li| IncrementsFrom::Checkpoint(cp.load_totals[li]))?;
         self.step = cp.step as usize;
         let s = &mut *self.summary;
         s.time_s = cp.time;

@@ -17,7 +17,7 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 4;
+pub const FORMAT_VERSION: u64 = 5;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
 pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
@@ -82,6 +82,9 @@ pub struct Checkpoint {
     pub diagnostics: Vec<f64>,
     /// The probes' signed excess-pressure extremes, in case order.
     pub probe_extremes: Vec<f64>,
+    /// Each load's factor reached so far, in case order (what a load with an `increment_factor`
+    /// has summed; see [`crate::model::loads::Increments`]).
+    pub load_totals: Vec<f64>,
     /// The verification check's own state (`None`: the check keeps none).
     pub check_state: Option<Vec<f64>>,
     /// This rank's slab of the particle records ([`pack`]) of all ranks sorted by id: records
@@ -133,8 +136,11 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
             cp.case_fingerprint
         ));
     }
-    if cp.stage as usize >= case.stages.len() || cp.probe_extremes.len() != case.probes.len() {
-        return Err("its stage or probes do not match the case".into());
+    if cp.stage as usize >= case.stages.len()
+        || cp.probe_extremes.len() != case.probes.len()
+        || cp.load_totals.len() != case.loads.len()
+    {
+        return Err("its stage, probes or loads do not match the case".into());
     }
     Ok(())
 }
@@ -269,6 +275,10 @@ impl Checkpoint {
         for &v in &self.probe_extremes {
             h.f64(v);
         }
+        h.u64(self.load_totals.len() as u64);
+        for &v in &self.load_totals {
+            h.f64(v);
+        }
         match &self.check_state {
             None => h.u64(u64::MAX),
             Some(s) => {
@@ -356,6 +366,7 @@ mod tests {
             counters: [1, 2, 3, 4],
             diagnostics: vec![0.1],
             probe_extremes: vec![1.0],
+            load_totals: vec![0.5],
             check_state: Some(vec![2.0]),
             particles: (0..ps.len()).map(|k| pack(&ps, k)).collect(),
             first: 0,

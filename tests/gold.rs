@@ -214,6 +214,7 @@ gold_tests!(
     harmonic_column_zone2,
     harmonic_column_zone3,
     hollow_cylinder,
+    hollow_cylinder_increments,
     lame_cylinder,
     large_strain_consolidation,
     patch_test,

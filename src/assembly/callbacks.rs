@@ -577,6 +577,35 @@ impl<'a> Assembler<'a> {
         out
     }
 
+    /// What a geometrically linear step (`analysis.kinematics = "linear_increments"`) adds to its
+    /// residual: minus the residual of the step's start on x_n (Δd = 0, the stress σ_n, the body
+    /// acceleration `body_acc_old` and the loads `fext_old` of t_n) at every free dof, zero at the
+    /// fixed ones. The step then solves F_int(Δσ) = ΔF_ext (less the body force's increment), the
+    /// increment of a stress-free body as [001]'s K Δu = ΔF: whatever the stress of earlier steps
+    /// leaves out of balance on the moved configuration is not carried. At the fixed dofs the
+    /// terms stay whole, so that the reactions are those of the total stress. Constant over the
+    /// step's iterations.
+    pub(super) fn start_out_of_balance(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        let step = self.step;
+        let nm = step.nm.expect("prepared");
+        let xl = vec![0.0; fext_old.len()];
+        let mut out: Vec<f64> = fext_old.iter().map(|f| -nm.w_force * f).collect();
+        let ps = self.particles();
+        let block = |k: usize, buf: &mut [f64]| {
+            let mut input = particle_input(ps.model, step, k);
+            input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
+            ps.with_point_of(k, &xl, input, |pt| {
+                kernels::residual(pt, &nm, &mut buf[..pt.size()]);
+                pt.size()
+            })
+        };
+        run_bands(&step.bands, &mut out, |a| a as usize * step.dofs.nd, |band, f| ps.residual_band(band, f, &block));
+        for (v, &fixed) in out.iter_mut().zip(&step.dofs.fixed) {
+            *v = if fixed { 0.0 } else { -*v };
+        }
+        out
+    }
+
     /// −S Δp of the pressure projection in the continuity rows of `f`.
     fn add_projection(&self, xl: &[f64], f: &mut [f64]) {
         let Some(p) = self.step.layout.and_then(|l| l.p) else { return };

@@ -38,7 +38,6 @@ mod stiffness;
 pub use check::BlockCheck;
 pub use stencils::WELL_FILLED_FRACTION;
 
-use crate::case::Side;
 use crate::kernels::{self, Layout, StepResult};
 use crate::model::loads::LoadTarget;
 use crate::model::shape;
@@ -615,7 +614,7 @@ impl GridSystem {
             .into_iter()
             .map(|(k, face)| {
                 let normal = model.face_normal(k, face);
-                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
+                let (xf, length) = crate::model::loads::face_point(face, ps.x[k], ps.lp[k]);
                 let area = length * model.geometry.measure(xf[0]);
                 let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
                 let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
@@ -725,7 +724,12 @@ impl GridSystem {
             ..StepData::default()
         };
         self.check_loads(&applied, t_new, coll)?;
-        if nm.history().is_some() {
+        if model.linear_increments {
+            // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
+            // the residual of the step's start on x_n is taken off (validation keeps these stages
+            // static or quasi-static, which have no generalized-α history).
+            self.step.history = self.start_out_of_balance(model, &model.body_accelerations(active, t_old), &fext_old);
+        } else if nm.history().is_some() {
             self.step.history = self.history(model, &model.body_accelerations(active, t_old), &fext_old);
         }
         self.step.fext_old = fext_old;
@@ -972,7 +976,7 @@ impl GridSystem {
         };
         for &li in &active.loads {
             let load = &model.loads[li];
-            let f = load.time_fn.eval(t_new);
+            let f = load.factor(t_new);
             if !matches!(load.target, LoadTarget::BodyForce { .. }) {
                 applied.names.push(load.name.clone());
             }
@@ -982,7 +986,7 @@ impl GridSystem {
                     // current face length) with the bilinear weights there (see shape::face_weights).
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
-                        let (point, length) = face_point(*face, x, lp);
+                        let (point, length) = crate::model::loads::face_point(*face, x, lp);
                         // The face's area: its length times the ring's 2πr in axial symmetry.
                         let length = length * model.geometry.measure(point[0]);
                         applied.add([traction[0] * f * length, traction[1] * f * length]);
@@ -1074,13 +1078,17 @@ impl GridSystem {
 
     /// Solves the prepared step by Newton's method from Δd = 0, or, when the analysis extrapolates,
     /// from the last accepted increment scaled by Δt / Δt_last; every fixed dof starts at its
-    /// prescribed increment.
+    /// prescribed increment. Geometrically linear steps start from Δd = 0: their residual is affine
+    /// in Δd, so the exact tangent needs one iteration from anywhere, and one solve with one of
+    /// [001]'s mapped stiffnesses is then [001]'s K Δu = ΔF.
     pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
         let _stage = self.stages.solve.push()?;
         {
             let mut x = self.x.write()?;
             match &self.last_increment {
-                Some((last, dt_last)) if model.integration.extrapolates() && last.len() == x.len() => {
+                Some((last, dt_last))
+                    if model.integration.extrapolates() && !model.linear_increments && last.len() == x.len() =>
+                {
                     let ratio = self.step.dt / dt_last;
                     for (xi, li) in x.iter_mut().zip(last) {
                         *xi = ratio * li;
@@ -1420,6 +1428,15 @@ impl GridSystem {
         Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
     }
 
+    /// The start-of-step out-of-balance of a geometrically linear step, negated (see
+    /// `Assembler::start_out_of_balance`).
+    fn start_out_of_balance(&mut self, model: &Model, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        let mut seconds = 0.0;
+        let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
+        Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly)
+            .start_out_of_balance(body_acc_old, fext_old)
+    }
+
     /// The generalized-α history of the prepared step (see `Assembler::history`).
     fn history(&mut self, model: &Model, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
         let mut seconds = 0.0;
@@ -1469,16 +1486,6 @@ struct Nodal {
     mass: Vec<f64>,
     mom: Vec<f64>,
     acc: Vec<f64>,
-}
-
-/// The centre of a particle's `face` and the face's length.
-fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
-    match face {
-        Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
-        Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
-        Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
-        Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
-    }
 }
 
 /// The Newton iterations a step may take (`-snes_max_it` overrides it): 30 with the exact tangent,

@@ -83,6 +83,25 @@ pub struct Analysis {
     /// Option A). Both reproduce the strains of u_r = α + βr exactly; the linear basis has one form.
     #[serde(default)]
     pub axisymmetric_weights: AxisymmetricWeights,
+    /// The kinematics of a step: `finite_strain` (the default: forces on the configuration at the
+    /// step's end, the objective Hughes–Winget update, the exact tangent with its geometric terms)
+    /// or `linear_increments` ([001] Eqs. 5, 7, 11: each step is geometrically linear on the
+    /// configuration at its start, Δε = sym ∇Δu, σ_{n+1} = σ_n + Δσ without rotation, forces
+    /// Bᵀσ V_n; the points still move and their volumes and domains update between steps, an
+    /// updated Lagrangian of small-strain increments). One-phase only.
+    #[serde(default)]
+    pub kinematics: KinematicsKind,
+}
+
+/// The kinematics of a step (see `Analysis::kinematics`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KinematicsKind {
+    /// Finite strain on the step's end configuration.
+    #[default]
+    FiniteStrain,
+    /// Geometrically linear steps on the step's start configuration ([001]).
+    LinearIncrements,
 }
 
 /// The geometry of the (x, y) plane.
@@ -494,6 +513,16 @@ pub enum Load {
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
+        /// An expression in `x` and `y` [m] (and the case's parameters) that scales each step's
+        /// increment of the load by where the loaded faces are at the start of the step: over the
+        /// step from t_n to t_{n+1} the traction grows by `traction` × (f(t_{n+1}) − f(t_n)) ×
+        /// g(x̄_n, ȳ_n), with x̄_n, ȳ_n the area-weighted mean centre of the loaded faces at t_n.
+        /// The total is the sum of the increments, each applied where the surface was (e.g.
+        /// [001]'s internal pressure re-evaluated at the current inner radius,
+        /// `"A / x^2 + 2 * C"`). Written without the leading `=` (it is evaluated during the run,
+        /// not when the case is read). Without it the traction is `traction` × f(t).
+        #[serde(default)]
+        increment_factor: Option<String>,
     },
     /// A traction [Pa] along the line of grid nodes inside `region`, each node taking its
     /// tributary length of the line. The load stays on that grid line: when the loaded surface moves
@@ -551,6 +580,15 @@ impl Load {
             | Load::NodalTraction { name, .. }
             | Load::LinePressure { name, .. }
             | Load::BodyForce { name, .. } => name,
+        }
+    }
+
+    /// The expression scaling its increments by the loaded faces' position, if any (see
+    /// `ParticleTraction::increment_factor`).
+    pub fn increment_factor(&self) -> Option<&str> {
+        match self {
+            Load::ParticleTraction { increment_factor, .. } => increment_factor.as_deref(),
+            _ => None,
         }
     }
 
@@ -1107,6 +1145,13 @@ pub enum Verification {
         /// RMS of the relative error of Δσ_rr over the body.
         #[serde(default = "default_hollow_stress_tol")]
         stress_tolerance: f64,
+        /// Checks every load step as an increment of the remaining cylinder ([001]'s 25
+        /// increments, Part E item 9): by uniqueness, the closed form of the original cylinder
+        /// restricted to [r_i, b] is the small-strain increment of the wall whose inner face has moved
+        /// to r_i when the load applied there is the original Δσ_rr(r_i) (an `increment_factor`
+        /// `A / x^2 + 2 * C`). Without it only the first step is checked.
+        #[serde(default)]
+        increments: Option<IncrementTolerances>,
     },
     /// The nodal stiffness diagnostic K_mag = √(K_x² + K_y²) ([001] Eq. 25, §6) of a block of
     /// material points in plane strain against the finite-element value of an interior node of a
@@ -1176,6 +1221,22 @@ impl Verification {
             Verification::ShockWave { .. } => "shock_wave",
         }
     }
+}
+
+/// Tolerances of the hollow cylinder's step-by-step comparison (the innermost column of points,
+/// mp1, against the closed form at its radius at the start of each step).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct IncrementTolerances {
+    /// Largest accepted relative error of Δq, the von Mises stress of the step's stress increment,
+    /// over the steps ([001]: 10 %).
+    pub q: f64,
+    /// Largest accepted error of Δσ_m over the steps, relative to the step's pressure at r = a
+    /// ([001]: 5 kPa per 100 kPa).
+    pub mean_stress: f64,
+    /// Largest accepted relative error of mp1's radius after the last step against the closed-form
+    /// path r_{k+1} = r_k + u_r(r_k) ([001]: 5 %).
+    pub radius: f64,
 }
 
 fn default_lame_tol() -> f64 {

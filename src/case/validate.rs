@@ -127,6 +127,19 @@ fn axisymmetry(c: &Case, tol: f64) -> R {
 pub fn validate(c: &Case) -> R {
     let two_phase = c.analysis.formulation == Formulation::TwoPhase;
     positive("analysis.g", c.analysis.g)?;
+    if c.analysis.kinematics == KinematicsKind::LinearIncrements {
+        if two_phase {
+            return Err("key `analysis.kinematics`: `linear_increments` is for a one_phase analysis (the two-phase \
+                        pressure and flow terms are written on the configuration at the step's end)"
+                .into());
+        }
+        if let Some(s) = c.stages.iter().find(|s| s.analysis == AnalysisType::Dynamic) {
+            return Err(format!(
+                "key `analysis.kinematics`: `linear_increments` steps are static (stage `{}` is dynamic)",
+                s.name
+            ));
+        }
+    }
 
     if let Some(alpha) = c.stabilisation.pressure_projection {
         magnitude(
@@ -412,6 +425,12 @@ pub fn validate(c: &Case) -> R {
                 if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
                     return Err(format!("key `loads[{i}].region`: max must not be below min"));
                 }
+                if let Some(e) = l.increment_factor() {
+                    // Tried where the loaded faces start: the region's centre.
+                    let centre = [0.5 * (region.min[0] + region.max[0]), 0.5 * (region.min[1] + region.max[1])];
+                    crate::model::loads::increment_factor(e, &c.parameters, centre)
+                        .map_err(|m| format!("key `loads[{i}].increment_factor`: `{e}` at {centre:?}: {m}"))?;
+                }
             }
             Load::BodyForce { acceleration, .. } => finite2(&format!("loads[{i}].acceleration"), *acceleration)?,
             Load::LinePressure { points, pressure, .. } => {
@@ -598,6 +617,7 @@ pub fn validate(c: &Case) -> R {
                 outer_radius,
                 displacement_tolerance,
                 stress_tolerance,
+                increments,
             } => {
                 positive("verification.inner_radius", *inner_radius)?;
                 if outer_radius <= inner_radius {
@@ -605,6 +625,11 @@ pub fn validate(c: &Case) -> R {
                 }
                 positive("verification.displacement_tolerance", *displacement_tolerance)?;
                 positive("verification.stress_tolerance", *stress_tolerance)?;
+                if let Some(t) = increments {
+                    positive("verification.increments.q", t.q)?;
+                    positive("verification.increments.mean_stress", t.mean_stress)?;
+                    positive("verification.increments.radius", t.radius)?;
+                }
                 if !matches!(c.load(load), Some(Load::NodalTraction { .. } | Load::ParticleTraction { .. })) {
                     return Err(format!(
                         "key `verification.load`: `{load}` must be a nodal_traction or particle_traction load"
@@ -794,6 +819,14 @@ pub fn validate(c: &Case) -> R {
             return Err(format!(
                 "key `verification.{}`: no load named `{load}`",
                 if matches!(v, Verification::ElasticColumn { .. }) { "gravity" } else { "load" }
+            ));
+        }
+        if c.load(load).and_then(|l| l.increment_factor()).is_some()
+            && !matches!(v, Verification::HollowCylinder { .. })
+        {
+            return Err(format!(
+                "key `verification.load`: the check's reference follows the load's time function, and `{load}` has an \
+                 `increment_factor` (only the hollow_cylinder check follows one)"
             ));
         }
         match v {

@@ -143,6 +143,7 @@ mod tests {
             body_acc: [0.0, -10.0],
             grad_n: [0.0; 2],
             pred: Default::default(),
+            linear: false,
         }
     }
 

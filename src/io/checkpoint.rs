@@ -4,7 +4,7 @@
 //! [s], `step`, `stage`, `dt` [s], `successes`, `has_check_state`, then
 //! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
 //! iterations, matrix-structure reuses), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
-//! `check_state`, and one dataset per
+//! `load_totals`, `check_state`, and one dataset per
 //! particle array under `/particles` (n × components, SI units, sorted by id).
 //!
 //! All ranks write and read the file together (HDF5's MPI-I/O driver): each writes the slab of the
@@ -98,6 +98,7 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..]))?;
         dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics)?;
         dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes)?;
+        dataset_f64(&f, "load_totals", &[cp.load_totals.len()], &cp.load_totals)?;
         let state = cp.check_state.clone().unwrap_or_default();
         dataset_f64(&f, "check_state", &[state.len()], &state)?;
         {
@@ -231,6 +232,7 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
         counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 4 values"))?,
         diagnostics: vec_f64("diagnostics").map_err(corrupt)?,
         probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
+        load_totals: vec_f64("load_totals").map_err(corrupt)?,
         check_state: has_state.then_some(state),
         particles,
         first: a as u64,
@@ -261,6 +263,7 @@ mod tests {
             counters: [1, 301, 302, 7],
             diagnostics: vec![f64::NAN, 0.5],
             probe_extremes: vec![-12.5, 3.0],
+            load_totals: vec![0.25, 1.0 / 3.0],
             check_state: Some(vec![1.0, 2.0]),
             particles: vec![r, r2],
             first: 0,

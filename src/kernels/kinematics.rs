@@ -22,6 +22,13 @@
 //! and the soil model starts from the rotated stress R σ_n Rᵀ. A rigid rotation by α gives
 //! sym L = 0 and θ = α exactly, so the stress turns with the material to round-off.
 //!
+//! **Geometrically linear steps** (`linear = true`, `analysis.kinematics = "linear_increments"`,
+//! [001] Eqs. 5, 7, 11): the step is small-strain on x_n. Δε = sym H − ⅓ tr H m + ⅓ tr H_v m (the
+//! hoop component H_θθ), no rotation (θ = 0), and the gradients and hoop operators the forces use
+//! stay those of x_n (F⁻ᵀ → I), so the step's residual is linear in Δu and its tangent is the
+//! material part alone. J, J_v and F̄ are still those of the motion: the particle's volume, domain
+//! and position follow it between steps.
+//!
 //! **Axial symmetry** (x ≡ r, `../shared/seeds-001-002.md` Part A2): F is block diagonal with the
 //! hoop stretch F_θθ = 1 + H_θθ, H_θθ = Σ T_i Δu_r,i (T_i the node's hoop operator, S_i/r_p for the
 //! planar weights: F_θθ = r_{n+1}/r_n), and F_v,θθ likewise with B̄'s T̄_i. Then J = det F_rz F_θθ,
@@ -100,11 +107,14 @@ pub struct Kinematics {
     pub f_hoop: f64,
     /// B̄'s hoop stretch F_v,θθ = 1 + Σ T̄_i Δu_r,i.
     pub fv_hoop: f64,
+    /// A geometrically linear step (see the module documentation).
+    pub linear: bool,
 }
 
 impl Kinematics {
-    /// The kinematics for displacement increments `du[k]` at the nodes of `basis`.
-    pub fn new(basis: &[NodeBasis], du: impl Iterator<Item = [f64; 2]>) -> Kinematics {
+    /// The kinematics for displacement increments `du[k]` at the nodes of `basis`, finite strain
+    /// or (`linear`) a geometrically linear step.
+    pub fn new(basis: &[NodeBasis], du: impl Iterator<Item = [f64; 2]>, linear: bool) -> Kinematics {
         let (mut h, mut hv) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
         let (mut ht, mut hvt) = (0.0, 0.0);
         for (b, u) in basis.iter().zip(du) {
@@ -119,6 +129,22 @@ impl Kinematics {
         }
         let add = |a: &M2, s: f64| [[1.0 + s * a[0][0], s * a[0][1]], [s * a[1][0], 1.0 + s * a[1][1]]];
         let (f, fv) = (add(&h, 1.0), add(&hv, 1.0));
+        if linear {
+            let tr = h[0][0] + h[1][1] + ht;
+            let trv = hv[0][0] + hv[1][1] + hvt;
+            let vol = (trv - tr) / 3.0;
+            return Kinematics {
+                f,
+                j: det(&f) * (1.0 + ht),
+                fv,
+                jv: det(&fv) * (1.0 + hvt),
+                f_hoop: 1.0 + ht,
+                fv_hoop: 1.0 + hvt,
+                deps: [h[0][0] + vol, h[1][1] + vol, h[0][1] + h[1][0], ht + vol],
+                linear,
+                ..Kinematics::rest()
+            };
+        }
         let (fh_inv, fvh_inv) = (inverse(&add(&h, 0.5)), inverse(&add(&hv, 0.5)));
         let l = mul(&h, &fh_inv);
         let lv = mul(&hv, &fvh_inv);
@@ -144,6 +170,7 @@ impl Kinematics {
             deps,
             omega,
             theta: 2.0 * (0.5 * omega).atan(),
+            linear,
         }
     }
 
@@ -165,12 +192,16 @@ impl Kinematics {
             theta: 0.0,
             f_hoop: 1.0,
             fv_hoop: 1.0,
+            linear: false,
         }
     }
 
     /// The hoop operators of a node on x_{n+1}: (T', T̄') = (T/F_θθ, T̄/F_v,θθ).
     #[inline]
     pub fn hoop(&self, b: &NodeBasis) -> (f64, f64) {
+        if self.linear {
+            return (b.t, b.tv);
+        }
         (b.t / self.f_hoop, b.tv / self.fv_hoop)
     }
 
@@ -188,7 +219,7 @@ impl Kinematics {
     pub fn deps_derivative(&self, b: &NodeBasis) -> [[f64; 2]; 4] {
         let gh = mul_t(&self.fh_inv, b.g);
         let gvh = mul_t(&self.fvh_inv, b.gv);
-        let mid = |f: f64| 1.0 / (0.5 * (1.0 + f)).powi(2);
+        let mid = |f: f64| if self.linear { 1.0 } else { 1.0 / (0.5 * (1.0 + f)).powi(2) };
         let (dlt, dlvt) = (b.t * mid(self.f_hoop), b.tv * mid(self.fv_hoop));
         // Column d: the strain increment of a unit increment of component d.
         let column = |d: usize| -> [f64; 4] {
@@ -207,6 +238,9 @@ impl Kinematics {
 
     /// ∂θ/∂Δu_l (2 displacement components) for a node with basis `b`.
     pub fn theta_derivative(&self, b: &NodeBasis) -> [f64; 2] {
+        if self.linear {
+            return [0.0; 2];
+        }
         let gh = mul_t(&self.fh_inv, b.g);
         let factor = 1.0 / (1.0 + 0.25 * self.omega * self.omega);
         let mut out = [0.0; 2];
@@ -274,7 +308,7 @@ mod tests {
     fn derivatives_match_central_differences() {
         let b = basis();
         let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.02)).collect();
-        let k0 = Kinematics::new(&b, u.iter().copied());
+        let k0 = Kinematics::new(&b, u.iter().copied(), false);
         let h = 1e-7;
         for l in 0..b.len() {
             let de = k0.deps_derivative(&b[l]);
@@ -283,7 +317,7 @@ mod tests {
                 let shifted = |s: f64| {
                     let mut v = u.clone();
                     v[l][d] += s;
-                    Kinematics::new(&b, v.into_iter())
+                    Kinematics::new(&b, v.into_iter(), false)
                 };
                 let (p, m) = (shifted(h), shifted(-h));
                 for (r, der) in de.iter().enumerate() {
@@ -315,7 +349,7 @@ mod tests {
         for alpha in [0.1f64, 0.9, -1.4] {
             let (c, s) = (alpha.cos(), alpha.sin());
             let u = pts.iter().map(|&(x, y)| [c * x - s * y - x, s * x + c * y - y]);
-            let k = Kinematics::new(&b, u);
+            let k = Kinematics::new(&b, u, false);
             assert!(k.deps.iter().all(|e| e.abs() < 1e-14), "{:?}", k.deps);
             assert!((k.theta - alpha).abs() < 1e-14, "{} vs {alpha}", k.theta);
             assert!((k.j - 1.0).abs() < 1e-14 && (k.jv - 1.0).abs() < 1e-14);

@@ -198,6 +198,9 @@ pub struct ParticleInput {
     pub grad_n: [f64; 2],
     /// Newmark predictors of the point.
     pub pred: Predictors,
+    /// A geometrically linear step (`analysis.kinematics = "linear_increments"`, [001] Eqs. 5, 7,
+    /// 11): see [`kinematics`].
+    pub linear: bool,
 }
 
 /// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
@@ -534,7 +537,7 @@ impl<'a> Point<'a> {
         layout: Layout,
     ) -> Point<'a> {
         let interp = interpolate(basis, states, &part.pred, layout);
-        let kin = Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]));
+        let kin = Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear);
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         let upd = model.update(&rotated, part.eps_pd, &kin.deps);
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
@@ -586,9 +589,14 @@ impl<'a> Point<'a> {
         self.basis.len() * self.layout.nd
     }
 
-    /// V_{n+1} = J_v V_n.
+    /// The volume the forces integrate over: V_{n+1} = J_v V_n, or V_n in a geometrically linear
+    /// step (the particle still takes V_{n+1} when it is updated).
     pub fn volume_new(&self) -> f64 {
-        self.part.volume * self.kin.jv
+        if self.kin.linear {
+            self.part.volume
+        } else {
+            self.part.volume * self.kin.jv
+        }
     }
 }
 

@@ -156,6 +156,7 @@ fn part() -> ParticleInput {
         body_acc: [0.0, -9.81],
         grad_n: [0.7, -1.3],
         pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
+        linear: false,
     }
 }
 
@@ -244,6 +245,7 @@ fn check_term(
     layout: Layout,
     nm: &Scheme,
     (hoop, recovery): (bool, bool),
+    linear: bool,
 ) -> Vec<BlockError> {
     let basis = sample_in(6, hoop);
     let strain = if recovery { sample_strain(6, hoop) } else { basis.clone() };
@@ -252,6 +254,7 @@ fn check_term(
     let nm = *nm;
     let mut p = part();
     p.stress = stress;
+    p.linear = linear;
     let d0 = increments(m, layout);
     let faces = sample_faces(basis.len());
     let point = |st: &[NodeState]| -> Vec<f64> {
@@ -275,7 +278,7 @@ fn every_term_matches_central_differences_block_by_block() {
         for (mname, model, stress) in models() {
             let modes = [(false, false), (true, false), (false, true), (true, true)];
             for (term, mode) in terms().into_iter().flat_map(|t| modes.map(|m| (t, m))) {
-                for b in check_term(&term, &model, stress, layout, &nm, mode) {
+                for b in check_term(&term, &model, stress, layout, &nm, mode, false) {
                     assert!(
                         b.pass(),
                         "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain) {mode:?}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
@@ -292,6 +295,63 @@ fn every_term_matches_central_differences_block_by_block() {
             }
         }
     }
+}
+
+/// Geometrically linear steps (`analysis.kinematics = "linear_increments"`, one-phase): every
+/// term's tangent matches central differences, the residual of an elastic point is affine in the
+/// increments (f(d₀ + s δ) is linear in s), and its stress increment is D sym ∇Δu without rotation.
+#[test]
+fn linear_increments_have_an_affine_residual_and_a_matching_tangent() {
+    let names = ["ux", "uy"];
+    for (layout, sname, nm) in layouts_and_schemes().into_iter().filter(|l| l.0.nd == 2) {
+        for (mname, model, stress) in models() {
+            for mode in [(false, false), (true, false), (false, true), (true, true)] {
+                for term in terms() {
+                    for b in check_term(&term, &model, stress, layout, &nm, mode, true) {
+                        assert!(
+                            b.pass(),
+                            "{} ({mname}, {sname}, {mode:?}, linear): block {}–{} differs by {:e} (|J| ≤ {:e})",
+                            term.0,
+                            names[b.row],
+                            names[b.col],
+                            b.err,
+                            b.jmax
+                        );
+                    }
+                }
+            }
+        }
+    }
+    let (_, model, stress) = models()[0];
+    let basis = sample_in(6, true);
+    let nm = Scheme::of(&Integration::Static, 1.0, false);
+    let m = basis.len() * 2;
+    let d0 = increments(m, Layout::U);
+    // The residual, stress and rotation for the increments s d₀, linear or finite strain.
+    let force = |s: f64, linear: bool| {
+        let p = ParticleInput { stress, linear, ..part() };
+        let d: Vec<f64> = d0.iter().map(|x| 30.0 * s * x).collect();
+        let st = states(&d, 2, &nm);
+        let pt = Point::new(&basis, &st, &p, &model, Layout::U);
+        let mut r = vec![0.0; m];
+        stress::residual(&pt, &nm, &mut r);
+        (r, pt.upd.stress, pt.kin.theta)
+    };
+    let (r0, s0, _) = force(0.0, true);
+    let (r1, s1, theta) = force(1.0, true);
+    let (r2, s2, _) = force(2.0, true);
+    let scale = r1.iter().map(|x| x.abs()).fold(0.0, f64::max);
+    for i in 0..m {
+        assert!((r2[i] - 2.0 * r1[i] + r0[i]).abs() < 1e-10 * scale, "row {i}: {} {} {}", r0[i], r1[i], r2[i]);
+    }
+    assert_eq!(theta, 0.0);
+    for c in 0..4 {
+        assert!((s2[c] - 2.0 * s1[c] + s0[c]).abs() < 1e-9 * (s1[c] - s0[c]).abs().max(1.0), "component {c}");
+    }
+    // The same increments under finite strain are not affine (the test can tell the two apart).
+    let (f0, f1, f2) = (force(0.0, false).0, force(1.0, false).0, force(2.0, false).0);
+    let curvature = (0..m).map(|i| (f2[i] - 2.0 * f1[i] + f0[i]).abs()).fold(0.0, f64::max);
+    assert!(curvature > 1e-4 * scale, "finite strain curvature {curvature:e} against {scale:e}");
 }
 
 #[test]

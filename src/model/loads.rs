@@ -76,6 +76,58 @@ pub struct LoadDef {
     pub time_fn: TimeFn,
     /// What it acts on.
     pub target: LoadTarget,
+    /// The state of a load whose increments follow the loaded faces (`increment_factor`).
+    pub increments: Option<Increments>,
+}
+
+/// A load whose increment over each step is scaled by g(x̄_n, ȳ_n), an expression evaluated at the
+/// loaded faces' mean centre at the start of the step: its factor at t in the step from t_n is
+/// `total + (f(t) − f(t_n)) g_n`.
+#[derive(Debug, Clone)]
+pub struct Increments {
+    /// The expression g (in `x`, `y` and the case's parameters).
+    pub expr: String,
+    /// The case's parameters.
+    pub params: std::collections::BTreeMap<String, f64>,
+    /// The factor reached at t_n: the sum of the increments so far.
+    pub total: f64,
+    /// t_n [s].
+    pub t_n: f64,
+    /// g at the loaded faces' mean centre at t_n.
+    pub g_n: f64,
+}
+
+/// Where [`LoadDef::set_increments`] takes a load's total from.
+#[derive(Debug, Clone, Copy)]
+pub enum IncrementsFrom {
+    /// The run starts: f(t) g.
+    Start,
+    /// A checkpoint's total.
+    Checkpoint(f64),
+    /// An accepted step ends: the step's factor.
+    Accepted,
+}
+
+/// The value of an `increment_factor` expression at `at` = (x, y) [m].
+pub fn increment_factor(
+    expr: &str,
+    params: &std::collections::BTreeMap<String, f64>,
+    at: [f64; 2],
+) -> Result<f64, String> {
+    let mut vars: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.clone(), *v)).collect();
+    vars.push(("x".into(), at[0]));
+    vars.push(("y".into(), at[1]));
+    crate::case::parameters::eval(expr, &vars)
+}
+
+/// The centre of a particle's `face` and the face's length.
+pub fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
+    match face {
+        Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
+        Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
+        Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
+        Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
+    }
 }
 
 /// What a load acts on.
@@ -123,7 +175,59 @@ impl LoadDef {
                     .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
             },
         };
-        LoadDef { name: l.name().to_string(), time_fn, target }
+        let increments = l.increment_factor().map(|e| Increments {
+            expr: e.to_string(),
+            params: c.parameters.clone(),
+            total: 0.0,
+            t_n: 0.0,
+            g_n: 0.0,
+        });
+        LoadDef { name: l.name().to_string(), time_fn, target, increments }
+    }
+
+    /// The load's factor at time t (in the step from the last accepted time on): f(t), or for a
+    /// load with increments the sum of those accepted plus the current step's.
+    pub fn factor(&self, t: f64) -> f64 {
+        match &self.increments {
+            None => self.time_fn.eval(t),
+            Some(s) => s.total + (self.time_fn.eval(t) - self.time_fn.eval(s.t_n)) * s.g_n,
+        }
+    }
+
+    /// This rank's moments of the loaded faces: [Σ a x, Σ a y, Σ a] with a the face's area
+    /// (length, times 2πr in axial symmetry); zero unless it is a face traction.
+    pub fn face_moments(&self, particles: &Particles, geometry: &super::shape::Geometry) -> [f64; 3] {
+        let mut m = [0.0; 3];
+        if let LoadTarget::ParticleTraction { particles: ks, face, .. } = &self.target {
+            for &k in ks {
+                let (point, length) = face_point(*face, particles.x[k], particles.lp[k]);
+                let a = length * geometry.measure(point[0]);
+                m[0] += a * point[0];
+                m[1] += a * point[1];
+                m[2] += a;
+            }
+        }
+        m
+    }
+
+    /// Sets a load with increments at time `t`: at the run's start (`total` = f(t) g, g evaluated
+    /// at `centre`), from a checkpoint (`restored` total), or at the end of an accepted step
+    /// (`accepted`: `total` becomes the step's factor at t, and g is evaluated anew). `centre` is
+    /// the loaded faces' mean centre now, from all ranks' [`Self::face_moments`].
+    pub fn set_increments(&mut self, t: f64, centre: [f64; 2], from: IncrementsFrom) -> Result<(), String> {
+        let Some(s) = &self.increments else { return Ok(()) };
+        let g = increment_factor(&s.expr, &s.params, centre)
+            .map_err(|e| format!("load `{}`: increment_factor `{}` at {centre:?}: {e}", self.name, s.expr))?;
+        let total = match from {
+            IncrementsFrom::Start => self.time_fn.eval(t) * g,
+            IncrementsFrom::Checkpoint(total) => total,
+            IncrementsFrom::Accepted => self.factor(t),
+        };
+        let s = self.increments.as_mut().expect("checked");
+        s.total = total;
+        s.t_n = t;
+        s.g_n = g;
+        Ok(())
     }
 
     /// Number of particles or nodes it acts on (for `check`).
@@ -372,6 +476,49 @@ impl BoundaryDef {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A load with increments sums f's increments, each times g where the faces were at the step's
+    /// start: with f = t and g = 10 x, faces at x = 1, then 2, then 4, the factor after three unit
+    /// steps is 10 + 20 + 40; within a step it is linear in f; a checkpoint's total is taken as it
+    /// is; without increments the factor is f(t).
+    #[test]
+    fn a_load_with_increments_sums_them_where_the_faces_were() {
+        let mut l = LoadDef {
+            name: "p".into(),
+            time_fn: TimeFn::Table { t: vec![0.0, 10.0], v: vec![0.0, 10.0] },
+            target: LoadTarget::BodyForce { acceleration: [0.0; 2], bodies: None },
+            increments: Some(Increments {
+                expr: "k * x + 0 * y".into(),
+                params: [("k".to_string(), 10.0)].into_iter().collect(),
+                total: f64::NAN,
+                t_n: f64::NAN,
+                g_n: f64::NAN,
+            }),
+        };
+        l.set_increments(0.0, [1.0, 5.0], IncrementsFrom::Start).unwrap();
+        assert_eq!(l.factor(0.0), 0.0);
+        assert_eq!(l.factor(0.5), 5.0);
+        assert_eq!(l.factor(1.0), 10.0);
+        l.set_increments(1.0, [2.0, 5.0], IncrementsFrom::Accepted).unwrap();
+        assert_eq!(l.factor(2.0), 30.0);
+        l.set_increments(2.0, [4.0, 5.0], IncrementsFrom::Accepted).unwrap();
+        assert_eq!(l.factor(3.0), 70.0);
+        l.set_increments(3.0, [4.0, 5.0], IncrementsFrom::Checkpoint(12.5)).unwrap();
+        assert_eq!(l.factor(3.0), 12.5);
+        assert_eq!(l.factor(4.0), 52.5);
+        // A constant f loads at the start: f(0) g.
+        let mut c = LoadDef { time_fn: TimeFn::Constant(2.0), ..l.clone() };
+        c.set_increments(0.0, [3.0, 0.0], IncrementsFrom::Start).unwrap();
+        assert_eq!(c.factor(0.0), 60.0);
+        assert_eq!(c.factor(7.0), 60.0);
+        // An expression that cannot be evaluated there is an error naming the load.
+        let mut bad = l.clone();
+        bad.increments.as_mut().unwrap().expr = "1 / (x - 4)".into();
+        let e = bad.set_increments(4.0, [4.0, 0.0], IncrementsFrom::Accepted).unwrap_err();
+        assert!(e.contains("load `p`") && e.contains("not finite"), "{e}");
+        let plain = LoadDef { increments: None, ..l };
+        assert_eq!(plain.factor(3.5), 3.5);
+    }
 
     #[test]
     fn time_functions_take_their_values() {

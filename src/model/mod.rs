@@ -59,6 +59,8 @@ pub struct Model {
     pub stiffness: crate::case::Stiffness,
     /// How a point's strain increment is recovered ([001] §5.5).
     pub stress_recovery: crate::case::StressRecovery,
+    /// Geometrically linear steps (`analysis.kinematics = "linear_increments"`).
+    pub linear_increments: bool,
 }
 
 /// The geometry of a case.
@@ -160,6 +162,7 @@ impl Model {
             geometry,
             stiffness: case.stabilisation.stiffness,
             stress_recovery: case.stabilisation.stress_recovery,
+            linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
@@ -171,7 +174,10 @@ impl Model {
     pub fn resolve_targets(&mut self, case: &Case) {
         for (l, c) in self.loads.iter_mut().zip(&case.loads) {
             if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
+                // The state of a load with increments is global (the same on every rank): kept.
+                let increments = l.increments.take();
                 *l = LoadDef::from_case(c, case, &self.grid, &self.particles);
+                l.increments = increments;
             }
         }
         for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
@@ -390,6 +396,7 @@ impl Model {
             body_acc: body_acc[ps.body[idx] as usize],
             grad_n: [0.0; 2],
             pred: Default::default(),
+            linear: self.linear_increments,
         }
     }
 

@@ -18,7 +18,7 @@
 //! increment.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Load, Verification};
+use crate::case::{Case, IncrementTolerances, Load, Verification};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -78,13 +78,41 @@ struct Increment {
     t: f64,
 }
 
+/// The innermost column of points (mp1) at one time: its mean stress (xx, yy, xy, zz, tension
+/// positive) and its mean position.
+#[derive(Debug, Clone, Copy, Default)]
+struct Mp1 {
+    stress: [f64; 4],
+    x: [f64; 2],
+}
+
+/// The step-by-step comparison ([001]'s increments, Part E item 9).
+#[derive(Debug, Clone, Copy)]
+struct Steps {
+    tolerances: IncrementTolerances,
+    /// The last observed time, the load's f there and mp1 then.
+    last: Option<(f64, f64, Mp1)>,
+    /// The largest relative error of Δq and of Δσ_m (over the step's pressure), with their times.
+    worst_q: (f64, f64),
+    worst_m: (f64, f64),
+    /// mp1's radius on the closed-form path r_{k+1} = r_k + u_r(r_k).
+    r_exact: f64,
+    /// Steps compared.
+    count: usize,
+}
+
 /// The hollow-cylinder check of a case.
 pub struct HollowCylinderCheck {
     body: u16,
     theory: FixedWallLame,
     time_fn: TimeFn,
+    /// The load's `increment_factor` g and the case's parameters, if it has one.
+    factor: Option<(String, std::collections::BTreeMap<String, f64>)>,
     tolerances: (f64, f64),
     first: Option<Increment>,
+    steps: Option<Steps>,
+    /// Values of the last step for `history.csv`: Δq, Δq*, Δσ_m at mp1 and mp1's radius.
+    last_row: [f64; 4],
 }
 
 impl HollowCylinderCheck {
@@ -97,6 +125,7 @@ impl HollowCylinderCheck {
             outer_radius,
             displacement_tolerance,
             stress_tolerance,
+            increments,
         }) = &c.verification
         else {
             return Err("not a hollow-cylinder verification".into());
@@ -118,15 +147,139 @@ impl HollowCylinderCheck {
                 nu: poisson_ratio,
             },
             time_fn,
+            factor: c.load(load).and_then(|l| l.increment_factor()).map(|e| (e.to_string(), c.parameters.clone())),
             tolerances: (*displacement_tolerance, *stress_tolerance),
             first: None,
+            steps: increments.map(|tolerances| Steps {
+                tolerances,
+                last: None,
+                worst_q: (0.0, 0.0),
+                worst_m: (0.0, 0.0),
+                r_exact: f64::NAN,
+                count: 0,
+            }),
+            last_row: [f64::NAN; 4],
         })
     }
 
-    /// The increment of the state at time `t` (collective).
-    fn increment(&self, t: f64, model: &Model, coll: &Collective) -> Result<Increment, String> {
+    /// The pressure at r = a of the original cylinder whose increment the load applies from time
+    /// `t0` (its f = `f0`) to `t`, loaded where the faces are at `x` (g(a, y) × traction ×
+    /// Δf; g ≡ 1 without an `increment_factor`).
+    fn pressure(&self, f0: f64, t: f64, x: [f64; 2]) -> Result<f64, String> {
+        let g = match &self.factor {
+            Some((e, params)) => crate::model::loads::increment_factor(e, params, [self.theory.a, x[1]])?,
+            None => 1.0,
+        };
+        Ok(self.theory.p * (self.time_fn.eval(t) - f0) * g)
+    }
+
+    /// The metrics of the step-by-step comparison, if the case asks for it.
+    fn step_metrics(&self) -> Vec<(String, Metric)> {
+        let Some(s) = self.steps else { return Vec::new() };
+        let Some((_, _, mp1)) = s.last else { return Vec::new() };
+        let t = s.tolerances;
+        let n = s.count;
+        vec![
+            (
+                "dq_mp1_max_rel_error".into(),
+                Metric::error(
+                    s.worst_q.0,
+                    t.q,
+                    format!(
+                        "largest relative error of Δq at mp1 over {n} steps (at t = {:.4e} s), against the closed form \
+                         of the remaining cylinder at mp1's radius at each step's start",
+                        s.worst_q.1
+                    ),
+                ),
+            ),
+            (
+                "dsigma_m_mp1_max_error".into(),
+                Metric::error(
+                    s.worst_m.0,
+                    t.mean_stress,
+                    format!(
+                        "largest error of Δσ_m at mp1 over {n} steps (at t = {:.4e} s), over the step's pressure at r = a",
+                        s.worst_m.1
+                    ),
+                ),
+            ),
+            (
+                "r_mp1_rel_error".into(),
+                Metric::error(
+                    (mp1.x[0] - s.r_exact).abs() / s.r_exact,
+                    t.radius,
+                    format!(
+                        "mp1's radius after {n} steps {:.5} m against the closed-form path r_(k+1) = r_k + u_r(r_k) {:.5} m",
+                        mp1.x[0], s.r_exact
+                    ),
+                ),
+            ),
+        ]
+    }
+
+    /// The innermost column of points now: mean stress and position (collective).
+    fn mp1(&self, model: &Model, coll: &Collective) -> Result<Mp1, String> {
         let ps = &model.particles;
-        let theory = FixedWallLame { p: self.theory.p * self.time_fn.eval(t), ..self.theory };
+        let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
+        let first = -coll.max(&[mine.iter().map(|&k| -ps.x0[k][0]).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        let tol = 1e-9 * self.theory.b;
+        let mut local = [0.0; 7];
+        for &k in mine.iter().filter(|&&k| (ps.x0[k][0] - first).abs() <= tol) {
+            for (l, v) in local.iter_mut().zip(ps.stress[k]) {
+                *l += v;
+            }
+            local[4] += ps.x[k][0];
+            local[5] += ps.x[k][1];
+            local[6] += 1.0;
+        }
+        let s = coll.sum(&local)?;
+        let n = s[6].max(1.0);
+        Ok(Mp1 { stress: [s[0] / n, s[1] / n, s[2] / n, s[3] / n], x: [s[4] / n, s[5] / n] })
+    }
+
+    /// Compares the step from the last observed time to `t` (mp1 now `now`) with the closed form
+    /// of the remaining cylinder at mp1's radius at the step's start.
+    fn compare_step(&mut self, t: f64, now: Mp1) -> Result<(), String> {
+        let Some(steps) = self.steps else { return Ok(()) };
+        let f_now = self.time_fn.eval(t);
+        let Some((_, f0, before)) = steps.last else {
+            self.steps = Some(Steps { last: Some((t, f_now, now)), r_exact: now.x[0], ..steps });
+            return Ok(());
+        };
+        let p = self.pressure(f0, t, before.x)?;
+        let theory = FixedWallLame { p, ..self.theory };
+        let (_, rr_star, tt_star, yy_star) = theory.at(before.x[0]);
+        let (u_path, ..) = theory.at(steps.r_exact);
+        let q_star = von_mises(rr_star, tt_star, yy_star, 0.0);
+        let d: Vec<f64> = (0..4).map(|c| now.stress[c] - before.stress[c]).collect();
+        // Compression positive: radial xx, axial yy, shear xy, hoop zz.
+        let (rr, yy, ry, tt) = (-d[0], -d[1], -d[2], -d[3]);
+        let q = von_mises(rr, tt, yy, ry);
+        let m = (rr + yy + tt) / 3.0;
+        let mut next = steps;
+        next.last = Some((t, f_now, now));
+        next.r_exact = steps.r_exact + u_path;
+        next.count += 1;
+        if p.abs() > 0.0 {
+            let eq = (q - q_star).abs() / q_star.abs();
+            let em = (m - theory.mean_stress()).abs() / p.abs();
+            if eq > next.worst_q.0 {
+                next.worst_q = (eq, t);
+            }
+            if em > next.worst_m.0 {
+                next.worst_m = (em, t);
+            }
+            self.last_row = [q, q_star, m, now.x[0]];
+        }
+        self.steps = Some(next);
+        Ok(())
+    }
+
+    /// The increment of the state at time `t` from the unloaded start (collective); `y` is where
+    /// the load's `increment_factor` is evaluated, at r = a.
+    fn increment(&self, t: f64, y: f64, model: &Model, coll: &Collective) -> Result<Increment, String> {
+        let ps = &model.particles;
+        let theory = FixedWallLame { p: self.pressure(0.0, t, [self.theory.a, y])?, ..self.theory };
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
         let tol = 1e-9 * theory.b;
         // The two innermost columns of points (by their radius at t = 0).
@@ -147,7 +300,7 @@ impl HollowCylinderCheck {
             }
             if (r0 - first).abs() <= tol {
                 let m = (rr + yy + tt) / 3.0;
-                let q = (0.5 * ((rr - tt).powi(2) + (tt - yy).powi(2) + (yy - rr).powi(2)) + 3.0 * s[2] * s[2]).sqrt();
+                let q = von_mises(rr, tt, yy, s[2]);
                 local[4] += rr;
                 local[5] += m;
                 local[6] += q;
@@ -174,7 +327,9 @@ impl HollowCylinderCheck {
 
 impl Check for HollowCylinderCheck {
     fn columns(&self) -> Vec<String> {
-        vec!["cylinder.u_inner".into(), "cylinder.sigma_rr_mp1".into()]
+        ["u_inner", "sigma_rr_mp1", "dq_mp1", "dq_mp1_exact", "dsigma_m_mp1", "r_mp1"]
+            .map(|c| format!("cylinder.{c}"))
+            .to_vec()
     }
 
     fn event_times(&self) -> Vec<f64> {
@@ -182,12 +337,15 @@ impl Check for HollowCylinderCheck {
     }
 
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
-        let inc = self.increment(t, model, coll)?;
+        let mp1 = self.mp1(model, coll)?;
+        let inc = self.increment(t, mp1.x[1], model, coll)?;
         // The initial state (t = 0) is observed too; the first increment is the first step's.
         if t > 0.0 {
             self.first.get_or_insert(inc);
         }
-        Ok(vec![inc.u_inner, inc.mp1[0]])
+        self.compare_step(t, mp1)?;
+        let r = self.last_row;
+        Ok(vec![inc.u_inner, inc.mp1[0], r[0], r[1], r[2], r[3]])
     }
 
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
@@ -227,13 +385,24 @@ impl Check for HollowCylinderCheck {
                     "sigma_rr_rms_rel_error".into(),
                     Metric::error(inc.rms, self.tolerances.1, format!("volume-weighted RMS over the body {where_}")),
                 ),
-            ],
+            ]
+            .into_iter()
+            .chain(self.step_metrics())
+            .collect(),
             Vec::new(),
         ))
     }
 
     fn results(&self) -> Vec<(String, f64)> {
         let Some(inc) = self.first else { return Vec::new() };
+        let steps: Vec<(String, f64)> = match self.steps {
+            Some(Steps { last: Some((_, _, mp1)), r_exact, count, .. }) => vec![
+                ("steps_compared".into(), count as f64),
+                ("r_mp1_final".into(), mp1.x[0]),
+                ("r_mp1_exact_final".into(), r_exact),
+            ],
+            _ => Vec::new(),
+        };
         let theory = FixedWallLame { p: inc.p, ..self.theory };
         let per_100kpa = 1.0e5 / inc.p;
         vec![
@@ -243,25 +412,54 @@ impl Check for HollowCylinderCheck {
             ("q_mp1_per_100kPa".into(), inc.mp1[2] * per_100kpa),
             ("sigma_m_exact_per_100kPa".into(), theory.mean_stress() * per_100kpa),
         ]
+        .into_iter()
+        .chain(steps)
+        .collect()
     }
 
     fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        Ok(Some(match self.first {
+        // [8 values of the first increment, or 8 NaN] [18 values of the step comparison, if any].
+        let mut v = match self.first {
             Some(i) => vec![i.u_inner, i.mp1[0], i.mp1[1], i.mp1[2], i.mp1[3], i.rms, i.p, i.t],
-            None => Vec::new(),
-        }))
+            None => vec![f64::NAN; 8],
+        };
+        if let Some(s) = self.steps {
+            let (t, f, m) = s.last.unwrap_or((f64::NAN, f64::NAN, Mp1::default()));
+            v.extend([t, f]);
+            v.extend(m.stress);
+            v.extend(m.x);
+            v.extend([s.worst_q.0, s.worst_q.1, s.worst_m.0, s.worst_m.1, s.r_exact, s.count as f64]);
+            v.extend(self.last_row);
+        }
+        Ok(Some(v))
     }
 
     fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
-        self.first = match state {
-            [] => None,
-            [u, a, b, c, d, rms, p, t] => {
-                Some(Increment { u_inner: *u, mp1: [*a, *b, *c, *d], rms: *rms, p: *p, t: *t })
-            }
-            _ => return Err("the hollow cylinder's check state has 8 values".into()),
+        let expected = if self.steps.is_some() { 26 } else { 8 };
+        if state.len() != expected {
+            return Err(format!("the hollow cylinder's check state has {expected} values, not {}", state.len()));
+        }
+        self.first = match state[..8] {
+            [u, a, b, c, d, rms, p, t] if !u.is_nan() => Some(Increment { u_inner: u, mp1: [a, b, c, d], rms, p, t }),
+            _ => None,
         };
+        if let Some(steps) = self.steps.as_mut() {
+            let v = &state[8..];
+            let mp1 = Mp1 { stress: [v[2], v[3], v[4], v[5]], x: [v[6], v[7]] };
+            steps.last = (!v[0].is_nan()).then_some((v[0], v[1], mp1));
+            steps.worst_q = (v[8], v[9]);
+            steps.worst_m = (v[10], v[11]);
+            steps.r_exact = v[12];
+            steps.count = v[13] as usize;
+            self.last_row = [v[14], v[15], v[16], v[17]];
+        }
         Ok(())
     }
+}
+
+/// The von Mises stress √(3 J₂) of (σ_rr, σ_θθ, σ_yy, σ_ry).
+fn von_mises(rr: f64, tt: f64, yy: f64, ry: f64) -> f64 {
+    (0.5 * ((rr - tt).powi(2) + (tt - yy).powi(2) + (yy - rr).powi(2)) + 3.0 * ry * ry).sqrt()
 }
 
 #[cfg(test)]

@@ -947,9 +947,14 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::Lame { inner_radius, outer_radius, .. } => {
             format!("Lamé cylinder, a = {inner_radius} m, b = {outer_radius} m: u_r, σ_rr, σ_θθ")
         }
-        Verification::HollowCylinder { inner_radius, outer_radius, .. } => format!(
+        Verification::HollowCylinder { inner_radius, outer_radius, increments, .. } => format!(
             "axisymmetric hollow cylinder with a fixed outer wall ([001] §3.1), a = {inner_radius} m, \
-             b = {outer_radius} m: u_r(a) and Δσ_rr after the first load step"
+             b = {outer_radius} m: u_r(a) and Δσ_rr after the first load step{}",
+            if increments.is_some() {
+                "; every step's Δq and Δσ_m at mp1 and mp1's radius against the closed form of the remaining cylinder"
+            } else {
+                ""
+            }
         ),
         Verification::StiffnessMap { center, radius, .. } => format!(
             "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",
