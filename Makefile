@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study gold bench bench-scaling bench-solvers lint clean
+.PHONY: setup build run test study gold bench bench-scaling bench-solvers maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -45,6 +45,10 @@ bench-scaling: build
 # (target/bench/solvers.md; about 90 minutes; SIZES, RANKS, STRATEGIES, RUNS, STEPS choose; docs/solvers.md).
 bench-solvers: build
 	python3 scripts/bench_solvers.py
+
+# The colour maps of docs/stress_maps.md (docs/figures/*.png) from fresh runs; about two minutes.
+maps: build
+	scripts/stress_maps.sh
 
 lint:
 	cargo fmt --check

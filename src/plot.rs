@@ -79,6 +79,57 @@ pub struct VerticalLine {
     pub colour: usize,
 }
 
+/// The (x, y, value) points of a [`ColourMap`].
+pub type MapPoints = Vec<(f64, f64, f64)>;
+
+/// A scalar field over the plane drawn as coloured rectangles, one per point, with a colour bar:
+/// e.g. σ_m at the material points or K_mag at the nodes. Drawn under the series, on linear axes
+/// with the same scale in x and y.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourMap {
+    /// (x, y, value) of each point.
+    pub points: MapPoints,
+    /// Half the width and height of each point's rectangle (x and y units).
+    pub half_size: (f64, f64),
+    /// What the colour shows, with its unit, e.g. `σ_m [kPa]`.
+    pub label: String,
+    /// The values at the ends of the colour bar (default: the values' range).
+    pub range: Option<(f64, f64)>,
+}
+
+impl ColourMap {
+    /// The range between the `lo` and `hi` quantiles of the finite values (e.g. 0.01 and 0.99, so
+    /// that a few extreme points do not wash out the colours of the rest); `None` without values.
+    pub fn quantiles(points: &[(f64, f64, f64)], lo: f64, hi: f64) -> Option<(f64, f64)> {
+        let mut v: Vec<f64> = points.iter().map(|p| p.2).filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((q.clamp(0.0, 1.0) * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
+        let (a, b) = (at(lo), at(hi));
+        (a < b).then_some((a, b))
+    }
+
+    /// The values at the ends of the colour bar: `range`, or the finite values' range (widened
+    /// when they are all equal).
+    pub fn limits(&self) -> (f64, f64) {
+        if let Some(r) = self.range {
+            return r;
+        }
+        let finite = self.points.iter().map(|p| p.2).filter(|v| v.is_finite());
+        let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        if lo > hi {
+            return (0.0, 1.0);
+        }
+        if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(f64::MIN_POSITIVE) {
+            let pad = 0.5 * hi.abs().max(1.0);
+            return (lo - pad, hi + pad);
+        }
+        (lo, hi)
+    }
+}
+
 /// A figure: one chart written as one PNG file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
@@ -94,12 +145,27 @@ pub struct Figure {
     pub series: Vec<Series>,
     /// Vertical marker lines.
     pub vertical_lines: Vec<VerticalLine>,
+    /// A scalar field drawn under the series.
+    pub map: Option<ColourMap>,
 }
 
 impl Figure {
     /// An empty figure.
     pub fn new(file: impl Into<String>, title: impl Into<String>, x: Axis, y: Axis) -> Figure {
-        Figure { file: file.into(), title: title.into(), x, y, series: Vec::new(), vertical_lines: Vec::new() }
+        Figure {
+            file: file.into(),
+            title: title.into(),
+            x,
+            y,
+            series: Vec::new(),
+            vertical_lines: Vec::new(),
+            map: None,
+        }
+    }
+
+    /// A figure of one scalar field over the plane (x and y in metres).
+    pub fn map(file: impl Into<String>, title: impl Into<String>, map: ColourMap) -> Figure {
+        Figure { map: Some(map), ..Figure::new(file, title, Axis::linear("x [m]"), Axis::linear("y [m]")) }
     }
 
     /// Adds a series (builder style).
@@ -111,6 +177,7 @@ impl Figure {
     /// Whether there is anything to draw.
     pub fn has_data(&self) -> bool {
         self.series.iter().any(|s| s.points.iter().any(|p| p.0.is_finite() && p.1.is_finite()))
+            || self.map.as_ref().is_some_and(|m| m.points.iter().any(|p| p.0.is_finite() && p.1.is_finite()))
     }
 }
 

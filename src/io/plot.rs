@@ -4,9 +4,10 @@
 //! A figure is 1000 × 650 pixels: the title on top, labelled axes with their units, a light grid,
 //! and a legend in the corner of the chart that holds the fewest data points. Reversed axes are
 //! drawn by negating the values and printing the ticks without the sign; logarithmic axes leave out
-//! non-positive values.
+//! non-positive values. A figure with a [`crate::plot::ColourMap`] draws it under its series on axes
+//! of equal scale, with a colour bar on the right (the viridis colour scale).
 
-use crate::plot::{Axis, Figure, Style};
+use crate::plot::{Axis, ColourMap, Figure, Style};
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
@@ -158,9 +159,96 @@ fn log_axis(r: (f64, f64)) -> WithKeyPoints<LogCoord<f64>> {
         .with_light_points(points(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]))
 }
 
+/// Width of a colour map's colour bar [px].
+const BAR_WIDTH: u32 = 130;
+
+/// The viridis colour scale at s ∈ [0, 1] (piecewise linear through nine of its colours).
+pub fn viridis(s: f64) -> RGBColor {
+    const STOPS: [[f64; 3]; 9] = [
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let t = if s.is_finite() { s.clamp(0.0, 1.0) * 8.0 } else { 0.0 };
+    let k = (t.floor() as usize).min(7);
+    let w = t - k as f64;
+    let c = |i: usize| (STOPS[k][i] * (1.0 - w) + STOPS[k + 1][i] * w).round() as u8;
+    RGBColor(c(0), c(1), c(2))
+}
+
+/// The (x, y) ranges of a colour map's figure: the points' rectangles with a margin, widened so
+/// that a metre is as long in x as in y on the chart of `pixels` (width, height).
+fn map_ranges(m: &ColourMap, pixels: (f64, f64)) -> ((f64, f64), (f64, f64)) {
+    let finite = || m.points.iter().filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (hx, hy) = m.half_size;
+    let fold = |f: &dyn Fn(&(f64, f64, f64)) -> f64, h: f64| {
+        finite().map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), v| (l.min(v - h), u.max(v + h)))
+    };
+    let (mut xr, mut yr) = (fold(&|p| p.0, hx), fold(&|p| p.1, hy));
+    if !xr.0.is_finite() || !yr.0.is_finite() {
+        return ((0.0, 1.0), (0.0, 1.0));
+    }
+    let (w, h) = ((xr.1 - xr.0).max(1e-12), (yr.1 - yr.0).max(1e-12));
+    let scale = (pixels.0 / w).min(pixels.1 / h);
+    let grow = |r: &mut (f64, f64), span: f64| {
+        let c = 0.5 * (r.0 + r.1);
+        *r = (c - 0.5 * span, c + 0.5 * span);
+    };
+    grow(&mut xr, 1.04 * pixels.0 / scale);
+    grow(&mut yr, 1.04 * pixels.1 / scale);
+    (xr, yr)
+}
+
+/// The colour bar of `m` in `area`: the scale from its low to its high value with ticks, and its
+/// label above.
+fn colour_bar(area: &DrawingArea<BitMapBackend, Shift>, m: &ColourMap) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+    let (lo, hi) = m.limits();
+    let mut bar = ChartBuilder::on(area)
+        .caption(&m.label, ("sans-serif", 17))
+        .margin_top(40)
+        .margin_bottom(73)
+        .margin_right(8)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(err)?;
+    bar.configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .disable_y_mesh()
+        .y_label_formatter(&|v: &f64| tick(*v))
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(err)?;
+    let n = 100;
+    bar.draw_series((0..n).map(|k| {
+        let (a, b) = (lo + (hi - lo) * k as f64 / n as f64, lo + (hi - lo) * (k + 1) as f64 / n as f64);
+        Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / n as f64).filled())
+    }))
+    .map_err(err)?;
+    Ok(())
+}
+
 fn render(path: &Path, f: &Figure) -> Result<(), String> {
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
+    if let Some(m) = &f.map {
+        let (chart, bar) = root.split_horizontally(SIZE.0 - BAR_WIDTH);
+        colour_bar(&bar, m)?;
+        // The plotting area of `draw`: the chart less its margins, label areas and caption.
+        let pixels = ((SIZE.0 - BAR_WIDTH) as f64 - 36.0 - 95.0, SIZE.1 as f64 - 36.0 - 55.0 - 40.0);
+        let (xr, yr) = map_ranges(m, pixels);
+        let (xa, ya) = ((to_axis(&f.x, xr.0), to_axis(&f.x, xr.1)), (to_axis(&f.y, yr.0), to_axis(&f.y, yr.1)));
+        let (xa, ya) = ((xa.0.min(xa.1), xa.0.max(xa.1)), (ya.0.min(ya.1), ya.0.max(ya.1)));
+        draw(&chart, f, xa.0..xa.1, ya.0..ya.1, xa, ya)?;
+        return root.present().map_err(|e| e.to_string());
+    }
     let xs = f.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).chain(f.vertical_lines.iter().map(|v| v.x));
     let xr = range(&f.x, xs);
     let yr = range(&f.y, f.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
@@ -213,6 +301,15 @@ where
         .bold_line_style(RGBColor(205, 205, 205))
         .draw()
         .map_err(err)?;
+    if let Some(m) = &f.map {
+        let (lo, hi) = m.limits();
+        let (hx, hy) = m.half_size;
+        let cells = m.points.iter().filter(|p| p.0.is_finite() && p.1.is_finite()).map(|&(x, y, v)| {
+            let corner = |dx: f64, dy: f64| (to_axis(&f.x, x + dx), to_axis(&f.y, y + dy));
+            Rectangle::new([corner(-hx, -hy), corner(hx, hy)], viridis((v - lo) / (hi - lo)).filled())
+        });
+        chart.draw_series(cells).map_err(err)?;
+    }
     for s in &f.series {
         let c = colour(s.colour);
         let pts: Vec<(f64, f64)> = s
@@ -274,6 +371,9 @@ where
             .label(&v.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y - 6), (x + 20, y + 6)], c.stroke_width(2)));
     }
+    if f.series.is_empty() && f.vertical_lines.is_empty() {
+        return Ok(());
+    }
     chart
         .configure_series_labels()
         .position(legend_corner(f, xr, yr))
@@ -318,6 +418,54 @@ mod tests {
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
         assert!(bytes.len() > 10_000, "{} bytes", bytes.len());
         assert!(!dir.join("none.png").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A colour map draws each point's rectangle in the colour of its value: a field rising from
+    /// left to right shows viridis' low end (dark purple) left of its high end (yellow), the
+    /// colour bar holds both, and a square block of points is drawn square (equal scales).
+    #[test]
+    fn a_colour_map_is_drawn_in_the_colours_of_its_values() {
+        use crate::plot::ColourMap;
+        assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
+        assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
+        let dir = std::env::temp_dir().join(format!("porompm-map-test-{}", std::process::id()));
+        let points: Vec<(f64, f64, f64)> =
+            (0..400).map(|k| ((k % 20) as f64 * 0.1 + 0.05, (k / 20) as f64 * 0.1 + 0.05, (k % 20) as f64)).collect();
+        let m = ColourMap { points, half_size: (0.05, 0.05), label: "v [-]".into(), range: None };
+        assert_eq!(m.limits(), (0.0, 19.0));
+        let written = write_figures(&dir, &[Figure::map("m.png", "Map", m)]).unwrap();
+        let img = image::open(&written[0]).unwrap().to_rgb8();
+        let find = |c: RGBColor| -> Vec<(u32, u32)> {
+            img.enumerate_pixels().filter(|(_, _, p)| p.0 == [c.0, c.1, c.2]).map(|(x, y, _)| (x, y)).collect()
+        };
+        let (low, high) = (viridis(0.0), viridis(1.0));
+        let chart = |v: &[(u32, u32)]| v.iter().copied().filter(|&(x, _)| x < SIZE.0 - BAR_WIDTH).collect::<Vec<_>>();
+        let (l, h) = (chart(&find(low)), chart(&find(high)));
+        assert!(!l.is_empty() && !h.is_empty(), "low {} and high {} pixels", l.len(), h.len());
+        let mean_x = |v: &[(u32, u32)]| v.iter().map(|p| p.0 as f64).sum::<f64>() / v.len() as f64;
+        assert!(mean_x(&l) < mean_x(&h), "the low end is drawn left of the high end");
+        // The bar shows the scale's ends; the block (all drawn cells) is as wide as it is tall.
+        let in_bar = |c: RGBColor| find(c).iter().any(|&(x, _)| x >= SIZE.0 - BAR_WIDTH);
+        assert!(in_bar(viridis(0.005)) && in_bar(viridis(0.995)));
+        let cells: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|(x, _, p)| {
+                *x < SIZE.0 - BAR_WIDTH
+                    && (0..20).any(|k| {
+                        p.0 == {
+                            let c = viridis(k as f64 / 19.0);
+                            [c.0, c.1, c.2]
+                        }
+                    })
+            })
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        let span = |f: &dyn Fn(&(u32, u32)) -> u32| {
+            cells.iter().map(f).max().unwrap() as f64 - cells.iter().map(f).min().unwrap() as f64
+        };
+        let (w, h) = (span(&|p| p.0), span(&|p| p.1));
+        assert!((w / h - 1.0).abs() < 0.03, "the square block is drawn {w} × {h} px");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -86,7 +86,7 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
     }
     let dev_tt = s[3] - pm;
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
-    let nonlinear = if pt.kin.linear { 0.0 } else { 1.0 };
+    let linear = pt.kin.linear;
     for k in 0..pt.basis.len() {
         let (gk, gvk) = pt.spatial[k];
         let hk = pt.hoop[k];
@@ -108,7 +108,8 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
                     if c == 0 && d == 0 {
                         geometric -= dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1;
                     }
-                    out[(k * nd + c) * m + l * nd + d] += v * (material + nonlinear * (volume + geometric));
+                    out[(k * nd + c) * m + l * nd + d] +=
+                        v * if linear { material } else { material + volume + geometric };
                 }
             }
         }

@@ -22,6 +22,9 @@ pub struct StiffnessMapCheck {
     tolerance: f64,
     /// [max |dev|, Σ dev², count, min ratio, max ratio] of the last step.
     last: Option<[f64; 5]>,
+    /// K_mag / K_FE at the nodes inside the material (filled more than half) after the last step,
+    /// (x, y, ratio), and half a cell [m]: the map of [001] Fig. 20.
+    map: (crate::plot::MapPoints, (f64, f64)),
 }
 
 impl StiffnessMapCheck {
@@ -37,6 +40,7 @@ impl StiffnessMapCheck {
             reference: fem_k_mag(e, nu),
             tolerance: *tolerance,
             last: None,
+            map: (Vec::new(), (0.0, 0.0)),
         })
     }
 }
@@ -68,9 +72,13 @@ impl Check for StiffnessMapCheck {
     fn observe_nodes(&mut self, block: &NodeBlock, model: &Model, coll: &Collective) -> Result<(), String> {
         let mut local = [0.0, 0.0, 0.0];
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut map = Vec::new();
         for (o, v) in block.values.chunks_exact(NODE_VALUES).enumerate() {
             let (i, j) = (block.start[0] + o % block.count[0], block.start[1] + o / block.count[0]);
             let x = model.grid.node_position(i, j);
+            if v[0] > 0.5 {
+                map.extend([x[0], x[1], v[6] / self.reference]);
+            }
             if (x[0] - self.center[0]).hypot(x[1] - self.center[1]) > self.radius {
                 continue;
             }
@@ -84,7 +92,23 @@ impl Check for StiffnessMapCheck {
         let worst = coll.max(&[local[0], hi, -lo])?;
         let sums = coll.sum(&local[1..])?;
         self.last = Some([worst[0], sums[0], sums[1], -worst[2], worst[1]]);
+        let h = model.grid.h;
+        self.map = (coll.gather(&map)?.chunks_exact(3).map(|c| (c[0], c[1], c[2])).collect(), (0.5 * h[0], 0.5 * h[1]));
         Ok(())
+    }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        use crate::plot::{ColourMap, Figure};
+        vec![Figure::map(
+            "k_mag_ratio.png",
+            format!("K_mag / K_FE at the nodes inside the block, K_FE = {:.2} kN/m", self.reference / 1e3),
+            ColourMap {
+                points: self.map.0.clone(),
+                half_size: self.map.1,
+                label: "K_mag / K_FE".into(),
+                range: Some((0.6, 1.1)),
+            },
+        )]
     }
 
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
