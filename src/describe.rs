@@ -219,9 +219,12 @@ pub fn describe(case: &Case, label: &str) -> String {
     let _ = writeln!(
         s,
         "stiffness in the Newton matrix: {}; strain recovery: {}",
-        match model.stiffness {
-            crate::case::Stiffness::Particle => "the exact tangent".to_string(),
-            other => format!(
+        match (model.stiffness, model.stiffness_in_jacobian) {
+            (crate::case::Stiffness::Particle, _) => "the exact tangent".to_string(),
+            (other, false) => {
+                format!("the exact tangent ({} serves the K_mag diagnostic only)", other.name())
+            }
+            (other, true) => format!(
                 "{} ([001]'s mapped stiffness: an approximate Jacobian, Newton converges linearly; up to {} \
                  iterations a step)",
                 other.name(),

@@ -382,7 +382,7 @@ pub fn test_jacobian(
     flip: Option<(usize, usize)>,
 ) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
     let stiffness = req.case.stabilisation.stiffness;
-    if stiffness != crate::case::Stiffness::Particle {
+    if req.case.jacobian_stiffness() != crate::case::Stiffness::Particle {
         return Err(RunError::Input(format!(
             "key `stabilisation.stiffness`: test-jacobian checks the exact tangent, and `{}` replaces its material \
              block by [001]'s approximate stiffness (Newton then converges linearly, by design); check the case \
@@ -421,7 +421,7 @@ impl<'a> Simulation<'a> {
         let input = |e: String| RunError::Input(e);
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
         let layout = StageAnalysis::of(case, &case.stages[first]).layout;
-        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout, None, case.stabilisation.stiffness)
+        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout, None, case.jacobian_stiffness())
             .map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::build(case, |i, j| system.owns_cell(i, j));
@@ -608,8 +608,9 @@ impl<'a> Simulation<'a> {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;
             let owners = self.system.owners().clone();
-            self.system = GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners), self.model.stiffness)
-                .map_err(|e| RunError::Failed(e.to_string()))?;
+            self.system =
+                GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners), self.case.jacobian_stiffness())
+                    .map_err(|e| RunError::Failed(e.to_string()))?;
             self.system.reused_patterns = reused;
             self.summary.grid_dofs = self.system.total_dofs();
         }
@@ -819,8 +820,9 @@ impl<'a> Simulation<'a> {
         let layout = self.system.layout();
         // The last step's nodal values, for the field output of this step on the new distribution.
         let carried = self.system.global_node_values(self.coll).map_err(RunError::Failed)?;
-        self.system = GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners), self.model.stiffness)
-            .map_err(|e| RunError::Failed(e.to_string()))?;
+        self.system =
+            GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners), self.case.jacobian_stiffness())
+                .map_err(|e| RunError::Failed(e.to_string()))?;
         self.system.reused_patterns = reused;
         self.system.carry_node_values(carried);
         self.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();

@@ -274,8 +274,13 @@ impl Particles<'_> {
             let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout)
                 .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
-            kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
-            step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
+            if self.model.stiffness_in_jacobian {
+                kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
+                step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
+            } else {
+                // The mapped stiffness serves the diagnostics only: the exact tangent.
+                kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
+            }
             self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);
         }
     }

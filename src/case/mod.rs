@@ -120,6 +120,15 @@ impl Case {
 }
 
 impl Case {
+    /// The material stiffness of Newton's matrix: `stabilisation.stiffness`, or the exact tangent
+    /// (`particle`) when the mapped stiffness serves the diagnostics only.
+    pub fn jacobian_stiffness(&self) -> Stiffness {
+        match self.stabilisation.mapped_stiffness {
+            MappedStiffnessUse::Jacobian => self.stabilisation.stiffness,
+            MappedStiffnessUse::Diagnostics => Stiffness::Particle,
+        }
+    }
+
     /// The first body containing `p` (bodies earlier in the file take precedence), if any.
     pub fn body_at(&self, p: [f64; 2]) -> Option<&Body> {
         self.bodies.iter().find(|b| b.shape.contains(p))

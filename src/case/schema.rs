@@ -707,6 +707,12 @@ pub struct Stabilisation {
     /// linear rate; with `-snes_type ksponly` a step is [001]'s single linear solve.
     #[serde(default)]
     pub stiffness: Stiffness,
+    /// Where a mapped `stiffness` serves: `jacobian` (the default: it is Newton's matrix, [001]'s
+    /// scheme, converging linearly) or `diagnostics` (only the nodal K_mag diagnostic is computed
+    /// with it; Newton keeps the exact tangent and converges quadratically to the same answer,
+    /// since the residual is the same).
+    #[serde(default)]
+    pub mapped_stiffness: MappedStiffnessUse,
     /// How a point's strain increment is recovered from the nodal displacements ([001] §5.5):
     /// `basis` (the default: with the gradients of the point's basis functions, as its forces are
     /// integrated) or `cmpm` (composite MPM: the higher-order Lagrange patch functions of [001]
@@ -739,6 +745,17 @@ pub enum StressRecovery {
     Basis,
     /// With [001]'s CMPM patch functions.
     Cmpm,
+}
+
+/// Where a mapped stiffness serves (see [`Stabilisation::mapped_stiffness`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MappedStiffnessUse {
+    /// Newton's matrix and the K_mag diagnostic.
+    #[default]
+    Jacobian,
+    /// The K_mag diagnostic only.
+    Diagnostics,
 }
 
 /// The material stiffness of the Newton matrix (see [`Stabilisation::stiffness`]).

@@ -163,6 +163,13 @@ pub fn validate(c: &Case) -> R {
         }
     }
 
+    if c.stabilisation.mapped_stiffness == MappedStiffnessUse::Diagnostics
+        && c.stabilisation.stiffness == crate::case::Stiffness::Particle
+    {
+        return Err("key `stabilisation.mapped_stiffness`: `diagnostics` computes K_mag with a mapped \
+                    `stabilisation.stiffness`, and the case has `particle`"
+            .into());
+    }
     if c.stabilisation.stiffness == crate::case::Stiffness::DoubleMappingGimp
         && c.analysis.shape_functions == crate::case::ShapeFunctions::Linear
     {

@@ -61,6 +61,8 @@ pub struct Model {
     pub stress_recovery: crate::case::StressRecovery,
     /// Geometrically linear steps (`analysis.kinematics = "linear_increments"`).
     pub linear_increments: bool,
+    /// Whether the mapped `stiffness` is Newton's matrix (else it serves the K_mag diagnostic only).
+    pub stiffness_in_jacobian: bool,
 }
 
 /// The geometry of a case.
@@ -163,6 +165,7 @@ impl Model {
             stiffness: case.stabilisation.stiffness,
             stress_recovery: case.stabilisation.stress_recovery,
             linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
+            stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
