@@ -1066,6 +1066,11 @@ impl<'a> Simulation<'a> {
     /// Sets every load whose increments follow its loaded faces at the current time
     /// ([`crate::model::loads::LoadDef::set_increments`]), at the faces' mean centre over all ranks.
     fn set_load_increments(&mut self, from: impl Fn(usize) -> IncrementsFrom) -> Result<(), RunError> {
+        // At the start a load that cannot be evaluated is the case's fault.
+        let fail = |m: String| match from(0) {
+            IncrementsFrom::Start => RunError::Input(m),
+            _ => RunError::Failed(m),
+        };
         for li in 0..self.model.loads.len() {
             // Whether a load has increments is the case's: every rank takes the same branch.
             if self.model.loads[li].increments.is_none() {
@@ -1075,12 +1080,12 @@ impl<'a> Simulation<'a> {
             let m = self.coll.sum(&local).map_err(RunError::Failed)?;
             let load = &mut self.model.loads[li];
             if m[2] <= 0.0 {
-                return Err(RunError::Failed(format!(
+                return Err(fail(format!(
                     "load `{}`: no loaded face is left to evaluate its increment_factor at",
                     load.name
                 )));
             }
-            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from(li)).map_err(RunError::Failed)?;
+            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from(li)).map_err(fail)?;
         }
         Ok(())
     }

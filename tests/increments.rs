@@ -125,9 +125,12 @@ fn the_increments_are_the_same_on_two_ranks_and_after_a_restart() {
 /// Bad input around the new keys is refused with one message naming the key.
 #[test]
 fn bad_increment_input_is_refused_with_a_clear_message() {
-    let cases: [(&str, &[&str], &str); 5] = [
+    let cases: [(&str, &[&str], &str); 7] = [
         (CASE, &["loads.0.increment_factor=1 / q"], "key `loads[0].increment_factor`"),
         (CASE, &["loads.0.increment_factor=1 / (x - x)"], "is not finite"),
+        // Valid at the region's centre, infinite where the faces are (x = 0.5 m) at the start.
+        (CASE, &["loads.0.increment_factor=1 / (x - 0.5)"], "at [0.5, 0.1]: the value inf is not finite"),
+        (CASE, &["loads.0.region.min=[1.0,0.0]", "loads.0.region.max=[1.1,0.2]"], "no loaded face is left"),
         ("cases/terzaghi.toml", &["analysis.kinematics=linear_increments"], "is for a one_phase analysis"),
         ("cases/vertical_cut.toml", &["analysis.kinematics=linear_increments"], "steps are static"),
         (
