@@ -116,6 +116,7 @@ fn the_increments_are_the_same_on_two_ranks_and_after_a_restart() {
     let r = run_case_on(2, CASE, &out_dir("restart-again"), &again);
     assert!(r.completed(), "{}", r.stderr());
     assert_eq!(r.summary["restarted_from"]["step"], 24);
+    assert_eq!(r.summary["results"]["steps_compared"].as_f64(), Some(25.0), "steps compared after the restart");
     for (k, want) in [("dq_mp1_max_rel_error", one.0), ("dsigma_m_mp1_max_error", one.1), ("r_mp1_rel_error", one.2)] {
         let got = metric(&r.summary, k);
         assert!((got - want).abs() <= 1e-9 * want.abs().max(1e-6), "{k}: {got} after the restart, {want} without");
