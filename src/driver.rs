@@ -35,6 +35,17 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// When the loads that follow their faces are set (see `Simulation::set_load_increments`).
+#[derive(Clone, Copy)]
+enum LoadsAt<'a> {
+    /// The run's start.
+    Start,
+    /// The end of an accepted step.
+    Accepted,
+    /// A restart, with the checkpoint's sums of increments per load.
+    Restart(&'a [f64]),
+}
+
 /// What a run is asked to do.
 pub struct RunRequest<'a> {
     /// The validated case.
@@ -487,7 +498,7 @@ impl<'a> Simulation<'a> {
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
         } else {
-            sim.set_load_increments(|_| IncrementsFrom::Start)?;
+            sim.set_load_increments(LoadsAt::Start)?;
         }
         sim.record_step(0.0)?;
         sim.write_fields()?;
@@ -556,7 +567,7 @@ impl<'a> Simulation<'a> {
                     self.migrate_particles()?;
                     self.balance_load()?;
                     self.t = control.advance(self.t, dt);
-                    self.set_load_increments(|_| IncrementsFrom::Accepted)?;
+                    self.set_load_increments(LoadsAt::Accepted)?;
                     control.accepted(self.last_newton.0);
                     self.step += 1;
                     self.summary.steps = self.step;
@@ -1064,11 +1075,12 @@ impl<'a> Simulation<'a> {
     }
 
     /// Sets every load whose increments follow its loaded faces at the current time
-    /// ([`crate::model::loads::LoadDef::set_increments`]), at the faces' mean centre over all ranks.
-    fn set_load_increments(&mut self, from: impl Fn(usize) -> IncrementsFrom) -> Result<(), RunError> {
+    /// ([`crate::model::loads::LoadDef::set_increments`]), at the faces' mean centre over all ranks:
+    /// at the run's start, after an accepted step, or from a checkpoint's `load_totals`.
+    fn set_load_increments(&mut self, at: LoadsAt) -> Result<(), RunError> {
         // At the start a load that cannot be evaluated is the case's fault.
-        let fail = |m: String| match from(0) {
-            IncrementsFrom::Start => RunError::Input(m),
+        let fail = |m: String| match at {
+            LoadsAt::Start => RunError::Input(m),
             _ => RunError::Failed(m),
         };
         for li in 0..self.model.loads.len() {
@@ -1085,7 +1097,12 @@ impl<'a> Simulation<'a> {
                     load.name
                 )));
             }
-            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from(li)).map_err(fail)?;
+            let from = match at {
+                LoadsAt::Start => IncrementsFrom::Start,
+                LoadsAt::Accepted => IncrementsFrom::Accepted,
+                LoadsAt::Restart(totals) => IncrementsFrom::Checkpoint(totals[li]),
+            };
+            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from).map_err(fail)?;
         }
         Ok(())
     }
@@ -1115,7 +1132,7 @@ impl<'a> Simulation<'a> {
         crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
         self.model.resolve_targets(self.case);
         self.t = cp.time;
-        self.set_load_increments(|li| IncrementsFrom::Checkpoint(cp.load_totals[li]))?;
+        self.set_load_increments(LoadsAt::Restart(&cp.load_totals))?;
         self.step = cp.step as usize;
         let s = &mut *self.summary;
         s.time_s = cp.time;

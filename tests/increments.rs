@@ -141,8 +141,6 @@ fn bad_increment_input_is_refused_with_a_clear_message() {
         ),
     ];
     for (i, (case, sets, message)) in cases.iter().enumerate() {
-        let r = run_case(case, &out_dir(&format!("bad-{i}")), &set_args(sets));
-        assert_eq!(r.output.status.code(), Some(2), "{sets:?}: {}", r.stderr());
-        assert!(r.stderr().contains(message), "{sets:?}: {}", r.stderr());
+        assert_refused(case, &out_dir(&format!("bad-{i}")), sets, message);
     }
 }

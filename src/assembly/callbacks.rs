@@ -558,23 +558,29 @@ impl<'a> Assembler<'a> {
         out
     }
 
-    /// The generalized-α history of the step per ghosted dof: every particle's terms at t_n
-    /// (Δd = 0, its velocity and acceleration at t_n in place of the predictors, the body
-    /// acceleration `body_acc_old` of t_n) weighted by α_m (inertia) and α_f (forces), minus
-    /// α_f f_ext,n (`fext_old`). Constant over the step's Newton iterations.
-    pub(super) fn history(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+    /// Every particle's terms at the step's start per ghosted dof, weighted by `scheme`: Δd = 0,
+    /// the body acceleration `body_acc_old` of t_n and, with `smooth`, the particle's velocity and
+    /// acceleration at t_n in place of the predictors; minus w_f f_ext,n (`fext_old`).
+    fn terms_at_start(
+        &self,
+        scheme: &kernels::Scheme,
+        body_acc_old: &[[f64; 2]],
+        fext_old: &[f64],
+        smooth: bool,
+    ) -> Vec<f64> {
         let step = self.step;
-        let hs = step.nm.and_then(|nm| nm.history()).expect("a scheme with a history");
         let xl = vec![0.0; fext_old.len()];
-        let mut out: Vec<f64> = fext_old.iter().map(|f| -hs.w_force * f).collect();
+        let mut out: Vec<f64> = fext_old.iter().map(|f| -scheme.w_force * f).collect();
         let ps = self.particles();
         let block = |k: usize, buf: &mut [f64]| {
             let mut input = particle_input(ps.model, step, k);
-            let s = &step.smooth[k];
-            input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
+            if smooth {
+                let s = &step.smooth[k];
+                input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
+            }
             input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
             ps.with_point_of(k, &xl, input, |pt| {
-                kernels::residual(pt, &hs, &mut buf[..pt.size()]);
+                kernels::residual(pt, scheme, &mut buf[..pt.size()]);
                 pt.size()
             })
         };
@@ -582,30 +588,27 @@ impl<'a> Assembler<'a> {
         out
     }
 
+    /// The generalized-α history of the step per ghosted dof: every particle's terms at t_n
+    /// (its velocity and acceleration at t_n in place of the predictors) weighted by α_m (inertia)
+    /// and α_f (forces), minus α_f f_ext,n ([`Self::terms_at_start`] with the history scheme).
+    /// Constant over the step's Newton iterations.
+    pub(super) fn history(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        let hs = self.step.nm.and_then(|nm| nm.history()).expect("a scheme with a history");
+        self.terms_at_start(&hs, body_acc_old, fext_old, true)
+    }
+
     /// What a geometrically linear step (`analysis.kinematics = "linear_increments"`) adds to its
-    /// residual: minus the residual of the step's start on x_n (Δd = 0, the stress σ_n, the body
-    /// acceleration `body_acc_old` and the loads `fext_old` of t_n) at every free dof, zero at the
+    /// residual: minus the residual of the step's start on x_n ([`Self::terms_at_start`]: the
+    /// stress σ_n, the body acceleration and the loads of t_n) at every free dof, zero at the
     /// fixed ones. The step then solves F_int(Δσ) = ΔF_ext (less the body force's increment), the
     /// increment of a stress-free body as [001]'s K Δu = ΔF: whatever the stress of earlier steps
     /// leaves out of balance on the moved configuration is not carried. At the fixed dofs the
     /// terms stay whole, so that the reactions are those of the total stress. Constant over the
     /// step's iterations.
     pub(super) fn start_out_of_balance(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
-        let step = self.step;
-        let nm = step.nm.expect("prepared");
-        let xl = vec![0.0; fext_old.len()];
-        let mut out: Vec<f64> = fext_old.iter().map(|f| -nm.w_force * f).collect();
-        let ps = self.particles();
-        let block = |k: usize, buf: &mut [f64]| {
-            let mut input = particle_input(ps.model, step, k);
-            input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
-            ps.with_point_of(k, &xl, input, |pt| {
-                kernels::residual(pt, &nm, &mut buf[..pt.size()]);
-                pt.size()
-            })
-        };
-        run_bands(&step.bands, &mut out, |a| a as usize * step.dofs.nd, |band, f| ps.residual_band(band, f, &block));
-        for (v, &fixed) in out.iter_mut().zip(&step.dofs.fixed) {
+        let nm = self.step.nm.expect("prepared");
+        let mut out = self.terms_at_start(&nm, body_acc_old, fext_old, false);
+        for (v, &fixed) in out.iter_mut().zip(&self.step.dofs.fixed) {
             *v = if fixed { 0.0 } else { -*v };
         }
         out

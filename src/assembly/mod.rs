@@ -39,7 +39,7 @@ pub use check::BlockCheck;
 pub use stencils::WELL_FILLED_FRACTION;
 
 use crate::kernels::{self, Layout, StepResult};
-use crate::model::loads::LoadTarget;
+use crate::model::loads::{face_point, LoadTarget};
 use crate::model::shape;
 use crate::model::{Active, Model};
 use crate::parallel::Collective;
@@ -614,7 +614,7 @@ impl GridSystem {
             .into_iter()
             .map(|(k, face)| {
                 let normal = model.face_normal(k, face);
-                let (xf, length) = crate::model::loads::face_point(face, ps.x[k], ps.lp[k]);
+                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
                 let area = length * model.geometry.measure(xf[0]);
                 let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
                 let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
@@ -728,9 +728,11 @@ impl GridSystem {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
             // static or quasi-static, which have no generalized-α history).
-            self.step.history = self.start_out_of_balance(model, &model.body_accelerations(active, t_old), &fext_old);
+            let body_acc_old = model.body_accelerations(active, t_old);
+            self.step.history = self.with_assembler(model, |asm| asm.start_out_of_balance(&body_acc_old, &fext_old));
         } else if nm.history().is_some() {
-            self.step.history = self.history(model, &model.body_accelerations(active, t_old), &fext_old);
+            let body_acc_old = model.body_accelerations(active, t_old);
+            self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
         }
         self.step.fext_old = fext_old;
         self.step.force_scale = self.force_scale(model, coll)?;
@@ -986,7 +988,7 @@ impl GridSystem {
                     // current face length) with the bilinear weights there (see shape::face_weights).
                     for &k in particles {
                         let (x, lp) = (ps.x[k], ps.lp[k]);
-                        let (point, length) = crate::model::loads::face_point(*face, x, lp);
+                        let (point, length) = face_point(*face, x, lp);
                         // The face's area: its length times the ring's 2πr in axial symmetry.
                         let length = length * model.geometry.measure(point[0]);
                         applied.add([traction[0] * f * length, traction[1] * f * length]);
@@ -1177,16 +1179,13 @@ impl GridSystem {
         let ng = self.ghost.len() * nd;
         let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         let (mut stiffness, mut internal) = (vec![0.0; ng], vec![0.0; ng]);
-        {
-            let xl = self.step.solution.clone();
-            let mut seconds = 0.0;
-            let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
-            let asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
+        let xl = self.step.solution.clone();
+        self.with_assembler(model, |asm| {
             asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
             if diagnostics {
                 asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
             }
-        }
+        });
         if diagnostics {
             for v in [&mut stiffness, &mut internal] {
                 self.sum_over_ranks(v).map_err(|e| e.to_string())?;
@@ -1418,31 +1417,18 @@ impl GridSystem {
 
     /// The norm over the free dofs of the prepared step's force magnitudes (collective).
     fn force_scale(&mut self, model: &Model, coll: &Collective) -> Result<f64, String> {
-        let mut mags = {
-            let mut seconds = 0.0;
-            let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
-            Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly).force_magnitudes()
-        };
+        let mut mags = self.with_assembler(model, |asm| asm.force_magnitudes());
         self.sum_over_ranks(&mut mags).map_err(|e| e.to_string())?;
         self.step.field_scales = self.field_norms(&mags, coll)?;
         Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
     }
 
-    /// The start-of-step out-of-balance of a geometrically linear step, negated (see
-    /// `Assembler::start_out_of_balance`).
-    fn start_out_of_balance(&mut self, model: &Model, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+    /// Runs `f` with the callbacks' view of the prepared step (outside the SNES solve: the nodal
+    /// terms, the force magnitudes, the histories of a step's start).
+    fn with_assembler<R>(&mut self, model: &Model, f: impl FnOnce(&Assembler) -> R) -> R {
         let mut seconds = 0.0;
         let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
-        Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly)
-            .start_out_of_balance(body_acc_old, fext_old)
-    }
-
-    /// The generalized-α history of the prepared step (see `Assembler::history`).
-    fn history(&mut self, model: &Model, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
-        let mut seconds = 0.0;
-        let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
-        Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly)
-            .history(body_acc_old, fext_old)
+        f(&Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly))
     }
 
     /// The converged step at particle `k` for the particle update: exactly the point the converged

@@ -210,10 +210,10 @@ impl LoadDef {
         m
     }
 
-    /// Sets a load with increments at time `t`: at the run's start (`total` = f(t) g, g evaluated
-    /// at `centre`), from a checkpoint (`restored` total), or at the end of an accepted step
-    /// (`accepted`: `total` becomes the step's factor at t, and g is evaluated anew). `centre` is
-    /// the loaded faces' mean centre now, from all ranks' [`Self::face_moments`].
+    /// Sets a load with increments at time `t`, with g evaluated anew at `centre`, the loaded
+    /// faces' mean centre now (from all ranks' [`Self::face_moments`]); `total` becomes f(t) g at
+    /// the run's start, the checkpoint's total on a restart, or the step's factor at t at the end
+    /// of an accepted step.
     pub fn set_increments(&mut self, t: f64, centre: [f64; 2], from: IncrementsFrom) -> Result<(), String> {
         let Some(s) = &self.increments else { return Ok(()) };
         let g = increment_factor(&s.expr, &s.params, centre)

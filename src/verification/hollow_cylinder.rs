@@ -113,6 +113,8 @@ pub struct HollowCylinderCheck {
     steps: Option<Steps>,
     /// Values of the last step for `history.csv`: Δq, Δq*, Δσ_m at mp1 and mp1's radius.
     last_row: [f64; 4],
+    /// The radii at t = 0 of the two innermost columns of points, once found.
+    columns: Option<[f64; 2]>,
 }
 
 impl HollowCylinderCheck {
@@ -159,6 +161,7 @@ impl HollowCylinderCheck {
                 count: 0,
             }),
             last_row: [f64::NAN; 4],
+            columns: None,
         })
     }
 
@@ -217,11 +220,27 @@ impl HollowCylinderCheck {
         ]
     }
 
-    /// The innermost column of points now: mean stress and position (collective).
-    fn mp1(&self, model: &Model, coll: &Collective) -> Result<Mp1, String> {
+    /// The radii at t = 0 of the two innermost columns of points (collective; the same for the
+    /// whole run, found once).
+    fn find_columns(&mut self, model: &Model, coll: &Collective) -> Result<[f64; 2], String> {
+        if let Some(c) = self.columns {
+            return Ok(c);
+        }
+        let ps = &model.particles;
+        let r0: Vec<f64> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).map(|k| ps.x0[k][0]).collect();
+        let tol = 1e-9 * self.theory.b;
+        let first = -coll.max(&[r0.iter().map(|r| -r).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        let beyond = r0.iter().filter(|&&r| r > first + tol);
+        let second = -coll.max(&[beyond.map(|r| -r).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        self.columns = Some([first, second]);
+        Ok([first, second])
+    }
+
+    /// The innermost column of points (radius `first` at t = 0) now: mean stress and position
+    /// (collective).
+    fn mp1(&self, first: f64, model: &Model, coll: &Collective) -> Result<Mp1, String> {
         let ps = &model.particles;
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
-        let first = -coll.max(&[mine.iter().map(|&k| -ps.x0[k][0]).fold(f64::NEG_INFINITY, f64::max)])?[0];
         let tol = 1e-9 * self.theory.b;
         let mut local = [0.0; 7];
         for &k in mine.iter().filter(|&&k| (ps.x0[k][0] - first).abs() <= tol) {
@@ -286,10 +305,7 @@ impl HollowCylinderCheck {
         let theory = FixedWallLame { p: self.pressure(0.0, t, [self.theory.a, y])?, ..self.theory };
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
         let tol = 1e-9 * theory.b;
-        // The two innermost columns of points (by their radius at t = 0).
-        let first = -coll.max(&[mine.iter().map(|&k| -ps.x0[k][0]).fold(f64::NEG_INFINITY, f64::max)])?[0];
-        let beyond = mine.iter().map(|&k| ps.x0[k][0]).filter(|&r| r > first + tol);
-        let second = -coll.max(&[beyond.map(|r| -r).fold(f64::NEG_INFINITY, f64::max)])?[0];
+        let [first, second] = self.columns.ok_or("the hollow cylinder's columns are not known yet")?;
         // [n₁, Σu₁, n₂, Σu₂, Σσ_rr, Σσ_m, Σq over column 1, Σ V e², Σ V]
         let mut local = [0.0; 9];
         for &k in &mine {
@@ -341,7 +357,8 @@ impl Check for HollowCylinderCheck {
     }
 
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
-        let mp1 = self.mp1(model, coll)?;
+        let [first, _] = self.find_columns(model, coll)?;
+        let mp1 = self.mp1(first, model, coll)?;
         let inc = self.increment(t, mp1.x[1], model, coll)?;
         // The initial state (t = 0) is observed too; the first increment is the first step's.
         if t > 0.0 {

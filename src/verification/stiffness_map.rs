@@ -22,8 +22,10 @@ pub struct StiffnessMapCheck {
     tolerance: f64,
     /// [max |dev|, Σ dev², count, min ratio, max ratio] of the last step.
     last: Option<[f64; 5]>,
-    /// K_mag / K_FE at the nodes inside the material (filled more than half) after the last step,
-    /// (x, y, ratio), and half a cell [m]: the map of [001] Fig. 20.
+    /// K_mag / K_FE at this rank's nodes inside the material (filled more than half) after the
+    /// last step, (x, y, ratio) flat; gathered over the ranks by `finish` into `map`.
+    local_map: Vec<f64>,
+    /// The map of [001] Fig. 20 over all ranks, and half a cell [m].
     map: (crate::plot::MapPoints, (f64, f64)),
 }
 
@@ -40,6 +42,7 @@ impl StiffnessMapCheck {
             reference: fem_k_mag(e, nu),
             tolerance: *tolerance,
             last: None,
+            local_map: Vec::new(),
             map: (Vec::new(), (0.0, 0.0)),
         })
     }
@@ -92,8 +95,7 @@ impl Check for StiffnessMapCheck {
         let worst = coll.max(&[local[0], hi, -lo])?;
         let sums = coll.sum(&local[1..])?;
         self.last = Some([worst[0], sums[0], sums[1], -worst[2], worst[1]]);
-        let h = model.grid.h;
-        self.map = (coll.gather(&map)?.chunks_exact(3).map(|c| (c[0], c[1], c[2])).collect(), (0.5 * h[0], 0.5 * h[1]));
+        self.local_map = map;
         Ok(())
     }
 
@@ -111,7 +113,11 @@ impl Check for StiffnessMapCheck {
         )]
     }
 
-    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
+        // The map of the last step, gathered once (every rank holds it; rank 0 draws it).
+        let h = model.grid.h;
+        let points = coll.gather(&self.local_map)?.chunks_exact(3).map(|c| (c[0], c[1], c[2])).collect();
+        self.map = (points, (0.5 * h[0], 0.5 * h[1]));
         let Some([max, sq, n, _, _]) = self.last else {
             return Err("the stiffness map saw no step".into());
         };

@@ -52,6 +52,14 @@ pub fn run_case(case: &str, dir: &Path, args: &[String]) -> Run {
     Run { output, summary, header, rows }
 }
 
+/// Runs `case` with `sets` into `dir` and asserts that it is refused as bad input: exit code 2 and
+/// `message` on standard error.
+pub fn assert_refused(case: &str, dir: &Path, sets: &[&str], message: &str) {
+    let r = run_case(case, dir, &set_args(sets));
+    assert_eq!(r.output.status.code(), Some(2), "{case} {sets:?}: {}", r.stderr());
+    assert!(r.stderr().contains(message), "{case} {sets:?}: `{message}` not in: {}", r.stderr());
+}
+
 /// `--set` arguments for each of `sets`.
 pub fn set_args(sets: &[&str]) -> Vec<String> {
     sets.iter().flat_map(|s| ["--set".to_string(), s.to_string()]).collect()
