@@ -51,6 +51,144 @@ def spectrum(S, Sp):
     return np.sort(w.real), np.abs(w.imag).max()
 
 
+def aggregate_inverse(Auu, plive, dpn, pcomp, nx, spec):
+    """Binv: exact inverse of A_uu on each aggregate's displacement dofs (u and U), diag(A_uu)^-1 elsewhere.
+
+    The displacement dofs are node-major with dpn - 1 of them per node (the order of the split), so node k owns the
+    rows (dpn - 1) k ... (dpn - 1) k + dpn - 2 of A_uu. Returns Binv (sparse) and a one-line description."""
+    nd = dpn - 1
+    nn = Auu.shape[0] // nd
+    I, J = np.arange(nn) % (nx + 1), np.arange(nn) // (nx + 1)
+    pnode = plive // dpn
+    imax, jmax = (pnode % (nx + 1)).max(), (pnode // (nx + 1)).max()
+    diag = Auu.diagonal()
+    off = Auu - sp.diags(diag)
+    active = np.asarray(abs(off).sum(axis=1)).ravel().reshape(nn, nd).sum(axis=1) > 0
+    kind, *kv = spec.split(":")
+    opt = dict(x.split("=") for x in kv if "=" in x)
+    bare = [x for x in kv if "=" not in x]
+    groups = []
+    node = lambda i, j: j * (nx + 1) + i
+    # the strip runs out to the last active displacement nodes, beyond the outermost live pressure layer
+    # where the material reaches nodes whose pressure is fixed (drained) or absent
+    iend, jend = I[active].max(), J[active].max()
+    if opt.get("base") == "u":  # count the K layers from the outermost active displacement node instead
+        imax, jmax = iend, jend
+    if kind == "root":
+        d = diag.reshape(nn, nd)
+        inner = active & (I < imax - 2) & (J < jmax - 2)
+        med = np.median(d[inner], axis=0)
+        if "tau" in opt:  # only the components that couple (fixed dofs keep an identity row)
+            dofact = (np.asarray(abs(off).sum(axis=1)).ravel() > 0).reshape(nn, nd)
+            sliver = active & (np.where(dofact, d / med, np.inf).min(axis=1) < float(opt["tau"]))
+        else:
+            L = int(opt.get("layers", 1))
+            sliver = active & ((I >= imax + 1 - L) | (J >= jmax + 1 - L))
+        # node-to-node coupling strength: Frobenius norm of the nd x nd blocks of A_uu
+        C = Auu.tocoo()
+        W = sp.coo_matrix((C.data ** 2, (C.row // nd, C.col // nd)), shape=(nn, nn)).tocsr()
+        W.sum_duplicates()
+        depth = int(opt.get("depth", 1))
+        owner = {}
+        for k in np.where(sliver)[0]:
+            r, seen = k, set()
+            # follow the strongest coupling to a non-sliver node
+            while sliver[r] and r not in seen:
+                seen.add(r)
+                row = W.getrow(r)
+                cand = [(v, c) for c, v in zip(row.indices, row.data) if c != r and active[c]
+                        and (not sliver[c] or (d[c] / med).min() > (d[r] / med).min())]
+                if not cand:
+                    break
+                r = max(cand)[1]
+            chain = [r]
+            for _ in range(depth - 1):  # further roots inwards
+                row = W.getrow(chain[-1])
+                cand = [(v, c) for c, v in zip(row.indices, row.data) if c not in chain and active[c]
+                        and not sliver[c] and (I[c] + J[c] < I[chain[-1]] + J[chain[-1]])]
+                if not cand:
+                    break
+                chain.append(max(cand)[1])
+            owner.setdefault(tuple(chain), []).append(k)
+        # non-overlapping: a root claimed by several chains keeps the first; merge aggregates sharing nodes
+        parent = {}
+        def find(x):
+            while parent.get(x, x) != x:
+                x = parent[x]
+            return x
+        members = {}
+        for chain, sl in owner.items():
+            nodes = list(chain) + sl
+            for q in nodes[1:]:
+                a_, b_ = find(nodes[0]), find(q)
+                if a_ != b_:
+                    parent[b_] = a_
+        for chain, sl in owner.items():
+            for q in list(chain) + sl:
+                members.setdefault(find(q), set()).add(q)
+        groups = [sorted(m) for m in members.values()]
+        weights = None
+    elif kind == "overlap":
+        K, Wd = int(bare[0]) if bare else 2, int(opt.get("width", 3))
+        groups = []
+        i0, j0 = imax + 1 - K, jmax + 1 - K
+        h = Wd // 2
+        for j in range(0, j0):
+            groups.append([node(i, jj) for jj in range(max(0, j - h), min(j0, j - h + Wd)) for i in range(i0, iend + 1)])
+        for i in range(0, i0):
+            groups.append([node(ii, j) for ii in range(max(0, i - h), min(i0, i - h + Wd)) for j in range(j0, jend + 1)])
+        groups.append([node(i, j) for i in range(i0, iend + 1) for j in range(j0, jend + 1)])
+        weights = True
+    else:
+        K = int(kind)
+        Wd = int(opt.get("width", 1))
+        corner = opt.get("corner", "block")
+        Cw = int(opt.get("cornerw", K))
+        i0, j0 = imax + 1 - K, jmax + 1 - K
+        ci0, cj0 = imax + 1 - Cw, jmax + 1 - Cw  # corner square
+        if corner == "block":
+            groups.append([node(i, j) for i in range(ci0, iend + 1) for j in range(cj0, jend + 1)])
+            right_top, top_right = cj0, ci0
+        elif corner == "top":
+            right_top, top_right = j0, iend + 1
+        elif corner == "right":
+            right_top, top_right = jend + 1, i0
+        elif corner == "nodes":
+            groups += [[node(i, j)] for i in range(i0, iend + 1) for j in range(j0, jend + 1)]
+            right_top, top_right = j0, i0
+        else:
+            sys.exit(f"unknown corner {corner}")
+        for j in range(0, right_top, Wd):  # right side: columns along i
+            groups.append([node(i, jj) for jj in range(j, min(j + Wd, right_top)) for i in range(i0, iend + 1)])
+        for i in range(0, top_right, Wd):  # top: columns along j
+            groups.append([node(ii, j) for ii in range(i, min(i + Wd, top_right)) for j in range(j0, jend + 1)])
+        weights = None
+    groups = [[k for k in g if active[k]] for g in groups]
+    groups = [g for g in groups if g]
+    covered = np.zeros(nn, int)
+    for g in groups:
+        covered[g] += 1
+    if weights is None and covered.max() > 1:
+        sys.exit(f"aggregates {spec} overlap")
+    dinv = np.where(covered.repeat(nd) > 0, 0.0, 1.0 / diag)
+    rows, cols, vals = [np.arange(len(diag))], [np.arange(len(diag))], [dinv]
+    A = Auu.tocsr()
+    nnz_blocks = 0
+    for g in groups:
+        dofs = (np.asarray(g)[:, None] * nd + np.arange(nd)).ravel()
+        B = la.inv(A[dofs][:, dofs].toarray())
+        if weights:
+            B = B * (1.0 / covered[np.asarray(g)].repeat(nd))[:, None]  # restricted-additive-Schwarz style weight
+        r, c = np.meshgrid(dofs, dofs, indexing="ij")
+        rows.append(r.ravel()); cols.append(c.ravel()); vals.append(B.ravel())
+        nnz_blocks += B.size
+    Binv = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=A.shape).tocsr()
+    sizes = np.array([len(g) for g in groups])
+    info = (f"{len(groups)} aggregates of {sizes.min()}-{sizes.max()} nodes (mean {sizes.mean():.2f}), "
+            f"{(covered > 0).sum()} nodes covered, Binv nnz {Binv.nnz} (diag alone {len(diag)})")
+    return Binv, info
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("matrix", help="PETSc binary file (the last matrix in it is used)")
@@ -71,6 +209,28 @@ def main():
                     help="with --strip and --drained-bulk-modulus: subtract this share c of (1-n)^2 M_L/K_dr "
                          "(n = --porosity) from the strip-corrected selfp (repeatable)")
     ap.add_argument("--porosity", type=float, default=0.3, help="n for --fixed-stress-share")
+    ap.add_argument("--aggregates", action="append", default=[], metavar="SPEC",
+                    help="also try selfp with an aggregate block inverse of A_uu (exact inverse of A_uu restricted to "
+                         "all displacement dofs, u and U, of each aggregate; diag(A_uu)^-1 elsewhere) and, with "
+                         "--drained-bulk-modulus, minus each --fixed-stress-share; repeatable; needs --cells-x. "
+                         "SPEC is K[:key=value...] with K the depth in node layers of the free-surface strip "
+                         "(i >= imax+1-K or j >= jmax+1-K, imax/jmax the outermost live pressure layer, out to the "
+                         "last active displacement node beyond it as --strip does; with base=u imax/jmax are the "
+                         "outermost active displacement nodes, so K counts all node layers), "
+                         "grouped in columns normal to the surface. Keys: width=W (W nodes along the surface per "
+                         "aggregate, default 1), corner=block|top|right|nodes (the K x K corner square: one "
+                         "aggregate, vertical or horizontal columns, or single nodes; default block), "
+                         "cornerw=C (the corner aggregate spans C x C nodes, C >= K, default K). "
+                         "SPEC root[:key=value...] is the AgFEM-like graph rule: sliver nodes (the outer "
+                         "layers=L layers, default 1, or with tau=T the active nodes whose diagonal of A_uu is "
+                         "below T times the interior median in any component) each join their most strongly "
+                         "coupled non-sliver neighbour (the root, by the Frobenius norm of the 4 x 4 coupling "
+                         "block of A_uu; depth=D follows D roots inwards, default 1); aggregate = root + its "
+                         "slivers. SPEC overlap:K[:width=W] sums the local inverses of overlapping K-deep, "
+                         "W-wide patches centred on each surface node, weighted by 1/multiplicity (a "
+                         "partition of unity, restricted additive Schwarz; not symmetric)")
+    ap.add_argument("--skip-basic", action="store_true",
+                    help="only selfp and the requested --strip/--aggregates variants (skip A_pp and the fixed-stress pair)")
     a = ap.parse_args()
 
     A = PetscBinaryIO.PetscBinaryIO().readBinaryFile(a.matrix, mattype="scipy.sparse")[-1].tocsr()
@@ -90,13 +250,14 @@ def main():
     S = (App.toarray() - Apu @ sla.splu(Auu).solve(Aup.toarray()))[keep]
     selfp = (App - Apu @ sp.diags(1.0 / Auu.diagonal()) @ Aup).toarray()[keep]
     print(f"{A.shape[0]} unknowns, {len(u)} displacement, {len(p)} pressure ({len(live)} coupled)")
-    cases = [("selfp", selfp), ("A_pp", App.toarray()[keep])]
+    cases = [("selfp", selfp)] + ([] if a.skip_basic else [("A_pp", App.toarray()[keep])])
     if a.drained_bulk_modulus:
         mass = -np.asarray(App.sum(axis=1)).ravel()[live] / a.storage
         if a.mass_cap:
             mass = np.minimum(mass, a.mass_cap)
-        cases.append(("selfp - bM", selfp - np.diag(mass / a.drained_bulk_modulus)))
-        cases.append(("A_pp - bM", App.toarray()[keep] - np.diag(mass / a.drained_bulk_modulus)))
+        if not a.skip_basic:
+            cases.append(("selfp - bM", selfp - np.diag(mass / a.drained_bulk_modulus)))
+            cases.append(("A_pp - bM", App.toarray()[keep] - np.diag(mass / a.drained_bulk_modulus)))
     if a.strip:
         if not a.cells_x:
             sys.exit("--strip needs --cells-x")
@@ -115,6 +276,17 @@ def main():
             for c in a.fixed_stress_share:
                 beta = c * (1.0 - a.porosity) ** 2 / a.drained_bulk_modulus
                 cases.append((f"strip {a.strip} - {c}(1-n)^2 M/K", corrected - np.diag(mass * beta)))
+    for spec in a.aggregates:
+        if not a.cells_x:
+            sys.exit("--aggregates needs --cells-x")
+        Binv, info = aggregate_inverse(Auu, p[live], a.dofs_per_node, a.pressure, a.cells_x, spec)
+        print(f"aggregates {spec}: {info}")
+        corrected = (App - Apu @ Binv @ Aup).toarray()[keep]
+        cases.append((f"agg {spec}", corrected))
+        if a.drained_bulk_modulus:
+            for c in a.fixed_stress_share:
+                beta = c * (1.0 - a.porosity) ** 2 / a.drained_bulk_modulus
+                cases.append((f"agg {spec} - {c}(1-n)^2 M/K", corrected - np.diag(mass * beta)))
     for name, Sp in cases:
         w, imag = spectrum(S, Sp)
         lo, hi = w[int(0.01 * len(w))], w[int(0.99 * len(w))]

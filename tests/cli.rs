@@ -636,6 +636,38 @@ fn bad_analysis_settings_are_named() {
     assert!(stderr(&o).contains("--threads"), "{}", stderr(&o));
 }
 
+/// What the B-spline bases do not combine with, each refused naming the key: B̄ (too soft with
+/// them), [001]'s mapped stiffnesses and CMPM recovery, and a quasi-static stage's weak drainage.
+#[test]
+fn bspline_bases_refuse_what_they_do_not_support() {
+    for (case, sets, needle) in [
+        ("cases/patch_test.toml", &["analysis.shape_functions=bspline2"][..], "key `stabilisation.bbar`"),
+        (
+            "cases/hollow_cylinder_increments.toml",
+            &["analysis.shape_functions=bspline3"][..],
+            "key `stabilisation.stiffness`",
+        ),
+        (
+            "cases/hollow_cylinder_increments.toml",
+            &["analysis.shape_functions=bspline3", "stabilisation.stiffness=particle"][..],
+            "key `stabilisation.stress_recovery`",
+        ),
+        (
+            "cases/terzaghi.toml",
+            &["analysis.shape_functions=bspline2", "stages.0.analysis=quasi_static"][..],
+            "key `stages.consolidation.analysis`",
+        ),
+    ] {
+        let mut args = vec!["check", case];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        assert_one_line_error(&porompm(&args), needle);
+    }
+    let o = porompm(&["check", "cases/terzaghi.toml", "--set", "analysis.shape_functions=bspline3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// More bad values, each one error naming its key: the grid, bodies, stages, probes, the
 /// verification, the time integration, the output, the stabilisation and the loads.
 #[test]

@@ -33,14 +33,18 @@ fn run_with(case: &str, label: &str, sets: &[&str], petsc: &[&str]) -> (Output, 
 }
 
 /// The kinematic patch test: every grid node follows a homogeneous stretch and shear, and every
-/// point must carry the same stress, that of linear elasticity for the flow — for GIMP, uGIMP and
-/// linear MPM, with and without B̄, at ν = 0.3, 0.49 and 0.4999, on regular and perturbed
-/// arrangements, after one step and after ten.
+/// point must carry the same stress, that of linear elasticity for the flow — for GIMP, uGIMP,
+/// linear MPM and quadratic and cubic B-splines, with and without B̄ (B-splines without: they
+/// refuse it), at ν = 0.3, 0.49 and 0.4999, on regular and perturbed arrangements, after one step
+/// and after ten.
 #[test]
 fn kinematic_patch_tests_hold_to_round_off() {
     let mut worst: (f64, f64) = (0.0, 0.0);
-    for basis in ["gimp", "ugimp", "linear"] {
+    for basis in ["gimp", "ugimp", "linear", "bspline2", "bspline3"] {
         for bbar in [true, false] {
+            if bbar && basis.starts_with("bspline") {
+                continue;
+            }
             for nu in ["0.3", "0.49", "0.4999"] {
                 for pert in ["0", "0.3"] {
                     for dt in ["1.0", "0.1"] {
@@ -77,22 +81,50 @@ fn kinematic_patch_tests_hold_to_round_off() {
 fn the_equilibrium_patch_test_is_exact_at_the_first_step() {
     for basis in ["gimp", "ugimp", "linear"] {
         for nu in ["0.3", "0.4999"] {
-            let label = format!("patch-free-{basis}-{nu}");
-            let (o, s, _, _) = run_with(
-                "cases/patch_test.toml",
-                &label,
-                &[
-                    "boundaries[0]={name=\"flow\",surface={body=\"block\",faces=[\"x_min\",\"x_max\",\"y_min\",\"y_max\"]},fix=[\"ux\",\"uy\"],velocity_gradient=[[1.0e-3,3.0e-4],[3.0e-4,-5.0e-4]],center=[4.0,4.0]}",
-                    &format!("analysis.shape_functions={basis}"),
-                    &format!("materials.solid.model.poisson_ratio={nu}"),
-                    "stages.stretch.duration=0.1",
-                ],
-                &["-snes_rtol", "1e-12", "-snes_atol", "1e-30"],
-            );
-            assert!(o.status.success(), "{label}: {}", String::from_utf8_lossy(&o.stderr));
-            assert!(s["dofs"].as_u64().unwrap() > 0, "{label}: the interior must be free");
-            let spread = metric(&s, "stress_spread");
-            assert!(spread <= 1e-10, "{label}: stress spread {spread:e}");
+            let (spread, dofs) = free_interior_patch(basis, nu, &[]);
+            assert!(dofs > 0, "{basis}, ν = {nu}: the interior must be free");
+            assert!(spread <= 1e-10, "{basis}, ν = {nu}: stress spread {spread:e}");
+        }
+    }
+}
+
+/// The equilibrium patch test's run: the block's surface prescribed, its interior free, one step;
+/// returns the stress spread and the number of free dofs.
+fn free_interior_patch(basis: &str, nu: &str, extra: &[&str]) -> (f64, u64) {
+    let label = format!("patch-free-{basis}-{nu}-{}", extra.len());
+    let (basis_set, nu_set) =
+        (format!("analysis.shape_functions={basis}"), format!("materials.solid.model.poisson_ratio={nu}"));
+    let mut sets = vec![
+        "boundaries[0]={name=\"flow\",surface={body=\"block\",faces=[\"x_min\",\"x_max\",\"y_min\",\"y_max\"]},fix=[\"ux\",\"uy\"],velocity_gradient=[[1.0e-3,3.0e-4],[3.0e-4,-5.0e-4]],center=[4.0,4.0]}",
+        &basis_set,
+        &nu_set,
+        "stages.stretch.duration=0.1",
+    ];
+    sets.extend_from_slice(extra);
+    let (o, s, _, _) =
+        run_with("cases/patch_test.toml", &label, &sets, &["-snes_rtol", "1e-12", "-snes_atol", "1e-30"]);
+    assert!(o.status.success(), "{label}: {}", String::from_utf8_lossy(&o.stderr));
+    (metric(&s, "stress_spread"), s["dofs"].as_u64().unwrap())
+}
+
+/// B-splines pass the equilibrium patch test when the body fills the grid: their edge-modified
+/// functions are interpolatory on the grid's edge, so the surface's nodes hold the surface, and
+/// every free node's function integrates to zero gradient over the body. (Inside a larger grid, the
+/// functions of the first free nodes reach past the body's surface (a quadratic spline is 1/8 one
+/// cell from its node), and a uniform stress leaves a net force there: the same test on the 4 m
+/// block in the 8 m grid gives a spread of 0.10 at ν = 0.3 — B-spline MPM's known boundary error.)
+#[test]
+fn bspline_equilibrium_patch_test_is_exact_when_the_body_fills_the_grid() {
+    let fill = [
+        "bodies.block.shape.rectangle.min=[0.0,0.0]",
+        "bodies.block.shape.rectangle.max=[8.0,8.0]",
+        "stabilisation.bbar=false",
+    ];
+    for basis in ["bspline2", "bspline3"] {
+        for nu in ["0.3", "0.4999"] {
+            let (spread, dofs) = free_interior_patch(basis, nu, &fill);
+            assert!(dofs >= 98, "{basis}, ν = {nu}: the interior must be free");
+            assert!(spread <= 1e-10, "{basis}, ν = {nu}: stress spread {spread:e}");
         }
     }
 }

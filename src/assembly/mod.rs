@@ -965,7 +965,14 @@ impl GridSystem {
                     continue;
                 }
                 let (i, j) = self.ghost.ij(l);
-                match stencils::extension((i, j), g.node_position(i, j), toward, &is_well, tiny) {
+                match stencils::extension(
+                    (i, j),
+                    g.node_position(i, j),
+                    toward,
+                    &is_well,
+                    tiny,
+                    model.basis.is_bspline(),
+                ) {
                     Some((masters, coefs, n)) => {
                         for m in 0..n {
                             let ml = self.ghost.node(masters[m].0 as usize, masters[m].1 as usize).expect("well");
@@ -992,7 +999,7 @@ impl GridSystem {
                         // The face's area: its length times the ring's 2πr in axial symmetry.
                         let length = length * model.geometry.measure(point[0]);
                         applied.add([traction[0] * f * length, traction[1] * f * length]);
-                        let w = shape::face_weights(g, point);
+                        let w = shape::face_weights(model.basis, g, point);
                         for ((i, j), s, _) in w.iter() {
                             let l = self.ghost.node(i as usize, j as usize).ok_or_else(|| {
                                 format!(
@@ -1025,7 +1032,7 @@ impl GridSystem {
                         // Shares on unfilled nodes are extended from the material's side.
                         let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
                         let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
-                        for ((i, j), s, _) in shape::face_weights(g, point).iter() {
+                        for ((i, j), s, _) in shape::face_weights(model.basis, g, point).iter() {
                             let l = self.ghost.node(i as usize, j as usize).expect("an owned cell's nodes are ghosted");
                             add(l, [s * force[0] * pressure * f, s * force[1] * pressure * f], inward);
                         }

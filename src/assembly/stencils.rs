@@ -14,11 +14,14 @@
 //! 1. along the grid line of the axis on which the particle lies farther away:
 //!    u_s = 2u_a − u_b with a, b the next two nodes towards the particle (both well filled);
 //! 2. along the other axis;
-//! 3. from the triangle of the cell corner towards the particle: u_s = u_a + u_b − u_c.
+//! 3. from the triangle of the cell corner towards the particle: u_s = u_a + u_b − u_c;
+//! 4. with B-splines only: along the diagonal towards the particle, u_s = 2u_a − u_b.
 //!
 //! The choice depends only on the particle's position and on φ, so it is the same on every rank.
-//! Without any of the three (a node diagonal to a body's corner), the node stays fixed: its
-//! influence on the particle is of second order in the sliver. The pore pressure of a node that is
+//! Without any of them (a node diagonal to a body's corner), the node stays fixed: with GIMP its
+//! influence on the particle is of second order in the sliver. B-splines reach a cell and a half
+//! (quadratic) or two (cubic) beyond a particle, so their weights at such nodes are not small, and
+//! a traction near a body's corner put a share there (the tapered plate lost 5e-4 of its load). The pore pressure of a node that is
 //! not well filled is fixed to zero (the material's free surface is drained), as before.
 //! This is the extension of aggregated unfitted finite elements (Badia, Verdugo & Martín 2018)
 //! with the particle's side as the aggregate.
@@ -232,7 +235,8 @@ pub struct Crossing {
 pub const SIDES: [&str; 4] = ["x_min", "x_max", "y_min", "y_max"];
 
 /// Builds the raw stencils on x_n (step 1 of a step), and lists the particles whose support
-/// reaches past the grid (GIMP: their domain, beyond round-off; linear: their centre), for
+/// reaches past the grid (GIMP: their domain, beyond round-off; linear and B-splines, whose
+/// functions stay a partition of unity up to the edge: their centre), for
 /// [`check_edges`]. Fails, naming the particle, when a stencil node lies outside this rank's ghost
 /// region or a position is not finite.
 pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(Stencils, Vec<Crossing>), String> {
@@ -248,7 +252,7 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
         if !(x[0].is_finite() && x[1].is_finite()) {
             return Err(format!("material point {}: its position is not finite (NaN or Inf)", ps.id[k]));
         }
-        let reach = if model.basis == Basis::Linear { [0.0; 2] } else { lp };
+        let reach = if model.basis == Basis::Gimp { lp } else { [0.0; 2] };
         let past = [
             x[0] - reach[0] < g.origin[0] - tol,
             x[0] + reach[0] > hi[0] + tol,
@@ -296,7 +300,7 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
 /// Where the particle's nodes on that side are held in the side's normal direction by a boundary
 /// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
 /// as its reaction; on any other side the run must stop, naming the particle, its body, the time
-/// and the side. (Linear MPM: a centre outside the grid always stops the run.)
+/// and the side. (Linear MPM and B-splines: a centre outside the grid always stops the run.)
 pub fn check_edges(
     model: &Model,
     st: &Stencils,
@@ -320,7 +324,7 @@ pub fn check_edges(
                 _ => j == g.cells[1],
             }
         };
-        let wall = model.basis != Basis::Linear && {
+        let wall = model.basis == Basis::Gimp && {
             let side_nodes: Vec<u32> = nodes.iter().copied().filter(|&l| on_side(l)).collect();
             !side_nodes.is_empty() && side_nodes.iter().all(|&l| dofs.boundary_fixed(l as usize, normal))
         };
@@ -340,13 +344,14 @@ pub fn check_edges(
 
 /// Coefficients extending node (i, j) from well-filled nodes towards the point `toward` (see the
 /// module documentation); `well(i, j)` says whether a node is well filled (false outside the
-/// ghost region or the grid).
+/// ghost region or the grid); `diagonal` allows the fourth rule (B-splines).
 pub fn extension(
     node: (usize, usize),
     pos: [f64; 2],
     toward: [f64; 2],
     well: &dyn Fn(i64, i64) -> bool,
     tiny: f64,
+    diagonal: bool,
 ) -> Option<ExtensionCoefficients> {
     let (i, j) = (node.0 as i64, node.1 as i64);
     let d = [toward[0] - pos[0], toward[1] - pos[1]];
@@ -376,6 +381,10 @@ pub fn extension(
         let (a, b, c) = ((i + dx, j), (i, j + dy), (i + dx, j + dy));
         if well(a.0, a.1) && well(b.0, b.1) && well(c.0, c.1) {
             return Some(([a, b, c], [1.0, 1.0, -1.0], 3));
+        }
+        let (a, b) = ((i + dx, j + dy), (i + 2 * dx, j + 2 * dy));
+        if diagonal && well(a.0, a.1) && well(b.0, b.1) {
+            return Some(([a, b, (0, 0)], [2.0, -1.0, 0.0], 2));
         }
     }
     None
@@ -517,7 +526,9 @@ pub fn extend(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &Dof
                 continue;
             }
             let (i, j) = ghost.ij(l);
-            let Some((masters, coefs, n)) = extension((i, j), g.node_position(i, j), ps.x[k], &is_well, tiny) else {
+            let Some((masters, coefs, n)) =
+                extension((i, j), g.node_position(i, j), ps.x[k], &is_well, tiny, model.basis.is_bspline())
+            else {
                 continue;
             };
             let mut e = Extension { slot: slot as u8, masters: [(0, 0.0); MAX_MASTERS], n: n as u8, mask };
@@ -549,7 +560,7 @@ mod tests {
         let well = |i: i64, j: i64| (0..=3).contains(&i) && (0..10).contains(&j);
         let pos = |i: i64, j: i64| [i as f64, j as f64];
         // Node (4, 5) reached from a particle at (3.8, 5.2): x-line from (3, 5) and (2, 5).
-        let (m, c, n) = extension((4, 5), [4.0, 5.0], [3.8, 5.2], &well, 1e-12).unwrap();
+        let (m, c, n) = extension((4, 5), [4.0, 5.0], [3.8, 5.2], &well, 1e-12, false).unwrap();
         assert_eq!(n, 2);
         assert_eq!(&m[..2], &[(3, 5), (2, 5)]);
         for f in [|x: [f64; 2]| 1.0 + 2.0 * x[0] - 3.0 * x[1], |x: [f64; 2]| x[1]] {
@@ -558,13 +569,19 @@ mod tests {
         }
         // A node diagonal to a corner (well: i ≤ 3 and j ≤ 3): no line, no triangle.
         let corner = |i: i64, j: i64| (0..=3).contains(&i) && (0..=3).contains(&j);
-        assert!(extension((4, 4), [4.0, 4.0], [3.8, 3.8], &corner, 1e-12).is_none());
+        assert!(extension((4, 4), [4.0, 4.0], [3.8, 3.8], &corner, 1e-12, false).is_none());
+        // With B-splines, along the diagonal from (3, 3) and (2, 2), exact for linear fields.
+        let (m, c, n) = extension((4, 4), [4.0, 4.0], [3.8, 3.7], &corner, 1e-12, true).unwrap();
+        assert_eq!((n, m[0], m[1]), (2, (3, 3), (2, 2)));
+        let f = |x: [f64; 2]| 0.7 + 1.5 * x[0] - 2.5 * x[1];
+        let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();
+        assert!((v - f([4.0, 4.0])).abs() < 1e-12);
         // Node (4, 3) beside the corner, reached from (3.8, 2.9): x-line.
-        let (m, _, n) = extension((4, 3), [4.0, 3.0], [3.8, 2.9], &corner, 1e-12).unwrap();
+        let (m, _, n) = extension((4, 3), [4.0, 3.0], [3.8, 2.9], &corner, 1e-12, false).unwrap();
         assert_eq!((n, m[0], m[1]), (2, (3, 3), (2, 3)));
         // A triangle when neither line has two well nodes: only (1, 1), (1, 2), (2, 1) are well.
         let tri = |i: i64, j: i64| [(1, 1), (1, 2), (2, 1)].contains(&(i, j));
-        let (m, c, n) = extension((2, 2), [2.0, 2.0], [1.9, 1.8], &tri, 1e-12).unwrap();
+        let (m, c, n) = extension((2, 2), [2.0, 2.0], [1.9, 1.8], &tri, 1e-12, false).unwrap();
         assert_eq!(n, 3);
         let f = |x: [f64; 2]| 0.5 - x[0] + 4.0 * x[1];
         let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();

@@ -80,7 +80,8 @@ pub struct Analysis {
     /// A2): `r_weighted` (the default; the particle's characteristic function integrated with the
     /// measure r dr, Option B, which distributes mass and volume with the ring's weight and is exact
     /// next to the axis) or `planar` (the planar GIMP functions with the hoop operator S_i/r_p,
-    /// Option A). Both reproduce the strains of u_r = α + βr exactly; the linear basis has one form.
+    /// Option A). Both reproduce the strains of u_r = α + βr exactly; the linear basis and the
+    /// B-splines have one form (their functions at the point with the hoop operator S_i/r_p).
     #[serde(default)]
     pub axisymmetric_weights: AxisymmetricWeights,
     /// The kinematics of a step: `finite_strain` (the default: forces on the configuration at the
@@ -158,6 +159,14 @@ pub enum ShapeFunctions {
     Ugimp,
     /// Standard MPM: bilinear hat functions evaluated at the particle.
     Linear,
+    /// Quadratic B-splines centred on the nodes ([002] §2.2.1; C¹, 3 × 3 nodes per particle),
+    /// modified at the grid's edges so that they stay a partition of unity, reproduce linear
+    /// fields and are interpolatory there (`model::shape::bspline_1d`). The points' domains (used
+    /// for cell fractions and B̄) follow the stretch as with `gimp`.
+    Bspline2,
+    /// Cubic B-splines centred on the nodes (C², 4 × 4 nodes per particle), with the same edge
+    /// treatment.
+    Bspline3,
 }
 
 /// A uniform structured background grid.

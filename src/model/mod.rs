@@ -3,6 +3,8 @@
 //! [`crate::assembly`].
 
 pub mod cmpm;
+pub mod fbar;
+pub mod finite_strain;
 pub mod grid;
 pub mod linalg;
 pub mod loads;
@@ -27,7 +29,8 @@ pub struct Model {
     pub two_phase: bool,
     /// Basis functions.
     pub basis: Basis,
-    /// Whether GIMP domains follow the material stretch (`shape_functions = "gimp"`).
+    /// Whether the points' domains follow the material stretch (`shape_functions = "gimp"` and the
+    /// B-splines).
     pub stretch_domains: bool,
     /// Background grid.
     pub grid: Grid,
@@ -144,8 +147,13 @@ impl Model {
             basis: match case.analysis.shape_functions {
                 ShapeFunctions::Gimp | ShapeFunctions::Ugimp => Basis::Gimp,
                 ShapeFunctions::Linear => Basis::Linear,
+                ShapeFunctions::Bspline2 => Basis::BSpline2,
+                ShapeFunctions::Bspline3 => Basis::BSpline3,
             },
-            stretch_domains: case.analysis.shape_functions == ShapeFunctions::Gimp,
+            stretch_domains: matches!(
+                case.analysis.shape_functions,
+                ShapeFunctions::Gimp | ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3
+            ),
             grid,
             materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
             particles,

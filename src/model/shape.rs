@@ -1,4 +1,5 @@
-//! Basis functions of the material point method: uGIMP ([003] Eqs. 13–15) and standard linear MPM.
+//! Basis functions of the material point method: uGIMP ([003] Eqs. 13–15), standard linear MPM, and
+//! quadratic and cubic B-splines ([002] §2.2.1; `../shared/seeds-001-002.md` Part C3).
 //!
 //! In 1D the GIMP function of node i for a particle at x_p with half-width l_p is the average of the
 //! linear hat N_i over the particle domain [x_p − l_p, x_p + l_p]:
@@ -15,6 +16,99 @@ pub enum Basis {
     Gimp,
     /// Bilinear hat functions evaluated at the particle.
     Linear,
+    /// Quadratic B-splines centred on the nodes (C¹, three nodes per direction), with the
+    /// boundary treatment of [`bspline_1d`].
+    BSpline2,
+    /// Cubic B-splines centred on the nodes (C², four nodes per direction), with the boundary
+    /// treatment of [`bspline_1d`].
+    BSpline3,
+}
+
+impl Basis {
+    /// Whether the basis is a B-spline (its support does not depend on the particle domain).
+    pub fn is_bspline(&self) -> bool {
+        matches!(self, Basis::BSpline2 | Basis::BSpline3)
+    }
+}
+
+/// The uniform B-spline of degree 2 or 3 centred on a node, N(ξ) and dN/dξ at ξ = (x − x_i)/h
+/// ([002] §2.2.1; seeds-001-002.md Part C3):
+///   quadratic: 3/4 − ξ² for |ξ| < 1/2, ½(3/2 − |ξ|)² for 1/2 ≤ |ξ| < 3/2;
+///   cubic: ½|ξ|³ − ξ² + 2/3 for |ξ| < 1, (2 − |ξ|)³/6 for 1 ≤ |ξ| < 2; 0 beyond.
+#[inline]
+pub fn uniform_bspline(degree: usize, xi: f64) -> (f64, f64) {
+    let a = xi.abs();
+    let sg = if xi < 0.0 { -1.0 } else { 1.0 };
+    match degree {
+        2 if a < 0.5 => (0.75 - xi * xi, -2.0 * xi),
+        2 if a < 1.5 => (0.5 * (1.5 - a) * (1.5 - a), -sg * (1.5 - a)),
+        3 if a < 1.0 => (0.5 * a * a * a - xi * xi + 2.0 / 3.0, 1.5 * xi * a - 2.0 * xi),
+        3 if a < 2.0 => ((2.0 - a).powi(3) / 6.0, -0.5 * sg * (2.0 - a) * (2.0 - a)),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// The B-spline basis of degree 2 or 3 of the nodes 0..=n of a grid line of n cells (spacing h,
+/// ξ measured in cells from node 0), at the point `s` ∈ [0, n]: up to four (node, N, dN/dx).
+///
+/// Boundary treatment: uniform B-splines centred on the nodes would need a ghost node −1 (and
+/// n + 1) beyond each end of the grid; its function is folded into the first two nodes by linear
+/// extrapolation, u₋₁ = 2u₀ − u₁, i.e. N₀ += 2N₋₁ and N₁ −= N₋₁ (the node beyond −1 does not reach
+/// into the grid for either degree). The basis then keeps the partition of unity and reproduces
+/// linear fields exactly up to the edge, every function stays non-negative, and it is
+/// interpolatory at the edge (N₀(0) = 1, all others 0), so a condition on the edge's nodes holds on
+/// the edge itself, as with the linear and GIMP bases. On the edge's half cell the quadratic basis
+/// is the linear hat; in a direction of one cell both degrees reduce to it (two functions that
+/// reproduce 1 and x). The uniform functions are used in the interior (quadratic B-spline MPM as in
+/// Steffen, Kirby & Berzins 2008; [002] uses them on a grid extended beyond the material).
+pub fn bspline_1d(degree: usize, s: f64, n: usize, h: f64) -> ([(u32, f64, f64); 4], usize) {
+    // Candidate nodes, ghosts included: quadratic the three nodes nearest s, cubic the four of
+    // the cell holding s and its neighbours (weights may be zero at the ends of the support, which
+    // keeps the stencil's shape fixed while the particle moves inside a cell).
+    let (first, count) = match degree {
+        2 => ((s + 0.5).floor() as i64 - 1, 3),
+        _ => ((s.floor() as i64).min(n as i64 - 1) - 1, 4),
+    };
+    let mut raw = [(0i64, 0.0, 0.0); 4];
+    for (k, r) in raw.iter_mut().enumerate().take(count) {
+        let i = first + k as i64;
+        let (w, g) = uniform_bspline(degree, s - i as f64);
+        *r = (i, w, g / h);
+    }
+    let mut out = [(0u32, 0.0, 0.0); 4];
+    let mut len = 0;
+    let mut add = |i: i64, w: f64, g: f64, out: &mut [(u32, f64, f64); 4]| {
+        let i = i as u32;
+        match out[..len].iter().position(|o| o.0 == i) {
+            Some(k) => {
+                out[k].1 += w;
+                out[k].2 += g;
+            }
+            None => {
+                out[len] = (i, w, g);
+                len += 1;
+            }
+        }
+    };
+    // Interior nodes first, in order, so that folded ghosts add to existing entries.
+    for &(i, w, g) in &raw[..count] {
+        if (0..=n as i64).contains(&i) {
+            add(i, w, g, &mut out);
+        }
+    }
+    for &(i, w, g) in &raw[..count] {
+        let (edge, next) = if i < 0 {
+            (0, 1)
+        } else if i > n as i64 {
+            (n as i64, n as i64 - 1)
+        } else {
+            continue;
+        };
+        add(edge, 2.0 * w, 2.0 * g, &mut out);
+        add(next, -w, -g, &mut out);
+    }
+    out[..len].sort_by_key(|o| o.0);
+    (out, len)
 }
 
 /// Hat function N(r) = max(0, 1 − |r|/h).
@@ -95,6 +189,15 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
             out[0] = (c as u32, 1.0 - xi, -1.0 / h);
             out[1] = (c as u32 + 1, xi, 1.0 / h);
             n = 2;
+        }
+        Basis::BSpline2 | Basis::BSpline3 => {
+            // As for the linear basis, points within round-off of the grid's edge are on it.
+            let s = (x - origin) / h;
+            if !(s >= -1e-9 && s <= ncells as f64 + 1e-9) {
+                return (out, 0);
+            }
+            let degree = if basis == Basis::BSpline2 { 2 } else { 3 };
+            return bspline_1d(degree, s.clamp(0.0, ncells as f64), ncells, h);
         }
         Basis::Gimp => {
             let tol = 1e-9 * h;
@@ -315,7 +418,12 @@ pub fn local_gimp(grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (LocalGimp, usize) 
 /// surface (domains that follow the stretch, `ShapeFunctions::Gimp`): for a uniform stress σ,
 /// ∫_Ω_p ∇N_i σ dV = N_i(x_face) σ A_face − N_i(x_opposite) σ A_face, so a surface traction equal to σ
 /// is balanced node by node, and it moves continuously as the surface crosses grid lines.
-pub fn face_weights(grid: &Grid, point: [f64; 2]) -> Stencil {
+/// B-splines take their own functions at the point: for a uniform stress, ∫_Ω ∇N_i σ dV =
+/// ∮ N_i σ n dS, so the consistent weights of a surface force are the basis's values there.
+pub fn face_weights(basis: Basis, grid: &Grid, point: [f64; 2]) -> Stencil {
+    if basis.is_bspline() {
+        return stencil(basis, grid, point, [0.0; 2]);
+    }
     let mut s = Stencil::default();
     let mut w = [[(0u32, 0.0); 2]; 2];
     for d in 0..2 {
@@ -384,7 +492,9 @@ pub fn volumetric_operators(
                 out[0] = ((s.floor() as usize).min(nc - 1), 1.0);
                 n = 1;
             }
-            Basis::Gimp => {
+            // B-splines: the cells the particle domain overlaps, as GIMP (the domain is the
+            // particle's share of the material in either case).
+            Basis::Gimp | Basis::BSpline2 | Basis::BSpline3 => {
                 let (a, b) = (x[d] - lp[d], x[d] + lp[d]);
                 let first = ((a - o) / h).floor().max(0.0) as usize;
                 let last = (((b - o) / h).floor().max(0.0) as usize).min(nc - 1);
@@ -457,6 +567,126 @@ mod tests {
     use super::*;
 
     #[test]
+    fn uniform_bsplines_are_partitions_of_unity_with_their_moments_and_derivatives() {
+        // Σ_i N(s − i) = 1, Σ_i i N(s − i) = s and Σ_i i² N(s − i) = s² + (p + 1)/12 for the centred
+        // B-spline of degree p; dN/dξ against central differences; C¹ at the knots.
+        for degree in [2usize, 3] {
+            for k in 0..=40 {
+                let s = 3.0 + k as f64 / 40.0;
+                let (mut m0, mut m1, mut m2, mut d0) = (0.0, 0.0, 0.0, 0.0);
+                for i in 0..8 {
+                    let (w, g) = uniform_bspline(degree, s - i as f64);
+                    m0 += w;
+                    m1 += i as f64 * w;
+                    m2 += (i * i) as f64 * w;
+                    d0 += g;
+                    let e = 1e-6;
+                    let fd = (uniform_bspline(degree, s - i as f64 + e).0
+                        - uniform_bspline(degree, s - i as f64 - e).0)
+                        / (2.0 * e);
+                    // Central differences across a knot see the jump of the second derivative: O(e).
+                    assert!((fd - g).abs() < 1e-5, "degree {degree} s {s} node {i}: {g} vs {fd}");
+                }
+                assert!((m0 - 1.0).abs() < 1e-14 && d0.abs() < 1e-14, "degree {degree}: {m0} {d0}");
+                assert!((m1 - s).abs() < 1e-13, "degree {degree}: first moment {m1} at {s}");
+                let c = (degree as f64 + 1.0) / 12.0;
+                assert!((m2 - s * s - c).abs() < 1e-12, "degree {degree}: second moment {m2} at {s}");
+            }
+            // C¹: the derivative is continuous at the knots (half-integers for p = 2, integers for 3).
+            let knots: &[f64] = if degree == 2 { &[0.5, 1.5] } else { &[1.0, 2.0] };
+            for &kn in knots {
+                let (l, r) = (uniform_bspline(degree, kn - 1e-12), uniform_bspline(degree, kn + 1e-12));
+                assert!((l.0 - r.0).abs() < 1e-10 && (l.1 - r.1).abs() < 1e-10, "degree {degree} knot {kn}");
+            }
+        }
+    }
+
+    #[test]
+    fn edge_modified_bsplines_keep_unity_and_linear_fields_up_to_the_edge() {
+        // On grid lines of 1, 2, 3 and 7 cells, at points across the whole line (edges included):
+        // Σ N = 1, Σ dN = 0, Σ x_i N_i = x, Σ x_i dN_i = 1, N ≥ 0, dN against central differences,
+        // N₀ = 1 on the edge, and the quadratic basis equal to the linear hat on the edge's half cell.
+        let h = 0.4;
+        for degree in [2usize, 3] {
+            for n in [1usize, 2, 3, 7] {
+                for k in 0..=(40 * n) {
+                    let s = k as f64 / 40.0;
+                    let (w, len) = bspline_1d(degree, s, n, h);
+                    assert!((2..=4).contains(&len));
+                    let sum: f64 = w[..len].iter().map(|o| o.1).sum();
+                    let dsum: f64 = w[..len].iter().map(|o| o.2).sum();
+                    let x1: f64 = w[..len].iter().map(|o| o.0 as f64 * h * o.1).sum();
+                    let dx1: f64 = w[..len].iter().map(|o| o.0 as f64 * h * o.2).sum();
+                    assert!((sum - 1.0).abs() < 1e-14, "p {degree} n {n} s {s}: Σ N = {sum}");
+                    assert!(dsum.abs() < 1e-13, "p {degree} n {n} s {s}: Σ dN = {dsum}");
+                    assert!((x1 - s * h).abs() < 1e-14, "p {degree} n {n} s {s}: Σ x N = {x1}");
+                    assert!((dx1 - 1.0).abs() < 1e-13, "p {degree} n {n} s {s}: Σ x dN = {dx1}");
+                    for &(i, wi, gi) in &w[..len] {
+                        assert!(wi >= -1e-15 && (i as usize) <= n, "p {degree} n {n} s {s}: N_{i} = {wi}");
+                        if (s > 1e-3 && s < n as f64 - 1e-3) && (s * 2.0).fract().abs() > 1e-3 {
+                            let e = 1e-7;
+                            let at = |t: f64| {
+                                let (v, l) = bspline_1d(degree, t, n, h);
+                                v[..l].iter().find(|o| o.0 == i).map_or(0.0, |o| o.1)
+                            };
+                            let fd = (at(s + e) - at(s - e)) / (2.0 * e * h);
+                            assert!((fd - gi).abs() < 1e-6, "p {degree} n {n} s {s} node {i}: {gi} vs {fd}");
+                        }
+                    }
+                    if degree == 2 && (s <= 0.5 || n == 1) {
+                        let n0 = w[..len].iter().find(|o| o.0 == 0).unwrap().1;
+                        assert!((n0 - (1.0 - s).max(0.0)).abs() < 1e-14, "p 2 n {n} s {s}: N₀ = {n0}");
+                    }
+                }
+                for (s, node) in [(0.0, 0u32), (n as f64, n as u32)] {
+                    let (w, len) = bspline_1d(degree, s, n, h);
+                    for &(i, wi, _) in &w[..len] {
+                        let want = if i == node { 1.0 } else { 0.0 };
+                        assert!((wi - want).abs() < 1e-15, "p {degree} n {n}: N_{i}({s}) = {wi}");
+                    }
+                }
+            }
+        }
+        // Far from the edges the functions are the uniform ones.
+        let (w, len) = bspline_1d(3, 3.3, 7, h);
+        assert_eq!(len, 4);
+        for &(i, wi, _) in &w[..len] {
+            assert!((wi - uniform_bspline(3, 3.3 - i as f64).0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn bspline_stencils_reproduce_linear_fields_in_two_dimensions() {
+        let g = Grid { origin: [-1.0, 0.5], h: [0.25, 0.2], cells: [8, 5] };
+        for basis in [Basis::BSpline2, Basis::BSpline3] {
+            for x in [[-1.0, 0.5], [-0.93, 0.61], [0.0, 1.5], [0.99, 1.45], [1.0, 1.3]] {
+                let st = stencil(basis, &g, x, [0.05, 0.05]);
+                let (mut sum, mut lin, mut grad) = (0.0, [0.0; 2], [[0.0; 2]; 2]);
+                for ((i, j), w, dw) in st.iter() {
+                    let xi = [g.origin[0] + i as f64 * g.h[0], g.origin[1] + j as f64 * g.h[1]];
+                    sum += w;
+                    for a in 0..2 {
+                        lin[a] += w * xi[a];
+                        for b in 0..2 {
+                            grad[a][b] += xi[a] * dw[b];
+                        }
+                    }
+                }
+                assert!((sum - 1.0).abs() < 1e-14, "{basis:?} at {x:?}");
+                assert!((lin[0] - x[0]).abs() < 1e-14 && (lin[1] - x[1]).abs() < 1e-14, "{basis:?} at {x:?}");
+                for a in 0..2 {
+                    for b in 0..2 {
+                        let want = if a == b { 1.0 } else { 0.0 };
+                        assert!((grad[a][b] - want).abs() < 1e-13, "{basis:?} at {x:?}: {grad:?}");
+                    }
+                }
+            }
+            // Outside the grid (beyond round-off) there is no stencil.
+            assert_eq!(stencil(basis, &g, [-1.001, 0.6], [0.05, 0.05]).len, 0);
+        }
+    }
+
+    #[test]
     fn the_right_stretch_ignores_rotation_and_squares_to_ftf() {
         let (c, sn) = (0.6f64.cos(), 0.6f64.sin());
         let stretch = [[1.3, 0.2], [0.2, 0.7]];
@@ -511,12 +741,13 @@ mod tests {
         let top = g.extent_max()[1];
         // A face on the grid's edge loads the edge nodes, also a hair beyond it.
         for y in [top, top * (1.0 + 1e-15)] {
-            let w = face_weights(&g, [1.1, y]);
+            let w = face_weights(Basis::Gimp, &g, [1.1, y]);
             let edge: f64 = w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum();
             assert!((edge - 1.0).abs() < 1e-12, "y = {y:e}: {edge}");
         }
         // Crossing the grid line y = 0.75 changes no weight by more than the motion.
-        let (a, b) = (face_weights(&g, [1.1, 0.75 - 1e-9]), face_weights(&g, [1.1, 0.75 + 1e-9]));
+        let (a, b) =
+            (face_weights(Basis::Gimp, &g, [1.1, 0.75 - 1e-9]), face_weights(Basis::Gimp, &g, [1.1, 0.75 + 1e-9]));
         for j in 2..=4u32 {
             let on = |w: &Stencil| -> f64 { w.iter().filter(|((_, jj), _, _)| *jj == j).map(|(_, s, _)| s).sum() };
             assert!((on(&a) - on(&b)).abs() < 1e-7, "row {j}: {} vs {}", on(&a), on(&b));
@@ -531,7 +762,10 @@ mod tests {
         let g = grid();
         for (x, lp) in [([1.2, 0.74], [0.1, 0.05]), ([1.2, 0.78], [0.2, 0.03]), ([1.2, 0.9], [0.2, 0.1])] {
             let st = stencil(Basis::Gimp, &g, x, lp);
-            let (top, bottom) = (face_weights(&g, [x[0], x[1] + lp[1]]), face_weights(&g, [x[0], x[1] - lp[1]]));
+            let (top, bottom) = (
+                face_weights(Basis::Gimp, &g, [x[0], x[1] + lp[1]]),
+                face_weights(Basis::Gimp, &g, [x[0], x[1] - lp[1]]),
+            );
             let v = 4.0 * lp[0] * lp[1];
             for (node, _, dw) in st.iter() {
                 let at = |w: &Stencil| w.iter().filter(|(n, _, _)| *n == node).map(|(_, s, _)| s).sum::<f64>();
