@@ -26,6 +26,8 @@ pub struct StageAnalysis {
     pub layout: Layout,
     /// Time treatment.
     pub integration: Integration,
+    /// The largest stable step of an explicit stage, C h_min / c_p [s] (`None` otherwise).
+    pub dt_limit: Option<f64>,
 }
 
 impl StageAnalysis {
@@ -37,10 +39,12 @@ impl StageAnalysis {
             AnalysisType::Dynamic => StageAnalysis {
                 layout: if two_phase { Layout::UPU } else { Layout::U },
                 integration: stage.time_integration.as_ref().unwrap_or(&case.time_integration).integration(),
+                dt_limit: None,
             },
             AnalysisType::QuasiStatic => StageAnalysis {
                 layout: Layout::UP,
                 integration: Integration::QuasiStatic { theta: stage.theta.unwrap_or(DEFAULT_THETA) },
+                dt_limit: None,
             },
             AnalysisType::Static => StageAnalysis {
                 layout: match (two_phase, stage.drainage) {
@@ -48,7 +52,16 @@ impl StageAnalysis {
                     _ => Layout::U,
                 },
                 integration: Integration::Static,
+                dt_limit: None,
             },
+            AnalysisType::DynamicExplicit => {
+                let e = stage.explicit.unwrap_or_default();
+                StageAnalysis {
+                    layout: Layout::U,
+                    integration: Integration::Explicit { flip: e.flip_blend, damping: e.local_damping },
+                    dt_limit: Some(e.cfl * wave_step(case)),
+                }
+            }
         }
     }
 
@@ -69,8 +82,30 @@ impl StageAnalysis {
             Integration::QuasiStatic { theta } => format!("quasi-static {unknowns} with Darcy flow, θ = {theta}"),
             Integration::Static if self.layout.p.is_some() => format!("static {unknowns}, undrained"),
             Integration::Static => format!("static {unknowns}"),
+            Integration::Explicit { flip, damping } => format!(
+                "explicit dynamic {unknowns} (update-stress-last, FLIP share {flip}, local damping {damping}, \
+                 Δt ≤ {:.3e} s)",
+                self.dt_limit.unwrap_or(f64::NAN)
+            ),
         }
     }
+}
+
+/// The time a P-wave takes to cross the smallest cell, h_min / max c_p, with c_p = sqrt(E_c/ρ) of
+/// each material at rest (E_c its constrained modulus, ρ its mixture density): the CFL limit of an
+/// explicit step (the explicit stage takes C times it) [s].
+pub fn wave_step(case: &Case) -> f64 {
+    let h = case.cell_size();
+    let c = case
+        .materials
+        .iter()
+        .map(|m| {
+            let model = crate::model::material::soil_model(&m.model);
+            let rho = (1.0 - m.porosity) * m.solid_density + m.porosity * m.water_density;
+            (model.elastic().constrained_modulus() / rho).sqrt()
+        })
+        .fold(0.0, f64::max);
+    h[0].min(h[1]) / c
 }
 
 /// θ of a quasi-static stage that does not give one: backward Euler, which does not oscillate

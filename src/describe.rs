@@ -176,14 +176,17 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     for st in &case.stages {
         let a = model.active(st);
+        let analysis = crate::analysis::StageAnalysis::of(case, st);
+        // An explicit stage's step is its stable step where that is the smaller.
+        let dt = analysis.dt_limit.map_or(st.dt(), |l| l.min(st.dt()));
         let _ = writeln!(
             s,
-            "stage `{}` ({}): {} s in steps of {} s ({} steps); loads [{}]; boundaries [{}]",
+            "stage `{}` ({}): {} s in steps of {:.4e} s ({} steps); loads [{}]; boundaries [{}]",
             st.name,
-            crate::analysis::StageAnalysis::of(case, st).describe(),
+            analysis.describe(),
             st.duration,
-            st.dt(),
-            (st.duration / st.dt()).ceil() as usize,
+            dt,
+            (st.duration / dt).ceil() as usize,
             a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
             a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
         );

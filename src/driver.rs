@@ -256,6 +256,8 @@ struct Simulation<'a> {
     step: usize,
     summary: &'a mut Summary,
     options_checked: bool,
+    /// When the running summary.json was last rewritten.
+    summary_written: Instant,
     last_newton: (usize, usize),
     /// The last converged solve's field residual norms, its fields' scales at the step's start
     /// and its linear solves' worst field residuals, until the step is accepted.
@@ -481,6 +483,7 @@ impl<'a> Simulation<'a> {
             step: 0,
             summary,
             options_checked: false,
+            summary_written: Instant::now(),
             last_newton: (0, 0),
             last_field_residuals: Default::default(),
             history: (columns, Vec::new()),
@@ -524,7 +527,7 @@ impl<'a> Simulation<'a> {
     fn run_stage(&mut self, stage: &Stage) -> Result<(), RunError> {
         let active = self.model.active(stage);
         let analysis = self.begin_stage(stage)?;
-        let mut control = StepControl::new(stage, self.stage_end(stage));
+        let mut control = StepControl::new(stage, self.stage_end(stage), analysis.dt_limit);
         let stage_index = self.case.stages.iter().position(|s| std::ptr::eq(s, stage)).unwrap_or(0);
         if let Some((_, dt, successes)) = self.resume.take() {
             control.dt = dt;
@@ -536,7 +539,7 @@ impl<'a> Simulation<'a> {
             analysis.describe(),
             self.t,
             control.t_end,
-            stage.dt()
+            control.dt
         ));
         while !control.finished(self.t) {
             let events = self.check.as_ref().map(|c| c.event_times()).unwrap_or_default();
@@ -552,9 +555,10 @@ impl<'a> Simulation<'a> {
                         let block = self.system.owned_node_block();
                         c.observe_nodes(&block, &self.model, self.coll).map_err(RunError::Failed)?;
                     }
+                    let before = forces.at_start.then(|| self.stress_integral(&forces));
                     let updated = self.update_particles(&active, dt)?;
                     if updated.is_ok() {
-                        self.record_equilibrium(&forces)?;
+                        self.record_equilibrium(&forces, before)?;
                         self.record_field_residuals(&forces.field_scales);
                     }
                     updated
@@ -847,17 +851,9 @@ impl<'a> Simulation<'a> {
         Ok(())
     }
 
-    /// The equilibrium identity of the converged step ([`StepForces`]): the volume integral of the
-    /// total Cauchy stress over the updated material points, ∫σ dV = Σ_p (σ' − p m) V_p, against the
-    /// first moment of the external forces, the reactions and the inertia forces about the same
-    /// point, Σ_i x_i ⊗ (F_ext + R − F_inertia)_i on the nodes at t_{n+1}. The relative error (in the
-    /// Frobenius norm, against the largest of the moments) is kept for the history row and its
-    /// worst for summary.json, with the boundaries' reactions. In axial symmetry the moments are
-    /// taken about the axis (r = 0) and the hoop stress takes part: Σ r_i f_r,i = ∫(σ_rr + σ_θθ) dV
-    /// and Σ (y_i − y_o) f_r,i = ∫(σ_ry + (y − y_o) σ_θθ / r) dV (virtual displacements r e_r and
-    /// (y − y_o) e_r), exact for the planar weights without B̄ and up to the discretisation of
-    /// the hoop operator otherwise.
-    fn record_equilibrium(&mut self, forces: &StepForces) -> Result<(), RunError> {
+    /// This rank's share of ∫σ dV (total stress, current configuration; in axial symmetry with
+    /// the hoop stress's share about `forces.origin`), the left side of the equilibrium identity.
+    fn stress_integral(&self, forces: &StepForces) -> [f64; 4] {
         let ps = &self.model.particles;
         let axisymmetric = self.model.geometry.axisymmetric();
         let mut local = [0.0; 4];
@@ -874,7 +870,27 @@ impl<'a> Simulation<'a> {
                 local[2] += (ps.x[k][1] - forces.origin[1]) * (s[3] - p) * v / ps.x[k][0];
             }
         }
-        let lhs = self.coll.sum(&local).map_err(RunError::Failed)?;
+        local
+    }
+
+    /// The equilibrium identity of the converged step ([`StepForces`]): the volume integral of the
+    /// total Cauchy stress over the updated material points, ∫σ dV = Σ_p (σ' − p m) V_p, against the
+    /// first moment of the external forces, the reactions and the inertia forces about the same
+    /// point, Σ_i x_i ⊗ (F_ext + R − F_inertia)_i on the nodes at t_{n+1}. The relative error (in the
+    /// Frobenius norm, against the largest of the moments) is kept for the history row and its
+    /// worst for summary.json, with the boundaries' reactions. In axial symmetry the moments are
+    /// taken about the axis (r = 0) and the hoop stress takes part: Σ r_i f_r,i = ∫(σ_rr + σ_θθ) dV
+    /// and Σ (y_i − y_o) f_r,i = ∫(σ_ry + (y − y_o) σ_θθ / r) dV (virtual displacements r e_r and
+    /// (y − y_o) e_r), exact for the planar weights without B̄ and up to the discretisation of
+    /// the hoop operator otherwise. An explicit step's forces are those of its start
+    /// (`StepForces::at_start`): `before` is then ∫σ dV of the points before their update, and the
+    /// identity holds at t_n on x_n with the lumped inertia of the nodal update.
+    fn record_equilibrium(&mut self, forces: &StepForces, before: Option<[f64; 4]>) -> Result<(), RunError> {
+        let lhs = match before {
+            Some(l) => l,
+            None => self.stress_integral(forces),
+        };
+        let lhs = self.coll.sum(&lhs).map_err(RunError::Failed)?;
         if matches!(self.model.integration, Integration::Dynamic { .. }) {
             self.monitor.ledger.external += forces.work;
         }
@@ -1020,12 +1036,16 @@ impl<'a> Simulation<'a> {
     /// After a complete step: if any rank was sent SIGINT or SIGTERM (agreed across ranks), write
     /// the step's history row and fields and a checkpoint to restart from, and stop. Otherwise
     /// keep the running summary's counts up to date (rank 0 rewrites summary.json atomically
-    /// every history row).
+    /// at a history row, at most every [`SUMMARY_INTERVAL`]: an explicit stage takes tens of
+    /// thousands of steps, and each rewrite is synchronised to disk).
     fn stop_if_interrupted(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
         let local = self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst));
         if !self.coll.any(local).map_err(RunError::Failed)? {
-            if self.step.is_multiple_of(self.case.output.history_every) {
+            if self.step.is_multiple_of(self.case.output.history_every)
+                && self.summary_written.elapsed() >= SUMMARY_INTERVAL
+            {
                 self.out.write_summary(&*self.summary).map_err(RunError::Failed)?;
+                self.summary_written = Instant::now();
             }
             return Ok(());
         }
@@ -1178,6 +1198,9 @@ const GROW_AFTER: usize = 3;
 /// last of them easy, Δt may grow beyond the stage's `dt` up to its `dt_max`.
 const EASY_NEWTON: usize = 3;
 
+/// The shortest wall time between two rewrites of the running summary.json.
+const SUMMARY_INTERVAL: std::time::Duration = std::time::Duration::from_secs(1);
+
 #[derive(Debug, Clone)]
 struct StepControl {
     stage_dt: f64,
@@ -1193,11 +1216,14 @@ struct StepControl {
 }
 
 impl StepControl {
-    fn new(stage: &Stage, t_end: f64) -> StepControl {
+    /// The control of `stage` up to `t_end`, its steps at most `limit` (an explicit stage's
+    /// stable step) as well as its `dt`.
+    fn new(stage: &Stage, t_end: f64, limit: Option<f64>) -> StepControl {
+        let dt = limit.map_or(stage.dt(), |l| l.min(stage.dt()));
         StepControl {
-            stage_dt: stage.dt(),
-            dt_max: stage.dt_max.unwrap_or(stage.dt()),
-            dt: stage.dt(),
+            stage_dt: dt,
+            dt_max: if limit.is_some() { dt } else { stage.dt_max.unwrap_or(dt) },
+            dt,
             cuts: 0,
             successes: 0,
             max_cuts: stage.max_step_cuts,
@@ -1363,12 +1389,28 @@ mod tests {
             theta: None,
             drainage: None,
             dt_max: None,
+            explicit: None,
         }
     }
 
     #[test]
+    fn an_explicit_stage_keeps_its_stable_step() {
+        // The limit caps the stage's Δt, and easy steps do not grow past it.
+        let mut st = stage(0.3, 2);
+        st.dt_max = Some(1.0);
+        let mut c = StepControl::new(&st, 10.0, Some(0.01));
+        assert_eq!(c.next(0.0, &[]), 0.01);
+        for _ in 0..20 {
+            c.accepted(0);
+        }
+        assert_eq!(c.next(0.0, &[]), 0.01);
+        // A stage Δt below the limit is kept.
+        assert_eq!(StepControl::new(&stage(0.003, 2), 1.0, Some(0.01)).next(0.0, &[]), 0.003);
+    }
+
+    #[test]
     fn steps_land_on_events_and_on_the_stage_end() {
-        let c = StepControl::new(&stage(0.3, 2), 1.0);
+        let c = StepControl::new(&stage(0.3, 2), 1.0, None);
         assert_eq!(c.next(0.0, &[]), 0.3);
         assert!((c.next(0.0, &[0.1, 0.5]) - 0.1).abs() < 1e-15);
         // An event at the current time is not a target.
@@ -1381,7 +1423,7 @@ mod tests {
 
     #[test]
     fn failed_steps_are_cut_then_grow_back_and_the_cuts_are_limited() {
-        let mut c = StepControl::new(&stage(0.2, 2), 1.0);
+        let mut c = StepControl::new(&stage(0.2, 2), 1.0, None);
         assert!(c.rejected(0.2).is_ok());
         assert!((c.next(0.0, &[]) - 0.1).abs() < 1e-15);
         assert!(c.rejected(0.1).is_ok());
@@ -1406,7 +1448,7 @@ mod tests {
     fn easy_steps_grow_up_to_dt_max_and_hard_ones_do_not() {
         let mut st = stage(0.1, 2);
         st.dt_max = Some(0.4);
-        let mut c = StepControl::new(&st, 10.0);
+        let mut c = StepControl::new(&st, 10.0, None);
         for _ in 0..GROW_AFTER {
             c.accepted(EASY_NEWTON + 1);
         }

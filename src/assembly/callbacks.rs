@@ -614,6 +614,14 @@ impl<'a> Assembler<'a> {
         out
     }
 
+    /// An explicit step's residual at its start ([`Self::terms_at_start`] with the step's scheme,
+    /// which has no inertia): this rank's share of f_int(σ_n) on x_n minus the body force and the
+    /// loads `fext` (the step's, of t_{n+1}), per ghosted dof; −1 times the force that accelerates
+    /// the nodes ([002] Eq. 9).
+    pub(super) fn start_residual(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+        self.terms_at_start(&self.step.nm.expect("prepared"), body_acc_old, fext_old, false)
+    }
+
     /// −S Δp of the pressure projection in the continuity rows of `f`.
     fn add_projection(&self, xl: &[f64], f: &mut [f64]) {
         let Some(p) = self.step.layout.and_then(|l| l.p) else { return };

@@ -30,6 +30,7 @@ mod bench;
 mod callbacks;
 mod check;
 pub mod dofs;
+mod explicit;
 pub mod pattern;
 mod splits;
 pub mod stencils;
@@ -109,6 +110,13 @@ struct StepData {
     face_owner: Vec<usize>,
     /// The material stiffness of the Newton matrix (`stabilisation.stiffness`).
     stiffness: stiffness::MappedStiffness,
+    /// An explicit step: the residual at the step's start per ghosted dof (this rank's share of
+    /// f_int(σ_n) on x_n minus the body force and the loads of t_{n+1}; see [`explicit`]), empty
+    /// otherwise.
+    start_residual: Vec<f64>,
+    /// An explicit step: the lumped inertia m_i a_i of its nodal update per ghosted dof (summed
+    /// over ranks), for the equilibrium identity; empty otherwise.
+    explicit_inertia: Vec<f64>,
 }
 
 impl StepData {
@@ -226,6 +234,9 @@ pub struct StepForces {
     /// scaling): with the magnitudes at the step's start, the scale of the field's final
     /// residual (a step that starts at rest has no continuity terms before it moves).
     pub field_scales: Vec<f64>,
+    /// Whether the forces are those of the step's start (an explicit step: σ_n on x_n), so that
+    /// ∫σ dV must be taken before the particle update; otherwise at the converged state.
+    pub at_start: bool,
 }
 
 /// The PETSc log stages of a run (shown by `-log_view`).
@@ -540,6 +551,11 @@ impl GridSystem {
         self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
         self.step.stiffness =
             coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
+        if model.integration.is_explicit() {
+            // An explicit step solves nothing: no matrix.
+            self.step.pattern = old_pattern;
+            return Ok(());
+        }
         self.matrix_pattern(old_pattern, coll)
     }
 
@@ -733,6 +749,9 @@ impl GridSystem {
         } else if nm.history().is_some() {
             let body_acc_old = model.body_accelerations(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
+        } else if model.integration.is_explicit() {
+            let (body_acc, fext) = (self.step.body_acc.clone(), self.step.fext.clone());
+            self.step.start_residual = self.with_assembler(model, |asm| asm.start_residual(&body_acc, &fext));
         }
         self.step.fext_old = fext_old;
         self.step.force_scale = self.force_scale(model, coll)?;
@@ -1091,6 +1110,9 @@ impl GridSystem {
     /// in Δd, so the exact tangent needs one iteration from anywhere, and one solve with one of
     /// [001]'s mapped stiffnesses is then [001]'s K Δu = ΔF.
     pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
+        if model.integration.is_explicit() {
+            return self.explicit_update(model);
+        }
         let _stage = self.stages.solve.push()?;
         {
             let mut x = self.x.write()?;
@@ -1186,7 +1208,10 @@ impl GridSystem {
         let ng = self.ghost.len() * nd;
         let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         let (mut stiffness, mut internal) = (vec![0.0; ng], vec![0.0; ng]);
-        let xl = self.step.solution.clone();
+        // An explicit step's forces are those of its start (σ_n on x_n, [`explicit`]): its balance
+        // is taken there, against the stress before the particle update (`StepForces::at_start`).
+        let at_start = model.integration.is_explicit();
+        let xl = if at_start { vec![0.0; ng] } else { self.step.solution.clone() };
         self.with_assembler(model, |asm| {
             asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
             if diagnostics {
@@ -1205,6 +1230,10 @@ impl GridSystem {
         let mut fext_old = self.step.fext_old.clone();
         for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
             self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+        }
+        // An explicit step's inertia is its lumped nodal update's (already summed over ranks).
+        for (i, m) in inertia.iter_mut().zip(&self.step.explicit_inertia) {
+            *i += m;
         }
         let field_scales = self.field_norms(&magnitude, coll)?;
         let g = &model.grid;
@@ -1225,7 +1254,7 @@ impl GridSystem {
             let l = a as usize;
             let (i, j) = self.ghost.ij(l);
             let p = g.node_position(i, j);
-            let u = &self.step.solution[l * nd..l * nd + 2];
+            let u = &xl[l * nd..l * nd + 2];
             let xr = [p[0] + u[0] - origin[0], p[1] + u[1] - origin[1]];
             for &(c, dir) in &motion {
                 let q = l * nd + c;
@@ -1256,6 +1285,7 @@ impl GridSystem {
             reactions: (0..nb).map(|b| [s[17 + 2 * b], s[18 + 2 * b]]).collect(),
             work: s[16],
             field_scales,
+            at_start,
         })
     }
 

@@ -830,8 +830,9 @@ pub struct Stage {
     pub cut_factor: f64,
     /// What the stage solves: `dynamic` (the default: inertia, the u–p–U system in two-phase
     /// cases), `quasi_static` (two-phase only: no inertia, the u–p Biot system with Darcy's law,
-    /// θ-method in time) or `static` (no inertia and no flow: one-phase, or two-phase with
-    /// `drainage`).
+    /// θ-method in time), `static` (no inertia and no flow: one-phase, or two-phase with
+    /// `drainage`) or `dynamic_explicit` (one-phase: explicit MPM, update-stress-last, with the
+    /// stage's `explicit` settings; [002] §2.2).
     #[serde(default)]
     pub analysis: AnalysisType,
     /// θ of the quasi-static stage's Darcy flux, 1/2 ≤ θ ≤ 1 (default 1, backward Euler: no
@@ -851,6 +852,41 @@ pub struct Stage {
     /// `{ beta = 0.49, gamma = 0.9 }` with a Δt near the lowest period of the soil.
     #[serde(default)]
     pub time_integration: Option<TimeIntegration>,
+    /// The explicit integrator's settings of a `dynamic_explicit` stage (defaults if absent).
+    #[serde(default)]
+    pub explicit: Option<Explicit>,
+}
+
+/// Settings of the explicit integrator ([002] §2.2, §4; seeds-001-002.md Parts C1 and C5).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Explicit {
+    /// Courant number C: the step is at most C h_min / c_p, with c_p = sqrt(E_c/ρ) the largest
+    /// P-wave speed of the materials at rest ([002] uses 0.3 and 0.4) [-]. The stage's `dt` caps
+    /// it further. In (0, 1].
+    #[serde(default = "default_cfl")]
+    pub cfl: f64,
+    /// FLIP share η of the particle velocity update, v_p ← η FLIP + (1 − η) PIC ([002] Eq. 13;
+    /// 1 is pure FLIP, [002]'s default; Cook's membrane used 0.85) [-]. In [0, 1].
+    #[serde(default = "default_flip")]
+    pub flip_blend: f64,
+    /// Local damping α (Al-Kafaji 2013): each free nodal force component f is reduced by
+    /// α |f| sign(v) ([002] used 0.002 for the footing) [-]. In [0, 1).
+    #[serde(default)]
+    pub local_damping: f64,
+}
+
+impl Default for Explicit {
+    fn default() -> Self {
+        Explicit { cfl: default_cfl(), flip_blend: default_flip(), local_damping: 0.0 }
+    }
+}
+
+fn default_cfl() -> f64 {
+    0.5
+}
+fn default_flip() -> f64 {
+    1.0
 }
 
 impl Stage {
@@ -871,6 +907,8 @@ pub enum AnalysisType {
     QuasiStatic,
     /// No inertia, no flow.
     Static,
+    /// Explicit dynamics (one-phase; [002]).
+    DynamicExplicit,
 }
 
 /// The water in a static stage of a two-phase case.

@@ -173,7 +173,9 @@ pub fn validate(c: &Case) -> R {
                         pressure and flow terms are written on the configuration at the step's end)"
                 .into());
         }
-        if let Some(s) = c.stages.iter().find(|s| s.analysis == AnalysisType::Dynamic) {
+        if let Some(s) =
+            c.stages.iter().find(|s| matches!(s.analysis, AnalysisType::Dynamic | AnalysisType::DynamicExplicit))
+        {
             return Err(format!(
                 "key `analysis.kinematics`: `linear_increments` steps are static (stage `{}` is dynamic)",
                 s.name
@@ -599,6 +601,35 @@ pub fn validate(c: &Case) -> R {
             if !(0.5..=1.0).contains(&th) {
                 return Err(format!("key `{}`: θ = {th} must lie in [1/2, 1] (1: backward Euler)", key("theta")));
             }
+        }
+        if s.analysis == super::AnalysisType::DynamicExplicit {
+            if two_phase {
+                return Err(format!(
+                    "key `{}`: `dynamic_explicit` is one-phase for now (the two-phase explicit u–p–U is not built); \
+                     use `dynamic`",
+                    key("analysis")
+                ));
+            }
+            let e = s.explicit.unwrap_or_default();
+            if !(e.cfl > 0.0 && e.cfl <= 1.0) {
+                return Err(format!(
+                    "key `{}`: C = {} must lie in (0, 1] (the explicit step's stability limit is C = 1)",
+                    key("explicit.cfl"),
+                    e.cfl
+                ));
+            }
+            if !(0.0..=1.0).contains(&e.flip_blend) {
+                return Err(format!("key `{}`: η = {} must lie in [0, 1]", key("explicit.flip_blend"), e.flip_blend));
+            }
+            if !(0.0..1.0).contains(&e.local_damping) {
+                return Err(format!(
+                    "key `{}`: α = {} must lie in [0, 1)",
+                    key("explicit.local_damping"),
+                    e.local_damping
+                ));
+            }
+        } else if s.explicit.is_some() {
+            return Err(format!("key `{}`: only a dynamic_explicit stage takes `explicit`", key("explicit")));
         }
         if s.time_integration.is_some() && s.analysis != super::AnalysisType::Dynamic {
             return Err(format!("key `{}`: only a dynamic stage takes `time_integration`", key("time_integration")));

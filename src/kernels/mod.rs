@@ -227,6 +227,16 @@ pub enum Integration {
     },
     /// No inertia, no flow (drained with the pore pressure held, total stress, or undrained).
     Static,
+    /// Explicit dynamics, update-stress-last ([002] §2.2, Eqs. 7–17): the nodal velocities follow
+    /// from the lumped mass and the forces of the step's start (`assembly::explicit`); the
+    /// kernels see the step as a static one (no inertia terms: the step's out-of-balance force is
+    /// the inertia).
+    Explicit {
+        /// FLIP share η of the particle velocity update ([002] Eq. 13).
+        flip: f64,
+        /// Local damping α (Al-Kafaji 2013).
+        damping: f64,
+    },
 }
 
 impl Integration {
@@ -236,7 +246,12 @@ impl Integration {
     /// Newton: an elastic load step then converges in one iteration instead of two. The dynamic
     /// schemes start from Δd = 0, which is their own (Newmark) predictor of the motion.
     pub fn extrapolates(&self) -> bool {
-        !matches!(self, Integration::Dynamic { .. })
+        !matches!(self, Integration::Dynamic { .. } | Integration::Explicit { .. })
+    }
+
+    /// Whether the step is explicit (no equations are solved).
+    pub fn is_explicit(&self) -> bool {
+        matches!(self, Integration::Explicit { .. })
     }
 
     /// Newmark's method with β and γ.
@@ -280,6 +295,9 @@ pub struct Scheme {
     beta: f64,
     gamma: f64,
     dt: f64,
+    /// An explicit step: its "predictors" are the velocity and acceleration of the step's start
+    /// interpolated from the nodes (what the FLIP update needs); no term of the residual uses them.
+    explicit: bool,
 }
 
 impl Scheme {
@@ -302,6 +320,7 @@ impl Scheme {
             beta: 0.25,
             gamma: 0.5,
             dt,
+            explicit: integration.is_explicit(),
         };
         match *integration {
             Integration::Dynamic { beta, gamma, alpha_m, alpha_f } => {
@@ -320,7 +339,7 @@ impl Scheme {
                     s.flow_dt = dt;
                 }
             }
-            Integration::Static => {}
+            Integration::Static | Integration::Explicit { .. } => {}
         }
         s
     }
@@ -338,12 +357,16 @@ impl Scheme {
     /// The same scheme with the terms at t_{n+1} unweighted (w_m = w_f = 1): the balance at t_{n+1}
     /// for the equilibrium identity.
     pub fn unweighted(&self) -> Scheme {
-        Scheme { w_inertia: 1.0, w_force: 1.0, ..*self }
+        // An explicit step has no inertia terms (its inertia is the lumped nodal update's).
+        Scheme { w_inertia: if self.explicit { 0.0 } else { 1.0 }, w_force: 1.0, ..*self }
     }
 
     /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
     /// at Δd = 0); zero without inertia.
     pub fn predict(&self, v: [f64; 2], a: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+        if self.explicit {
+            return (a, v);
+        }
         if self.a0 == 0.0 {
             return ([0.0; 2], [0.0; 2]);
         }

@@ -1,0 +1,113 @@
+//! The explicit step ([002] §2.2, Eqs. 7–17; `../shared/seeds-001-002.md` Part C1):
+//! update-stress-last with symplectic Euler on the lumped mass, over the same stencils, dof map,
+//! loads and kernels as the implicit steps. It is the `solve` of a `dynamic_explicit` stage:
+//!
+//! 1. P2G (Eqs. 7–8): m_i = Σ_p S_ip m_p and m_i v_i^n = Σ_p S_ip m_p v_p^n over the points'
+//!    effective stencils (a barely filled node's share goes to the nodes its motion is extended
+//!    from, with the extension's coefficients, so that its motion is theirs as in the implicit
+//!    steps);
+//! 2. forces (Eq. 10): f_i = −r_i with r the residual at the step's start, f_int(σ_n) on x_n
+//!    minus the body force and the loads of t_n (prepared with the step, `start_residual`);
+//! 3. local damping (Al-Kafaji 2013): f_i ← f_i − α |f_i| sign(v_i^n) per component;
+//! 4. grid update (Eq. 9): v_i^{n+1} = v_i^n + Δt f_i/m_i at free dofs; a fixed dof moves by its
+//!    prescribed increment (zero, or a boundary's motion);
+//! 5. the step's nodal increments Δu_i = Δt v_i^{n+1}, from which the particle update (the same
+//!    as the implicit steps': position, F, volume, the objective stress update from ∇Δu; Eqs.
+//!    14–17) and the FLIP/PIC velocity update of `Model::update_particle` ([002] Eqs. 11–13)
+//!    follow.
+//!
+//! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
+
+use super::{Error, GridSystem, StepSolve};
+use crate::kernels::Integration;
+use crate::model::Model;
+
+impl GridSystem {
+    /// The explicit step's nodal update (see the module documentation); always "converged".
+    pub(super) fn explicit_update(&mut self, model: &Model) -> Result<StepSolve, Error> {
+        let t0 = std::time::Instant::now();
+        let Integration::Explicit { damping, .. } = model.integration else {
+            unreachable!("explicit_update is only called for explicit stages")
+        };
+        let nd = self.layout.nd;
+        let ng = self.ghost.len() * nd;
+        let (mass, momentum) = self.lumped_mass_and_momentum(model);
+        let (mut mass, mut momentum) = (mass, momentum);
+        let mut residual = self.step.start_residual.clone();
+        for v in [&mut mass, &mut momentum, &mut residual] {
+            self.sum_over_ranks(v)?;
+        }
+        let dt = self.step.dt;
+        let dofs = &self.step.dofs;
+        let mut solution = vec![0.0; ng];
+        let mut inertia = vec![0.0; ng];
+        for q in 0..ng {
+            if dofs.fixed[q] {
+                solution[q] = dofs.value[q];
+                continue;
+            }
+            if mass[q] <= 0.0 {
+                continue;
+            }
+            let v0 = momentum[q] / mass[q];
+            let mut f = -residual[q];
+            if damping > 0.0 && v0 != 0.0 {
+                f -= damping * f.abs() * v0.signum();
+            }
+            let v1 = v0 + dt * f / mass[q];
+            solution[q] = dt * v1;
+            inertia[q] = mass[q] * (v1 - v0) / dt;
+        }
+        self.step.solution = solution;
+        self.step.explicit_inertia = inertia;
+        let seconds = t0.elapsed().as_secs_f64();
+        Ok(StepSolve {
+            converged: true,
+            reason: "EXPLICIT".into(),
+            newton_iterations: 0,
+            linear_iterations: 0,
+            residual_history: Vec::new(),
+            domain_error: None,
+            nonfinite: None,
+            assembly_seconds: seconds,
+            solve_seconds: seconds,
+            field_residuals: Vec::new(),
+            field_scales: self.step.field_scales.clone(),
+            linear_field_residuals: Vec::new(),
+        })
+    }
+
+    /// This rank's lumped nodal mass and momentum of the solid per ghosted dof ([002] Eqs. 7–8),
+    /// with the shares of extended nodes given to their masters.
+    fn lumped_mass_and_momentum(&self, model: &Model) -> (Vec<f64>, Vec<f64>) {
+        let nd = self.layout.nd;
+        let ng = self.ghost.len() * nd;
+        let (mut mass, mut momentum) = (vec![0.0; ng], vec![0.0; ng]);
+        let (st, ps) = (&self.step.stencils, &model.particles);
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
+            let (eff, ext) = (st.effective(k), st.extensions(k));
+            for (slot, (&node, nb)) in nodes.iter().zip(basis).enumerate() {
+                let e = ext.iter().find(|e| e.slot as usize == slot);
+                for c in 0..2 {
+                    let share = nb.s * ps.mass[k];
+                    match e.filter(|e| e.mask & (1 << c) != 0) {
+                        Some(e) => {
+                            for &(m, coef) in &e.masters[..e.n as usize] {
+                                let q = eff[m as usize] as usize * nd + c;
+                                mass[q] += coef * share;
+                                momentum[q] += coef * share * ps.vel[k][c];
+                            }
+                        }
+                        None => {
+                            let q = node as usize * nd + c;
+                            mass[q] += share;
+                            momentum[q] += share * ps.vel[k][c];
+                        }
+                    }
+                }
+            }
+        }
+        (mass, momentum)
+    }
+}
