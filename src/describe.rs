@@ -52,6 +52,9 @@ pub fn describe(case: &Case, label: &str) -> String {
             SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
                 format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
             }
+            SoilModel::NeoHookean { young_modulus, poisson_ratio } => {
+                format!("neo-Hookean, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
+            }
             SoilModel::MohrCoulomb {
                 young_modulus,
                 poisson_ratio,

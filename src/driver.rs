@@ -657,7 +657,7 @@ impl<'a> Simulation<'a> {
         self.summary.snes_iterations += solve.newton_iterations;
         self.summary.ksp_iterations += solve.linear_iterations;
         self.last_newton = (solve.newton_iterations, solve.linear_iterations);
-        if !self.options_checked {
+        if !self.options_checked && solve.solver_used {
             self.options_checked = true;
             self.summary.solver = assembly::describe_solver(&mut self.system).unwrap_or_default();
             let iterative = assembly::is_iterative(&mut self.system).map_err(|e| RunError::Failed(e.to_string()))?;
@@ -950,6 +950,9 @@ impl<'a> Simulation<'a> {
     /// Results of the probes, metrics, results and tables of the check, and the figures.
     fn finish(mut self) -> Result<(), RunError> {
         let t0 = Instant::now();
+        if self.summary.solver.is_empty() && !self.options_checked {
+            self.summary.solver = "none (explicit steps only)".into();
+        }
         let warnings = self.monitor.finish(self.t);
         self.warn(warnings);
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;

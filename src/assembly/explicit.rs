@@ -74,6 +74,7 @@ impl GridSystem {
             field_residuals: Vec::new(),
             field_scales: self.step.field_scales.clone(),
             linear_field_residuals: Vec::new(),
+            solver_used: false,
         })
     }
 

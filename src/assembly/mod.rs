@@ -208,6 +208,8 @@ pub struct StepSolve {
     /// The largest relative residual of each field over the step's linear solves (see
     /// `petsc::fields::relative_field_residuals`; empty when not measured).
     pub linear_field_residuals: Vec<f64>,
+    /// Whether PETSc's solver ran (false for an explicit step).
+    pub solver_used: bool,
 }
 
 /// The forces of a converged step, summed over ranks, for the equilibrium identity and the
@@ -1168,6 +1170,7 @@ impl GridSystem {
             field_residuals,
             field_scales: self.step.field_scales.clone(),
             linear_field_residuals: out.linear_field_residuals,
+            solver_used: true,
         })
     }
 

@@ -287,6 +287,16 @@ pub enum SoilModel {
         #[serde(default)]
         softening_modulus: f64,
     },
+    /// Compressible neo-Hookean hyperelasticity ([002] §4.1, Cook's membrane;
+    /// `model::finite_strain::NeoHookean`): Kirchhoff stress τ = μ(b − 1) + λ ln J 1 of the
+    /// point's total deformation gradient, σ = τ/J. Only in `dynamic_explicit` stages (the
+    /// implicit stages need its consistent tangent, which is not built), without an initial stress.
+    NeoHookean {
+        /// Young's modulus E [Pa], in (0, 1e13].
+        young_modulus: f64,
+        /// Poisson's ratio ν [-].
+        poisson_ratio: f64,
+    },
 }
 
 /// A body filled with material points.

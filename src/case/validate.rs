@@ -136,6 +136,34 @@ fn bspline_options(c: &Case) -> R {
     Ok(())
 }
 
+/// Where a hyperelastic (neo-Hookean) material may be used: in explicit stages only (the implicit
+/// stages need its consistent tangent, not built), and without an initial stress (its stress is a
+/// function of the deformation alone).
+fn hyperelastic_materials(c: &Case) -> R {
+    for (i, m) in c.materials.iter().enumerate() {
+        if !matches!(m.model, SoilModel::NeoHookean { .. }) {
+            continue;
+        }
+        if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
+            return Err(format!(
+                "key `materials[{i}].model`: `neo_hookean` runs in dynamic_explicit stages only (its consistent \
+                 tangent for the implicit stages is not built), and stage `{}` is not one",
+                s.name
+            ));
+        }
+        if let Some(b) =
+            c.bodies.iter().find(|b| b.material == m.name && (b.initial_stress.is_some() || b.uniform_stress.is_some()))
+        {
+            return Err(format!(
+                "key `bodies.{}`: a neo_hookean body takes no initial stress (its stress is a function of its \
+                 deformation)",
+                b.name
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn axisymmetry(c: &Case, tol: f64) -> R {
     if c.analysis.geometry != crate::case::Geometry::Axisymmetric {
         return Ok(());
@@ -225,6 +253,7 @@ pub fn validate(c: &Case) -> R {
     if matches!(c.analysis.shape_functions, ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3) {
         bspline_options(c)?;
     }
+    hyperelastic_materials(c)?;
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         if two_phase {
             return Err("key `stabilisation.stress_recovery`: `cmpm` is for one_phase analyses ([001] is one-phase; \
@@ -783,9 +812,10 @@ pub fn validate(c: &Case) -> R {
                     return Err(format!("key `verification.body`: no body named `{body}`"));
                 };
                 let mat = &c.materials[c.material_index(&b.material).expect("validated")];
-                if !matches!(mat.model, SoilModel::LinearElastic { .. }) {
+                if !matches!(mat.model, SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. }) {
                     return Err(format!(
-                        "key `verification.body`: the patch reference needs a linear elastic body, and `{body}` is not"
+                        "key `verification.body`: the patch reference needs a linear elastic or neo-Hookean body, and \
+                         `{body}` is neither"
                     ));
                 }
                 match c.boundaries.iter().find(|x| &x.name == boundary) {
@@ -945,7 +975,8 @@ pub fn validate(c: &Case) -> R {
 pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
     let k = |f: &str| format!("{prefix}.{f}");
     match model {
-        SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
+        SoilModel::LinearElastic { young_modulus, poisson_ratio }
+        | SoilModel::NeoHookean { young_modulus, poisson_ratio } => {
             modulus(&k("young_modulus"), *young_modulus)?;
             in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
         }

@@ -138,6 +138,7 @@ mod tests {
             water_density: 1000.0,
             grad_p: [0.0; 2],
             stress,
+            def_grad: [[1.0, 0.0], [0.0, 1.0]],
             eps_pd: 0.0,
             p,
             body_acc: [0.0, -10.0],

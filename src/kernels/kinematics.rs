@@ -63,6 +63,11 @@ fn mul(a: &M2, b: &M2) -> M2 {
     c
 }
 
+/// The product a b of two in-plane matrices.
+pub fn product(a: &M2, b: &M2) -> M2 {
+    mul(a, b)
+}
+
 /// det(a) a⁻ᵀ v, the cofactor matrix of `a` times `v`: a gradient pushed forward by `a` up to the
 /// factor 1/det a (Nanson's normal, a material field's gradient on the new configuration).
 pub fn cofactor_mul(a: &M2, v: [f64; 2]) -> [f64; 2] {

@@ -188,6 +188,8 @@ pub struct ParticleInput {
     pub grad_p: [f64; 2],
     /// Effective stress at t_n [Pa].
     pub stress: [f64; 4],
+    /// Deformation gradient at t_n (in-plane; what a hyperelastic model's stress follows).
+    pub def_grad: [[f64; 2]; 2],
     /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
     pub eps_pd: f64,
     /// Pore pressure at t_n [Pa].
@@ -562,7 +564,10 @@ impl<'a> Point<'a> {
         let interp = interpolate(basis, states, &part.pred, layout);
         let kin = Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear);
         let rotated = kinematics::rotate(&part.stress, kin.theta);
-        let upd = model.update(&rotated, part.eps_pd, &kin.deps);
+        // A hyperelastic model takes the total deformation F_{n+1} = F̄ F_n; the others the
+        // objective increment.
+        let f_new = kinematics::product(&kin.f_bar(), &part.def_grad);
+        let upd = model.total(&f_new, part.eps_pd).unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
         let mut hoop = [(0.0, 0.0); MAX_NODES];
         for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {

@@ -151,6 +151,7 @@ fn part() -> ParticleInput {
         water_density: 1000.0,
         grad_p: [300.0, -9.0e3],
         stress: [-1.0e3, -2.0e3, 150.0, -1.2e3],
+        def_grad: [[1.02, 0.01], [-0.03, 0.97]],
         eps_pd: 0.0,
         p: 500.0,
         body_acc: [0.0, -9.81],

@@ -106,6 +106,10 @@ pub fn soil_model(m: &SoilModel) -> Constitutive {
                 },
             )
         }
+        SoilModel::NeoHookean { young_modulus, poisson_ratio } => Constitutive::NeoHookean(
+            LinearElastic::new(young_modulus, poisson_ratio),
+            crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio),
+        ),
         SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
             let el = LinearElastic::new(young_modulus, poisson_ratio);
             Constitutive::VonMises(

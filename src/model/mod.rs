@@ -402,6 +402,7 @@ impl Model {
             water_density: mat.water_density,
             grad_p: ps.grad_p[idx],
             stress: ps.stress[idx],
+            def_grad: ps.def_grad[idx],
             eps_pd: ps.eps_pd[idx],
             p: ps.p[idx],
             body_acc: body_acc[ps.body[idx] as usize],

@@ -80,7 +80,7 @@ impl BearingCheck {
         let mat = c.material(&soil.material).expect("validated");
         let cohesion = match &mat.model {
             SoilModel::MohrCoulomb { cohesion, .. } | SoilModel::VonMises { cohesion, .. } => *cohesion,
-            SoilModel::LinearElastic { .. } => {
+            SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } => {
                 return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil))
             }
         };

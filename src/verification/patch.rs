@@ -8,7 +8,8 @@
 //! * `stress_spread` = max_p ‖σ_p − σ̄‖ / ‖σ̄‖ (tensor norms; σ̄ the particles' mean stress);
 //! * `stress_rel_error` = ‖σ̄ − σ*‖ / ‖σ*‖ with σ* = R σ₀ Rᵀ + D ln V, F = exp(L s) = V R, s = ∫ f dt
 //!   (exact for a pure stretch, where the Hughes–Winget increments sum to ln V up to O(Δt²) per
-//!   step, and for a pure rotation, which it rotates exactly).
+//!   step, and for a pure rotation, which it rotates exactly); for a neo-Hookean body σ* is its
+//!   stress of F itself, exact to round-off.
 
 use super::{Check, Findings, Metric};
 use crate::case::{Case, SoilModel, Verification};
@@ -22,6 +23,8 @@ pub struct PatchCheck {
     body: u16,
     motion: Motion,
     elastic: LinearElastic,
+    /// A neo-Hookean body's model (its σ* is the model's stress of F).
+    hyperelastic: Option<crate::model::finite_strain::NeoHookean>,
     initial: [f64; 4],
     spread_tolerance: f64,
     tolerance: f64,
@@ -51,11 +54,15 @@ impl PatchCheck {
         let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
         let b = &c.bodies[bi];
         let mat = &c.materials[c.material_index(&b.material).expect("validated")];
-        let elastic = match mat.model {
+        let (elastic, hyperelastic) = match mat.model {
             SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-                LinearElastic::new(young_modulus, poisson_ratio)
+                (LinearElastic::new(young_modulus, poisson_ratio), None)
             }
-            _ => return Err(format!("body `{body}` is not linear elastic")),
+            SoilModel::NeoHookean { young_modulus, poisson_ratio } => (
+                LinearElastic::new(young_modulus, poisson_ratio),
+                Some(crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio)),
+            ),
+            _ => return Err(format!("body `{body}` is not elastic (linear or neo-Hookean)")),
         };
         let motion = model
             .boundaries
@@ -67,6 +74,7 @@ impl PatchCheck {
             body: bi as u16,
             motion,
             elastic,
+            hyperelastic,
             initial: b.uniform_stress.unwrap_or([0.0; 4]),
             spread_tolerance: *spread_tolerance,
             tolerance: *tolerance,
@@ -79,6 +87,9 @@ impl PatchCheck {
         let Some((l, _)) = &self.motion.gradient else { return self.initial };
         let s = self.motion.flow_parameter(t);
         let f = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
+        if let Some(h) = &self.hyperelastic {
+            return h.stress(f).unwrap_or([f64::NAN; 4]);
+        }
         // F Fᵀ = V², ln V from its eigen-decomposition; R = V⁻¹ F.
         let b = [
             [f[0][0] * f[0][0] + f[0][1] * f[0][1], f[0][0] * f[1][0] + f[0][1] * f[1][1]],
@@ -200,6 +211,7 @@ mod tests {
                 time_fn: TimeFn::Constant(1.0),
             },
             elastic: LinearElastic::new(1e6, 0.3),
+            hyperelastic: None,
             initial,
             spread_tolerance: 1e-9,
             tolerance: 1e-6,

@@ -147,6 +147,9 @@ pub enum Constitutive {
     MohrCoulomb(LinearElastic, MohrCoulomb),
     /// Von Mises.
     VonMises(LinearElastic, VonMises),
+    /// Compressible neo-Hookean hyperelasticity (its stress from the total deformation gradient,
+    /// [`Constitutive::total`]; the elasticity of the same moduli serves the estimates).
+    NeoHookean(LinearElastic, crate::model::finite_strain::NeoHookean),
 }
 
 impl Constitutive {
@@ -183,13 +186,35 @@ impl Constitutive {
             Constitutive::VonMises(el, vm) => {
                 isotropic_return(el, stress, eps_pd, deps, |l, e| vm.return_principal(l, e))
             }
+            // A hyperelastic model's stress comes from the total deformation (`total`); its
+            // increment here is the small-strain one of the same moduli, with their tangent (the
+            // element test and the kernels' tests use it; a case runs it in explicit stages only).
+            Constitutive::NeoHookean(el, _) => Constitutive::LinearElastic(*el).update(stress, eps_pd, deps),
         }
+    }
+
+    /// A hyperelastic model's stress for the point's total in-plane deformation gradient `f`
+    /// (F_zz = 1), with the small-strain elasticity of its moduli as the tangent (no consistent
+    /// tangent: explicit stages only); NaN if det F ≤ 0 (an inadmissible step). `None` for the
+    /// incremental models.
+    pub fn total(&self, f: &[[f64; 2]; 2], eps_pd: f64) -> Option<StressUpdate> {
+        let Constitutive::NeoHookean(el, nh) = self else { return None };
+        Some(StressUpdate {
+            stress: nh.stress(*f).unwrap_or([f64::NAN; 4]),
+            tangent: el.d,
+            trial_tangent: IDENTITY4,
+            eps_pd,
+            region: Region::Elastic,
+        })
     }
 
     /// Elastic part (for the reference solutions and time-step estimates).
     pub fn elastic(&self) -> &LinearElastic {
         match self {
-            Constitutive::LinearElastic(el) | Constitutive::MohrCoulomb(el, _) | Constitutive::VonMises(el, _) => el,
+            Constitutive::LinearElastic(el)
+            | Constitutive::MohrCoulomb(el, _)
+            | Constitutive::VonMises(el, _)
+            | Constitutive::NeoHookean(el, _) => el,
         }
     }
 
