@@ -114,9 +114,12 @@ struct StepData {
     /// f_int(σ_n) on x_n minus the body force and the loads of t_{n+1}; see [`explicit`]), empty
     /// otherwise.
     start_residual: Vec<f64>,
-    /// An explicit step: the lumped inertia m_i a_i of its nodal update per ghosted dof (summed
-    /// over ranks), for the equilibrium identity; empty otherwise.
+    /// An explicit step: the lumped inertia m_i a_i of its nodal update plus the local damping
+    /// force per ghosted dof (summed over ranks), for the equilibrium identity; empty otherwise.
     explicit_inertia: Vec<f64>,
+    /// The F̄ projection's scale c_p of each particle's step (`stabilisation.fbar`, explicit
+    /// steps; [`explicit`]), empty otherwise.
+    fbar_scale: Vec<f64>,
 }
 
 impl StepData {
@@ -1476,7 +1479,12 @@ impl GridSystem {
     pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
         let (nodes, basis) = self.step.stencils.get(k);
         let states = callbacks::node_states(&self.step, k, &self.step.solution);
-        let input = callbacks::particle_input(model, &self.step, k);
+        let mut input = callbacks::particle_input(model, &self.step, k);
+        // The F̄ projection's scale of an explicit step (only the particle update sees it: the
+        // step's forces are those of its start).
+        if let Some(&c) = self.step.fbar_scale.get(k) {
+            input.fbar = c;
+        }
         let mat = &model.materials[model.particles.material[k] as usize];
         let strain = self.step.stencils.strain_of(k);
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)

@@ -703,6 +703,13 @@ pub struct Stabilisation {
     /// by the share of the particle domain in each cell. Default: off.
     #[serde(default)]
     pub bbar: bool,
+    /// [002]'s F̄ by volume-averaged projection ([002] §3, Algorithm 1; `model::fbar`): each
+    /// point's step scales its in-plane deformation increment so that its volume ratio is the
+    /// volume-weighted average of the points sharing its nodes, which relieves volumetric locking
+    /// for any non-negative basis. In `dynamic_explicit` stages, plane strain, without B̄.
+    /// Default: off.
+    #[serde(default)]
+    pub fbar: bool,
     /// Pressure-projection stabilisation of the equal-order pressure (Bochev & Dohrmann 2006): the
     /// factor α of τ = α/G (G the skeleton's shear modulus) in the cell-wise penalty on the
     /// non-constant part of the pressure increment (see `kernels::pressure_projection`). Default:

@@ -254,6 +254,23 @@ pub fn validate(c: &Case) -> R {
         bspline_options(c)?;
     }
     hyperelastic_materials(c)?;
+    if c.stabilisation.fbar {
+        if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
+            return Err(format!(
+                "key `stabilisation.fbar`: the F̄ projection runs in dynamic_explicit stages only (the implicit \
+                 residual modification and its tangent are not built), and stage `{}` is not one",
+                s.name
+            ));
+        }
+        if c.stabilisation.bbar {
+            return Err("keys `stabilisation.fbar` and `stabilisation.bbar` exclude each other: both replace the \
+                        volumetric deformation"
+                .into());
+        }
+        if c.analysis.geometry == Geometry::Axisymmetric {
+            return Err("key `stabilisation.fbar`: plane strain only for now (axial symmetry scales three axes)".into());
+        }
+    }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         if two_phase {
             return Err("key `stabilisation.stress_recovery`: `cmpm` is for one_phase analyses ([001] is one-phase; \

@@ -145,6 +145,7 @@ mod tests {
             grad_n: [0.0; 2],
             pred: Default::default(),
             linear: false,
+            fbar: 1.0,
         }
     }
 

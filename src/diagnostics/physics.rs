@@ -57,7 +57,7 @@ pub fn warnings(case: &Case, model: &Model) -> Vec<Warning> {
         out.push(Warning { kind: kind.into(), message, time_s: None, value: None, threshold: None })
     };
     let h = model.grid.h[0].min(model.grid.h[1]);
-    if !model.bbar {
+    if !model.bbar && !model.fbar {
         for (i, m) in model.materials.iter().enumerate() {
             let nu = m.model.elastic().poisson;
             if nu >= LOCKING_NU {
@@ -65,7 +65,7 @@ pub fn warnings(case: &Case, model: &Model) -> Vec<Warning> {
                     &mut out,
                     "locking",
                     format!(
-                        "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true",
+                        "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ or F̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true (implicit stages) or stabilisation.fbar = true (explicit stages)",
                         m.name
                     ),
                 );

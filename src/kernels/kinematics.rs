@@ -179,6 +179,31 @@ impl Kinematics {
         }
     }
 
+    /// The kinematics with [002]'s F̄ (plane strain, without B̄): the strain increment's
+    /// volumetric part is the mid-step rate of ΔF̄ = c ΔF (F_v = c F, Eq. 27), its deviatoric part
+    /// and the rotation are ΔF's; only the stress sees F̄ ([002] L237): the volume ratio J_v and the
+    /// deformation gradient the point keeps stay ΔF's. c = 1 leaves the kinematics as they are.
+    pub fn with_volume_scale(self, c: f64) -> Kinematics {
+        if c == 1.0 || self.linear {
+            return self;
+        }
+        let fv = [[c * self.f[0][0], c * self.f[0][1]], [c * self.f[1][0], c * self.f[1][1]]];
+        let hv = [[fv[0][0] - 1.0, fv[0][1]], [fv[1][0], fv[1][1] - 1.0]];
+        let fvh_inv = inverse(&[[1.0 + 0.5 * hv[0][0], 0.5 * hv[0][1]], [0.5 * hv[1][0], 1.0 + 0.5 * hv[1][1]]]);
+        let lv = mul(&hv, &fvh_inv);
+        let (tr, trv) = (self.l[0][0] + self.l[1][1], lv[0][0] + lv[1][1]);
+        let vol = (trv - tr) / 3.0;
+        let l = &self.l;
+        Kinematics {
+            fv,
+            fv_inv: inverse(&fv),
+            fvh_inv,
+            lv,
+            deps: [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol],
+            ..self
+        }
+    }
+
     /// The kinematics of a step without motion.
     pub fn rest() -> Kinematics {
         Kinematics {

@@ -203,6 +203,9 @@ pub struct ParticleInput {
     /// A geometrically linear step (`analysis.kinematics = "linear_increments"`, [001] Eqs. 5, 7,
     /// 11): see [`kinematics`].
     pub linear: bool,
+    /// The F̄ projection's scale c of the step's in-plane deformation, ΔF̄ = c ΔF ([002] Eq. 27;
+    /// 1 without it): see [`kinematics::Kinematics::new`].
+    pub fbar: f64,
 }
 
 /// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
@@ -562,7 +565,8 @@ impl<'a> Point<'a> {
         layout: Layout,
     ) -> Point<'a> {
         let interp = interpolate(basis, states, &part.pred, layout);
-        let kin = Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear);
+        let kin =
+            Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear).with_volume_scale(part.fbar);
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         // A hyperelastic model takes the total deformation F_{n+1} = F̄ F_n; the others the
         // objective increment.

@@ -158,6 +158,7 @@ fn part() -> ParticleInput {
         grad_n: [0.7, -1.3],
         pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
         linear: false,
+        fbar: 1.0,
     }
 }
 

@@ -48,6 +48,8 @@ pub struct Model {
     pub integration: crate::kernels::Integration,
     /// B̄ for GIMP ([000] §3).
     pub bbar: bool,
+    /// [002]'s F̄ projection (explicit stages; `assembly::explicit`).
+    pub fbar: bool,
     /// MLSA patch recovery of the pore-pressure increments ([003] §3.3).
     pub patch_recovery: bool,
     /// How the particles' pressure follows a converged step (two-phase).
@@ -162,6 +164,7 @@ impl Model {
             g: case.analysis.g,
             integration: case.time_integration.integration(),
             bbar: case.stabilisation.bbar,
+            fbar: case.stabilisation.fbar,
             n_bodies: case.bodies.len(),
             pressure_projection: if case.analysis.formulation == Formulation::TwoPhase {
                 case.stabilisation.pressure_projection
@@ -409,6 +412,7 @@ impl Model {
             grad_n: [0.0; 2],
             pred: Default::default(),
             linear: self.linear_increments,
+            fbar: 1.0,
         }
     }
 
