@@ -100,9 +100,8 @@ pub fn wave_step(case: &Case) -> f64 {
         .materials
         .iter()
         .map(|m| {
-            let model = crate::model::material::soil_model(&m.model);
-            let rho = (1.0 - m.porosity) * m.solid_density + m.porosity * m.water_density;
-            (model.elastic().constrained_modulus() / rho).sqrt()
+            let mat = crate::model::material::Material::from_case(m, case.analysis.formulation);
+            (mat.model.elastic().constrained_modulus() / mat.mixture_density(m.porosity)).sqrt()
         })
         .fold(0.0, f64::max);
     h[0].min(h[1]) / c

@@ -615,11 +615,38 @@ impl<'a> Assembler<'a> {
     }
 
     /// An explicit step's residual at its start ([`Self::terms_at_start`] with the step's scheme,
-    /// which has no inertia): this rank's share of f_int(σ_n) on x_n minus the body force and the
-    /// loads `fext` (the step's, of t_{n+1}), per ghosted dof; −1 times the force that accelerates
-    /// the nodes ([002] Eq. 9).
-    pub(super) fn start_residual(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
-        self.terms_at_start(&self.step.nm.expect("prepared"), body_acc_old, fext_old, false)
+    /// which has no inertia): this rank's share of f_int(σ_n) on x_n minus the body force
+    /// `body_acc` and the loads `fext` (the step's, of t_{n+1}), per ghosted dof; −1 times the
+    /// force that accelerates the nodes ([002] Eq. 9).
+    pub(super) fn start_residual(&self, body_acc: &[[f64; 2]], fext: &[f64]) -> Vec<f64> {
+        self.terms_at_start(&self.step.nm.expect("prepared"), body_acc, fext, false)
+    }
+
+    /// An explicit step's lumped mass and momentum of the solid per ghosted dof, this rank's
+    /// points' shares S_ip m_p and S_ip m_p v_p ([002] Eqs. 7–8), given through the extensions of
+    /// barely filled nodes as the residual is.
+    pub(super) fn lumped_mass_and_momentum(&self) -> (Vec<f64>, Vec<f64>) {
+        let step = self.step;
+        let nd = step.dofs.nd;
+        let ng = step.dofs.fixed.len();
+        let (mut mass, mut momentum) = (vec![0.0; ng], vec![0.0; ng]);
+        let (ps, points) = (self.particles(), &self.model.particles);
+        let whole = ps.whole();
+        let (mut m, mut p) = ([0.0; MAX_LOCAL], [0.0; MAX_LOCAL]);
+        for k in 0..step.stencils.len() {
+            let (nodes, basis) = step.stencils.get(k);
+            let len = nodes.len() * nd;
+            for (n, b) in basis.iter().enumerate() {
+                for c in 0..nd {
+                    let motion = c < 2;
+                    m[n * nd + c] = if motion { b.s * points.mass[k] } else { 0.0 };
+                    p[n * nd + c] = if motion { m[n * nd + c] * points.vel[k][c] } else { 0.0 };
+                }
+            }
+            ps.scatter(k, &m[..len], &mut mass, whole);
+            ps.scatter(k, &p[..len], &mut momentum, whole);
+        }
+        (mass, momentum)
     }
 
     /// −S Δp of the pressure projection in the continuity rows of `f`.

@@ -7,7 +7,8 @@
 //!    from, with the extension's coefficients, so that its motion is theirs as in the implicit
 //!    steps);
 //! 2. forces (Eq. 10): f_i = −r_i with r the residual at the step's start, f_int(σ_n) on x_n
-//!    minus the body force and the loads of t_n (prepared with the step, `start_residual`);
+//!    minus the body force and the loads of the step (those of t_{n+1}; prepared with the step,
+//!    `start_residual`);
 //! 3. local damping (Al-Kafaji 2013): f_i ← f_i − α |f_i| sign(v_i^n) per component;
 //! 4. grid update (Eq. 9): v_i^{n+1} = v_i^n + Δt f_i/m_i at free dofs; a fixed dof moves by its
 //!    prescribed increment (zero, or a boundary's motion);
@@ -43,8 +44,7 @@ impl GridSystem {
         };
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
-        let (mass, momentum) = self.lumped_mass_and_momentum(model);
-        let (mut mass, mut momentum) = (mass, momentum);
+        let (mut mass, mut momentum) = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum());
         let mut residual = self.step.start_residual.clone();
         for v in [&mut mass, &mut momentum, &mut residual] {
             self.sum_over_ranks(v)?;
@@ -98,23 +98,19 @@ impl GridSystem {
         let (nd, nn) = (self.layout.nd, self.ghost.len());
         let (st, ps) = (&self.step.stencils, &model.particles);
         let count = st.len();
-        let mut shares = Vec::with_capacity(st.len());
-        let mut own = Vec::with_capacity(st.len());
-        for k in 0..st.len() {
+        // Per point: its shares of the nodes, J^n = det F and J^n ΔJ.
+        let (mut shares, mut jn, mut own) =
+            (Vec::with_capacity(count), Vec::with_capacity(count), Vec::with_capacity(count));
+        for k in 0..count {
             let (nodes, basis) = st.get(k);
             let states = callbacks::node_states(&self.step, k, &self.step.solution);
             let kin = Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false);
             let f = ps.def_grad[k];
-            own.push((f[0][0] * f[1][1] - f[0][1] * f[1][0]) * kin.j);
+            jn.push(f[0][0] * f[1][1] - f[0][1] * f[1][0]);
+            own.push(jn[k] * kin.j);
             shares.push(nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect::<Vec<_>>());
         }
         let (volume, weighted) = fbar::scatter(nn, (0..count).map(|k| (shares[k].as_slice(), ps.volume[k], own[k])));
-        let jn: Vec<f64> = (0..count)
-            .map(|k| {
-                let f = ps.def_grad[k];
-                f[0][0] * f[1][1] - f[0][1] * f[1][0]
-            })
-            .collect();
         let (_, weighted_n) = fbar::scatter(nn, (0..count).map(|k| (shares[k].as_slice(), ps.volume[k], jn[k])));
         // The nodal sums over ranks (the first component's slot of each node).
         let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd], vec![0.0; nn * nd]];
@@ -134,39 +130,5 @@ impl GridSystem {
                 fbar::scale(ratio * jn[k], own[k], 2)
             })
             .collect())
-    }
-
-    /// This rank's lumped nodal mass and momentum of the solid per ghosted dof ([002] Eqs. 7–8),
-    /// with the shares of extended nodes given to their masters.
-    fn lumped_mass_and_momentum(&self, model: &Model) -> (Vec<f64>, Vec<f64>) {
-        let nd = self.layout.nd;
-        let ng = self.ghost.len() * nd;
-        let (mut mass, mut momentum) = (vec![0.0; ng], vec![0.0; ng]);
-        let (st, ps) = (&self.step.stencils, &model.particles);
-        for k in 0..st.len() {
-            let (nodes, basis) = st.get(k);
-            let (eff, ext) = (st.effective(k), st.extensions(k));
-            for (slot, (&node, nb)) in nodes.iter().zip(basis).enumerate() {
-                let e = ext.iter().find(|e| e.slot as usize == slot);
-                for c in 0..2 {
-                    let share = nb.s * ps.mass[k];
-                    match e.filter(|e| e.mask & (1 << c) != 0) {
-                        Some(e) => {
-                            for &(m, coef) in &e.masters[..e.n as usize] {
-                                let q = eff[m as usize] as usize * nd + c;
-                                mass[q] += coef * share;
-                                momentum[q] += coef * share * ps.vel[k][c];
-                            }
-                        }
-                        None => {
-                            let q = node as usize * nd + c;
-                            mass[q] += share;
-                            momentum[q] += share * ps.vel[k][c];
-                        }
-                    }
-                }
-            }
-        }
-        (mass, momentum)
     }
 }

@@ -10,22 +10,10 @@
 //! stresses are isotropic functions of b = F Fᵀ (or b^e), so a rotation R of the deformation turns
 //! the stress into R σ Rᵀ.
 
+use super::soil::principal::Principal;
+
 /// An in-plane 2 × 2 matrix.
 pub type M2 = [[f64; 2]; 2];
-
-/// The symmetric in-plane eigen-decomposition of [a_xx, a_yy, a_xy]: eigenvalues (λ₁ ≥ λ₂) and the
-/// angle θ of the first eigenvector (cos θ, sin θ).
-fn eig_sym(a: [f64; 3]) -> ([f64; 2], f64) {
-    let m = 0.5 * (a[0] + a[1]);
-    let d = (0.25 * (a[0] - a[1]) * (a[0] - a[1]) + a[2] * a[2]).sqrt();
-    ([m + d, m - d], 0.5 * (2.0 * a[2]).atan2(a[0] - a[1]))
-}
-
-/// R diag(v₁, v₂) Rᵀ as [xx, yy, xy] for the frame at angle θ.
-fn compose(v: [f64; 2], theta: f64) -> [f64; 3] {
-    let (c, s) = (theta.cos(), theta.sin());
-    [v[0] * c * c + v[1] * s * s, v[0] * s * s + v[1] * c * c, (v[0] - v[1]) * c * s]
-}
 
 /// det of an in-plane matrix (the volume ratio in plane strain, F_zz = 1).
 pub fn det(f: M2) -> f64 {
@@ -152,12 +140,14 @@ impl HenckyJ2 {
         }
         let [bxx, byy, bxy, bzz] = state.be;
         let trial = push(df, [bxx, byy, bxy]);
-        let (lam, theta) = eig_sym(trial);
+        // b^e's principal values (A ≥ B in plane, Z) and frame.
+        let frame = Principal::of(&[trial[0], trial[1], trial[2], bzz]);
+        let lam = frame.values;
         if lam[1] <= 0.0 || bzz <= 0.0 {
             return None;
         }
         // Principal logarithmic elastic strains: the two in-plane ones and zz.
-        let eps = [0.5 * lam[0].ln(), 0.5 * lam[1].ln(), 0.5 * bzz.ln()];
+        let eps = [0.5 * lam[0].ln(), 0.5 * lam[1].ln(), 0.5 * lam[2].ln()];
         let tr = eps[0] + eps[1] + eps[2];
         let dev = [eps[0] - tr / 3.0, eps[1] - tr / 3.0, eps[2] - tr / 3.0];
         let mu2 = 2.0 * self.shear;
@@ -196,15 +186,9 @@ impl HenckyJ2 {
         }
         // The returned deviator is the trial one scaled (radial return); the volume is elastic.
         let e = [factor * dev[0] + tr / 3.0, factor * dev[1] + tr / 3.0, factor * dev[2] + tr / 3.0];
-        let tau = |k: usize| self.bulk * tr + factor * s_trial[k];
-        let t_in = compose([tau(0), tau(1)], theta);
-        let b_in = compose([(2.0 * e[0]).exp(), (2.0 * e[1]).exp()], theta);
-        let inv = 1.0 / j;
-        Some(HenckyUpdate {
-            stress: [t_in[0] * inv, t_in[1] * inv, t_in[2] * inv, tau(2) * inv],
-            state: PlasticState { be: [b_in[0], b_in[1], b_in[2], (2.0 * e[2]).exp()], eps: out_eps },
-            plastic,
-        })
+        let tau = frame.compose(&std::array::from_fn(|k| (self.bulk * tr + factor * s_trial[k]) / j));
+        let be = frame.compose(&std::array::from_fn(|k| (2.0 * e[k]).exp()));
+        Some(HenckyUpdate { stress: tau, state: PlasticState { be, eps: out_eps }, plastic })
     }
 }
 
