@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study gold bench bench-scaling bench-solvers maps lint clean
+.PHONY: setup build run test study study-cook gold bench bench-scaling bench-solvers maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -25,6 +25,10 @@ test: setup
 study: build
 	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1
 	python3 scripts/terzaghi_family.py
+
+# Cook's membrane alone ([002] §4.1, Part E item 13; about 3½ hours, COOK_H=1 for the 1 m grid only).
+study-cook: build
+	cargo test --release --locked --test studies cook_membrane_item_13 -- --ignored --nocapture
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
 gold: setup

@@ -197,10 +197,11 @@ pub fn describe(case: &Case, label: &str) -> String {
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
     let _ = writeln!(
         s,
-        "features: gravity {}; return mapping {}; B-bar {}; patch recovery {}; GIMP domains {}",
+        "features: gravity {}; return mapping {}; B-bar {}; F-bar {}; patch recovery {}; GIMP domains {}",
         if gravity { "on" } else { "off" },
-        if model.materials.iter().all(|m| m.model.is_linear()) { "never called (elastic)" } else { "on" },
+        if model.materials.iter().all(|m| m.model.is_elastic()) { "never called (elastic)" } else { "on" },
         if model.bbar { "on" } else { "off" },
+        if model.fbar { "on (explicit stages)" } else { "off" },
         match (model.patch_recovery, model.pressure_update) {
             (_, crate::case::PressureUpdate::ProjectedTotal) => "off (pressure from the projected total field)",
             (true, _) => "on",

@@ -968,8 +968,8 @@ impl<'a> Simulation<'a> {
             }
         }
         if let Some(c) = self.check.as_mut() {
-            self.summary.results.extend(c.results());
             let (metrics, tables) = c.finish(&self.model, self.coll).map_err(RunError::Failed)?;
+            self.summary.results.extend(c.results());
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
             for t in &tables {
                 self.out.write_table(&t.name, &t.header, &t.rows).map_err(RunError::Failed)?;

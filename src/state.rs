@@ -17,10 +17,10 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 5;
+pub const FORMAT_VERSION: u64 = 6;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
-pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
+pub const PARTICLE_FIELDS: [(&str, usize); 22] = [
     ("id", 1),
     ("body", 1),
     ("material", 1),
@@ -42,10 +42,11 @@ pub const PARTICLE_FIELDS: [(&str, usize); 21] = [
     ("p0", 1),
     ("eps_pd", 1),
     ("grad_p", 2),
+    ("jbar", 1),
 ];
 
 /// Values per particle record (the sum of [`PARTICLE_FIELDS`]' components).
-pub const RECORD: usize = 37;
+pub const RECORD: usize = 38;
 
 /// `summary.json`'s `restarted_from`: the checkpoint a run continued from.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -149,7 +150,7 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
 pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
     let mut r = [0.0; RECORD];
     let f = &ps.def_grad[k];
-    let parts: [&[f64]; 21] = [
+    let parts: [&[f64]; 22] = [
         &[ps.id[k] as f64],
         &[ps.body[k] as f64],
         &[ps.material[k] as f64],
@@ -171,6 +172,7 @@ pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
         &[ps.p0[k]],
         &[ps.eps_pd[k]],
         &ps.grad_p[k],
+        &[ps.jbar[k]],
     ];
     let mut i = 0;
     for p in parts {
@@ -201,6 +203,7 @@ fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
     ps.p0[k] = r[33];
     ps.eps_pd[k] = r[34];
     ps.grad_p[k] = two(35);
+    ps.jbar[k] = r[37];
 }
 
 /// The points of `records`, in their order (every array from its record).
@@ -335,6 +338,7 @@ mod tests {
         ps.p0[k] = next();
         ps.eps_pd[k] = next();
         ps.grad_p[k] = [next(), next()];
+        ps.jbar[k] = next();
         let mut records: Vec<[f64; RECORD]> = (0..ps.len()).rev().map(|k| pack(&ps, k)).collect();
         records.sort_by(|a, b| a[0].total_cmp(&b[0]));
         let flat: Vec<f64> = records.iter().flatten().copied().collect();

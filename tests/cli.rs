@@ -706,6 +706,16 @@ fn bad_values_across_the_case_are_named() {
             ("analysis.g=-1", "key `analysis.g`: must be a positive number"),
         ],
     );
+    // A clamp on a line the grid does not have (x = 0 with nodes at x = −4.5 + i) would hold nothing.
+    assert_sets_refused(
+        "cases/cook_membrane.toml",
+        &[
+            ("grid.origin=[-4.5,-4.5]", "key `boundaries[0].region`: holds no grid node"),
+            ("verification.tolerance=1.5", "key `verification.tolerance`: must be in (0, 1)"),
+            ("verification.fit_radius=0.5", "key `verification.fit_radius`: must be in [1, 10] cells"),
+            ("verification.body=nonesuch", "key `verification.body`: no body named `nonesuch`"),
+        ],
+    );
 }
 
 /// `porompm check` lists the physics warnings of a case (what would lock or oscillate), and a

@@ -205,6 +205,7 @@ macro_rules! gold_tests {
 
 gold_tests!(
     consolidation_layer,
+    cook_membrane,
     elastic_column,
     footing_ld,
     footing_near_slope,

@@ -37,6 +37,7 @@ pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernel
 
 /// The nodal states of particle `k`'s raw stencil from the ghosted increments `xl`, with the
 /// motion of extended nodes taken from their masters.
+#[inline]
 pub(super) fn node_states(step: &StepData, k: usize, xl: &[f64]) -> [NodeState; MAX_NODES] {
     let nm = step.nm.expect("prepared");
     let nd = step.dofs.nd;
@@ -612,14 +613,6 @@ impl<'a> Assembler<'a> {
             *v = if fixed { 0.0 } else { -*v };
         }
         out
-    }
-
-    /// An explicit step's residual at its start ([`Self::terms_at_start`] with the step's scheme,
-    /// which has no inertia): this rank's share of f_int(σ_n) on x_n minus the body force
-    /// `body_acc` and the loads `fext` (the step's, of t_{n+1}), per ghosted dof; −1 times the
-    /// force that accelerates the nodes ([002] Eq. 9).
-    pub(super) fn start_residual(&self, body_acc: &[[f64; 2]], fext: &[f64]) -> Vec<f64> {
-        self.terms_at_start(&self.step.nm.expect("prepared"), body_acc, fext, false)
     }
 
     /// An explicit step's lumped mass and momentum of the solid per ghosted dof, this rank's

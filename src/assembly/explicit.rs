@@ -7,8 +7,9 @@
 //!    from, with the extension's coefficients, so that its motion is theirs as in the implicit
 //!    steps);
 //! 2. forces (Eq. 10): f_i = −r_i with r the residual at the step's start, f_int(σ_n) on x_n
-//!    minus the body force and the loads of the step (those of t_{n+1}; prepared with the step,
-//!    `start_residual`);
+//!    minus the body force and the loads of the step (those of t_{n+1}); its terms are prepared
+//!    with the step (`StartTerms`, by the same pass as the implicit step's balance,
+//!    `Assembler::nodal_terms` at Δd = 0), and serve the step's equilibrium identity too;
 //! 3. local damping (Al-Kafaji 2013): f_i ← f_i − α |f_i| sign(v_i^n) per component;
 //! 4. grid update (Eq. 9): v_i^{n+1} = v_i^n + Δt f_i/m_i at free dofs; a fixed dof moves by its
 //!    prescribed increment (zero, or a boundary's motion);
@@ -16,17 +17,23 @@
 //!    as the implicit steps': position, F, volume, the objective stress update from ∇Δu; Eqs.
 //!    14–17) and the FLIP/PIC velocity update of `Model::update_particle` ([002] Eqs. 11–13)
 //!    follow;
-//! 6. with `stabilisation.fbar`, [002]'s projection between the two (Eqs. 19–21, 27): each
-//!    point's J_p^n = det F_p and ΔJ_p of the step; the nodal sums of V_p^n, V_p^n J_p^n and
-//!    V_p^n J_p^n ΔJ_p (`model::fbar::scatter`, summed over ranks); J̄_p^n = Π(J^n) and
-//!    J̄_p^{n+1} = Π(J^n ΔJ) gathered back with the step's weights, and the scale
-//!    c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/2} of the point's in-plane increment, which the kernels
-//!    apply to the stress's volumetric strain (`Kinematics::with_volume_scale`). Only the stress
-//!    sees F̄ ([002] L237): the volume stays det(F) V⁰ and the points keep F, so J̄^n is
-//!    projected again each step from J^n rather than carried (the same weights in both
-//!    projections: a uniform J^n gives J̄^n = J^n). Measured alternative, not kept: the volume
-//!    following J̄ as with B̄ (F̄ carried as the point's F) made the tapered plate 2.4 times too
-//!    soft at ν = 0.3.
+//! 6. with `stabilisation.fbar`, [002]'s projection between the two (Eqs. 18–21, 27): each
+//!    point's own volume ratio J_p^n ΔJ_p (J_p^n = det F_p, ΔJ_p of the step) is projected,
+//!    J̄_p^{n+1} = Π(J^n ΔJ)_p (the nodal sums of V_p^n and V_p^n J_p^n ΔJ_p, `model::fbar`,
+//!    summed over ranks, gathered back with the step's weights). A rate-form model's stress
+//!    update sees the increment scaled by c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/2}, J̄_p^n the point's
+//!    stored value (`Kinematics::with_volume_scale`, on the stress's volumetric strain only); a
+//!    hyperelastic one the total F̄ = s_p F_{n+1} with s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/2}
+//!    (`ParticleInput::fbar_total`). The point stores J̄_p^{n+1} (`Particles::jbar`), so that the
+//!    next step's start sees exactly the stress it was left with, and the rate form's volumetric
+//!    increments telescope to ln J̄. Only the stress sees F̄ ([002] L237): the volume stays
+//!    det(F) V⁰ and the points keep F. Two departures from [002] Algorithm 1, each measured:
+//!    (i) Algorithm 1 projects J̄^n ΔJ, not J^n ΔJ; repeated every step that smooths J̄ without
+//!    end (at rest J̄ ← Π(J̄)), and its pressure loses the volume changes it should resist: the
+//!    tapered plate at ν = 0.499 came out at 5.64e-4 against 3.10e-4 from finite elements, Cook's
+//!    membrane on 4 m cells at 0.485 m against 0.2765 m (this projection: 2.80e-4 and 0.261 m);
+//!    (ii) the volume following J̄ as with B̄ (F̄ carried as the point's F) made the tapered
+//!    plate 2.4 times too soft at ν = 0.3.
 //!
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
@@ -45,7 +52,8 @@ impl GridSystem {
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
         let (mut mass, mut momentum) = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum());
-        let mut residual = self.step.start_residual.clone();
+        let start = self.step.start_terms.as_ref().expect("an explicit step's start terms");
+        let mut residual: Vec<f64> = start.all.iter().zip(&self.step.fext).map(|(a, e)| a - e).collect();
         for v in [&mut mass, &mut momentum, &mut residual] {
             self.sum_over_ranks(v)?;
         }
@@ -93,28 +101,45 @@ impl GridSystem {
     }
 
     /// [002]'s projection for the step's nodal increments (see the module documentation): the
-    /// scale c_p of each particle's in-plane increment.
-    fn fbar_scales(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
+    /// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
+    /// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/2} of the in-plane increment (Eq. 27, J̄_p^n the point's
+    /// stored value) and s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/2} of the total deformation (Eq. 18).
+    fn fbar_scales(&mut self, model: &Model) -> Result<Vec<[f64; 3]>, Error> {
+        let (st, ps) = (&self.step.stencils, &model.particles);
+        // Per point: ΔJ.
+        let dj: Vec<f64> = (0..st.len())
+            .map(|k| {
+                let (nodes, _) = st.get(k);
+                let states = callbacks::node_states(&self.step, k, &self.step.solution);
+                Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false).j
+            })
+            .collect();
+        let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();
+        let projected = self.project_per_point(model, &own)?;
+        Ok((0..own.len())
+            .map(|k| {
+                let p = projected[k];
+                [fbar::scale(p, ps.jbar[k] * dj[k], 2), fbar::scale(p, own[k], 2), p]
+            })
+            .collect())
+    }
+
+    /// The volume-weighted projection Π(q) of a per-point quantity `q` (this rank's points) on the
+    /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
+    /// the ranks).
+    fn project_per_point(&mut self, model: &Model, q: &[f64]) -> Result<Vec<f64>, Error> {
         let (nd, nn) = (self.layout.nd, self.ghost.len());
         let (st, ps) = (&self.step.stencils, &model.particles);
-        let count = st.len();
-        // Per point: its shares of the nodes, J^n = det F and J^n ΔJ.
-        let (mut shares, mut jn, mut own) =
-            (Vec::with_capacity(count), Vec::with_capacity(count), Vec::with_capacity(count));
-        for k in 0..count {
-            let (nodes, basis) = st.get(k);
-            let states = callbacks::node_states(&self.step, k, &self.step.solution);
-            let kin = Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false);
-            let f = ps.def_grad[k];
-            jn.push(f[0][0] * f[1][1] - f[0][1] * f[1][0]);
-            own.push(jn[k] * kin.j);
-            shares.push(nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect::<Vec<_>>());
-        }
-        let (volume, weighted) = fbar::scatter(nn, (0..count).map(|k| (shares[k].as_slice(), ps.volume[k], own[k])));
-        let (_, weighted_n) = fbar::scatter(nn, (0..count).map(|k| (shares[k].as_slice(), ps.volume[k], jn[k])));
+        let shares: Vec<Vec<(usize, f64)>> = (0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect()
+            })
+            .collect();
+        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), ps.volume[k], q[k])));
         // The nodal sums over ranks (the first component's slot of each node).
-        let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd], vec![0.0; nn * nd]];
-        for (sum, local) in sums.iter_mut().zip([&volume, &weighted, &weighted_n]) {
+        let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
+        for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
             for (l, v) in local.iter().enumerate() {
                 sum[l * nd] = *v;
             }
@@ -122,13 +147,11 @@ impl GridSystem {
         }
         let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
         let weighted: Vec<f64> = (0..nn).map(|l| sums[1][l * nd]).collect();
-        let weighted_n: Vec<f64> = (0..nn).map(|l| sums[2][l * nd]).collect();
-        Ok((0..count)
-            .map(|k| {
-                let ratio =
-                    fbar::gather(&shares[k], &volume, &weighted) / fbar::gather(&shares[k], &volume, &weighted_n);
-                fbar::scale(ratio * jn[k], own[k], 2)
-            })
-            .collect())
+        Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
     }
+}
+
+/// det F of an in-plane deformation gradient.
+fn det(f: &[[f64; 2]; 2]) -> f64 {
+    f[0][0] * f[1][1] - f[0][1] * f[1][0]
 }

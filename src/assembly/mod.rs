@@ -110,16 +110,29 @@ struct StepData {
     face_owner: Vec<usize>,
     /// The material stiffness of the Newton matrix (`stabilisation.stiffness`).
     stiffness: stiffness::MappedStiffness,
-    /// An explicit step: the residual at the step's start per ghosted dof (this rank's share of
-    /// f_int(σ_n) on x_n minus the body force and the loads of t_{n+1}; see [`explicit`]), empty
-    /// otherwise.
-    start_residual: Vec<f64>,
+    /// An explicit step: the terms of its start (σ_n on x_n, the body force and the loads of
+    /// t_{n+1}; see [`explicit`]), this rank's shares per ghosted dof; `None` otherwise.
+    start_terms: Option<StartTerms>,
     /// An explicit step: the lumped inertia m_i a_i of its nodal update plus the local damping
     /// force per ghosted dof (summed over ranks), for the equilibrium identity; empty otherwise.
     explicit_inertia: Vec<f64>,
-    /// The F̄ projection's scale c_p of each particle's step (`stabilisation.fbar`, explicit
-    /// steps; [`explicit`]), empty otherwise.
-    fbar_scale: Vec<f64>,
+    /// The F̄ projection of each particle's step (`stabilisation.fbar`, explicit steps;
+    /// [`explicit`]): the scale c_p of its increment, the scale s_p of its total deformation and
+    /// its projected J̄_p^{n+1}; empty otherwise.
+    fbar_scale: Vec<[f64; 3]>,
+}
+
+/// The nodal terms of an explicit step's start, this rank's shares per ghosted dof (see
+/// `Assembler::nodal_terms` at Δd = 0): one pass over the points gives the force that accelerates
+/// the nodes and the step's equilibrium identity.
+#[derive(Debug, Default)]
+struct StartTerms {
+    /// The residual without the external loads: f_int(σ_n) minus the body force.
+    all: Vec<f64>,
+    /// `all` minus the internal forces: the body force's share.
+    inertia: Vec<f64>,
+    /// Σ of the absolute values of the points' blocks plus the absolute external loads.
+    magnitude: Vec<f64>,
 }
 
 impl StepData {
@@ -754,12 +767,24 @@ impl GridSystem {
         } else if nm.history().is_some() {
             let body_acc_old = model.body_accelerations(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
-        } else if model.integration.is_explicit() {
-            let (body_acc, fext) = (self.step.body_acc.clone(), self.step.fext.clone());
-            self.step.start_residual = self.with_assembler(model, |asm| asm.start_residual(&body_acc, &fext));
         }
         self.step.fext_old = fext_old;
-        self.step.force_scale = self.force_scale(model, coll)?;
+        self.step.force_scale = if model.integration.is_explicit() {
+            // An explicit step's forces are those of its start: one pass gives them and their
+            // magnitudes (the scale of each field's equation).
+            let ng = self.step.fext.len();
+            let mut terms = StartTerms { all: vec![0.0; ng], inertia: vec![0.0; ng], magnitude: vec![0.0; ng] };
+            let xl = vec![0.0; ng];
+            self.with_assembler(model, |asm| {
+                asm.nodal_terms(&xl, &mut terms.all, &mut terms.inertia, &mut terms.magnitude)
+            });
+            let mut mags = terms.magnitude.clone();
+            self.step.start_terms = Some(terms);
+            self.force_scale_of(&mut mags, coll)?
+        } else {
+            let mut mags = self.with_assembler(model, |asm| asm.force_magnitudes());
+            self.force_scale_of(&mut mags, coll)?
+        };
         Ok(())
     }
 
@@ -1218,8 +1243,13 @@ impl GridSystem {
         // is taken there, against the stress before the particle update (`StepForces::at_start`).
         let at_start = model.integration.is_explicit();
         let xl = if at_start { vec![0.0; ng] } else { self.step.solution.clone() };
+        if let Some(start) = self.step.start_terms.take() {
+            (all, inertia, magnitude) = (start.all, start.inertia, start.magnitude);
+        }
         self.with_assembler(model, |asm| {
-            asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
+            if !at_start {
+                asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
+            }
             if diagnostics {
                 asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
             }
@@ -1459,10 +1489,9 @@ impl GridSystem {
     }
 
     /// The norm over the free dofs of the prepared step's force magnitudes (collective).
-    fn force_scale(&mut self, model: &Model, coll: &Collective) -> Result<f64, String> {
-        let mut mags = self.with_assembler(model, |asm| asm.force_magnitudes());
-        self.sum_over_ranks(&mut mags).map_err(|e| e.to_string())?;
-        self.step.field_scales = self.field_norms(&mags, coll)?;
+    fn force_scale_of(&mut self, mags: &mut [f64], coll: &Collective) -> Result<f64, String> {
+        self.sum_over_ranks(mags).map_err(|e| e.to_string())?;
+        self.step.field_scales = self.field_norms(mags, coll)?;
         Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
     }
 
@@ -1482,14 +1511,16 @@ impl GridSystem {
         let mut input = callbacks::particle_input(model, &self.step, k);
         // The F̄ projection's scale of an explicit step (only the particle update sees it: the
         // step's forces are those of its start).
-        if let Some(&c) = self.step.fbar_scale.get(k) {
+        let fbar = self.step.fbar_scale.get(k).copied();
+        if let Some([c, s, _]) = fbar {
             input.fbar = c;
+            input.fbar_total = s;
         }
         let mat = &model.materials[model.particles.material[k] as usize];
         let strain = self.step.stencils.strain_of(k);
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
-        StepResult::of(&pt)
+        StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) }
     }
 }
 

@@ -1268,6 +1268,27 @@ pub enum Verification {
         #[serde(default)]
         snapshots: Vec<f64>,
     },
+    /// Cook's membrane of [002] §4.1 (`../shared/seeds-001-002.md` Parts D1 and E item 13): the
+    /// tapered plate clamped on its left edge and sheared on its right, brought to rest. The
+    /// vertical displacement of the tip (the upper-right corner), by a linear least-squares fit of
+    /// the points' displacements around it, against `reference`; the chequerboard index of the
+    /// mean stress over the body's points.
+    CookMembrane {
+        /// The membrane.
+        body: String,
+        /// The tip at t = 0 [m].
+        tip: [f64; 2],
+        /// The tip's vertical displacement at rest [m] (0.2765 for [002]'s membrane: plane-strain
+        /// finite elements, `scripts/cook_membrane_fe.py`).
+        reference: f64,
+        /// Largest accepted relative error of the tip's displacement (Part E item 13: 3 %).
+        #[serde(default = "default_cook_tol")]
+        tolerance: f64,
+        /// The radius around the tip within which the points' displacements are fitted, in cells
+        /// (default 2).
+        #[serde(default = "default_cook_radius")]
+        fit_radius: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1300,6 +1321,7 @@ impl Verification {
             Verification::StiffnessMap { .. } => "stiffness_map",
             Verification::VerticalCut { .. } => "vertical_cut",
             Verification::ShockWave { .. } => "shock_wave",
+            Verification::CookMembrane { .. } => "cook_membrane",
         }
     }
 }
@@ -1364,6 +1386,12 @@ fn default_bearing_tol() -> f64 {
 }
 fn default_column_tol() -> f64 {
     0.01
+}
+fn default_cook_tol() -> f64 {
+    0.03
+}
+fn default_cook_radius() -> f64 {
+    2.0
 }
 fn default_fast_tol() -> f64 {
     0.02

@@ -458,6 +458,18 @@ pub fn validate(c: &Case) -> R {
         if b.fix.is_empty() {
             return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
         }
+        if let Some(r) = &b.region {
+            // A region between grid lines fixes nothing: the body it was meant to hold would move
+            // freely (a clamp at x = 0 on a grid whose lines miss x = 0).
+            let nodes = |d: usize| (0..=c.grid.cells[d]).map(move |i| lo[d] + i as f64 * h[d]);
+            if !nodes(0).any(|x| nodes(1).any(|y| r.contains([x, y]))) {
+                return Err(format!(
+                    "key `boundaries[{i}].region`: holds no grid node (the grid lines lie at x = {} + i·{}, \
+                     y = {} + j·{} m); move the region onto them or change the grid",
+                    lo[0], h[0], lo[1], h[1]
+                ));
+            }
+        }
         if b.displacement.is_some() && b.velocity.is_some() {
             return Err(format!("key `boundaries[{i}]`: give `displacement` or `velocity`, not both"));
         }
@@ -794,6 +806,23 @@ pub fn validate(c: &Case) -> R {
                     return Err(format!(
                         "key `verification.body`: the vertical cut's checks need a von_mises body, and `{body}` is not"
                     ));
+                }
+                return Ok(());
+            }
+            Verification::CookMembrane { body, tip, reference, tolerance, fit_radius } => {
+                finite2("verification.tip", *tip)?;
+                positive("verification.reference", *reference)?;
+                if !(*tolerance > 0.0 && *tolerance < 1.0) {
+                    return Err(format!("key `verification.tolerance`: must be in (0, 1), got {tolerance}"));
+                }
+                if !(1.0..=10.0).contains(fit_radius) {
+                    return Err(format!("key `verification.fit_radius`: must be in [1, 10] cells, got {fit_radius}"));
+                }
+                if c.body(body).is_none() {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                }
+                if two_phase {
+                    return Err("key `verification`: Cook's membrane is for a one_phase analysis".into());
                 }
                 return Ok(());
             }

@@ -146,6 +146,7 @@ mod tests {
             pred: Default::default(),
             linear: false,
             fbar: 1.0,
+            fbar_total: 1.0,
         }
     }
 
@@ -162,6 +163,7 @@ mod tests {
             jacobian: 0.99,
             deps: [0.0, -0.01, 0.0, 0.0],
             grad_n: [0.0; 2],
+            jbar: None,
         };
         let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &step, 20.0, 1.98);
         let v = 1.99;
@@ -198,6 +200,7 @@ mod tests {
             jacobian: 1.0,
             deps: [0.0; 4],
             grad_n: [0.0; 2],
+            jbar: None,
         };
         assert!((darcy(2.0, 0.5, &step) - 4.0).abs() < 1e-12);
         assert!((kinetic(2.0, 1.0, [1.0, 1.0], [0.0, 2.0]) - 4.0).abs() < 1e-12);

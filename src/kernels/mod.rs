@@ -204,8 +204,13 @@ pub struct ParticleInput {
     /// 11): see [`kinematics`].
     pub linear: bool,
     /// The F̄ projection's scale c of the step's in-plane deformation, ΔF̄ = c ΔF ([002] Eq. 27;
-    /// 1 without it): see [`kinematics::Kinematics::new`].
+    /// 1 without it), which the rate-form stress updates see: see
+    /// [`kinematics::Kinematics::with_volume_scale`].
     pub fbar: f64,
+    /// The F̄ projection's scale of the point's total deformation, F̄ = s F with s = (J̄/J)^{1/2}
+    /// ([002] Eq. 18; 1 without it), which a hyperelastic model sees: at the step's start that
+    /// of the point's stored J̄ (its stress σ_n), at its end that of the projected J̄_{n+1}.
+    pub fbar_total: f64,
 }
 
 /// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
@@ -556,6 +561,7 @@ impl<'a> Point<'a> {
     /// increment the soil model sees, the rotation and the volume change; the forces keep the
     /// basis, f_i = B̄'_iᵀσ V. [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
     /// passes its patch functions; `strain = basis` is the usual point.
+    #[inline]
     pub fn with_recovery(
         basis: &'a [NodeBasis],
         strain: &'a [NodeBasis],
@@ -570,7 +576,7 @@ impl<'a> Point<'a> {
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         // A hyperelastic model takes the total deformation F_{n+1} = F̄ F_n; the others the
         // objective increment.
-        let f_new = kinematics::product(&kin.f_bar(), &part.def_grad);
+        let f_new = kinematics::product(&kin.f_bar(), &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model.total(&f_new, part.eps_pd).unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
         let mut hoop = [(0.0, 0.0); MAX_NODES];
@@ -606,6 +612,7 @@ impl<'a> Point<'a> {
 
     /// The point with its drained `faces` (at most [`MAX_FACES`]), their pressure increments
     /// interpolated from the same nodal `states`.
+    #[inline]
     pub fn with_faces(mut self, faces: &'a [DrainedFace], states: &[NodeState]) -> Point<'a> {
         let Some(p) = self.layout.p else { return self };
         let faces = &faces[..faces.len().min(MAX_FACES)];
@@ -714,6 +721,8 @@ pub struct StepResult {
     pub deps: [f64; 4],
     /// The porosity gradient ∇n at t_n the step used (two-phase u–p–U; zero otherwise).
     pub grad_n: [f64; 2],
+    /// [002]'s projected J̄ at t_{n+1} (`stabilisation.fbar`; `None`: the point keeps its J̄).
+    pub jbar: Option<f64>,
 }
 
 impl StepResult {
@@ -727,6 +736,7 @@ impl StepResult {
             jacobian: pt.kin.jv,
             deps: pt.kin.deps,
             grad_n: pt.part.grad_n,
+            jbar: None,
         }
     }
 }

@@ -159,6 +159,7 @@ fn part() -> ParticleInput {
         pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
         linear: false,
         fbar: 1.0,
+        fbar_total: 1.0,
     }
 }
 

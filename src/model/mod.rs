@@ -413,6 +413,12 @@ impl Model {
             pred: Default::default(),
             linear: self.linear_increments,
             fbar: 1.0,
+            fbar_total: if self.fbar {
+                let f = &ps.def_grad[idx];
+                fbar::scale(ps.jbar[idx], f[0][0] * f[1][1] - f[0][1] * f[1][0], 2)
+            } else {
+                1.0
+            },
         }
     }
 
@@ -525,6 +531,9 @@ impl Model {
         }
         ps.stress[k] = step.stress;
         ps.eps_pd[k] = step.eps_pd;
+        if let Some(jbar) = step.jbar {
+            ps.jbar[k] = jbar;
+        }
         ps.p[k] += dp;
         ps.volume[k] *= j;
         ps.porosity[k] = n_new;

@@ -54,6 +54,10 @@ pub struct Particles {
     /// Pore-pressure gradient [Pa/m] (two-phase), carried like p: it drives the Darcy flux of the
     /// u–p system from the start of a step.
     pub grad_p: Vec<[f64; 2]>,
+    /// [002]'s projected volume ratio J̄ = det F̄ (`stabilisation.fbar`, §3 Algorithm 1): the
+    /// stress sees F̄ = (J̄/J)^{1/2} F, while the volume and F follow the point's own motion; 1 at
+    /// t = 0 and without F̄ [-].
+    pub jbar: Vec<f64>,
 }
 
 impl Particles {
@@ -91,6 +95,7 @@ impl Particles {
         self.p0.push(0.0);
         self.eps_pd.push(0.0);
         self.grad_p.push([0.0; 2]);
+        self.jbar.push(1.0);
     }
 
     /// Fills the bodies of the case with `n × n` points per cell, keeping those whose cell
@@ -160,6 +165,7 @@ impl Particles {
                             ps.p.push(p);
                             ps.p0.push(p);
                             ps.eps_pd.push(0.0);
+                            ps.jbar.push(1.0);
                         }
                     }
                 }

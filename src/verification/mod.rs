@@ -23,6 +23,7 @@
 pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
+pub mod cook;
 pub mod figures;
 pub mod hollow_cylinder;
 pub mod lame;
@@ -141,6 +142,13 @@ pub(crate) fn elastic_body(c: &Case, body: &str) -> Result<(usize, f64, f64), St
     }
 }
 
+/// σ_m and q = √(3J₂) of a stress [xx, yy, xy, zz].
+pub(crate) fn invariants(s: &[f64; 4]) -> (f64, f64) {
+    let m = (s[0] + s[1] + s[3]) / 3.0;
+    let d = [s[0] - m, s[1] - m, s[3] - m];
+    (m, (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * s[2] * s[2])).sqrt())
+}
+
 /// The time function a load names (a constant 1 if none).
 pub(crate) fn load_time_fn(c: &Case, name: &Option<String>) -> crate::model::loads::TimeFn {
     name.as_ref()
@@ -215,6 +223,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::HollowCylinder { .. } => Box::new(hollow_cylinder::HollowCylinderCheck::new(c)?),
         Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
         Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
+        Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -955,6 +964,11 @@ pub fn describe(v: &case::Verification) -> String {
             } else {
                 ""
             }
+        ),
+        Verification::CookMembrane { tip, reference, .. } => format!(
+            "Cook's membrane ([002] §4.1): the tip ({}, {})'s vertical displacement at rest against {reference} m, \
+             the mean stress's chequerboard index",
+            tip[0], tip[1]
         ),
         Verification::StiffnessMap { center, radius, .. } => format!(
             "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",

@@ -16,7 +16,7 @@
 //! * the total variation Σ|Δσ_m| over the run of the mean stress at the points nearest `b` (in
 //!   the shear band) and `c` (in the sliding block), [001]'s p–q paths of Figs. 30–31 in one number.
 
-use super::{Check, Findings, Metric};
+use super::{invariants, Check, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::case::{Case, SoilModel, Verification};
 use crate::model::Model;
@@ -137,13 +137,6 @@ impl VerticalCutCheck {
         }
         ((sq / n).sqrt() / (sum / n), n)
     }
-}
-
-/// σ_m and q = √(3J₂) of a stress [xx, yy, xy, zz].
-fn invariants(s: &[f64; 4]) -> (f64, f64) {
-    let m = (s[0] + s[1] + s[3]) / 3.0;
-    let d = [s[0] - m, s[1] - m, s[3] - m];
-    (m, (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * s[2] * s[2])).sqrt())
 }
 
 impl Check for VerticalCutCheck {

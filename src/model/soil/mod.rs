@@ -222,6 +222,11 @@ impl Constitutive {
     pub fn is_linear(&self) -> bool {
         matches!(self, Constitutive::LinearElastic(_))
     }
+
+    /// Whether the model is elastic (linear or hyperelastic: no return mapping).
+    pub fn is_elastic(&self) -> bool {
+        matches!(self, Constitutive::LinearElastic(_) | Constitutive::NeoHookean(..))
+    }
 }
 
 /// Elastic trial, return of the principal values by `ret`, and the tangent through the principal

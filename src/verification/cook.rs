@@ -1,0 +1,260 @@
+//! Cook's membrane of [002] §4.1 (`../shared/seeds-001-002.md` Parts D1 and E item 13): a tapered
+//! plate clamped on its left edge and sheared on its right, run until it is at rest. What the run
+//! says about itself:
+//!
+//! * the vertical displacement of the tip (the upper-right corner), against the case's
+//!   `reference`. No material point sits on the corner (the nearest is a quarter cell inside it
+//!   with 2 × 2 points per cell), and the membrane turns there, so the tip's displacement is the
+//!   value at the corner of the linear least-squares fit u_y ≈ a + b (X − X_tip) + c (Y − Y_tip)
+//!   over the points of the body whose initial positions X lie within `fit_radius` cells of it
+//!   (the fit's normal equations are summed over the ranks). The nearest point's displacement is
+//!   reported beside it (`results`);
+//! * whether the membrane has come to rest: the change of the tip's displacement over the last
+//!   tenth of the run, relative to the displacement (a metric with a tolerance of a tenth of the
+//!   accuracy asked of the tip, so that a run stopped while still moving cannot pass);
+//! * the chequerboard index of the mean stress σ_m over the body's points at the end
+//!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which item 13 compares
+//!   between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
+
+use super::{invariants, Check, Findings, Metric};
+use crate::case::{Case, Verification};
+use crate::model::Model;
+use crate::parallel::Collective;
+use crate::plot::MapPoints;
+
+/// The Cook's-membrane check of a case.
+pub struct CookCheck {
+    body: u16,
+    tip: [f64; 2],
+    reference: f64,
+    tolerance: f64,
+    fit_radius: f64,
+    end: f64,
+    /// (t, fitted tip u_y, nearest point's u_y) after every step.
+    history: Vec<[f64; 3]>,
+    /// σ_m at the points at the end, gathered, and a point's half size [m].
+    map: (MapPoints, (f64, f64)),
+    checkerboard: f64,
+    points: usize,
+}
+
+impl CookCheck {
+    /// The check of a `cook_membrane` verification.
+    pub fn new(c: &Case) -> Result<CookCheck, String> {
+        let Some(Verification::CookMembrane { body, tip, reference, tolerance, fit_radius }) = &c.verification else {
+            return Err("not a Cook's-membrane verification".into());
+        };
+        let bi = c.body_index(body).ok_or(format!("verification: no body `{body}`"))?;
+        Ok(CookCheck {
+            body: bi as u16,
+            tip: *tip,
+            reference: *reference,
+            tolerance: *tolerance,
+            fit_radius: *fit_radius,
+            end: c.end_time(),
+            history: Vec::new(),
+            map: (Vec::new(), (0.0, 0.0)),
+            checkerboard: f64::NAN,
+            points: 0,
+        })
+    }
+
+    /// The fitted vertical displacement of the tip and the nearest point's (collective).
+    fn tip_displacement(&self, model: &Model, coll: &Collective) -> Result<(f64, f64), String> {
+        let ps = &model.particles;
+        let radius = self.fit_radius * model.grid.h[0].max(model.grid.h[1]);
+        let mine = (0..ps.len()).filter(|&k| ps.body[k] == self.body).map(|k| {
+            ([ps.x[k][0] - ps.disp[k][0] - self.tip[0], ps.x[k][1] - ps.disp[k][1] - self.tip[1]], ps.disp[k][1])
+        });
+        let (sums, nearest) = fit_sums(mine, radius);
+        let sums = coll.sum(&sums)?;
+        // The nearest point over the ranks: the smallest distance wins.
+        let all = coll.gather(&[nearest.0, nearest.1])?;
+        let near = all.chunks_exact(2).min_by(|a, b| a[0].total_cmp(&b[0])).map_or(f64::NAN, |c| c[1]);
+        Ok((fitted(&sums), near))
+    }
+
+    /// The tip's displacement at the end and its change over the last tenth of the run.
+    fn settled(&self) -> (f64, f64) {
+        let Some(last) = self.history.last() else { return (f64::NAN, f64::NAN) };
+        let from = last[0] - 0.1 * self.end;
+        let change = self.history.iter().filter(|h| h[0] >= from).map(|h| (h[1] - last[1]).abs()).fold(0.0, f64::max);
+        (last[1], change / last[1].abs())
+    }
+}
+
+/// The sums of the tip's fit over points (offset of the initial position from the tip, u_y): the
+/// normal equations A = Σ φ φᵀ (upper triangle, row by row) and r = Σ φ u_y with φ = (1, dX, dY)
+/// over the points within `radius` of the tip, and the nearest point (distance, u_y).
+fn fit_sums(points: impl Iterator<Item = ([f64; 2], f64)>, radius: f64) -> ([f64; 9], (f64, f64)) {
+    let mut sums = [0.0; 9];
+    let mut nearest = (f64::INFINITY, f64::NAN);
+    for (d, u) in points {
+        let r = d[0].hypot(d[1]);
+        if r < nearest.0 {
+            nearest = (r, u);
+        }
+        if r > radius {
+            continue;
+        }
+        let phi = [1.0, d[0], d[1]];
+        let mut s = 0;
+        for a in 0..3 {
+            for b in a..3 {
+                sums[s] += phi[a] * phi[b];
+                s += 1;
+            }
+        }
+        for a in 0..3 {
+            sums[6 + a] += phi[a] * u;
+        }
+    }
+    (sums, nearest)
+}
+
+/// The fit's value at the tip from the (rank-summed) sums of [`fit_sums`]; NaN if the points
+/// do not determine a plane.
+fn fitted(sums: &[f64]) -> f64 {
+    let a = [[sums[0], sums[1], sums[2]], [sums[1], sums[3], sums[4]], [sums[2], sums[4], sums[5]]];
+    solve3(a, [sums[6], sums[7], sums[8]]).map_or(f64::NAN, |c| c[0])
+}
+
+/// The solution of the 3 × 3 system `a x = b` by Cramer's rule; `None` if `a` is singular (fewer
+/// than three points, or all on a line).
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&a);
+    let scale = a.iter().flatten().map(|v| v.abs()).fold(0.0, f64::max).powi(3);
+    if d.abs() <= 1e-12 * scale {
+        return None;
+    }
+    let mut x = [0.0; 3];
+    for (c, xc) in x.iter_mut().enumerate() {
+        let mut m = a;
+        for r in 0..3 {
+            m[r][c] = b[r];
+        }
+        *xc = det(&m) / d;
+    }
+    Some(x)
+}
+
+impl Check for CookCheck {
+    fn columns(&self) -> Vec<String> {
+        vec!["cook.tip_uy".into()]
+    }
+
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+        let (fit, near) = self.tip_displacement(model, coll)?;
+        self.history.push([t, fit, near]);
+        Ok(vec![fit])
+    }
+
+    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
+        let ps = &model.particles;
+        let mine: Vec<f64> = (0..ps.len())
+            .filter(|&k| ps.body[k] == self.body)
+            .flat_map(|k| [ps.x[k][0], ps.x[k][1], invariants(&ps.stress[k]).0])
+            .collect();
+        let points: MapPoints = coll.gather(&mine)?.chunks_exact(3).map(|c| (c[0], c[1], c[2])).collect();
+        let g = &model.grid;
+        let fitted: Vec<[f64; 4]> = points.iter().map(|p| [p.0, p.1, p.2, 0.0]).collect();
+        self.checkerboard = super::checkerboard::fit_of(&fitted, g.origin, g.h).index;
+        self.points = points.len();
+        let lp = (0..ps.len()).find(|&k| ps.body[k] == self.body).map(|k| ps.lp0[k]);
+        let lp = coll.max(&lp.map_or([0.0; 2], |l| l))?;
+        self.map = (points, (1.2 * lp[0], 1.2 * lp[1]));
+        let (tip, change) = self.settled();
+        let mut metrics = vec![(
+            "tip_uy_rel_error".to_string(),
+            Metric::error(
+                (tip / self.reference - 1.0).abs(),
+                self.tolerance,
+                format!(
+                    "tip u_y {tip:.5} m (fit over the points within {} cells of ({}, {})) against {} m",
+                    self.fit_radius, self.tip[0], self.tip[1], self.reference
+                ),
+            ),
+        )];
+        metrics.push((
+            "tip_uy_change_last_tenth".to_string(),
+            Metric::error(
+                change,
+                0.1 * self.tolerance,
+                "largest change of the tip's u_y over the last tenth of the run, relative to its final value".into(),
+            ),
+        ));
+        Ok((metrics, Vec::new()))
+    }
+
+    fn results(&self) -> Vec<(String, f64)> {
+        let last = self.history.last().copied().unwrap_or([f64::NAN; 3]);
+        vec![
+            ("tip_uy".into(), last[1]),
+            ("tip_uy_nearest_point".into(), last[2]),
+            ("mean_stress_checkerboard".into(), self.checkerboard),
+            ("points".into(), self.points as f64),
+        ]
+    }
+
+    fn figures(&self) -> Vec<crate::plot::Figure> {
+        use crate::plot::{ColourMap, Figure};
+        vec![Figure::map(
+            "mean_stress.png",
+            "Mean stress σ_m at the end (colours: 1–99 % of the values)",
+            ColourMap {
+                points: self.map.0.clone(),
+                half_size: self.map.1,
+                label: "σ_m [Pa]".into(),
+                range: ColourMap::quantiles(&self.map.0, 0.01, 0.99),
+            },
+        )]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{fit_sums, fitted, solve3};
+
+    /// The fit reproduces a linear field at the tip exactly, from points on one side of it, and
+    /// ignores the points beyond its radius.
+    #[test]
+    fn the_tip_fit_is_exact_for_a_linear_field() {
+        let field = |d: [f64; 2]| 0.27 + 0.004 * d[0] - 0.0015 * d[1];
+        let mut points = Vec::new();
+        for i in 0..8 {
+            for j in 0..8 {
+                let d = [-0.25 - 0.5 * i as f64, -0.25 - 0.5 * j as f64];
+                // Far points carry a wrong value the fit must not see.
+                let far = d[0].hypot(d[1]) > 2.0;
+                points.push((d, if far { 99.0 } else { field(d) }));
+            }
+        }
+        let (sums, nearest) = fit_sums(points.iter().copied(), 2.0);
+        assert!((fitted(&sums) - 0.27).abs() < 1e-14, "{}", fitted(&sums));
+        assert_eq!(nearest, ([-0.25f64, -0.25].iter().map(|v| v * v).sum::<f64>().sqrt(), field([-0.25, -0.25])));
+        // Two points do not determine a plane.
+        let (few, _) = fit_sums(points.iter().copied().take(2), 2.0);
+        assert!(fitted(&few).is_nan());
+    }
+
+    #[test]
+    fn the_fit_solves_its_normal_equations() {
+        let a = [[4.0, 1.0, 2.0], [1.0, 3.0, 0.5], [2.0, 0.5, 5.0]];
+        let x = [0.3, -1.2, 2.5];
+        let b = [0, 1, 2].map(|r| (0..3).map(|c| a[r][c] * x[c]).sum::<f64>());
+        let got = solve3(a, b).unwrap();
+        for c in 0..3 {
+            assert!((got[c] - x[c]).abs() < 1e-14, "{got:?}");
+        }
+        // Points on a line leave the plane undetermined.
+        assert!(solve3([[2.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, 1.0]], [1.0, 1.0, 1.0]).is_none());
+    }
+}
