@@ -968,8 +968,10 @@ impl<'a> Simulation<'a> {
             }
         }
         if let Some(c) = self.check.as_mut() {
-            let (metrics, tables) = c.finish(&self.model, self.coll).map_err(RunError::Failed)?;
+            // The results after `finish` (which may complete them), also when it fails.
+            let finished = c.finish(&self.model, self.coll);
             self.summary.results.extend(c.results());
+            let (metrics, tables) = finished.map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
             for t in &tables {
                 self.out.write_table(&t.name, &t.header, &t.rows).map_err(RunError::Failed)?;

@@ -110,8 +110,8 @@ struct StepData {
     face_owner: Vec<usize>,
     /// The material stiffness of the Newton matrix (`stabilisation.stiffness`).
     stiffness: stiffness::MappedStiffness,
-    /// An explicit step: the terms of its start (σ_n on x_n, the body force and the loads of
-    /// t_{n+1}; see [`explicit`]), this rank's shares per ghosted dof; `None` otherwise.
+    /// An explicit step: the terms of its start (σ_n on x_n and the body force of t_{n+1}, without
+    /// the loads; see [`explicit`]), this rank's shares per ghosted dof; `None` otherwise.
     start_terms: Option<StartTerms>,
     /// An explicit step: the lumped inertia m_i a_i of its nodal update plus the local damping
     /// force per ghosted dof (summed over ranks), for the equilibrium identity; empty otherwise.
@@ -1243,7 +1243,8 @@ impl GridSystem {
         // is taken there, against the stress before the particle update (`StepForces::at_start`).
         let at_start = model.integration.is_explicit();
         let xl = if at_start { vec![0.0; ng] } else { self.step.solution.clone() };
-        if let Some(start) = self.step.start_terms.take() {
+        if at_start {
+            let start = self.step.start_terms.take().expect("an explicit step's start terms");
             (all, inertia, magnitude) = (start.all, start.inertia, start.magnitude);
         }
         self.with_assembler(model, |asm| {

@@ -208,10 +208,21 @@ impl Region {
     /// size and coordinates, so that points on a grid line are not lost to round-off, also when the
     /// box is a line).
     pub fn contains(&self, p: [f64; 2]) -> bool {
-        (0..2).all(|d| {
-            let tol = 1e-9 * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs()) + 1e-15;
-            p[d] >= self.min[d] - tol && p[d] <= self.max[d] + tol
-        })
+        (0..2).all(|d| self.spans(d, p[d], 0.0))
+    }
+
+    /// Whether the grid node at `p` lies in the box: as [`Region::contains`], with a further
+    /// 1e-9 of the cell size `h`, the round-off of origin + i h (a line at x = 0 holds the node
+    /// computed at −2e-15).
+    pub fn holds_node(&self, p: [f64; 2], h: [f64; 2]) -> bool {
+        (0..2).all(|d| self.spans(d, p[d], 1e-9 * h[d]))
+    }
+
+    /// Whether coordinate `x` of direction `d` lies in the box's range, with `slack` beyond the
+    /// tolerance of [`Region::contains`].
+    pub fn spans(&self, d: usize, x: f64, slack: f64) -> bool {
+        let tol = 1e-9 * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs()) + 1e-15 + slack;
+        x >= self.min[d] - tol && x <= self.max[d] + tol
     }
 }
 
@@ -251,6 +262,19 @@ pub(crate) mod tests_support {
 mod tests {
     use super::tests_support::MINIMAL;
     use super::*;
+
+    /// A line region holds the grid node round-off put a hair beside it (origin −8.4 m, 25 cells
+    /// of 2.8 m: the node meant for x = 0 at −1.8e-15 m), and not the node a cell away.
+    #[test]
+    fn a_line_region_holds_the_node_on_its_line() {
+        let clamp = Region { min: [0.0, -1.0], max: [0.0, 1.0] };
+        let (origin, h) = (-8.4f64, 2.8f64);
+        let x = origin + 3.0 * h;
+        assert!(x != 0.0 && x.abs() < 1e-14, "{x}");
+        assert!(!clamp.contains([x, 0.0]));
+        assert!(clamp.holds_node([x, 0.0], [h, h]));
+        assert!(!clamp.holds_node([x + h, 0.0], [h, h]));
+    }
 
     /// The names the messages use are the case file's.
     #[test]

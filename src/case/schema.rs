@@ -1279,7 +1279,7 @@ pub enum Verification {
         /// The tip at t = 0 [m].
         tip: [f64; 2],
         /// The tip's vertical displacement at rest [m] (0.2765 for [002]'s membrane: plane-strain
-        /// finite elements, `scripts/cook_membrane_fe.py`).
+        /// Q9 finite elements, `scripts/cook_membrane_neo_hookean.py`).
         reference: f64,
         /// Largest accepted relative error of the tip's displacement (Part E item 13: 3 %).
         #[serde(default = "default_cook_tol")]

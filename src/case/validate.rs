@@ -460,9 +460,10 @@ pub fn validate(c: &Case) -> R {
         }
         if let Some(r) = &b.region {
             // A region between grid lines fixes nothing: the body it was meant to hold would move
-            // freely (a clamp at x = 0 on a grid whose lines miss x = 0).
-            let nodes = |d: usize| (0..=c.grid.cells[d]).map(move |i| lo[d] + i as f64 * h[d]);
-            if !nodes(0).any(|x| nodes(1).any(|y| r.contains([x, y]))) {
+            // freely (a clamp at x = 0 on a grid whose lines miss x = 0). A box holds a node if
+            // some grid line of each direction crosses it (`Region::holds_node`, one axis at a time).
+            let crossed = |d: usize| (0..=c.grid.cells[d]).any(|i| r.spans(d, lo[d] + i as f64 * h[d], 1e-9 * h[d]));
+            if !(crossed(0) && crossed(1)) {
                 return Err(format!(
                     "key `boundaries[{i}].region`: holds no grid node (the grid lines lie at x = {} + i·{}, \
                      y = {} + j·{} m); move the region onto them or change the grid",

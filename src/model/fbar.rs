@@ -11,6 +11,12 @@
 //! 3. G2P (Eq. 20): J̄_p^{n+1} = Σ_i w_ip (V J̄)_i / V_i ([`gather`]);
 //! 4. ΔF̄_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/dim} ΔF_p (Eq. 27, [`scaled_increment`]).
 //!
+//! These functions are the algorithm's pieces, tested as [002] states them. The explicit step
+//! (`assembly::explicit`) projects the points' own J_p^n ΔJ_p rather than J̄_p^n ΔJ_p (one pass,
+//! measured: repeating the projection of J̄ every step smooths it without end), and uses
+//! [`scale`] both for the increment, (J̄^{n+1}/(J̄^n ΔJ))^{1/dim}, and for a hyperelastic
+//! model's total F, (J̄^{n+1}/(J^n ΔJ))^{1/dim}.
+//!
 //! The weights w_ip are the step's, at x_p^n, in both passes. Only the stress sees F̄; the volume
 //! stays det(F) V⁰ ([002] L237). ΔF̄ is ΔF times a scalar, so a pure shear or a rigid motion is
 //! untouched and the in-plane deviator of log ΔF̄ is that of log ΔF. dim is 2 in plane strain (the
@@ -42,7 +48,8 @@ pub fn gather(shares: Shares, volume: &[f64], weighted: &[f64]) -> f64 {
 }
 
 /// The factor c = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/dim} by which ΔF̄_p = c ΔF_p ([002] Eq. 27):
-/// `projected` is J̄_p^{n+1} from [`gather`], `own` the point's J̄_p^n ΔJ_p.
+/// `projected` is J̄_p^{n+1} from [`gather`], `own` the point's J̄_p^n ΔJ_p (or, for the scale of
+/// a total F̄ = c F, its J_p^{n+1}: Eq. 18).
 pub fn scale(projected: f64, own: f64, dim: usize) -> f64 {
     (projected / own).powf(1.0 / dim as f64)
 }

@@ -469,7 +469,7 @@ impl BoundaryDef {
                 Side::YMax => j == grid.cells[1],
             };
         }
-        self.region.is_some_and(|r| r.contains(grid.node_position(i, j)))
+        self.region.is_some_and(|r| r.holds_node(grid.node_position(i, j), grid.h))
     }
 }
 

@@ -74,10 +74,15 @@ impl CookCheck {
         Ok((fitted(&sums), near))
     }
 
-    /// The tip's displacement at the end and its change over the last tenth of the run.
+    /// The tip's displacement at the end and its change over the last tenth of the run (NaN if
+    /// the observations do not cover it: a run restarted within the last tenth keeps no earlier
+    /// history).
     fn settled(&self) -> (f64, f64) {
         let Some(last) = self.history.last() else { return (f64::NAN, f64::NAN) };
         let from = last[0] - 0.1 * self.end;
+        if self.history[0][0] > from {
+            return (last[1], f64::NAN);
+        }
         let change = self.history.iter().filter(|h| h[0] >= from).map(|h| (h[1] - last[1]).abs()).fold(0.0, f64::max);
         (last[1], change / last[1].abs())
     }
@@ -127,8 +132,8 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     };
     let d = det(&a);
-    let scale = a.iter().flatten().map(|v| v.abs()).fold(0.0, f64::max).powi(3);
-    if d.abs() <= 1e-12 * scale {
+    // Relative to the product of the diagonal (each row's own units).
+    if d.abs() <= 1e-12 * (a[0][0] * a[1][1] * a[2][2]).abs() {
         return None;
     }
     let mut x = [0.0; 3];
