@@ -26,8 +26,8 @@ study: build
 	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13
 	python3 scripts/terzaghi_family.py
 
-# Cook's membrane ([002] §4.1, Part E item 13; eight runs, about 7 hours on one core; COOK_H=1 for
-# the 1 m grid only, about 50 minutes).
+# Cook's membrane ([002] §4.1, Part E item 13; eight runs on two ranks, about 7 hours; COOK_H=1
+# for the 1 m grid only, about 30 minutes).
 study-cook: build
 	cargo test --release --locked --test studies cook_membrane_item_13 -- --ignored --nocapture
 

@@ -12,6 +12,11 @@ fn run(label: &str, sets: &[String]) -> Value {
 }
 
 fn run_case(case: &str, label: &str, sets: &[String]) -> Value {
+    run_case_on(1, case, label, sets)
+}
+
+/// `run_case` on `ranks` MPI ranks (through `mpirun` when more than one).
+fn run_case_on(ranks: usize, case: &str, label: &str, sets: &[String]) -> Value {
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("studies").join(label);
     let _ = std::fs::remove_dir_all(&out);
     let mut args: Vec<String> =
@@ -20,11 +25,15 @@ fn run_case(case: &str, label: &str, sets: &[String]) -> Value {
         args.push("--set".into());
         args.push(s.clone());
     }
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(&args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("porompm runs");
+    let mut cmd = if ranks > 1 {
+        let mut c = Command::new("mpirun");
+        c.args(["--oversubscribe", "-n", &ranks.to_string(), env!("CARGO_BIN_EXE_porompm")]);
+        c.env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+        c
+    } else {
+        Command::new(env!("CARGO_BIN_EXE_porompm"))
+    };
+    let o = cmd.args(&args).current_dir(env!("CARGO_MANIFEST_DIR")).output().expect("porompm runs");
     assert!(o.status.success(), "{label}: {}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
@@ -240,8 +249,10 @@ fn slope_sand_dilatancy() {
 /// tip within 3 % of 0.2765 m for both bases; closer on the fine grid than on the coarse one;
 /// standard MPM below F̄ at each resolution; F̄'s chequerboard index of σ_m at most a third of
 /// the standard one on the finest grid (printed for each; on 1 m cells the B-splines' is 0.34).
-/// Each 1 m run takes about 12 minutes on one core, each 0.5 m run about 45 minutes on two
-/// ranks (the study runs one rank: about 90 minutes); `COOK_H=1` keeps the coarse grid only.
+/// Runs on two ranks. The 0.5 m runs last 400 s: at 200 s the membrane still swings about its
+/// rest state by ±0.3 % with the 55 s period (less PIC dissipation on the finer cells), and the
+/// check's at-rest metric fails (measured 1.09 %). Each 1 m run takes about 7 minutes, each 0.5 m
+/// run about 95 (about 7 hours in all); `COOK_H=1` keeps the coarse grid only.
 #[test]
 #[ignore]
 fn cook_membrane_item_13() {
@@ -260,13 +271,15 @@ fn cook_membrane_item_13() {
     for &h in &sizes {
         for basis in ["ugimp", "bspline2"] {
             for fbar in [true, false] {
-                let s = run_case(
+                let s = run_case_on(
+                    2,
                     "cook_membrane",
                     &format!("cook-{h}-{basis}-{fbar}"),
                     &[
                         format!("parameters.h={h}"),
                         format!("analysis.shape_functions={basis}"),
                         format!("stabilisation.fbar={fbar}"),
+                        format!("stages.load.duration={}", if h < 1.0 { 400 } else { 200 }),
                     ],
                 );
                 assert!(
