@@ -159,10 +159,13 @@ fn a_checkpoint_of_another_case_or_a_damaged_one_is_refused() {
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
     let o = porompm(&args(&other, &[cut.to_str().unwrap()]));
     assert_one_line_error(&o, "cut.h5");
-    // One flipped byte in the particle data is caught by the checksum (or by HDF5 itself).
+    // One flipped byte in the particle data is caught by the checksum (or by HDF5 itself): a byte
+    // of the first stored 0.025 m (the column's points sit at x = 0.025 m with half-widths of
+    // 0.025 m), wherever the layout puts the particle datasets (a fixed offset from the end fell
+    // into unused space once the records grew by a field).
     let mut flipped = bytes.clone();
-    let at = bytes.len() - bytes.len() / 5;
-    flipped[at] ^= 0x40;
+    let at = bytes.windows(8).position(|w| w == 0.025f64.to_le_bytes()).expect("a point's x or half-width in the file");
+    flipped[at + 3] ^= 0x40;
     let bad = dir.join("flipped.h5");
     std::fs::write(&bad, &flipped).unwrap();
     let o = porompm(&args(&other, &[bad.to_str().unwrap(), "--set", "stages.consolidation.duration=0.1"]));
