@@ -40,6 +40,7 @@
 use super::{callbacks, Error, GridSystem, StepSolve};
 use crate::kernels::kinematics::Kinematics;
 use crate::kernels::Integration;
+use crate::model::finite_strain::det;
 use crate::model::{fbar, Model};
 
 impl GridSystem {
@@ -114,7 +115,7 @@ impl GridSystem {
                 Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false).j
             })
             .collect();
-        let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();
+        let own: Vec<f64> = (0..dj.len()).map(|k| det(ps.def_grad[k]) * dj[k]).collect();
         let projected = self.project_per_point(model, &own)?;
         Ok((0..own.len())
             .map(|k| {
@@ -149,9 +150,4 @@ impl GridSystem {
         let weighted: Vec<f64> = (0..nn).map(|l| sums[1][l * nd]).collect();
         Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
     }
-}
-
-/// det F of an in-plane deformation gradient.
-fn det(f: &[[f64; 2]; 2]) -> f64 {
-    f[0][0] * f[1][1] - f[0][1] * f[1][0]
 }

@@ -414,8 +414,7 @@ impl Model {
             linear: self.linear_increments,
             fbar: 1.0,
             fbar_total: if self.fbar {
-                let f = &ps.def_grad[idx];
-                fbar::scale(ps.jbar[idx], f[0][0] * f[1][1] - f[0][1] * f[1][0], 2)
+                fbar::scale(ps.jbar[idx], finite_strain::det(ps.def_grad[idx]), 2)
             } else {
                 1.0
             },

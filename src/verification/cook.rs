@@ -121,30 +121,7 @@ fn fit_sums(points: impl Iterator<Item = ([f64; 2], f64)>, radius: f64) -> ([f64
 /// do not determine a plane.
 fn fitted(sums: &[f64]) -> f64 {
     let a = [[sums[0], sums[1], sums[2]], [sums[1], sums[3], sums[4]], [sums[2], sums[4], sums[5]]];
-    solve3(a, [sums[6], sums[7], sums[8]]).map_or(f64::NAN, |c| c[0])
-}
-
-/// The solution of the 3 × 3 system `a x = b` by Cramer's rule; `None` if `a` is singular (fewer
-/// than three points, or all on a line).
-fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&a);
-    // Relative to the product of the diagonal (each row's own units).
-    if d.abs() <= 1e-12 * (a[0][0] * a[1][1] * a[2][2]).abs() {
-        return None;
-    }
-    let mut x = [0.0; 3];
-    for (c, xc) in x.iter_mut().enumerate() {
-        let mut m = a;
-        for r in 0..3 {
-            m[r][c] = b[r];
-        }
-        *xc = det(&m) / d;
-    }
-    Some(x)
+    crate::model::linalg::solve(a, [sums[6], sums[7], sums[8]], 3).map_or(f64::NAN, |c| c[0])
 }
 
 impl Check for CookCheck {
@@ -226,7 +203,7 @@ impl Check for CookCheck {
 
 #[cfg(test)]
 mod tests {
-    use super::{fit_sums, fitted, solve3};
+    use super::{fit_sums, fitted};
 
     /// The fit reproduces a linear field at the tip exactly, from points on one side of it, and
     /// ignores the points beyond its radius.
@@ -248,18 +225,5 @@ mod tests {
         // Two points do not determine a plane.
         let (few, _) = fit_sums(points.iter().copied().take(2), 2.0);
         assert!(fitted(&few).is_nan());
-    }
-
-    #[test]
-    fn the_fit_solves_its_normal_equations() {
-        let a = [[4.0, 1.0, 2.0], [1.0, 3.0, 0.5], [2.0, 0.5, 5.0]];
-        let x = [0.3, -1.2, 2.5];
-        let b = [0, 1, 2].map(|r| (0..3).map(|c| a[r][c] * x[c]).sum::<f64>());
-        let got = solve3(a, b).unwrap();
-        for c in 0..3 {
-            assert!((got[c] - x[c]).abs() < 1e-14, "{got:?}");
-        }
-        // Points on a line leave the plane undetermined.
-        assert!(solve3([[2.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, 1.0]], [1.0, 1.0, 1.0]).is_none());
     }
 }
