@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study study-cook gold bench bench-scaling bench-solvers maps lint clean
+.PHONY: setup build run test study study-cook study-footing gold bench bench-scaling bench-solvers maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -23,13 +23,17 @@ test: setup
 
 # Long convergence studies (tables in target/studies/).
 study: build
-	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13
+	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13 --skip footing_fbar_item_14
 	python3 scripts/terzaghi_family.py
 
 # Cook's membrane ([002] §4.1, Part E item 13; eight runs on two ranks, about 7 hours; COOK_H=1
 # for the 1 m grid only, about 30 minutes).
 study-cook: build
 	cargo test --release --locked --test studies cook_membrane_item_13 -- --ignored --nocapture
+
+# [002]'s strip footing (Part E item 14; nine runs on two ranks, about 80 minutes).
+study-footing: build
+	cargo test --release --locked --test studies footing_fbar_item_14 -- --ignored --nocapture
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
 gold: setup

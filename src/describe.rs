@@ -88,6 +88,12 @@ pub fn describe(case: &Case, label: &str) -> String {
                     residual_cohesion.unwrap_or(*cohesion)
                 )
             }
+            SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
+                format!(
+                    "Hencky–J2 (finite strain), E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, c = {cohesion:.4e} Pa → c_r = {:.4e} Pa, η = {softening_rate}",
+                    residual_cohesion.unwrap_or(*cohesion)
+                )
+            }
         };
         let _ = writeln!(s, "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³", m.name, m.porosity, m.solid_density);
     }

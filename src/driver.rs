@@ -555,6 +555,9 @@ impl<'a> Simulation<'a> {
                         let block = self.system.owned_node_block();
                         c.observe_nodes(&block, &self.model, self.coll).map_err(RunError::Failed)?;
                     }
+                    if let Some(c) = self.check.as_mut() {
+                        c.observe_reactions(&forces.reactions);
+                    }
                     let before = forces.at_start.then(|| self.stress_integral(&forces));
                     let updated = self.update_particles(&active, dt)?;
                     if updated.is_ok() {

@@ -207,6 +207,7 @@ gold_tests!(
     consolidation_layer,
     cook_membrane,
     elastic_column,
+    footing_fbar,
     footing_ld,
     footing_near_slope,
     footing_peer,

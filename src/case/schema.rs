@@ -297,6 +297,28 @@ pub enum SoilModel {
         /// Poisson's ratio ν [-].
         poisson_ratio: f64,
     },
+    /// Hencky elasticity with J2 (von Mises) plasticity and exponential softening ([002] §4.2 and
+    /// §4.4, the strip footing and the landslide; `model::finite_strain::HenckyJ2`): multiplicative
+    /// plasticity in principal logarithmic strains, τ = K tr ε^e 1 + 2μ dev ε^e with ε^e = ½ ln b^e,
+    /// radial return of dev τ onto q = √3 c(ε̄), c(ε̄) = c_r + (c_p − c_r) exp(−η ε̄), σ = τ/J (with
+    /// F̄, J̄). c is the plane-strain shear strength (the undrained strength s_u). The point's b^e is
+    /// not stored: it is recovered from its stress and J, which determine it. Only in
+    /// `dynamic_explicit` stages (no consistent tangent for the implicit ones), without an initial
+    /// stress.
+    HenckyJ2 {
+        /// Young's modulus E [Pa], in (0, 1e13].
+        young_modulus: f64,
+        /// Poisson's ratio ν [-].
+        poisson_ratio: f64,
+        /// Peak shear strength c_p [Pa], > 0.
+        cohesion: f64,
+        /// Residual shear strength c_r [Pa], in [0, c_p] (default: c_p, no softening).
+        #[serde(default)]
+        residual_cohesion: Option<f64>,
+        /// Softening rate η of c(ε̄) [-], ≥ 0 (default 0).
+        #[serde(default)]
+        softening_rate: f64,
+    },
 }
 
 /// A body filled with material points.
@@ -1115,8 +1137,14 @@ pub enum Verification {
         /// The soil body (its cohesion normalises the pressure).
         soil: String,
         /// The load: a traction (its pressure), or a body force on the footing body (its weight
-        /// over `loaded_width`).
-        load: String,
+        /// over `loaded_width`). Give `load` or `footing`.
+        #[serde(default)]
+        load: Option<String>,
+        /// A rigid footing pushed into the soil under displacement control: a boundary that moves
+        /// its nodes (`velocity` or `displacement`); the pressure is its vertical reaction on the
+        /// soil over `loaded_width` ([002] §4.2). Give `load` or `footing`.
+        #[serde(default)]
+        footing: Option<String>,
         /// Width carrying the load in the model [m] (the half-width in a half model).
         loaded_width: f64,
         /// Footing breadth B [m] (normalises the settlement).
@@ -1124,9 +1152,15 @@ pub enum Verification {
         /// The settlement is the downward displacement of the material point nearest to this point
         /// at t = 0 [m].
         settlement_point: [f64; 2],
-        /// d/B at which q_ult is read for the metric `bearing_capacity_ratio` (none: no metric).
+        /// d/B at which q_ult is read for the metric `bearing_capacity_ratio` (a load-controlled
+        /// footing; give this or `plateau`, or neither for no metric).
         #[serde(default)]
         failure_settlement: Option<f64>,
+        /// The range [d/B_from, d/B_to] over which the mean of q is q_ult for the metric
+        /// `bearing_capacity_ratio` (a displacement-controlled footing, whose load levels off at the
+        /// limit load).
+        #[serde(default)]
+        plateau: Option<[f64; 2]>,
         /// Reference q_ult/c (default 2 + π, Prandtl).
         #[serde(default = "default_prandtl")]
         reference: f64,

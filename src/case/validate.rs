@@ -136,20 +136,33 @@ fn bspline_options(c: &Case) -> R {
     Ok(())
 }
 
-/// Where a hyperelastic (neo-Hookean) material may be used: in explicit stages only (the implicit
-/// stages need its consistent tangent, not built), and without an initial stress (its stress is a
-/// function of the deformation alone).
-fn hyperelastic_materials(c: &Case) -> R {
+/// Where a finite-strain material (`neo_hookean`, `hencky_j2`) may be used: in explicit stages
+/// only (the implicit stages need its consistent tangent, not built), in plane strain (its
+/// kinematics have F_zz = 1), and, for the hyperelastic neo-Hookean, without an initial stress (its
+/// stress is a function of the deformation alone; a Hencky–J2 point's initial stress is its initial
+/// elastic strain).
+fn finite_strain_materials(c: &Case) -> R {
     for (i, m) in c.materials.iter().enumerate() {
-        if !matches!(m.model, SoilModel::NeoHookean { .. }) {
-            continue;
-        }
+        let name = match m.model {
+            SoilModel::NeoHookean { .. } => "neo_hookean",
+            SoilModel::HenckyJ2 { .. } => "hencky_j2",
+            _ => continue,
+        };
         if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
             return Err(format!(
-                "key `materials[{i}].model`: `neo_hookean` runs in dynamic_explicit stages only (its consistent \
+                "key `materials[{i}].model`: `{name}` runs in dynamic_explicit stages only (its consistent \
                  tangent for the implicit stages is not built), and stage `{}` is not one",
                 s.name
             ));
+        }
+        if c.analysis.geometry == crate::case::Geometry::Axisymmetric {
+            return Err(format!(
+                "key `materials[{i}].model`: `{name}` is written for plane strain (F_zz = 1) and the analysis is \
+                 axisymmetric"
+            ));
+        }
+        if name != "neo_hookean" {
+            continue;
         }
         if let Some(b) =
             c.bodies.iter().find(|b| b.material == m.name && (b.initial_stress.is_some() || b.uniform_stress.is_some()))
@@ -253,7 +266,7 @@ pub fn validate(c: &Case) -> R {
     if matches!(c.analysis.shape_functions, ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3) {
         bspline_options(c)?;
     }
-    hyperelastic_materials(c)?;
+    finite_strain_materials(c)?;
     if c.stabilisation.fbar {
         if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
             return Err(format!(
@@ -938,13 +951,27 @@ pub fn validate(c: &Case) -> R {
                 breadth,
                 settlement_point,
                 failure_settlement,
+                plateau,
                 reference,
                 tolerance,
                 report_settlements,
                 report_loads,
                 stop_settlement,
+                footing,
             } => {
                 positive("verification.loaded_width", *loaded_width)?;
+                if let Some([from, to]) = plateau {
+                    if !(*from >= 0.0 && to > from && to.is_finite()) {
+                        return Err(format!(
+                            "key `verification.plateau`: give 0 ≤ d/B_from < d/B_to, got [{from}, {to}]"
+                        ));
+                    }
+                    if failure_settlement.is_some() {
+                        return Err(
+                            "key `verification.plateau`: give `plateau` or `failure_settlement`, not both".into()
+                        );
+                    }
+                }
                 if let Some(s) = stop_settlement {
                     positive("verification.stop_settlement", *s)?;
                 }
@@ -961,6 +988,31 @@ pub fn validate(c: &Case) -> R {
                 for (j, r) in report_loads.iter().enumerate() {
                     positive(&format!("verification.report_loads[{j}]"), *r)?;
                 }
+                let load = match (load, footing) {
+                    (Some(load), None) => load,
+                    (None, Some(f)) => {
+                        let Some(b) = c.boundaries.iter().find(|b| &b.name == f) else {
+                            return Err(format!("key `verification.footing`: no boundary named `{f}`"));
+                        };
+                        if !b.fix.contains(&Dof::Uy) || (b.velocity.is_none() && b.displacement.is_none()) {
+                            return Err(format!(
+                                "key `verification.footing`: the boundary `{f}` must fix `uy` and move it (`velocity` \
+                                 or `displacement`): its reaction is the footing's load"
+                            ));
+                        }
+                        if c.body(soil).is_none() {
+                            return Err(format!("key `verification.soil`: no body named `{soil}`"));
+                        }
+                        return Ok(());
+                    }
+                    _ => {
+                        return Err(
+                            "key `verification`: a bearing_capacity check takes either `load` (load control) or \
+                             `footing` (a moving boundary)"
+                                .into(),
+                        )
+                    }
+                };
                 if matches!(c.load(load), Some(Load::BodyForce { bodies: None, .. })) {
                     return Err(format!(
                         "key `verification.load`: the body force `{load}` must name the footing body in `bodies`"
@@ -1092,6 +1144,34 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
                     "key `{}`: must be in (-√3 G, 0] = ({:.4e}, 0], got {softening_modulus}",
                     k("softening_modulus"),
                     -3f64.sqrt() * g
+                ));
+            }
+        }
+        SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
+            modulus(&k("young_modulus"), *young_modulus)?;
+            in_open(&k("poisson_ratio"), *poisson_ratio, -1.0, 0.5)?;
+            positive(&k("cohesion"), *cohesion)?;
+            let residual = residual_cohesion.unwrap_or(*cohesion);
+            if !(0.0..=*cohesion).contains(&residual) {
+                return Err(format!(
+                    "key `{}`: must be in [0, cohesion = {cohesion}], got {residual}",
+                    k("residual_cohesion")
+                ));
+            }
+            non_negative(&k("softening_rate"), *softening_rate)?;
+            let m = crate::model::finite_strain::HenckyJ2::new(
+                *young_modulus,
+                *poisson_ratio,
+                *cohesion,
+                residual,
+                *softening_rate,
+            );
+            if !m.well_posed() {
+                return Err(format!(
+                    "key `{}`: the softening outpaces the elastic unloading (3μ ≤ √3 η (c_p − c_r)), so the return \
+                     is not unique; it must be below {:.4e}",
+                    k("softening_rate"),
+                    3.0 * m.shear / (3f64.sqrt() * (cohesion - residual))
                 ));
             }
         }

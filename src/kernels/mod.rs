@@ -574,10 +574,13 @@ impl<'a> Point<'a> {
         let kin =
             Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear).with_volume_scale(part.fbar);
         let rotated = kinematics::rotate(&part.stress, kin.theta);
-        // A hyperelastic model takes the total deformation F_{n+1} = F̄ F_n; the others the
-        // objective increment.
+        // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
+        // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
+        let df = kin.f_bar().map(|r| r.map(|v| v * part.fbar));
         let f_new = kinematics::product(&kin.f_bar(), &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
-        let upd = model.total(&f_new, part.eps_pd).unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
+        let upd = model
+            .finite(&df, &f_new, &part.stress, part.eps_pd)
+            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
         let mut hoop = [(0.0, 0.0); MAX_NODES];
         for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {

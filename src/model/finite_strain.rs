@@ -131,6 +131,19 @@ impl HenckyJ2 {
         3.0 * self.shear > 3f64.sqrt() * self.softening_rate * (self.cohesion - self.residual_cohesion)
     }
 
+    /// The elastic left Cauchy–Green tensor b^e [xx, yy, xy, zz] of a point with Cauchy stress
+    /// `stress` at volume ratio `j` (with F̄, J̄): τ = J σ determines the elastic logarithmic strain,
+    /// ε^e = dev τ/(2μ) + tr τ/(9K) 1 (the inverse of Hencky's law, in τ's principal frame, which is
+    /// b^e's), and b^e = exp(2ε^e). The inverse of [`HenckyJ2::update`]'s stress to round-off, so
+    /// that a point's stress and J are its whole elastic state.
+    pub fn elastic_left_cauchy_green(&self, stress: &[f64; 4], j: f64) -> [f64; 4] {
+        let frame = Principal::of(stress);
+        let tau = frame.values.map(|v| v * j);
+        let mean = (tau[0] + tau[1] + tau[2]) / 3.0;
+        let (mu2, k3) = (2.0 * self.shear, 3.0 * self.bulk);
+        frame.compose(&tau.map(|t| (2.0 * ((t - mean) / mu2 + mean / k3)).exp()))
+    }
+
     /// One step: the increment `df` of the deformation gradient (in-plane, ΔF_zz = 1) from
     /// `state`, with `j` the volume ratio det F of the point after the step (with F̄, J̄) by which
     /// the Kirchhoff stress is divided. `None` when b^e or J is not positive definite.
@@ -356,6 +369,43 @@ mod tests {
         }
         assert!(eps_small > 0.0 && state.eps > 0.0);
         assert!((state.eps - eps_small).abs() <= 5e-3 * eps_small + 1e-9, "{} vs {eps_small}", state.eps);
+    }
+
+    #[test]
+    fn a_hencky_points_stress_and_volume_ratio_determine_its_elastic_state() {
+        // After elastic and plastic steps (with softening), b^e recovered from σ and J is the b^e
+        // the update left, to round-off.
+        let m = HenckyJ2::new(25e6, 0.45, 40.82e3, 2.45e3, 5.0);
+        let (mut state, mut j) = (PlasticState::default(), 1.0);
+        let mut plastic = 0;
+        for k in 0..60 {
+            let df = [[1.0 + 4e-4 * (k as f64 * 0.3).cos(), 2e-3], [-1e-3, 1.0 - 1e-4]];
+            j *= det(df);
+            let u = m.update(df, &state, j).unwrap();
+            plastic += usize::from(u.plastic);
+            let be = m.elastic_left_cauchy_green(&u.stress, j);
+            assert!(close(&be, &u.state.be, 1e-13), "step {k}: {be:?} vs {:?}", u.state.be);
+            state = u.state;
+        }
+        assert!(plastic > 20 && state.eps > 0.0);
+        // And the path run through `Constitutive::finite`, which stores only σ, F and ε̄ (F̄ = F
+        // here), is the path run with the stored b^e.
+        let model = Constitutive::HenckyJ2(LinearElastic::new(25e6, 0.45), m);
+        let (mut stress, mut f, mut eps) = ([0.0; 4], [[1.0, 0.0], [0.0, 1.0]], 0.0);
+        let (mut state, mut j) = (PlasticState::default(), 1.0);
+        for k in 0..60 {
+            let df = [[1.0 - 3e-4, 1.5e-3 * (k as f64 * 0.2).sin()], [2e-3, 1.0 + 1e-4]];
+            f = mul(df, f);
+            j *= det(df);
+            let u = model.finite(&df, &f, &stress, eps).unwrap();
+            let direct = m.update(df, &state, j).unwrap();
+            assert!(close(&u.stress, &direct.stress, 1e-11), "step {k}: {:?} vs {:?}", u.stress, direct.stress);
+            assert!((u.eps_pd - direct.state.eps).abs() <= 1e-12 * direct.state.eps.max(1e-300) + 1e-18);
+            (stress, eps, state) = (u.stress, u.eps_pd, direct.state);
+        }
+        assert!(eps > 0.0);
+        // The incremental models have no finite-strain stress.
+        assert!(Constitutive::LinearElastic(LinearElastic::new(1.0, 0.3)).finite(&f, &f, &stress, 0.0).is_none());
     }
 
     #[test]

@@ -396,6 +396,10 @@ pub struct BoundaryDef {
     pub region: Option<Region>,
     /// Or the moving surface of a body: (local particle index, exposed face) pairs.
     pub surface: Option<Vec<(usize, Side)>>,
+    /// The surface's region, if it has one: only the nodes within its extent along each face
+    /// (x for a y face, y for an x face) are fixed, so that a footing's edge stays where the
+    /// region puts it when the points next to the edge move.
+    pub surface_span: Option<Region>,
     /// Components fixed.
     pub fix: Vec<Dof>,
     /// Their prescribed motion (none: fixed to zero).
@@ -411,6 +415,7 @@ impl BoundaryDef {
             side: Some(Side::XMin),
             region: None,
             surface: None,
+            surface_span: None,
             fix: vec![Dof::Ux, Dof::WUx],
             motion: None,
         }
@@ -455,7 +460,15 @@ impl BoundaryDef {
             }
             _ => None,
         };
-        BoundaryDef { name: b.name.clone(), side: b.side, region: b.region, surface, fix: b.fix.clone(), motion }
+        BoundaryDef {
+            name: b.name.clone(),
+            side: b.side,
+            region: b.region,
+            surface,
+            surface_span: b.surface.as_ref().and_then(|sf| sf.region),
+            fix: b.fix.clone(),
+            motion,
+        }
     }
 
     /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the

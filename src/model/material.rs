@@ -106,6 +106,18 @@ pub fn soil_model(m: &SoilModel) -> Constitutive {
                 },
             )
         }
+        SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
+            Constitutive::HenckyJ2(
+                LinearElastic::new(young_modulus, poisson_ratio),
+                crate::model::finite_strain::HenckyJ2::new(
+                    young_modulus,
+                    poisson_ratio,
+                    cohesion,
+                    residual_cohesion.unwrap_or(cohesion),
+                    softening_rate,
+                ),
+            )
+        }
         SoilModel::NeoHookean { young_modulus, poisson_ratio } => Constitutive::NeoHookean(
             LinearElastic::new(young_modulus, poisson_ratio),
             crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio),

@@ -260,7 +260,10 @@ impl Model {
     /// * the motion (a wall, a platen, a patch's boundary) is prescribed at the nodes on the face's
     ///   side of the particle, (x_i − x_p)·n ≥ 0: they include the well-filled node just inside a
     ///   face that has moved past a grid line, which carries the boundary's reaction (the nodes
-    ///   beyond the face alone are barely filled and cannot).
+    ///   beyond the face alone are barely filled and cannot);
+    /// * with a region on the surface, only the nodes within the region's extent along the face:
+    ///   the stencil of a point next to a footing's edge reaches the node beyond the edge, which
+    ///   would otherwise widen the footing by a cell as soon as the point moves towards it.
     pub fn surface_fixes(&self, active: &Active, weak_drainage: bool) -> Vec<((u32, u32), usize, [bool; 5])> {
         let mut out = Vec::new();
         let tol = 1e-9 * self.grid.h[0].min(self.grid.h[1]);
@@ -282,6 +285,12 @@ impl Model {
                         continue;
                     }
                     let node = self.grid.node_position(i as usize, j as usize);
+                    if let Some(r) = &b.surface_span {
+                        let t = if matches!(face, Side::YMin | Side::YMax) { 0 } else { 1 };
+                        if node[t] < r.min[t] - tol || node[t] > r.max[t] + tol {
+                            continue;
+                        }
+                    }
                     let along = (node[0] - x[0]) * n[0] + (node[1] - x[1]) * n[1];
                     let mut c = [false; 5];
                     for d in 0..5 {

@@ -4,15 +4,19 @@
 //! Every step the check records the footing pressure q and the settlement d:
 //! * q is the applied pressure: |traction_y| f(t) for a traction load, or, for a body force acting on
 //!   a footing body ([000] §4.1.2: a footing of increasing unit weight), the weight of that body's
-//!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest);
+//!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest), or,
+//!   for a rigid footing pushed in under displacement control (a boundary moving its nodes,
+//!   [002] §4.2), the boundary's downward reaction on the soil over the loaded width, −R_y / w;
 //! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0,
 //!   counted from the last observation before the load starts (q = 0), so that a gravity stage
 //!   before the loading does not count as settlement.
 //!
 //! The curve goes to `load_settlement.csv` and history.csv (q, q/c, d/B). With `failure_settlement`,
-//! q_ult is the pressure at which d/B first reaches it (interpolated between steps), and the metric
+//! q_ult is the pressure at which d/B first reaches it (interpolated between steps); with `plateau`
+//! = [a, b] (displacement control, where q levels off at the limit load), q_ult is the mean of q
+//! over the steps with d/B in [a, b] (an explicit run's reaction oscillates about it). The metric
 //! `bearing_capacity_ratio` = (q_ult/c)/reference, with reference 2 + π for Prandtl's undrained
-//! strip footing; c is the soil's cohesion. `results` gets q/c at each of `report_settlements`
+//! strip footing; c is the soil's cohesion (its peak strength). `results` gets q/c at each of `report_settlements`
 //! (interpolated), the settlement d [m] at each q/c of `report_loads` and the largest q/c reached. With `stop_settlement` the run ends (completed) once
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
@@ -29,6 +33,7 @@ pub struct BearingCheck {
     breadth: f64,
     point_id: u64,
     failure: Option<f64>,
+    plateau: Option<[f64; 2]>,
     reference: f64,
     tolerance: f64,
     report: Vec<f64>,
@@ -36,6 +41,8 @@ pub struct BearingCheck {
     stop_at: Option<f64>,
     /// Downward displacement of the point while q = 0 [m].
     baseline: f64,
+    /// The footing boundary's last reaction [N per m] (a displacement-controlled footing).
+    reaction: [f64; 2],
     /// (t, d/B, q/c) per step.
     curve: Vec<[f64; 3]>,
 }
@@ -45,6 +52,16 @@ enum LoadKind {
     Traction(f64),
     /// |b_y| [m/s²], bodies, loaded width [m].
     Weight(f64, Vec<u16>, f64),
+    /// The index of the footing's boundary in `Model::boundaries`, loaded width [m].
+    Reaction(usize, f64),
+}
+
+/// What loads the footing.
+pub enum Loading<'a> {
+    /// A load of the case (a traction or a body force on the footing body).
+    Load(&'a str),
+    /// A boundary of the case moving the nodes under the footing (displacement control).
+    Footing(&'a str),
 }
 
 /// Parameters of [`BearingCheck::new`], as in the case's `[verification]`.
@@ -52,7 +69,7 @@ pub struct BearingSpec<'a> {
     /// The soil body.
     pub soil: &'a str,
     /// The load.
-    pub load: &'a str,
+    pub load: Loading<'a>,
     /// Loaded width in the model [m].
     pub loaded_width: f64,
     /// Footing breadth B [m].
@@ -61,6 +78,8 @@ pub struct BearingSpec<'a> {
     pub settlement_point: [f64; 2],
     /// d/B at which q_ult is read.
     pub failure_settlement: Option<f64>,
+    /// d/B range over which q is averaged for q_ult.
+    pub plateau: Option<[f64; 2]>,
     /// Reference q_ult/c.
     pub reference: f64,
     /// Tolerance of the ratio.
@@ -79,7 +98,9 @@ impl BearingCheck {
         let soil = c.body(spec.soil).ok_or(format!("no body `{}`", spec.soil))?;
         let mat = c.material(&soil.material).expect("validated");
         let cohesion = match &mat.model {
-            SoilModel::MohrCoulomb { cohesion, .. } | SoilModel::VonMises { cohesion, .. } => *cohesion,
+            SoilModel::MohrCoulomb { cohesion, .. }
+            | SoilModel::VonMises { cohesion, .. }
+            | SoilModel::HenckyJ2 { cohesion, .. } => *cohesion,
             SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } => {
                 return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil))
             }
@@ -87,33 +108,13 @@ impl BearingCheck {
         if cohesion <= 0.0 {
             return Err("the bearing capacity check normalises by the cohesion, which must be positive".into());
         }
-        let case_load = c.load(spec.load);
-        let load = match case_load {
-            Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }) => {
-                LoadKind::Traction(traction[1].abs())
+        let (load, time_fn) = match spec.load {
+            Loading::Footing(name) => {
+                let b = model.boundaries.iter().position(|b| b.name == name).ok_or(format!("no boundary `{name}`"))?;
+                (LoadKind::Reaction(b, spec.loaded_width), crate::model::loads::TimeFn::Constant(1.0))
             }
-            Some(Load::BodyForce { acceleration, bodies, .. }) => {
-                let names = bodies.clone().unwrap_or_default();
-                if names.is_empty() {
-                    return Err(format!("the body force `{}` must name the footing body in `bodies`", spec.load));
-                }
-                let idx = names
-                    .iter()
-                    .map(|n| c.body_index(n).map(|i| i as u16))
-                    .collect::<Option<Vec<_>>>()
-                    .ok_or("unknown body")?;
-                LoadKind::Weight(acceleration[1].abs(), idx, spec.loaded_width)
-            }
-            Some(Load::LinePressure { .. }) => {
-                return Err(format!("the load `{}` of a bearing check must be a traction or a weight", spec.load))
-            }
-            None => return Err(format!("no load `{}`", spec.load)),
+            Loading::Load(name) => load_of(c, name, spec.loaded_width)?,
         };
-        let time_fn = case_load
-            .and_then(|l| l.time_function())
-            .and_then(|n| c.time_function(n))
-            .map(crate::model::loads::TimeFn::from_case)
-            .unwrap_or(crate::model::loads::TimeFn::Constant(1.0));
         // The material point nearest to the settlement point (over all ranks).
         let ps = &model.particles;
         let local: Vec<f64> = (0..ps.len())
@@ -134,12 +135,14 @@ impl BearingCheck {
             breadth: spec.breadth,
             point_id: best[1] as u64,
             failure: spec.failure_settlement,
+            plateau: spec.plateau,
             reference: spec.reference,
             tolerance: spec.tolerance,
             report: spec.report_settlements.to_vec(),
             report_loads: spec.report_loads.to_vec(),
             stop_at: spec.stop_settlement,
             baseline: 0.0,
+            reaction: [0.0; 2],
             curve: Vec::new(),
         })
     }
@@ -156,6 +159,7 @@ impl BearingCheck {
                     .sum();
                 coll.sum(&[local])?[0] * b * f / width
             }
+            LoadKind::Reaction(_, width) => -self.reaction[1] / width,
         })
     }
 
@@ -176,6 +180,38 @@ impl BearingCheck {
     }
 }
 
+/// The pressure of a case load on the footing and its time function.
+fn load_of(c: &Case, name: &str, width: f64) -> Result<(LoadKind, crate::model::loads::TimeFn), String> {
+    let case_load = c.load(name);
+    let load = match case_load {
+        Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }) => {
+            LoadKind::Traction(traction[1].abs())
+        }
+        Some(Load::BodyForce { acceleration, bodies, .. }) => {
+            let names = bodies.clone().unwrap_or_default();
+            if names.is_empty() {
+                return Err(format!("the body force `{name}` must name the footing body in `bodies`"));
+            }
+            let idx = names
+                .iter()
+                .map(|n| c.body_index(n).map(|i| i as u16))
+                .collect::<Option<Vec<_>>>()
+                .ok_or("unknown body")?;
+            LoadKind::Weight(acceleration[1].abs(), idx, width)
+        }
+        Some(Load::LinePressure { .. }) => {
+            return Err(format!("the load `{name}` of a bearing check must be a traction or a weight"))
+        }
+        None => return Err(format!("no load `{name}`")),
+    };
+    let time_fn = case_load
+        .and_then(|l| l.time_function())
+        .and_then(|n| c.time_function(n))
+        .map(crate::model::loads::TimeFn::from_case)
+        .unwrap_or(crate::model::loads::TimeFn::Constant(1.0));
+    Ok((load, time_fn))
+}
+
 impl Check for BearingCheck {
     fn columns(&self) -> Vec<String> {
         ["bearing.q", "bearing.q_over_c", "bearing.d_over_B"].iter().map(|s| s.to_string()).collect()
@@ -183,6 +219,12 @@ impl Check for BearingCheck {
 
     fn event_times(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    fn observe_reactions(&mut self, reactions: &[[f64; 2]]) {
+        if let LoadKind::Reaction(b, _) = self.load {
+            self.reaction = reactions[b];
+        }
     }
 
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
@@ -219,6 +261,35 @@ impl Check for BearingCheck {
                     pass: false,
                     detail: format!("the settlement never reached d/B = {fs}"),
                 },
+            };
+            metrics.push(("bearing_capacity_ratio".to_string(), m));
+        }
+        if let Some([from, to]) = self.plateau {
+            let q: Vec<f64> = self.curve.iter().filter(|r| r[1] >= from && r[1] <= to).map(|r| r[2]).collect();
+            let reached = self.curve.last().is_some_and(|r| r[1] >= to);
+            let m = if q.is_empty() || !reached {
+                Metric {
+                    value: f64::NAN,
+                    reference: 1.0,
+                    tolerance: self.tolerance,
+                    pass: false,
+                    detail: format!("the settlement never reached d/B = {to}"),
+                }
+            } else {
+                let qc = q.iter().sum::<f64>() / q.len() as f64;
+                let spread = q.iter().fold(0.0f64, |m, v| m.max((v - qc).abs()));
+                Metric {
+                    value: qc / self.reference,
+                    reference: 1.0,
+                    tolerance: self.tolerance,
+                    pass: (qc / self.reference - 1.0).abs() <= self.tolerance,
+                    detail: format!(
+                        "q_ult/c = {qc:.4} (mean of {} steps with d/B in [{from}, {to}], largest deviation {spread:.3}) vs \
+                         {:.4}; (q_ult/c)/reference",
+                        q.len(),
+                        self.reference
+                    ),
+                }
             };
             metrics.push(("bearing_capacity_ratio".to_string(), m));
         }

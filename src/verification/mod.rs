@@ -91,6 +91,9 @@ pub trait Check {
     fn needs_nodes(&self) -> bool {
         false
     }
+    /// Called after every converged step, before [`Check::observe`], with each boundary's reaction
+    /// on the material ([f_x, f_y] per `Model::boundaries` entry, summed over ranks) [N per m].
+    fn observe_reactions(&mut self, _reactions: &[[f64; 2]]) {}
     /// Called after every converged step, before the particle update, with this rank's owned
     /// nodes (`crate::assembly::NodeBlock`, values per node as `crate::assembly::NODE_VALUES`
     /// says) when [`Check::needs_nodes`]; collective.
@@ -314,22 +317,29 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
             breadth,
             settlement_point,
             failure_settlement,
+            plateau,
             reference,
             tolerance,
             report_settlements,
             report_loads,
             stop_settlement,
+            footing,
         } => Box::new(bearing::BearingCheck::new(
             c,
             model,
             coll,
             &bearing::BearingSpec {
                 soil,
-                load,
+                load: match (load, footing) {
+                    (_, Some(f)) => bearing::Loading::Footing(f),
+                    (Some(l), None) => bearing::Loading::Load(l),
+                    (None, None) => unreachable!("validated"),
+                },
                 loaded_width: *loaded_width,
                 breadth: *breadth,
                 settlement_point: *settlement_point,
                 failure_settlement: *failure_settlement,
+                plateau: *plateau,
                 reference: *reference,
                 tolerance: *tolerance,
                 report_settlements,
@@ -980,9 +990,14 @@ pub fn describe(v: &case::Verification) -> String {
         Verification::Patch { boundary, .. } => {
             format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")
         }
-        Verification::BearingCapacity { failure_settlement, reference, .. } => match failure_settlement {
-            Some(f) => format!("bearing capacity: q_ult/c at d/B = {f} against {reference:.4}"),
-            None => "load–settlement curve of a footing".into(),
-        },
+        Verification::BearingCapacity { failure_settlement, plateau, reference, .. } => {
+            match (failure_settlement, plateau) {
+                (Some(f), _) => format!("bearing capacity: q_ult/c at d/B = {f} against {reference:.4}"),
+                (None, Some([a, b])) => {
+                    format!("bearing capacity: q_ult/c, the mean q/c over d/B in [{a}, {b}], against {reference:.4}")
+                }
+                (None, None) => "load–settlement curve of a footing".into(),
+            }
+        }
     }
 }

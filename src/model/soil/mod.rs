@@ -150,6 +150,10 @@ pub enum Constitutive {
     /// Compressible neo-Hookean hyperelasticity (its stress from the total deformation gradient,
     /// [`Constitutive::total`]; the elasticity of the same moduli serves the estimates).
     NeoHookean(LinearElastic, crate::model::finite_strain::NeoHookean),
+    /// Hencky elasticity with J2 plasticity and exponential softening (a multiplicative
+    /// finite-strain model, [`Constitutive::finite`]; the elasticity of the same moduli serves the
+    /// estimates).
+    HenckyJ2(LinearElastic, crate::model::finite_strain::HenckyJ2),
 }
 
 impl Constitutive {
@@ -190,21 +194,60 @@ impl Constitutive {
             // increment here is the small-strain one of the same moduli, with their tangent (the
             // element test and the kernels' tests use it; a case runs it in explicit stages only).
             Constitutive::NeoHookean(el, _) => Constitutive::LinearElastic(*el).update(stress, eps_pd, deps),
+            // Likewise the finite-strain plasticity's small-strain counterpart (von Mises of the
+            // same strength, without its softening law).
+            Constitutive::HenckyJ2(el, hj) => {
+                let vm = VonMises {
+                    shear: hj.shear,
+                    cohesion: hj.cohesion,
+                    residual_cohesion: hj.cohesion,
+                    softening_modulus: 0.0,
+                };
+                Constitutive::VonMises(*el, vm).update(stress, eps_pd, deps)
+            }
         }
     }
 
-    /// A hyperelastic model's stress for the point's total in-plane deformation gradient `f`
-    /// (F_zz = 1), with the small-strain elasticity of its moduli as the tangent (no consistent
-    /// tangent: explicit stages only); NaN if det F ≤ 0 (an inadmissible step). `None` for the
-    /// incremental models.
-    pub fn total(&self, f: &[[f64; 2]; 2], eps_pd: f64) -> Option<StressUpdate> {
-        let Constitutive::NeoHookean(el, nh) = self else { return None };
+    /// A finite-strain model's stress after a step (`None` for the incremental models, whose
+    /// stress follows [`Constitutive::update`]), with the small-strain elasticity of its moduli as
+    /// the tangent (no consistent tangent: explicit stages only). `df` is the step's in-plane
+    /// deformation gradient ΔF (with F̄, ΔF̄; F_zz = 1), `f` the total one after the step
+    /// (F_{n+1}, or F̄_{n+1}), `stress` the Cauchy stress the point starts from, unrotated. The
+    /// neo-Hookean stress is a function of `f` alone. Hencky–J2 needs b^e_n, which is not stored
+    /// but recovered: the Kirchhoff stress τ_n = J_n σ_n, J_n = det f / det ΔF, determines the
+    /// elastic logarithmic strain (ε^e = dev τ/2μ + tr τ/(9K) 1, in τ's principal frame), and
+    /// b^e_n = exp(2ε^e). The stress is NaN when det F ≤ 0 or b^e is not positive (an
+    /// inadmissible step).
+    pub fn finite(
+        &self,
+        df: &[[f64; 2]; 2],
+        f: &[[f64; 2]; 2],
+        stress: &[f64; 4],
+        eps_pd: f64,
+    ) -> Option<StressUpdate> {
+        let (el, stress, eps_pd, region) = match self {
+            Constitutive::NeoHookean(el, nh) => (el, nh.stress(*f), eps_pd, Region::Elastic),
+            Constitutive::HenckyJ2(el, hj) => {
+                let (j_new, dj) = (crate::model::finite_strain::det(*f), crate::model::finite_strain::det(*df));
+                let state = crate::model::finite_strain::PlasticState {
+                    be: hj.elastic_left_cauchy_green(stress, j_new / dj),
+                    eps: eps_pd,
+                };
+                match hj.update(*df, &state, j_new) {
+                    Some(u) => {
+                        (el, Some(u.stress), u.state.eps, if u.plastic { Region::Plane } else { Region::Elastic })
+                    }
+                    None => (el, None, eps_pd, Region::Elastic),
+                }
+            }
+            _ => return None,
+        };
         Some(StressUpdate {
-            stress: nh.stress(*f).unwrap_or([f64::NAN; 4]),
+            stress: stress.unwrap_or([f64::NAN; 4]),
             tangent: el.d,
             trial_tangent: IDENTITY4,
             eps_pd,
-            region: Region::Elastic,
+            region,
         })
     }
 
@@ -214,7 +257,8 @@ impl Constitutive {
             Constitutive::LinearElastic(el)
             | Constitutive::MohrCoulomb(el, _)
             | Constitutive::VonMises(el, _)
-            | Constitutive::NeoHookean(el, _) => el,
+            | Constitutive::NeoHookean(el, _)
+            | Constitutive::HenckyJ2(el, _) => el,
         }
     }
 
