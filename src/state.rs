@@ -17,7 +17,7 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 6;
+pub const FORMAT_VERSION: u64 = 7;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
 pub const PARTICLE_FIELDS: [(&str, usize); 22] = [

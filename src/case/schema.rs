@@ -302,9 +302,9 @@ pub enum SoilModel {
     /// plasticity in principal logarithmic strains, τ = K tr ε^e 1 + 2μ dev ε^e with ε^e = ½ ln b^e,
     /// radial return of dev τ onto q = √3 c(ε̄), c(ε̄) = c_r + (c_p − c_r) exp(−η ε̄), σ = τ/J (with
     /// F̄, J̄). c is the plane-strain shear strength (the undrained strength s_u). The point's b^e is
-    /// not stored: it is recovered from its stress and J, which determine it. Only in
-    /// `dynamic_explicit` stages (no consistent tangent for the implicit ones), without an initial
-    /// stress.
+    /// not stored: it is recovered from its stress and J, which determine it (so an initial stress
+    /// is an initial elastic strain). Only in `dynamic_explicit` stages (no consistent tangent for
+    /// the implicit ones), in plane strain.
     HenckyJ2 {
         /// Young's modulus E [Pa], in (0, 1e13].
         young_modulus: f64,
@@ -527,7 +527,10 @@ pub struct Surface {
     /// Which faces: the particles whose face in one of these directions is exposed at t = 0.
     pub faces: Vec<Side>,
     /// Only the particles whose centres lie in this box at t = 0 (default: all of the body's), e.g.
-    /// the part of the ground under a footing [m].
+    /// the part of the ground under a footing [m]. The box also bounds the nodes fixed along each
+    /// face (x for a y face, y for an x face; the box stays where it is at t = 0), so that a
+    /// footing's edge stays at the box's edge; put that edge on a grid line (a boundary fixes whole
+    /// nodes).
     #[serde(default)]
     pub region: Option<Region>,
 }

@@ -994,10 +994,11 @@ pub fn validate(c: &Case) -> R {
                         let Some(b) = c.boundaries.iter().find(|b| &b.name == f) else {
                             return Err(format!("key `verification.footing`: no boundary named `{f}`"));
                         };
-                        if !b.fix.contains(&Dof::Uy) || (b.velocity.is_none() && b.displacement.is_none()) {
+                        let vertical = |v: Option<[f64; 2]>| v.is_some_and(|v| v[1] != 0.0);
+                        if !b.fix.contains(&Dof::Uy) || !(vertical(b.velocity) || vertical(b.displacement)) {
                             return Err(format!(
-                                "key `verification.footing`: the boundary `{f}` must fix `uy` and move it (`velocity` \
-                                 or `displacement`): its reaction is the footing's load"
+                                "key `verification.footing`: the boundary `{f}` must fix `uy` and move it vertically \
+                                 (`velocity` or `displacement`): its reaction is the footing's load"
                             ));
                         }
                         if c.body(soil).is_none() {

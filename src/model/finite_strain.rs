@@ -404,6 +404,22 @@ mod tests {
             (stress, eps, state) = (u.stress, u.eps_pd, direct.state);
         }
         assert!(eps > 0.0);
+        // With F̄: the kernel passes ΔF̄ = c ΔF and F̄_{n+1} = s ΔF F_n with c = (J̄^{n+1}/(J̄^n ΔJ))^½
+        // and s = (J̄^{n+1}/(J^n ΔJ))^½, and the stored σ_n = τ(b^e_n)/J̄^n; `finite` must recover
+        // J̄^n = det F̄_{n+1}/det ΔF̄ and give the direct update with ΔF̄ divided by J̄^{n+1}.
+        let f_n = [[1.02, 0.03], [-0.01, 0.97]];
+        let (jbar_n, jbar_new) = (0.9981, 0.9975);
+        let pre = m.update([[1.0, 0.004], [0.002, 1.0]], &PlasticState::default(), jbar_n).unwrap();
+        let df = [[1.001, 0.0015], [0.0005, 0.9985]];
+        let (j_n, dj) = (det(f_n), det(df));
+        let c = (jbar_new / (jbar_n * dj)).sqrt();
+        let s = (jbar_new / (j_n * dj)).sqrt();
+        assert!((c - s).abs() > 1e-4, "c and s must differ here: {c} {s}");
+        let dfbar = df.map(|r| r.map(|v| v * c));
+        let fbar_new = mul(df, f_n).map(|r| r.map(|v| v * s));
+        let u = model.finite(&dfbar, &fbar_new, &pre.stress, pre.state.eps).unwrap();
+        let direct = m.update(dfbar, &pre.state, jbar_new).unwrap();
+        assert!(close(&u.stress, &direct.stress, 1e-11), "{:?} vs {:?}", u.stress, direct.stress);
         // The incremental models have no finite-strain stress.
         assert!(Constitutive::LinearElastic(LinearElastic::new(1.0, 0.3)).finite(&f, &f, &stress, 0.0).is_none());
     }

@@ -232,12 +232,15 @@ impl Check for BearingCheck {
         let ps = &model.particles;
         let local: f64 = (0..ps.len()).find(|&k| ps.id[k] == self.point_id).map_or(0.0, |k| -ps.disp[k][1]);
         let mut d = coll.sum(&[local])?[0];
-        if q == 0.0 {
+        // A new step (not the repeated observation of a restart) with no load yet sets the zero
+        // of the settlement.
+        let new_row = self.curve.last().is_none_or(|l| l[0] < t);
+        if q == 0.0 && new_row {
             self.baseline = d;
         }
         d -= self.baseline;
         let row = [t, d / self.breadth, q / self.cohesion];
-        if self.curve.last().is_none_or(|l| l[0] < t) {
+        if new_row {
             self.curve.push(row);
         }
         Ok(vec![q, row[2], row[1]])
@@ -306,17 +309,24 @@ impl Check for BearingCheck {
     }
 
     fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        Ok(Some(std::iter::once(self.baseline).chain(self.curve.iter().flatten().copied()).collect()))
+        // [baseline, reaction_x, reaction_y, rows…]: the reaction of the last step is the footing's
+        // load when the run restarts.
+        Ok(Some(
+            [self.baseline, self.reaction[0], self.reaction[1]]
+                .into_iter()
+                .chain(self.curve.iter().flatten().copied())
+                .collect(),
+        ))
     }
 
     fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
-        let Some((&baseline, rows)) = state.split_first() else {
-            return Err("an empty load-settlement state".into());
+        let [baseline, rx, ry, rows @ ..] = state else {
+            return Err("a load-settlement state without its baseline and reaction".into());
         };
         if !rows.len().is_multiple_of(3) {
             return Err(format!("{} values do not make rows of a load-settlement curve", rows.len()));
         }
-        self.baseline = baseline;
+        (self.baseline, self.reaction) = (*baseline, [*rx, *ry]);
         self.curve = rows.chunks(3).map(|r| [r[0], r[1], r[2]]).collect();
         Ok(())
     }

@@ -148,7 +148,7 @@ pub enum Constitutive {
     /// Von Mises.
     VonMises(LinearElastic, VonMises),
     /// Compressible neo-Hookean hyperelasticity (its stress from the total deformation gradient,
-    /// [`Constitutive::total`]; the elasticity of the same moduli serves the estimates).
+    /// [`Constitutive::finite`]; the elasticity of the same moduli serves the estimates).
     NeoHookean(LinearElastic, crate::model::finite_strain::NeoHookean),
     /// Hencky elasticity with J2 plasticity and exponential softening (a multiplicative
     /// finite-strain model, [`Constitutive::finite`]; the elasticity of the same moduli serves the
@@ -190,18 +190,19 @@ impl Constitutive {
             Constitutive::VonMises(el, vm) => {
                 isotropic_return(el, stress, eps_pd, deps, |l, e| vm.return_principal(l, e))
             }
-            // A hyperelastic model's stress comes from the total deformation (`total`); its
+            // A hyperelastic model's stress comes from the total deformation (`finite`); its
             // increment here is the small-strain one of the same moduli, with their tangent (the
-            // element test and the kernels' tests use it; a case runs it in explicit stages only).
+            // kernels' tests use it; a case runs it in explicit stages only, through `finite`).
             Constitutive::NeoHookean(el, _) => Constitutive::LinearElastic(*el).update(stress, eps_pd, deps),
-            // Likewise the finite-strain plasticity's small-strain counterpart (von Mises of the
-            // same strength, without its softening law).
+            // Likewise Hencky–J2's small-strain limit, von Mises of the same strength with the
+            // exponential softening linearised at ε̄ = 0 (H = −η (c_p − c_r), floored at c_r). A run
+            // never takes this path: `finite` answers for Hencky–J2 in every kernel.
             Constitutive::HenckyJ2(el, hj) => {
                 let vm = VonMises {
                     shear: hj.shear,
                     cohesion: hj.cohesion,
-                    residual_cohesion: hj.cohesion,
-                    softening_modulus: 0.0,
+                    residual_cohesion: hj.residual_cohesion,
+                    softening_modulus: -hj.softening_rate * (hj.cohesion - hj.residual_cohesion),
                 };
                 Constitutive::VonMises(*el, vm).update(stress, eps_pd, deps)
             }
