@@ -576,8 +576,9 @@ impl<'a> Point<'a> {
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
-        let df = kin.f_bar().map(|r| r.map(|v| v * part.fbar));
-        let f_new = kinematics::product(&kin.f_bar(), &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
+        let f_bar = kin.f_bar();
+        let df = f_bar.map(|r| r.map(|v| v * part.fbar));
+        let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
             .finite(&df, &f_new, &part.stress, part.eps_pd)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));

@@ -247,55 +247,48 @@ impl Check for BearingCheck {
     }
 
     fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
-        let mut metrics = Vec::new();
-        if let Some(fs) = self.failure {
-            let m = match self.at(fs) {
-                Some(qc) => Metric {
-                    value: qc / self.reference,
-                    reference: 1.0,
-                    tolerance: self.tolerance,
-                    pass: (qc / self.reference - 1.0).abs() <= self.tolerance,
-                    detail: format!("q_ult/c = {qc:.4} at d/B = {fs} vs {:.4}; (q_ult/c)/reference", self.reference),
-                },
-                None => Metric {
-                    value: f64::NAN,
-                    reference: 1.0,
-                    tolerance: self.tolerance,
-                    pass: false,
-                    detail: format!("the settlement never reached d/B = {fs}"),
-                },
-            };
-            metrics.push(("bearing_capacity_ratio".to_string(), m));
-        }
-        if let Some([from, to]) = self.plateau {
-            let q: Vec<f64> = self.curve.iter().filter(|r| r[1] >= from && r[1] <= to).map(|r| r[2]).collect();
-            let reached = self.curve.last().is_some_and(|r| r[1] >= to);
-            let m = if q.is_empty() || !reached {
-                Metric {
-                    value: f64::NAN,
-                    reference: 1.0,
-                    tolerance: self.tolerance,
-                    pass: false,
-                    detail: format!("the settlement never reached d/B = {to}"),
+        // q_ult/c and how it was read (NaN when the curve never got there), by the settlement at
+        // failure or by the plateau's mean.
+        let read = match (self.failure, self.plateau) {
+            (Some(fs), _) => Some(match self.at(fs) {
+                Some(qc) => {
+                    (qc, format!("q_ult/c = {qc:.4} at d/B = {fs} vs {:.4}; (q_ult/c)/reference", self.reference))
                 }
-            } else {
-                let qc = q.iter().sum::<f64>() / q.len() as f64;
-                let spread = q.iter().fold(0.0f64, |m, v| m.max((v - qc).abs()));
-                Metric {
-                    value: qc / self.reference,
-                    reference: 1.0,
-                    tolerance: self.tolerance,
-                    pass: (qc / self.reference - 1.0).abs() <= self.tolerance,
-                    detail: format!(
+                None => (f64::NAN, format!("the settlement never reached d/B = {fs}")),
+            }),
+            (None, Some([from, to])) => {
+                let q: Vec<f64> = self.curve.iter().filter(|r| r[1] >= from && r[1] <= to).map(|r| r[2]).collect();
+                let reached = self.curve.last().is_some_and(|r| r[1] >= to);
+                Some(if q.is_empty() || !reached {
+                    (f64::NAN, format!("the settlement never reached d/B = {to}"))
+                } else {
+                    let qc = q.iter().sum::<f64>() / q.len() as f64;
+                    let spread = q.iter().fold(0.0f64, |m, v| m.max((v - qc).abs()));
+                    let detail = format!(
                         "q_ult/c = {qc:.4} (mean of {} steps with d/B in [{from}, {to}], largest deviation {spread:.3}) vs \
                          {:.4}; (q_ult/c)/reference",
                         q.len(),
                         self.reference
-                    ),
-                }
-            };
-            metrics.push(("bearing_capacity_ratio".to_string(), m));
-        }
+                    );
+                    (qc, detail)
+                })
+            }
+            (None, None) => None,
+        };
+        let metrics = read
+            .map(|(qc, detail)| {
+                let ratio = qc / self.reference;
+                let metric = Metric {
+                    value: ratio,
+                    reference: 1.0,
+                    tolerance: self.tolerance,
+                    pass: (ratio - 1.0).abs() <= self.tolerance,
+                    detail,
+                };
+                ("bearing_capacity_ratio".to_string(), metric)
+            })
+            .into_iter()
+            .collect();
         let table = Table {
             name: "load_settlement.csv".into(),
             header: vec!["time", "d_over_B", "q_over_c"],

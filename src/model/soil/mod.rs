@@ -229,11 +229,9 @@ impl Constitutive {
         let (el, stress, eps_pd, region) = match self {
             Constitutive::NeoHookean(el, nh) => (el, nh.stress(*f), eps_pd, Region::Elastic),
             Constitutive::HenckyJ2(el, hj) => {
-                let (j_new, dj) = (crate::model::finite_strain::det(*f), crate::model::finite_strain::det(*df));
-                let state = crate::model::finite_strain::PlasticState {
-                    be: hj.elastic_left_cauchy_green(stress, j_new / dj),
-                    eps: eps_pd,
-                };
+                use crate::model::finite_strain::{det, PlasticState};
+                let (j_new, dj) = (det(*f), det(*df));
+                let state = PlasticState { be: hj.elastic_left_cauchy_green(stress, j_new / dj), eps: eps_pd };
                 match hj.update(*df, &state, j_new) {
                     Some(u) => {
                         (el, Some(u.stress), u.state.eps, if u.plastic { Region::Plane } else { Region::Elastic })
