@@ -55,6 +55,10 @@ pub fn describe(case: &Case, label: &str) -> String {
             SoilModel::NeoHookean { young_modulus, poisson_ratio } => {
                 format!("neo-Hookean, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
             }
+            SoilModel::NewtonianFluid { bulk_modulus, viscosity, bulk_viscosity } => format!(
+                "Newtonian fluid (finite strain), K = {bulk_modulus:.4e} Pa, μ_v = {viscosity:.4e} Pa s, ζ = \
+                 {bulk_viscosity:.4e} Pa s"
+            ),
             SoilModel::MohrCoulomb {
                 young_modulus,
                 poisson_ratio,

@@ -206,6 +206,8 @@ macro_rules! gold_tests {
 gold_tests!(
     consolidation_layer,
     cook_membrane,
+    dam_break,
+    dam_break_martin_moyce,
     elastic_column,
     footing_fbar,
     footing_ld,

@@ -32,6 +32,7 @@ pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernel
     let nm = step.nm.as_ref().expect("prepared");
     let s = &step.smooth[k];
     input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
+    input.dt = nm.dt();
     input
 }
 

@@ -90,10 +90,10 @@ fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Resul
 pub fn parse_material(text: &str, origin: &str) -> Result<MaterialFile, CaseError> {
     let m: MaterialFile = parse_toml(text, origin)?;
     validate::soil_model("model", &m.model).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
-    if matches!(m.model, SoilModel::NeoHookean { .. } | SoilModel::HenckyJ2 { .. }) {
+    if matches!(m.model, SoilModel::NeoHookean { .. } | SoilModel::HenckyJ2 { .. } | SoilModel::NewtonianFluid { .. }) {
         return Err(CaseError::new(format!(
             "{origin}: key `model.type`: the element test drives incremental models along strain increments; \
-             the finite-strain models (`neo_hookean`, `hencky_j2`) follow the deformation gradient and are not \
+             the finite-strain models (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) follow the deformation gradient and are not \
              supported"
         )));
     }

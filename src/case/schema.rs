@@ -189,7 +189,8 @@ pub struct Grid {
 pub struct Material {
     /// Name used by bodies.
     pub name: String,
-    /// Initial porosity n [-].
+    /// Initial porosity n [-], in (0, 1) (in [0, 1) in a one-phase analysis, whose density is the
+    /// mixture's (1 − n) ρ_s + n ρ_w).
     pub porosity: f64,
     /// Density of the solid grains ρ_s [kg/m³], in (0, 1e5].
     pub solid_density: f64,
@@ -318,6 +319,24 @@ pub enum SoilModel {
         /// Softening rate η of c(ε̄) [-], ≥ 0 (default 0).
         #[serde(default)]
         softening_rate: f64,
+    },
+    /// A weakly compressible Newtonian fluid ([002] §4.3, the dam break;
+    /// `model::finite_strain::NewtonianFluid`): σ = −p 1 + 2μ_v dev d with the pressure of the
+    /// equation of state p = K(1 − J) (with F̄, J̄) and d the step's rate of deformation. Its density
+    /// is the material's (`porosity = 0`, `solid_density` = ρ). The stress is a function of J and the
+    /// rate, so the body takes no initial stress: a hydrostatic state is reached by a settling
+    /// stage. Only in `dynamic_explicit` stages, in plane strain.
+    NewtonianFluid {
+        /// Bulk modulus K [Pa], in (0, 1e13] (water: 2.0e9 Pa; a smaller K is the usual weakly
+        /// compressible substitute when the flow's Mach number v/√(K/ρ) stays below 0.1).
+        bulk_modulus: f64,
+        /// Dynamic viscosity μ_v [Pa s], ≥ 0 (water: 1.0e-3 Pa s).
+        viscosity: f64,
+        /// Bulk viscosity ζ [Pa s], ≥ 0 (default 0): σ gains ζ tr d 1. Water has none (Stokes);
+        /// explicit codes add ζ = b₁ ρ c_p h (Abaqus/Explicit: b₁ = 0.06) to damp the volumetric
+        /// ringing of a stiff fluid at the grid's scale.
+        #[serde(default)]
+        bulk_viscosity: f64,
     },
 }
 
@@ -1326,6 +1345,40 @@ pub enum Verification {
         #[serde(default = "default_cook_radius")]
         fit_radius: f64,
     },
+    /// The collapse of a water column after a gate is removed ([002] §4.3; `verification::dam_break`,
+    /// `../shared/seeds-001-002.md` Parts D3 and E item 15). A settling stage brings the water to
+    /// rest behind the gate (the stage names it; the gate is a boundary the next stages leave out);
+    /// at its end the pressure must be hydrostatic. After it, the front and the centre of mass are
+    /// followed, the front's advance is bounded by the shallow-water (Ritter) speed 2√(gH), and the
+    /// mass must not change. With `experiment`, the front is compared with a laboratory series.
+    DamBreak {
+        /// The water body (a rectangle at t = 0 against the back wall at its left).
+        body: String,
+        /// The body-force load carrying gravity.
+        gravity: String,
+        /// The settling stage, at whose end the water is checked for the hydrostatic pressure and
+        /// after which it flows.
+        settle_stage: String,
+        /// Largest accepted |p − ρ g d| / (ρ g H) over the points more than one cell above the base
+        /// at the end of the settling stage (Part E item 15: 2 %) [-].
+        #[serde(default = "default_hydrostatic_tol")]
+        hydrostatic_tolerance: f64,
+        /// x of the wall the front runs into [m]; the front's speed bound applies while the front is
+        /// more than a cell from it (default: no wall, the whole run).
+        #[serde(default)]
+        far_wall: Option<f64>,
+        /// A measured front position to compare with: `"martin_moyce_1952"` (Martin & Moyce 1952,
+        /// the column of height 2a on width a, n² = 2; the body must have that aspect ratio).
+        #[serde(default)]
+        experiment: Option<String>,
+        /// Largest accepted mean |Z/Z_exp − 1| of the front against `experiment` [-].
+        #[serde(default = "default_front_tol")]
+        front_tolerance: f64,
+        /// The share of the water's mass that may lie ahead of the front, as spray shed from its
+        /// tip, in [0, 0.05] (default 0.005) [-].
+        #[serde(default = "default_spray")]
+        spray_fraction: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1359,6 +1412,7 @@ impl Verification {
             Verification::VerticalCut { .. } => "vertical_cut",
             Verification::ShockWave { .. } => "shock_wave",
             Verification::CookMembrane { .. } => "cook_membrane",
+            Verification::DamBreak { .. } => "dam_break",
         }
     }
 }
@@ -1379,6 +1433,15 @@ pub struct IncrementTolerances {
     pub radius: f64,
 }
 
+fn default_hydrostatic_tol() -> f64 {
+    0.02
+}
+fn default_front_tol() -> f64 {
+    0.1
+}
+fn default_spray() -> f64 {
+    0.005
+}
 fn default_lame_tol() -> f64 {
     0.05
 }

@@ -136,16 +136,17 @@ fn bspline_options(c: &Case) -> R {
     Ok(())
 }
 
-/// Where a finite-strain material (`neo_hookean`, `hencky_j2`) may be used: in explicit stages
-/// only (the implicit stages need its consistent tangent, not built), in plane strain (its
-/// kinematics have F_zz = 1), and, for the hyperelastic neo-Hookean, without an initial stress (its
-/// stress is a function of the deformation alone; a Hencky–J2 point's initial stress is its initial
-/// elastic strain).
+/// Where a finite-strain material (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) may be used: in
+/// explicit stages only (the implicit stages need its consistent tangent, not built), in plane
+/// strain (its kinematics have F_zz = 1), and, for the hyperelastic neo-Hookean and the fluid,
+/// without an initial stress (their stress is a function of the deformation and rate alone; a
+/// Hencky–J2 point's initial stress is its initial elastic strain).
 fn finite_strain_materials(c: &Case) -> R {
     for (i, m) in c.materials.iter().enumerate() {
         let name = match m.model {
             SoilModel::NeoHookean { .. } => "neo_hookean",
             SoilModel::HenckyJ2 { .. } => "hencky_j2",
+            SoilModel::NewtonianFluid { .. } => "newtonian_fluid",
             _ => continue,
         };
         if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
@@ -161,16 +162,17 @@ fn finite_strain_materials(c: &Case) -> R {
                  axisymmetric"
             ));
         }
-        if name != "neo_hookean" {
+        if name == "hencky_j2" {
             continue;
         }
         if let Some(b) =
             c.bodies.iter().find(|b| b.material == m.name && (b.initial_stress.is_some() || b.uniform_stress.is_some()))
         {
             return Err(format!(
-                "key `bodies.{}`: a neo_hookean body takes no initial stress (its stress is a function of its \
-                 deformation)",
-                b.name
+                "key `bodies.{}`: a {name} body takes no initial stress (its stress is a function of its \
+                 deformation{}; reach a stressed state with a settling stage)",
+                b.name,
+                if name == "newtonian_fluid" { " and its rate" } else { "" }
             ));
         }
     }
@@ -323,7 +325,12 @@ pub fn validate(c: &Case) -> R {
     unique("materials", c.materials.iter().map(|m| m.name.as_str()))?;
     for (i, m) in c.materials.iter().enumerate() {
         let k = |f: &str| format!("materials[{i}].{f}");
-        in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+        // A one-phase material may have no pores (a fluid, a solid): its density is the mixture's.
+        if two_phase {
+            in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+        } else {
+            in_closed_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+        }
         for (f, v) in [("solid_density", m.solid_density), ("water_density", m.water_density)] {
             magnitude(&k(f), v, MAX_DENSITY, "kg/m³", "denser than any material")?;
         }
@@ -840,6 +847,57 @@ pub fn validate(c: &Case) -> R {
                 }
                 return Ok(());
             }
+            Verification::DamBreak {
+                body,
+                gravity,
+                settle_stage,
+                hydrostatic_tolerance,
+                far_wall,
+                experiment,
+                front_tolerance,
+                spray_fraction,
+            } => {
+                positive("verification.hydrostatic_tolerance", *hydrostatic_tolerance)?;
+                if !(0.0..=0.05).contains(spray_fraction) {
+                    return Err(format!(
+                        "key `verification.spray_fraction`: must be in [0, 0.05], got {spray_fraction}"
+                    ));
+                }
+                positive("verification.front_tolerance", *front_tolerance)?;
+                if let Some(x) = far_wall {
+                    finite2("verification.far_wall", [*x, 0.0])?;
+                }
+                let Some(bd) = c.body(body) else {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                };
+                if !matches!(bd.shape, crate::case::Shape::Rectangle { .. }) {
+                    return Err(format!(
+                        "key `verification.body`: the dam break's column `{body}` must be a rectangle"
+                    ));
+                }
+                if !matches!(c.load(gravity), Some(Load::BodyForce { .. })) {
+                    return Err(format!("key `verification.gravity`: `{gravity}` must be a body_force load"));
+                }
+                let Some(s) = c.stages.iter().position(|s| &s.name == settle_stage) else {
+                    return Err(format!("key `verification.settle_stage`: no stage named `{settle_stage}`"));
+                };
+                if s + 1 == c.stages.len() {
+                    return Err(format!(
+                        "key `verification.settle_stage`: `{settle_stage}` is the last stage, so the water never flows"
+                    ));
+                }
+                if let Some(e) = experiment {
+                    if e != "martin_moyce_1952" {
+                        return Err(format!(
+                            "key `verification.experiment`: unknown experiment `{e}` (known: martin_moyce_1952)"
+                        ));
+                    }
+                }
+                if two_phase {
+                    return Err("key `verification`: the dam break is for a one_phase analysis".into());
+                }
+                return Ok(());
+            }
             Verification::StiffnessMap { body, center, radius, tolerance } => {
                 finite2("verification.center", *center)?;
                 positive("verification.radius", *radius)?;
@@ -1147,6 +1205,11 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
                     -3f64.sqrt() * g
                 ));
             }
+        }
+        SoilModel::NewtonianFluid { bulk_modulus, viscosity, bulk_viscosity } => {
+            modulus(&k("bulk_modulus"), *bulk_modulus)?;
+            non_negative(&k("viscosity"), *viscosity)?;
+            non_negative(&k("bulk_viscosity"), *bulk_viscosity)?;
         }
         SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
             modulus(&k("young_modulus"), *young_modulus)?;

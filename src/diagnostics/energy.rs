@@ -147,6 +147,7 @@ mod tests {
             linear: false,
             fbar: 1.0,
             fbar_total: 1.0,
+            dt: 0.0,
         }
     }
 

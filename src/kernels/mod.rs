@@ -211,6 +211,9 @@ pub struct ParticleInput {
     /// ([002] Eq. 18; 1 without it), which a hyperelastic model sees: at the step's start that
     /// of the point's stored J̄ (its stress σ_n), at its end that of the projected J̄_{n+1}.
     pub fbar_total: f64,
+    /// The step's Δt [s], which a rate-dependent model (the Newtonian fluid's viscosity) divides
+    /// the step's deformation by; 0 where no step is being taken.
+    pub dt: f64,
 }
 
 /// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
@@ -311,6 +314,11 @@ pub struct Scheme {
 }
 
 impl Scheme {
+    /// The step's Δt [s].
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
     /// Newmark factors for step `dt`.
     pub fn newmark(beta: f64, gamma: f64, dt: f64) -> Scheme {
         Scheme::of(&Integration::newmark(beta, gamma), dt, false)
@@ -580,7 +588,7 @@ impl<'a> Point<'a> {
         let df = f_bar.map(|r| r.map(|v| v * part.fbar));
         let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
-            .finite(&df, &f_new, &part.stress, part.eps_pd)
+            .finite(&df, &f_new, &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
         let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
         let mut hoop = [(0.0, 0.0); MAX_NODES];

@@ -160,6 +160,7 @@ fn part() -> ParticleInput {
         linear: false,
         fbar: 1.0,
         fbar_total: 1.0,
+        dt: 0.0,
     }
 }
 

@@ -205,22 +205,27 @@ impl HenckyJ2 {
     }
 }
 
-/// A weakly compressible Newtonian fluid (the dam break, [002] §4.3): σ = −p 1 + 2μ_v dev d with
-/// the pressure of the equation of state p = K(1 − J) and the rate of deformation d = sym L
+/// A weakly compressible Newtonian fluid (the dam break, [002] §4.3): σ = −p 1 + 2μ_v dev d + ζ tr d 1
+/// with the pressure of the equation of state p = K max(1 − J, 0) (water takes no tension: a
+/// stretched point is separating, not pulling) and the rate of deformation d = sym L
 /// (seeds-001-002.md Part C4; for the |J − 1| ~ 1e-5 of water any equation of state is the same).
-/// With F̄, only the pressure sees J̄.
+/// The bulk viscosity ζ is the explicit codes' damping of volumetric ringing (Abaqus/Explicit's
+/// linear bulk viscosity ζ = b₁ ρ c h, b₁ = 0.06 by default; Stokes' hypothesis gives water none).
+/// With F̄, the pressure sees J̄ and the bulk viscosity the rate of J̄.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonianFluid {
     /// Bulk modulus K [Pa].
     pub bulk: f64,
     /// Dynamic viscosity μ_v [Pa s].
     pub viscosity: f64,
+    /// Bulk viscosity ζ [Pa s].
+    pub bulk_viscosity: f64,
 }
 
 impl NewtonianFluid {
     /// The Cauchy stress at volume ratio `j` and in-plane velocity gradient `l` [1/s].
     pub fn stress(&self, j: f64, l: M2) -> [f64; 4] {
-        let p = self.bulk * (1.0 - j);
+        let p = self.bulk * (1.0 - j).max(0.0);
         let d = [l[0][0], l[1][1], 0.5 * (l[0][1] + l[1][0])];
         let m = (d[0] + d[1]) / 3.0;
         let mu2 = 2.0 * self.viscosity;
@@ -231,6 +236,39 @@ impl NewtonianFluid {
     pub fn pressure(&self, j: f64) -> f64 {
         self.bulk * (1.0 - j)
     }
+
+    /// The stress after a step of deformation gradient `df` over `dt` seconds that leaves the
+    /// fluid at the in-plane total deformation `f`: the pressure of J = det f and the viscous
+    /// stress of the step's rate of deformation ([`rate_of_deformation`]).
+    pub fn stress_after(&self, df: M2, f: M2, dt: f64) -> [f64; 4] {
+        let mut s = self.stress(det(f), rate_of_deformation(df, dt));
+        // ζ tr d with tr d = ln(det ΔF)/Δt (with F̄, det ΔF̄ = J̄_{n+1}/J̄_n).
+        let dj = det(df);
+        if dt > 0.0 && dj > 0.0 && self.bulk_viscosity > 0.0 {
+            let q = self.bulk_viscosity * dj.ln() / dt;
+            for c in [0, 1, 3] {
+                s[c] += q;
+            }
+        }
+        s
+    }
+}
+
+/// The rate of deformation of a step of deformation gradient ΔF over Δt [1/s]:
+/// d = (V_iso − 1)/Δt, with V_iso the left stretch of the isochoric part ΔF/√det ΔF (polar
+/// decomposition ΔF = V R). It is objective (a rigid rotation of the step gives d = 0 whatever its
+/// angle), it is the same for ΔF and for F̄'s c ΔF (only the pressure sees J̄), and it is sym L + O(Δt)
+/// for a step of velocity gradient L. Zero when `dt` is not positive or ΔF is inadmissible
+/// (det ΔF ≤ 0, which the pressure's J then reports).
+pub fn rate_of_deformation(df: M2, dt: f64) -> M2 {
+    let j = det(df);
+    if dt <= 0.0 || j.is_nan() || j <= 0.0 {
+        return [[0.0; 2]; 2];
+    }
+    let s = j.sqrt();
+    // V = sqrt(ΔF ΔFᵀ) is the right stretch of ΔFᵀ.
+    let v = super::shape::right_stretch([[df[0][0] / s, df[1][0] / s], [df[0][1] / s, df[1][1] / s]]);
+    [[(v[0][0] - 1.0) / dt, v[0][1] / dt], [v[1][0] / dt, (v[1][1] - 1.0) / dt]]
 }
 
 #[cfg(test)]
@@ -397,7 +435,7 @@ mod tests {
             let df = [[1.0 - 3e-4, 1.5e-3 * (k as f64 * 0.2).sin()], [2e-3, 1.0 + 1e-4]];
             f = mul(df, f);
             j *= det(df);
-            let u = model.finite(&df, &f, &stress, eps).unwrap();
+            let u = model.finite(&df, &f, &stress, eps, 1e-3).unwrap();
             let direct = m.update(df, &state, j).unwrap();
             assert!(close(&u.stress, &direct.stress, 1e-11), "step {k}: {:?} vs {:?}", u.stress, direct.stress);
             assert!((u.eps_pd - direct.state.eps).abs() <= 1e-12 * direct.state.eps.max(1e-300) + 1e-18);
@@ -417,16 +455,16 @@ mod tests {
         assert!((c - s).abs() > 1e-4, "c and s must differ here: {c} {s}");
         let dfbar = df.map(|r| r.map(|v| v * c));
         let fbar_new = mul(df, f_n).map(|r| r.map(|v| v * s));
-        let u = model.finite(&dfbar, &fbar_new, &pre.stress, pre.state.eps).unwrap();
+        let u = model.finite(&dfbar, &fbar_new, &pre.stress, pre.state.eps, 1e-3).unwrap();
         let direct = m.update(dfbar, &pre.state, jbar_new).unwrap();
         assert!(close(&u.stress, &direct.stress, 1e-11), "{:?} vs {:?}", u.stress, direct.stress);
         // The incremental models have no finite-strain stress.
-        assert!(Constitutive::LinearElastic(LinearElastic::new(1.0, 0.3)).finite(&f, &f, &stress, 0.0).is_none());
+        assert!(Constitutive::LinearElastic(LinearElastic::new(1.0, 0.3)).finite(&f, &f, &stress, 0.0, 1e-3).is_none());
     }
 
     #[test]
     fn the_newtonian_fluid_has_its_pressure_and_viscous_shear() {
-        let w = NewtonianFluid { bulk: 2e9, viscosity: 1e-3 };
+        let w = NewtonianFluid { bulk: 2e9, viscosity: 1e-3, bulk_viscosity: 0.0 };
         let s = w.stress(1.0 - 1e-5, [[0.0, 0.0], [0.0, 0.0]]);
         assert!(close(&s, &[-2e4, -2e4, 0.0, -2e4], 1e-9), "{s:?}");
         // Simple shear v_x = γ̇ y: σ_xy = μ γ̇, no normal stress; a rigid spin carries no stress.
@@ -440,5 +478,48 @@ mod tests {
         let lr = mul(mul(r, l), rot(-0.8));
         assert!(close(&w.stress(0.99, lr), &rotate(r, w.stress(0.99, l)), 1e-12));
         assert!((w.pressure(0.99) - 2e7).abs() < 1e-6);
+    }
+
+    /// The fluid through `Constitutive::finite`: a step that only rotates (by a finite angle)
+    /// leaves the pressure of J and no viscous stress; a small simple-shear step gives μ_v γ̇ and
+    /// the same viscous stress when F̄ scales the step (c ΔF), only the pressure following J̄.
+    #[test]
+    fn the_fluid_step_is_objective_and_its_viscosity_does_not_see_fbar() {
+        use crate::model::soil::Constitutive;
+        let w = NewtonianFluid { bulk: 2e9, viscosity: 0.5, bulk_viscosity: 0.0 };
+        let model = Constitutive::NewtonianFluid(LinearElastic::from_bulk_shear(2e9, 0.0), w);
+        let dt = 1e-3;
+        let f = [[0.99999, 0.0], [0.0, 1.0]];
+        let spin = model.finite(&rot(0.7), &f, &[0.0; 4], 0.0, dt).unwrap();
+        assert!(close(&spin.stress, &[-2e4, -2e4, 0.0, -2e4], 1e-9), "{:?}", spin.stress);
+        // Simple shear at γ̇ = 10/s over the step: σ_xy = μ_v γ̇ to first order in γ̇ Δt.
+        let df = [[1.0, 10.0 * dt], [0.0, 1.0]];
+        let u = model.finite(&df, &df, &[0.0; 4], 0.0, dt).unwrap();
+        assert!((u.stress[2] - 0.5 * 10.0).abs() < 1e-3 * 5.0, "{:?}", u.stress);
+        // Normal viscous stresses are of the next order, γ̇Δt σ_xy.
+        assert!(u.stress.iter().take(2).all(|v| v.abs() < 10.0 * dt * 5.0), "{:?}", u.stress);
+        // F̄: c ΔF changes the pressure (through J̄ = det F̄), not the viscous part.
+        let c = 1.0 - 3e-6;
+        let dfc = df.map(|r| r.map(|v| v * c));
+        let ub = model.finite(&dfc, &dfc, &[0.0; 4], 0.0, dt).unwrap();
+        let p = w.pressure(det(dfc));
+        assert!((ub.stress[2] - u.stress[2]).abs() < 1e-14, "{} vs {}", ub.stress[2], u.stress[2]);
+        let mean = (ub.stress[0] + ub.stress[1] + ub.stress[3]) / 3.0;
+        assert!((mean + p).abs() < 1e-9 * p.abs() && p > 0.0, "{:?} p = {p}", ub.stress);
+        // The estimates see the bulk modulus as the constrained modulus, no shear stiffness.
+        assert_eq!(model.elastic().constrained_modulus(), 2e9);
+        assert_eq!(model.elastic().shear_modulus(), 0.0);
+        // A bulk viscosity adds ζ tr d = ζ ln(det ΔF)/Δt to the mean stress, nothing to the shear.
+        let zeta = NewtonianFluid { bulk_viscosity: 300.0, ..w };
+        let squeeze = [[1.0 - 2e-4, 0.0], [0.0, 1.0]];
+        let (plain, damped) = (w.stress_after(squeeze, squeeze, dt), zeta.stress_after(squeeze, squeeze, dt));
+        let expected = 300.0 * (1.0f64 - 2e-4).ln() / dt;
+        for c in [0, 1, 3] {
+            assert!((damped[c] - plain[c] - expected).abs() < 1e-9 * expected.abs(), "{damped:?} vs {plain:?}");
+        }
+        assert_eq!(damped[2], plain[2]);
+        // Inadmissible: det F ≤ 0 gives NaN.
+        let bad = model.finite(&df, &[[-1.0, 0.0], [0.0, 1.0]], &[0.0; 4], 0.0, dt).unwrap();
+        assert!(bad.stress.iter().all(|v| v.is_nan()));
     }
 }

@@ -118,6 +118,10 @@ pub fn soil_model(m: &SoilModel) -> Constitutive {
                 ),
             )
         }
+        SoilModel::NewtonianFluid { bulk_modulus, viscosity, bulk_viscosity } => Constitutive::NewtonianFluid(
+            LinearElastic::from_bulk_shear(bulk_modulus, 0.0),
+            crate::model::finite_strain::NewtonianFluid { bulk: bulk_modulus, viscosity, bulk_viscosity },
+        ),
         SoilModel::NeoHookean { young_modulus, poisson_ratio } => Constitutive::NeoHookean(
             LinearElastic::new(young_modulus, poisson_ratio),
             crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio),

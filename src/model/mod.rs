@@ -427,12 +427,14 @@ impl Model {
             } else {
                 1.0
             },
+            dt: 0.0,
         }
     }
 
     /// Whether particle `k` may take the converged step: every quantity it would take must be finite,
     /// its volume ratio J positive and the porosity it implies ([`Model::porosity_after`]) inside
-    /// (0, 1). The message names the particle and the quantity.
+    /// (0, 1) in a two-phase analysis (a one-phase point keeps its porosity, which may be 0). The
+    /// message names the particle and the quantity.
     pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
         if let Some(e) = self.nonfinite(k, step) {
             return Err(e);
@@ -440,7 +442,9 @@ impl Model {
         let j = step.jacobian;
         let ps = &self.particles;
         let n_new = self.porosity_after(k, j);
-        if j <= 0.0 || n_new.is_nan() || n_new <= 0.0 || n_new >= 1.0 {
+        // A one-phase point keeps its porosity, which may be zero (a fluid, a solid).
+        let porous = !self.two_phase || (n_new > 0.0 && n_new < 1.0);
+        if j <= 0.0 || n_new.is_nan() || !porous {
             return Err(InadmissibleStep(format!(
                 "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
                 ps.id[k], ps.x[k][0], ps.x[k][1]
@@ -543,14 +547,24 @@ impl Model {
             ps.jbar[k] = jbar;
         }
         ps.p[k] += dp;
-        ps.volume[k] *= j;
         ps.porosity[k] = n_new;
         let f = &mut ps.def_grad[k];
         let fi = &step.f_inc;
-        *f = [
+        let f_new = [
             [fi[0][0] * f[0][0] + fi[0][1] * f[1][0], fi[0][0] * f[0][1] + fi[0][1] * f[1][1]],
             [fi[1][0] * f[0][0] + fi[1][1] * f[1][0], fi[1][0] * f[0][1] + fi[1][1] * f[1][1]],
         ];
+        match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(f_new, step.jbar) {
+            // A fluid point carries its volume ratio only (see `Constitutive::fluid_volume_ratio`).
+            Some(jf) => {
+                ps.volume[k] *= jf / finite_strain::det(*f);
+                *f = [[jf.sqrt(), 0.0], [0.0, jf.sqrt()]];
+            }
+            None => {
+                ps.volume[k] *= j;
+                *f = f_new;
+            }
+        }
         if self.stretch_domains {
             let u = shape::right_stretch(*f);
             for (d, lp) in ps.lp[k].iter_mut().enumerate() {

@@ -101,7 +101,7 @@ impl BearingCheck {
             SoilModel::MohrCoulomb { cohesion, .. }
             | SoilModel::VonMises { cohesion, .. }
             | SoilModel::HenckyJ2 { cohesion, .. } => *cohesion,
-            SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } => {
+            SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } | SoilModel::NewtonianFluid { .. } => {
                 return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil))
             }
         };

@@ -24,6 +24,7 @@ pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
 pub mod cook;
+pub mod dam_break;
 pub mod figures;
 pub mod hollow_cylinder;
 pub mod lame;
@@ -227,6 +228,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
         Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
         Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
+        Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
@@ -979,6 +981,11 @@ pub fn describe(v: &case::Verification) -> String {
             "Cook's membrane ([002] §4.1): the tip ({}, {})'s vertical displacement at rest against {reference} m, \
              the mean stress's chequerboard index",
             tip[0], tip[1]
+        ),
+        Verification::DamBreak { settle_stage, experiment, .. } => format!(
+            "dam break ([002] §4.3): the hydrostatic pressure at the end of stage `{settle_stage}`, the mass, the \
+             front's advance against the shallow-water speed 2√(gH){}",
+            experiment.as_ref().map_or(String::new(), |e| format!(", the front against `{e}`"))
         ),
         Verification::StiffnessMap { center, radius, .. } => format!(
             "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",

@@ -102,6 +102,17 @@ impl LinearElastic {
     pub fn new(e: f64, nu: f64) -> Self {
         let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
         let mu = e / (2.0 * (1.0 + nu));
+        Self::of_lame(lam, mu, e, nu)
+    }
+
+    /// Elasticity with bulk modulus `k` and shear modulus `g` [Pa], which may be zero (a fluid's
+    /// pressure–volume response: E = 0, ν = 1/2, D = K m mᵀ).
+    pub fn from_bulk_shear(k: f64, g: f64) -> Self {
+        let (e, nu) = (9.0 * k * g / (3.0 * k + g), (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)));
+        Self::of_lame(k - 2.0 * g / 3.0, g, e, nu)
+    }
+
+    fn of_lame(lam: f64, mu: f64, e: f64, nu: f64) -> Self {
         let a = lam + 2.0 * mu;
         let d = [[a, lam, 0.0, lam], [lam, a, 0.0, lam], [0.0, 0.0, mu, 0.0], [lam, lam, 0.0, a]];
         LinearElastic { young: e, poisson: nu, d }
@@ -154,6 +165,10 @@ pub enum Constitutive {
     /// finite-strain model, [`Constitutive::finite`]; the elasticity of the same moduli serves the
     /// estimates).
     HenckyJ2(LinearElastic, crate::model::finite_strain::HenckyJ2),
+    /// A weakly compressible Newtonian fluid (the dam break, [002] §4.3; its stress from J and the
+    /// step's rate of deformation, [`Constitutive::finite`]; the elasticity of its bulk modulus and
+    /// no shear stiffness serves the estimates).
+    NewtonianFluid(LinearElastic, crate::model::finite_strain::NewtonianFluid),
 }
 
 impl Constitutive {
@@ -206,6 +221,9 @@ impl Constitutive {
                 };
                 Constitutive::VonMises(*el, vm).update(stress, eps_pd, deps)
             }
+            // The fluid's small-strain limit without viscosity: the pressure of its bulk modulus.
+            // A run never takes this path either.
+            Constitutive::NewtonianFluid(el, _) => Constitutive::LinearElastic(*el).update(stress, eps_pd, deps),
         }
     }
 
@@ -218,16 +236,23 @@ impl Constitutive {
     /// but recovered: the Kirchhoff stress τ_n = J_n σ_n, J_n = det f / det ΔF, determines the
     /// elastic logarithmic strain (ε^e = dev τ/2μ + tr τ/(9K) 1, in τ's principal frame), and
     /// b^e_n = exp(2ε^e). The stress is NaN when det F ≤ 0 or b^e is not positive (an
-    /// inadmissible step).
+    /// inadmissible step). The Newtonian fluid's pressure follows J = det `f` and its viscous
+    /// stress the step's rate of deformation, ΔF over `dt` [s]
+    /// (`finite_strain::rate_of_deformation`).
     pub fn finite(
         &self,
         df: &[[f64; 2]; 2],
         f: &[[f64; 2]; 2],
         stress: &[f64; 4],
         eps_pd: f64,
+        dt: f64,
     ) -> Option<StressUpdate> {
         let (el, stress, eps_pd, region) = match self {
             Constitutive::NeoHookean(el, nh) => (el, nh.stress(*f), eps_pd, Region::Elastic),
+            Constitutive::NewtonianFluid(el, fl) => {
+                let admissible = crate::model::finite_strain::det(*f) > 0.0;
+                (el, admissible.then(|| fl.stress_after(*df, *f, dt)), eps_pd, Region::Elastic)
+            }
             Constitutive::HenckyJ2(el, hj) => {
                 use crate::model::finite_strain::{det, PlasticState};
                 let (j_new, dj) = (det(*f), det(*df));
@@ -250,6 +275,21 @@ impl Constitutive {
         })
     }
 
+    /// A fluid point's volume ratio after a step (`None` for the other models, whose points keep
+    /// F_{n+1} = ΔF F_n and V_{n+1} = det ΔF V_n). A fluid remembers only its volume: its stress is
+    /// a function of J and the rate alone, and the shear a flow piles into F would only make det F
+    /// lose digits (Taichi's MPM fluids, [002]'s platform, keep √J 1 likewise). Its point keeps
+    /// F = √J 1 and V = J V⁰ with J the volume ratio its pressure follows: det F_{n+1} (`f`), or
+    /// with F̄ the projected J̄_{n+1} (`jbar`). So with F̄ a fluid point carries J̄ and the next
+    /// step projects J̄_n ΔJ, [002] Algorithm 1 exactly: the points' own volume ratios, which
+    /// nothing in a fluid holds in place, cannot drift apart beneath the projection.
+    pub fn fluid_volume_ratio(&self, f: [[f64; 2]; 2], jbar: Option<f64>) -> Option<f64> {
+        match self {
+            Constitutive::NewtonianFluid(..) => Some(jbar.unwrap_or_else(|| crate::model::finite_strain::det(f))),
+            _ => None,
+        }
+    }
+
     /// Elastic part (for the reference solutions and time-step estimates).
     pub fn elastic(&self) -> &LinearElastic {
         match self {
@@ -257,7 +297,8 @@ impl Constitutive {
             | Constitutive::MohrCoulomb(el, _)
             | Constitutive::VonMises(el, _)
             | Constitutive::NeoHookean(el, _)
-            | Constitutive::HenckyJ2(el, _) => el,
+            | Constitutive::HenckyJ2(el, _)
+            | Constitutive::NewtonianFluid(el, _) => el,
         }
     }
 
@@ -266,9 +307,9 @@ impl Constitutive {
         matches!(self, Constitutive::LinearElastic(_))
     }
 
-    /// Whether the model is elastic (linear or hyperelastic: no return mapping).
+    /// Whether the model has no return mapping (linear elastic, hyperelastic, a fluid).
     pub fn is_elastic(&self) -> bool {
-        matches!(self, Constitutive::LinearElastic(_) | Constitutive::NeoHookean(..))
+        matches!(self, Constitutive::LinearElastic(_) | Constitutive::NeoHookean(..) | Constitutive::NewtonianFluid(..))
     }
 }
 
