@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study study-cook study-footing gold bench bench-scaling bench-solvers maps lint clean
+.PHONY: setup build run test study study-cook study-footing study-dam gold bench bench-scaling bench-solvers maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -34,6 +34,11 @@ study-cook: build
 # [002]'s strip footing (Part E item 14; nine runs on two ranks, about 80 minutes).
 study-footing: build
 	cargo test --release --locked --test studies footing_fbar_item_14 -- --ignored --nocapture
+
+# [002]'s dam break at the water's stiffness (Part E item 15; four runs on two ranks, about 15
+# minutes; also part of `make study`).
+study-dam: build
+	cargo test --release --locked --test studies dam_break_item_15 -- --ignored --nocapture
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
 gold: setup

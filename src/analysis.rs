@@ -58,7 +58,11 @@ impl StageAnalysis {
                 let e = stage.explicit.unwrap_or_default();
                 StageAnalysis {
                     layout: Layout::U,
-                    integration: Integration::Explicit { flip: e.flip_blend, damping: e.local_damping },
+                    integration: Integration::Explicit {
+                        flip: e.flip_blend,
+                        damping: e.local_damping,
+                        xpic: e.xpic_order.unwrap_or(0),
+                    },
                     dt_limit: Some(e.cfl * wave_step(case)),
                 }
             }
@@ -82,9 +86,9 @@ impl StageAnalysis {
             Integration::QuasiStatic { theta } => format!("quasi-static {unknowns} with Darcy flow, θ = {theta}"),
             Integration::Static if self.layout.p.is_some() => format!("static {unknowns}, undrained"),
             Integration::Static => format!("static {unknowns}"),
-            Integration::Explicit { flip, damping } => format!(
-                "explicit dynamic {unknowns} (update-stress-last, FLIP share {flip}, local damping {damping}, \
-                 Δt ≤ {:.3e} s)",
+            Integration::Explicit { flip, damping, xpic } => format!(
+                "explicit dynamic {unknowns} (update-stress-last, {}, local damping {damping}, Δt ≤ {:.3e} s)",
+                if xpic > 0 { format!("XPIC({xpic}) transfer") } else { format!("FLIP share {flip}") },
                 self.dt_limit.unwrap_or(f64::NAN)
             ),
         }

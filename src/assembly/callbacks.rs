@@ -617,9 +617,10 @@ impl<'a> Assembler<'a> {
     }
 
     /// An explicit step's lumped mass and momentum of the solid per ghosted dof, this rank's
-    /// points' shares S_ip m_p and S_ip m_p v_p ([002] Eqs. 7–8), given through the extensions of
-    /// barely filled nodes as the residual is.
-    pub(super) fn lumped_mass_and_momentum(&self) -> (Vec<f64>, Vec<f64>) {
+    /// points' shares S_ip m_p and S_ip m_p v_p ([002] Eqs. 7–8) with v_p the point's entry of
+    /// `velocities` (its own velocity, or a field XPIC maps through the points), given through the
+    /// extensions of barely filled nodes as the residual is.
+    pub(super) fn lumped_mass_and_momentum(&self, velocities: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
         let step = self.step;
         let nd = step.dofs.nd;
         let ng = step.dofs.fixed.len();
@@ -627,14 +628,15 @@ impl<'a> Assembler<'a> {
         let (ps, points) = (self.particles(), &self.model.particles);
         let whole = ps.whole();
         let (mut m, mut p) = ([0.0; MAX_LOCAL], [0.0; MAX_LOCAL]);
-        for k in 0..step.stencils.len() {
+        debug_assert_eq!(velocities.len(), step.stencils.len());
+        for (k, v) in velocities.iter().enumerate() {
             let (nodes, basis) = step.stencils.get(k);
             let len = nodes.len() * nd;
             for (n, b) in basis.iter().enumerate() {
                 for c in 0..nd {
                     let motion = c < 2;
                     m[n * nd + c] = if motion { b.s * points.mass[k] } else { 0.0 };
-                    p[n * nd + c] = if motion { m[n * nd + c] * points.vel[k][c] } else { 0.0 };
+                    p[n * nd + c] = if motion { m[n * nd + c] * v[c] } else { 0.0 };
                 }
             }
             ps.scatter(k, &m[..len], &mut mass, whole);

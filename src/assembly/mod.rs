@@ -120,6 +120,9 @@ struct StepData {
     /// [`explicit`]): the scale c_p of its increment, the scale s_p of its total deformation and
     /// its projected J̄_p^{n+1}; empty otherwise.
     fbar_scale: Vec<[f64; 3]>,
+    /// An explicit XPIC step: the nodal field w − v^n its points' velocities take (see
+    /// [`explicit`]), per ghosted dof; empty otherwise.
+    xpic_correction: Vec<f64>,
 }
 
 /// The nodal terms of an explicit step's start, this rank's shares per ghosted dof (see
@@ -1521,7 +1524,15 @@ impl GridSystem {
         let strain = self.step.stencils.strain_of(k);
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
-        StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) }
+        let mut result = StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) };
+        if !self.step.xpic_correction.is_empty() {
+            // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
+            let states = callbacks::node_states(&self.step, k, &self.step.xpic_correction);
+            let c = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du;
+            let dt = self.step.dt;
+            result.velocity = Some([result.interp.du[0] / dt + c[0], result.interp.du[1] / dt + c[1]]);
+        }
+        result
     }
 }
 

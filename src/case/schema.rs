@@ -935,11 +935,20 @@ pub struct Explicit {
     /// α |f| sign(v) ([002] used 0.002 for the footing) [-]. In [0, 1).
     #[serde(default)]
     pub local_damping: f64,
+    /// The order m of the extended PIC transfer XPIC(m) of Hammerquist & Nairn (2017), which
+    /// replaces the FLIP/PIC blend: v_p ← S(v^{n+1} − v^n + w) with
+    /// w = Σ_{k=1..m} (−1)^{k+1} C(m, k) (S⁺S)^{k−1} v^n, S⁺S the map of nodal velocities to the
+    /// points and back (mass-weighted). m = 1 is PIC; a larger m keeps more of FLIP's
+    /// resolved motion while filtering the particle velocities the grid cannot see (the null
+    /// space that lets pure FLIP ring), at m − 1 extra passes over the points per step. In
+    /// [1, 8]; default: none (the blend). Hammerquist & Nairn suggest 2 to 5.
+    #[serde(default)]
+    pub xpic_order: Option<u8>,
 }
 
 impl Default for Explicit {
     fn default() -> Self {
-        Explicit { cfl: default_cfl(), flip_blend: default_flip(), local_damping: 0.0 }
+        Explicit { cfl: default_cfl(), flip_blend: default_flip(), local_damping: 0.0, xpic_order: None }
     }
 }
 

@@ -700,6 +700,17 @@ pub fn validate(c: &Case) -> R {
             if !(0.0..=1.0).contains(&e.flip_blend) {
                 return Err(format!("key `{}`: η = {} must lie in [0, 1]", key("explicit.flip_blend"), e.flip_blend));
             }
+            if let Some(m) = e.xpic_order {
+                if !(1..=8).contains(&m) {
+                    return Err(format!("key `{}`: m = {m} must lie in [1, 8]", key("explicit.xpic_order")));
+                }
+                if e.flip_blend != 1.0 {
+                    return Err(format!(
+                        "key `{}`: XPIC (`xpic_order`) replaces the FLIP/PIC blend; leave flip_blend out",
+                        key("explicit.flip_blend")
+                    ));
+                }
+            }
             if !(0.0..1.0).contains(&e.local_damping) {
                 return Err(format!(
                     "key `{}`: α = {} must lie in [0, 1)",

@@ -165,6 +165,7 @@ mod tests {
             deps: [0.0, -0.01, 0.0, 0.0],
             grad_n: [0.0; 2],
             jbar: None,
+            velocity: None,
         };
         let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &step, 20.0, 1.98);
         let v = 1.99;
@@ -202,6 +203,7 @@ mod tests {
             deps: [0.0; 4],
             grad_n: [0.0; 2],
             jbar: None,
+            velocity: None,
         };
         assert!((darcy(2.0, 0.5, &step) - 4.0).abs() < 1e-12);
         assert!((kinetic(2.0, 1.0, [1.0, 1.0], [0.0, 2.0]) - 4.0).abs() < 1e-12);

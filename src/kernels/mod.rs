@@ -249,6 +249,9 @@ pub enum Integration {
         flip: f64,
         /// Local damping α (Al-Kafaji 2013).
         damping: f64,
+        /// The order m of the XPIC transfer (Hammerquist & Nairn 2017) that replaces the FLIP/PIC
+        /// blend; 0 for the blend.
+        xpic: u8,
     },
 }
 
@@ -735,6 +738,9 @@ pub struct StepResult {
     pub grad_n: [f64; 2],
     /// [002]'s projected J̄ at t_{n+1} (`stabilisation.fbar`; `None`: the point keeps its J̄).
     pub jbar: Option<f64>,
+    /// The point's velocity after an explicit step whose transfer sets it (XPIC,
+    /// `assembly::explicit`); `None`: the stage's own update (FLIP/PIC blend, Newmark, …).
+    pub velocity: Option<[f64; 2]>,
 }
 
 impl StepResult {
@@ -749,6 +755,7 @@ impl StepResult {
             deps: pt.kin.deps,
             grad_n: pt.part.grad_n,
             jbar: None,
+            velocity: None,
         }
     }
 }

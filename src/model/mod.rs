@@ -509,10 +509,12 @@ impl Model {
             crate::kernels::Integration::Explicit { flip, .. } => {
                 // [002] Eqs. 11–13: FLIP v_p + Σ S (v_i^{n+1} − v_i^n) blended with PIC Σ S v_i^{n+1};
                 // Σ S v_i^{n+1} = Δu_p/Δt, and Σ S v_i^n is the interpolated nodal velocity of the
-                // step's start (the scheme's predictor, `interp.v_u`). One-phase only.
+                // step's start (the scheme's predictor, `interp.v_u`). One-phase only. XPIC sets
+                // the velocity itself (`StepResult::velocity`).
                 for c in 0..2 {
                     let pic = it.du[c] / dt;
-                    let v = flip * (ps.vel[k][c] + pic - it.v_u[c]) + (1.0 - flip) * pic;
+                    let blend = flip * (ps.vel[k][c] + pic - it.v_u[c]) + (1.0 - flip) * pic;
+                    let v = step.velocity.map_or(blend, |v| v[c]);
                     ps.acc[k][c] = (v - ps.vel[k][c]) / dt;
                     ps.vel[k][c] = v;
                 }
