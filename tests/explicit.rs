@@ -568,6 +568,9 @@ fn the_dam_break_settles_flows_and_runs_on_two_ranks() {
     }
     let two = run_case_on(2, "cases/dam_break.toml", &out_dir("dam002-two"), &sets);
     assert!(two.completed(), "{}", two.stderr());
+    for name in ["hydrostatic_pressure_error", "mass_change", "front_speed_ratio"] {
+        assert_eq!(two.summary["verification"][name]["pass"], true, "{name}: {}", two.summary["verification"][name]);
+    }
     for name in ["dam_break.front", "dam_break.centre_x"] {
         let (a, b) = (*one.column(name).last().unwrap(), *two.column(name).last().unwrap());
         assert!((a - b).abs() <= 1e-9 * a.abs(), "{name}: {a} on one rank, {b} on two");

@@ -138,8 +138,8 @@ pub struct DamBreakCheck {
 const FRONT_BINS: usize = 20;
 
 impl DamBreakCheck {
-    /// The check of a `dam_break` verification (its case validated).
-    pub fn new(c: &Case, model: &Model) -> Result<DamBreakCheck, String> {
+    /// The check of a `dam_break` verification (its case validated); collective.
+    pub fn new(c: &Case, model: &Model, coll: &Collective) -> Result<DamBreakCheck, String> {
         let Some(Verification::DamBreak {
             body,
             gravity,
@@ -178,7 +178,8 @@ impl DamBreakCheck {
             ));
         }
         let ps = &model.particles;
-        let mass0 = (0..ps.len()).filter(|&k| ps.body[k] as usize == bi).map(|k| ps.mass[k]).sum::<f64>();
+        let mine = (0..ps.len()).filter(|&k| ps.body[k] as usize == bi).map(|k| ps.mass[k]).sum::<f64>();
+        let mass0 = coll.sum(&[mine])?[0];
         Ok(DamBreakCheck {
             body: bi as u16,
             density,
@@ -331,12 +332,14 @@ impl Check for DamBreakCheck {
         let hist = coll.sum(&hist)?;
         let (mass, moment) = (hist[bins], hist[bins + 1]);
         self.tip = coll.max(&[tip])?[0] - self.back;
-        // The front: the upper edge of the bin where the mass ahead first exceeds the spray.
+        // The front: the upper edge of the bin where the mass ahead first exceeds the spray (by
+        // more than round-off: points of equal mass can make the mass ahead equal the spray, and
+        // the sums over the ranks must not decide the bin).
         let mut ahead = 0.0;
         let mut front = x0;
         for b in (0..bins).rev() {
             ahead += hist[b];
-            if ahead > self.spray * mass {
+            if ahead > self.spray * mass * (1.0 + 1e-9) {
                 front = x0 + (b + 1) as f64 * width;
                 break;
             }

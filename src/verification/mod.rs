@@ -228,7 +228,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
         Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
         Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
-        Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model)?),
+        Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model, coll)?),
         Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             let theory = terzaghi::Terzaghi::new(
