@@ -35,8 +35,8 @@ study-cook: build
 study-footing: build
 	cargo test --release --locked --test studies footing_fbar_item_14 -- --ignored --nocapture
 
-# [002]'s dam break at the water's stiffness (Part E item 15; four runs on two ranks, about 15
-# minutes; also part of `make study`).
+# [002]'s dam break at the water's stiffness (Part E item 15; four runs on two ranks, about 7
+# minutes; also part of `make study`; it reports the unmet assertions and fails).
 study-dam: build
 	cargo test --release --locked --test studies dam_break_item_15 -- --ignored --nocapture
 

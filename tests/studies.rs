@@ -418,7 +418,9 @@ fn study_history(label: &str, name: &str) -> Vec<(f64, f64)> {
 /// assertions, each checked and all failures reported together at the end: hydrostatic within 2 %
 /// of ρ g H after settling, the mass unchanged, the front behind Ritter's before the far wall,
 /// x_c(t) of F̄-uGIMP and F̄-B-spline within 0.1 m of each other, and the pressure chequerboard of
-/// F̄ at most a third of standard MPM's (settled and at the end). On two ranks; about 15 minutes.
+/// F̄ at most a third of standard MPM's (settled and at the end). On two ranks; about 7 minutes.
+/// Measured: unmet the B-spline run's hydrostatic error (11.6 %) and the x_c gap (0.146 m at the
+/// end; under 0.1 m until 1.69 s of flow); the rest met.
 #[test]
 #[ignore]
 fn dam_break_item_15() {
@@ -456,8 +458,9 @@ fn dam_break_item_15() {
             r("pressure_checkerboard_end"),
             s["wall_time_s"].as_f64().unwrap_or(f64::NAN)
         );
+        // Item 15 asks its metrics of F̄; the standard run is there for the chequerboard.
         for m in ["hydrostatic_pressure_error", "mass_change", "front_speed_ratio", "front_vs_experiment"] {
-            if s["verification"][m].is_object() && s["verification"][m]["pass"] != true {
+            if fbar && s["verification"][m].is_object() && s["verification"][m]["pass"] != true {
                 unmet.push(format!("{label}: {m} = {}", v(m)));
             }
         }
