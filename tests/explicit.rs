@@ -511,7 +511,7 @@ fn bad_explicit_settings_are_named() {
 }
 
 /// The collapse of Martin & Moyce's n² = 2 water column (`cases/dam_break_martin_moyce.toml`,
-/// weakly compressible here, K = 2e7 Pa, to keep the suite short: `make study` runs the water's
+/// weakly compressible here, K = 2e7 Pa, to keep the suite short: `make study-dam` runs the water's
 /// 2 GPa): after the settling stage the pressure is hydrostatic within 2 % of ρ g H, the mass is
 /// unchanged, the front stays behind Ritter's shallow-water front and within 10 % of the measured
 /// one on average, and the equilibrium identity of every step holds. Without F̄ (standard MPM)
