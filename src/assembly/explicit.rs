@@ -49,7 +49,7 @@
 
 use super::{callbacks, Error, GridSystem, StepSolve};
 use crate::kernels::kinematics::Kinematics;
-use crate::kernels::{self, Integration};
+use crate::kernels::Integration;
 use crate::model::finite_strain::det;
 use crate::model::{fbar, Model};
 
@@ -128,14 +128,8 @@ impl GridSystem {
             binomial *= f64::from(m - k + 1) / f64::from(k);
             if k > 1 {
                 // S⁺S u: u at the points, their momenta back to the nodes.
-                let st = &self.step.stencils;
-                let at_points: Vec<[f64; 2]> = (0..st.len())
-                    .map(|p| {
-                        let (nodes, basis) = st.get(p);
-                        let states = callbacks::node_states(&self.step, p, &u);
-                        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du
-                    })
-                    .collect();
+                let at_points: Vec<[f64; 2]> =
+                    (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u)).collect();
                 let (mut mk, mut pk) = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points));
                 for v in [&mut mk, &mut pk] {
                     self.sum_over_ranks(v)?;

@@ -1507,6 +1507,14 @@ impl GridSystem {
         f(&Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly))
     }
 
+    /// Σ S_ip u_i at particle `k` of a nodal 2-vector field `u` per ghosted dof (barely filled
+    /// nodes extended from their masters).
+    fn interpolated(&self, k: usize, u: &[f64]) -> [f64; 2] {
+        let (nodes, basis) = self.step.stencils.get(k);
+        let states = callbacks::node_states(&self.step, k, u);
+        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du
+    }
+
     /// The converged step at particle `k` for the particle update: exactly the point the converged
     /// residual evaluated.
     pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
@@ -1527,8 +1535,7 @@ impl GridSystem {
         let mut result = StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) };
         if !self.step.xpic_correction.is_empty() {
             // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
-            let states = callbacks::node_states(&self.step, k, &self.step.xpic_correction);
-            let c = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du;
+            let c = self.interpolated(k, &self.step.xpic_correction);
             let dt = self.step.dt;
             result.velocity = Some([result.interp.du[0] / dt + c[0], result.interp.du[1] / dt + c[1]]);
         }

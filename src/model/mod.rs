@@ -551,11 +551,7 @@ impl Model {
         ps.p[k] += dp;
         ps.porosity[k] = n_new;
         let f = &mut ps.def_grad[k];
-        let fi = &step.f_inc;
-        let f_new = [
-            [fi[0][0] * f[0][0] + fi[0][1] * f[1][0], fi[0][0] * f[0][1] + fi[0][1] * f[1][1]],
-            [fi[1][0] * f[0][0] + fi[1][1] * f[1][0], fi[1][0] * f[0][1] + fi[1][1] * f[1][1]],
-        ];
+        let f_new = crate::kernels::kinematics::product(&step.f_inc, f);
         match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(f_new, step.jbar) {
             // A fluid point carries its volume ratio only (see `Constitutive::fluid_volume_ratio`).
             Some(jf) => {
