@@ -11,6 +11,8 @@
 //! | `static`, `drainage = "undrained"` | two-phase | u, p (no flow) | none (load stepping) |
 //! | `static`, `drainage = "drained"` | two-phase | u (p held) | none |
 //! | `static` | one-phase | u | none |
+//! | `dynamic_explicit` | one-phase | u | explicit ([002]: lumped mass, update-stress-last) |
+//! | `dynamic_explicit` | two-phase | u, U (the pore pressure at the points) | explicit, the drag implicit at each node |
 //!
 //! Each stage hands its particles (stress, pore pressure and its gradient, internal variables,
 //! positions) to the next, whatever the types: e.g. a drained static gravity stage, a
@@ -57,11 +59,12 @@ impl StageAnalysis {
             AnalysisType::DynamicExplicit => {
                 let e = stage.explicit.unwrap_or_default();
                 StageAnalysis {
-                    layout: Layout::U,
+                    layout: if two_phase { Layout::UW } else { Layout::U },
                     integration: Integration::Explicit {
                         flip: e.flip_blend,
                         damping: e.local_damping,
                         xpic: e.xpic_order.unwrap_or(0),
+                        pointwise_pressure: e.pore_pressure != Some(crate::case::ExplicitPressure::Nodal),
                     },
                     dt_limit: Some(e.cfl * wave_step(case)),
                 }
@@ -74,6 +77,7 @@ impl StageAnalysis {
         let unknowns = match (self.layout.p, self.layout.w) {
             (Some(_), Some(_)) => "u–p–U",
             (Some(_), None) => "u–p",
+            (None, Some(_)) => "u–U",
             _ => "u",
         };
         match self.integration {
@@ -86,8 +90,14 @@ impl StageAnalysis {
             Integration::QuasiStatic { theta } => format!("quasi-static {unknowns} with Darcy flow, θ = {theta}"),
             Integration::Static if self.layout.p.is_some() => format!("static {unknowns}, undrained"),
             Integration::Static => format!("static {unknowns}"),
-            Integration::Explicit { flip, damping, xpic } => format!(
-                "explicit dynamic {unknowns} (update-stress-last, {}, local damping {damping}, Δt ≤ {:.3e} s)",
+            Integration::Explicit { flip, damping, xpic, pointwise_pressure } => format!(
+                "explicit dynamic {unknowns}{} (update-stress-last, {}, local damping {damping}, Δt ≤ {:.3e} s)",
+                match (self.layout.w, pointwise_pressure) {
+                    (None, _) => "",
+                    (Some(_), false) =>
+                        " with the pore pressure at the nodes (lumped continuity), drag implicit per node",
+                    (Some(_), true) => " with the pore pressure point by point, drag implicit per node",
+                },
                 if xpic > 0 { format!("XPIC({xpic}) transfer") } else { format!("FLIP share {flip}") },
                 self.dt_limit.unwrap_or(f64::NAN)
             ),
@@ -95,22 +105,68 @@ impl StageAnalysis {
     }
 }
 
-/// The time a P-wave takes to cross the smallest cell, h_min / max c_p, with c_p = sqrt(E_c/ρ) of
-/// each material at rest (E_c its constrained modulus, ρ its mixture density): the CFL limit of an
-/// explicit step (the explicit stage takes C times it) [s].
+/// The time a P-wave takes to cross the smallest cell, h_min / max c_p, with c_p of each material
+/// at rest: the CFL limit of an explicit step (the explicit stage takes C times it) [s]. One-phase,
+/// c_p = sqrt(E_c/ρ) (E_c the constrained modulus, ρ the mixture density); two-phase, the faster
+/// of the two P-waves of the u–U system without drag ([`two_phase_wave_speed`]), which bounds the
+/// undrained wave (the phases locked by a large drag) too.
 pub fn wave_step(case: &Case) -> f64 {
     let h = case.cell_size();
+    let two_phase = case.analysis.formulation == Formulation::TwoPhase;
     let c = case
         .materials
         .iter()
         .map(|m| {
             let mat = crate::model::material::Material::from_case(m, case.analysis.formulation);
-            (mat.model.elastic().constrained_modulus() / mat.mixture_density(m.porosity)).sqrt()
+            let e_c = mat.model.elastic().constrained_modulus();
+            if two_phase {
+                two_phase_wave_speed(e_c, mat.inv_q_at(m.porosity), m.porosity, mat.solid_density, mat.water_density)
+            } else {
+                (e_c / mat.mixture_density(m.porosity)).sqrt()
+            }
         })
         .fold(0.0, f64::max);
     h[0].min(h[1]) / c
 }
 
+/// The fast P-wave speed of the u–U system without drag [m/s]: per unit wave number the
+/// stiffness K = [[E_c + (1 − n)²Q, n(1 − n)Q], [n(1 − n)Q, n²Q]] (the skeleton's constrained
+/// modulus E_c and the pore pressure p = −Q((1 − n)∇·u + n∇·U) shared (1 − n) : n by the phases,
+/// [003] Eqs. 23a–c) against the mass M = diag((1 − n)ρ_s, nρ_w); c² is the larger eigenvalue of
+/// M⁻¹K. Any drag couples the phases towards the undrained wave, whose c² = (E_c + Q)/ρ is a
+/// Rayleigh quotient of the same pair and so no larger.
+pub fn two_phase_wave_speed(e_c: f64, inv_q: f64, n: f64, rho_s: f64, rho_w: f64) -> f64 {
+    let q = 1.0 / inv_q;
+    let (ms, mw) = ((1.0 - n) * rho_s, n * rho_w);
+    let (a, b, d) = ((e_c + (1.0 - n).powi(2) * q) / ms, n * (1.0 - n) * q / (ms * mw).sqrt(), n * n * q / mw);
+    // The larger eigenvalue of the symmetric M^{-1/2} K M^{-1/2} = [[a, b], [b, d]].
+    (0.5 * (a + d) + (0.25 * (a - d).powi(2) + b * b).sqrt()).sqrt()
+}
+
 /// θ of a quasi-static stage that does not give one: backward Euler, which does not oscillate
 /// however large c_v Δt / h² is (Crank–Nicolson, θ = 1/2, rings there; see docs/analysis.md).
 pub const DEFAULT_THETA: f64 = 1.0;
+
+#[cfg(test)]
+mod tests {
+    use super::two_phase_wave_speed;
+
+    /// The fast wave of the u–U pair: without a water stiffness it is the skeleton's own wave in
+    /// the grains' mass; without a skeleton, K = Q v vᵀ (v = (1 − n, n)) has the one eigenvalue
+    /// Q vᵀM⁻¹v = Q ((1 − n)/ρ_s + n/ρ_w); and it is never slower than the undrained wave of the
+    /// locked mixture, sqrt((E_c + Q)/ρ).
+    #[test]
+    fn the_two_phase_wave_speed_has_its_limits() {
+        let (n, rs, rw) = (0.3, 2650.0, 1000.0);
+        let c = two_phase_wave_speed(1e7, 1e6, n, rs, rw);
+        assert!((c / (1e7 / ((1.0 - n) * rs)).sqrt() - 1.0).abs() < 1e-9, "{c}");
+        let q = 2.2e9 / n;
+        let c = two_phase_wave_speed(0.0, 1.0 / q, n, rs, rw);
+        assert!((c / (q * ((1.0 - n) / rs + n / rw)).sqrt() - 1.0).abs() < 1e-12, "{c}");
+        for e_c in [1e5, 1e7, 1e9, 1e11] {
+            let fast = two_phase_wave_speed(e_c, 1.0 / q, n, rs, rw);
+            let undrained = ((e_c + q) / ((1.0 - n) * rs + n * rw)).sqrt();
+            assert!(fast >= undrained * (1.0 - 1e-12), "E_c = {e_c}: {fast} < {undrained}");
+        }
+    }
+}

@@ -123,12 +123,14 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     let active_nodes = filled.iter().filter(|&&f| f > WELL_FILLED_FRACTION).count();
     let first = model.active(&case.stages[0]);
+    // The first stage's own unknowns per node (its analysis type's layout).
+    let layout = crate::analysis::StageAnalysis::of(case, &case.stages[0]).layout;
     let mut unknowns = 0;
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {
             if filled[j * g.nodes()[0] + i] > WELL_FILLED_FRACTION {
                 let fixed = model.fixing_boundaries(&first, i, j);
-                unknowns += (0..nd).filter(|&c| fixed[c].is_none()).count();
+                unknowns += (0..layout.nd).filter(|&c| fixed[layout.canonical(c)].is_none()).count();
             }
         }
     }

@@ -74,6 +74,11 @@ enum Command {
         /// values, and a list with a `;` is split at `;` only (e.g. `grid.cells=[1,20];[1,40]`).
         #[arg(long = "vary", value_name = "KEY=V1,V2,...")]
         vary: Vec<String>,
+        /// A named version of the case, `NAME:KEY=VALUE;KEY=VALUE...` (e.g.
+        /// `explicit:stages.consolidation.analysis=dynamic_explicit`): every strategy runs every
+        /// variant, and the keys a variant sets are not varied for it.
+        #[arg(long = "variant", value_name = "NAME:KEY=VALUE;...")]
+        variant: Vec<String>,
         /// Override a case value in every run, e.g. `--set time.dt=5e-4`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -470,6 +475,7 @@ fn sweep(
     out: &Path,
     options_files: &[PathBuf],
     vary: &[String],
+    variant: &[String],
     sets: &[String],
     metric: &Option<String>,
     quiet: bool,
@@ -477,12 +483,14 @@ fn sweep(
 ) -> Result<(), Failure> {
     use porompm::sweep::{self, SweepError};
     let varies = vary.iter().map(|v| sweep::Vary::parse(v)).collect::<Result<Vec<_>, _>>().map_err(input)?;
+    let variants = variant.iter().map(|v| sweep::Variant::parse(v)).collect::<Result<Vec<_>, _>>().map_err(input)?;
     let exe = std::env::current_exe().map_err(|e| input(format!("cannot find the porompm executable: {e}")))?;
     let req = sweep::SweepRequest {
         exe,
         case: case.to_path_buf(),
         out: out.to_path_buf(),
         options_files: options_files.to_vec(),
+        variants,
         varies,
         sets: sets.to_vec(),
         metric: metric.clone(),
@@ -546,8 +554,8 @@ fn main() -> ExitCode {
             };
             run(case, out, options_file, set, *quiet, cont, petsc)
         }
-        Command::Sweep { case, out, options_file, vary, set, metric, quiet, petsc } => {
-            sweep(case, out, options_file, vary, set, metric, *quiet, petsc)
+        Command::Sweep { case, out, options_file, vary, variant, set, metric, quiet, petsc } => {
+            sweep(case, out, options_file, vary, variant, set, metric, *quiet, petsc)
         }
         Command::Report { dir } => porompm::report::report(dir).map(|t| print!("{t}")).map_err(input),
         Command::Check { case, set } => {

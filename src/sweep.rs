@@ -7,8 +7,13 @@
 //! * `--vary KEY=V1,V2,...` varies one `--set` key over a list. Commas inside brackets, braces or
 //!   quotes do not separate values (`grid.cells=[1,20],[1,40]` is two values); a list holding a
 //!   semicolon is split at semicolons only (`grid.cells=[1,20];[1,40]`).
-//! * Run i (numbered from 0, strategies outermost, then the `--vary` keys in order with the last
-//!   one varying fastest) writes into `DIR/run_<i>`. A run that fails (a step that does not
+//! * `--variant NAME:KEY=VALUE;KEY=VALUE...` names a set of `--set`s (e.g. an analysis type and
+//!   its settings), so that differently run versions of one problem sit side by side: every
+//!   strategy runs every variant (none given: the case as it is). A key the variant sets is not
+//!   varied for it (`--vary time.dt=...` with `--variant explicit:time.dt=1` runs the explicit
+//!   variant once per other value); its table cell shows the variant's value.
+//! * Run i (numbered from 0, strategies outermost, then the variants, then the `--vary` keys in
+//!   order with the last one varying fastest) writes into `DIR/run_<i>`. A run that fails (a step that does not
 //!   converge, an invalid varied value, a crash) cannot stop the sweep: it becomes a row with its
 //!   status and the reason (the run's one-line error), and the sweep goes on. Each run's standard
 //!   error is kept as `DIR/run_<i>/stderr.txt`.
@@ -18,7 +23,9 @@
 //!
 //! The work–precision figure plots the error (the `--metric`, else the first verification metric
 //! of the first completed run in summary.json's alphabetical order) against the run's wall time,
-//! log–log, one series per strategy, each point labelled with its varied values.
+//! log–log, one series per strategy and variant, each point labelled with its varied values. The
+//! table gives each run's mean step (simulated time over steps), so that the steps of two
+//! variants can be compared at equal error.
 
 use crate::io;
 use crate::plot::{Axis, Figure, Series, Style};
@@ -88,6 +95,45 @@ fn split_values(list: &str) -> Result<Vec<String>, String> {
 }
 
 /// A solver strategy: its name and options file (none for porompm's defaults).
+/// One `--variant`: a name and the `--set`s that make it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variant {
+    /// The series' name.
+    pub name: String,
+    /// (key, value) pairs, each a `--set KEY=VALUE`.
+    pub sets: Vec<(String, String)>,
+}
+
+impl Variant {
+    /// Parses `NAME:KEY=VALUE;KEY=VALUE...` (no settings after the colon: the case as it is).
+    pub fn parse(text: &str) -> Result<Variant, String> {
+        let (name, list) = text
+            .split_once(':')
+            .ok_or(format!("--variant `{text}`: expected NAME:KEY=VALUE;KEY=VALUE... (e.g. explicit:time.dt=1)"))?;
+        let name = name.trim();
+        if name.is_empty() {
+            return Err(format!("--variant `{text}`: the name is empty"));
+        }
+        let mut sets = Vec::new();
+        for item in list.split(';').map(str::trim).filter(|s| !s.is_empty()) {
+            let (k, v) = item
+                .split_once('=')
+                .filter(|(k, v)| !k.trim().is_empty() && !v.trim().is_empty())
+                .ok_or(format!("--variant `{text}`: `{item}` is not KEY=VALUE"))?;
+            if sets.iter().any(|(key, _): &(String, String)| key == k.trim()) {
+                return Err(format!("--variant `{text}`: `{}` is set twice", k.trim()));
+            }
+            sets.push((k.trim().to_string(), v.trim().to_string()));
+        }
+        Ok(Variant { name: name.to_string(), sets })
+    }
+
+    /// The variant's value of `key`, if it sets it.
+    fn value(&self, key: &str) -> Option<&str> {
+        self.sets.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Strategy {
     /// The options file's stem, or `default`.
@@ -119,29 +165,39 @@ pub struct RunSpec {
     pub index: usize,
     /// Index into the strategies.
     pub strategy: usize,
-    /// One value per `--vary` key.
+    /// Index into the variants (0 when there are none).
+    pub variant: usize,
+    /// One value per `--vary` key (the variant's own where it sets the key).
     pub values: Vec<String>,
 }
 
-/// The Cartesian product: strategies outermost, then the keys in order, the last fastest.
-pub fn plan(strategies: usize, varies: &[Vary]) -> Vec<RunSpec> {
-    let mut combos: Vec<Vec<String>> = vec![Vec::new()];
-    for v in varies {
-        combos = combos
-            .into_iter()
-            .flat_map(|c| {
-                v.values.iter().map(move |x| {
-                    let mut c = c.clone();
-                    c.push(x.clone());
-                    c
-                })
-            })
-            .collect();
-    }
+/// The runs: strategies outermost, then the variants (one unnamed if `variants` is empty), then
+/// the Cartesian product of the `--vary` values, the last key fastest; a key a variant sets is
+/// held at its value.
+pub fn plan(strategies: usize, variants: &[Variant], varies: &[Vary]) -> Vec<RunSpec> {
+    let none = [Variant { name: String::new(), sets: Vec::new() }];
+    let variants = if variants.is_empty() { &none[..] } else { variants };
     let mut runs = Vec::new();
     for s in 0..strategies {
-        for c in &combos {
-            runs.push(RunSpec { index: runs.len(), strategy: s, values: c.clone() });
+        for (vi, variant) in variants.iter().enumerate() {
+            let mut combos: Vec<Vec<String>> = vec![Vec::new()];
+            for v in varies {
+                let own = variant.value(&v.key).map(|x| vec![x.to_string()]);
+                let values = own.as_ref().unwrap_or(&v.values);
+                combos = combos
+                    .into_iter()
+                    .flat_map(|c| {
+                        values.iter().map(move |x| {
+                            let mut c = c.clone();
+                            c.push(x.clone());
+                            c
+                        })
+                    })
+                    .collect();
+            }
+            for c in combos {
+                runs.push(RunSpec { index: runs.len(), strategy: s, variant: vi, values: c });
+            }
         }
     }
     runs
@@ -157,6 +213,8 @@ pub struct SweepRequest {
     pub out: PathBuf,
     /// One strategy per options file.
     pub options_files: Vec<PathBuf>,
+    /// The named variants (`--variant`).
+    pub variants: Vec<Variant>,
     /// The varied keys.
     pub varies: Vec<Vary>,
     /// `--set` overrides applied to every run.
@@ -225,8 +283,24 @@ pub fn run(req: &SweepRequest) -> Result<SweepOutcome, SweepError> {
     if let Some(w) = keys.windows(2).find(|w| w[0] == w[1]) {
         return Err(input(format!("--vary {} is given twice", w[0])));
     }
+    let mut names: Vec<&str> = req.variants.iter().map(|v| v.name.as_str()).collect();
+    names.sort();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return Err(input(format!("--variant {} is given twice", w[0])));
+    }
+    for v in &req.variants {
+        let mut sets = overrides.clone();
+        for (k, x) in &v.sets {
+            sets.push(
+                crate::case::Override::parse(&format!("{k}={x}"))
+                    .map_err(|e| input(format!("--variant {}: {e}", v.name)))?,
+            );
+        }
+        crate::case::parse(&text, &req.case.display().to_string(), &sets)
+            .map_err(|e| input(format!("--variant {}: {e}", v.name)))?;
+    }
     let strategies = Strategy::from_files(&req.options_files);
-    let specs = plan(strategies.len(), &req.varies);
+    let specs = plan(strategies.len(), &req.variants, &req.varies);
     io::create_dir(&req.out).map_err(input)?;
     let mut rows = Vec::new();
     for spec in &specs {
@@ -278,8 +352,14 @@ fn run_one(req: &SweepRequest, strategies: &[Strategy], spec: &RunSpec) -> RunRo
     for s in &req.sets {
         cmd.arg("--set").arg(s);
     }
+    let variant = req.variants.get(spec.variant);
+    for (k, value) in variant.iter().flat_map(|v| &v.sets) {
+        cmd.arg("--set").arg(format!("{k}={value}"));
+    }
     for (v, value) in req.varies.iter().zip(&spec.values) {
-        cmd.arg("--set").arg(format!("{}={value}", v.key));
+        if variant.is_none_or(|x| x.value(&v.key).is_none()) {
+            cmd.arg("--set").arg(format!("{}={value}", v.key));
+        }
     }
     if !req.petsc.is_empty() {
         cmd.arg("--").args(&req.petsc);
@@ -314,7 +394,7 @@ fn run_one(req: &SweepRequest, strategies: &[Strategy], spec: &RunSpec) -> RunRo
 
 fn describe_row(req: &SweepRequest, strategies: &[Strategy], row: &RunRow) -> String {
     let values: Vec<String> = req.varies.iter().zip(&row.spec.values).map(|(v, x)| format!("{}={x}", v.key)).collect();
-    let mut s = format!("{} {}: {}", strategies[row.spec.strategy].name, values.join(" "), row.status);
+    let mut s = format!("{} {}: {}", series_name(req, strategies, &row.spec), values.join(" "), row.status);
     match row.status.as_str() {
         "completed" => s.push_str(&format!(" in {:.2} s", wall_time(row))),
         _ => s.push_str(&format!(" ({})", row.failure)),
@@ -323,6 +403,24 @@ fn describe_row(req: &SweepRequest, strategies: &[Strategy], row: &RunRow) -> St
 }
 
 /// The run's wall time: summary.json's, else the child process's.
+/// The name of a run's series: its strategy, its variant, or both when the sweep has several
+/// strategies and variants.
+fn series_name(req: &SweepRequest, strategies: &[Strategy], spec: &RunSpec) -> String {
+    let strategy = &strategies[spec.strategy].name;
+    match req.variants.get(spec.variant) {
+        None => strategy.clone(),
+        Some(v) if strategies.len() == 1 => v.name.clone(),
+        Some(v) => format!("{strategy}/{}", v.name),
+    }
+}
+
+/// A run's mean step, its simulated time over its steps [s].
+fn mean_step(row: &RunRow) -> Option<f64> {
+    let s = row.summary.as_ref()?;
+    let steps = s["steps"].as_f64().filter(|&n| n > 0.0)?;
+    Some(s["time_s"].as_f64()? / steps)
+}
+
 fn wall_time(row: &RunRow) -> f64 {
     row.summary.as_ref().and_then(|s| s["wall_time_s"].as_f64()).unwrap_or(row.process_time_s)
 }
@@ -366,10 +464,14 @@ fn table(
     metrics: &[String],
 ) -> (Vec<String>, Vec<Vec<String>>) {
     let mut header: Vec<String> = vec!["run".into(), "strategy".into()];
+    if !req.variants.is_empty() {
+        header.push("variant".into());
+    }
     header.extend(req.varies.iter().map(|v| v.key.clone()));
     header.extend(["status", "exit_code", "failure", "wall_time_s", "process_time_s"].map(String::from));
     header.extend(PHASES.iter().map(|p| format!("time_{p}")));
     header.extend(COUNTS.map(String::from));
+    header.push("mean_dt_s".into());
     header.push("peak_memory_mib".into());
     header.extend(metrics.iter().cloned());
     let num = |v: Option<f64>, prec: usize| v.map_or(String::new(), |x| format!("{x:.prec$}"));
@@ -379,6 +481,9 @@ fn table(
         .map(|r| {
             let s = r.summary.as_ref();
             let mut line = vec![r.spec.index.to_string(), strategies[r.spec.strategy].name.clone()];
+            if let Some(v) = req.variants.get(r.spec.variant) {
+                line.push(v.name.clone());
+            }
             line.extend(r.spec.values.iter().cloned());
             line.push(r.status.clone());
             line.push(r.exit_code.map_or(String::new(), |c| c.to_string()));
@@ -387,6 +492,7 @@ fn table(
             line.push(format!("{:.4}", r.process_time_s));
             line.extend(PHASES.iter().map(|p| num(s.and_then(|s| s["timings"][p].as_f64()), 4)));
             line.extend(COUNTS.iter().map(|c| s.and_then(|s| s[c].as_u64()).map_or(String::new(), |v| v.to_string())));
+            line.push(sci(mean_step(r)));
             line.push(num(s.and_then(|s| s["peak_memory_mib"].as_f64()), 1));
             line.extend(metrics.iter().map(|m| sci(metric_value(r, m))));
             line
@@ -436,10 +542,10 @@ fn work_precision(req: &SweepRequest, strategies: &[Strategy], rows: &[RunRow], 
         Axis::log("wall time of the run [s]"),
         Axis::log(format!("error {metric} [-]")),
     );
-    for (si, s) in strategies.iter().enumerate() {
-        let mut pts: Vec<(f64, f64, String)> = rows
+    for (colour, (name, runs)) in line_groups(req, strategies, rows).into_iter().enumerate() {
+        let mut pts: Vec<(f64, f64, String)> = runs
             .iter()
-            .filter(|r| r.spec.strategy == si && r.status == "completed")
+            .filter(|r| r.status == "completed")
             .filter_map(|r| {
                 let label: Vec<String> =
                     req.varies.iter().zip(&r.spec.values).map(|(v, x)| format!("{}={x}", short_key(&v.key))).collect();
@@ -447,11 +553,43 @@ fn work_precision(req: &SweepRequest, strategies: &[Strategy], rows: &[RunRow], 
             })
             .collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut series = Series::new(s.name.clone(), pts.iter().map(|p| (p.0, p.1)).collect(), Style::LineMarkers, si);
-        series.point_labels = pts.into_iter().map(|p| p.2).collect();
-        fig.series.push(series);
+        let points = pts.iter().map(|p| (p.0, p.1)).collect();
+        let mut line = Series::new(name, points, Style::LineMarkers, colour);
+        line.point_labels = pts.into_iter().map(|p| p.2).collect();
+        fig.series.push(line);
     }
     fig
+}
+
+/// The lines of the work–precision figure, in the plan's order: one per (strategy, variant); when
+/// more than one `--vary` key takes several values within it, one per combination of those keys
+/// but the last varying one (e.g. one line over Δt per grid), named by them, so that a line joins
+/// runs that differ in one setting only.
+fn line_groups<'a>(req: &SweepRequest, strategies: &[Strategy], rows: &'a [RunRow]) -> Vec<(String, Vec<&'a RunRow>)> {
+    let mut series: Vec<(usize, usize)> = rows.iter().map(|r| (r.spec.strategy, r.spec.variant)).collect();
+    series.dedup();
+    let mut out = Vec::new();
+    for (si, vi) in series {
+        let runs: Vec<&RunRow> = rows.iter().filter(|r| (r.spec.strategy, r.spec.variant) == (si, vi)).collect();
+        let name = series_name(req, strategies, &runs[0].spec);
+        let varying: Vec<usize> = (0..req.varies.len())
+            .filter(|&k| runs.iter().any(|r| r.spec.values[k] != runs[0].spec.values[k]))
+            .collect();
+        let Some((_, split)) = varying.split_last().filter(|(_, s)| !s.is_empty()) else {
+            out.push((name, runs));
+            continue;
+        };
+        let key = |r: &RunRow| split.iter().map(|&k| r.spec.values[k].clone()).collect::<Vec<_>>();
+        let mut keys: Vec<Vec<String>> = runs.iter().map(|r| key(r)).collect();
+        keys.dedup();
+        for k in keys {
+            let label: Vec<String> =
+                split.iter().zip(&k).map(|(&i, x)| format!("{}={x}", short_key(&req.varies[i].key))).collect();
+            let group = runs.iter().copied().filter(|r| key(r) == k).collect();
+            out.push((format!("{name} ({})", label.join(" ")), group));
+        }
+    }
+    out
 }
 
 /// The last part of a dotted key (`time.dt` → `dt`), for point labels.
@@ -484,12 +622,50 @@ mod tests {
             Vary { key: "a".into(), values: vec!["1".into(), "2".into()] },
             Vary { key: "b".into(), values: vec!["x".into(), "y".into(), "z".into()] },
         ];
-        let p = plan(2, &v);
+        let p = plan(2, &[], &v);
         assert_eq!(p.len(), 12);
         assert_eq!(p[1].values, vec!["1", "y"]);
         assert_eq!(p[3].values, vec!["2", "x"]);
         assert_eq!((p[6].strategy, p[6].index), (1, 6));
-        assert_eq!(plan(1, &[]).len(), 1);
+        assert_eq!(plan(1, &[], &[]).len(), 1);
+        // A variant holds the keys it sets: it does not multiply them.
+        let variants = [Variant::parse("implicit:").unwrap(), Variant::parse("explicit:b=w; c=1").unwrap()];
+        assert_eq!(variants[1].sets, vec![("b".to_string(), "w".to_string()), ("c".to_string(), "1".to_string())]);
+        let p = plan(1, &variants, &v);
+        assert_eq!(p.len(), 6 + 2);
+        assert_eq!((p[6].variant, p[6].values.clone()), (1, vec!["1".to_string(), "w".to_string()]));
+        assert_eq!((p[7].variant, p[7].values.clone()), (1, vec!["2".to_string(), "w".to_string()]));
+        assert!(Variant::parse("no colon").is_err());
+        assert!(Variant::parse(":a=1").is_err());
+        assert!(Variant::parse("x:a").is_err());
+        assert!(Variant::parse("x:a=1;a=2").is_err());
+        // The figure's lines: per variant, and per value of every varying key but the last.
+        let req = SweepRequest {
+            exe: PathBuf::new(),
+            case: PathBuf::from("c.toml"),
+            out: PathBuf::new(),
+            options_files: Vec::new(),
+            variants: variants.to_vec(),
+            varies: v.to_vec(),
+            sets: Vec::new(),
+            metric: None,
+            petsc: Vec::new(),
+            quiet: true,
+        };
+        let rows: Vec<RunRow> = p
+            .iter()
+            .map(|s| RunRow {
+                spec: s.clone(),
+                status: "completed".into(),
+                exit_code: Some(0),
+                failure: String::new(),
+                process_time_s: 0.0,
+                summary: None,
+            })
+            .collect();
+        let groups = line_groups(&req, &Strategy::from_files(&[]), &rows);
+        let names: Vec<(&str, usize)> = groups.iter().map(|(n, g)| (n.as_str(), g.len())).collect();
+        assert_eq!(names, vec![("implicit (a=1)", 3), ("implicit (a=2)", 3), ("explicit", 2)]);
         let s = Strategy::from_files(&[PathBuf::from("petsc_options/direct-lu.opts")]);
         assert_eq!(s[0].name, "direct-lu");
         assert_eq!(Strategy::from_files(&[])[0].name, "default");

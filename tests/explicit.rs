@@ -404,7 +404,14 @@ fn a_footing_run_restarts_from_its_checkpoint_and_runs_on_two_ranks() {
 #[test]
 fn bad_explicit_settings_are_named() {
     let dir = out_dir("bad");
-    assert_refused("cases/terzaghi.toml", &dir, &["stages.0.analysis=dynamic_explicit"], "one-phase for now");
+    // A two-phase explicit stage holds its pore pressure at the points by default: a drained
+    // boundary cannot fix it (tests/explicit_two_phase.rs has the rest).
+    assert_refused(
+        "cases/terzaghi.toml",
+        &dir,
+        &["stages.0.analysis=dynamic_explicit"],
+        "key `boundaries` (`drained_top`): stage `consolidation` is explicit two-phase",
+    );
     assert_refused(
         "cases/elastic_column.toml",
         &dir,

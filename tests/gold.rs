@@ -229,6 +229,7 @@ gold_tests!(
     slope_sand,
     slumping_block,
     terzaghi,
+    terzaghi_explicit,
     vertical_cut,
 );
 

@@ -616,33 +616,53 @@ impl<'a> Assembler<'a> {
         out
     }
 
-    /// An explicit step's lumped mass and momentum of the solid per ghosted dof, this rank's
-    /// points' shares S_ip m_p and S_ip m_p v_p ([002] Eqs. 7–8) with v_p the point's entry of
-    /// `velocities` (its own velocity, or a field XPIC maps through the points), given through the
-    /// extensions of barely filled nodes as the residual is.
-    pub(super) fn lumped_mass_and_momentum(&self, velocities: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
+    /// An explicit step's lumped masses and momenta per ghosted dof, this rank's points' shares
+    /// S_ip m_p and S_ip m_p v_p ([002] Eqs. 7–8) with v_p the point's entry of `velocities` (its own
+    /// velocity, or a field XPIC maps through the points), given through the extensions of barely
+    /// filled nodes as the residual is. With `water` (the u–U system: the points' water
+    /// velocities), the water's S_ip n ρ_w V_p and momenta at the water's dofs, and the lumped drag
+    /// S_ip c_p at the solid's and the water's dofs alike.
+    pub(super) fn lumped_mass_and_momentum(&self, velocities: &[[f64; 2]], water: Option<&[[f64; 2]]>) -> Lumped {
         let step = self.step;
         let nd = step.dofs.nd;
         let ng = step.dofs.fixed.len();
-        let (mut mass, mut momentum) = (vec![0.0; ng], vec![0.0; ng]);
+        let w = step.layout.and_then(|l| l.w).filter(|_| water.is_some());
+        let mut out = Lumped {
+            mass: vec![0.0; ng],
+            momentum: vec![0.0; ng],
+            drag: if w.is_some() { vec![0.0; ng] } else { Vec::new() },
+        };
         let (ps, points) = (self.particles(), &self.model.particles);
         let whole = ps.whole();
-        let (mut m, mut p) = ([0.0; MAX_LOCAL], [0.0; MAX_LOCAL]);
+        let (mut m, mut p, mut c) = ([0.0; MAX_LOCAL], [0.0; MAX_LOCAL], [0.0; MAX_LOCAL]);
         debug_assert_eq!(velocities.len(), step.stencils.len());
         for (k, v) in velocities.iter().enumerate() {
             let (nodes, basis) = step.stencils.get(k);
             let len = nodes.len() * nd;
+            m[..len].fill(0.0);
+            p[..len].fill(0.0);
+            let (mw, drag) = (self.model.water_mass(k), self.model.drag(k));
             for (n, b) in basis.iter().enumerate() {
-                for c in 0..nd {
-                    let motion = c < 2;
-                    m[n * nd + c] = if motion { b.s * points.mass[k] } else { 0.0 };
-                    p[n * nd + c] = if motion { m[n * nd + c] * v[c] } else { 0.0 };
+                for c in 0..2 {
+                    m[n * nd + c] = b.s * points.mass[k];
+                    p[n * nd + c] = m[n * nd + c] * v[c];
+                }
+                if let (Some(w), Some(vw)) = (w, water) {
+                    for d in 0..2 {
+                        m[n * nd + w + d] = b.s * mw;
+                        p[n * nd + w + d] = b.s * mw * vw[k][d];
+                        c[n * nd + d] = b.s * drag;
+                        c[n * nd + w + d] = b.s * drag;
+                    }
                 }
             }
-            ps.scatter(k, &m[..len], &mut mass, whole);
-            ps.scatter(k, &p[..len], &mut momentum, whole);
+            ps.scatter(k, &m[..len], &mut out.mass, whole);
+            ps.scatter(k, &p[..len], &mut out.momentum, whole);
+            if w.is_some() {
+                ps.scatter(k, &c[..len], &mut out.drag, whole);
+            }
         }
-        (mass, momentum)
+        out
     }
 
     /// −S Δp of the pressure projection in the continuity rows of `f`.
@@ -671,6 +691,18 @@ impl<'a> Assembler<'a> {
             }
         }
     }
+}
+
+/// An explicit step's lumped nodal quantities per ghosted dof (this rank's shares; see
+/// [`Assembler::lumped_mass_and_momentum`]).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Lumped {
+    /// Σ S_ip m_p at the solid's dofs and Σ S_ip n ρ_w V_p at the water's.
+    pub mass: Vec<f64>,
+    /// Σ S_ip m_p v_p, likewise.
+    pub momentum: Vec<f64>,
+    /// Σ S_ip c_p (the drag) at the solid's and the water's dofs; empty without water.
+    pub drag: Vec<f64>,
 }
 
 impl NonlinearProblem for Assembler<'_> {

@@ -7,6 +7,7 @@
 //! pressure is the drained value zero. Fixed dofs keep their rows in the global vector (residual
 //! x − value, unit diagonal, no column entries), so the layout never changes.
 
+use crate::kernels::Layout;
 use crate::model::{Active, Model};
 use petsc::GhostedRange;
 
@@ -54,7 +55,7 @@ pub fn build(
     phi: &[f64],
     surface: &[f64],
     well_fraction: f64,
-    layout_water: Option<usize>,
+    layout: Layout,
 ) -> DofMap {
     let n = ghost.len();
     let mut m = DofMap {
@@ -69,14 +70,14 @@ pub fn build(
     for l in 0..n {
         let (i, j) = ghost.ij(l);
         let by = model.fixing_boundaries(active, i, j);
-        for (c, by_c) in by.iter().enumerate().take(nd) {
-            let q = l * nd + c;
+        for c in 0..nd {
+            let (q, by_c) = (l * nd + c, &by[layout.canonical(c)]);
             let b = by_c.or_else(|| (surface[q] > 0.5).then(|| surface[q].round() as usize - 1));
             if let Some(b) = b {
                 m.boundary[q] = b as u16;
                 // A moving boundary: its solid components and the water's move by its increment.
                 if let Some(motion) = &model.boundaries[b].motion {
-                    let dir = if c < 2 { Some(c) } else { layout_water.and_then(|w| (c >= w).then(|| c - w)) };
+                    let dir = if c < 2 { Some(c) } else { layout.w.and_then(|w| (c >= w).then(|| c - w)) };
                     if let Some(d) = dir.filter(|&d| d < 2) {
                         m.value[q] = motion.increment_at(model.grid.node_position(i, j), t0, t1)[d];
                     }

@@ -45,11 +45,25 @@
 //!    unchecked). The field w − v^n (zero at fixed dofs) is kept for the particle update
 //!    (`StepResult::velocity`). Each order above 1 costs one more pass over the points.
 //!
+//! 8. two-phase (the u–U system, `kernels::Layout::UW`; docs/analysis.md "Two-phase explicit"):
+//!    step 1 maps the water's mass nρ_w V and momentum too, and the drag C_i = Σ S_ip c_p
+//!    (c = n²γ_w V/k, [003] Eqs. 16c–e); step 2's forces are the u–p–U kernels' at Δd = 0 (the
+//!    effective stress, (1 − n)p on the skeleton and np on the water, [003] Eqs. 23a, c) without
+//!    the drag; step 4 takes the drag at the new velocities, node by node and direction by
+//!    direction ([`nodal_velocities`]: a 2 × 2 solve, stable at any permeability); the pore
+//!    pressure's increment follows from the continuity equation of the step ([003] Eq. 23b) at
+//!    each point (`kernels::flow::continuity::pointwise_increment`), or, with
+//!    `explicit.pore_pressure = "nodal"`, from its lumped form per node,
+//!    Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p, zero at drained nodes
+//!    (`GridSystem::drained_nodes`), each point taking Σ_i S_ip Δp_i
+//!    (`GridSystem::nodal_pressure_increments`). The lumped inertia the balance counts includes
+//!    each phase's drag.
+//!
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
 use super::{callbacks, Error, GridSystem, StepSolve};
 use crate::kernels::kinematics::Kinematics;
-use crate::kernels::Integration;
+use crate::kernels::{self, Integration};
 use crate::model::finite_strain::det;
 use crate::model::{fbar, Model};
 
@@ -62,39 +76,55 @@ impl GridSystem {
         };
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
-        let velocities = &model.particles.vel;
-        let (mut mass, mut momentum) = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(velocities));
+        let ps = &model.particles;
+        let water = self.layout.w.map(|_| ps.vel_w.as_slice());
+        let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&ps.vel, water));
         let start = self.step.start_terms.as_ref().expect("an explicit step's start terms");
         let mut residual: Vec<f64> = start.all.iter().zip(&self.step.fext).map(|(a, e)| a - e).collect();
-        for v in [&mut mass, &mut momentum, &mut residual] {
-            self.sum_over_ranks(v)?;
+        for v in [&mut lumped.mass, &mut lumped.momentum, &mut lumped.drag, &mut residual] {
+            if !v.is_empty() {
+                self.sum_over_ranks(v)?;
+            }
         }
         let dt = self.step.dt;
         let dofs = &self.step.dofs;
+        let (mass, momentum) = (&lumped.mass, &lumped.momentum);
         let mut solution = vec![0.0; ng];
         let mut inertia = vec![0.0; ng];
-        for q in 0..ng {
-            if dofs.fixed[q] {
-                solution[q] = dofs.value[q];
-                continue;
+        // (solid dof, water dof) of each node and direction: the phases' updates are coupled by
+        // the drag; one-phase nodes have no water dof.
+        let water_offset = self.layout.w;
+        let pairs =
+            (0..self.ghost.len()).flat_map(|l| (0..2).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
+        for (qs, qw) in pairs {
+            let phase = |q: usize| NodalPhase {
+                fixed: dofs.fixed[q].then(|| dofs.value[q] / dt),
+                mass: mass[q],
+                v0: if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 },
+                force: damped(-residual[q], damping, if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 }),
+            };
+            let solid = phase(qs);
+            let fluid = qw.map(phase);
+            let drag = qw.map_or(0.0, |_| lumped.drag[qs]);
+            let (vs, vw) = nodal_velocities(&solid, fluid.as_ref(), drag, dt);
+            // The inertia with the damping force and the drag (forces the balance must count).
+            for (q, ph, v, sign) in [(Some(qs), Some(&solid), vs, 1.0), (qw, fluid.as_ref(), vw, -1.0)] {
+                let (Some(q), Some(ph)) = (q, ph) else { continue };
+                solution[q] = dt * v;
+                if ph.fixed.is_none() && ph.mass > 0.0 {
+                    inertia[q] = ph.mass * (v - ph.v0) / dt + ph.force.1 + sign * drag * (vs - vw);
+                }
             }
-            if mass[q] <= 0.0 {
-                continue;
-            }
-            let v0 = momentum[q] / mass[q];
-            let force = -residual[q];
-            let damped = if damping > 0.0 && v0 != 0.0 { force - damping * force.abs() * v0.signum() } else { force };
-            let v1 = v0 + dt * damped / mass[q];
-            solution[q] = dt * v1;
-            // The inertia with the damping force (an applied force the balance must count).
-            inertia[q] = mass[q] * (v1 - v0) / dt + (force - damped);
         }
         self.step.solution = solution;
         self.step.explicit_inertia = inertia;
         self.step.xpic_correction =
-            if xpic > 0 { self.xpic_correction(model, xpic, &mass, &momentum)? } else { Vec::new() };
+            if xpic > 0 { self.xpic_correction(model, xpic, &lumped.mass, &lumped.momentum)? } else { Vec::new() };
         if model.fbar {
             self.step.fbar_scale = self.fbar_scales(model)?;
+        }
+        if !self.step.drained.is_empty() {
+            self.step.pressure_increment = self.nodal_pressure_increments(model)?;
         }
         let seconds = t0.elapsed().as_secs_f64();
         Ok(StepSolve {
@@ -130,11 +160,11 @@ impl GridSystem {
                 // S⁺S u: u at the points, their momenta back to the nodes.
                 let at_points: Vec<[f64; 2]> =
                     (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u)).collect();
-                let (mut mk, mut pk) = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points));
-                for v in [&mut mk, &mut pk] {
+                let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points, None));
+                for v in [&mut lumped.mass, &mut lumped.momentum] {
                     self.sum_over_ranks(v)?;
                 }
-                u = velocity(&mk, &pk);
+                u = velocity(&lumped.mass, &lumped.momentum);
             }
             let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
             for (wi, ui) in w.iter_mut().zip(&u) {
@@ -169,19 +199,50 @@ impl GridSystem {
             .collect())
     }
 
+    /// The nodal pore pressure's increment at each point of a two-phase step (see the module
+    /// documentation): the points' own increments Δp_p of the step's solution, their lumped
+    /// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
+    /// drained nodes), and Σ_i S_ip Δp_i at each point.
+    fn nodal_pressure_increments(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
+        let st = &self.step.stencils;
+        let mut storage = Vec::with_capacity(st.len());
+        let own: Vec<f64> = (0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                let states = callbacks::node_states(&self.step, k, &self.step.solution);
+                let input = callbacks::particle_input(model, &self.step, k);
+                storage.push(input.volume * input.inv_q);
+                let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout);
+                kernels::flow::continuity::pointwise_increment(&it, &input)
+            })
+            .collect();
+        let drained = std::mem::take(&mut self.step.drained);
+        let out = self.project_weighted(&storage, &own, &drained);
+        self.step.drained = drained;
+        out
+    }
+
     /// The volume-weighted projection Π(q) of a per-point quantity `q` (this rank's points) on the
     /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
     /// the ranks).
     fn project_per_point(&mut self, model: &Model, q: &[f64]) -> Result<Vec<f64>, Error> {
+        let volume = model.particles.volume[..q.len()].to_vec();
+        self.project_weighted(&volume, q, &[])
+    }
+
+    /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
+    /// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
+    /// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
+    fn project_weighted(&mut self, weight: &[f64], q: &[f64], zero: &[bool]) -> Result<Vec<f64>, Error> {
         let (nd, nn) = (self.layout.nd, self.ghost.len());
-        let (st, ps) = (&self.step.stencils, &model.particles);
+        let st = &self.step.stencils;
         let shares: Vec<Vec<(usize, f64)>> = (0..st.len())
             .map(|k| {
                 let (nodes, basis) = st.get(k);
                 nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect()
             })
             .collect();
-        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), ps.volume[k], q[k])));
+        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), weight[k], q[k])));
         // The nodal sums over ranks (the first component's slot of each node).
         let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
         for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
@@ -191,7 +252,119 @@ impl GridSystem {
             self.sum_over_ranks(sum)?;
         }
         let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
-        let weighted: Vec<f64> = (0..nn).map(|l| sums[1][l * nd]).collect();
+        let weighted: Vec<f64> =
+            (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
         Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
+    }
+}
+
+/// One phase of one nodal direction in an explicit step (summed over the ranks).
+#[derive(Debug, Clone, Copy)]
+struct NodalPhase {
+    /// The prescribed velocity of a fixed dof (its increment over Δt).
+    fixed: Option<f64>,
+    /// The lumped mass m_i.
+    mass: f64,
+    /// The velocity of the step's start, the lumped momentum over the mass (0 without mass).
+    v0: f64,
+    /// The force of the step's start after local damping, and what the damping took off.
+    force: (f64, f64),
+}
+
+/// A force `f` after local damping α (Al-Kafaji 2013), f − α |f| sign(v) at velocity `v`, with what
+/// the damping took off.
+fn damped(f: f64, alpha: f64, v: f64) -> (f64, f64) {
+    if alpha > 0.0 && v != 0.0 {
+        let d = alpha * f.abs() * v.signum();
+        (f - d, d)
+    } else {
+        (f, 0.0)
+    }
+}
+
+/// The new velocities (v_s, v_w) of a node's solid and, with `water`, its water in one direction
+/// (symplectic Euler on the lumped masses), the drag `c` (the lumped Σ S_ip c_p) taken at the new
+/// velocities, so that it is stable however small the permeability:
+///   m_s (v_s − v_s⁰)/Δt = f_s − c (v_s − v_w),   m_w (v_w − v_w⁰)/Δt = f_w + c (v_s − v_w).
+/// A fixed dof keeps its prescribed velocity and the other phase feels the drag against it; a
+/// free dof without mass keeps velocity 0 (nothing reaches it). Without water, v_w = 0.
+fn nodal_velocities(solid: &NodalPhase, water: Option<&NodalPhase>, c: f64, dt: f64) -> (f64, f64) {
+    // The explicit velocity of a phase that feels no drag (or none is left to solve for).
+    let free = |p: &NodalPhase, other: Option<f64>| -> f64 {
+        match (p.fixed, p.mass > 0.0, other) {
+            (Some(v), _, _) => v,
+            (None, false, _) => 0.0,
+            (None, true, None) => p.v0 + dt * p.force.0 / p.mass,
+            // The drag at the new velocity against a known one: (m/Δt + c) v = m v⁰/Δt + f + c v_o.
+            (None, true, Some(vo)) => (p.mass * p.v0 / dt + p.force.0 + c * vo) / (p.mass / dt + c),
+        }
+    };
+    let Some(w) = water else { return (free(solid, None), 0.0) };
+    match (solid.fixed.or((solid.mass <= 0.0).then_some(0.0)), w.fixed.or((w.mass <= 0.0).then_some(0.0))) {
+        (Some(vs), Some(vw)) => (vs, vw),
+        (Some(vs), None) => (vs, free(w, Some(vs))),
+        (None, Some(vw)) => (free(solid, Some(vw)), vw),
+        (None, None) => {
+            // [[m_s/Δt + c, −c], [−c, m_w/Δt + c]] (v_s, v_w) = (m_s v_s⁰/Δt + f_s, m_w v_w⁰/Δt + f_w).
+            let (a, d) = (solid.mass / dt + c, w.mass / dt + c);
+            let (bs, bw) = (solid.mass * solid.v0 / dt + solid.force.0, w.mass * w.v0 / dt + w.force.0);
+            // a d − c², without the cancellation of c² that a large drag (a low permeability)
+            // would bring.
+            let det = solid.mass * w.mass / (dt * dt) + c * (solid.mass + w.mass) / dt;
+            ((d * bs + c * bw) / det, (c * bs + a * bw) / det)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn phase(mass: f64, v0: f64, f: f64) -> NodalPhase {
+        NodalPhase { fixed: None, mass, v0, force: (f, 0.0) }
+    }
+
+    #[test]
+    fn the_nodal_update_balances_momentum_and_drag() {
+        let (dt, c) = (1e-3, 50.0);
+        let (s, w) = (phase(2.0, 0.3, 4.0), phase(0.5, -0.1, 1.0));
+        let (vs, vw) = nodal_velocities(&s, Some(&w), c, dt);
+        // Each phase's balance with the drag at the new velocities.
+        assert!((s.mass * (vs - s.v0) / dt - (4.0 - c * (vs - vw))).abs() < 1e-9);
+        assert!((w.mass * (vw - w.v0) / dt - (1.0 + c * (vs - vw))).abs() < 1e-9);
+        // The mixture's momentum does not see the drag.
+        let total = s.mass * (vs - s.v0) + w.mass * (vw - w.v0);
+        assert!((total - dt * 5.0).abs() < 1e-12);
+        // Without drag each phase is symplectic Euler; an enormous drag locks them together at the
+        // mixture's velocity.
+        let (a, b) = nodal_velocities(&s, Some(&w), 0.0, dt);
+        assert!((a - (0.3 + dt * 2.0)).abs() < 1e-12 && (b - (-0.1 + dt * 2.0)).abs() < 1e-12);
+        let (a, b) = nodal_velocities(&s, Some(&w), 1e15, dt);
+        let mixture = (2.0 * 0.3 + 0.5 * -0.1 + dt * 5.0) / 2.5;
+        assert!((a - mixture).abs() < 1e-9 && (b - mixture).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_fixed_phase_drags_the_other() {
+        let (dt, c) = (1e-3, 50.0);
+        let s = NodalPhase { fixed: Some(0.0), ..phase(2.0, 0.0, 0.0) };
+        let w = phase(0.5, 1.0, 0.0);
+        let (vs, vw) = nodal_velocities(&s, Some(&w), c, dt);
+        assert_eq!(vs, 0.0);
+        // Backward Euler on m v' = −c v: v = v⁰/(1 + cΔt/m), never past zero however large c Δt.
+        assert!((vw - 1.0 / (1.0 + c * dt / 0.5)).abs() < 1e-12);
+        let (_, vw) = nodal_velocities(&s, Some(&w), 1e12, dt);
+        assert!((0.0..1e-6).contains(&vw));
+        // A free dof without mass stays at rest; a one-phase node has no water.
+        assert_eq!(nodal_velocities(&phase(0.0, 0.0, 3.0), None, 0.0, dt), (0.0, 0.0));
+        assert_eq!(nodal_velocities(&phase(1.0, 0.0, 3.0), None, 0.0, dt), (3.0 * dt, 0.0));
+    }
+
+    #[test]
+    fn local_damping_opposes_the_motion() {
+        assert_eq!(damped(10.0, 0.1, 2.0), (9.0, 1.0));
+        assert_eq!(damped(10.0, 0.1, -2.0), (11.0, -1.0));
+        assert_eq!(damped(-10.0, 0.1, 2.0), (-11.0, 1.0));
+        assert_eq!(damped(10.0, 0.1, 0.0), (10.0, 0.0));
     }
 }

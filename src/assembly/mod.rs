@@ -114,7 +114,8 @@ struct StepData {
     /// the loads; see [`explicit`]), this rank's shares per ghosted dof; `None` otherwise.
     start_terms: Option<StartTerms>,
     /// An explicit step: the lumped inertia m_i a_i of its nodal update plus the local damping
-    /// force per ghosted dof (summed over ranks), for the equilibrium identity; empty otherwise.
+    /// force and, two-phase, the drag on the phase, per ghosted dof (summed over ranks), for the
+    /// equilibrium identity; empty otherwise.
     explicit_inertia: Vec<f64>,
     /// The F̄ projection of each particle's step (`stabilisation.fbar`, explicit steps;
     /// [`explicit`]): the scale c_p of its increment, the scale s_p of its total deformation and
@@ -123,6 +124,13 @@ struct StepData {
     /// An explicit XPIC step: the nodal field w − v^n its points' velocities take (see
     /// [`explicit`]), per ghosted dof; empty otherwise.
     xpic_correction: Vec<f64>,
+    /// A two-phase explicit step with the nodal pore pressure: whether each ghosted node is
+    /// drained (a boundary fixes `p` there, or the material barely fills it; see [`explicit`]);
+    /// empty otherwise.
+    drained: Vec<bool>,
+    /// A two-phase explicit step with the nodal pore pressure: each point's Δp, Σ_i S_ip Δp_i
+    /// (see [`explicit`]); empty otherwise (a point-wise pressure is the point's own).
+    pressure_increment: Vec<f64>,
 }
 
 /// The nodal terms of an explicit step's start, this rank's shares per ghosted dof (see
@@ -575,9 +583,36 @@ impl GridSystem {
         if model.integration.is_explicit() {
             // An explicit step solves nothing: no matrix.
             self.step.pattern = old_pattern;
+            if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
+                if self.layout.w.is_some() {
+                    self.step.drained = self.drained_nodes(model, active).map_err(|e| e.to_string())?;
+                }
+            }
             return Ok(());
         }
         self.matrix_pattern(old_pattern, coll)
+    }
+
+    /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
+    /// (see [`explicit`]): a side or region boundary of the stage fixes `p` there, a moving
+    /// surface that fixes `p` reaches it (`Model::surface_fixes`, marks summed over the ranks), or
+    /// the material barely fills it (the drained value of implicit stages' barely filled nodes).
+    fn drained_nodes(&mut self, model: &Model, active: &Active) -> Result<Vec<bool>, Error> {
+        let nd = self.layout.nd;
+        let p = kernels::dof::P;
+        let mut marks = vec![0.0; self.ghost.len() * nd];
+        for ((i, j), _, comps) in model.surface_fixes(active, false) {
+            if let (true, Some(l)) = (comps[p], self.ghost.node(i as usize, j as usize)) {
+                marks[l * nd] = 1.0;
+            }
+        }
+        self.sum_over_ranks(&mut marks)?;
+        Ok((0..self.ghost.len())
+            .map(|l| {
+                let (i, j) = self.ghost.ij(l);
+                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, i, j)[p].is_some()
+            })
+            .collect())
     }
 
     /// Step 4: the diagonal of the fixed-stress Schur preconditioner Sp = A_pp + diag(d) of the
@@ -693,7 +728,7 @@ impl GridSystem {
             let mut marks = vec![0.0; self.ghost.len() * nd];
             for ((i, j), _, comps) in fixes.iter().filter(|f| f.1 == bi) {
                 if let Some(l) = self.ghost.node(*i as usize, *j as usize) {
-                    for c in (0..nd).filter(|&c| comps[c]) {
+                    for c in (0..nd).filter(|&c| comps[self.layout.canonical(c)]) {
                         marks[l * nd + c] = 1.0;
                     }
                 }
@@ -716,7 +751,7 @@ impl GridSystem {
             &nodal.phi,
             &surface,
             WELL_FILLED_FRACTION,
-            self.layout.w,
+            self.layout,
         );
         dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
         Ok(dofs)
@@ -1533,6 +1568,13 @@ impl GridSystem {
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
         let mut result = StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) };
+        if self.layout.w.is_some() && self.layout.p.is_none() {
+            // The u–U system: the nodal pressure's increment, or the point's own.
+            result.interp.dp = match self.step.pressure_increment.get(k) {
+                Some(&dp) => dp,
+                None => kernels::flow::continuity::pointwise_increment(&pt.interp, pt.part),
+            };
+        }
         if !self.step.xpic_correction.is_empty() {
             // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
             let c = self.interpolated(k, &self.step.xpic_correction);

@@ -682,14 +682,15 @@ pub fn validate(c: &Case) -> R {
             }
         }
         if s.analysis == super::AnalysisType::DynamicExplicit {
+            let e = s.explicit.unwrap_or_default();
             if two_phase {
+                explicit_two_phase(c, s, &e)?;
+            } else if e.pore_pressure.is_some() {
                 return Err(format!(
-                    "key `{}`: `dynamic_explicit` is one-phase for now (the two-phase explicit u–p–U is not built); \
-                     use `dynamic`",
-                    key("analysis")
+                    "key `{}`: a one-phase stage has no pore pressure; leave `pore_pressure` out",
+                    key("explicit.pore_pressure")
                 ));
             }
-            let e = s.explicit.unwrap_or_default();
             if !(e.cfl > 0.0 && e.cfl <= 1.0) {
                 return Err(format!(
                     "key `{}`: C = {} must lie in (0, 1] (the explicit step's stability limit is C = 1)",
@@ -1250,6 +1251,43 @@ pub(crate) fn soil_model(prefix: &str, model: &SoilModel) -> R {
                 ));
             }
         }
+    }
+    Ok(())
+}
+
+/// The limits of a two-phase `dynamic_explicit` stage (the u–U system, `Layout::UW`): its pore
+/// pressure lives at the points, so no boundary can fix it (a surface where the water may leave is
+/// drained by itself, one where its normal motion is fixed is impermeable), and the transfers and
+/// projections built for the one-phase system (XPIC, F̄) are not built for the water.
+fn explicit_two_phase(c: &Case, s: &super::Stage, e: &super::Explicit) -> Result<(), String> {
+    let key = |k: &str| format!("stages.{}.{k}", s.name);
+    let pointwise = e.pore_pressure != Some(super::ExplicitPressure::Nodal);
+    if e.xpic_order.is_some() {
+        return Err(format!(
+            "key `{}`: XPIC is built for one-phase explicit stages only (the water's velocities would need their \
+             own passes); use `flip_blend`",
+            key("explicit.xpic_order")
+        ));
+    }
+    if c.stabilisation.fbar {
+        return Err(
+            "key `stabilisation.fbar`: the F̄ projection is built for one-phase explicit stages only (the pore \
+             pressure of a two-phase explicit stage follows the points' own volume changes); use \
+             `stabilisation.bbar` for the volumetric smoothing"
+                .into(),
+        );
+    }
+    let active = |name: &str| s.boundaries.as_ref().is_none_or(|list| list.iter().any(|n| n == name));
+    let fixes_p = c.boundaries.iter().find(|b| active(&b.name) && b.fix.contains(&super::Dof::P));
+    if let (true, Some(b)) = (pointwise, fixes_p) {
+        return Err(format!(
+            "key `boundaries` (`{}`): stage `{}` is explicit two-phase and holds its pore pressure point by point \
+             (`explicit.pore_pressure = \"pointwise\"`, the default), so `p` cannot be fixed; a surface where the \
+             water's motion is free is drained (p = 0) by itself, one that fixes the water's normal motion \
+             (`Ux`/`Uy`) is impermeable. Take `p` out of `fix`, leave the boundary out of the stage's `boundaries`, \
+             or set `explicit.pore_pressure = \"nodal\"` (the pressure at the nodes, which drained nodes fix)",
+            b.name, s.name
+        ));
     }
     Ok(())
 }

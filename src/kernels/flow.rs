@@ -20,7 +20,7 @@ fn solid_share(pt: &Point) -> f64 {
 /// tangent −G₁ᵀ, −G₂ᵀ and −P, weighted by w_mass. In axial symmetry the divergences include the
 /// hoop term, ∇̄·Δu + Σ T̄_j Δu_r,j ([`super::super::Interp::dvol_u`]).
 pub mod continuity {
-    use super::super::{Point, Scheme};
+    use super::super::{Interp, ParticleInput, Point, Scheme};
 
     /// Adds the continuity residual (layouts with a pressure).
     pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
@@ -32,6 +32,17 @@ pub mod continuity {
         for (k, b) in pt.basis.iter().enumerate() {
             out[k * nd + p] -= nm.w_mass * b.s * rate * part.volume;
         }
+    }
+
+    /// The pore-pressure increment that holds the continuity equation at the point itself, the
+    /// explicit two-phase system's (u–U, no nodal pressure): the residual's integrand
+    /// (1 − n) ∇̄·Δu + n ∇̄·ΔU + ∇n·(ΔU − Δu) + Δp/Q = 0 ([003] Eq. 23b with the porosity-gradient
+    /// term of [`super::porosity_gradient`]) solved for Δp, with the divergences of the step's
+    /// increments on x_n (B̄'s cell-centre divergences where the case asks for B̄).
+    pub fn pointwise_increment(it: &Interp, part: &ParticleInput) -> f64 {
+        let n = part.porosity;
+        let relative: f64 = (0..2).map(|c| part.grad_n[c] * (it.dw[c] - it.du[c])).sum();
+        -((1.0 - n) * it.dvol_u + n * it.dvol_w + relative) / part.inv_q
     }
 
     /// Adds −G₁ᵀ (p–u), −G₂ᵀ (p–U) and −P (p–p, [003] 16i with the sign of Eq. 23b).
@@ -97,13 +108,15 @@ pub mod darcy {
 }
 
 /// The porosity-gradient terms (see the kernels' documentation): R_u,i += w_f S_i p ∇n V,
-/// R_U,i −= w_f S_i p ∇n V, R_p,i −= w_mass S_i ∇n·(ΔU − Δu) V, with ∇n at t_n.
+/// R_U,i −= w_f S_i p ∇n V, R_p,i −= w_mass S_i ∇n·(ΔU − Δu) V, with ∇n at t_n. The u–U system
+/// (no nodal pressure) takes the momentum terms; its continuity equation holds at the points
+/// ([`super::continuity::pointwise_increment`]).
 pub mod porosity_gradient {
     use super::super::{Point, Scheme};
 
-    /// Adds the ∇n residual (u–p–U layouts only).
+    /// Adds the ∇n residual (layouts with the water's motion).
     pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
-        let (Some(p), Some(w)) = (pt.layout.p, pt.layout.w) else { return };
+        let Some(w) = pt.layout.w else { return };
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
         let gn = part.grad_n;
         let rel: f64 = (0..2).map(|c| gn[c] * (it.dw[c] - it.du[c])).sum();
@@ -113,11 +126,14 @@ pub mod porosity_gradient {
                 out[k * nd + c] += f;
                 out[k * nd + w + c] -= f;
             }
-            out[k * nd + p] -= nm.w_mass * b.s * rel * part.volume;
+            if let Some(p) = pt.layout.p {
+                out[k * nd + p] -= nm.w_mass * b.s * rel * part.volume;
+            }
         }
     }
 
-    /// Adds ±S_k S_l ∇n V in u–p, U–p (weight w_f) and p–u, p–U (weight w_mass).
+    /// Adds ±S_k S_l ∇n V in u–p, U–p (weight w_f) and p–u, p–U (weight w_mass); without a nodal
+    /// pressure (u–U) the momentum terms depend on no unknown.
     pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let (Some(p), Some(w)) = (pt.layout.p, pt.layout.w) else { return };
         let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);

@@ -39,13 +39,19 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 }
 
 /// Drag between the phases: w_f S_i c (v_u − v_U) in the u rows and w_f S_i c (v_U − v_u) in the U
-/// rows, c = n² γ_w V / k ([003] Eqs. 16c–e with the coefficient of the spec).
+/// rows, c = n² γ_w V / k ([003] Eqs. 16c–e with the coefficient of the spec). An explicit step
+/// takes the drag at the nodes instead, lumped and implicit in the new velocities
+/// (`assembly::explicit`), so that a low permeability does not limit its step; the kernels then
+/// add none.
 pub mod drag {
     use super::super::{Point, Scheme};
 
     /// Adds the drag residual (two-phase layouts only).
     pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
+        if nm.explicit {
+            return;
+        }
         let (nd, it) = (pt.layout.nd, &pt.interp);
         for (k, b) in pt.basis.iter().enumerate() {
             for c in 0..2 {
@@ -59,6 +65,9 @@ pub mod drag {
     /// Adds w_f a₁ C in the u–u, u–U, U–u and U–U blocks.
     pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
+        if nm.explicit {
+            return;
+        }
         let (nd, m) = (pt.layout.nd, pt.size());
         for (k, bk) in pt.basis.iter().enumerate() {
             for (l, bl) in pt.basis.iter().enumerate() {

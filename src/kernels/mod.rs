@@ -98,10 +98,27 @@ impl Layout {
     pub const UP: Layout = Layout { nd: 3, p: Some(dof::P), w: None };
     /// u–p–U.
     pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX) };
+    /// u–U (the explicit two-phase system, the "v–w form"): the motion of both phases at the
+    /// nodes, the pore pressure at the points (its continuity equation held point by point,
+    /// [`flow::continuity::pointwise_increment`]).
+    pub const UW: Layout = Layout { nd: 4, p: None, w: Some(2) };
 
     /// The names of the layout's nodal fields, in dof order.
     pub fn field_names(&self) -> &'static [&'static str] {
+        if self.p.is_none() && self.w.is_some() {
+            return &["ux", "uy", "Ux", "Uy"];
+        }
         &["ux", "uy", "p", "Ux", "Uy"][..self.nd]
+    }
+
+    /// The position in the full two-phase order (ux, uy, p, Ux, Uy; [`dof`]) of this layout's
+    /// dof component `c`, the order in which boundaries name what they fix.
+    pub fn canonical(&self, c: usize) -> usize {
+        match (self.p, self.w) {
+            (_, Some(w)) if c >= w => dof::WX + c - w,
+            (Some(p), _) if c == p => dof::P,
+            _ => c,
+        }
     }
 
     /// The physical fields and their dof offsets: the solid displacement u, then the pore
@@ -252,6 +269,9 @@ pub enum Integration {
         /// The order m of the XPIC transfer (Hammerquist & Nairn 2017) that replaces the FLIP/PIC
         /// blend; 0 for the blend.
         xpic: u8,
+        /// A two-phase stage's pore pressure held point by point (the "v–w" form) rather than by
+        /// the lumped nodal continuity equation (`assembly::explicit`).
+        pointwise_pressure: bool,
     },
 }
 

@@ -378,6 +378,18 @@ impl Model {
         }
     }
 
+    /// The drag coefficient c = n² γ_w V/k between the phases of particle `k` ([003] Eqs. 16c–e;
+    /// zero in a one-phase run) [N s/m].
+    #[inline]
+    pub fn drag(&self, k: usize) -> f64 {
+        if !self.two_phase {
+            return 0.0;
+        }
+        let ps = &self.particles;
+        let (mat, n) = (&self.materials[ps.material[k] as usize], ps.porosity[k]);
+        n * n * mat.water_density * self.g * ps.volume[k] / mat.conductivity_at(n)
+    }
+
     /// The porosity of particle `k` after a step with volume ratio J, by conservation of solid mass,
     /// n = 1 − (1 − n₀)/J; a one-phase (total-stress) run has no porosity among its state variables
     /// and keeps the initial value.
@@ -398,8 +410,7 @@ impl Model {
         let (v, n) = (ps.volume[idx], ps.porosity[idx]);
         let (water_mass, drag, inv_q, mobility) = if self.two_phase {
             let gw = mat.water_density * self.g;
-            let k = mat.conductivity_at(n);
-            (self.water_mass(idx), n * n * gw * v / k, mat.inv_q_at(n), k / gw)
+            (self.water_mass(idx), self.drag(idx), mat.inv_q_at(n), mat.conductivity_at(n) / gw)
         } else {
             (0.0, 0.0, 0.0, 0.0)
         };
@@ -509,14 +520,21 @@ impl Model {
             crate::kernels::Integration::Explicit { flip, .. } => {
                 // [002] Eqs. 11–13: FLIP v_p + Σ S (v_i^{n+1} − v_i^n) blended with PIC Σ S v_i^{n+1};
                 // Σ S v_i^{n+1} = Δu_p/Δt, and Σ S v_i^n is the interpolated nodal velocity of the
-                // step's start (the scheme's predictor, `interp.v_u`). One-phase only. XPIC sets
-                // the velocity itself (`StepResult::velocity`).
+                // step's start (the scheme's predictor, `interp.v_u`); the water's likewise
+                // (Δw_p/Δt and `interp.v_w`). XPIC sets the solid's velocity itself
+                // (`StepResult::velocity`; one-phase only).
                 for c in 0..2 {
                     let pic = it.du[c] / dt;
                     let blend = flip * (ps.vel[k][c] + pic - it.v_u[c]) + (1.0 - flip) * pic;
                     let v = step.velocity.map_or(blend, |v| v[c]);
                     ps.acc[k][c] = (v - ps.vel[k][c]) / dt;
                     ps.vel[k][c] = v;
+                    if self.two_phase {
+                        let pic = it.dw[c] / dt;
+                        let v = flip * (ps.vel_w[k][c] + pic - it.v_w[c]) + (1.0 - flip) * pic;
+                        ps.acc_w[k][c] = (v - ps.vel_w[k][c]) / dt;
+                        ps.vel_w[k][c] = v;
+                    }
                 }
             }
             _ => {
