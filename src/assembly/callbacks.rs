@@ -190,6 +190,15 @@ impl Particles<'_> {
         f(&pt.with_faces(step.faces_of(k), &states[..nodes.len()]))
     }
 
+    /// Particle `k` at an explicit step's start with the stress it carries
+    /// ([`kernels::Point::at_start`]).
+    fn with_point_at_start<R>(&self, k: usize, f: impl FnOnce(&kernels::Point) -> R) -> R {
+        let step = self.step;
+        let (_, basis) = step.stencils.get(k);
+        let input = particle_input(self.model, step, k);
+        f(&kernels::Point::at_start(basis, step.stencils.strain_of(k), &input, step.layout.expect("prepared")))
+    }
+
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
     fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
         let nm = self.step.nm.expect("prepared");
@@ -470,8 +479,11 @@ impl<'a> Assembler<'a> {
         let mut unweighted = if weighted { vec![0.0; all.len()] } else { Vec::new() };
         let ps = self.particles();
         let whole = ps.whole();
+        // An explicit step's terms are those of its start, with the stress each point carries.
+        let at_start = nm.is_explicit();
+        debug_assert!(!at_start || xl.iter().all(|&x| x == 0.0));
         for k in 0..step.stencils.len() {
-            let m = ps.with_point(k, xl, |pt| {
+            let terms = |pt: &kernels::Point| {
                 let m = pt.size();
                 kernels::residual(pt, &nm, &mut buf[..m]);
                 if weighted {
@@ -479,7 +491,8 @@ impl<'a> Assembler<'a> {
                 }
                 kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
                 m
-            });
+            };
+            let m = if at_start { ps.with_point_at_start(k, terms) } else { ps.with_point(k, xl, terms) };
             ps.scatter(k, &buf[..m], all, whole);
             for v in &mut buf[..m] {
                 *v = v.abs();

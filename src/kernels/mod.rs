@@ -342,6 +342,11 @@ impl Scheme {
         self.dt
     }
 
+    /// Whether the step is explicit (its forces are those of its start).
+    pub fn is_explicit(&self) -> bool {
+        self.explicit
+    }
+
     /// Newmark factors for step `dt`.
     pub fn newmark(beta: f64, gamma: f64, dt: f64) -> Scheme {
         Scheme::of(&Integration::newmark(beta, gamma), dt, false)
@@ -640,6 +645,60 @@ impl<'a> Point<'a> {
             strain_spatial,
             strain_hoop,
             p: part.p + interp.dp,
+            faces: &[],
+            face_dp: [0.0; MAX_FACES],
+        }
+    }
+
+    /// The point at its step's start (Δd = 0) with the stress it carries, σ_n on x_n, as an
+    /// explicit step's forces take it (update-stress-last, [002] Algorithm 1): no soil-model call
+    /// (the stored stress is the one the last step's update left, the viscous part of a fluid's
+    /// included, which a model evaluated again at a zero increment would drop) and no tangent (an
+    /// explicit step builds no matrix). The interpolated velocities and accelerations are the
+    /// point's predictors, as at Δd = 0.
+    pub fn at_start(
+        basis: &'a [NodeBasis],
+        strain: &'a [NodeBasis],
+        part: &'a ParticleInput,
+        layout: Layout,
+    ) -> Point<'a> {
+        let mut interp = Interp { a_u: part.pred.a_u, v_u: part.pred.v_u, ..Interp::default() };
+        if layout.w.is_some() {
+            interp.a_w = part.pred.a_w;
+            interp.v_w = part.pred.v_w;
+        }
+        let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
+        let mut hoop = [(0.0, 0.0); MAX_NODES];
+        for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
+            *s = (b.g, b.gv);
+            *t = (b.t, b.tv);
+        }
+        let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
+        for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
+            *s = (b.g, b.gv);
+            *t = (b.t, b.tv);
+        }
+        let zero = [[0.0; 4]; 4];
+        Point {
+            basis,
+            part,
+            layout,
+            interp,
+            kin: Kinematics::rest(),
+            rotated: part.stress,
+            upd: StressUpdate {
+                stress: part.stress,
+                tangent: zero,
+                trial_tangent: zero,
+                eps_pd: part.eps_pd,
+                region: crate::model::soil::Region::Elastic,
+            },
+            spatial,
+            hoop,
+            strain,
+            strain_spatial,
+            strain_hoop,
+            p: part.p,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
         }
