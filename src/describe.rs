@@ -10,14 +10,16 @@ pub fn describe(case: &Case, label: &str) -> String {
     let model = Model::build(case, |_, _| true);
     let g = &model.grid;
     let nd = model.ndof();
+    // The first stage's own unknowns per node (its analysis type's layout).
+    let layout = crate::analysis::StageAnalysis::of(case, &case.stages[0]).layout;
     let mut s = String::new();
     let _ = writeln!(s, "case: {label}");
     let _ = writeln!(
         s,
-        "formulation: {} ({} dofs per node: {})",
-        if model.two_phase { "two_phase, u–p–U" } else { "one_phase, u" },
-        nd,
-        model.field_names().join(", ")
+        "formulation: {} (the first stage: {} dofs per node: {})",
+        if model.two_phase { "two_phase" } else { "one_phase" },
+        layout.nd,
+        layout.field_names().join(", ")
     );
     let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
     let _ = writeln!(
@@ -123,8 +125,6 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     let active_nodes = filled.iter().filter(|&&f| f > WELL_FILLED_FRACTION).count();
     let first = model.active(&case.stages[0]);
-    // The first stage's own unknowns per node (its analysis type's layout).
-    let layout = crate::analysis::StageAnalysis::of(case, &case.stages[0]).layout;
     let mut unknowns = 0;
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {

@@ -185,3 +185,24 @@ fn bad_two_phase_explicit_input_is_named() {
         "key `stages.self_weight.explicit.pore_pressure`: a one-phase stage has no pore pressure",
     );
 }
+
+/// `porompm check` describes the u–U system of a two-phase explicit stage: four dofs per node,
+/// the unknowns of its first step (both phases' free motion: 2 × 20 on Terzaghi's column), and how
+/// its pore pressure and drag are taken.
+#[test]
+fn check_describes_the_two_phase_explicit_stage() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_porompm"))
+        .args(["check", CASE])
+        .current_dir(root())
+        .output()
+        .expect("porompm runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "the first stage: 4 dofs per node: ux, uy, Ux, Uy",
+        "unknowns of the first step: 40",
+        "explicit dynamic u–U with the pore pressure at the nodes (lumped continuity), drag implicit per node",
+    ] {
+        assert!(text.contains(want), "`{want}` missing in:\n{text}");
+    }
+}

@@ -209,7 +209,8 @@ impl Monitor {
             format!(
                 "the pore pressure oscillates from particle to particle: a particle deviates from its local smooth fit by {v:.2} of the largest total stress (limit {OSCILLATION_LIMIT}), \
                  for {OSCILLATION_ROWS} history rows in a row or at the end; equal-order pressures need stabilisation near undrained conditions: set stabilisation.pressure_projection = 2.0 \
-                 (or, in a dynamic stage, patch_recovery = true), or take larger steps"
+                 (or, in a dynamic stage, patch_recovery = true), or take larger steps; in an explicit two-phase stage, use the point-wise pore pressure (the default), and write \
+                 history rows less often than every step (a sudden load's wave front trips this check for a few steps)"
             )
         })
     }
