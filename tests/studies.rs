@@ -2,6 +2,8 @@
 //! `cargo test --release --test studies -- --ignored --nocapture --test-threads=1`. Each prints a
 //! Markdown table and writes it to `target/studies/`.
 
+mod common;
+use common::csv_fields;
 use serde_json::Value;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -492,6 +494,22 @@ fn dam_break_item_15() {
     assert!(unmet.is_empty(), "Part E item 15, unmet:\n  {}", unmet.join("\n  "));
 }
 
+/// Runs `porompm sweep ARGS --out target/studies/NAME --quiet` (the case first in `args`) into a
+/// fresh directory, asserts that it succeeded, and returns the directory.
+fn study_sweep(name: &str, args: &[&str]) -> PathBuf {
+    let out = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/studies").join(name);
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
+        .arg("sweep")
+        .args(args)
+        .args(["--out", &out.display().to_string(), "--quiet"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("porompm sweep runs");
+    assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
 /// Implicit against explicit on Terzaghi's column (issue «Seed [002]» item 6; [003]'s claim that
 /// the implicit step can be ~100× larger at equal accuracy): one `porompm sweep` of
 /// cases/terzaghi.toml with three variants (the implicit dynamic u–p–U as shipped, the implicit
@@ -504,43 +522,34 @@ fn dam_break_item_15() {
 #[test]
 #[ignore]
 fn implicit_against_explicit_terzaghi() {
-    let out = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/studies/implicit_explicit_terzaghi");
-    let _ = std::fs::remove_dir_all(&out);
     let metric = "p_rms_error_Tv0.5";
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(["sweep", "cases/terzaghi.toml", "--out", &out.display().to_string(), "--quiet"])
-        .args(["--variant", "implicit_dynamic:"])
-        .args(["--variant", "quasi_static:stages.consolidation.analysis=quasi_static"])
-        .args([
+    let out = study_sweep(
+        "implicit_explicit_terzaghi",
+        &[
+            "cases/terzaghi.toml",
+            "--variant",
+            "implicit_dynamic:",
+            "--variant",
+            "quasi_static:stages.consolidation.analysis=quasi_static",
             "--variant",
             "explicit:stages.consolidation.analysis=dynamic_explicit;\
              stages.consolidation.explicit={cfl=0.5,pore_pressure=\"nodal\"};time.dt=1e-3",
-        ])
-        .args(["--vary", "grid.cells=[1,10],[1,20]"])
-        .args(["--vary", "time.dt=0.05,0.02,1e-2,7e-3,5e-3,3e-3,2e-3,1.5e-3,1e-3,5e-4"])
-        .args(["--set", "output.fields_every=0", "--metric", metric])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("porompm sweep runs");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            "--vary",
+            "grid.cells=[1,10],[1,20]",
+            "--vary",
+            "time.dt=0.05,0.02,1e-2,7e-3,5e-3,3e-3,2e-3,1.5e-3,1e-3,5e-4",
+            "--set",
+            "output.fields_every=0",
+            "--metric",
+            metric,
+        ],
+    );
     let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
-    // Fields with commas ("[1,10]") are quoted: split on commas outside quotes.
-    let split = |line: &str| -> Vec<String> {
-        let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
-        for ch in line.chars() {
-            match ch {
-                '"' => quoted = !quoted,
-                ',' if !quoted => out.push(std::mem::take(&mut cur)),
-                _ => cur.push(ch),
-            }
-        }
-        out.push(cur);
-        out
-    };
-    let rows: Vec<Vec<String>> = lines.map(split).collect();
+    let header = csv_fields(lines.next().unwrap());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    // Fields with commas ("[1,10]") are quoted.
+    let rows: Vec<Vec<String>> = lines.map(csv_fields).collect();
     let num = |r: &Vec<String>, c: &str| r[col(c)].parse::<f64>().unwrap_or(f64::NAN);
     let mut text = String::from(
         "## Implicit against explicit: Terzaghi's column (RMS pressure error at T_v = 0.5)\n\n\
@@ -600,24 +609,28 @@ fn implicit_against_explicit_terzaghi() {
 #[test]
 #[ignore]
 fn implicit_against_explicit_footing() {
-    let out = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/studies/implicit_explicit_footing");
-    let _ = std::fs::remove_dir_all(&out);
-    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(["sweep", "cases/footing_fbar.toml", "--out", &out.display().to_string(), "--quiet"])
-        .args(["--metric", "bearing_capacity_ratio", "--variant", "explicit_fbar:"])
-        .args([
+    let out = study_sweep(
+        "implicit_explicit_footing",
+        &[
+            "cases/footing_fbar.toml",
+            "--metric",
+            "bearing_capacity_ratio",
+            "--variant",
+            "explicit_fbar:",
             "--variant",
             "implicit_static:stages.penetration={name=\"penetration\",analysis=\"static\",duration=3.0,dt=0.01};\
              materials.clay.model={type=\"von_mises\",young_modulus=1e6,poisson_ratio=0.49,cohesion=100.0};\
              stabilisation={bbar=true}",
-        ])
-        .args(["--vary", "parameters.h=0.1,0.05"])
-        .args(["--set", "verification.plateau=[0.005,0.01]", "--set", "verification.stop_settlement=0.0115"])
-        .args(["--set", "output.history_every=10"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("porompm sweep runs");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            "--vary",
+            "parameters.h=0.1,0.05",
+            "--set",
+            "verification.plateau=[0.005,0.01]",
+            "--set",
+            "verification.stop_settlement=0.0115",
+            "--set",
+            "output.history_every=10",
+        ],
+    );
     let mut text = String::from(
         "## Implicit against explicit: [002]'s rigid strip footing (q_ult/s_u over d/B in [0.005, 0.01])\n\n\
          | h | run | q_ult/s_u | error vs 2 + π | steps | mean step [s] | wall [s] |\n|---|---|---|---|---|---|---|\n",

@@ -1,6 +1,8 @@
 //! `porompm sweep` end to end (runs, failed rows, the three result files, bad input) and the PNG
 //! figures a verification run draws into DIR/plots/. Every test runs the real binary.
 
+mod common;
+use common::csv_fields;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -34,20 +36,6 @@ fn assert_png(path: &Path, series: usize) {
         SERIES_COLOURS[..6].iter().map(|c| img.pixels().filter(|p| p.0 == *c).count()).collect();
     let drawn = counts.iter().filter(|n| **n > 300).count();
     assert!(drawn >= series, "{}: {drawn} series drawn (pixels per colour {counts:?})", path.display());
-}
-
-/// Splits a CSV line at commas outside double quotes.
-fn csv_fields(line: &str) -> Vec<String> {
-    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
-    for c in line.chars() {
-        match c {
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
-            _ => cur.push(c),
-        }
-    }
-    fields.push(cur);
-    fields
 }
 
 #[test]

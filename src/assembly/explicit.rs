@@ -97,11 +97,14 @@ impl GridSystem {
         let pairs =
             (0..self.ghost.len()).flat_map(|l| (0..2).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
         for (qs, qw) in pairs {
-            let phase = |q: usize| NodalPhase {
-                fixed: dofs.fixed[q].then(|| dofs.value[q] / dt),
-                mass: mass[q],
-                v0: if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 },
-                force: damped(-residual[q], damping, if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 }),
+            let phase = |q: usize| {
+                let v0 = if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 };
+                NodalPhase {
+                    fixed: dofs.fixed[q].then(|| dofs.value[q] / dt),
+                    mass: mass[q],
+                    v0,
+                    force: damped(-residual[q], damping, v0),
+                }
             };
             let solid = phase(qs);
             let fluid = qw.map(phase);
@@ -226,8 +229,7 @@ impl GridSystem {
     /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
     /// the ranks).
     fn project_per_point(&mut self, model: &Model, q: &[f64]) -> Result<Vec<f64>, Error> {
-        let volume = model.particles.volume[..q.len()].to_vec();
-        self.project_weighted(&volume, q, &[])
+        self.project_weighted(&model.particles.volume[..q.len()], q, &[])
     }
 
     /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):

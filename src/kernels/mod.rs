@@ -559,6 +559,36 @@ pub struct Point<'a> {
     pub face_dp: [f64; MAX_FACES],
 }
 
+/// The gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each node of
+/// `basis` and of the strain operators `strain` ([`Point::spatial`], [`Point::hoop`],
+/// [`Point::strain_spatial`], [`Point::strain_hoop`]; the latter a copy when `strain` is `basis`).
+#[allow(clippy::type_complexity)]
+fn on_new_configuration(
+    kin: &Kinematics,
+    basis: &[NodeBasis],
+    strain: &[NodeBasis],
+) -> (
+    [([f64; 2], [f64; 2]); MAX_NODES],
+    [(f64, f64); MAX_NODES],
+    [([f64; 2], [f64; 2]); MAX_NODES],
+    [(f64, f64); MAX_NODES],
+) {
+    let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
+    let mut hoop = [(0.0, 0.0); MAX_NODES];
+    for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
+        *s = kin.spatial(b);
+        *t = kin.hoop(b);
+    }
+    let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
+    if !std::ptr::eq(strain, basis) {
+        for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
+            *s = kin.spatial(b);
+            *t = kin.hoop(b);
+        }
+    }
+    (spatial, hoop, strain_spatial, strain_hoop)
+}
+
 /// Largest number of drained faces of one particle (all four sides of its domain).
 pub const MAX_FACES: usize = 4;
 
@@ -618,19 +648,7 @@ impl<'a> Point<'a> {
         let upd = model
             .finite(&df, &f_new, &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
-        let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
-        let mut hoop = [(0.0, 0.0); MAX_NODES];
-        for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
-            *s = kin.spatial(b);
-            *t = kin.hoop(b);
-        }
-        let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
-        if !std::ptr::eq(strain, basis) {
-            for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
-                *s = kin.spatial(b);
-                *t = kin.hoop(b);
-            }
-        }
+        let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
         Point {
             basis,
             part,
@@ -662,29 +680,16 @@ impl<'a> Point<'a> {
         part: &'a ParticleInput,
         layout: Layout,
     ) -> Point<'a> {
-        let mut interp = Interp { a_u: part.pred.a_u, v_u: part.pred.v_u, ..Interp::default() };
-        if layout.w.is_some() {
-            interp.a_w = part.pred.a_w;
-            interp.v_w = part.pred.v_w;
-        }
-        let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
-        let mut hoop = [(0.0, 0.0); MAX_NODES];
-        for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
-            *s = (b.g, b.gv);
-            *t = (b.t, b.tv);
-        }
-        let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
-        for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
-            *s = (b.g, b.gv);
-            *t = (b.t, b.tv);
-        }
+        let interp = interpolate(basis, &[NodeState::default(); MAX_NODES], &part.pred, layout);
+        let kin = Kinematics::rest();
+        let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
         let zero = [[0.0; 4]; 4];
         Point {
             basis,
             part,
             layout,
             interp,
-            kin: Kinematics::rest(),
+            kin,
             rotated: part.stress,
             upd: StressUpdate {
                 stress: part.stress,

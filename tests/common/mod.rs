@@ -116,3 +116,17 @@ pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run
     let (header, rows) = read_history(dir);
     Run { output, summary, header, rows }
 }
+
+/// Splits a CSV line at commas outside double quotes.
+pub fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    for c in line.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    fields.push(cur);
+    fields
+}
