@@ -14,6 +14,9 @@
 //! | `dynamic_explicit` | one-phase | u | explicit ([002]: lumped mass, update-stress-last) |
 //! | `dynamic_explicit` | two-phase | u, U (the pore pressure at the points) | explicit, the drag implicit at each node |
 //!
+//! With `stabilisation.fbar` an implicit u or u–p stage adds ϑ = J̄ − 1, [002]'s projected volume
+//! ratio, to each node's unknowns (`kernels::fbar`, [`Layout::with_fbar`]).
+//!
 //! Each stage hands its particles (stress, pore pressure and its gradient, internal variables,
 //! positions) to the next, whatever the types: e.g. a drained static gravity stage, a
 //! quasi-static consolidation and a dynamic failure in one case.
@@ -37,7 +40,7 @@ impl StageAnalysis {
     /// stage of a two-phase case says its drainage).
     pub fn of(case: &Case, stage: &Stage) -> StageAnalysis {
         let two_phase = case.analysis.formulation == Formulation::TwoPhase;
-        match stage.analysis {
+        let mut analysis = match stage.analysis {
             AnalysisType::Dynamic => StageAnalysis {
                 layout: if two_phase { Layout::UPU } else { Layout::U },
                 integration: stage.time_integration.as_ref().unwrap_or(&case.time_integration).integration(),
@@ -69,7 +72,13 @@ impl StageAnalysis {
                     dt_limit: Some(e.cfl * wave_step(case)),
                 }
             }
+        };
+        // [002]'s F̄ in an implicit stage: the projected volume ratio joins the unknowns
+        // (`kernels::fbar`; validated: u and u–p stages only).
+        if case.stabilisation.fbar && stage.analysis != AnalysisType::DynamicExplicit {
+            analysis.layout = analysis.layout.with_fbar().expect("validated: F̄ in u or u–p stages");
         }
+        analysis
     }
 
     /// A short description for progress lines and `porompm check`.
@@ -79,6 +88,10 @@ impl StageAnalysis {
             (Some(_), None) => "u–p",
             (None, Some(_)) => "u–U",
             _ => "u",
+        };
+        let unknowns = match self.layout.jbar {
+            Some(_) => format!("{unknowns} with F̄ (the projected J̄ at the nodes)"),
+            None => unknowns.to_string(),
         };
         match self.integration {
             Integration::Dynamic { beta, gamma, alpha_m, alpha_f } if alpha_m == 0.0 && alpha_f == 0.0 => {

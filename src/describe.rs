@@ -1,6 +1,6 @@
 //! `porompm check`: what a case will build, computed without PETSc (one process).
 
-use crate::assembly::WELL_FILLED_FRACTION;
+use crate::assembly::{REACHED_FRACTION, WELL_FILLED_FRACTION};
 use crate::case::{Case, Load, SoilModel};
 use crate::model::{shape, Model};
 use std::fmt::Write;
@@ -128,10 +128,16 @@ pub fn describe(case: &Case, label: &str) -> String {
     let mut unknowns = 0;
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {
-            if filled[j * g.nodes()[0] + i] > WELL_FILLED_FRACTION {
-                let fixed = model.fixing_boundaries(&first, i, j);
-                unknowns += (0..layout.nd).filter(|&c| fixed[layout.canonical(c)].is_none()).count();
-            }
+            let f = filled[j * g.nodes()[0] + i];
+            let fixed = model.fixing_boundaries(&first, i, j);
+            // As `assembly::dofs`: a well-filled node's free dofs, and an implicit F̄ step's J̄
+            // wherever points reach.
+            unknowns += (0..layout.nd)
+                .filter(|&c| match layout.canonical(c) {
+                    None => f > REACHED_FRACTION,
+                    Some(k) => f > WELL_FILLED_FRACTION && fixed[k].is_none(),
+                })
+                .count();
         }
     }
     let _ = writeln!(s, "active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}");
@@ -213,7 +219,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         if gravity { "on" } else { "off" },
         if model.materials.iter().all(|m| m.model.is_elastic()) { "never called (elastic)" } else { "on" },
         if model.bbar { "on" } else { "off" },
-        if model.fbar { "on (explicit stages)" } else { "off" },
+        if model.fbar { "on" } else { "off" },
         match (model.patch_recovery, model.pressure_update) {
             (_, crate::case::PressureUpdate::ProjectedTotal) => "off (pressure from the projected total field)",
             (true, _) => "on",

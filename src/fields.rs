@@ -26,7 +26,7 @@ use crate::model::Model;
 use crate::parallel::Collective;
 
 /// Values per particle record in the redistribution.
-const PREC: usize = 18;
+const PREC: usize = 19;
 
 /// The grid's geometry for the field files.
 pub fn grid_geometry(model: &Model) -> GridGeometry {
@@ -63,6 +63,7 @@ pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Fra
                 ps.eps_pd[k],
                 ps.mass[k],
                 ps.volume[k],
+                ps.jbar[k],
             ]
         })
         .collect();
@@ -95,6 +96,10 @@ pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Fra
         scalar("body_id", int(1)),
         scalar("particle_id", Values::Real(all.iter().map(|r| r[0]).collect())),
     ];
+    if model.fbar {
+        // [002]'s projected volume ratio J̄ the stress sees (its volume is det F V⁰).
+        pf.push(scalar("jbar", real(&|r| r[18])));
+    }
     if model.two_phase {
         pf.push(scalar("p", real(&|r| r[13])));
         pf.push(scalar("p_excess", real(&|r| r[13] - r[14])));

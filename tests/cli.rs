@@ -342,28 +342,29 @@ fn the_assembled_tangent_matches_finite_differences_block_by_block() {
     assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
 }
 
+/// The small slumping block of the tangent checks: 6 × 5 cells, a 0.5 m block, no probes.
+const SMALL_BLOCK: [&str; 8] = [
+    "--set",
+    "grid.cells=[6,5]",
+    "--set",
+    "grid.size=[0.75,0.625]",
+    "--set",
+    "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.5,0.5]}}",
+    "--set",
+    "probes=[]",
+];
+
+/// A non-associated Mohr–Coulomb soil with evolving dilatancy, for the plastic tangent checks.
+const PLASTIC_SOIL: &str = "materials[0].model={type=\"mohr_coulomb\",young_modulus=1e6,poisson_ratio=0.3,\
+                            friction_angle=20.0,cohesion=2000.0,dilation_angle=-5.0,critical_dilation_angle=0.0,\
+                            dilation_decay=25.0}";
+
 #[test]
 fn the_tangent_with_bbar_matches_finite_differences_on_a_two_dimensional_block() {
     // A small slumping block after five steps under gravity: a genuinely two-dimensional
     // deformation, B̄ on ([000] §3), moving drained surfaces and GIMP domains that follow the stretch.
-    let o = porompm(&[
-        "test-jacobian",
-        "cases/slumping_block.toml",
-        "--steps",
-        "5",
-        "--set",
-        "stabilisation.bbar=true",
-        "--set",
-        "grid.cells=[6,5]",
-        "--set",
-        "grid.size=[0.75,0.625]",
-        "--set",
-        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.5,0.5]}}",
-        "--set",
-        "probes=[]",
-        "--set",
-        "time.dt=0.01",
-    ]);
+    let head = ["test-jacobian", "cases/slumping_block.toml", "--steps", "5", "--set", "stabilisation.bbar=true"];
+    let o = porompm(&[&head[..], &SMALL_BLOCK, &["--set", "time.dt=0.01"]].concat());
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{text}\n{}", stderr(&o));
     assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 25, "{text}");
@@ -456,29 +457,9 @@ fn an_expression_with_an_unknown_parameter_is_named() {
 /// most points have yielded and every block still matches central differences.
 #[test]
 fn the_plastic_tangent_with_pressure_projection_matches_finite_differences() {
-    let o = porompm(&[
-        "test-jacobian",
-        "cases/slumping_block.toml",
-        "--steps",
-        "10",
-        "--set",
-        "stabilisation.bbar=true",
-        "--set",
-        "stabilisation.pressure_projection=1.0",
-        "--set",
-        "grid.cells=[6,5]",
-        "--set",
-        "grid.size=[0.75,0.625]",
-        "--set",
-        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.5,0.5]}}",
-        "--set",
-        "probes=[]",
-        "--set",
-        "time.dt=0.02",
-        "--set",
-        "materials[0].model={type=\"mohr_coulomb\",young_modulus=1e6,poisson_ratio=0.3,friction_angle=20.0,\
-         cohesion=2000.0,dilation_angle=-5.0,critical_dilation_angle=0.0,dilation_decay=25.0}",
-    ]);
+    let head = ["test-jacobian", "cases/slumping_block.toml", "--steps", "10", "--set", "stabilisation.bbar=true"];
+    let projection = ["--set", "stabilisation.pressure_projection=1.0", "--set", "time.dt=0.02", "--set", PLASTIC_SOIL];
+    let o = porompm(&[&head[..], &SMALL_BLOCK, &projection].concat());
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{text}\n{}", stderr(&o));
     let yielded: usize = text
@@ -488,6 +469,50 @@ fn the_plastic_tangent_with_pressure_projection_matches_finite_differences() {
         .unwrap_or_else(|| panic!("no yield count in:\n{text}"));
     assert!(yielded >= 10, "only {yielded} points have yielded:\n{text}");
     assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+}
+
+/// The tangent of the implicit F̄ (`kernels::fbar`: the projected volume ratio J̄ as a nodal
+/// unknown, its projection rows, the forces' dependence on it): on the small slumping block as a
+/// one-phase body of non-associated Mohr–Coulomb soil after ten steps under gravity (points have
+/// yielded), and as the quasi-static u–p system, every block (ux, uy, [p,] Jbar)² matches central
+/// differences; negating the ux–Jbar block is seen.
+#[test]
+fn the_fbar_tangent_matches_finite_differences_for_u_and_u_p() {
+    let small = [&SMALL_BLOCK[..], &["--set", "stabilisation={fbar=true}", "--set", "time.dt=0.02"]].concat();
+    let plastic = ["--set", "analysis.formulation=one_phase", "--set", PLASTIC_SOIL];
+    let quasi_static = ["--set", "stages.0.analysis=quasi_static"];
+    let check = |extra: &[&str], flip: Option<&str>| {
+        let mut args = vec!["test-jacobian", "cases/slumping_block.toml", "--steps", "10"];
+        args.extend_from_slice(&small);
+        args.extend_from_slice(extra);
+        if let Some(f) = flip {
+            args.extend_from_slice(&["--flip-block", f]);
+        }
+        porompm(&args)
+    };
+    let mut texts = Vec::new();
+    for (extra, blocks) in [(&plastic[..], 9), (&quasi_static[..], 16)] {
+        let o = check(extra, None);
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{extra:?}: {text}\n{}", stderr(&o));
+        let rows = text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count();
+        assert_eq!(rows, blocks, "{text}");
+        assert!(text.lines().any(|l| l.trim_start().starts_with("Jbar   ux")), "{text}");
+        assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+        texts.push(text);
+    }
+    let yielded: usize = texts[0]
+        .lines()
+        .find_map(|l| l.strip_prefix("material points that have yielded: ").and_then(|v| v.trim().parse().ok()))
+        .expect("a yield count");
+    assert!(yielded >= 5, "only {yielded} points have yielded");
+    let o = check(&plastic, Some("ux,Jbar"));
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "a negated ux–Jbar block must be seen: {}",
+        String::from_utf8_lossy(&o.stdout)
+    );
 }
 
 /// A load that overflows the Newton update (NaN in the solve) ends the run `failed` on every rank

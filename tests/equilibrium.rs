@@ -35,26 +35,29 @@ fn run_with(case: &str, label: &str, sets: &[&str], petsc: &[&str]) -> (Output, 
 /// The kinematic patch test: every grid node follows a homogeneous stretch and shear, and every
 /// point must carry the same stress, that of linear elasticity for the flow — for GIMP, uGIMP,
 /// linear MPM and quadratic and cubic B-splines, with and without B̄ (B-splines without: they
-/// refuse it), at ν = 0.3, 0.49 and 0.4999, on regular and perturbed arrangements, after one step
-/// and after ten.
+/// refuse it), with the implicit F̄ instead (`kernels::fbar`: the projected J̄ of a homogeneous
+/// motion is the motion's own), at ν = 0.3, 0.49 and 0.4999, on regular and perturbed arrangements,
+/// after one step and after ten.
 #[test]
 fn kinematic_patch_tests_hold_to_round_off() {
     let mut worst: (f64, f64) = (0.0, 0.0);
     for basis in ["gimp", "ugimp", "linear", "bspline2", "bspline3"] {
-        for bbar in [true, false] {
+        // The volumetric treatment: B̄, the implicit F̄ (`kernels::fbar`) or none.
+        for (bbar, fbar) in [(true, false), (false, true), (false, false)] {
             if bbar && basis.starts_with("bspline") {
                 continue;
             }
             for nu in ["0.3", "0.49", "0.4999"] {
                 for pert in ["0", "0.3"] {
                     for dt in ["1.0", "0.1"] {
-                        let label = format!("patch-{basis}-{bbar}-{nu}-{pert}-{dt}");
+                        let label = format!("patch-{basis}-{bbar}-{fbar}-{nu}-{pert}-{dt}");
                         let (o, s, _, _) = run(
                             "cases/patch_test.toml",
                             &label,
                             &[
                                 &format!("analysis.shape_functions={basis}"),
                                 &format!("stabilisation.bbar={bbar}"),
+                                &format!("stabilisation.fbar={fbar}"),
                                 &format!("materials.solid.model.poisson_ratio={nu}"),
                                 &format!("bodies.block.perturbation={pert}"),
                                 &format!("time.dt={dt}"),
@@ -75,15 +78,17 @@ fn kinematic_patch_tests_hold_to_round_off() {
 }
 
 /// With only the surface's nodes prescribed and the interior free, the first step on the regular
-/// arrangement is in exact equilibrium too (the domains tile the block); Newton is run to 1e-12
-/// (at ν = 0.4999 the default 1e-6 leaves a spread of 3e-7).
+/// arrangement is in exact equilibrium too (the domains tile the block), with B̄ and with the
+/// implicit F̄; Newton is run to 1e-12 (at ν = 0.4999 the default 1e-6 leaves a spread of 3e-7).
 #[test]
 fn the_equilibrium_patch_test_is_exact_at_the_first_step() {
     for basis in ["gimp", "ugimp", "linear"] {
         for nu in ["0.3", "0.4999"] {
-            let (spread, dofs) = free_interior_patch(basis, nu, &[]);
-            assert!(dofs > 0, "{basis}, ν = {nu}: the interior must be free");
-            assert!(spread <= 1e-10, "{basis}, ν = {nu}: stress spread {spread:e}");
+            for extra in [&[][..], &["stabilisation.bbar=false", "stabilisation.fbar=true"][..]] {
+                let (spread, dofs) = free_interior_patch(basis, nu, extra);
+                assert!(dofs > 0, "{basis}, ν = {nu}, {extra:?}: the interior must be free");
+                assert!(spread <= 1e-10, "{basis}, ν = {nu}, {extra:?}: stress spread {spread:e}");
+            }
         }
     }
 }
@@ -91,7 +96,7 @@ fn the_equilibrium_patch_test_is_exact_at_the_first_step() {
 /// The equilibrium patch test's run: the block's surface prescribed, its interior free, one step;
 /// returns the stress spread and the number of free dofs.
 fn free_interior_patch(basis: &str, nu: &str, extra: &[&str]) -> (f64, u64) {
-    let label = format!("patch-free-{basis}-{nu}-{}", extra.len());
+    let label = format!("patch-free-{basis}-{nu}-{}", extra.join("-"));
     let (basis_set, nu_set) =
         (format!("analysis.shape_functions={basis}"), format!("materials.solid.model.poisson_ratio={nu}"));
     let mut sets = vec![
@@ -142,21 +147,27 @@ fn a_rigid_rotation_turns_the_stress_and_keeps_its_invariants() {
     }
 }
 
-/// The nearly incompressible tapered plate (ν = 0.499) with B̄ and GIMP, uGIMP or linear MPM:
+/// The nearly incompressible tapered plate (ν = 0.499) with B̄ and GIMP, uGIMP or linear MPM, and
+/// with the implicit F̄ and GIMP or linear MPM:
 /// every converged step satisfies ∫σ dV = Σ x ⊗ (F_ext + R − F_inertia) to 1e-6, and the tip
 /// displacement per unit load agrees within 0.1 % over a 100× range of load in the small-strain
 /// range (q = 0.1 … 10 Pa: strains up to 1e-5; at q = 100 Pa the geometric nonlinearity of the
 /// current configuration alone changes it by 0.1 %).
 #[test]
 fn the_nearly_incompressible_plate_is_in_equilibrium_and_proportional() {
-    for basis in ["gimp", "ugimp", "linear"] {
+    let runs = [("gimp", "bbar"), ("ugimp", "bbar"), ("linear", "bbar"), ("gimp", "fbar"), ("linear", "fbar")];
+    for (basis, vol) in runs {
         let mut per_load = Vec::new();
         for q in ["0.1", "1", "10"] {
-            let label = format!("plate-{basis}-{q}");
+            let label = format!("plate-{basis}-{vol}-{q}");
             let (o, s, h, rows) = run(
                 "tests/cases/tapered_plate.toml",
                 &label,
-                &[&format!("analysis.shape_functions={basis}"), &format!("parameters.q={q}")],
+                &[
+                    &format!("analysis.shape_functions={basis}"),
+                    &format!("parameters.q={q}"),
+                    &format!("stabilisation={{{vol}=true}}"),
+                ],
             );
             assert!(o.status.success(), "{label}: {}", String::from_utf8_lossy(&o.stderr));
             let eq = s["equilibrium_error"].as_f64().unwrap();
@@ -168,8 +179,8 @@ fn the_nearly_incompressible_plate_is_in_equilibrium_and_proportional() {
             per_load.push(*column(&h, &rows, "tip.uy").last().unwrap() / qv);
         }
         let (lo, hi) = per_load.iter().fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-        eprintln!("{basis}: tip uy/q = {per_load:?}");
-        assert!(lo > 0.0 && (hi - lo) / lo <= 1e-3, "{basis}: displacement per unit load {per_load:?}");
+        eprintln!("{basis}, {vol}: tip uy/q = {per_load:?}");
+        assert!(lo > 0.0 && (hi - lo) / lo <= 1e-3, "{basis}, {vol}: displacement per unit load {per_load:?}");
     }
 }
 

@@ -442,11 +442,19 @@ fn bad_explicit_settings_are_named() {
         &["stages.0.analysis=dynamic_explicit", "stages.0.explicit={courant=0.3}"],
         "courant",
     );
+    // F̄ runs in explicit stages and in the implicit u and u–p systems (`kernels::fbar`), not in
+    // the u–p–U system of a two-phase dynamic stage, nor in geometrically linear steps.
     assert_refused(
-        "cases/elastic_column.toml",
+        "cases/terzaghi.toml",
         &dir,
-        &["stabilisation.fbar=true", "stages.0.analysis=dynamic_explicit"],
-        "the F̄ projection runs in dynamic_explicit stages only",
+        &["stabilisation.fbar=true", "stabilisation.bbar=false"],
+        "the F̄ projection is built for the u and u–p systems",
+    );
+    assert_refused(
+        "cases/hollow_cylinder_increments.toml",
+        &dir,
+        &["stabilisation.fbar=true", "analysis.geometry=\"plane_strain\""],
+        "`analysis.kinematics = \"linear_increments\"` has none",
     );
     assert_refused(
         "cases/patch_test.toml",

@@ -33,6 +33,10 @@ pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernel
     let s = &step.smooth[k];
     input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
     input.dt = nm.dt();
+    if step.layout.is_some_and(|l| l.jbar.is_some()) {
+        // An implicit F̄ step's projection rows weigh as much as the forces (`kernels::fbar`).
+        input.fbar_rows = step.p_scale;
+    }
     input
 }
 
@@ -594,6 +598,9 @@ impl<'a> Assembler<'a> {
                 input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
             }
             input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
+            // With an implicit F̄ the point at Δd = 0, ϑ = 0 sees r = 1/J̄_n: J̄_n = 1 makes it the
+            // point at rest, with the stress it carries.
+            input.jbar = 1.0;
             ps.with_point_of(k, &xl, input, |pt| {
                 kernels::residual(pt, scheme, &mut buf[..pt.size()]);
                 pt.size()

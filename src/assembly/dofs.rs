@@ -4,7 +4,8 @@
 //! prescribed increment is then `value`, and its reaction is booked to that boundary), or when its
 //! node is not well filled (see [`super::stencils`]): such a node's motion is extended from its
 //! neighbours in every particle that reaches it, so its own motion dofs carry nothing, and its pore
-//! pressure is the drained value zero. Fixed dofs keep their rows in the global vector (residual
+//! pressure is the drained value zero (its projected volume ratio in an implicit F̄ step stays
+//! free wherever a point reaches the node, `kernels::fbar`). Fixed dofs keep their rows in the global vector (residual
 //! x − value, unit diagonal, no column entries), so the layout never changes.
 
 use crate::kernels::Layout;
@@ -67,11 +68,11 @@ pub fn build(
         owned_fixed: Vec::new(),
         free_dofs: 0,
     };
-    for l in 0..n {
+    for (l, reached) in phi.iter().enumerate() {
         let (i, j) = ghost.ij(l);
         let by = model.fixing_boundaries(active, i, j);
         for c in 0..nd {
-            let (q, by_c) = (l * nd + c, &by[layout.canonical(c)]);
+            let (q, by_c) = (l * nd + c, layout.canonical(c).and_then(|k| by[k]));
             let b = by_c.or_else(|| (surface[q] > 0.5).then(|| surface[q].round() as usize - 1));
             if let Some(b) = b {
                 m.boundary[q] = b as u16;
@@ -83,7 +84,12 @@ pub fn build(
                     }
                 }
             }
-            m.fixed[q] = b.is_some() || !m.well[l];
+            // The projected volume ratio of an implicit F̄ step is [002]'s average over the points
+            // that reach the node, however few: an unknown wherever they fill more than
+            // `REACHED_FRACTION` of a cell (its row's diagonal is κ Σ_p S_ip V_p), unlike the
+            // motion, which is extended, and the pressure, which is drained.
+            let unfilled = if Some(c) == layout.jbar { *reached <= super::REACHED_FRACTION } else { !m.well[l] };
+            m.fixed[q] = b.is_some() || unfilled;
         }
     }
     for jj in 0..owned_count[1] {

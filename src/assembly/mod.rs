@@ -37,7 +37,7 @@ pub mod stencils;
 mod stiffness;
 
 pub use check::BlockCheck;
-pub use stencils::WELL_FILLED_FRACTION;
+pub use stencils::{REACHED_FRACTION, WELL_FILLED_FRACTION};
 
 use crate::kernels::{self, Layout, StepResult};
 use crate::model::loads::{face_point, LoadTarget};
@@ -728,7 +728,7 @@ impl GridSystem {
             let mut marks = vec![0.0; self.ghost.len() * nd];
             for ((i, j), _, comps) in fixes.iter().filter(|f| f.1 == bi) {
                 if let Some(l) = self.ghost.node(*i as usize, *j as usize) {
-                    for c in (0..nd).filter(|&c| comps[self.layout.canonical(c)]) {
+                    for c in (0..nd).filter(|&c| self.layout.canonical(c).is_some_and(|k| comps[k])) {
                         marks[l * nd + c] = 1.0;
                     }
                 }
@@ -1567,7 +1567,10 @@ impl GridSystem {
         let strain = self.step.stencils.strain_of(k);
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
-        let mut result = StepResult { jbar: fbar.map(|f| f[2]), ..StepResult::of(&pt) };
+        let mut result = StepResult::of(&pt);
+        if let Some(f) = fbar {
+            result.jbar = Some(f[2]);
+        }
         if self.layout.w.is_some() && self.layout.p.is_none() {
             // The u–U system: the nodal pressure's increment, or the point's own.
             result.interp.dp = match self.step.pressure_increment.get(k) {

@@ -270,12 +270,25 @@ pub fn validate(c: &Case) -> R {
     }
     finite_strain_materials(c)?;
     if c.stabilisation.fbar {
-        if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
+        if let Some(s) = c.stages.iter().find(|s| two_phase && s.analysis == AnalysisType::Dynamic) {
             return Err(format!(
-                "key `stabilisation.fbar`: the F̄ projection runs in dynamic_explicit stages only (the implicit \
-                 residual modification and its tangent are not built), and stage `{}` is not one",
+                "key `stabilisation.fbar`: stage `{}` solves u–p–U, and the F̄ projection is built for the u and \
+                 u–p systems of implicit stages and for explicit stages (one more nodal unknown would exceed the \
+                 five a node carries); run it as quasi_static or static, or without F̄",
                 s.name
             ));
+        }
+        if c.analysis.kinematics == KinematicsKind::LinearIncrements {
+            return Err("key `stabilisation.fbar`: F̄ scales the finite-strain increment, and \
+                        `analysis.kinematics = \"linear_increments\"` has none; use B̄ for small strains"
+                .into());
+        }
+        if c.stabilisation.stiffness != Stiffness::Particle
+            || c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm
+        {
+            return Err("key `stabilisation.fbar`: F̄ is built with the particle-integrated tangent and the \
+                        basis's own strain; [001]'s stiffness options and CMPM recovery are for cases without it"
+                .into());
         }
         if c.stabilisation.bbar {
             return Err("keys `stabilisation.fbar` and `stabilisation.bbar` exclude each other: both replace the \

@@ -148,6 +148,8 @@ mod tests {
             fbar: 1.0,
             fbar_total: 1.0,
             dt: 0.0,
+            jbar: 1.0,
+            fbar_rows: 0.0,
         }
     }
 

@@ -69,7 +69,7 @@ pub fn warnings(case: &Case, model: &Model) -> Vec<Warning> {
                     &mut out,
                     "locking",
                     format!(
-                        "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ or F̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true (implicit stages) or stabilisation.fbar = true (explicit stages)",
+                        "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ or F̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true (implicit stages) or stabilisation.fbar = true",
                         m.name
                     ),
                 );

@@ -86,6 +86,10 @@ pub struct Kinematics {
     pub f: M2,
     /// J = det F.
     pub j: f64,
+    /// J − 1, formed from H without the cancellation of det F − 1 (what an implicit F̄ step's
+    /// projection and volumetric strain take: at small strains det F − 1 keeps only the digits
+    /// of J beyond 1, and the residual's round-off then swamps its changes).
+    pub dj: f64,
     /// F_v = I + H_v.
     pub fv: M2,
     /// J_v = det F_v: the volume ratio of the step.
@@ -114,6 +118,25 @@ pub struct Kinematics {
     pub fv_hoop: f64,
     /// A geometrically linear step (see the module documentation).
     pub linear: bool,
+    /// The volumetric part of the strain from [002]'s projected J̄ of an implicit step
+    /// ([`Kinematics::with_projected_volume`]); `None` otherwise.
+    projected: Option<Projected>,
+}
+
+/// What an implicit step's F̄ needs of its projected volume ratio (see
+/// [`Kinematics::with_projected_volume`]).
+#[derive(Debug, Clone, Copy)]
+struct Projected {
+    /// r = J̄_{n+1}/J̄_n, the volume ratio of the step the stress sees.
+    r: f64,
+    /// c = (r/J)^{1/2}, ΔF̄ = c ΔF.
+    c: f64,
+    /// a = tr ΔF̄ = c tr ΔF.
+    a: f64,
+    /// ∂ tr L̄/∂a at fixed r.
+    dtr_da: f64,
+    /// ∂ tr L̄/∂r at fixed a.
+    dtr_dr: f64,
 }
 
 impl Kinematics {
@@ -134,6 +157,9 @@ impl Kinematics {
         }
         let add = |a: &M2, s: f64| [[1.0 + s * a[0][0], s * a[0][1]], [s * a[1][0], 1.0 + s * a[1][1]]];
         let (f, fv) = (add(&h, 1.0), add(&hv, 1.0));
+        // J − 1 = (1 + d)(1 + H_θθ) − 1 with d = det(I + H) − 1 = tr H + det H.
+        let d = h[0][0] + h[1][1] + (h[0][0] * h[1][1] - h[0][1] * h[1][0]);
+        let dj = d + ht + d * ht;
         if linear {
             let tr = h[0][0] + h[1][1] + ht;
             let trv = hv[0][0] + hv[1][1] + hvt;
@@ -141,6 +167,7 @@ impl Kinematics {
             return Kinematics {
                 f,
                 j: det(&f) * (1.0 + ht),
+                dj,
                 fv,
                 jv: det(&fv) * (1.0 + hvt),
                 f_hoop: 1.0 + ht,
@@ -162,6 +189,7 @@ impl Kinematics {
         Kinematics {
             f,
             j: det(&f) * (1.0 + ht),
+            dj,
             fv,
             jv: det(&fv) * (1.0 + hvt),
             f_hoop: 1.0 + ht,
@@ -176,6 +204,7 @@ impl Kinematics {
             omega,
             theta: 2.0 * (0.5 * omega).atan(),
             linear,
+            projected: None,
         }
     }
 
@@ -209,6 +238,7 @@ impl Kinematics {
         Kinematics {
             f: I2,
             j: 1.0,
+            dj: 0.0,
             fv: I2,
             jv: 1.0,
             f_inv: I2,
@@ -223,7 +253,51 @@ impl Kinematics {
             f_hoop: 1.0,
             fv_hoop: 1.0,
             linear: false,
+            projected: None,
         }
+    }
+
+    /// The kinematics of an implicit step with [002]'s F̄ (`stabilisation.fbar`, plane strain,
+    /// without B̄, finite strain): the stress sees ΔF̄ = c ΔF whose determinant is the projected
+    /// volume ratio of the step, r = J̄_{n+1}/J̄_n (c = (r/J)^{1/2}, [002] Eq. 27). As in
+    /// [`Kinematics::with_volume_scale`], the strain increment's volumetric part is the mid-step
+    /// rate of ΔF̄, its deviatoric part and the rotation are ΔF's, and the volume ratio, the
+    /// gradients on x_{n+1} and the deformation gradient the point keeps stay ΔF's ([002] L237).
+    /// For a 2 × 2 ΔF̄ with a = tr ΔF̄ the mid-step rate's trace has the closed form
+    /// tr L̄ = tr(H̄ (I + H̄/2)⁻¹) = 4 − 4 (2 + a)/(1 + a + r) = 4 (r − 1)/(1 + a + r) (H̄ = ΔF̄ − I,
+    /// det ΔF̄ = r), which [`Kinematics::deps_derivative`] and
+    /// [`Kinematics::deps_volume_derivative`] differentiate. The caller passes `r_minus_one` = r − 1,
+    /// formed without cancellation, so that the volumetric strain keeps its relative precision at
+    /// small strains. r = J gives c = 1 and the step's own kinematics.
+    pub fn with_projected_volume(self, r_minus_one: f64) -> Kinematics {
+        debug_assert!(!self.linear && self.f_hoop == 1.0, "F̄ is built for finite-strain plane-strain steps");
+        let r = 1.0 + r_minus_one;
+        let c = (r / self.j).sqrt();
+        let a = c * (self.f[0][0] + self.f[1][1]);
+        let den = 1.0 + a + r;
+        let tr_bar = 4.0 * r_minus_one / den;
+        let l = &self.l;
+        let vol = (tr_bar - (l[0][0] + l[1][1])) / 3.0;
+        Kinematics {
+            deps: [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol],
+            projected: Some(Projected {
+                r,
+                c,
+                a,
+                dtr_da: -4.0 * (r - 1.0) / (den * den),
+                dtr_dr: 4.0 * (2.0 + a) / (den * den),
+            }),
+            ..self
+        }
+    }
+
+    /// ∂Δε/∂r, the strain increment's derivative with respect to the projected volume ratio of an
+    /// implicit F̄ step ([`Kinematics::with_projected_volume`]; zero without it): ⅓ d(tr L̄)/dr m,
+    /// m = [1, 1, 0, 1].
+    pub fn deps_volume_derivative(&self) -> [f64; 4] {
+        let Some(pj) = self.projected else { return [0.0; 4] };
+        let d = (pj.dtr_da * pj.a / (2.0 * pj.r) + pj.dtr_dr) / 3.0;
+        [d, d, 0.0, d]
     }
 
     /// The hoop operators of a node on x_{n+1}: (T', T̄') = (T/F_θθ, T̄/F_v,θθ).
@@ -249,6 +323,7 @@ impl Kinematics {
     pub fn deps_derivative(&self, b: &NodeBasis) -> [[f64; 2]; 4] {
         let gh = mul_t(&self.fh_inv, b.g);
         let gvh = mul_t(&self.fvh_inv, b.gv);
+        let gs = mul_t(&self.f_inv, b.g);
         let mid = |f: f64| if self.linear { 1.0 } else { 1.0 / (0.5 * (1.0 + f)).powi(2) };
         let (dlt, dlvt) = (b.t * mid(self.f_hoop), b.tv * mid(self.fv_hoop));
         // Column d: the strain increment of a unit increment of component d.
@@ -258,7 +333,12 @@ impl Kinematics {
             let dlv = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.lv[a][d]) * gvh[c];
             let (lt, lvt) = if d == 0 { (dlt, dlvt) } else { (0.0, 0.0) };
             let tr = dl(0, 0) + dl(1, 1) + lt;
-            let trv = dlv(0, 0) + dlv(1, 1) + lvt;
+            // With an implicit F̄: d tr L̄ = ∂tr L̄/∂a (c ∂tr ΔF − (a/2J) ∂J), ∂tr ΔF/∂Δu_l,d = (∇S_l)_d
+            // and ∂J/∂Δu_l,d = J (F⁻ᵀ∇S_l)_d.
+            let trv = match self.projected {
+                Some(pj) => pj.dtr_da * (pj.c * b.g[d] - 0.5 * pj.a * gs[d]),
+                None => dlv(0, 0) + dlv(1, 1) + lvt,
+            };
             let vol = (trv - tr) / 3.0;
             [dl(0, 0) + vol, dl(1, 1) + vol, dl(0, 1) + dl(1, 0), lt + vol]
         };
@@ -362,6 +442,69 @@ mod tests {
                 assert!((fd - dt[d]).abs() < 1e-7 * (1.0 + fd.abs()), "theta node {l} comp {d}: {fd} vs {}", dt[d]);
             }
         }
+    }
+
+    /// The basis of an F̄ step: plane strain, no B̄ (∇̄S = ∇S, no hoop operators).
+    fn plane_basis() -> Vec<NodeBasis> {
+        basis().into_iter().map(|b| NodeBasis { gv: b.g, t: 0.0, tv: 0.0, ..b }).collect()
+    }
+
+    #[test]
+    fn the_projected_volume_is_the_explicit_scale_of_the_increment() {
+        // with_projected_volume(r) is ΔF̄ = c ΔF with c = (r/J)^{1/2}: the same strain increment as
+        // the explicit step's with_volume_scale(c), whose trace is formed by matrix products; and
+        // r = J leaves the step's own kinematics.
+        let b = plane_basis();
+        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
+        let k0 = Kinematics::new(&b, u.iter().copied(), false);
+        for r in [0.93, 1.0, 1.08] {
+            let proj = k0.with_projected_volume(r - 1.0);
+            let scaled = k0.with_volume_scale((r / k0.j).sqrt());
+            for (a, e) in proj.deps.iter().zip(&scaled.deps) {
+                assert!((a - e).abs() < 1e-14, "{:?} vs {:?}", proj.deps, scaled.deps);
+            }
+            assert_eq!(proj.jv, k0.jv, "the volume stays the step's own");
+        }
+        let own = k0.with_projected_volume(k0.dj);
+        for (a, e) in own.deps.iter().zip(&k0.deps) {
+            assert!((a - e).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn projected_derivatives_match_central_differences() {
+        let b = plane_basis();
+        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
+        let r0 = 1.04;
+        let at = |v: &[[f64; 2]], r: f64| Kinematics::new(&b, v.iter().copied(), false).with_projected_volume(r - 1.0);
+        let k0 = at(&u, r0);
+        let h = 1e-7;
+        for l in 0..b.len() {
+            let de = k0.deps_derivative(&b[l]);
+            for d in 0..2 {
+                let shifted = |s: f64| {
+                    let mut v = u.clone();
+                    v[l][d] += s;
+                    at(&v, r0)
+                };
+                let (p, m) = (shifted(h), shifted(-h));
+                for (row, der) in de.iter().enumerate() {
+                    let fd = (p.deps[row] - m.deps[row]) / (2.0 * h);
+                    assert!(
+                        (fd - der[d]).abs() < 1e-7 * (1.0 + fd.abs()),
+                        "deps[{row}] node {l} comp {d}: {fd} vs {}",
+                        der[d]
+                    );
+                }
+            }
+        }
+        let dr = k0.deps_volume_derivative();
+        let (p, m) = (at(&u, r0 + h), at(&u, r0 - h));
+        for (row, der) in dr.iter().enumerate() {
+            let fd = (p.deps[row] - m.deps[row]) / (2.0 * h);
+            assert!((fd - der).abs() < 1e-7 * (1.0 + fd.abs()), "deps[{row}] in r: {fd} vs {der}");
+        }
+        assert!(dr[0].abs() > 0.1, "the strain sees r: {dr:?}");
     }
 
     #[test]

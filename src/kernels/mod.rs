@@ -48,6 +48,7 @@
 //! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B.
 
 pub mod cell;
+pub mod fbar;
 pub mod flow;
 pub mod inertia;
 pub mod kinematics;
@@ -79,7 +80,8 @@ pub mod dof {
 }
 
 /// Which unknowns a node carries and where: the solid displacement always at 0 and 1, then the
-/// pore pressure and the water displacement if the system has them.
+/// pore pressure and the water displacement if the system has them, and last the projected volume
+/// ratio of an implicit F̄ step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Layout {
     /// Dofs per node.
@@ -88,36 +90,58 @@ pub struct Layout {
     pub p: Option<usize>,
     /// Offset of the water displacement's x component.
     pub w: Option<usize>,
+    /// Offset of ϑ = J̄ − 1, the nodal value of [002]'s projected volume ratio in an implicit
+    /// step with F̄ ([`fbar`]; `stabilisation.fbar`).
+    pub jbar: Option<usize>,
 }
 
 impl Layout {
     /// u (one-phase: total stress or dry).
-    pub const U: Layout = Layout { nd: 2, p: None, w: None };
+    pub const U: Layout = Layout { nd: 2, p: None, w: None, jbar: None };
     /// u–p (the quasi-static Biot system, or undrained static): solid displacement and pore
     /// pressure; the water follows the solid plus its Darcy flux.
-    pub const UP: Layout = Layout { nd: 3, p: Some(dof::P), w: None };
+    pub const UP: Layout = Layout { nd: 3, p: Some(dof::P), w: None, jbar: None };
     /// u–p–U.
-    pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX) };
+    pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX), jbar: None };
     /// u–U (the explicit two-phase system, the "v–w form"): the motion of both phases at the
     /// nodes, the pore pressure at the points (its continuity equation held point by point,
     /// [`flow::continuity::pointwise_increment`]).
-    pub const UW: Layout = Layout { nd: 4, p: None, w: Some(2) };
+    pub const UW: Layout = Layout { nd: 4, p: None, w: Some(2), jbar: None };
+    /// u with [002]'s F̄ in an implicit step: the solid displacement and the projected volume
+    /// ratio ϑ = J̄ − 1 at the nodes ([`fbar`]).
+    pub const U_FBAR: Layout = Layout { nd: 3, p: None, w: None, jbar: Some(2) };
+    /// u–p with F̄ (the quasi-static Biot system or an undrained static stage).
+    pub const UP_FBAR: Layout = Layout { nd: 4, p: Some(dof::P), w: None, jbar: Some(3) };
+
+    /// The layout with the projected volume ratio of an implicit F̄ step added (u and u–p only:
+    /// `None` for the others).
+    pub fn with_fbar(&self) -> Option<Layout> {
+        match *self {
+            Layout::U => Some(Layout::U_FBAR),
+            Layout::UP => Some(Layout::UP_FBAR),
+            _ => None,
+        }
+    }
 
     /// The names of the layout's nodal fields, in dof order.
     pub fn field_names(&self) -> &'static [&'static str] {
-        if self.p.is_none() && self.w.is_some() {
-            return &["ux", "uy", "Ux", "Uy"];
+        match (self.p, self.w, self.jbar) {
+            (None, Some(_), _) => &["ux", "uy", "Ux", "Uy"],
+            (None, None, Some(_)) => &["ux", "uy", "Jbar"],
+            (Some(_), None, Some(_)) => &["ux", "uy", "p", "Jbar"],
+            _ => &["ux", "uy", "p", "Ux", "Uy"][..self.nd],
         }
-        &["ux", "uy", "p", "Ux", "Uy"][..self.nd]
     }
 
     /// The position in the full two-phase order (ux, uy, p, Ux, Uy; [`dof`]) of this layout's
-    /// dof component `c`, the order in which boundaries name what they fix.
-    pub fn canonical(&self, c: usize) -> usize {
-        match (self.p, self.w) {
-            (_, Some(w)) if c >= w => dof::WX + c - w,
-            (Some(p), _) if c == p => dof::P,
-            _ => c,
+    /// dof component `c`, the order in which boundaries name what they fix; `None` for the
+    /// projected volume ratio, which no boundary fixes.
+    pub fn canonical(&self, c: usize) -> Option<usize> {
+        match (self.p, self.w, self.jbar) {
+            (_, _, Some(j)) if c == j => None,
+            (_, Some(w), _) if c >= w => Some(dof::WX + c - w),
+            (Some(p), _, _) if c == p => Some(dof::P),
+            _ => Some(c),
         }
     }
 
@@ -130,6 +154,9 @@ impl Layout {
         }
         if let Some(w) = self.w {
             out.push(("U", vec![w, w + 1]));
+        }
+        if let Some(j) = self.jbar {
+            out.push(("Jbar", vec![j]));
         }
         out
     }
@@ -231,6 +258,11 @@ pub struct ParticleInput {
     /// The step's Δt [s], which a rate-dependent model (the Newtonian fluid's viscosity) divides
     /// the step's deformation by; 0 where no step is being taken.
     pub dt: f64,
+    /// [002]'s projected volume ratio J̄_p^n the point carries (1 without F̄): an implicit F̄
+    /// step's stress sees the volume ratio J̄_{n+1}/J̄_n ([`fbar`]).
+    pub jbar: f64,
+    /// The scale κ [Pa/m] of an implicit F̄ step's projection rows ([`fbar`]; 0 otherwise).
+    pub fbar_rows: f64,
 }
 
 /// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
@@ -477,6 +509,8 @@ pub struct Interp {
     pub dvol_w: f64,
     /// Gradient of the pressure increment on x_n, Σ ∇S Δp.
     pub grad_dp: [f64; 2],
+    /// The projected volume ratio's excess at t_{n+1}, J̄_{n+1} − 1 = Σ S ϑ (implicit F̄ steps).
+    pub jbar: f64,
     /// Solid acceleration at t_{n+1}.
     pub a_u: [f64; 2],
     /// Water acceleration at t_{n+1}.
@@ -506,6 +540,9 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
             k.dp += b.s * st.d[p];
             k.grad_dp[0] += b.g[0] * st.d[p];
             k.grad_dp[1] += b.g[1] * st.d[p];
+        }
+        if let Some(j) = layout.jbar {
+            k.jbar += b.s * st.d[j];
         }
         if let Some(w) = layout.w {
             k.dvol_w += b.tv * st.d[w];
@@ -557,6 +594,8 @@ pub struct Point<'a> {
     pub faces: &'a [DrainedFace],
     /// Σ N_j(x_f) Δp_j at each of `faces`.
     pub face_dp: [f64; MAX_FACES],
+    /// The nodal ϑ_i = J̄_i − 1 of an implicit F̄ step, per stencil node (zero otherwise).
+    pub jbar_nodes: [f64; MAX_NODES],
 }
 
 /// The gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each node of
@@ -637,8 +676,17 @@ impl<'a> Point<'a> {
         layout: Layout,
     ) -> Point<'a> {
         let interp = interpolate(basis, states, &part.pred, layout);
-        let kin =
+        let mut kin =
             Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear).with_volume_scale(part.fbar);
+        // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
+        let mut jbar_nodes = [0.0; MAX_NODES];
+        if let Some(j) = layout.jbar {
+            for (t, st) in jbar_nodes.iter_mut().zip(states.iter().take(basis.len())) {
+                *t = st.d[j];
+            }
+            // r − 1 = (1 + Σ S ϑ − J̄_n)/J̄_n, without the cancellation of forming r first.
+            kin = kin.with_projected_volume((interp.jbar - (part.jbar - 1.0)) / part.jbar);
+        }
         let rotated = kinematics::rotate(&part.stress, kin.theta);
         // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
@@ -665,6 +713,7 @@ impl<'a> Point<'a> {
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
+            jbar_nodes,
         }
     }
 
@@ -706,6 +755,7 @@ impl<'a> Point<'a> {
             p: part.p,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
+            jbar_nodes: [0.0; MAX_NODES],
         }
     }
 
@@ -772,6 +822,9 @@ pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
         flow::darcy::residual(pt, nm, out);
         flow::drained_face::residual(pt, nm, out);
     }
+    if pt.layout.jbar.is_some() && terms == Terms::All {
+        fbar::residual(pt, nm, out);
+    }
 }
 
 /// The tangent block d(residual)/d(Δd) of one particle, row-major `(nn·nd)²`. Every entry of
@@ -796,6 +849,9 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
         flow::continuity::tangent(pt, nm, out);
         flow::darcy::tangent(pt, nm, out);
         flow::drained_face::tangent(pt, nm, out);
+    }
+    if pt.layout.jbar.is_some() {
+        fbar::tangent(pt, nm, out);
     }
 }
 
@@ -838,7 +894,7 @@ impl StepResult {
             jacobian: pt.kin.jv,
             deps: pt.kin.deps,
             grad_n: pt.part.grad_n,
-            jbar: None,
+            jbar: pt.layout.jbar.map(|_| 1.0 + pt.interp.jbar),
             velocity: None,
         }
     }

@@ -114,6 +114,24 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
             }
         }
     }
+    // An implicit F̄ step ([`super::fbar`]): the stress sees r = (1 + Σ_i S_ip ϑ_i)/J̄_p^n, so
+    // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
+    if let Some(j) = pt.layout.jbar {
+        let de = pt.kin.deps_volume_derivative();
+        let dsig: [f64; 4] = std::array::from_fn(|r| (0..4).map(|q| d_alg[r][q] * de[q]).sum::<f64>());
+        let vj = v * material / pt.part.jbar;
+        for k in 0..pt.basis.len() {
+            let (gk, gvk) = pt.spatial[k];
+            let bk = bbar(gk, gvk, pt.hoop[k]);
+            let force: [f64; 2] = std::array::from_fn(|c| vj * (0..4).map(|r| bk[r][c] * dsig[r]).sum::<f64>());
+            for (c, f) in force.into_iter().enumerate() {
+                let row = (k * nd + c) * m;
+                for (i, b) in pt.basis.iter().enumerate() {
+                    out[row + i * nd + j] += f * b.s;
+                }
+            }
+        }
+    }
 }
 
 /// The pore pressure's forces: −(1 − n) p ∇̄'S_i V_{n+1} on the solid and −n p ∇̄'S_i V_{n+1} on the

@@ -161,6 +161,8 @@ fn part() -> ParticleInput {
         fbar: 1.0,
         fbar_total: 1.0,
         dt: 0.0,
+        jbar: 1.0,
+        fbar_rows: 0.0,
     }
 }
 
@@ -183,7 +185,17 @@ fn increments(m: usize, layout: Layout) -> Vec<f64> {
 }
 
 fn steps(layout: Layout) -> Vec<f64> {
-    (0..layout.nd).map(|c| if Some(c) == layout.p { 1e-3 } else { 1e-9 }).collect()
+    (0..layout.nd)
+        .map(|c| {
+            if Some(c) == layout.p {
+                1e-3
+            } else if Some(c) == layout.jbar {
+                1e-6
+            } else {
+                1e-9
+            }
+        })
+        .collect()
 }
 
 type Term = (&'static str, fn(&Point, &Scheme, &mut [f64]), fn(&Point, &Scheme, &mut [f64]));
@@ -251,12 +263,19 @@ fn check_term(
     (hoop, recovery): (bool, bool),
     linear: bool,
 ) -> Vec<BlockError> {
-    let basis = sample_in(6, hoop);
+    let mut basis = sample_in(6, hoop);
+    let mut p = part();
+    if layout.jbar.is_some() {
+        // F̄ replaces B̄: the basis's volumetric gradients are its own; the point carries a J̄ of
+        // its own and the projection rows their scale.
+        basis.iter_mut().for_each(|b| b.gv = b.g);
+        p.jbar = 1.03;
+        p.fbar_rows = 2.0e8;
+    }
     let strain = if recovery { sample_strain(6, hoop) } else { basis.clone() };
     let nd = layout.nd;
     let m = basis.len() * nd;
     let nm = *nm;
-    let mut p = part();
     p.stress = stress;
     p.linear = linear;
     let d0 = increments(m, layout);
@@ -275,6 +294,20 @@ fn check_term(
     fd_blocks(nd, &d0, &steps(layout), &res, &t)
 }
 
+/// Asserts that block `b` agrees with central differences, naming it by `names` and `what`.
+fn assert_block(b: &BlockError, names: &[&str], what: &str) {
+    assert!(
+        b.pass(),
+        "{what}: block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
+        names[b.row],
+        names[b.col],
+        b.err,
+        b.jmax,
+        b.fdmax,
+        b.noise
+    );
+}
+
 #[test]
 fn every_term_matches_central_differences_block_by_block() {
     let names = ["ux", "uy", "p", "Ux", "Uy"];
@@ -283,18 +316,45 @@ fn every_term_matches_central_differences_block_by_block() {
             let modes = [(false, false), (true, false), (false, true), (true, true)];
             for (term, mode) in terms().into_iter().flat_map(|t| modes.map(|m| (t, m))) {
                 for b in check_term(&term, &model, stress, layout, &nm, mode, false) {
-                    assert!(
-                        b.pass(),
-                        "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain) {mode:?}): block {}–{} differs by {:e} (|J| ≤ {:e}, |FD| ≤ {:e}, noise {:e})",
-                        term.0,
-                        layout.nd,
-                        names[b.row],
-                        names[b.col],
-                        b.err,
-                        b.jmax,
-                        b.fdmax,
-                        b.noise
+                    let what = format!(
+                        "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain) {mode:?})",
+                        term.0, layout.nd
                     );
+                    assert_block(&b, &names, &what);
+                }
+            }
+        }
+    }
+}
+
+/// Implicit F̄ steps (`kernels::fbar`, plane strain, the basis's own strain operators): every
+/// term's tangent, the projection rows' and the ϑ columns of the forces among them, matches
+/// central differences, for the u and u–p layouts with their schemes, elastic and plastic.
+#[test]
+fn fbar_terms_match_central_differences_block_by_block() {
+    let dt = 1e-3;
+    let cases = [
+        (Layout::U_FBAR, "static", Scheme::of(&Integration::Static, dt, false)),
+        (Layout::U_FBAR, "Newmark", Scheme::newmark(0.25, 0.5, dt)),
+        (Layout::UP_FBAR, "quasi-static", Scheme::of(&Integration::QuasiStatic { theta: 0.7 }, dt, true)),
+        (Layout::UP_FBAR, "static undrained", Scheme::of(&Integration::Static, dt, true)),
+    ];
+    let mut terms = terms();
+    terms.push(("F̄ projection", fbar::residual, fbar::tangent));
+    for (layout, sname, nm) in cases {
+        let names = layout.field_names();
+        for (mname, model, stress) in models() {
+            for term in &terms {
+                let blocks = check_term(term, &model, stress, layout, &nm, (false, false), false);
+                for b in &blocks {
+                    assert_block(b, names, &format!("{} ({mname}, {sname})", term.0));
+                }
+                if term.0 == "all" {
+                    // The check sees the coupling: the forces' ϑ columns and the rows' u columns.
+                    let j = layout.jbar.unwrap();
+                    let at =
+                        |r: usize, c: usize| blocks.iter().find(|b| b.row == r && b.col == c).map_or(0.0, |b| b.jmax);
+                    assert!(at(0, j) > 0.0 && at(j, 0) > 0.0 && at(j, j) > 0.0, "{sname} {mname}: F̄ couplings missing");
                 }
             }
         }

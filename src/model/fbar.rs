@@ -61,15 +61,15 @@ pub fn scaled_increment(df: [[f64; 2]; 2], c: f64) -> [[f64; 2]; 2] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::model::grid::Grid;
     use crate::model::shape::{self, Basis};
 
     /// A small deterministic generator (no dependency): uniform in [0, 1).
-    struct Lcg(u64);
+    pub(crate) struct Lcg(pub u64);
     impl Lcg {
-        fn next(&mut self) -> f64 {
+        pub(crate) fn next(&mut self) -> f64 {
             self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (self.0 >> 11) as f64 / (1u64 << 53) as f64
         }

@@ -439,6 +439,8 @@ impl Model {
                 1.0
             },
             dt: 0.0,
+            jbar: ps.jbar[idx],
+            fbar_rows: 0.0,
         }
     }
 
