@@ -8,6 +8,7 @@
 //! │       ├── Δt ← min(stage Δt after cuts, time to the next event / stage end)
 //! │       ├── newton_solve: map to grid, constraints, loads; SNES on the Newmark residual
 //! │       ├── if converged: update_particles ([003] Eq. 24, [000] Eq. 11) unless inadmissible
+//! │       │   (full Newton steps; if they fail, once more with a line search)
 //! │       ├── if not: cut Δt (stage.cut_factor), retry; fail after stage.max_step_cuts cuts in a row
 //! │       ├── record_step: probes, check, history.csv
 //! │       └── every output.fields_every steps and at the stage end: fields.h5/.xdmf;
@@ -152,6 +153,9 @@ pub struct Summary {
     pub steps: usize,
     /// Step cuts (retries with smaller Δt).
     pub step_cuts: usize,
+    /// Steps whose full Newton steps failed and that were solved again with a line search
+    /// (`assembly::LINE_SEARCH_RETRY`), converged or not.
+    pub line_search_retries: usize,
     /// Material points that moved to another rank over the run (since the restart, if restarted).
     pub migrated_particles: usize,
     /// Repartitions of the grid over the ranks to balance the material points.
@@ -351,6 +355,7 @@ impl Summary {
             end_time_s: req.case.end_time(),
             steps: 0,
             step_cuts: 0,
+            line_search_retries: 0,
             migrated_particles: 0,
             repartitions: 0,
             load_imbalance_max: 1.0,
@@ -686,6 +691,14 @@ impl<'a> Simulation<'a> {
                     unused.join(", ")
                 )));
             }
+        }
+        self.summary.line_search_retries += usize::from(solve.line_search_retry);
+        if solve.converged && solve.line_search_retry {
+            self.progress(&format!(
+                "  step from t = {:.6e} s: full Newton steps failed, solved with a line search ({})",
+                self.t,
+                assembly::LINE_SEARCH_RETRY
+            ));
         }
         if solve.converged {
             self.last_field_residuals = (solve.field_residuals, solve.field_scales, solve.linear_field_residuals);
@@ -1088,7 +1101,14 @@ impl<'a> Simulation<'a> {
             stage: stage_index as u64,
             dt: control.dt,
             successes: control.successes as u64,
-            counters: [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses].map(|c| c as u64),
+            counters: [
+                s.step_cuts,
+                s.snes_iterations,
+                s.ksp_iterations,
+                s.matrix_structure_reuses,
+                s.line_search_retries,
+            ]
+            .map(|c| c as u64),
             diagnostics: self.monitor.state(self.coll).map_err(RunError::Failed)?,
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
             load_totals: self.model.loads.iter().map(|l| l.increments.as_ref().map_or(0.0, |s| s.total)).collect(),
@@ -1165,7 +1185,8 @@ impl<'a> Simulation<'a> {
         let s = &mut *self.summary;
         s.time_s = cp.time;
         s.steps = self.step;
-        [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses] = cp.counters.map(|c| c as usize);
+        [s.step_cuts, s.snes_iterations, s.ksp_iterations, s.matrix_structure_reuses, s.line_search_retries] =
+            cp.counters.map(|c| c as usize);
         self.monitor
             .restore_state(&cp.diagnostics, self.coll.rank() == 0)
             .map_err(|e| refuse(format!("diagnostics: {e}")))?;

@@ -78,7 +78,7 @@ pub struct Checkpoint {
     /// Accepted steps since Δt last changed.
     pub successes: u64,
     /// Step cuts, Newton iterations, Krylov iterations and matrix-structure reuses so far.
-    pub counters: [u64; 4],
+    pub counters: [u64; 5],
     /// The stability diagnostics' state ([`crate::diagnostics::Monitor::state`]).
     pub diagnostics: Vec<f64>,
     /// The probes' signed excess-pressure extremes, in case order.
@@ -367,7 +367,7 @@ mod tests {
             stage: 0,
             dt: 1e-3,
             successes: 2,
-            counters: [1, 2, 3, 4],
+            counters: [1, 2, 3, 4, 5],
             diagnostics: vec![0.1],
             probe_extremes: vec![1.0],
             load_totals: vec![0.5],

@@ -275,3 +275,40 @@ fn quasi_static_large_strain_consolidation_drains_through_the_moving_surface() {
     let (s, _, _) = run("cases/large_strain_consolidation.toml", "large-strain-qs-patch", &sets);
     assert!(has_warning(&s, "patch_recovery_quasi_static"), "{}", s["warnings"]);
 }
+
+/// A step that full Newton steps cannot take is solved again with a line search before its Δt is
+/// cut (`assembly::LINE_SEARCH_RETRY`): [002]'s strip footing (cases/footing_fbar.toml) as an
+/// implicit static stage (von Mises clay, B̄, B/20, load steps of 0.01 s) at d/B ≈ 0.014, where a
+/// node beside the footing that the heave has barely reached (1 % filled) takes unknowns of its
+/// own. With the retry turned off (`-porompm_snes_line_search_retry false`) Newton diverges at
+/// every cut of Δt and the run fails there; with it the run goes on to d/B = 0.0145.
+#[test]
+fn a_step_that_full_newton_steps_cannot_take_is_taken_with_a_line_search() {
+    let sets = [
+        "parameters.h=0.05",
+        "stages.penetration={name=\"penetration\",analysis=\"static\",duration=3.0,dt=0.01}",
+        "materials.clay.model={type=\"von_mises\",young_modulus=1e6,poisson_ratio=0.49,cohesion=100.0}",
+        "stabilisation={bbar=true}",
+        "verification.plateau=[0.005,0.01]",
+        "verification.stop_settlement=0.0145",
+        "output.history_every=10",
+    ];
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("analysis");
+    let mut args = common::set_args(&sets);
+    let with = common::run_case("cases/footing_fbar.toml", &dir.join("retry"), &args);
+    assert!(with.completed(), "{}", with.stderr());
+    let retries = with.summary["line_search_retries"].as_u64().unwrap();
+    assert!(retries >= 1, "line-search retries: {retries}");
+    args.extend(["--".to_string(), "-porompm_snes_line_search_retry".into(), "false".into()]);
+    let without = common::run_case("cases/footing_fbar.toml", &dir.join("no-retry"), &args);
+    assert_eq!(without.summary["status"], "failed", "{}", without.stderr());
+    assert!(without.stderr().contains("DIVERGED"), "{}", without.stderr());
+    assert_eq!(without.summary["line_search_retries"], 0);
+    let t = |r: &common::Run| r.summary["time_s"].as_f64().unwrap();
+    eprintln!(
+        "footing: {retries} retries, reached t = {:.2} s; without them failed at t = {:.2} s",
+        t(&with),
+        t(&without)
+    );
+    assert!(t(&with) > t(&without), "the retry carried the run past the failure");
+}

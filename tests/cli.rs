@@ -235,6 +235,8 @@ fn a_step_that_never_converges_is_cut_then_the_run_fails_cleanly() {
     let s = summary(&dir);
     assert_eq!(s["status"], "failed");
     assert_eq!(s["step_cuts"], 5);
+    // Running out of iterations is not a divergence: no try was solved again with a line search.
+    assert_eq!(s["line_search_retries"], 0);
     assert_eq!(s["steps"], 0);
     // What was written stays readable: the header and the initial state.
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();

@@ -600,10 +600,10 @@ fn implicit_against_explicit_terzaghi() {
 /// `porompm sweep` of cases/footing_fbar.toml, the explicit F̄-uGIMP run as shipped (Hencky–J2,
 /// Δt = 0.4 h/c_p) against an implicit static stage of the same geometry and footing (von Mises
 /// with q ≤ √3 s_u, the same plane-strain collapse load, with B̄, and with the implicit F̄ of
-/// `kernels::fbar`; load steps of 0.01 s, d = 0.1 mm) at B/10 and B/20. q_ult/s_u is read over d/B in [0.005, 0.01]: the implicit static footing
-/// stops converging at d/B ≈ 0.012 on B/20 (a step whose residual at zero increment does not
-/// vanish as Δt is cut: the active nodes change under it), so the later window of item 14 is out
-/// of its reach. The table gives each run's error against 2 + π, step and wall time. The
+/// `kernels::fbar`; load steps of 0.01 s, d = 0.1 mm) at B/10 and B/20. q_ult/s_u is read over
+/// item 14's window, d/B in [0.01, 0.02] (the implicit static footing reaches it at B/20 since a
+/// failed step is retried with a line search, `assembly::LINE_SEARCH_RETRY`). The table gives each
+/// run's error against 2 + π, step and wall time. The
 /// assertions: the implicit B̄ run is at least as accurate as the explicit one on each grid, in
 /// less wall time; the implicit F̄ run finds the explicit F̄ run's plateau within 1.5 %.
 #[test]
@@ -628,15 +628,15 @@ fn implicit_against_explicit_footing() {
             "--vary",
             "parameters.h=0.1,0.05",
             "--set",
-            "verification.plateau=[0.005,0.01]",
+            "verification.plateau=[0.01,0.02]",
             "--set",
-            "verification.stop_settlement=0.0115",
+            "verification.stop_settlement=0.021",
             "--set",
             "output.history_every=10",
         ],
     );
     let mut text = String::from(
-        "## Implicit against explicit: [002]'s rigid strip footing (q_ult/s_u over d/B in [0.005, 0.01])\n\n\
+        "## Implicit against explicit: [002]'s rigid strip footing (q_ult/s_u over d/B in [0.01, 0.02])\n\n\
          | h | run | q_ult/s_u | error vs 2 + π | steps | mean step [s] | wall [s] |\n|---|---|---|---|---|---|---|\n",
     );
     let mut unmet = Vec::new();

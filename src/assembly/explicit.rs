@@ -144,6 +144,7 @@ impl GridSystem {
             field_scales: self.step.field_scales.clone(),
             linear_field_residuals: Vec::new(),
             solver_used: false,
+            line_search_retry: false,
         })
     }
 

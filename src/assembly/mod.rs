@@ -50,6 +50,7 @@ use mpi::raw::AsRaw;
 use pattern::Pattern;
 use petsc::ksp::KspOps;
 use petsc::mat::MatOps;
+use petsc::snes::SolveOutcome;
 use petsc::{Comm, DmDa, GhostedRange, Ksp, LogStage, Mat, Options, Snes, StageGuard, VecOps, Vector};
 use std::time::Instant;
 use stencils::{Crossing, Stencils};
@@ -237,7 +238,32 @@ pub struct StepSolve {
     pub linear_field_residuals: Vec<f64>,
     /// Whether PETSc's solver ran (false for an explicit step).
     pub solver_used: bool,
+    /// Whether full Newton steps failed and the step was solved again with a line search
+    /// after they diverged ([`LINE_SEARCH_RETRY`]; `converged` is then the second solve's outcome).
+    pub line_search_retry: bool,
 }
+
+/// The line search of a step's second try when full Newton steps (porompm's default, `basic`)
+/// failed, before the driver cuts Δt: PETSc's backtracking (cubic) search, which shortens a Newton
+/// step that would raise the residual norm. Full steps stay the default: they converge
+/// quadratically on every shipped case and leave its answers as they are; a failed step costs one
+/// more solve. Measured on the static strip footing (`cases/footing_fbar.toml` as an implicit
+/// static stage, B/20): at d/B ≈ 0.014 a node beside the footing that the heave had barely reached
+/// (1 % filled) took unknowns of its own, full Newton steps diverged whatever the cut of Δt, and
+/// the line search carried every step to d/B = 0.021. A case that sets its own line search
+/// (`-snes_linesearch_type`) is left as it is; [`LINE_SEARCH_RETRY_OPTION`] turns the retry off.
+/// Only a divergence is retried ([`DIVERGED_BY_FULL_STEPS`]): a step that ran out of iterations
+/// (`DIVERGED_MAX_IT`) is better served by a shorter Δt (on `cases/slope_sand.toml`, retrying
+/// those too took 27 % more wall time and 37 % more Newton iterations).
+pub const LINE_SEARCH_RETRY: &str = "bt";
+
+/// The SNES outcomes of full Newton steps that [`LINE_SEARCH_RETRY`] retries: the residual norm
+/// grew past the divergence tolerance, or became NaN, or left the residual's domain.
+pub const DIVERGED_BY_FULL_STEPS: [&str; 3] = ["DIVERGED_DTOL", "DIVERGED_FNORM_NAN", "DIVERGED_FUNCTION_DOMAIN"];
+
+/// The PETSc option that turns the line-search retry of failed steps off (`false`; see
+/// [`LINE_SEARCH_RETRY`]).
+pub const LINE_SEARCH_RETRY_OPTION: &str = "-porompm_snes_line_search_retry";
 
 /// The forces of a converged step, summed over ranks, for the equilibrium identity and the
 /// boundaries' reactions.
@@ -327,6 +353,9 @@ pub struct GridSystem {
     /// The absolute residual tolerance given in the options (`-snes_atol`), a floor for the
     /// per-step one.
     user_atol: f64,
+    /// Whether a step whose full Newton steps failed is solved once more with a line search
+    /// ([`LINE_SEARCH_RETRY`]; off with `-porompm_snes_line_search_retry false`).
+    retry_with_line_search: bool,
     /// The one-field DMDA and CG solver of the pressure's L² projection (built on first use).
     l2_projection: Option<(DmDa, Ksp)>,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
@@ -451,6 +480,7 @@ impl GridSystem {
             snes.monitor_fields(layout.fields().into_iter().map(|(_, c)| c).collect(), test)?;
         }
         let user_atol = snes.tolerances()?.0;
+        let retry_with_line_search = petsc::Options::global().get_bool(LINE_SEARCH_RETRY_OPTION)?.unwrap_or(true);
         let stages = Stages {
             run_setup: LogStage::register("porompm: setup")?,
             setup: LogStage::register("porompm: step setup")?,
@@ -478,6 +508,7 @@ impl GridSystem {
             jac: None,
             schur,
             user_atol,
+            retry_with_line_search,
             last_reactions: Vec::new(),
             node_diagnostics: Vec::new(),
             carried: Vec::new(),
@@ -1182,33 +1213,48 @@ impl GridSystem {
             return self.explicit_update(model);
         }
         let _stage = self.stages.solve.push()?;
-        {
-            let mut x = self.x.write()?;
-            match &self.last_increment {
-                Some((last, dt_last))
-                    if model.integration.extrapolates() && !model.linear_increments && last.len() == x.len() =>
-                {
-                    let ratio = self.step.dt / dt_last;
-                    for (xi, li) in x.iter_mut().zip(last) {
-                        *xi = ratio * li;
-                    }
-                }
-                _ => x.fill(0.0),
-            }
-            for &(o, q) in &self.step.dofs.owned_fixed {
-                x[o] = self.step.dofs.value[q] / self.step.unit(q);
-            }
-        }
         // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.
         let atol = self.user_atol.max(FORCE_ATOL * self.step.force_scale);
         self.snes.set_tolerances(Some(atol), None, None, None)?;
         let mut assembly_seconds = 0.0;
         let t0 = Instant::now();
-        let (out, nonfinite) = {
+        self.initial_guess(model)?;
+        let (mut out, mut nonfinite) = {
             let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
             let out = snes.solve(x, jac, &mut asm)?;
             (out, asm.nonfinite.take())
         };
+        // Full Newton steps that diverged are tried once more from the same start with a
+        // backtracking line search, before the driver cuts Δt (see [`LINE_SEARCH_RETRY`]).
+        let mut line_search_retry = false;
+        if !out.converged
+            && DIVERGED_BY_FULL_STEPS.contains(&out.reason_text.as_str())
+            && self.retry_with_line_search
+            && self.snes.type_name()? == "newtonls"
+            && self.snes.line_search_type()? == "basic"
+        {
+            line_search_retry = true;
+            self.initial_guess(model)?;
+            self.snes.set_line_search(LINE_SEARCH_RETRY)?;
+            let retry = {
+                let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
+                snes.solve(x, jac, &mut asm).map(|o| (o, asm.nonfinite.take()))
+            };
+            self.snes.set_line_search("basic")?;
+            let (second, second_nonfinite) = retry?;
+            let (first_newton, first_krylov) = (out.iterations, out.linear_iterations);
+            out = SolveOutcome {
+                iterations: first_newton + second.iterations,
+                linear_iterations: first_krylov + second.linear_iterations,
+                reason_text: if second.converged {
+                    second.reason_text.clone()
+                } else {
+                    format!("{} ({} with a line search)", out.reason_text, second.reason_text)
+                },
+                ..second
+            };
+            nonfinite = nonfinite.or(second_nonfinite);
+        }
         let solve_seconds = t0.elapsed().as_secs_f64();
         self.dm.global_to_local(&self.x, &mut self.x_local)?;
         let mut solution = self.x_local.read()?.to_vec();
@@ -1237,7 +1283,30 @@ impl GridSystem {
             field_scales: self.step.field_scales.clone(),
             linear_field_residuals: out.linear_field_residuals,
             solver_used: true,
+            line_search_retry,
         })
+    }
+
+    /// Sets PETSc's solution vector to the step's first iterate: the last accepted increment
+    /// scaled to the new Δt where the stage extrapolates (static and quasi-static), zero
+    /// otherwise, with the prescribed increments at the fixed dofs.
+    fn initial_guess(&mut self, model: &Model) -> Result<(), Error> {
+        let mut x = self.x.write()?;
+        match &self.last_increment {
+            Some((last, dt_last))
+                if model.integration.extrapolates() && !model.linear_increments && last.len() == x.len() =>
+            {
+                let ratio = self.step.dt / dt_last;
+                for (xi, li) in x.iter_mut().zip(last) {
+                    *xi = ratio * li;
+                }
+            }
+            _ => x.fill(0.0),
+        }
+        for &(o, q) in &self.step.dofs.owned_fixed {
+            x[o] = self.step.dofs.value[q] / self.step.unit(q);
+        }
+        Ok(())
     }
 
     /// Keeps the increment of the step just accepted (of length `dt`) as the next step's

@@ -3,7 +3,7 @@
 //! Layout: root attributes `format` ("porompm-checkpoint"), `version`, `case_fingerprint`, `time`
 //! [s], `step`, `stage`, `dt` [s], `successes`, `has_check_state`, then
 //! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
-//! iterations, matrix-structure reuses), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
+//! iterations, matrix-structure reuses, line-search retries), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
 //! `load_totals`, `check_state`, and one dataset per
 //! particle array under `/particles` (n × components, SI units, sorted by id).
 //!
@@ -95,7 +95,10 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         attr_f64(loc, "dt", cp.dt)?;
         attr_u64(loc, "successes", cp.successes)?;
         attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64)?;
-        f.new_dataset::<u64>().shape(4).create("counters").and_then(|d| d.write_raw(&cp.counters[..]))?;
+        f.new_dataset::<u64>()
+            .shape(cp.counters.len())
+            .create("counters")
+            .and_then(|d| d.write_raw(&cp.counters[..]))?;
         dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics)?;
         dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes)?;
         dataset_f64(&f, "load_totals", &[cp.load_totals.len()], &cp.load_totals)?;
@@ -229,7 +232,7 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
         stage: u("stage").map_err(corrupt)?,
         dt: x("dt").map_err(corrupt)?,
         successes: u("successes").map_err(corrupt)?,
-        counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 4 values"))?,
+        counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 5 values"))?,
         diagnostics: vec_f64("diagnostics").map_err(corrupt)?,
         probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
         load_totals: vec_f64("load_totals").map_err(corrupt)?,
@@ -260,7 +263,7 @@ mod tests {
             stage: 1,
             dt: 1e-3 / 3.0,
             successes: 2,
-            counters: [1, 301, 302, 7],
+            counters: [1, 301, 302, 7, 2],
             diagnostics: vec![f64::NAN, 0.5],
             probe_extremes: vec![-12.5, 3.0],
             load_totals: vec![0.25, 1.0 / 3.0],

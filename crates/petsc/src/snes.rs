@@ -237,6 +237,16 @@ impl Snes {
         call!(SNESLineSearchSetType(ls, c.as_ptr()))
     }
 
+    /// The line search's PETSc name (`"basic"`, `"bt"`, ...).
+    pub fn line_search_type(&self) -> Result<String> {
+        let mut ls = std::ptr::null_mut();
+        call!(SNESGetLineSearch(self.raw, &mut ls))?;
+        let mut t: sys::SNESLineSearchType = std::ptr::null();
+        call!(SNESLineSearchGetType(ls, &mut t))?;
+        // SAFETY: PETSc returns a NUL-terminated static string.
+        Ok(if t.is_null() { String::new() } else { unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned() })
+    }
+
     /// Current (atol, rtol, stol, max_it).
     pub fn tolerances(&self) -> Result<(Real, Real, Real, usize)> {
         let (mut a, mut r, mut s) = (0.0, 0.0, 0.0);
