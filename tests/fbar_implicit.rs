@@ -79,3 +79,18 @@ fn the_implicit_and_explicit_projections_find_the_same_footing_plateau() {
     assert!((implicit - 1.0).abs() <= 0.18, "implicit {implicit}");
     assert!((implicit - explicit).abs() <= 0.015, "implicit {implicit} against explicit {explicit}");
 }
+
+/// The implicit F̄ on two ranks: the projection rows of the nodes on the ranks' border sum the
+/// shares of both ranks' points, so the tapered plate's tip deflection and Newton iterations are
+/// those of one rank (measured: equal to the 11 digits of history.csv).
+#[test]
+fn the_implicit_projection_gives_the_same_plate_on_two_ranks() {
+    let args = set_args(&["stabilisation={fbar=true}"]);
+    let one = run_case("tests/cases/tapered_plate.toml", &out_dir("plate-1rank"), &args);
+    let two = run_case_on(2, "tests/cases/tapered_plate.toml", &out_dir("plate-2ranks"), &args);
+    assert!(one.completed() && two.completed(), "{}\n{}", one.stderr(), two.stderr());
+    assert_eq!(two.summary["ranks"], 2);
+    let (a, b) = (*one.column("tip.uy").last().unwrap(), *two.column("tip.uy").last().unwrap());
+    assert!((a - b).abs() <= 1e-9 * a.abs(), "tip u_y {a} on one rank, {b} on two");
+    assert_eq!(one.summary["snes_iterations"], two.summary["snes_iterations"]);
+}

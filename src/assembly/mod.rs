@@ -1242,6 +1242,9 @@ impl GridSystem {
             };
             self.snes.set_line_search("basic")?;
             let (second, second_nonfinite) = retry?;
+            // A point that was not finite in the first try names the failure only if the second
+            // fails too.
+            nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
             let (first_newton, first_krylov) = (out.iterations, out.linear_iterations);
             out = SolveOutcome {
                 iterations: first_newton + second.iterations,
@@ -1253,7 +1256,6 @@ impl GridSystem {
                 },
                 ..second
             };
-            nonfinite = nonfinite.or(second_nonfinite);
         }
         let solve_seconds = t0.elapsed().as_secs_f64();
         self.dm.global_to_local(&self.x, &mut self.x_local)?;

@@ -25,6 +25,7 @@
 //! | [`flow::continuity`] | p | −S_i [(1 − n) ∇̄·Δu + n ∇̄·ΔU + Δp/Q] V ([003] 23b) |
 //! | [`flow::darcy`] | p | −Δt V (k/γ_w) ∇S_i·(∇p_θ − ρ_w b) (u–p with flow) |
 //! | [`flow::drained_face`] | p | Nitsche's terms of p = 0 on the particle's drained faces (u–p with flow) |
+//! | [`fbar`] | Jbar | κ S_i V_n (ϑ_i − (J_n ΔJ − 1)), [002]'s projection of J (implicit F̄ steps) |
 //!
 //! with m_s = (1 − n)ρ_s V (the mixture's mass in one-phase runs), m_w = nρ_w V, p = p_n + Σ S_j Δp_j,
 //! σ' the effective stress after the soil model's objective update (see [`kinematics`]) and ∇̄'
@@ -45,7 +46,9 @@
 //!
 //! # B̄
 //! Each node carries the gradient ∇S_i used for the deviatoric part of B and a gradient ∇̄S_i for the
-//! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B.
+//! volumetric part ([000] Eqs. 12–16). Without B̄ the two are equal and B̄ reduces to B. With an
+//! implicit F̄ instead, the stress's volumetric strain comes from the projected J̄ at the nodes
+//! ([`fbar`], [`kinematics::Kinematics::with_projected_volume`]).
 
 pub mod cell;
 pub mod fbar;
