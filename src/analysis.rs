@@ -74,9 +74,12 @@ impl StageAnalysis {
             }
         };
         // [002]'s F̄ in an implicit stage: the projected volume ratio joins the unknowns
-        // (`kernels::fbar`; validated: u and u–p stages only).
+        // (`kernels::fbar`) of the u and u–p systems; validation refuses F̄ in a stage whose
+        // layout has no such form (u–p–U), which it finds by this function.
         if case.stabilisation.fbar && stage.analysis != AnalysisType::DynamicExplicit {
-            analysis.layout = analysis.layout.with_fbar().expect("validated: F̄ in u or u–p stages");
+            if let Some(layout) = analysis.layout.with_fbar() {
+                analysis.layout = layout;
+            }
         }
         analysis
     }

@@ -1,6 +1,6 @@
 //! `porompm check`: what a case will build, computed without PETSc (one process).
 
-use crate::assembly::{REACHED_FRACTION, WELL_FILLED_FRACTION};
+use crate::assembly::{dofs, WELL_FILLED_FRACTION};
 use crate::case::{Case, Load, SoilModel};
 use crate::model::{shape, Model};
 use std::fmt::Write;
@@ -130,12 +130,10 @@ pub fn describe(case: &Case, label: &str) -> String {
         for i in 0..g.nodes()[0] {
             let f = filled[j * g.nodes()[0] + i];
             let fixed = model.fixing_boundaries(&first, i, j);
-            // As `assembly::dofs`: a well-filled node's free dofs, and an implicit F̄ step's J̄
-            // wherever points reach.
             unknowns += (0..layout.nd)
-                .filter(|&c| match layout.canonical(c) {
-                    None => f > REACHED_FRACTION,
-                    Some(k) => f > WELL_FILLED_FRACTION && fixed[k].is_none(),
+                .filter(|&c| {
+                    layout.canonical(c).is_none_or(|k| fixed[k].is_none())
+                        && dofs::carries_unknown(layout, c, f, WELL_FILLED_FRACTION)
                 })
                 .count();
         }

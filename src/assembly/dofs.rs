@@ -42,6 +42,20 @@ impl DofMap {
     }
 }
 
+/// Whether component `c` of a node that the material fills to `fill` (a fraction of a cell) is an
+/// unknown where no boundary fixes it: every component of a well-filled node (above
+/// `well_fraction`); and the projected volume ratio of an implicit F̄ step wherever points reach
+/// the node at all (above [`super::REACHED_FRACTION`]), since it is [002]'s average over the points
+/// that reach it, however few (its row's diagonal is κ Σ_p S_ip V_p), unlike the motion, which is
+/// extended, and the pressure, which is drained.
+pub fn carries_unknown(layout: Layout, c: usize, fill: f64, well_fraction: f64) -> bool {
+    if Some(c) == layout.jbar {
+        fill > super::REACHED_FRACTION
+    } else {
+        fill > well_fraction
+    }
+}
+
 /// Builds the dof map from the filled fractions `phi` (per ghosted node, summed over ranks) and the
 /// moving-surface fixes `surface` (per ghosted dof, the boundary index + 1 or 0, maximum over ranks).
 #[allow(clippy::too_many_arguments)]
@@ -84,12 +98,7 @@ pub fn build(
                     }
                 }
             }
-            // The projected volume ratio of an implicit F̄ step is [002]'s average over the points
-            // that reach the node, however few: an unknown wherever they fill more than
-            // `REACHED_FRACTION` of a cell (its row's diagonal is κ Σ_p S_ip V_p), unlike the
-            // motion, which is extended, and the pressure, which is drained.
-            let unfilled = if Some(c) == layout.jbar { *reached <= super::REACHED_FRACTION } else { !m.well[l] };
-            m.fixed[q] = b.is_some() || unfilled;
+            m.fixed[q] = b.is_some() || !carries_unknown(layout, c, *reached, well_fraction);
         }
     }
     for jj in 0..owned_count[1] {

@@ -270,11 +270,15 @@ pub fn validate(c: &Case) -> R {
     }
     finite_strain_materials(c)?;
     if c.stabilisation.fbar {
-        if let Some(s) = c.stages.iter().find(|s| two_phase && s.analysis == AnalysisType::Dynamic) {
+        // The implicit stages whose unknowns have no F̄ form (`Layout::with_fbar`: u–p–U).
+        if let Some(s) = c.stages.iter().find(|s| {
+            s.analysis != AnalysisType::DynamicExplicit
+                && crate::analysis::StageAnalysis::of(c, s).layout.jbar.is_none()
+        }) {
             return Err(format!(
                 "key `stabilisation.fbar`: stage `{}` solves u–p–U, and the F̄ projection is built for the u and \
-                 u–p systems of implicit stages and for explicit stages (one more nodal unknown would exceed the \
-                 five a node carries); run it as quasi_static or static, or without F̄",
+                 u–p systems of implicit stages and for one-phase explicit stages (one more nodal unknown would \
+                 exceed the five a node carries); run it as quasi_static or static, or without F̄",
                 s.name
             ));
         }

@@ -45,14 +45,14 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let (nd, m) = (pt.layout.nd, pt.size());
     let part = pt.part;
     let w = part.fbar_rows * part.volume * nm.w_mass;
-    let dj = crate::model::finite_strain::det(part.def_grad) * pt.kin.j;
+    let j_new = crate::model::finite_strain::det(part.def_grad) * pt.kin.j;
     for (i, b) in pt.basis.iter().enumerate() {
         let row = (i * nd + j) * m;
         out[row + i * nd + j] += w * b.s;
         for l in 0..pt.basis.len() {
             let g = pt.strain_spatial[l].0;
             for d in 0..2 {
-                out[row + l * nd + d] -= w * b.s * dj * g[d];
+                out[row + l * nd + d] -= w * b.s * j_new * g[d];
             }
         }
     }
@@ -60,7 +60,7 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{plain_basis, Layout, NodeBasis, NodeState, ParticleInput, Point, Predictors, Scheme};
+    use super::super::{plain_basis, Layout, NodeBasis, NodeState, ParticleInput, Point, Scheme};
     use crate::kernels::Integration;
     use crate::model::fbar::tests::Lcg;
     use crate::model::fbar::{gather, scatter};
@@ -68,31 +68,10 @@ mod tests {
     use crate::model::shape::{self, Basis};
     use crate::model::soil::{Constitutive, LinearElastic};
 
+    /// The kernels' sample particle with the volume, deformation gradient and J̄ of a point of
+    /// the cloud, and the projection rows' scale.
     fn input(volume: f64, def_grad: [[f64; 2]; 2], jbar: f64) -> ParticleInput {
-        ParticleInput {
-            volume,
-            porosity: 0.0,
-            mass: 1.0,
-            water_mass: 0.0,
-            drag: 0.0,
-            inv_q: 0.0,
-            mobility: 0.0,
-            water_density: 0.0,
-            grad_p: [0.0; 2],
-            stress: [0.0; 4],
-            def_grad,
-            eps_pd: 0.0,
-            p: 0.0,
-            body_acc: [0.0; 2],
-            grad_n: [0.0; 2],
-            pred: Predictors::default(),
-            linear: false,
-            fbar: 1.0,
-            fbar_total: 1.0,
-            dt: 0.0,
-            jbar,
-            fbar_rows: 3.0e7,
-        }
+        ParticleInput { volume, def_grad, jbar, fbar_rows: 3.0e7, ..super::super::tests::part() }
     }
 
     /// The converged projection rows are [002]'s Algorithm 1: for random nodal motions of points

@@ -127,15 +127,13 @@ pub struct Kinematics {
 /// [`Kinematics::with_projected_volume`]).
 #[derive(Debug, Clone, Copy)]
 struct Projected {
-    /// r = J̄_{n+1}/J̄_n, the volume ratio of the step the stress sees.
-    r: f64,
-    /// c = (r/J)^{1/2}, ΔF̄ = c ΔF.
+    /// c = (r/J)^{1/2}, ΔF̄ = c ΔF (r = J̄_{n+1}/J̄_n, the volume ratio of the step the stress sees).
     c: f64,
     /// a = tr ΔF̄ = c tr ΔF.
     a: f64,
     /// ∂ tr L̄/∂a at fixed r.
     dtr_da: f64,
-    /// ∂ tr L̄/∂r at fixed a.
+    /// d tr L̄/dr at fixed ΔF (through a = (r/J)^{1/2} tr ΔF as well).
     dtr_dr: f64,
 }
 
@@ -278,15 +276,12 @@ impl Kinematics {
         let tr_bar = 4.0 * r_minus_one / den;
         let l = &self.l;
         let vol = (tr_bar - (l[0][0] + l[1][1])) / 3.0;
+        // ∂ tr L̄/∂a = −4(r − 1)/den², ∂ tr L̄/∂r|_a = 4(2 + a)/den² and ∂a/∂r = a/(2r).
+        let dtr_da = -4.0 * r_minus_one / (den * den);
+        let dtr_dr = dtr_da * a / (2.0 * r) + 4.0 * (2.0 + a) / (den * den);
         Kinematics {
             deps: [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol],
-            projected: Some(Projected {
-                r,
-                c,
-                a,
-                dtr_da: -4.0 * (r - 1.0) / (den * den),
-                dtr_dr: 4.0 * (2.0 + a) / (den * den),
-            }),
+            projected: Some(Projected { c, a, dtr_da, dtr_dr }),
             ..self
         }
     }
@@ -296,7 +291,7 @@ impl Kinematics {
     /// m = [1, 1, 0, 1].
     pub fn deps_volume_derivative(&self) -> [f64; 4] {
         let Some(pj) = self.projected else { return [0.0; 4] };
-        let d = (pj.dtr_da * pj.a / (2.0 * pj.r) + pj.dtr_dr) / 3.0;
+        let d = pj.dtr_dr / 3.0;
         [d, d, 0.0, d]
     }
 
@@ -418,16 +413,22 @@ mod tests {
     fn derivatives_match_central_differences() {
         let b = basis();
         let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.02)).collect();
-        let k0 = Kinematics::new(&b, u.iter().copied(), false);
+        check_derivatives(&b, &u, |v| Kinematics::new(&b, v.iter().copied(), false));
+    }
+
+    /// Asserts that ∂Δε/∂Δu_l and ∂θ/∂Δu_l of the kinematics `at(u)` match central differences at
+    /// the nodal increments `u`, for every node of `b` and both components.
+    fn check_derivatives(b: &[NodeBasis], u: &[[f64; 2]], at: impl Fn(&[[f64; 2]]) -> Kinematics) {
+        let k0 = at(u);
         let h = 1e-7;
         for l in 0..b.len() {
             let de = k0.deps_derivative(&b[l]);
             let dt = k0.theta_derivative(&b[l]);
             for d in 0..2 {
                 let shifted = |s: f64| {
-                    let mut v = u.clone();
+                    let mut v = u.to_vec();
                     v[l][d] += s;
-                    Kinematics::new(&b, v.into_iter(), false)
+                    at(&v)
                 };
                 let (p, m) = (shifted(h), shifted(-h));
                 for (r, der) in de.iter().enumerate() {
@@ -477,27 +478,8 @@ mod tests {
         let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
         let r0 = 1.04;
         let at = |v: &[[f64; 2]], r: f64| Kinematics::new(&b, v.iter().copied(), false).with_projected_volume(r - 1.0);
-        let k0 = at(&u, r0);
-        let h = 1e-7;
-        for l in 0..b.len() {
-            let de = k0.deps_derivative(&b[l]);
-            for d in 0..2 {
-                let shifted = |s: f64| {
-                    let mut v = u.clone();
-                    v[l][d] += s;
-                    at(&v, r0)
-                };
-                let (p, m) = (shifted(h), shifted(-h));
-                for (row, der) in de.iter().enumerate() {
-                    let fd = (p.deps[row] - m.deps[row]) / (2.0 * h);
-                    assert!(
-                        (fd - der[d]).abs() < 1e-7 * (1.0 + fd.abs()),
-                        "deps[{row}] node {l} comp {d}: {fd} vs {}",
-                        der[d]
-                    );
-                }
-            }
-        }
+        check_derivatives(&b, &u, |v| at(v, r0));
+        let (k0, h) = (at(&u, r0), 1e-7);
         let dr = k0.deps_volume_derivative();
         let (p, m) = (at(&u, r0 + h), at(&u, r0 - h));
         for (row, der) in dr.iter().enumerate() {

@@ -139,7 +139,8 @@ fn sample_faces(nn: usize) -> Vec<DrainedFace> {
         .collect()
 }
 
-fn part() -> ParticleInput {
+/// A sample particle (two-phase quantities set, stressed, J ≠ 1).
+pub(super) fn part() -> ParticleInput {
     ParticleInput {
         volume: 2.5e-3,
         porosity: 0.35,
