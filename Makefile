@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study study-cook study-footing study-dam gold bench bench-scaling bench-solvers maps lint clean
+.PHONY: setup build run test study study-cook study-footing study-dam gold gold-table bench bench-scaling bench-solvers maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -39,6 +39,11 @@ study-footing: build
 # minutes; it reports the unmet assertions and fails).
 study-dam: build
 	cargo test --release --locked --test studies dam_break_item_15 -- --ignored --nocapture
+
+# Every case against its gold values, one rank: the largest relative difference of each
+# (target/gold/table.md), the before/after table of a change that must not change the answers.
+gold-table: setup
+	cargo test --release --locked --test gold -- --ignored --nocapture every_case_against_its_gold_values_table
 
 # Rewrites the gold values of every case (cases/gold/*.json) from fresh runs; review the diff.
 gold: setup

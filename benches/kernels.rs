@@ -141,8 +141,8 @@ fn particle_kernels(c: &mut Criterion) {
 
     // Stress updates: the slumping block's elastic soil, and a Mohr–Coulomb soil (φ = 30°) sheared
     // into yield.
-    let deps: Vec<[f64; 4]> =
-        (0..n).map(|k| [1e-5 * noise(k), -1e-5 * noise(k + 1), 1e-5 * noise(k + 2), 0.0]).collect();
+    let deps: Vec<[f64; 6]> =
+        (0..n).map(|k| [1e-5 * noise(k), -1e-5 * noise(k + 1), 1e-5 * noise(k + 2), 0.0, 0.0, 0.0]).collect();
     let mut g = group(c, "soil", n);
     g.bench_function("linear_elastic", |b| {
         b.iter(|| {
@@ -155,12 +155,12 @@ fn particle_kernels(c: &mut Criterion) {
     });
     let footing = load("cases/footing_sd.toml", &["materials.clay.model.friction_angle=30"]);
     let mc = porompm::model::material::soil_model(&footing.materials[0].model);
-    let stress0 = [-2e3, -2e3, 0.0, -2e3];
+    let stress0 = [-2e3, -2e3, 0.0, -2e3, 0.0, 0.0];
     // Isochoric (the soil is nearly incompressible, ν = 0.49): ε_xx = −ε_yy.
-    let shear: Vec<[f64; 4]> = (0..n)
+    let shear: Vec<[f64; 6]> = (0..n)
         .map(|k| {
             let a = 1e-2 * (1.0 + 0.1 * noise(k));
-            [a, -a, 2e-3 * noise(k + 7), 0.0]
+            [a, -a, 2e-3 * noise(k + 7), 0.0, 0.0, 0.0]
         })
         .collect();
     for d in &shear {
@@ -171,6 +171,22 @@ fn particle_kernels(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = 0.0;
             for d in &shear {
+                sum += mc.update(&stress0, 0.0, d).stress[0];
+            }
+            black_box(sum)
+        })
+    });
+    // The same steps with out-of-plane shears as well (a three-dimensional point: the principal
+    // frame by Jacobi rotations instead of the plane's closed form).
+    let shear3: Vec<[f64; 6]> = shear
+        .iter()
+        .enumerate()
+        .map(|(k, d)| [d[0], d[1], d[2], 0.0, 3e-3 * noise(k + 3), -2e-3 * noise(k + 5)])
+        .collect();
+    g.bench_function("mohr_coulomb_plastic_3d", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for d in &shear3 {
                 sum += mc.update(&stress0, 0.0, d).stress[0];
             }
             black_box(sum)

@@ -7,7 +7,7 @@
 //! converges quadratically, as the residual history of each row shows.
 
 use crate::case::element::{Control, LoadPath};
-use crate::model::soil::{Constitutive, Region};
+use crate::model::soil::{Constitutive, Region, Stress, NS};
 
 /// The state after one increment.
 #[derive(Debug, Clone)]
@@ -16,10 +16,10 @@ pub struct Row {
     pub step: usize,
     /// Segment index.
     pub segment: usize,
-    /// Total strain [xx, yy, γxy, zz].
-    pub strain: [f64; 4],
-    /// Stress [xx, yy, xy, zz] [Pa].
-    pub stress: [f64; 4],
+    /// Total strain [xx, yy, γxy, zz, γyz, γzx].
+    pub strain: Stress,
+    /// Stress [xx, yy, xy, zz, yz, zx] [Pa].
+    pub stress: Stress,
     /// Accumulated deviatoric plastic strain ε̄.
     pub eps_pd: f64,
     /// Region of the return.
@@ -38,26 +38,27 @@ impl Row {
     pub fn q(&self) -> f64 {
         let p = self.mean();
         let s = &self.stress;
-        (1.5 * ((s[0] - p).powi(2) + (s[1] - p).powi(2) + (s[3] - p).powi(2) + 2.0 * s[2] * s[2])).sqrt()
+        let shear = s[2] * s[2] + s[4] * s[4] + s[5] * s[5];
+        (1.5 * ((s[0] - p).powi(2) + (s[1] - p).powi(2) + (s[3] - p).powi(2) + 2.0 * shear)).sqrt()
     }
 }
 
 /// Drives `model` along `path`; fails if an increment's mixed control does not converge.
 pub fn run(model: &Constitutive, path: &LoadPath) -> Result<Vec<Row>, String> {
-    let mut stress = path.initial_stress;
-    let mut strain = [0.0; 4];
+    let mut stress = path.initial();
+    let mut strain = [0.0; NS];
     let mut eps = path.initial_plastic_strain;
     let mut rows = Vec::new();
     let scale = model.elastic().d[0][0];
     for (si, seg) in path.segments.iter().enumerate() {
         let start = stress;
         let controls = seg.controls();
-        let free: Vec<usize> = (0..4).filter(|&c| matches!(controls[c], Control::Stress(_))).collect();
+        let free: Vec<usize> = (0..NS).filter(|&c| matches!(controls[c], Control::Stress(_))).collect();
         for n in 1..=seg.steps {
             let frac = n as f64 / seg.steps as f64;
-            let mut de = [0.0; 4];
-            let mut target = [0.0; 4];
-            for c in 0..4 {
+            let mut de = [0.0; NS];
+            let mut target = [0.0; NS];
+            for c in 0..NS {
                 match controls[c] {
                     Control::Strain(total) => de[c] = total / seg.steps as f64,
                     Control::Stress(end) => target[c] = start[c] + (end - start[c]) * frac,
@@ -80,8 +81,8 @@ pub fn run(model: &Constitutive, path: &LoadPath) -> Result<Vec<Row>, String> {
                 // stresses controlled it is singular (the split of the lateral flow between them is
                 // free) and the regularised solve picks the smallest correction.
                 let m = free.len();
-                let mut a = [[0.0; 4]; 4];
-                let mut rhs = [0.0; 4];
+                let mut a = [[0.0; NS]; NS];
+                let mut rhs = [0.0; NS];
                 for (i, &ci) in free.iter().enumerate() {
                     rhs[i] = r[i];
                     for (j, &cj) in free.iter().enumerate() {
@@ -104,7 +105,7 @@ pub fn run(model: &Constitutive, path: &LoadPath) -> Result<Vec<Row>, String> {
                     ));
                 }
             }
-            for c in 0..4 {
+            for c in 0..NS {
                 strain[c] += de[c];
             }
             stress = upd.stress;
@@ -124,17 +125,21 @@ pub fn run(model: &Constitutive, path: &LoadPath) -> Result<Vec<Row>, String> {
 }
 
 /// The CSV header of [`table`].
-pub const HEADER: [&str; 15] = [
+pub const HEADER: [&str; 19] = [
     "step",
     "segment",
     "eps_xx",
     "eps_yy",
     "gamma_xy",
     "eps_zz",
+    "gamma_yz",
+    "gamma_zx",
     "sig_xx",
     "sig_yy",
     "sig_xy",
     "sig_zz",
+    "sig_yz",
+    "sig_zx",
     "p",
     "q",
     "eps_pd",
@@ -282,5 +287,58 @@ mod tests {
             }
         }
         assert!((rows.last().unwrap().stress[2] - 3e3).abs() < 1e-6);
+    }
+
+    /// A strain path driven in a turned frame (every shear component non-zero) gives the stresses
+    /// of the same path in the material's own frame, turned: the soil models see the full
+    /// three-dimensional state, and an isotropic one does not care about the frame.
+    #[test]
+    fn a_path_in_a_turned_frame_gives_the_turned_stresses() {
+        use crate::model::soil::principal;
+        // Strain-controlled compression with a lateral stretch, in principal axes, from a
+        // geostatic start: the loose sand softens, dilates and reaches its edge regions.
+        let axes = [-0.02, 0.006, 0.003];
+        let start = [-100e3, -60e3, -80e3];
+        let tensor_path = |r: &[[f64; 3]; 3]| -> String {
+            let e = principal::rotate(r, &[axes[0], axes[1], 0.0, axes[2], 0.0, 0.0]);
+            let s = principal::rotate(r, &[start[0], start[1], 0.0, start[2], 0.0, 0.0]);
+            // Engineering shears γ = 2ε for the strain controls.
+            let c = |k: usize| e[k] * if matches!(k, 2 | 4 | 5) { 2.0 } else { 1.0 };
+            format!(
+                "initial_stress = [{}, {}, {}, {}, {}, {}]\n[[segments]]\nsteps = 40\nxx = {{ strain = {} }}\n\
+                 yy = {{ strain = {} }}\nxy = {{ strain = {} }}\nzz = {{ strain = {} }}\nyz = {{ strain = {} }}\n\
+                 zx = {{ strain = {} }}\n",
+                s[0],
+                s[1],
+                s[2],
+                s[3],
+                s[4],
+                s[5],
+                c(0),
+                c(1),
+                c(2),
+                c(3),
+                c(4),
+                c(5)
+            )
+        };
+        let m = model(
+            "[model]\ntype = \"mohr_coulomb\"\nyoung_modulus = 20e6\npoisson_ratio = 0.3\nfriction_angle = 30.0\n\
+             cohesion = 5e3\ndilation_angle = 5.0\n",
+        );
+        let own = principal::rotation([0.0, 0.0, 1.0], 0.0);
+        let n = 14f64.sqrt();
+        let turn = principal::rotation([1.0 / n, -2.0 / n, 3.0 / n], 1.1);
+        let a = run(&m, &parse_path(&tensor_path(&own), "own").unwrap()).unwrap();
+        let b = run(&m, &parse_path(&tensor_path(&turn), "turned").unwrap()).unwrap();
+        assert!(a.iter().any(|r| r.region != Region::Elastic), "the path must yield");
+        for (ra, rb) in a.iter().zip(&b) {
+            let expected = principal::rotate(&turn, &ra.stress);
+            for (c, (got, want)) in rb.stress.iter().zip(&expected).enumerate() {
+                assert!((got - want).abs() < 1e-6, "step {} component {c}: {got} vs {want}", ra.step);
+            }
+            assert_eq!(ra.region, rb.region);
+            assert!((ra.q() - rb.q()).abs() < 1e-6 && (ra.mean() - rb.mean()).abs() < 1e-6);
+        }
     }
 }

@@ -453,12 +453,14 @@ fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure>
     if let Some(last) = rows.last() {
         let peak_q = rows.iter().map(|r| r.q()).fold(0.0, f64::max);
         println!(
-            "{} increments; final stress [xx, yy, xy, zz] = [{:.4e}, {:.4e}, {:.4e}, {:.4e}] Pa, p = {:.4e} Pa, q = {:.4e} Pa (peak {:.4e}), ε̄ = {:.4e}",
+            "{} increments; final stress [xx, yy, xy, zz, yz, zx] = [{:.4e}, {:.4e}, {:.4e}, {:.4e}, {:.4e}, {:.4e}] Pa, p = {:.4e} Pa, q = {:.4e} Pa (peak {:.4e}), ε̄ = {:.4e}",
             rows.len(),
             last.stress[0],
             last.stress[1],
             last.stress[2],
             last.stress[3],
+            last.stress[4],
+            last.stress[5],
             last.mean(),
             last.q(),
             peak_q,

@@ -17,7 +17,7 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 7;
+pub const FORMAT_VERSION: u64 = 8;
 
 /// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
 pub const PARTICLE_FIELDS: [(&str, usize); 22] = [
@@ -37,7 +37,7 @@ pub const PARTICLE_FIELDS: [(&str, usize); 22] = [
     ("acc", 2),
     ("vel_w", 2),
     ("acc_w", 2),
-    ("stress", 4),
+    ("stress", 6),
     ("p", 1),
     ("p0", 1),
     ("eps_pd", 1),
@@ -46,7 +46,7 @@ pub const PARTICLE_FIELDS: [(&str, usize); 22] = [
 ];
 
 /// Values per particle record (the sum of [`PARTICLE_FIELDS`]' components).
-pub const RECORD: usize = 38;
+pub const RECORD: usize = 40;
 
 /// `summary.json`'s `restarted_from`: the checkpoint a run continued from.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -184,26 +184,31 @@ pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
 
 /// Overwrites particle `k` with record `r` (same id, body and material, checked by the caller).
 fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
-    let two = |o: usize| [r[o], r[o + 1]];
-    ps.x[k] = two(3);
-    ps.x0[k] = two(5);
-    ps.disp[k] = two(7);
-    ps.lp[k] = two(9);
-    ps.lp0[k] = two(11);
-    ps.def_grad[k] = [[r[13], r[14]], [r[15], r[16]]];
-    ps.volume[k] = r[17];
-    ps.porosity[k] = r[18];
-    ps.mass[k] = r[19];
-    ps.vel[k] = two(20);
-    ps.acc[k] = two(22);
-    ps.vel_w[k] = two(24);
-    ps.acc_w[k] = two(26);
-    ps.stress[k] = [r[28], r[29], r[30], r[31]];
-    ps.p[k] = r[32];
-    ps.p0[k] = r[33];
-    ps.eps_pd[k] = r[34];
-    ps.grad_p[k] = two(35);
-    ps.jbar[k] = r[37];
+    // The fields after id, body and material, in the order of `PARTICLE_FIELDS`.
+    fn take<const N: usize>(rest: &mut impl Iterator<Item = f64>) -> [f64; N] {
+        std::array::from_fn(|_| rest.next().expect("RECORD values"))
+    }
+    let rest = &mut r[3..].iter().copied();
+    let one = |rest: &mut _| take::<1>(rest)[0];
+    ps.x[k] = take(rest);
+    ps.x0[k] = take(rest);
+    ps.disp[k] = take(rest);
+    ps.lp[k] = take(rest);
+    ps.lp0[k] = take(rest);
+    ps.def_grad[k] = [take(rest), take(rest)];
+    ps.volume[k] = one(rest);
+    ps.porosity[k] = one(rest);
+    ps.mass[k] = one(rest);
+    ps.vel[k] = take(rest);
+    ps.acc[k] = take(rest);
+    ps.vel_w[k] = take(rest);
+    ps.acc_w[k] = take(rest);
+    ps.stress[k] = take(rest);
+    ps.p[k] = one(rest);
+    ps.p0[k] = one(rest);
+    ps.eps_pd[k] = one(rest);
+    ps.grad_p[k] = take(rest);
+    ps.jbar[k] = one(rest);
 }
 
 /// The points of `records`, in their order (every array from its record).
@@ -333,7 +338,7 @@ mod tests {
         ps.acc[k] = [next(), next()];
         ps.vel_w[k] = [next(), next()];
         ps.acc_w[k] = [next(), next()];
-        ps.stress[k] = [next(), next(), next(), next()];
+        ps.stress[k] = std::array::from_fn(|_| next());
         ps.p[k] = next();
         ps.p0[k] = next();
         ps.eps_pd[k] = next();

@@ -146,13 +146,20 @@ fn values_of(out: &Path, s: &Value) -> BTreeMap<String, Option<f64>> {
     v
 }
 
-/// The differences of `got` from `gold` beyond the tolerance, one line each.
-fn differences(gold: &Gold, got: &BTreeMap<String, Option<f64>>) -> Vec<String> {
+/// The largest magnitude of the gold values of each kind: the scale a value's difference is
+/// measured against besides its own magnitude.
+fn kind_scales(gold: &Gold) -> BTreeMap<&'static str, f64> {
     let mut scale: BTreeMap<&str, f64> = BTreeMap::new();
     for (k, g) in &gold.values {
         let s = scale.entry(kind(k)).or_insert(0.0);
         *s = s.max(g.unwrap_or(0.0).abs());
     }
+    scale
+}
+
+/// The differences of `got` from `gold` beyond the tolerance, one line each.
+fn differences(gold: &Gold, got: &BTreeMap<String, Option<f64>>) -> Vec<String> {
+    let scale = kind_scales(gold);
     let mut out = Vec::new();
     for (k, g) in &gold.values {
         let floor = match kind(k) {
@@ -438,15 +445,55 @@ fn every_case_gives_its_gold_values_on_two_and_three_ranks() {
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
+/// Every case on one rank against its gold values: per case the number of values compared and the
+/// largest difference relative to the value plus the scale of its kind (as [`differences`] measures,
+/// with no floor), written to `target/gold/table.md`. This is the before/after table of a change
+/// that must not change the answers (a refactor): the gold files hold the answers before it.
+/// `make gold-table`.
+#[test]
+#[ignore = "writes the table of every case against its gold values (make gold-table)"]
+fn every_case_against_its_gold_values_table() {
+    let mut table = vec![
+        "| case | values compared | largest relative difference | value | run time (s) |".to_string(),
+        "|---|---|---|---|---|".to_string(),
+    ];
+    let mut failed = Vec::new();
+    for case in CASES {
+        let gold = read_gold(case);
+        let (out, s) = run(case, case, &gold.sets, &[], &[]);
+        let got = values_of(&out, &s);
+        let scale = kind_scales(&gold);
+        let (mut worst, mut which, mut compared) = (0.0f64, String::from("-"), 0);
+        for (k, g) in &gold.values {
+            if let (Some(g), Some(Some(v))) = (g, got.get(k)) {
+                compared += 1;
+                let d = (v - g).abs() / (g.abs() + scale[kind(k)]).max(f64::MIN_POSITIVE);
+                if d > worst {
+                    (worst, which) = (d, k.clone());
+                }
+            }
+        }
+        table.push(format!(
+            "| {case} | {compared} | {worst:.1e} | {which} | {:.1} |",
+            s["wall_time_s"].as_f64().unwrap_or(f64::NAN)
+        ));
+        let diff = differences(&gold, &got);
+        if !diff.is_empty() {
+            failed.push(format!("{case}:\n  {}", diff.join("\n  ")));
+        }
+    }
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/gold");
+    std::fs::create_dir_all(&dir).expect("target/gold");
+    std::fs::write(dir.join("table.md"), table.join("\n") + "\n").expect("table.md");
+    eprintln!("{}", table.join("\n"));
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
 /// The smallest relative tolerance under which a run's values would match the gold values (as
 /// [`differences`] compares them: against |g| plus the scale of their kind), and the value that
 /// needs it.
 fn largest_relative_difference(gold: &Gold, got: &BTreeMap<String, Option<f64>>) -> (f64, String) {
-    let mut scale: BTreeMap<&str, f64> = BTreeMap::new();
-    for (k, g) in &gold.values {
-        let s = scale.entry(kind(k)).or_insert(0.0);
-        *s = s.max(g.unwrap_or(0.0).abs());
-    }
+    let scale = kind_scales(gold);
     let mut worst = (0.0, String::from("-"));
     for (k, g) in &gold.values {
         if let (Some(g), Some(Some(v))) = (g, got.get(k)) {

@@ -64,7 +64,7 @@
 use super::{callbacks, Error, GridSystem, StepSolve};
 use crate::kernels::kinematics::Kinematics;
 use crate::kernels::{self, Integration};
-use crate::model::finite_strain::det;
+use crate::model::finite_strain::det2;
 use crate::model::{fbar, Model};
 
 impl GridSystem {
@@ -193,7 +193,7 @@ impl GridSystem {
                 Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false).j
             })
             .collect();
-        let own: Vec<f64> = (0..dj.len()).map(|k| det(ps.def_grad[k]) * dj[k]).collect();
+        let own: Vec<f64> = (0..dj.len()).map(|k| det2(ps.def_grad[k]) * dj[k]).collect();
         let projected = self.project_per_point(model, &own)?;
         Ok((0..own.len())
             .map(|k| {

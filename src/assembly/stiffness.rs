@@ -31,7 +31,7 @@
 use super::stencils::Stencils;
 use crate::case::Stiffness;
 use crate::kernels::cell::{mapped_stiffness, q4, CellGeometry, Moduli};
-use crate::model::{shape, Model};
+use crate::model::{shape, soil, Model};
 use petsc::GhostedRange;
 
 /// A cell (its lower-left node) and a point's weights w_i W_p of its four nodes.
@@ -105,7 +105,7 @@ impl MappedStiffness {
             };
             out.material.push(factor);
             let (nodes, _) = st.get(k);
-            let d: &Moduli = &model.materials[ps.material[k] as usize].model.elastic().d;
+            let d: &Moduli = &soil::plane_block(&model.materials[ps.material[k] as usize].model.elastic().d);
             for ((i, j), weights) in cells {
                 let mut slots = [0u8; 4];
                 for (s, (di, dj)) in slots.iter_mut().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {

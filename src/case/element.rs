@@ -2,13 +2,16 @@
 //!
 //! MATERIAL.toml holds the `model` table exactly as a case's `[materials.model]` (and an optional
 //! `name`). PATH.toml holds the initial state and segments; in each segment every stress-vector
-//! component (xx, yy, xy, zz; tension positive, plane strain) is either strain-controlled,
-//! `{ strain = Δε }` (the change over the segment, engineering shear γ_xy for xy), or
-//! stress-controlled, `{ stress = σ }` (the value reached at the end of the segment, approached
-//! linearly from the value at its start). Examples live in `element_tests/`.
+//! component (xx, yy, xy, zz and the out-of-plane shears yz, zx; tension positive) is either
+//! strain-controlled, `{ strain = Δε }` (the change over the segment, engineering shears γ for
+//! xy, yz, zx), or stress-controlled, `{ stress = σ }` (the value reached at the end of the
+//! segment, approached linearly from the value at its start). yz and zx default to
+//! `{ strain = 0.0 }`, which with `zz = { strain = 0.0 }` is plane strain. Examples live in
+//! `element_tests/`.
 
 use super::schema::SoilModel;
 use super::{validate, CaseError};
+use crate::model::soil::{Stress, NS};
 use serde::{Deserialize, Serialize};
 
 /// MATERIAL.toml.
@@ -49,15 +52,25 @@ pub struct Segment {
     pub xy: Control,
     /// σ_zz / ε_zz (ε_zz = 0 is plane strain).
     pub zz: Control,
+    /// σ_yz / γ_yz (default: no strain).
+    #[serde(default = "no_strain")]
+    pub yz: Control,
+    /// σ_zx / γ_zx (default: no strain).
+    #[serde(default = "no_strain")]
+    pub zx: Control,
+}
+
+fn no_strain() -> Control {
+    Control::Strain(0.0)
 }
 
 /// PATH.toml.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadPath {
-    /// Stress at the start [xx, yy, xy, zz] [Pa] (default zero).
+    /// Stress at the start [xx, yy, xy, zz] or [xx, yy, xy, zz, yz, zx] [Pa] (default zero).
     #[serde(default)]
-    pub initial_stress: [f64; 4],
+    pub initial_stress: Vec<f64>,
     /// Accumulated deviatoric plastic strain at the start [-].
     #[serde(default)]
     pub initial_plastic_strain: f64,
@@ -67,8 +80,20 @@ pub struct LoadPath {
 
 impl Segment {
     /// The controls in component order.
-    pub fn controls(&self) -> [Control; 4] {
-        [self.xx, self.yy, self.xy, self.zz]
+    pub fn controls(&self) -> [Control; NS] {
+        [self.xx, self.yy, self.xy, self.zz, self.yz, self.zx]
+    }
+}
+
+/// The names of the components, in order.
+pub const COMPONENTS: [&str; NS] = ["xx", "yy", "xy", "zz", "yz", "zx"];
+
+impl LoadPath {
+    /// The stress at the start (zero when not given; yz = zx = 0 when four components are given).
+    pub fn initial(&self) -> Stress {
+        let mut s = [0.0; NS];
+        s[..self.initial_stress.len()].copy_from_slice(&self.initial_stress);
+        s
     }
 }
 
@@ -107,6 +132,12 @@ pub fn parse_path(text: &str, origin: &str) -> Result<LoadPath, CaseError> {
     if p.segments.is_empty() {
         return Err(err("at least one [[segments]] table is needed".into()));
     }
+    if !matches!(p.initial_stress.len(), 0 | 4 | NS) {
+        return Err(err(format!(
+            "key `initial_stress`: give 4 components [xx, yy, xy, zz] or 6 [xx, yy, xy, zz, yz, zx], not {}",
+            p.initial_stress.len()
+        )));
+    }
     if p.initial_stress.iter().any(|v| !v.is_finite()) {
         return Err(err("key `initial_stress`: must be finite".into()));
     }
@@ -117,7 +148,7 @@ pub fn parse_path(text: &str, origin: &str) -> Result<LoadPath, CaseError> {
         if s.steps == 0 {
             return Err(err(format!("key `segments[{i}].steps`: must be at least 1")));
         }
-        for (name, c) in ["xx", "yy", "xy", "zz"].iter().zip(s.controls()) {
+        for (name, c) in COMPONENTS.iter().zip(s.controls()) {
             let v = match c {
                 Control::Strain(v) | Control::Stress(v) => v,
             };

@@ -35,7 +35,7 @@ pub struct ParticleStep {
 /// input at t_n, `step` the converged result, `dp` its pressure increment and `v_after` its volume
 /// at t_{n+1}.
 pub fn particle_step(before: &ParticleInput, step: &StepResult, dp: f64, v_after: f64) -> ParticleStep {
-    // Δε = [xx, yy, γxy, zz] (engineering shear), stress [xx, yy, xy, zz].
+    // Δε = [xx, yy, γxy, zz] (engineering shear) and the stress's plane components [xx, yy, xy, zz].
     let de = step.deps;
     let (s0, s1) = (before.stress, step.stress);
     let mean = |a: f64, b: f64| 0.5 * (a + b);
@@ -137,7 +137,7 @@ mod tests {
             mobility: 0.0,
             water_density: 1000.0,
             grad_p: [0.0; 2],
-            stress,
+            stress: crate::model::soil::plane(stress),
             def_grad: [[1.0, 0.0], [0.0, 1.0]],
             eps_pd: 0.0,
             p,
@@ -160,7 +160,7 @@ mod tests {
         let it = Interp { du: [0.0, -0.1], dw: [0.0, -0.2], dvol_u: -0.01, dvol_w: -0.02, ..Interp::default() };
         let step = StepResult {
             interp: it,
-            stress: [0.0, -300.0, 0.0, 0.0],
+            stress: crate::model::soil::plane([0.0, -300.0, 0.0, 0.0]),
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 0.99]],
             jacobian: 0.99,
@@ -176,7 +176,11 @@ mod tests {
         // Body work: g = −10 on m Δu = 3 × −0.1 and m_w ΔU = 0.5 × −0.2.
         assert!((e.body - (3.0 * 1.0 + 0.5 * 2.0)).abs() < 1e-12, "{e:?}");
         // Shear: σ_xy Δγ_xy.
-        let shear = StepResult { deps: [0.0, 0.0, 0.02, 0.0], stress: [0.0, 0.0, 50.0, 0.0], ..step };
+        let shear = StepResult {
+            deps: [0.0, 0.0, 0.02, 0.0],
+            stress: crate::model::soil::plane([0.0, 0.0, 50.0, 0.0]),
+            ..step
+        };
         let e = particle_step(&input([0.0, 0.0, 50.0, 0.0], 0.0), &shear, 0.0, 1.98);
         assert!((e.internal - 1.99 * (50.0 * 0.02 - 0.0)).abs() < 1e-9, "{e:?}");
         // The porosity gradient's term: ∇n·(ΔU − Δu) = 0.5 × (−0.2 + 0.1) beside the volumetric ones.
@@ -198,7 +202,7 @@ mod tests {
         let it = Interp { v_u: [1.0, 0.0], v_w: [3.0, 0.0], ..Interp::default() };
         let step = StepResult {
             interp: it,
-            stress: [0.0; 4],
+            stress: [0.0; crate::model::soil::NS],
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 1.0]],
             jacobian: 1.0,

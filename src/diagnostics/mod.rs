@@ -11,6 +11,7 @@
 pub mod energy;
 pub mod physics;
 
+use crate::model::soil::{principal::Principal, Stress};
 use crate::model::Model;
 use crate::parallel::Collective;
 use serde::{Deserialize, Serialize};
@@ -274,13 +275,10 @@ impl Monitor {
 /// The warnings the run's diagnostics give (at most once each).
 const RUN_KINDS: [&str; 2] = ["pressure_oscillation", "energy_balance"];
 
-/// The largest principal magnitude of the in-plane total stress σ' − p I (`[xx, yy, xy, zz]`) and
-/// of its out-of-plane component.
-fn principal_magnitude(s: [f64; 4], p: f64) -> f64 {
-    let (a, b, c) = (s[0] - p, s[1] - p, s[2]);
-    let mid = 0.5 * (a + b);
-    let r = (0.25 * (a - b) * (a - b) + c * c).sqrt();
-    (mid + r).abs().max((mid - r).abs()).max((s[3] - p).abs())
+/// The largest principal magnitude of the total stress σ' − p I.
+fn principal_magnitude(s: Stress, p: f64) -> f64 {
+    let total = [s[0] - p, s[1] - p, s[2], s[3] - p, s[4], s[5]];
+    Principal::of(&total).values.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
 #[cfg(test)]
@@ -290,9 +288,11 @@ mod tests {
     #[test]
     fn the_stress_scale_is_the_largest_principal_total_stress() {
         // σ' = diag(−100, −300), p = 50: total diag(−150, −350).
-        assert_eq!(principal_magnitude([-100.0, -300.0, 0.0, -80.0], 50.0), 350.0);
+        assert_eq!(principal_magnitude([-100.0, -300.0, 0.0, -80.0, 0.0, 0.0], 50.0), 350.0);
         // Pure shear 40 on zero: principal ±40.
-        assert!((principal_magnitude([0.0, 0.0, 40.0, 0.0], 0.0) - 40.0).abs() < 1e-12);
+        assert!((principal_magnitude([0.0, 0.0, 40.0, 0.0, 0.0, 0.0], 0.0) - 40.0).abs() < 1e-12);
+        // Shear out of the plane: yz = 30, zx = 40 give principal ±50.
+        assert!((principal_magnitude([0.0, 0.0, 0.0, 0.0, 30.0, 40.0], 0.0) - 50.0).abs() < 1e-12);
     }
 
     #[test]

@@ -30,7 +30,7 @@ pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let nd = pt.layout.nd;
     let part = pt.part;
     // J_p^n ΔJ_p − 1 = (J_p^n − 1) ΔJ_p + (ΔJ_p − 1), the step's part without cancellation.
-    let own = (crate::model::finite_strain::det(part.def_grad) - 1.0) * pt.kin.j + pt.kin.dj;
+    let own = (crate::model::finite_strain::det2(part.def_grad) - 1.0) * pt.kin.j + pt.kin.dj;
     let w = part.fbar_rows * part.volume * nm.w_mass;
     for (i, b) in pt.basis.iter().enumerate() {
         out[i * nd + j] += w * b.s * (pt.jbar_nodes[i] - own);
@@ -45,7 +45,7 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
     let (nd, m) = (pt.layout.nd, pt.size());
     let part = pt.part;
     let w = part.fbar_rows * part.volume * nm.w_mass;
-    let j_new = crate::model::finite_strain::det(part.def_grad) * pt.kin.j;
+    let j_new = crate::model::finite_strain::det2(part.def_grad) * pt.kin.j;
     for (i, b) in pt.basis.iter().enumerate() {
         let row = (i * nd + j) * m;
         out[row + i * nd + j] += w * b.s;
@@ -136,7 +136,7 @@ mod tests {
             for (basis, ids, part) in &points {
                 let st = states(ids, &theta);
                 let pt = Point::new(basis, &st, part, &model, layout);
-                own.push(crate::model::finite_strain::det(part.def_grad) * pt.kin.j);
+                own.push(crate::model::finite_strain::det2(part.def_grad) * pt.kin.j);
                 jbar.push(super::super::StepResult::of(&pt).jbar.expect("an F̄ layout carries J̄"));
                 shares.push(ids.iter().zip(basis).map(|(&n, b)| (n, b.s)).collect::<Vec<_>>());
             }

@@ -38,6 +38,7 @@
 //! plane strain T = 0 and every hoop quantity drops out.
 
 use super::NodeBasis;
+use crate::model::soil::Stress;
 
 /// A 2 × 2 matrix, rows first.
 pub type M2 = [[f64; 2]; 2];
@@ -366,8 +367,9 @@ impl Kinematics {
     }
 }
 
-/// The stress σ [xx, yy, xy, zz] rotated in the plane by θ: R σ Rᵀ (σ_zz unchanged).
-pub fn rotate(s: &[f64; 4], theta: f64) -> [f64; 4] {
+/// The stress σ rotated about z by θ: R σ Rᵀ (σ_zz unchanged; the out-of-plane shears
+/// (σ_zx, σ_yz) turn as a vector).
+pub fn rotate(s: &Stress, theta: f64) -> Stress {
     if theta == 0.0 {
         return *s;
     }
@@ -377,12 +379,13 @@ pub fn rotate(s: &[f64; 4], theta: f64) -> [f64; 4] {
     let rm = mul(&r, &m);
     let rt = [[c, sn], [-sn, c]];
     let out = mul(&rm, &rt);
-    [out[0][0], out[1][1], 0.5 * (out[0][1] + out[1][0]), s[3]]
+    let (zx, yz) = if s[4] == 0.0 && s[5] == 0.0 { (0.0, 0.0) } else { (c * s[5] - sn * s[4], sn * s[5] + c * s[4]) };
+    [out[0][0], out[1][1], 0.5 * (out[0][1] + out[1][0]), s[3], yz, zx]
 }
 
-/// d(R σ Rᵀ)/dθ at the rotated stress `s`: [−2σ_xy, 2σ_xy, σ_xx − σ_yy, 0].
-pub fn rotate_derivative(s: &[f64; 4]) -> [f64; 4] {
-    [-2.0 * s[2], 2.0 * s[2], s[0] - s[1], 0.0]
+/// d(R σ Rᵀ)/dθ at the rotated stress `s`: [−2σ_xy, 2σ_xy, σ_xx − σ_yy, 0, σ_zx, −σ_yz].
+pub fn rotate_derivative(s: &Stress) -> Stress {
+    [-2.0 * s[2], 2.0 * s[2], s[0] - s[1], 0.0, s[5], -s[4]]
 }
 
 #[cfg(test)]
@@ -513,16 +516,20 @@ mod tests {
 
     #[test]
     fn rotation_of_stress_and_its_derivative() {
-        let s = [3.0, -1.0, 0.7, 2.0];
+        let s = [3.0, -1.0, 0.7, 2.0, 0.4, -1.3];
         let r = rotate(&s, 0.3);
+        // It is R σ Rᵀ with R the turn about z.
+        let rz = crate::model::soil::principal::rotation([0.0, 0.0, 1.0], 0.3);
+        let full = crate::model::soil::principal::rotate(&rz, &s);
+        assert!(r.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-14), "{r:?} vs {full:?}");
         // Invariants in the plane are kept.
         assert!(((r[0] + r[1]) - (s[0] + s[1])).abs() < 1e-14);
         assert!(((r[0] * r[1] - r[2] * r[2]) - (s[0] * s[1] - s[2] * s[2])).abs() < 1e-13);
         let h = 1e-6;
         let (p, m) = (rotate(&s, 0.3 + h), rotate(&s, 0.3 - h));
         let d = rotate_derivative(&r);
-        for c in 0..4 {
-            assert!(((p[c] - m[c]) / (2.0 * h) - d[c]).abs() < 1e-8);
+        for c in 0..6 {
+            assert!(((p[c] - m[c]) / (2.0 * h) - d[c]).abs() < 1e-8, "component {c}");
         }
         // Four quarter turns are the identity; one is the swap of xx and yy with σ_xy negated.
         let q = rotate(&s, std::f64::consts::FRAC_PI_2);

@@ -57,8 +57,9 @@ pub mod inertia;
 pub mod kinematics;
 pub mod stress;
 
+use crate::model::finite_strain;
 use crate::model::shape::Stencil;
-use crate::model::soil::{Constitutive, StressUpdate};
+use crate::model::soil::{self, Constitutive, Stress, StressUpdate};
 pub use kinematics::Kinematics;
 
 /// Largest number of stencil nodes of a particle (4 × 4, see [`crate::model::shape::MAX_STENCIL`]).
@@ -234,7 +235,7 @@ pub struct ParticleInput {
     /// Pore-pressure gradient at t_n [Pa/m] (two-phase), carried by the particle.
     pub grad_p: [f64; 2],
     /// Effective stress at t_n [Pa].
-    pub stress: [f64; 4],
+    pub stress: Stress,
     /// Deformation gradient at t_n (in-plane; what a hyperelastic model's stress follows).
     pub def_grad: [[f64; 2]; 2],
     /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
@@ -575,7 +576,7 @@ pub struct Point<'a> {
     /// Finite-strain kinematics of the step.
     pub kin: Kinematics,
     /// The effective stress at t_n rotated with the material (Hughes–Winget).
-    pub rotated: [f64; 4],
+    pub rotated: Stress,
     /// The soil model's update from `rotated` by the strain increment.
     pub upd: StressUpdate,
     /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}.
@@ -697,8 +698,8 @@ impl<'a> Point<'a> {
         let df = f_bar.map(|r| r.map(|v| v * part.fbar));
         let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
-            .finite(&df, &f_new, &part.stress, part.eps_pd, part.dt)
-            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
+            .finite(&finite_strain::plane(df), &finite_strain::plane(f_new), &part.stress, part.eps_pd, part.dt)
+            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &soil::plane(kin.deps)));
         let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
         Point {
             basis,
@@ -735,7 +736,7 @@ impl<'a> Point<'a> {
         let interp = interpolate(basis, &[NodeState::default(); MAX_NODES], &part.pred, layout);
         let kin = Kinematics::rest();
         let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
-        let zero = [[0.0; 4]; 4];
+        let zero = [[0.0; soil::NS]; soil::NS];
         Point {
             basis,
             part,
@@ -867,7 +868,7 @@ pub struct StepResult {
     pub interp: Interp,
     /// The effective stress at t_{n+1} from the soil model [Pa] (its tangents are not kept: a
     /// step's results are held for every particle at once).
-    pub stress: [f64; 4],
+    pub stress: Stress,
     /// The accumulated deviatoric plastic strain ε̄ at t_{n+1} [-].
     pub eps_pd: f64,
     /// Incremental deformation gradient the particle keeps, F̄ = (J_v/J)^{1/2} F.

@@ -22,9 +22,10 @@
 //! −V_{n+1} (dev σ'_θθ T'_i T'_l + σ'_m T̄'_i T̄'_l) in the r–r entry.
 
 use super::{bbar, kinematics, Point, Scheme};
+use crate::model::soil::Stress;
 
-/// In-plane deviatoric stress and the mean stress of [xx, yy, xy, zz].
-fn split(s: &[f64; 4]) -> ([[f64; 2]; 2], f64) {
+/// In-plane deviatoric stress and the mean stress of a plane state [xx, yy, xy, zz, 0, 0].
+fn split(s: &Stress) -> ([[f64; 2]; 2], f64) {
     let pm = (s[0] + s[1] + s[3]) / 3.0;
     ([[s[0] - pm, s[2]], [s[2], s[1] - pm]], pm)
 }
@@ -38,7 +39,7 @@ fn traction(dev: &[[f64; 2]; 2], pm: f64, g: [f64; 2], gv: [f64; 2]) -> [f64; 2]
 /// The radial force of the hoop stress on a node with hoop operators (T', T̄') on x_{n+1}, per
 /// unit volume: dev σ_θθ T' + σ_m T̄' (zero in plane strain).
 #[inline]
-fn hoop_force(s: &[f64; 4], pm: f64, hoop: (f64, f64)) -> f64 {
+fn hoop_force(s: &Stress, pm: f64, hoop: (f64, f64)) -> f64 {
     (s[3] - pm) * hoop.0 + pm * hoop.1
 }
 

@@ -151,7 +151,7 @@ pub(super) fn part() -> ParticleInput {
         mobility: 2.0e-7,
         water_density: 1000.0,
         grad_p: [300.0, -9.0e3],
-        stress: [-1.0e3, -2.0e3, 150.0, -1.2e3],
+        stress: soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]),
         def_grad: [[1.02, 0.01], [-0.03, 0.97]],
         eps_pd: 0.0,
         p: 500.0,
@@ -230,12 +230,12 @@ fn layouts_and_schemes() -> Vec<(Layout, &'static str, Scheme)> {
     ]
 }
 
-fn models() -> Vec<(&'static str, Constitutive, [f64; 4])> {
+fn models() -> Vec<(&'static str, Constitutive, Stress)> {
     let el = LinearElastic::new(1e7, 0.3);
     // A Mohr–Coulomb point close to its yield surface, so the step returns plastically.
     vec![
-        ("elastic", Constitutive::LinearElastic(el), [-1.0e3, -2.0e3, 150.0, -1.2e3]),
-        ("mohr-coulomb", mohr_coulomb(1.0e3), [-1.0e4, -4.0e4, 9.0e3, -2.0e4]),
+        ("elastic", Constitutive::LinearElastic(el), soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3])),
+        ("mohr-coulomb", mohr_coulomb(1.0e3), soil::plane([-1.0e4, -4.0e4, 9.0e3, -2.0e4])),
     ]
 }
 
@@ -258,7 +258,7 @@ fn sample_strain(nn: usize, hoop: bool) -> Vec<NodeBasis> {
 fn check_term(
     term: &Term,
     model: &Constitutive,
-    stress: [f64; 4],
+    stress: Stress,
     layout: Layout,
     nm: &Scheme,
     (hoop, recovery): (bool, bool),
@@ -511,7 +511,7 @@ fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
         b.s /= total;
     }
     let mut p = part();
-    p.stress = [0.0; 4];
+    p.stress = [0.0; soil::NS];
     p.p = 0.0;
     p.grad_n = [0.0; 2];
     p.pred = Predictors::default();
@@ -548,7 +548,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
     let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
     let st: Vec<NodeState> = pts.iter().map(|&(x, y)| NodeState::new(&[-0.01 * x, -0.02 * y], &nm)).collect();
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
-    let p = ParticleInput { stress: [0.0; 4], ..part() };
+    let p = ParticleInput { stress: [0.0; soil::NS], ..part() };
     let pt = Point::new(&basis, &st, &p, &model, Layout::U);
     let r = StepResult::of(&pt);
     assert!((r.jacobian - 0.99 * 0.98).abs() < 1e-14);
@@ -564,7 +564,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
 fn a_rigid_rotation_turns_the_stress_with_the_material() {
     for model in [Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)), mohr_coulomb(1.0e5)] {
         for n in [10usize, 100] {
-            let s0 = [-3.0e4, -1.0e4, 4.0e3, -2.0e4];
+            let s0 = soil::plane([-3.0e4, -1.0e4, 4.0e3, -2.0e4]);
             let mut s = s0;
             let alpha = std::f64::consts::FRAC_PI_2 / n as f64;
             let (c, sn) = (alpha.cos(), alpha.sin());
@@ -585,8 +585,8 @@ fn a_rigid_rotation_turns_the_stress_with_the_material() {
                 s = Point::new(&basis, &st, &p, &model, Layout::U).upd.stress;
             }
             // A quarter turn: σ_xx ↔ σ_yy, σ_xy → −σ_xy.
-            let expected = [s0[1], s0[0], -s0[2], s0[3]];
-            let worst = (0..4).map(|i| (s[i] - expected[i]).abs()).fold(0.0, f64::max);
+            let expected = soil::plane([s0[1], s0[0], -s0[2], s0[3]]);
+            let worst = (0..soil::NS).map(|i| (s[i] - expected[i]).abs()).fold(0.0, f64::max);
             assert!(worst < 1e-9 * 3.0e4, "{n} steps: {s:?} vs {expected:?}");
         }
     }

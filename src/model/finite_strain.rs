@@ -1,8 +1,8 @@
 //! Finite-strain materials of [002] (`../shared/seeds-001-002.md` Part C4; the paper omits their
 //! forms, so these are the standard ones it names): compressible neo-Hookean, Hencky elasticity
-//! with J2 plasticity and exponential softening, and a Newtonian fluid. Plane strain: the
-//! deformation is in-plane with F_zz = 1; stresses are 4-vectors [xx, yy, xy, zz] (Cauchy,
-//! tension positive) as in [`super::soil`].
+//! with J2 plasticity and exponential softening, and a Newtonian fluid. The deformation gradient is
+//! 3 × 3 ([`M3`]; a plane-strain point's is [`plane`], F_zz = 1); stresses are the 6-vectors
+//! [xx, yy, xy, zz, yz, zx] of [`super::soil`] (Cauchy, tension positive).
 //!
 //! They are total (hyperelastic) or multiplicative forms driven by the deformation gradient (with
 //! [002]'s F̄, by F̄; [`super::fbar`]); they are used by the explicit integrator (issue «Seed
@@ -10,27 +10,58 @@
 //! stresses are isotropic functions of b = F Fᵀ (or b^e), so a rotation R of the deformation turns
 //! the stress into R σ Rᵀ.
 
-use super::soil::principal::Principal;
+use super::soil::principal::{self, Principal};
+use super::soil::{Stress, NS};
 
 /// An in-plane 2 × 2 matrix.
 pub type M2 = [[f64; 2]; 2];
 
-/// det of an in-plane matrix (the volume ratio in plane strain, F_zz = 1).
-pub fn det(f: M2) -> f64 {
-    f[0][0] * f[1][1] - f[0][1] * f[1][0]
+/// A 3 × 3 matrix.
+pub type M3 = [[f64; 3]; 3];
+
+/// The identity.
+pub const I3: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// The deformation gradient of a plane-strain point with in-plane part `f` (F_zz = 1).
+pub fn plane(f: M2) -> M3 {
+    [[f[0][0], f[0][1], 0.0], [f[1][0], f[1][1], 0.0], [0.0, 0.0, 1.0]]
 }
 
-/// A Aᵀ-like product F S Fᵀ for a symmetric S = [xx, yy, xy]: [xx, yy, xy] of the result.
-fn push(f: M2, s: [f64; 3]) -> [f64; 3] {
-    let sm = [[s[0], s[2]], [s[2], s[1]]];
-    let mut fs = [[0.0; 2]; 2];
-    for i in 0..2 {
-        for j in 0..2 {
-            fs[i][j] = f[i][0] * sm[0][j] + f[i][1] * sm[1][j];
-        }
-    }
-    let r = |i: usize, j: usize| fs[i][0] * f[j][0] + fs[i][1] * f[j][1];
-    [r(0, 0), r(1, 1), r(0, 1)]
+/// Whether `f` is a plane deformation (F_zz = 1, no out-of-plane shear): what [`plane`] makes.
+pub fn is_plane(f: &M3) -> bool {
+    f[0][2] == 0.0 && f[1][2] == 0.0 && f[2][0] == 0.0 && f[2][1] == 0.0 && f[2][2] == 1.0
+}
+
+/// det F (the volume ratio).
+pub fn det(f: M3) -> f64 {
+    f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) - f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0])
+        + f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0])
+}
+
+/// det of a plane-strain point's in-plane deformation gradient (its volume ratio, F_zz = 1).
+pub fn det2(f: M2) -> f64 {
+    det(plane(f))
+}
+
+/// A B.
+pub fn mul(a: M3, b: M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j]))
+}
+
+/// F S Fᵀ for a symmetric S given as a stress vector; the result as a stress vector.
+fn push(f: M3, s: &Stress) -> Stress {
+    let sm = principal::tensor(s);
+    let fs: M3 =
+        std::array::from_fn(|i| std::array::from_fn(|j| f[i][0] * sm[0][j] + f[i][1] * sm[1][j] + f[i][2] * sm[2][j]));
+    principal::TENSOR_INDEX.map(|(i, j)| fs[i][0] * f[j][0] + fs[i][1] * f[j][1] + fs[i][2] * f[j][2])
+}
+
+/// The stress vector of the identity.
+const UNIT: Stress = [1.0, 1.0, 0.0, 1.0, 0.0, 0.0];
+
+/// Whether component `c` of a stress vector is a normal one (xx, yy, zz).
+fn normal(c: usize) -> bool {
+    matches!(c, 0 | 1 | 3)
 }
 
 /// Compressible neo-Hookean elasticity (Cook's membrane, [002] §4.1): Kirchhoff stress
@@ -50,32 +81,32 @@ impl NeoHookean {
         NeoHookean { shear: e / (2.0 * (1.0 + nu)), lame: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
     }
 
-    /// The Cauchy stress of the in-plane deformation gradient `f` (F_zz = 1). `None` when J ≤ 0.
-    pub fn stress(&self, f: M2) -> Option<[f64; 4]> {
+    /// The Cauchy stress of the deformation gradient `f`. `None` when J ≤ 0.
+    pub fn stress(&self, f: M3) -> Option<Stress> {
         let j = det(f);
         if j <= 0.0 {
             return None;
         }
-        let b = push(f, [1.0, 1.0, 0.0]);
+        let b = push(f, &UNIT);
         let vol = self.lame * j.ln();
         let (mu, inv) = (self.shear, 1.0 / j);
-        Some([(mu * (b[0] - 1.0) + vol) * inv, (mu * (b[1] - 1.0) + vol) * inv, mu * b[2] * inv, vol * inv])
+        Some(std::array::from_fn(|c| if normal(c) { (mu * (b[c] - 1.0) + vol) * inv } else { mu * b[c] * inv }))
     }
 }
 
-/// The state of a Hencky–J2 point: the elastic left Cauchy–Green tensor b^e ([xx, yy, xy, zz];
+/// The state of a Hencky–J2 point: the elastic left Cauchy–Green tensor b^e (a stress vector;
 /// 1 at rest) and the accumulated equivalent plastic strain ε̄ = Σ √(2/3) |Δε^p|.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlasticState {
-    /// b^e as [xx, yy, xy, zz].
-    pub be: [f64; 4],
+    /// b^e as [xx, yy, xy, zz, yz, zx].
+    pub be: Stress,
     /// ε̄ [-].
     pub eps: f64,
 }
 
 impl Default for PlasticState {
     fn default() -> Self {
-        PlasticState { be: [1.0, 1.0, 0.0, 1.0], eps: 0.0 }
+        PlasticState { be: UNIT, eps: 0.0 }
     }
 }
 
@@ -103,8 +134,8 @@ pub struct HenckyJ2 {
 /// The result of a Hencky–J2 update.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HenckyUpdate {
-    /// Cauchy stress [xx, yy, xy, zz] [Pa].
-    pub stress: [f64; 4],
+    /// Cauchy stress [Pa].
+    pub stress: Stress,
     /// The state after the step.
     pub state: PlasticState,
     /// Whether the step flowed plastically.
@@ -131,12 +162,12 @@ impl HenckyJ2 {
         3.0 * self.shear > 3f64.sqrt() * self.softening_rate * (self.cohesion - self.residual_cohesion)
     }
 
-    /// The elastic left Cauchy–Green tensor b^e [xx, yy, xy, zz] of a point with Cauchy stress
+    /// The elastic left Cauchy–Green tensor b^e of a point with Cauchy stress
     /// `stress` at volume ratio `j` (with F̄, J̄): τ = J σ determines the elastic logarithmic strain,
     /// ε^e = dev τ/(2μ) + tr τ/(9K) 1 (the inverse of Hencky's law, in τ's principal frame, which is
     /// b^e's), and b^e = exp(2ε^e). The inverse of [`HenckyJ2::update`]'s stress to round-off, so
     /// that a point's stress and J are its whole elastic state.
-    pub fn elastic_left_cauchy_green(&self, stress: &[f64; 4], j: f64) -> [f64; 4] {
+    pub fn elastic_left_cauchy_green(&self, stress: &Stress, j: f64) -> Stress {
         let frame = Principal::of(stress);
         let tau = frame.values.map(|v| v * j);
         let mean = (tau[0] + tau[1] + tau[2]) / 3.0;
@@ -144,22 +175,20 @@ impl HenckyJ2 {
         frame.compose(&tau.map(|t| (2.0 * ((t - mean) / mu2 + mean / k3)).exp()))
     }
 
-    /// One step: the increment `df` of the deformation gradient (in-plane, ΔF_zz = 1) from
-    /// `state`, with `j` the volume ratio det F of the point after the step (with F̄, J̄) by which
+    /// One step: the increment `df` of the deformation gradient from `state`, with `j` the volume ratio det F of the point after the step (with F̄, J̄) by which
     /// the Kirchhoff stress is divided. `None` when b^e or J is not positive definite.
-    pub fn update(&self, df: M2, state: &PlasticState, j: f64) -> Option<HenckyUpdate> {
+    pub fn update(&self, df: M3, state: &PlasticState, j: f64) -> Option<HenckyUpdate> {
         if j <= 0.0 {
             return None;
         }
-        let [bxx, byy, bxy, bzz] = state.be;
-        let trial = push(df, [bxx, byy, bxy]);
-        // b^e's principal values (A ≥ B in plane, Z) and frame.
-        let frame = Principal::of(&[trial[0], trial[1], trial[2], bzz]);
+        let trial = push(df, &state.be);
+        // b^e's principal values and frame.
+        let frame = Principal::of(&trial);
         let lam = frame.values;
-        if lam[1] <= 0.0 || bzz <= 0.0 {
+        if lam.iter().any(|&l| l <= 0.0) {
             return None;
         }
-        // Principal logarithmic elastic strains: the two in-plane ones and zz.
+        // Principal logarithmic elastic strains.
         let eps = [0.5 * lam[0].ln(), 0.5 * lam[1].ln(), 0.5 * lam[2].ln()];
         let tr = eps[0] + eps[1] + eps[2];
         let dev = [eps[0] - tr / 3.0, eps[1] - tr / 3.0, eps[2] - tr / 3.0];
@@ -223,13 +252,13 @@ pub struct NewtonianFluid {
 }
 
 impl NewtonianFluid {
-    /// The Cauchy stress at volume ratio `j` and in-plane velocity gradient `l` [1/s].
-    pub fn stress(&self, j: f64, l: M2) -> [f64; 4] {
+    /// The Cauchy stress at volume ratio `j` and velocity gradient `l` [1/s].
+    pub fn stress(&self, j: f64, l: M3) -> Stress {
         let p = self.bulk * (1.0 - j).max(0.0);
-        let d = [l[0][0], l[1][1], 0.5 * (l[0][1] + l[1][0])];
-        let m = (d[0] + d[1]) / 3.0;
+        let d = principal::TENSOR_INDEX.map(|(a, b)| 0.5 * (l[a][b] + l[b][a]));
+        let m = (d[0] + d[1] + d[3]) / 3.0;
         let mu2 = 2.0 * self.viscosity;
-        [-p + mu2 * (d[0] - m), -p + mu2 * (d[1] - m), mu2 * d[2], -p - mu2 * m]
+        std::array::from_fn(|c| if normal(c) { -p + mu2 * (d[c] - m) } else { mu2 * d[c] })
     }
 
     /// The fluid's pressure at volume ratio `j` [Pa].
@@ -238,15 +267,15 @@ impl NewtonianFluid {
     }
 
     /// The stress after a step of deformation gradient `df` over `dt` seconds that leaves the
-    /// fluid at the in-plane total deformation `f`: the pressure of J = det f and the viscous
+    /// fluid at the total deformation `f`: the pressure of J = det f and the viscous
     /// stress of the step's rate of deformation ([`rate_of_deformation`]).
-    pub fn stress_after(&self, df: M2, f: M2, dt: f64) -> [f64; 4] {
+    pub fn stress_after(&self, df: M3, f: M3, dt: f64) -> Stress {
         let mut s = self.stress(det(f), rate_of_deformation(df, dt));
         // ζ tr d with tr d = ln(det ΔF)/Δt (with F̄, det ΔF̄ = J̄_{n+1}/J̄_n).
         let dj = det(df);
         if dt > 0.0 && dj > 0.0 && self.bulk_viscosity > 0.0 {
             let q = self.bulk_viscosity * dj.ln() / dt;
-            for c in [0, 1, 3] {
+            for c in (0..NS).filter(|&c| normal(c)) {
                 s[c] += q;
             }
         }
@@ -256,19 +285,28 @@ impl NewtonianFluid {
 
 /// The rate of deformation of a step of deformation gradient ΔF over Δt [1/s]:
 /// d = (V_iso − 1)/Δt, with V_iso the left stretch of the isochoric part ΔF/√det ΔF (polar
-/// decomposition ΔF = V R). It is objective (a rigid rotation of the step gives d = 0 whatever its
+/// decomposition ΔF = V R; for a plane step, of its in-plane part ΔF/√det ΔF, whose own plane is
+/// where it is isochoric). It is objective (a rigid rotation of the step gives d = 0 whatever its
 /// angle), it is the same for ΔF and for F̄'s c ΔF (only the pressure sees J̄), and it is sym L + O(Δt)
 /// for a step of velocity gradient L. Zero when `dt` is not positive or ΔF is inadmissible
 /// (det ΔF ≤ 0, which the pressure's J then reports).
-pub fn rate_of_deformation(df: M2, dt: f64) -> M2 {
+pub fn rate_of_deformation(df: M3, dt: f64) -> M3 {
     let j = det(df);
     if dt <= 0.0 || j.is_nan() || j <= 0.0 {
-        return [[0.0; 2]; 2];
+        return [[0.0; 3]; 3];
     }
-    let s = j.sqrt();
-    // V = sqrt(ΔF ΔFᵀ) is the right stretch of ΔFᵀ.
-    let v = super::shape::right_stretch([[df[0][0] / s, df[1][0] / s], [df[0][1] / s, df[1][1] / s]]);
-    [[(v[0][0] - 1.0) / dt, v[0][1] / dt], [v[1][0] / dt, (v[1][1] - 1.0) / dt]]
+    if is_plane(&df) {
+        let s = j.sqrt();
+        // V = sqrt(ΔF ΔFᵀ) is the right stretch of ΔFᵀ.
+        let v = super::shape::right_stretch([[df[0][0] / s, df[1][0] / s], [df[0][1] / s, df[1][1] / s]]);
+        return [[(v[0][0] - 1.0) / dt, v[0][1] / dt, 0.0], [v[1][0] / dt, (v[1][1] - 1.0) / dt, 0.0], [0.0; 3]];
+    }
+    // V_iso = (ΔF ΔFᵀ)^½ / J^⅓, in the principal frame of ΔF ΔFᵀ.
+    let b = push(df, &UNIT);
+    let frame = Principal::of(&b);
+    let scale = j.cbrt();
+    let v = principal::tensor(&frame.compose(&frame.values.map(|l| l.max(0.0).sqrt() / scale)));
+    std::array::from_fn(|a| std::array::from_fn(|c| (v[a][c] - if a == c { 1.0 } else { 0.0 }) / dt))
 }
 
 #[cfg(test)]
@@ -276,24 +314,34 @@ mod tests {
     use super::*;
     use crate::model::soil::{Constitutive, LinearElastic, VonMises};
 
-    fn rot(a: f64) -> M2 {
-        [[a.cos(), -a.sin()], [a.sin(), a.cos()]]
+    /// The rotation by `a` about z.
+    fn rot(a: f64) -> M3 {
+        plane([[a.cos(), -a.sin()], [a.sin(), a.cos()]])
     }
 
-    fn mul(a: M2, b: M2) -> M2 {
-        let mut c = [[0.0; 2]; 2];
-        for i in 0..2 {
-            for j in 0..2 {
-                c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j];
-            }
-        }
-        c
+    /// A rotation about a tilted axis (out of every coordinate plane).
+    fn tilt(a: f64) -> M3 {
+        let n = 14f64.sqrt();
+        principal::rotation([1.0 / n, -2.0 / n, 3.0 / n], a)
     }
 
-    /// R σ Rᵀ of a stress 4-vector (zz unchanged).
-    fn rotate(r: M2, s: [f64; 4]) -> [f64; 4] {
-        let t = push(r, [s[0], s[1], s[2]]);
-        [t[0], t[1], t[2], s[3]]
+    /// R σ Rᵀ.
+    fn rotate(r: M3, s: Stress) -> Stress {
+        principal::rotate(&r, &s)
+    }
+
+    /// A plane velocity gradient (no zz rate).
+    fn gradient(l: M2) -> M3 {
+        [[l[0][0], l[0][1], 0.0], [l[1][0], l[1][1], 0.0], [0.0; 3]]
+    }
+
+    /// A plane deformation with its in-plane part scaled by `c` (2D F̄'s ΔF̄ = c ΔF, F_zz = 1).
+    fn scale_plane(f: M3, c: f64) -> M3 {
+        std::array::from_fn(|i| std::array::from_fn(|j| if i < 2 && j < 2 { f[i][j] * c } else { f[i][j] }))
+    }
+
+    fn transpose(a: M3) -> M3 {
+        std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
     }
 
     fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
@@ -301,16 +349,14 @@ mod tests {
         a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol * scale)
     }
 
-    fn q_of(s: [f64; 4]) -> f64 {
-        let p = (s[0] + s[1] + s[3]) / 3.0;
-        let d = [s[0] - p, s[1] - p, s[3] - p];
-        (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * s[2] * s[2])).sqrt()
+    fn q_of(s: Stress) -> f64 {
+        crate::verification::invariants(&s).1
     }
 
     #[test]
     fn neo_hooke_is_objective_and_linear_elastic_for_small_strains() {
         let m = NeoHookean::new(70.0, 0.499);
-        let f = [[1.12, 0.31], [-0.05, 0.93]];
+        let f = plane([[1.12, 0.31], [-0.05, 0.93]]);
         let s = m.stress(f).unwrap();
         for a in [0.3, 1.7, -2.2] {
             let r = rot(a);
@@ -318,21 +364,21 @@ mod tests {
             assert!(close(&sr, &rotate(r, s), 1e-13), "{sr:?} vs {:?}", rotate(r, s));
         }
         // At rest: no stress. Small strains: σ = D ε to O(ε²).
-        assert!(m.stress([[1.0, 0.0], [0.0, 1.0]]).unwrap().iter().all(|v| v.abs() < 1e-15));
+        assert!(m.stress(I3).unwrap().iter().all(|v| v.abs() < 1e-15));
         let e = 1e-7;
-        let f = [[1.0 + 2.0 * e, 0.5 * e], [0.5 * e, 1.0 - e]];
-        let lin = LinearElastic::new(70.0, 0.499).trial(&[0.0; 4], &[2.0 * e, -e, e, 0.0]);
+        let f = plane([[1.0 + 2.0 * e, 0.5 * e], [0.5 * e, 1.0 - e]]);
+        let lin = LinearElastic::new(70.0, 0.499).trial(&[0.0; NS], &[2.0 * e, -e, e, 0.0, 0.0, 0.0]);
         assert!(close(&m.stress(f).unwrap(), &lin, 1e-5), "{:?} vs {lin:?}", m.stress(f));
-        assert!(m.stress([[0.5, 0.0], [0.0, -0.1]]).is_none());
+        assert!(m.stress(plane([[0.5, 0.0], [0.0, -0.1]])).is_none());
     }
 
     #[test]
     fn hencky_j2_is_objective_and_leaves_a_rigidly_rotated_stress_unrotated_in_the_material_frame() {
         let m = HenckyJ2::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
         // A state with stress and plastic history from a plastic shearing step.
-        let first = m.update([[1.0, 0.01], [0.0, 1.0]], &PlasticState::default(), 1.0).unwrap();
+        let first = m.update(plane([[1.0, 0.01], [0.0, 1.0]]), &PlasticState::default(), 1.0).unwrap();
         assert!(first.plastic);
-        let df = [[1.003, 0.004], [-0.002, 0.999]];
+        let df = plane([[1.003, 0.004], [-0.002, 0.999]]);
         let j = det(df);
         let base = m.update(df, &first.state, j).unwrap();
         for a in [0.4, -1.3, 3.0] {
@@ -358,7 +404,7 @@ mod tests {
         let mut j = 1.0;
         let mut plastic_steps = 0;
         for k in 0..200 {
-            let df = [[1.0 + 2e-4, 3e-3], [1e-3, 1.0 - 1.5e-4]];
+            let df = plane([[1.0 + 2e-4, 3e-3], [1e-3, 1.0 - 1.5e-4]]);
             j *= det(df);
             let u = m.update(df, &state, j).unwrap();
             let q = q_of(u.stress) * j; // q of the Kirchhoff stress
@@ -393,14 +439,14 @@ mod tests {
             el,
             VonMises { shear: el.shear_modulus(), cohesion: c, residual_cohesion: c, softening_modulus: 0.0 },
         );
-        let (mut state, mut small, mut eps_small, mut j) = (PlasticState::default(), [0.0; 4], 0.0, 1.0);
+        let (mut state, mut small, mut eps_small, mut j) = (PlasticState::default(), [0.0; NS], 0.0, 1.0);
         for _ in 0..20 {
             let (a, g) = (5e-5, 1e-4);
-            let df = [[1.0 + a, g], [0.0, 1.0]];
+            let df = plane([[1.0 + a, g], [0.0, 1.0]]);
             j *= det(df);
             let u = m.update(df, &state, j).unwrap();
             state = u.state;
-            let up = vm.update(&small, eps_small, &[a, 0.0, g, 0.0]);
+            let up = vm.update(&small, eps_small, &[a, 0.0, g, 0.0, 0.0, 0.0]);
             small = up.stress;
             eps_small = up.eps_pd;
             assert!(close(&u.stress, &small, 5e-3), "{:?} vs {small:?}", u.stress);
@@ -417,7 +463,7 @@ mod tests {
         let (mut state, mut j) = (PlasticState::default(), 1.0);
         let mut plastic = 0;
         for k in 0..60 {
-            let df = [[1.0 + 4e-4 * (k as f64 * 0.3).cos(), 2e-3], [-1e-3, 1.0 - 1e-4]];
+            let df = plane([[1.0 + 4e-4 * (k as f64 * 0.3).cos(), 2e-3], [-1e-3, 1.0 - 1e-4]]);
             j *= det(df);
             let u = m.update(df, &state, j).unwrap();
             plastic += usize::from(u.plastic);
@@ -429,10 +475,10 @@ mod tests {
         // And the path run through `Constitutive::finite`, which stores only σ, F and ε̄ (F̄ = F
         // here), is the path run with the stored b^e.
         let model = Constitutive::HenckyJ2(LinearElastic::new(25e6, 0.45), m);
-        let (mut stress, mut f, mut eps) = ([0.0; 4], [[1.0, 0.0], [0.0, 1.0]], 0.0);
+        let (mut stress, mut f, mut eps) = ([0.0; NS], plane([[1.0, 0.0], [0.0, 1.0]]), 0.0);
         let (mut state, mut j) = (PlasticState::default(), 1.0);
         for k in 0..60 {
-            let df = [[1.0 - 3e-4, 1.5e-3 * (k as f64 * 0.2).sin()], [2e-3, 1.0 + 1e-4]];
+            let df = plane([[1.0 - 3e-4, 1.5e-3 * (k as f64 * 0.2).sin()], [2e-3, 1.0 + 1e-4]]);
             f = mul(df, f);
             j *= det(df);
             let u = model.finite(&df, &f, &stress, eps, 1e-3).unwrap();
@@ -445,16 +491,16 @@ mod tests {
         // With F̄: the kernel passes ΔF̄ = c ΔF and F̄_{n+1} = s ΔF F_n with c = (J̄^{n+1}/(J̄^n ΔJ))^½
         // and s = (J̄^{n+1}/(J^n ΔJ))^½, and the stored σ_n = τ(b^e_n)/J̄^n; `finite` must recover
         // J̄^n = det F̄_{n+1}/det ΔF̄ and give the direct update with ΔF̄ divided by J̄^{n+1}.
-        let f_n = [[1.02, 0.03], [-0.01, 0.97]];
+        let f_n = plane([[1.02, 0.03], [-0.01, 0.97]]);
         let (jbar_n, jbar_new) = (0.9981, 0.9975);
-        let pre = m.update([[1.0, 0.004], [0.002, 1.0]], &PlasticState::default(), jbar_n).unwrap();
-        let df = [[1.001, 0.0015], [0.0005, 0.9985]];
+        let pre = m.update(plane([[1.0, 0.004], [0.002, 1.0]]), &PlasticState::default(), jbar_n).unwrap();
+        let df = plane([[1.001, 0.0015], [0.0005, 0.9985]]);
         let (j_n, dj) = (det(f_n), det(df));
         let c = (jbar_new / (jbar_n * dj)).sqrt();
         let s = (jbar_new / (j_n * dj)).sqrt();
         assert!((c - s).abs() > 1e-4, "c and s must differ here: {c} {s}");
-        let dfbar = df.map(|r| r.map(|v| v * c));
-        let fbar_new = mul(df, f_n).map(|r| r.map(|v| v * s));
+        let dfbar = scale_plane(df, c);
+        let fbar_new = scale_plane(mul(df, f_n), s);
         let u = model.finite(&dfbar, &fbar_new, &pre.stress, pre.state.eps, 1e-3).unwrap();
         let direct = m.update(dfbar, &pre.state, jbar_new).unwrap();
         assert!(close(&u.stress, &direct.stress, 1e-11), "{:?} vs {:?}", u.stress, direct.stress);
@@ -465,15 +511,15 @@ mod tests {
     #[test]
     fn the_newtonian_fluid_has_its_pressure_and_viscous_shear() {
         let w = NewtonianFluid { bulk: 2e9, viscosity: 1e-3, bulk_viscosity: 0.0 };
-        let s = w.stress(1.0 - 1e-5, [[0.0, 0.0], [0.0, 0.0]]);
+        let s = w.stress(1.0 - 1e-5, gradient([[0.0, 0.0], [0.0, 0.0]]));
         assert!(close(&s, &[-2e4, -2e4, 0.0, -2e4], 1e-9), "{s:?}");
         // Simple shear v_x = γ̇ y: σ_xy = μ γ̇, no normal stress; a rigid spin carries no stress.
-        let s = w.stress(1.0, [[0.0, 10.0], [0.0, 0.0]]);
+        let s = w.stress(1.0, gradient([[0.0, 10.0], [0.0, 0.0]]));
         assert!(close(&s, &[0.0, 0.0, 1e-2, 0.0], 1e-12), "{s:?}");
-        let s = w.stress(1.0, [[0.0, 3.0], [-3.0, 0.0]]);
+        let s = w.stress(1.0, gradient([[0.0, 3.0], [-3.0, 0.0]]));
         assert!(s.iter().all(|v| v.abs() < 1e-15), "{s:?}");
         // Objective: σ(R L Rᵀ) = R σ(L) Rᵀ for the symmetric part.
-        let l = [[0.2, 0.5], [0.1, -0.7]];
+        let l = gradient([[0.2, 0.5], [0.1, -0.7]]);
         let r = rot(0.8);
         let lr = mul(mul(r, l), rot(-0.8));
         assert!(close(&w.stress(0.99, lr), &rotate(r, w.stress(0.99, l)), 1e-12));
@@ -489,19 +535,19 @@ mod tests {
         let w = NewtonianFluid { bulk: 2e9, viscosity: 0.5, bulk_viscosity: 0.0 };
         let model = Constitutive::NewtonianFluid(LinearElastic::from_bulk_shear(2e9, 0.0), w);
         let dt = 1e-3;
-        let f = [[0.99999, 0.0], [0.0, 1.0]];
-        let spin = model.finite(&rot(0.7), &f, &[0.0; 4], 0.0, dt).unwrap();
+        let f = plane([[0.99999, 0.0], [0.0, 1.0]]);
+        let spin = model.finite(&rot(0.7), &f, &[0.0; NS], 0.0, dt).unwrap();
         assert!(close(&spin.stress, &[-2e4, -2e4, 0.0, -2e4], 1e-9), "{:?}", spin.stress);
         // Simple shear at γ̇ = 10/s over the step: σ_xy = μ_v γ̇ to first order in γ̇ Δt.
-        let df = [[1.0, 10.0 * dt], [0.0, 1.0]];
-        let u = model.finite(&df, &df, &[0.0; 4], 0.0, dt).unwrap();
+        let df = plane([[1.0, 10.0 * dt], [0.0, 1.0]]);
+        let u = model.finite(&df, &df, &[0.0; NS], 0.0, dt).unwrap();
         assert!((u.stress[2] - 0.5 * 10.0).abs() < 1e-3 * 5.0, "{:?}", u.stress);
         // Normal viscous stresses are of the next order, γ̇Δt σ_xy.
         assert!(u.stress.iter().take(2).all(|v| v.abs() < 10.0 * dt * 5.0), "{:?}", u.stress);
         // F̄: c ΔF changes the pressure (through J̄ = det F̄), not the viscous part.
         let c = 1.0 - 3e-6;
-        let dfc = df.map(|r| r.map(|v| v * c));
-        let ub = model.finite(&dfc, &dfc, &[0.0; 4], 0.0, dt).unwrap();
+        let dfc = scale_plane(df, c);
+        let ub = model.finite(&dfc, &dfc, &[0.0; NS], 0.0, dt).unwrap();
         let p = w.pressure(det(dfc));
         assert!((ub.stress[2] - u.stress[2]).abs() < 1e-14, "{} vs {}", ub.stress[2], u.stress[2]);
         let mean = (ub.stress[0] + ub.stress[1] + ub.stress[3]) / 3.0;
@@ -511,7 +557,7 @@ mod tests {
         assert_eq!(model.elastic().shear_modulus(), 0.0);
         // A bulk viscosity adds ζ tr d = ζ ln(det ΔF)/Δt to the mean stress, nothing to the shear.
         let zeta = NewtonianFluid { bulk_viscosity: 300.0, ..w };
-        let squeeze = [[1.0 - 2e-4, 0.0], [0.0, 1.0]];
+        let squeeze = plane([[1.0 - 2e-4, 0.0], [0.0, 1.0]]);
         let (plain, damped) = (w.stress_after(squeeze, squeeze, dt), zeta.stress_after(squeeze, squeeze, dt));
         let expected = 300.0 * (1.0f64 - 2e-4).ln() / dt;
         for c in [0, 1, 3] {
@@ -519,7 +565,64 @@ mod tests {
         }
         assert_eq!(damped[2], plain[2]);
         // Inadmissible: det F ≤ 0 gives NaN.
-        let bad = model.finite(&df, &[[-1.0, 0.0], [0.0, 1.0]], &[0.0; 4], 0.0, dt).unwrap();
+        let bad = model.finite(&df, &plane([[-1.0, 0.0], [0.0, 1.0]]), &[0.0; NS], 0.0, dt).unwrap();
         assert!(bad.stress.iter().all(|v| v.is_nan()));
+    }
+
+    /// The three models under a general three-dimensional deformation (no plane of symmetry):
+    /// objective under a rotation about a tilted axis, Hencky–J2 on its softened yield surface with
+    /// det b^e = J², its elastic state recovered from σ and J, and the fluid's rate of a rigid spin
+    /// zero.
+    #[test]
+    fn the_models_are_objective_and_consistent_in_three_dimensions() {
+        let f = [[1.05, 0.12, -0.04], [0.03, 0.96, 0.08], [-0.06, 0.02, 1.02]];
+        let nh = NeoHookean::new(70.0, 0.45);
+        let s = nh.stress(f).unwrap();
+        assert!(s[4].abs() > 1e-3 && s[5].abs() > 1e-3, "{s:?}");
+        for a in [0.4, -1.9] {
+            let r = tilt(a);
+            assert!(close(&nh.stress(mul(r, f)).unwrap(), &rotate(r, s), 1e-13));
+        }
+        // Hencky–J2 along a 3D path with out-of-plane shears.
+        let m = HenckyJ2::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
+        let (mut state, mut j, mut plastic) = (PlasticState::default(), 1.0, 0);
+        for k in 0..80 {
+            let df = [[1.0 + 2e-4, 1e-3, 5e-4], [2e-4, 1.0 - 1e-4, 2e-3 * (k as f64 * 0.1).cos()], [-1e-3, 4e-4, 1.0]];
+            j *= det(df);
+            let u = m.update(df, &state, j).unwrap();
+            let (c, _) = m.cohesion_at(u.state.eps);
+            let q = q_of(u.stress) * j;
+            if u.plastic {
+                plastic += 1;
+                assert!((q - 3f64.sqrt() * c).abs() <= 1e-9 * q, "step {k}: q {q} vs √3 c {}", 3f64.sqrt() * c);
+            }
+            let be = principal::tensor(&u.state.be);
+            assert!((det(be) - j * j).abs() <= 1e-12, "step {k}: det b^e {} vs J² {}", det(be), j * j);
+            let back = m.elastic_left_cauchy_green(&u.stress, j);
+            assert!(close(&back, &u.state.be, 1e-12), "step {k}");
+            // Objective: the same step turned by R gives R σ Rᵀ and R b^e Rᵀ from R b^e_n Rᵀ.
+            let r = tilt(0.7);
+            let turned_state = PlasticState { be: rotate(r, state.be), eps: state.eps };
+            let turned = m.update(mul(mul(r, df), transpose(r)), &turned_state, j).unwrap();
+            assert!(close(&turned.stress, &rotate(r, u.stress), 1e-11), "step {k}");
+            state = u.state;
+        }
+        assert!(plastic > 30, "{plastic} plastic steps");
+        // The fluid: a rigid spin about a tilted axis has no rate of deformation; a shear in yz
+        // gives μ_v γ̇ in σ_yz.
+        let spin = rate_of_deformation(tilt(0.3), 1e-3);
+        assert!(spin.iter().flatten().all(|v| v.abs() < 1e-9), "{spin:?}");
+        let w = NewtonianFluid { bulk: 2e9, viscosity: 0.5, bulk_viscosity: 0.0 };
+        let dt = 1e-3;
+        let shear = [[1.0, 0.0, 0.0], [0.0, 1.0, 10.0 * dt], [0.0, 0.0, 1.0]];
+        let st = w.stress_after(shear, shear, dt);
+        assert!((st[4] - 5.0).abs() < 1e-2, "{st:?}");
+        assert!(st[2].abs() < 1e-9 && st[5].abs() < 1e-9, "{st:?}");
+        // A volume change is not a rate of deformation of the viscous stress (ζ takes it): a 1 %
+        // growth with a small yz shear leaves the normal rates at second order.
+        let grow = [[1.01, 0.0, 0.0], [0.0, 1.01, 1e-3], [0.0, 0.0, 1.01]];
+        let d = rate_of_deformation(grow, dt);
+        assert!((0..3).all(|k| d[k][k].abs() < 1e-3), "{d:?}");
+        assert!((d[1][2] - 0.5 / 1.01).abs() < 1e-3, "{d:?}");
     }
 }

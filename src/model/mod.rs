@@ -434,7 +434,7 @@ impl Model {
             linear: self.linear_increments,
             fbar: 1.0,
             fbar_total: if self.fbar {
-                fbar::scale(ps.jbar[idx], finite_strain::det(ps.def_grad[idx]), 2)
+                fbar::scale(ps.jbar[idx], finite_strain::det2(ps.def_grad[idx]), 2)
             } else {
                 1.0
             },
@@ -572,10 +572,10 @@ impl Model {
         ps.porosity[k] = n_new;
         let f = &mut ps.def_grad[k];
         let f_new = crate::kernels::kinematics::product(&step.f_inc, f);
-        match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(f_new, step.jbar) {
+        match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(finite_strain::plane(f_new), step.jbar) {
             // A fluid point carries its volume ratio only (see `Constitutive::fluid_volume_ratio`).
             Some(jf) => {
-                ps.volume[k] *= jf / finite_strain::det(*f);
+                ps.volume[k] *= jf / finite_strain::det2(*f);
                 *f = [[jf.sqrt(), 0.0], [0.0, jf.sqrt()]];
             }
             None => {

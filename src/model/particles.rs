@@ -43,8 +43,9 @@ pub struct Particles {
     pub vel_w: Vec<[f64; 2]>,
     /// Water acceleration [m/s²] (two-phase).
     pub acc_w: Vec<[f64; 2]>,
-    /// Effective stress [xx, yy, xy, zz] (total stress in one-phase analyses) [Pa].
-    pub stress: Vec<[f64; 4]>,
+    /// Effective stress [xx, yy, xy, zz, yz, zx] (total stress in one-phase analyses; yz = zx = 0 in
+    /// plane strain and axial symmetry) [Pa].
+    pub stress: Vec<crate::model::soil::Stress>,
     /// Pore pressure (compression positive) [Pa].
     pub p: Vec<f64>,
     /// Pore pressure at t = 0 [Pa] (the excess pore pressure is p − p₀).
@@ -90,7 +91,7 @@ impl Particles {
         self.acc.push([0.0; 2]);
         self.vel_w.push([0.0; 2]);
         self.acc_w.push([0.0; 2]);
-        self.stress.push([0.0; 4]);
+        self.stress.push([0.0; crate::model::soil::NS]);
         self.p.push(0.0);
         self.p0.push(0.0);
         self.eps_pd.push(0.0);
@@ -161,7 +162,7 @@ impl Particles {
                                 (None, None) => ([0.0; 4], 0.0, [0.0; 2]),
                             };
                             ps.grad_p.push(grad_p);
-                            ps.stress.push(stress);
+                            ps.stress.push(crate::model::soil::plane(stress));
                             ps.p.push(p);
                             ps.p0.push(p);
                             ps.eps_pd.push(0.0);

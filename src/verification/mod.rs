@@ -146,11 +146,12 @@ pub(crate) fn elastic_body(c: &Case, body: &str) -> Result<(usize, f64, f64), St
     }
 }
 
-/// σ_m and q = √(3J₂) of a stress [xx, yy, xy, zz].
-pub(crate) fn invariants(s: &[f64; 4]) -> (f64, f64) {
+/// σ_m and q = √(3J₂) of a stress [xx, yy, xy, zz, yz, zx].
+pub(crate) fn invariants(s: &crate::model::soil::Stress) -> (f64, f64) {
     let m = (s[0] + s[1] + s[3]) / 3.0;
     let d = [s[0] - m, s[1] - m, s[3] - m];
-    (m, (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * s[2] * s[2])).sqrt())
+    let shear = s[2] * s[2] + s[4] * s[4] + s[5] * s[5];
+    (m, (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * shear)).sqrt())
 }
 
 /// The time function a load names (a constant 1 if none).

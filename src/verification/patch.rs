@@ -14,7 +14,7 @@
 use super::{Check, Findings, Metric};
 use crate::case::{Case, SoilModel, Verification};
 use crate::model::loads::{exp2, Motion};
-use crate::model::soil::LinearElastic;
+use crate::model::soil::{self, LinearElastic, Stress, NS};
 use crate::model::Model;
 use crate::parallel::Collective;
 
@@ -25,16 +25,16 @@ pub struct PatchCheck {
     elastic: LinearElastic,
     /// A neo-Hookean body's model (its σ* is the model's stress of F).
     hyperelastic: Option<crate::model::finite_strain::NeoHookean>,
-    initial: [f64; 4],
+    initial: Stress,
     spread_tolerance: f64,
     tolerance: f64,
     /// (stress spread, error against σ*, t) after the last step.
     last: (f64, f64, f64),
 }
 
-/// ‖s‖ of a stress 4-vector as a tensor (σ_xy counted twice).
-fn norm(s: &[f64; 4]) -> f64 {
-    (s[0] * s[0] + s[1] * s[1] + 2.0 * s[2] * s[2] + s[3] * s[3]).sqrt()
+/// ‖s‖ of a stress vector as a tensor (the shears counted twice).
+fn norm(s: &Stress) -> f64 {
+    (s[0] * s[0] + s[1] * s[1] + s[3] * s[3] + 2.0 * (s[2] * s[2] + s[4] * s[4] + s[5] * s[5])).sqrt()
 }
 
 /// Eigen-decomposition of a symmetric 2 × 2 matrix: (values, unit eigenvector of the first).
@@ -75,7 +75,7 @@ impl PatchCheck {
             motion,
             elastic,
             hyperelastic,
-            initial: b.uniform_stress.unwrap_or([0.0; 4]),
+            initial: soil::plane(b.uniform_stress.unwrap_or([0.0; 4])),
             spread_tolerance: *spread_tolerance,
             tolerance: *tolerance,
             last: (f64::NAN, f64::NAN, 0.0),
@@ -83,12 +83,12 @@ impl PatchCheck {
     }
 
     /// σ* at time `t` (see the module documentation).
-    pub fn theory(&self, t: f64) -> [f64; 4] {
+    pub fn theory(&self, t: f64) -> Stress {
         let Some((l, _)) = &self.motion.gradient else { return self.initial };
         let s = self.motion.flow_parameter(t);
         let f = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
         if let Some(h) = &self.hyperelastic {
-            return h.stress(f).unwrap_or([f64::NAN; 4]);
+            return h.stress(crate::model::finite_strain::plane(f)).unwrap_or([f64::NAN; NS]);
         }
         // F Fᵀ = V², ln V from its eigen-decomposition; R = V⁻¹ F.
         let b = [
@@ -111,27 +111,27 @@ impl PatchCheck {
         ];
         let theta = r[1][0].atan2(r[0][0]);
         let mut s = crate::kernels::kinematics::rotate(&self.initial, theta);
-        let eps = [ln_v[0][0], ln_v[1][1], 2.0 * ln_v[0][1], 0.0];
+        let eps = soil::plane([ln_v[0][0], ln_v[1][1], 2.0 * ln_v[0][1], 0.0]);
         for (i, si) in s.iter_mut().enumerate() {
-            *si += (0..4).map(|j| self.elastic.d[i][j] * eps[j]).sum::<f64>();
+            *si += (0..NS).map(|j| self.elastic.d[i][j] * eps[j]).sum::<f64>();
         }
         s
     }
 
-    fn measure(&self, model: &Model, coll: &Collective) -> Result<(f64, [f64; 4]), String> {
+    fn measure(&self, model: &Model, coll: &Collective) -> Result<(f64, Stress), String> {
         let ps = &model.particles;
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
-        let mut local = [0.0; 5];
+        let mut local = [0.0; NS + 1];
         for &k in &mine {
             for (l, s) in local.iter_mut().zip(ps.stress[k]) {
                 *l += s;
             }
-            local[4] += 1.0;
+            local[NS] += 1.0;
         }
         let sum = coll.sum(&local)?;
-        let mean: [f64; 4] = std::array::from_fn(|c| sum[c] / sum[4].max(1.0));
+        let mean: Stress = std::array::from_fn(|c| sum[c] / sum[NS].max(1.0));
         let worst = mine.iter().fold(0.0f64, |w, &k| {
-            let d: [f64; 4] = std::array::from_fn(|c| ps.stress[k][c] - mean[c]);
+            let d: Stress = std::array::from_fn(|c| ps.stress[k][c] - mean[c]);
             w.max(norm(&d))
         });
         let worst = coll.max(&[worst])?[0];
@@ -151,7 +151,7 @@ impl Check for PatchCheck {
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let (spread, mean) = self.measure(model, coll)?;
         let theory = self.theory(t);
-        let d: [f64; 4] = std::array::from_fn(|c| mean[c] - theory[c]);
+        let d: Stress = std::array::from_fn(|c| mean[c] - theory[c]);
         let error = if norm(&theory) > 0.0 { norm(&d) / norm(&theory) } else { norm(&d) };
         self.last = (spread, error, t);
         Ok(vec![spread, error])
@@ -212,7 +212,7 @@ mod tests {
             },
             elastic: LinearElastic::new(1e6, 0.3),
             hyperelastic: None,
-            initial,
+            initial: soil::plane(initial),
             spread_tolerance: 1e-9,
             tolerance: 1e-6,
             last: (0.0, 0.0, 0.0),

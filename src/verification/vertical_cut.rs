@@ -339,7 +339,7 @@ mod tests {
         let (r, n) = VerticalCutCheck::roughness(&ring(false), nx, 6, INSIDE_DEPTH);
         assert!(r == 0.0 && n == 30.0, "{r} over {n}");
         assert!(VerticalCutCheck::roughness(&ring(true), nx, 6, INSIDE_DEPTH).0 > 0.2);
-        let (s, q) = invariants(&[-3.0, -1.0, 0.5, -2.0]);
+        let (s, q) = invariants(&[-3.0, -1.0, 0.5, -2.0, 0.0, 0.0]);
         assert!((s + 2.0).abs() < 1e-14 && (q - (1.5f64 * (1.0 + 1.0 + 0.0 + 0.5)).sqrt()).abs() < 1e-14);
     }
 }

@@ -1,13 +1,16 @@
 //! Soil models: the stress update of a material point and its consistent tangent.
 //!
-//! Stress and strain are 4-vectors [xx, yy, xy, zz] (plane strain; engineering shear strain
-//! γ_xy = 2ε_xy; tension positive). A model maps the stress σ_n, its internal variables and a strain
-//! increment Δε to σ_{n+1}, the new internal variables and the consistent tangent dσ_{n+1}/dΔε (4×4),
-//! the exact derivative of the algorithm, which gives Newton's method its quadratic convergence.
+//! Stress and strain are 6-vectors [xx, yy, xy, zz, yz, zx] ([`Stress`]; engineering shear strains
+//! γ = 2ε, tensor shear stresses; tension positive): the full three-dimensional state, of which a
+//! plane-strain or axisymmetric point uses the first four (its yz and zx stay zero, exactly). A
+//! model maps the stress σ_n, its internal variables and a strain increment Δε to σ_{n+1}, the new
+//! internal variables and the consistent tangent dσ_{n+1}/dΔε (6×6), the exact derivative of the
+//! algorithm, which gives Newton's method its quadratic convergence. The models are isotropic, so
+//! they are the same in two and in three dimensions.
 //!
 //! The elastoplastic models are isotropic: the elastic trial stress σ_trial = σ_n + D Δε is returned
 //! in its principal frame ([`principal`]), and the tangent is dσ/dσ_trial · D with dσ/dσ_trial from
-//! the principal-space derivative of the return and the spin term of the in-plane directions.
+//! the principal-space derivative of the return and the spin terms of the principal directions.
 //! Internal variable: the accumulated deviatoric plastic strain ε̄ = Σ sqrt(2/3 Δe_p : Δe_p)
 //! ([000] §4.1.2's e_p^d), which drives softening and dilatancy.
 
@@ -18,13 +21,42 @@ pub mod von_mises;
 pub use mohr_coulomb::MohrCoulomb;
 pub use von_mises::VonMises;
 
-use principal::{mul4, Principal};
+use crate::model::finite_strain::M3;
+use principal::{mul6, Principal};
 
-/// A 4×4 matrix in the stress-vector basis.
-pub type Mat4 = [[f64; 4]; 4];
+/// Components of the stress and strain vectors.
+pub const NS: usize = 6;
 
-/// The 4×4 identity.
-pub const IDENTITY4: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+/// Components of the stress and strain vectors a plane-strain or axisymmetric point uses
+/// ([xx, yy, xy, zz]; its yz and zx are zero).
+pub const NS_PLANE: usize = 4;
+
+/// A stress [xx, yy, xy, zz, yz, zx] (tensor shears) or strain (engineering shears) vector.
+pub type Stress = [f64; NS];
+
+/// A 6×6 matrix in the stress-vector basis.
+pub type Mat6 = [[f64; NS]; NS];
+
+/// The 6×6 identity.
+pub const IDENTITY6: Mat6 = {
+    let mut m = [[0.0; NS]; NS];
+    let mut k = 0;
+    while k < NS {
+        m[k][k] = 1.0;
+        k += 1;
+    }
+    m
+};
+
+/// The block of a 6×6 matrix a plane-strain or axisymmetric point uses ([xx, yy, xy, zz]).
+pub fn plane_block(m: &Mat6) -> [[f64; NS_PLANE]; NS_PLANE] {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[r][c]))
+}
+
+/// The stress vector of a plane state [xx, yy, xy, zz] (yz = zx = 0).
+pub fn plane(s: [f64; NS_PLANE]) -> Stress {
+    [s[0], s[1], s[2], s[3], 0.0, 0.0]
+}
 
 /// Where a return mapping ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,20 +105,20 @@ impl ReturnResult {
 #[derive(Debug, Clone, Copy)]
 pub struct StressUpdate {
     /// The updated stress [Pa].
-    pub stress: [f64; 4],
+    pub stress: Stress,
     /// Consistent tangent dσ/dΔε [Pa].
-    pub tangent: Mat4,
+    pub tangent: Mat6,
     /// dσ/dσ_trial of the return (identity for an elastic step), with σ_trial = σ_n + D Δε; the
     /// derivative with respect to the stress the step starts from (rotated by the objective
     /// update) is the same, and `tangent` = `trial_tangent` · D.
-    pub trial_tangent: Mat4,
+    pub trial_tangent: Mat6,
     /// Accumulated deviatoric plastic strain ε̄ after the step [-].
     pub eps_pd: f64,
     /// Where the return ended.
     pub region: Region,
 }
 
-/// Isotropic linear elasticity in plane strain.
+/// Isotropic linear elasticity.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearElastic {
     /// Young's modulus [Pa].
@@ -94,7 +126,7 @@ pub struct LinearElastic {
     /// Poisson's ratio [-].
     pub poisson: f64,
     /// Elastic matrix D^e.
-    pub d: Mat4,
+    pub d: Mat6,
 }
 
 impl LinearElastic {
@@ -114,7 +146,14 @@ impl LinearElastic {
 
     fn of_lame(lam: f64, mu: f64, e: f64, nu: f64) -> Self {
         let a = lam + 2.0 * mu;
-        let d = [[a, lam, 0.0, lam], [lam, a, 0.0, lam], [0.0, 0.0, mu, 0.0], [lam, lam, 0.0, a]];
+        let d = [
+            [a, lam, 0.0, lam, 0.0, 0.0],
+            [lam, a, 0.0, lam, 0.0, 0.0],
+            [0.0, 0.0, mu, 0.0, 0.0, 0.0],
+            [lam, lam, 0.0, a, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, mu, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, mu],
+        ];
         LinearElastic { young: e, poisson: nu, d }
     }
 
@@ -140,10 +179,10 @@ impl LinearElastic {
     }
 
     /// σ + D Δε.
-    pub fn trial(&self, stress: &[f64; 4], deps: &[f64; 4]) -> [f64; 4] {
+    pub fn trial(&self, stress: &Stress, deps: &Stress) -> Stress {
         let mut s = *stress;
         for (r, sr) in s.iter_mut().enumerate() {
-            *sr += (0..4).map(|c| self.d[r][c] * deps[c]).sum::<f64>();
+            *sr += (0..NS).map(|c| self.d[r][c] * deps[c]).sum::<f64>();
         }
         s
     }
@@ -175,12 +214,12 @@ impl Constitutive {
     /// New stress, internal variable and consistent tangent for the strain increment `deps` from
     /// `stress` and ε̄ = `eps_pd` ([003] Eq. 24c, [000] Eq. 11d with D^ep).
     #[inline]
-    pub fn update(&self, stress: &[f64; 4], eps_pd: f64, deps: &[f64; 4]) -> StressUpdate {
+    pub fn update(&self, stress: &Stress, eps_pd: f64, deps: &Stress) -> StressUpdate {
         match self {
             Constitutive::LinearElastic(el) => StressUpdate {
                 stress: el.trial(stress, deps),
                 tangent: el.d,
-                trial_tangent: IDENTITY4,
+                trial_tangent: IDENTITY6,
                 eps_pd,
                 region: Region::Elastic,
             },
@@ -229,8 +268,8 @@ impl Constitutive {
 
     /// A finite-strain model's stress after a step (`None` for the incremental models, whose
     /// stress follows [`Constitutive::update`]), with the small-strain elasticity of its moduli as
-    /// the tangent (no consistent tangent: explicit stages only). `df` is the step's in-plane
-    /// deformation gradient ΔF (with F̄, ΔF̄; F_zz = 1), `f` the total one after the step
+    /// the tangent (no consistent tangent: explicit stages only). `df` is the step's
+    /// deformation gradient ΔF (with F̄, ΔF̄; a plane-strain point's has F_zz = 1), `f` the total one after the step
     /// (F_{n+1}, or F̄_{n+1}), `stress` the Cauchy stress the point starts from, unrotated. The
     /// neo-Hookean stress is a function of `f` alone. Hencky–J2 needs b^e_n, which is not stored
     /// but recovered: the Kirchhoff stress τ_n = J_n σ_n, J_n = det f / det ΔF, determines the
@@ -239,14 +278,7 @@ impl Constitutive {
     /// inadmissible step). The Newtonian fluid's pressure follows J = det `f` and its viscous
     /// stress the step's rate of deformation, ΔF over `dt` [s]
     /// (`finite_strain::rate_of_deformation`).
-    pub fn finite(
-        &self,
-        df: &[[f64; 2]; 2],
-        f: &[[f64; 2]; 2],
-        stress: &[f64; 4],
-        eps_pd: f64,
-        dt: f64,
-    ) -> Option<StressUpdate> {
+    pub fn finite(&self, df: &M3, f: &M3, stress: &Stress, eps_pd: f64, dt: f64) -> Option<StressUpdate> {
         let (el, stress, eps_pd, region) = match self {
             Constitutive::NeoHookean(el, nh) => (el, nh.stress(*f), eps_pd, Region::Elastic),
             Constitutive::NewtonianFluid(el, fl) => {
@@ -267,9 +299,9 @@ impl Constitutive {
             _ => return None,
         };
         Some(StressUpdate {
-            stress: stress.unwrap_or([f64::NAN; 4]),
+            stress: stress.unwrap_or([f64::NAN; NS]),
             tangent: el.d,
-            trial_tangent: IDENTITY4,
+            trial_tangent: IDENTITY6,
             eps_pd,
             region,
         })
@@ -283,7 +315,7 @@ impl Constitutive {
     /// with F̄ the projected J̄_{n+1} (`jbar`). So with F̄ a fluid point carries J̄ and the next
     /// step projects J̄_n ΔJ, [002] Algorithm 1 exactly: the points' own volume ratios, which
     /// nothing in a fluid holds in place, cannot drift apart beneath the projection.
-    pub fn fluid_volume_ratio(&self, f: [[f64; 2]; 2], jbar: Option<f64>) -> Option<f64> {
+    pub fn fluid_volume_ratio(&self, f: M3, jbar: Option<f64>) -> Option<f64> {
         match self {
             Constitutive::NewtonianFluid(..) => Some(jbar.unwrap_or_else(|| crate::model::finite_strain::det(f))),
             _ => None,
@@ -317,9 +349,9 @@ impl Constitutive {
 /// frame.
 fn isotropic_return(
     el: &LinearElastic,
-    stress: &[f64; 4],
+    stress: &Stress,
     eps: f64,
-    deps: &[f64; 4],
+    deps: &Stress,
     ret: impl Fn(&[f64; 3], f64) -> ReturnResult,
 ) -> StressUpdate {
     let trial = el.trial(stress, deps);
@@ -329,7 +361,7 @@ fn isotropic_return(
         return StressUpdate {
             stress: trial,
             tangent: el.d,
-            trial_tangent: IDENTITY4,
+            trial_tangent: IDENTITY6,
             eps_pd: eps,
             region: Region::Elastic,
         };
@@ -337,7 +369,7 @@ fn isotropic_return(
     let dsdt = p.derivative(&r.stress, &r.tangent);
     StressUpdate {
         stress: p.compose(&r.stress),
-        tangent: mul4(&dsdt, &el.d),
+        tangent: mul6(&dsdt, &el.d),
         trial_tangent: dsdt,
         eps_pd: r.eps,
         region: r.region,

@@ -1,119 +1,279 @@
-//! Plane-strain stresses in their principal frame, and the derivative of an isotropic stress
-//! function through it.
+//! Stresses in their principal frame, and the derivative of an isotropic stress function through
+//! it.
 //!
-//! A stress vector [xx, yy, xy, zz] (tensor shear component) has the in-plane principal values
-//! λ_A ≥ λ_B with unit directions e_A = (cos θ, sin θ), e_B = (−sin θ, cos θ), and λ_Z = σ_zz. An
-//! isotropic return map σ = F(σ_trial) keeps the principal directions and maps the principal values,
-//! σ_i = f_i(λ_A, λ_B, λ_Z). Its derivative (de Souza Neto, Perić & Owen 2008, Appendix A, for two
-//! in-plane eigenvalues) is, in the principal frame,
-//!   dσ_ii = Σ_j (∂f_i/∂λ_j) dλ_j,   dσ_AB = (σ_A − σ_B)/(λ_A − λ_B) dσ_trial,AB,
-//! where the spin factor tends to ½(∂f_A/∂λ_A − ∂f_A/∂λ_B − ∂f_B/∂λ_A + ∂f_B/∂λ_B) when λ_A = λ_B.
+//! A stress vector [xx, yy, xy, zz, yz, zx] (tensor shear components; [`super::Stress`]) has the
+//! principal values λ_1, λ_2, λ_3 with orthonormal directions e_1, e_2, e_3. An isotropic return map
+//! σ = F(σ_trial) keeps the principal directions and maps the principal values,
+//! σ_i = f_i(λ_1, λ_2, λ_3). Its derivative (de Souza Neto, Perić & Owen 2008, Appendix A) is, in
+//! the principal frame,
+//!   dσ_ii = Σ_j (∂f_i/∂λ_j) dλ_j,   dσ_ij = (σ_i − σ_j)/(λ_i − λ_j) dσ_trial,ij  (i ≠ j),
+//! where the spin factor tends to ½(∂f_i/∂λ_i − ∂f_i/∂λ_j − ∂f_j/∂λ_i + ∂f_j/∂λ_j) when λ_i = λ_j.
+//!
+//! A plane stress state (yz = zx = 0: every plane-strain and axisymmetric point) is decomposed in
+//! closed form: the in-plane values λ_A ≥ λ_B with e_A = (cos θ, sin θ, 0), e_B = (−sin θ, cos θ, 0),
+//! and λ_Z = σ_zz with e_Z = (0, 0, 1). A general one is diagonalised by cyclic Jacobi rotations,
+//! which keep every eigenvalue to relative round-off.
 
-/// Principal values and in-plane directions of a plane-strain stress.
+use super::{Mat6, Stress, NS};
+
+/// The (row, column) of each stress-vector component in the symmetric tensor.
+pub const TENSOR_INDEX: [(usize, usize); NS] = [(0, 0), (1, 1), (0, 1), (2, 2), (1, 2), (2, 0)];
+
+/// The symmetric 3 × 3 tensor of a stress vector.
+pub fn tensor(s: &Stress) -> [[f64; 3]; 3] {
+    [[s[0], s[2], s[5]], [s[2], s[1], s[4]], [s[5], s[4], s[3]]]
+}
+
+/// The stress vector of a symmetric 3 × 3 tensor (its upper triangle's shears).
+pub fn vector(t: &[[f64; 3]; 3]) -> Stress {
+    TENSOR_INDEX.map(|(a, b)| t[a][b])
+}
+
+/// Principal values and directions of a stress.
 #[derive(Debug, Clone, Copy)]
 pub struct Principal {
-    /// λ_A ≥ λ_B (in plane), λ_Z (out of plane).
+    /// λ_1, λ_2, λ_3; for a plane state λ_A ≥ λ_B (in plane) and λ_Z (out of plane).
     pub values: [f64; 3],
-    /// cos θ, sin θ of e_A.
-    pub dir: [f64; 2],
+    /// The unit directions e_1, e_2, e_3, one per row.
+    pub vectors: [[f64; 3]; 3],
 }
 
 impl Principal {
-    /// The principal decomposition of `s` = [xx, yy, xy, zz].
-    pub fn of(s: &[f64; 4]) -> Principal {
+    /// The principal decomposition of `s`.
+    pub fn of(s: &Stress) -> Principal {
+        if s[4] == 0.0 && s[5] == 0.0 {
+            Principal::of_plane(s)
+        } else {
+            Principal::of_general(s)
+        }
+    }
+
+    /// The closed form of a plane state (yz = zx = 0).
+    fn of_plane(s: &Stress) -> Principal {
         let m = 0.5 * (s[0] + s[1]);
         let d = 0.5 * (s[0] - s[1]);
         let r = d.hypot(s[2]);
         let theta = 0.5 * s[2].atan2(d);
-        Principal { values: [m + r, m - r, s[3]], dir: [theta.cos(), theta.sin()] }
+        Principal::in_plane([m + r, m - r, s[3]], theta)
     }
 
-    /// The stress with principal values `v` (A, B, Z) in this frame.
-    pub fn compose(&self, v: &[f64; 3]) -> [f64; 4] {
-        let [c, s] = self.dir;
-        [v[0] * c * c + v[1] * s * s, v[0] * s * s + v[1] * c * c, (v[0] - v[1]) * c * s, v[2]]
+    /// The frame of a plane state with values `values` (A, B, Z) whose e_A makes the angle
+    /// `theta` with x.
+    pub fn in_plane(values: [f64; 3], theta: f64) -> Principal {
+        let (sn, c) = theta.sin_cos();
+        Principal { values, vectors: [[c, sn, 0.0], [-sn, c, 0.0], [0.0, 0.0, 1.0]] }
     }
 
-    /// dσ/dσ_trial (4 × 4, stress-vector components with tensor shear) of an isotropic map whose
-    /// principal values are `returned` with derivatives `m[i][j]` = ∂σ_i/∂λ_j (A, B, Z order); `self`
-    /// is the trial stress's decomposition.
-    pub fn derivative(&self, returned: &[f64; 3], m: &[[f64; 3]; 3]) -> [[f64; 4]; 4] {
-        let [c, s] = self.dir;
-        let (ea, eb) = ([c, s], [-s, c]);
-        let gap = self.values[0] - self.values[1];
+    /// Cyclic Jacobi rotations (Golub & Van Loan, Algorithm 8.4.3) until the off-diagonal part is
+    /// below round-off of the diagonal.
+    fn of_general(s: &Stress) -> Principal {
+        let mut a = tensor(s);
+        let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        for _sweep in 0..50 {
+            let off = a[0][1] * a[0][1] + a[1][2] * a[1][2] + a[2][0] * a[2][0];
+            let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+            if off <= 1e-34 * diag || off == 0.0 {
+                break;
+            }
+            for (p, q) in [(0, 1), (1, 2), (0, 2)] {
+                if a[p][q] == 0.0 {
+                    continue;
+                }
+                // The rotation that zeroes a_pq: t = tan of its angle, the smaller root.
+                let tau = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                let t = tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt());
+                let c = 1.0 / (1.0 + t * t).sqrt();
+                let sn = t * c;
+                // A ← Jᵀ A J, V ← V J (columns of V are the directions).
+                for row in a.iter_mut() {
+                    let (akp, akq) = (row[p], row[q]);
+                    row[p] = c * akp - sn * akq;
+                    row[q] = sn * akp + c * akq;
+                }
+                let (rp, rq) = (a[p], a[q]);
+                for k in 0..3 {
+                    a[p][k] = c * rp[k] - sn * rq[k];
+                    a[q][k] = sn * rp[k] + c * rq[k];
+                }
+                for row in v.iter_mut() {
+                    let (vp, vq) = (row[p], row[q]);
+                    row[p] = c * vp - sn * vq;
+                    row[q] = sn * vp + c * vq;
+                }
+            }
+        }
+        let vectors = [0, 1, 2].map(|i| [v[0][i], v[1][i], v[2][i]]);
+        Principal { values: [a[0][0], a[1][1], a[2][2]], vectors }
+    }
+
+    /// The stress with principal values `v` in this frame.
+    pub fn compose(&self, v: &[f64; 3]) -> Stress {
+        let e = &self.vectors;
+        TENSOR_INDEX.map(|(a, b)| v[0] * e[0][a] * e[0][b] + v[1] * e[1][a] * e[1][b] + v[2] * e[2][a] * e[2][b])
+    }
+
+    /// dσ/dσ_trial (stress-vector components with tensor shear) of an isotropic map whose
+    /// principal values are `returned` with derivatives `m[i][j]` = ∂σ_i/∂λ_j (in the order of
+    /// `values`); `self` is the trial stress's decomposition.
+    pub fn derivative(&self, returned: &[f64; 3], m: &[[f64; 3]; 3]) -> Mat6 {
+        let e = &self.vectors;
         let scale = self.values.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
-        let spin = if gap.abs() > 1e-9 * scale {
-            (returned[0] - returned[1]) / gap
-        } else {
-            0.5 * (m[0][0] - m[0][1] - m[1][0] + m[1][1])
+        const PAIRS: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
+        let spin = PAIRS.map(|(i, j)| {
+            let gap = self.values[i] - self.values[j];
+            if gap.abs() > 1e-9 * scale {
+                (returned[i] - returned[j]) / gap
+            } else {
+                0.5 * (m[i][i] - m[i][j] - m[j][i] + m[j][j])
+            }
+        });
+        // uᵀ E_c v for the symmetric unit tensor E_c of stress component c.
+        let quad = |u: &[f64; 3], c: usize, v: &[f64; 3]| -> f64 {
+            let (a, b) = TENSOR_INDEX[c];
+            if a == b {
+                u[a] * v[a]
+            } else {
+                u[a] * v[b] + u[b] * v[a]
+            }
         };
-        let quad = |u: [f64; 2], t: &[[f64; 2]; 2], v: [f64; 2]| -> f64 {
-            u[0] * (t[0][0] * v[0] + t[0][1] * v[1]) + u[1] * (t[1][0] * v[0] + t[1][1] * v[1])
-        };
-        let mut out = [[0.0; 4]; 4];
-        for (j, col) in [[[1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0; 2]; 2]]
-            .iter()
-            .enumerate()
-        {
-            let dl = [quad(ea, col, ea), quad(eb, col, eb), if j == 3 { 1.0 } else { 0.0 }];
-            let dt = quad(ea, col, eb);
-            let ds: Vec<f64> = (0..3).map(|i| (0..3).map(|k| m[i][k] * dl[k]).sum()).collect();
-            let dab = spin * dt;
-            // dS = dσ_A e_A e_Aᵀ + dσ_B e_B e_Bᵀ + dσ_AB (e_A e_Bᵀ + e_B e_Aᵀ).
-            out[0][j] = ds[0] * ea[0] * ea[0] + ds[1] * eb[0] * eb[0] + 2.0 * dab * ea[0] * eb[0];
-            out[1][j] = ds[0] * ea[1] * ea[1] + ds[1] * eb[1] * eb[1] + 2.0 * dab * ea[1] * eb[1];
-            out[2][j] = ds[0] * ea[0] * ea[1] + ds[1] * eb[0] * eb[1] + dab * (ea[0] * eb[1] + eb[0] * ea[1]);
-            out[3][j] = ds[2];
+        let mut out = [[0.0; NS]; NS];
+        #[allow(clippy::needless_range_loop)] // c is a component of the stress and a column of out.
+        for c in 0..NS {
+            let dl = [quad(&e[0], c, &e[0]), quad(&e[1], c, &e[1]), quad(&e[2], c, &e[2])];
+            let ds: [f64; 3] = [0, 1, 2].map(|i| (0..3).map(|k| m[i][k] * dl[k]).sum());
+            let dt: [f64; 3] = [0, 1, 2].map(|k| {
+                let (i, j) = PAIRS[k];
+                spin[k] * quad(&e[i], c, &e[j])
+            });
+            // dS = Σ_i dσ_i e_i e_iᵀ + Σ_{i<j} dσ_ij (e_i e_jᵀ + e_j e_iᵀ).
+            for (r, &(a, b)) in TENSOR_INDEX.iter().enumerate() {
+                let mut v = ds[0] * e[0][a] * e[0][b] + ds[1] * e[1][a] * e[1][b] + ds[2] * e[2][a] * e[2][b];
+                for (k, &(i, j)) in PAIRS.iter().enumerate() {
+                    v += dt[k] * (e[i][a] * e[j][b] + e[j][a] * e[i][b]);
+                }
+                out[r][c] = v;
+            }
         }
         out
     }
 }
 
-/// A · B for 4 × 4 matrices.
-pub fn mul4(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
-    let mut out = [[0.0; 4]; 4];
+/// A · B for 6 × 6 matrices.
+pub fn mul6(a: &Mat6, b: &Mat6) -> Mat6 {
+    let mut out = [[0.0; NS]; NS];
     for (r, row) in out.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {
-            *v = (0..4).map(|k| a[r][k] * b[k][c]).sum();
+            *v = (0..NS).map(|k| a[r][k] * b[k][c]).sum();
         }
     }
     out
+}
+
+/// R σ Rᵀ of a stress vector under the rotation (or any matrix) `r`.
+pub fn rotate(r: &[[f64; 3]; 3], s: &Stress) -> Stress {
+    let t = tensor(s);
+    let mut out = [[0.0; 3]; 3];
+    for a in 0..3 {
+        for b in 0..3 {
+            out[a][b] = (0..3).map(|k| (0..3).map(|l| r[a][k] * t[k][l] * r[b][l]).sum::<f64>()).sum();
+        }
+    }
+    vector(&out)
+}
+
+/// The rotation by `angle` about the unit `axis` (Rodrigues).
+pub fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let (s, c) = angle.sin_cos();
+    let [x, y, z] = axis;
+    [
+        [c + x * x * (1.0 - c), x * y * (1.0 - c) - z * s, x * z * (1.0 - c) + y * s],
+        [y * x * (1.0 - c) + z * s, c + y * y * (1.0 - c), y * z * (1.0 - c) - x * s],
+        [z * x * (1.0 - c) - y * s, z * y * (1.0 - c) + x * s, c + z * z * (1.0 - c)],
+    ]
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A general rotation (axis not along a coordinate axis).
+    fn tilt() -> [[f64; 3]; 3] {
+        let n = (1.0f64 + 4.0 + 9.0).sqrt();
+        rotation([1.0 / n, -2.0 / n, 3.0 / n], 0.83)
+    }
+
     #[test]
     fn decomposition_and_composition_round_trip() {
-        for s in [[3.0, -1.0, 2.0, 0.5], [-5.0, -5.0, 0.0, -2.0], [1.0, 4.0, -3.0, 7.0], [0.0, 0.0, 1.0, 0.0]] {
-            let p = Principal::of(&s);
-            assert!(p.values[0] >= p.values[1]);
+        let plane =
+            [[3.0, -1.0, 2.0, 0.5, 0.0, 0.0], [-5.0, -5.0, 0.0, -2.0, 0.0, 0.0], [1.0, 4.0, -3.0, 7.0, 0.0, 0.0]];
+        let general =
+            [[3.0, -1.0, 2.0, 0.5, 1.5, -0.7], [-5.0, -5.0, 0.0, -5.0, 1e-3, 0.0], [0.0, 0.0, 1.0, 0.0, 1.0, 1.0]];
+        for s in plane.iter().chain(&general) {
+            let p = Principal::of(s);
             let back = p.compose(&p.values);
-            for k in 0..4 {
+            for k in 0..NS {
                 assert!((back[k] - s[k]).abs() < 1e-12, "{s:?} -> {back:?}");
             }
+            // Orthonormal directions.
+            for i in 0..3 {
+                for j in 0..3 {
+                    let d: f64 = (0..3).map(|k| p.vectors[i][k] * p.vectors[j][k]).sum();
+                    assert!((d - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14, "{s:?}: e{i}·e{j} = {d}");
+                }
+            }
+        }
+        // A plane state's values are A ≥ B then Z.
+        let p = Principal::of(&plane[0]);
+        assert!(p.values[0] >= p.values[1] && p.values[2] == 0.5);
+    }
+
+    #[test]
+    fn a_rotated_state_has_the_same_principal_values() {
+        let s = [3.0, -1.0, 2.0, 0.5, 0.0, 0.0];
+        let r = rotate(&tilt(), &s);
+        assert!(r[4].abs() > 0.1 && r[5].abs() > 0.1, "the rotation must leave the plane: {r:?}");
+        let (mut a, mut b) = (Principal::of(&s).values, Principal::of(&r).values);
+        a.sort_by(f64::total_cmp);
+        b.sort_by(f64::total_cmp);
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() < 1e-13, "{a:?} against {b:?}");
         }
     }
 
     #[test]
     fn derivative_of_a_nonlinear_isotropic_map_matches_finite_differences() {
-        // σ_i = λ_i³ + λ_A λ_B (A, B), λ_Z² (Z): isotropic in the plane.
-        let f = |l: &[f64; 3]| [l[0].powi(3) + l[0] * l[1], l[1].powi(3) + l[0] * l[1], l[2] * l[2]];
-        let m = |l: &[f64; 3]| {
-            [[3.0 * l[0] * l[0] + l[1], l[0], 0.0], [l[1], 3.0 * l[1] * l[1] + l[0], 0.0], [0.0, 0.0, 2.0 * l[2]]]
+        // σ_i = λ_i³ + λ_1 λ_2 λ_3 + Σλ: isotropic (a symmetric function of the values).
+        let f = |l: &[f64; 3]| {
+            let (p, s) = (l[0] * l[1] * l[2], l[0] + l[1] + l[2]);
+            l.map(|x| x.powi(3) + p + s)
         };
-        for s in [[1.2, -0.4, 0.7, 0.3], [0.5, 0.5, 0.0, -1.0], [2.0, 1.0, -0.2, 0.8]] {
+        let m = |l: &[f64; 3]| {
+            std::array::from_fn(|i| {
+                std::array::from_fn(|j| {
+                    let others: f64 = (0..3).filter(|&k| k != j).map(|k| l[k]).product();
+                    others + 1.0 + if i == j { 3.0 * l[i] * l[i] } else { 0.0 }
+                })
+            })
+        };
+        let states = [
+            [1.2, -0.4, 0.7, 0.3, 0.0, 0.0],
+            [0.5, 0.5, 0.0, -1.0, 0.0, 0.0],
+            [1.2, -0.4, 0.7, 0.3, 0.45, -0.25],
+            // Two equal values out of the plane.
+            [0.5, 0.5, 0.0, 0.5, 0.0, 0.0],
+            rotate(&tilt(), &[2.0, 1.0, -0.2, 0.8, 0.0, 0.0]),
+        ];
+        for s in states {
             let p = Principal::of(&s);
             let d = p.derivative(&f(&p.values), &m(&p.values));
-            for j in 0..4 {
+            for j in 0..NS {
                 let h = 1e-6;
                 let (mut sp, mut sm) = (s, s);
                 sp[j] += h;
                 sm[j] -= h;
                 let (pp, pm) = (Principal::of(&sp), Principal::of(&sm));
                 let (up, um) = (pp.compose(&f(&pp.values)), pm.compose(&f(&pm.values)));
-                for i in 0..4 {
+                for i in 0..NS {
                     let fd = (up[i] - um[i]) / (2.0 * h);
                     assert!((fd - d[i][j]).abs() < 1e-6, "{s:?} d{i}/d{j}: {fd} vs {}", d[i][j]);
                 }

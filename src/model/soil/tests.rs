@@ -1,4 +1,5 @@
 use super::*;
+use principal::Principal;
 
 const KPA: f64 = 1e3;
 
@@ -48,32 +49,51 @@ fn vm(c: f64, c_r: f64, h: f64) -> Constitutive {
     )
 }
 
-/// The stress [xx, yy, xy, zz] with principal values `l` (l[2] out of plane) rotated by `theta`.
-fn stress_with(l: [f64; 3], theta: f64) -> [f64; 4] {
-    Principal { values: l, dir: [theta.cos(), theta.sin()] }.compose(&l)
+/// The plane stress [xx, yy, xy, zz, 0, 0] with principal values `l` (l[2] out of plane) rotated by
+/// `theta` about z.
+fn stress_with(l: [f64; 3], theta: f64) -> Stress {
+    Principal::in_plane(l, theta).compose(&l)
 }
 
-/// A start state and strain increment whose elastic trial is `trial`.
-fn start_for(model: &Constitutive, trial: [f64; 4]) -> ([f64; 4], [f64; 4]) {
-    let deps = [1.3e-4, -2.1e-4, 0.7e-4, 0.0];
+/// A general rotation (its axis in no coordinate plane).
+fn tilt() -> [[f64; 3]; 3] {
+    let n = 14f64.sqrt();
+    principal::rotation([1.0 / n, -2.0 / n, 3.0 / n], 0.83)
+}
+
+/// The stress with principal values `l` along the columns of `r` (every shear non-zero).
+fn stress_in(l: [f64; 3], r: &[[f64; 3]; 3]) -> Stress {
+    principal::rotate(r, &[l[0], l[1], 0.0, l[2], 0.0, 0.0])
+}
+
+/// A start state and strain increment whose elastic trial is `trial` (with out-of-plane strains
+/// when `out_of_plane`).
+fn start_for_3d(model: &Constitutive, trial: Stress, out_of_plane: bool) -> (Stress, Stress) {
+    let g = if out_of_plane { 1.0 } else { 0.0 };
+    let deps = [1.3e-4, -2.1e-4, 0.7e-4, 0.0, 0.4e-4 * g, -0.9e-4 * g];
     let el = model.elastic();
-    let de = el.trial(&[0.0; 4], &deps);
-    let s0 = [trial[0] - de[0], trial[1] - de[1], trial[2] - de[2], trial[3] - de[3]];
-    (s0, deps)
+    let de = el.trial(&[0.0; NS], &deps);
+    (std::array::from_fn(|c| trial[c] - de[c]), deps)
 }
 
-/// Largest |analytic − central difference| of the tangent, relative to the elastic modulus.
-fn tangent_error(model: &Constitutive, s0: &[f64; 4], eps: f64, deps: &[f64; 4]) -> f64 {
+/// A start state and in-plane strain increment whose elastic trial is `trial`.
+fn start_for(model: &Constitutive, trial: Stress) -> (Stress, Stress) {
+    start_for_3d(model, trial, false)
+}
+
+/// Largest |analytic − central difference| of the tangent, relative to the elastic modulus (all
+/// six components: the out-of-plane ones take a plane state out of its plane).
+fn tangent_error(model: &Constitutive, s0: &Stress, eps: f64, deps: &Stress) -> f64 {
     let u = model.update(s0, eps, deps);
     let scale = model.elastic().d[0][0];
     let mut worst: f64 = 0.0;
-    for c in 0..4 {
+    for c in 0..NS {
         let h = 1e-9;
         let (mut dp, mut dm) = (*deps, *deps);
         dp[c] += h;
         dm[c] -= h;
         let (up, um) = (model.update(s0, eps, &dp), model.update(s0, eps, &dm));
-        for r in 0..4 {
+        for r in 0..NS {
             let fd = (up.stress[r] - um.stress[r]) / (2.0 * h);
             worst = worst.max((fd - u.tangent[r][c]).abs() / scale);
         }
@@ -81,7 +101,7 @@ fn tangent_error(model: &Constitutive, s0: &[f64; 4], eps: f64, deps: &[f64; 4])
     worst
 }
 
-fn principal_sorted(s: &[f64; 4]) -> [f64; 3] {
+fn principal_sorted(s: &Stress) -> [f64; 3] {
     let mut v = Principal::of(s).values;
     v.sort_by(|a, b| b.total_cmp(a));
     v
@@ -96,7 +116,7 @@ fn mc_f(m: &MohrCoulomb, s: &[f64; 3], eps: f64) -> f64 {
 fn plane_strain_elasticity_gives_the_constrained_modulus_in_an_oedometer() {
     let el = LinearElastic::new(1e7, 0.3);
     let m = Constitutive::LinearElastic(el);
-    let u = m.update(&[0.0; 4], 0.0, &[0.0, -1e-3, 0.0, 0.0]);
+    let u = m.update(&[0.0; NS], 0.0, &[0.0, -1e-3, 0.0, 0.0, 0.0, 0.0]);
     let ec = 1e7 * 0.7 / (1.3 * 0.4);
     assert!((u.stress[1] + ec * 1e-3).abs() < 1e-6 * ec);
     assert!((u.stress[0] / u.stress[1] - 0.3 / 0.7).abs() < 1e-12);
@@ -107,8 +127,8 @@ fn plane_strain_elasticity_gives_the_constrained_modulus_in_an_oedometer() {
 #[test]
 fn an_elastic_step_of_a_plastic_model_is_elastic() {
     let m = mc(30.0, 10.0 * KPA, 10.0, None);
-    let s0 = [-50.0 * KPA, -60.0 * KPA, 2.0 * KPA, -55.0 * KPA];
-    let de = [1e-6, -1e-6, 0.0, 0.0];
+    let s0 = [-50.0 * KPA, -60.0 * KPA, 2.0 * KPA, -55.0 * KPA, 0.0, 0.0];
+    let de = [1e-6, -1e-6, 0.0, 0.0, 0.0, 0.0];
     let u = m.update(&s0, 0.0, &de);
     assert_eq!(u.region, Region::Elastic);
     assert_eq!(u.tangent, m.elastic().d);
@@ -220,9 +240,7 @@ fn the_return_is_invariant_to_a_rotation_of_the_stress() {
         }
         assert!((a.eps_pd - b.eps_pd).abs() < 1e-12);
         // The returned stress is coaxial with the trial stress.
-        let (ta, tb) = (Principal::of(&stress_with(l, theta)), Principal::of(&b.stress));
-        let cross = ta.dir[0] * tb.dir[1] - ta.dir[1] * tb.dir[0];
-        assert!(cross.abs() < 1e-9 || (b.stress[0] - b.stress[1]).abs() < 1e-6, "θ = {theta}");
+        assert!(commutator(&stress_with(l, theta), &b.stress) < 1e-9, "θ = {theta}");
     }
 }
 
@@ -236,7 +254,7 @@ fn tresca_limits_the_largest_shear_stress_to_the_cohesion() {
         let s = principal_sorted(&u.stress);
         assert!(((s[0] - s[2]) / 2.0 - 10.0 * KPA).abs() < 1e-6, "{s:?}");
         // Isochoric: the mean stress is the trial's.
-        let mean = |v: &[f64; 4]| (v[0] + v[1] + v[3]) / 3.0;
+        let mean = |v: &Stress| (v[0] + v[1] + v[3]) / 3.0;
         assert!((mean(&u.stress) - mean(&trial)).abs() < 1e-6);
         assert!(tangent_error(&model, &s0, 0.0, &de) < 1e-6);
     }
@@ -246,10 +264,7 @@ fn tresca_limits_the_largest_shear_stress_to_the_cohesion() {
 fn von_mises_returns_radially_and_softens_to_the_residual_strength() {
     let model = vm(12.0 * KPA, 3.0 * KPA, -30.0 * KPA);
     let Constitutive::VonMises(_, p) = model else { unreachable!() };
-    let q = |s: &[f64; 4]| {
-        let m = (s[0] + s[1] + s[3]) / 3.0;
-        (1.5 * ((s[0] - m).powi(2) + (s[1] - m).powi(2) + (s[3] - m).powi(2) + 2.0 * s[2] * s[2])).sqrt()
-    };
+    let q = |s: &Stress| crate::verification::invariants(s).1;
     for (eps0, l) in [
         (0.0, [0.0, -40.0, -10.0]),
         (0.1, [5.0, -60.0, -20.0]),
@@ -270,4 +285,58 @@ fn von_mises_returns_radially_and_softens_to_the_residual_strength() {
         assert!(tangent_error(&model, &s0, eps0, &de) < 1e-6, "tangent at ε̄ = {eps0}");
     }
     assert_eq!(p.cohesion_at(1.0).0, 3.0 * KPA);
+}
+
+/// ‖T S − S T‖/(‖T‖‖S‖) of two stresses: zero when they are coaxial.
+fn commutator(t: &Stress, s: &Stress) -> f64 {
+    let (a, b) = (principal::tensor(t), principal::tensor(s));
+    let mut worst: f64 = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            let c: f64 = (0..3).map(|k| a[i][k] * b[k][j] - b[i][k] * a[k][j]).sum();
+            worst = worst.max(c.abs());
+        }
+    }
+    let norm = |m: [[f64; 3]; 3]| m.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+    worst / (norm(a) * norm(b)).max(f64::MIN_POSITIVE)
+}
+
+/// A three-dimensional state (every shear non-zero) returns as its plane-strain twin does, turned
+/// with it: the same principal stresses, ε̄ and region, R σ Rᵀ, and the tangent exact in all six
+/// components, in every Mohr–Coulomb region, for von Mises and with softening; and a rotation of
+/// the whole step (trial stress and strain increment) rotates the returned stress.
+#[test]
+fn a_general_three_dimensional_state_returns_as_its_rotated_plane_twin() {
+    let r = tilt();
+    let cases: Vec<(Constitutive, [f64; 3], f64)> = vec![
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -50.0, -150.0], 0.0),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -140.0, -150.0], 0.0),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [-10.0, -15.0, -150.0], 0.0),
+        (mc(30.0, 10.0 * KPA, 10.0, None), [50.0, 40.0, 30.0], 0.0),
+        (mc(30.0, 10.0 * KPA, 10.0, Some(5.0 * KPA)), [8.0, -5.0, -10.0], 0.0),
+        (mc(30.0, 10.0 * KPA, 10.0, Some(5.0 * KPA)), [40.0, -5.0, -10.0], 0.0),
+        (mc(0.0, 10.0 * KPA, 0.0, None), [-10.0, -30.0, -60.0], 0.0),
+        (softening_mc(), [-10.0, -80.0, -300.0], 0.02),
+        (vm(12.0 * KPA, 3.0 * KPA, -30.0 * KPA), [5.0, -60.0, -20.0], 0.1),
+    ];
+    for (model, l, eps0) in cases {
+        let l = l.map(|v| v * KPA);
+        // The plane twin: principal values along x, y, z.
+        let plane_trial = stress_in(l, &principal::rotation([0.0, 0.0, 1.0], 0.0));
+        let (p0, pde) = start_for(&model, plane_trial);
+        let flat = model.update(&p0, eps0, &pde);
+        // The same trial turned by R, reached from a start with out-of-plane strains.
+        let trial = stress_in(l, &r);
+        assert!(trial[4].abs() > 1.0 && trial[5].abs() > 1.0, "{trial:?}");
+        let (s0, de) = start_for_3d(&model, trial, true);
+        let u = model.update(&s0, eps0, &de);
+        assert_eq!(u.region, flat.region, "{l:?}");
+        assert!((u.eps_pd - flat.eps_pd).abs() <= 1e-12 * flat.eps_pd.max(1e-12), "{l:?}");
+        let turned = principal::rotate(&r, &flat.stress);
+        for c in 0..NS {
+            assert!((u.stress[c] - turned[c]).abs() < 1e-6, "{l:?} component {c}: {:?} vs {turned:?}", u.stress);
+        }
+        let e = tangent_error(&model, &s0, eps0, &de);
+        assert!(e < 1e-6, "{:?} {l:?}: tangent error {e:e}", u.region);
+    }
 }
