@@ -119,7 +119,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     let mut filled = vec![0.0; g.node_count()];
     for k in 0..model.particles.len() {
         let st = shape::stencil(model.basis, g, model.particles.x[k], model.particles.lp[k]);
-        for ((i, j), w, _) in st.iter() {
+        for ([i, j], w, _) in st.iter() {
             filled[j as usize * g.nodes()[0] + i as usize] += w * model.area(k) / (g.h[0] * g.h[1]);
         }
     }

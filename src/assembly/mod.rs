@@ -1118,7 +1118,7 @@ impl GridSystem {
                         let length = length * model.geometry.measure(point[0]);
                         applied.add([traction[0] * f * length, traction[1] * f * length]);
                         let w = shape::face_weights(model.basis, g, point);
-                        for ((i, j), s, _) in w.iter() {
+                        for ([i, j], s, _) in w.iter() {
                             let l = self.ghost.node(i as usize, j as usize).ok_or_else(|| {
                                 format!(
                                     "the traction `{}` on material point {} acts outside this rank's ghost region",
@@ -1150,7 +1150,7 @@ impl GridSystem {
                         // Shares on unfilled nodes are extended from the material's side.
                         let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
                         let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
-                        for ((i, j), s, _) in shape::face_weights(model.basis, g, point).iter() {
+                        for ([i, j], s, _) in shape::face_weights(model.basis, g, point).iter() {
                             let l = self.ghost.node(i as usize, j as usize).expect("an owned cell's nodes are ghosted");
                             add(l, [s * force[0] * pressure * f, s * force[1] * pressure * f], inward);
                         }

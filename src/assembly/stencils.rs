@@ -276,7 +276,7 @@ pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(
         if st.len == 0 {
             return Err(format!("material point {} at ({:.4}, {:.4}) m has left the grid", ps.id[k], x[0], x[1]));
         }
-        for &(i, j) in &st.nodes[..st.len] {
+        for &[i, j] in &st.nodes[..st.len] {
             let l = ghost.node(i as usize, j as usize).ok_or_else(|| {
                 format!(
                     "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \

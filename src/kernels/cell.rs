@@ -200,7 +200,7 @@ mod tests {
                     };
                     let vol = if method == Method::WStar { h[0] * h[1] / count[&cell_of(x)] as f64 } else { v };
                     for (node, _, g) in st.iter() {
-                        let e = diag.entry(node).or_default();
+                        let e = diag.entry((node[0], node[1])).or_default();
                         e[0] += (g[0] * d[0][0] * g[0] + g[1] * d[2][2] * g[1]) * vol;
                         e[1] += (g[1] * d[1][1] * g[1] + g[0] * d[2][2] * g[0]) * vol;
                     }

@@ -104,7 +104,7 @@ mod tests {
                 let st = shape::stencil(basis_kind, &grid, x, lp);
                 let mut basis: Vec<NodeBasis> = Vec::new();
                 plain_basis(&st, &[0.0; shape::MAX_STENCIL], &mut basis);
-                let ids: Vec<usize> = st.iter().map(|((i, j), _, _)| j as usize * 7 + i as usize).collect();
+                let ids: Vec<usize> = st.iter().map(|([i, j], _, _)| j as usize * 7 + i as usize).collect();
                 let a = 0.03 * (rng.next() - 0.5);
                 let part =
                     input(0.02 * (0.5 + rng.next()), [[1.0 + a, 0.01], [0.0, 1.0 - 0.5 * a]], 0.95 + 0.1 * rng.next());

@@ -110,7 +110,7 @@ pub(crate) mod tests {
             let lp = [0.125, 0.1];
             let x = [lp[0] + (3.0 - 2.0 * lp[0]) * rng.next(), lp[1] + (2.0 - 2.0 * lp[1]) * rng.next()];
             let st = shape::stencil(basis, &grid, x, lp);
-            c.shares.push(st.iter().map(|((i, j), w, _)| (j as usize * 7 + i as usize, w)).collect());
+            c.shares.push(st.iter().map(|([i, j], w, _)| (j as usize * 7 + i as usize, w)).collect());
             c.volume.push(0.05 * (0.5 + rng.next()));
             c.jbar.push(0.9 + 0.2 * rng.next());
             let (a, b, s) = (0.02 * (rng.next() - 0.5), 0.02 * (rng.next() - 0.5), 0.01 * (rng.next() - 0.5));

@@ -280,7 +280,7 @@ impl Model {
                 let n = self.face_normal(k, face);
                 let extent = n[0].abs() * lp[0] + n[1].abs() * lp[1];
                 let st = shape::stencil(self.basis, &self.grid, x, lp);
-                for ((i, j), w, _) in st.iter() {
+                for ([i, j], w, _) in st.iter() {
                     if w <= 0.0 {
                         continue;
                     }

@@ -139,34 +139,96 @@ pub fn gimp_1d(r: f64, lp: f64, h: f64) -> (f64, f64) {
     (w, g)
 }
 
-/// Largest stencil: 4 × 4 nodes (a domain of one particle per cell touches the grid lines on both
-/// sides; two or more particles per cell reach at most 3 × 3 nodes), plus the nodes of B̄'s root
-/// cells outside them (a 5 × 5 box at most).
+/// Largest stencil of a two-dimensional point: 4 × 4 nodes (a domain of one particle per cell
+/// touches the grid lines on both sides; two or more particles per cell reach at most 3 × 3 nodes),
+/// plus the nodes of B̄'s root cells outside them (a 5 × 5 box at most).
 pub const MAX_STENCIL: usize = 25;
 
-/// Nodes, weights and weight gradients of one particle.
+/// Largest stencil of a three-dimensional point: the 5 × 5 × 5 box of [`MAX_STENCIL`]'s argument.
+pub const MAX_STENCIL_3D: usize = 125;
+
+/// Nodes, weights and weight gradients of one particle in `D` dimensions, at most `M` nodes
+/// (two-dimensional, [`MAX_STENCIL`], unless said otherwise).
 #[derive(Debug, Clone, Copy)]
-pub struct Stencil {
+pub struct Stencil<const D: usize = 2, const M: usize = MAX_STENCIL> {
     /// Number of nodes used.
     pub len: usize,
-    /// Global node indices (i, j).
-    pub nodes: [(u32, u32); MAX_STENCIL],
+    /// Node indices per direction.
+    pub nodes: [[u32; D]; M],
     /// S_i.
-    pub w: [f64; MAX_STENCIL],
+    pub w: [f64; M],
     /// ∇S_i.
-    pub dw: [[f64; 2]; MAX_STENCIL],
+    pub dw: [[f64; D]; M],
 }
 
-impl Default for Stencil {
+impl<const D: usize, const M: usize> Default for Stencil<D, M> {
     fn default() -> Self {
-        Stencil { len: 0, nodes: [(0, 0); MAX_STENCIL], w: [0.0; MAX_STENCIL], dw: [[0.0; 2]; MAX_STENCIL] }
+        Stencil { len: 0, nodes: [[0; D]; M], w: [0.0; M], dw: [[0.0; D]; M] }
     }
 }
 
-impl Stencil {
+impl<const D: usize, const M: usize> Stencil<D, M> {
     /// Iterates (node, S, ∇S).
-    pub fn iter(&self) -> impl Iterator<Item = ((u32, u32), f64, [f64; 2])> + '_ {
+    pub fn iter(&self) -> impl Iterator<Item = ([u32; D], f64, [f64; D])> + '_ {
         (0..self.len).map(move |k| (self.nodes[k], self.w[k], self.dw[k]))
+    }
+
+    /// The slot of `node`, appended with zero weight and gradient if it is not in the stencil
+    /// (`None` when the stencil is full).
+    fn slot(&mut self, node: [u32; D]) -> Option<usize> {
+        match self.nodes[..self.len].iter().position(|&n| n == node) {
+            Some(k) => Some(k),
+            None if self.len < M => {
+                self.nodes[self.len] = node;
+                self.w[self.len] = 0.0;
+                self.dw[self.len] = [0.0; D];
+                self.len += 1;
+                Some(self.len - 1)
+            }
+            None => None,
+        }
+    }
+}
+
+/// Up to four (node index, value, derivative) along one direction, and how many.
+type Weights1d = ([(u32, f64, f64); 4], usize);
+
+/// The tensor product of per-direction lists of (index, value, derivative): every combination,
+/// x fastest, with the product of the values and, in direction d, the derivative in d times the
+/// other directions' values.
+fn tensor_product<const D: usize, const M: usize>(per: &[Weights1d; D]) -> Stencil<D, M> {
+    let mut s = Stencil::default();
+    if per.iter().any(|p| p.1 == 0) {
+        return s;
+    }
+    let mut at = [0usize; D];
+    loop {
+        let k = s.len;
+        let (mut w, mut dw) = (1.0, [0.0; D]);
+        for d in 0..D {
+            let (i, v, _) = per[d].0[at[d]];
+            s.nodes[k][d] = i;
+            w = if d == 0 { v } else { w * v };
+        }
+        for (d, g) in dw.iter_mut().enumerate() {
+            *g = (0..D).filter(|&e| e != d).fold(per[d].0[at[d]].2, |acc, e| acc * per[e].0[at[e]].1);
+        }
+        s.w[k] = w;
+        s.dw[k] = dw;
+        s.len += 1;
+        // The next combination, x fastest.
+        let mut d = 0;
+        loop {
+            at[d] += 1;
+            if at[d] < per[d].1 {
+                break;
+            }
+            at[d] = 0;
+            d += 1;
+            if d == D {
+                return s;
+            }
+        }
     }
 }
 
@@ -233,21 +295,21 @@ pub fn right_stretch(f: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     [[(c[0][0] + s) / t, c[0][1] / t], [c[1][0] / t, (c[1][1] + s) / t]]
 }
 
-/// Builds the stencil of a particle at `x` with half-widths `lp` on `grid`.
+/// Builds the stencil of a particle at `x` with half-widths `lp` on a grid of any dimension: the
+/// tensor product of [`weights_1d`] in each direction.
+pub fn stencil_in<const D: usize, const M: usize>(
+    basis: Basis,
+    grid: &Grid<D>,
+    x: [f64; D],
+    lp: [f64; D],
+) -> Stencil<D, M> {
+    let per = std::array::from_fn(|d| weights_1d(basis, x[d], lp[d], grid.origin[d], grid.h[d], grid.cells[d]));
+    tensor_product(&per)
+}
+
+/// Builds the stencil of a particle at `x` with half-widths `lp` on a two-dimensional `grid`.
 pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil {
-    let (wx, nx) = weights_1d(basis, x[0], lp[0], grid.origin[0], grid.h[0], grid.cells[0]);
-    let (wy, ny) = weights_1d(basis, x[1], lp[1], grid.origin[1], grid.h[1], grid.cells[1]);
-    let mut s = Stencil::default();
-    for &(j, sy, gy) in &wy[..ny] {
-        for &(i, sx, gx) in &wx[..nx] {
-            let k = s.len;
-            s.nodes[k] = (i, j);
-            s.w[k] = sx * sy;
-            s.dw[k] = [gx * sy, sx * gy];
-            s.len += 1;
-        }
-    }
-    s
+    stencil_in(basis, grid, x, lp)
 }
 
 /// The geometry of an analysis: plane strain, or axial symmetry about the y axis (x ≡ r ≥ 0) with
@@ -361,7 +423,7 @@ pub fn axisymmetric_stencil(
                 _ => (sx, gx, sx / x[0]),
             };
             let k = s.len;
-            s.nodes[k] = (i, j);
+            s.nodes[k] = [i, j];
             s.w[k] = sr * sy;
             s.dw[k] = [gr * sy, sr * gy];
             hoop[k] = tr * sy;
@@ -421,26 +483,25 @@ pub fn local_gimp(grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (LocalGimp, usize) 
 /// B-splines take their own functions at the point: for a uniform stress, ∫_Ω ∇N_i σ dV =
 /// ∮ N_i σ n dS, so the consistent weights of a surface force are the basis's values there.
 pub fn face_weights(basis: Basis, grid: &Grid, point: [f64; 2]) -> Stencil {
+    face_weights_in(basis, grid, point)
+}
+
+/// [`face_weights`] on a grid of any dimension (the multilinear functions of the cell holding the
+/// point, or the B-splines at it).
+pub fn face_weights_in<const D: usize, const M: usize>(basis: Basis, grid: &Grid<D>, point: [f64; D]) -> Stencil<D, M> {
     if basis.is_bspline() {
-        return stencil(basis, grid, point, [0.0; 2]);
+        return stencil_in(basis, grid, point, [0.0; D]);
     }
-    let mut s = Stencil::default();
-    let mut w = [[(0u32, 0.0); 2]; 2];
-    for d in 0..2 {
+    let per = std::array::from_fn(|d| {
         let r = ((point[d] - grid.origin[d]) / grid.h[d]).clamp(0.0, grid.cells[d] as f64);
         let c = r.floor().min((grid.cells[d] - 1) as f64);
         let xi = r - c;
-        w[d] = [(c as u32, 1.0 - xi), (c as u32 + 1, xi)];
-    }
-    for &(j, wy) in &w[1] {
-        for &(i, wx) in &w[0] {
-            let k = s.len;
-            s.nodes[k] = (i, j);
-            s.w[k] = wx * wy;
-            s.len += 1;
-        }
-    }
-    s
+        let mut w = [(0u32, 0.0, 0.0); 4];
+        w[0] = (c as u32, 1.0 - xi, 0.0);
+        w[1] = (c as u32 + 1, xi, 0.0);
+        (w, 2)
+    });
+    tensor_product(&per)
 }
 
 /// Volumetric gradients of B̄ for a particle ([000] Eqs. 13–16, with the support-domain portion per
@@ -479,8 +540,23 @@ pub fn volumetric_operators(
     root: &dyn Fn(usize, usize) -> (usize, usize),
     hoop: bool,
 ) -> ([[f64; 2]; MAX_STENCIL], [f64; MAX_STENCIL]) {
-    let mut gv = [[0.0; 2]; MAX_STENCIL];
-    let mut tv = [0.0; MAX_STENCIL];
+    volumetric_operators_in(basis, grid, x, lp, st, &|[i, j]| root(i, j).into(), hoop)
+}
+
+/// [`volumetric_operators`] on a grid of any dimension: the gradient of a corner node's multilinear
+/// function at a cell's centre is ±1/(2^{D−1} h_d) in direction d, its value 1/2^D (the hoop
+/// operator, axial symmetry only, is that value over the centre's radius).
+pub fn volumetric_operators_in<const D: usize, const M: usize>(
+    basis: Basis,
+    grid: &Grid<D>,
+    x: [f64; D],
+    lp: [f64; D],
+    st: &mut Stencil<D, M>,
+    root: &dyn Fn([usize; D]) -> [usize; D],
+    hoop: bool,
+) -> ([[f64; D]; M], [f64; M]) {
+    let mut gv = [[0.0; D]; M];
+    let mut tv = [0.0; M];
     // Cells overlapped in each direction, with the length of the overlap.
     let overlaps = |d: usize| -> ([(usize, f64); 3], usize) {
         let mut out = [(0usize, 0.0); 3];
@@ -510,39 +586,43 @@ pub fn volumetric_operators(
         }
         (out, n)
     };
-    let (ox, nx) = overlaps(0);
-    let (oy, ny) = overlaps(1);
-    let total: f64 = ox[..nx].iter().map(|a| a.1).sum::<f64>() * oy[..ny].iter().map(|a| a.1).sum::<f64>();
-    if total <= 0.0 {
+    let per: [([(usize, f64); 3], usize); D] = std::array::from_fn(overlaps);
+    let total: f64 = per.iter().map(|(o, n)| o[..*n].iter().map(|a| a.1).sum::<f64>()).product();
+    if total <= 0.0 || per.iter().any(|p| p.1 == 0) {
         return (gv, tv);
     }
-    for &(cy, ly) in &oy[..ny] {
-        for &(cx, lx) in &ox[..nx] {
-            let f = lx * ly / total;
-            let (rx, ry) = root(cx, cy);
-            let centre_hoop = if hoop { 0.25 / (grid.origin[0] + (rx as f64 + 0.5) * grid.h[0]) } else { 0.0 };
-            for (di, sx) in [(0u32, -1.0), (1u32, 1.0)] {
-                for (dj, sy) in [(0u32, -1.0), (1u32, 1.0)] {
-                    let node = (rx as u32 + di, ry as u32 + dj);
-                    let k = match st.nodes[..st.len].iter().position(|&n| n == node) {
-                        Some(k) => k,
-                        None if st.len < MAX_STENCIL => {
-                            st.nodes[st.len] = node;
-                            st.w[st.len] = 0.0;
-                            st.dw[st.len] = [0.0; 2];
-                            st.len += 1;
-                            st.len - 1
-                        }
-                        None => continue,
-                    };
-                    gv[k][0] += f * sx / (2.0 * grid.h[0]);
-                    gv[k][1] += f * sy / (2.0 * grid.h[1]);
-                    tv[k] += f * centre_hoop;
-                }
+    let corner_scale = (1u32 << (D - 1)) as f64;
+    let mut at = [0usize; D];
+    loop {
+        let cell: [usize; D] = std::array::from_fn(|d| per[d].0[at[d]].0);
+        let f = (0..D).map(|d| per[d].0[at[d]].1).product::<f64>() / total;
+        let r = root(cell);
+        let centre_hoop = if hoop { 1.0 / (2.0 * corner_scale * grid.centre(r)[0]) } else { 0.0 };
+        // The root cell's corners, the last direction fastest.
+        for corner in 0..(1usize << D) {
+            let bit = |d: usize| (corner >> (D - 1 - d)) & 1;
+            let node: [u32; D] = std::array::from_fn(|d| (r[d] + bit(d)) as u32);
+            let Some(k) = st.slot(node) else { continue };
+            for (d, g) in gv[k].iter_mut().enumerate() {
+                let sign = if bit(d) == 1 { 1.0 } else { -1.0 };
+                *g += f * sign / (corner_scale * grid.h[d]);
+            }
+            tv[k] += f * centre_hoop;
+        }
+        // The next cell, x fastest.
+        let mut d = 0;
+        loop {
+            at[d] += 1;
+            if at[d] < per[d].1 {
+                break;
+            }
+            at[d] = 0;
+            d += 1;
+            if d == D {
+                return (gv, tv);
             }
         }
     }
-    (gv, tv)
 }
 
 /// The grid's bilinear shape function of the node at `node` and its gradient at the point `x`, the
@@ -550,8 +630,13 @@ pub fn volumetric_operators(
 /// N = Π_d max(0, 1 − |x_d − x_i,d|/h_d). A gradient component on a grid line itself with `side`
 /// on it too is the mean of the two sides, 0.
 pub fn bilinear(node: [f64; 2], x: [f64; 2], side: [f64; 2], h: [f64; 2]) -> (f64, [f64; 2]) {
-    let n: [f64; 2] = std::array::from_fn(|d| (1.0 - (x[d] - node[d]).abs() / h[d]).max(0.0));
-    let dn: [f64; 2] = std::array::from_fn(|d| {
+    multilinear(node, x, side, h)
+}
+
+/// [`bilinear`] in any dimension: N = Π_d max(0, 1 − |x_d − x_i,d|/h_d) and its gradient.
+pub fn multilinear<const D: usize>(node: [f64; D], x: [f64; D], side: [f64; D], h: [f64; D]) -> (f64, [f64; D]) {
+    let n: [f64; D] = std::array::from_fn(|d| (1.0 - (x[d] - node[d]).abs() / h[d]).max(0.0));
+    let dn: [f64; D] = std::array::from_fn(|d| {
         let r = side[d] - node[d];
         if r.abs() < h[d] && r != 0.0 {
             -r.signum() / h[d]
@@ -559,7 +644,8 @@ pub fn bilinear(node: [f64; 2], x: [f64; 2], side: [f64; 2], h: [f64; 2]) -> (f6
             0.0
         }
     });
-    (n[0] * n[1], [dn[0] * n[1], n[0] * dn[1]])
+    let value = n.iter().skip(1).fold(n[0], |acc, v| acc * v);
+    (value, std::array::from_fn(|d| (0..D).filter(|&e| e != d).fold(dn[d], |acc, e| acc * n[e])))
 }
 
 #[cfg(test)]
@@ -662,7 +748,7 @@ mod tests {
             for x in [[-1.0, 0.5], [-0.93, 0.61], [0.0, 1.5], [0.99, 1.45], [1.0, 1.3]] {
                 let st = stencil(basis, &g, x, [0.05, 0.05]);
                 let (mut sum, mut lin, mut grad) = (0.0, [0.0; 2], [[0.0; 2]; 2]);
-                for ((i, j), w, dw) in st.iter() {
+                for ([i, j], w, dw) in st.iter() {
                     let xi = [g.origin[0] + i as f64 * g.h[0], g.origin[1] + j as f64 * g.h[1]];
                     sum += w;
                     for a in 0..2 {
@@ -742,14 +828,14 @@ mod tests {
         // A face on the grid's edge loads the edge nodes, also a hair beyond it.
         for y in [top, top * (1.0 + 1e-15)] {
             let w = face_weights(Basis::Gimp, &g, [1.1, y]);
-            let edge: f64 = w.iter().filter(|((_, j), _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum();
+            let edge: f64 = w.iter().filter(|([_, j], _, _)| *j as usize == g.cells[1]).map(|(_, s, _)| s).sum();
             assert!((edge - 1.0).abs() < 1e-12, "y = {y:e}: {edge}");
         }
         // Crossing the grid line y = 0.75 changes no weight by more than the motion.
         let (a, b) =
             (face_weights(Basis::Gimp, &g, [1.1, 0.75 - 1e-9]), face_weights(Basis::Gimp, &g, [1.1, 0.75 + 1e-9]));
         for j in 2..=4u32 {
-            let on = |w: &Stencil| -> f64 { w.iter().filter(|((_, jj), _, _)| *jj == j).map(|(_, s, _)| s).sum() };
+            let on = |w: &Stencil| -> f64 { w.iter().filter(|([_, jj], _, _)| *jj == j).map(|(_, s, _)| s).sum() };
             assert!((on(&a) - on(&b)).abs() < 1e-7, "row {j}: {} vs {}", on(&a), on(&b));
         }
         assert!((a.iter().map(|(_, s, _)| s).sum::<f64>() - 1.0).abs() < 1e-12);
@@ -790,7 +876,7 @@ mod tests {
             assert!(sum[0].abs() < 1e-12 && sum[1].abs() < 1e-12, "{basis:?} {sum:?}");
             let mut m = [[0.0; 2]; 2];
             for (node, gk) in st.nodes[..st.len].iter().zip(&gv) {
-                let p = g.node_position(node.0 as usize, node.1 as usize);
+                let p = g.node_position(node[0] as usize, node[1] as usize);
                 for a in 0..2 {
                     for b in 0..2 {
                         m[a][b] += gk[a] * p[b];
@@ -805,7 +891,7 @@ mod tests {
         // A domain inside one cell takes that cell's centre gradients: ±1/(2h).
         let mut st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);
         let gv = volumetric_gradients(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &mut st, &|i, j| (i, j));
-        let k = st.nodes[..st.len].iter().position(|&n| n == (2, 2)).unwrap();
+        let k = st.nodes[..st.len].iter().position(|&n| n == [2, 2]).unwrap();
         assert!((gv[k][0] + 1.0).abs() < 1e-12 && (gv[k][1] + 2.0).abs() < 1e-12, "{:?}", gv[k]);
     }
 
@@ -833,10 +919,10 @@ mod tests {
                 let gy: f64 = s.iter().map(|(_, _, d)| d[1]).sum();
                 assert!((sum - 1.0).abs() < 1e-12 && gx.abs() < 1e-9 && gy.abs() < 1e-9, "{basis:?} at {x:?}");
                 // Linear completeness: Σ S_i x_i = x_p.
-                let xr: f64 = s.iter().map(|((i, _), w, _)| w * g.node_position(i as usize, 0)[0]).sum();
+                let xr: f64 = s.iter().map(|([i, _], w, _)| w * g.node_position(i as usize, 0)[0]).sum();
                 assert!((xr - x[0]).abs() < 1e-12);
                 // Σ ∇S_i x_i = 1.
-                let dxx: f64 = s.iter().map(|((i, _), _, d)| d[0] * g.node_position(i as usize, 0)[0]).sum();
+                let dxx: f64 = s.iter().map(|([i, _], _, d)| d[0] * g.node_position(i as usize, 0)[0]).sum();
                 assert!((dxx - 1.0).abs() < 1e-9);
             }
         }
@@ -852,8 +938,8 @@ mod tests {
         let s = stencil(Basis::Gimp, &g, [0.5 + 0.125, 0.1], [0.125, 0.0625]);
         assert_eq!(s.len, 6);
         assert!(
-            s.iter().any(|((i, _), w, d)| i == 0 && w == 0.0 && d == [0.0, 0.0])
-                || s.iter().any(|((i, _), w, _)| i == 1 && w == 0.0)
+            s.iter().any(|([i, _], w, d)| i == 0 && w == 0.0 && d == [0.0, 0.0])
+                || s.iter().any(|([i, _], w, _)| i == 1 && w == 0.0)
         );
         let s = stencil(Basis::Linear, &g, [0.5 + 0.01, 0.125], [0.125, 0.0625]);
         assert_eq!(s.len, 4);
@@ -918,7 +1004,7 @@ mod tests {
             let (st, hoop) = axisymmetric_stencil(basis, weights, &grid, x, lp);
             let (mut sum, mut err, mut eyy, mut ett) = (0.0, 0.0, 0.0, 0.0);
             for (k, t) in hoop.iter().enumerate().take(st.len) {
-                let (i, j) = st.nodes[k];
+                let [i, j] = st.nodes[k];
                 let (r, y) = (i as f64 * grid.h[0], j as f64 * grid.h[1]);
                 let ur = alpha + beta * r;
                 sum += st.w[k];
@@ -978,11 +1064,111 @@ mod tests {
                     .flat_map(|&((ci, cj), s)| {
                         [((ci, cj), s[0]), ((ci + 1, cj), s[1]), ((ci, cj + 1), s[2]), ((ci + 1, cj + 1), s[3])]
                     })
-                    .filter(|&(m, _)| m == node)
+                    .filter(|&(m, _)| [m.0, m.1] == node)
                     .map(|(_, v)| v)
                     .sum();
                 assert!((sum - w).abs() < 1e-14, "{x:?}, node {node:?}: Σ_e S* = {sum}, GIMP {w}");
             }
+        }
+    }
+
+    /// The bases in three dimensions: for every basis, at points across a grid of 3 × 2 × 4 cells
+    /// (edges and faces included, domains crossing grid lines), the stencil is a partition of unity
+    /// that reproduces linear fields, Σ S = 1, Σ ∇S = 0, Σ x_i S_i = x_p, Σ x_i ⊗ ∇S_i = I; its
+    /// gradient is the derivative of its values with respect to the point's position (central
+    /// differences, away from the kinks of the linear basis); B̄'s volumetric gradients reproduce
+    /// a linear field's gradient as well, Σ x_i ⊗ ∇̄S_i = I; the face weights are a partition of
+    /// unity that interpolates x; and a point of a plane z = const on a grid line sees the plane
+    /// stencil times its z weights.
+    #[test]
+    fn every_basis_reproduces_linear_fields_in_three_dimensions() {
+        let g: Grid<3> = Grid::new([0.0, -0.5, 1.0], [0.5, 0.25, 0.4], [3, 2, 4]);
+        let lp = [0.125, 0.0625, 0.1];
+        // Domains inside the grid, some touching its faces or crossing grid lines; and, for the bases
+        // whose support does not depend on a domain, points on the grid's faces and edges.
+        let inner =
+            [[0.3, -0.4, 1.3], [0.125, -0.0625, 2.5], [1.375, -0.25, 1.1], [0.74, -0.26, 2.21], [1.2, -0.07, 1.79]];
+        let faces = [[0.0, 0.0, 2.6], [1.5, -0.5, 1.0], [1.5, 0.0, 2.6]];
+        for basis in [Basis::Gimp, Basis::Linear, Basis::BSpline2, Basis::BSpline3] {
+            let on_faces: &[[f64; 3]] = if basis == Basis::Gimp { &[] } else { &faces };
+            for &x in inner.iter().chain(on_faces) {
+                let st: Stencil<3, MAX_STENCIL_3D> = stencil_in(basis, &g, x, lp);
+                assert!(st.len >= 8, "{basis:?} {x:?}: {} nodes", st.len);
+                let sum: f64 = st.w[..st.len].iter().sum();
+                assert!((sum - 1.0).abs() < 1e-14, "{basis:?} {x:?}: Σ S = {sum}");
+                for d in 0..3 {
+                    let gsum: f64 = st.dw[..st.len].iter().map(|v| v[d]).sum();
+                    assert!(gsum.abs() < 1e-12, "{basis:?} {x:?}: Σ ∂S/∂x{d} = {gsum}");
+                    let xd: f64 = st.iter().map(|(n, w, _)| w * g.position(n.map(|i| i as usize))[d]).sum();
+                    assert!((xd - x[d]).abs() < 1e-14, "{basis:?} {x:?}: Σ x S = {xd}");
+                    for e in 0..3 {
+                        let gx: f64 = st.iter().map(|(n, _, dw)| dw[e] * g.position(n.map(|i| i as usize))[d]).sum();
+                        let want = if d == e { 1.0 } else { 0.0 };
+                        assert!((gx - want).abs() < 1e-12, "{basis:?} {x:?}: Σ x{d} ∂S/∂x{e} = {gx}");
+                    }
+                }
+                // The gradient is the derivative of the values (the linear basis has kinks at the
+                // grid lines: only strictly inside a cell).
+                let inside = (0..3).all(|d| {
+                    let s = (x[d] - g.origin[d]) / g.h[d];
+                    (s - s.round()).abs() > 1e-3
+                });
+                // (Central differences need both sides inside the grid: not on its faces.)
+                if inner.contains(&x) && (basis != Basis::Linear || inside) {
+                    for d in 0..3 {
+                        let e = 1e-7;
+                        let (mut xp, mut xm) = (x, x);
+                        xp[d] += e;
+                        xm[d] -= e;
+                        let (sp, sm): (Stencil<3, MAX_STENCIL_3D>, Stencil<3, MAX_STENCIL_3D>) =
+                            (stencil_in(basis, &g, xp, lp), stencil_in(basis, &g, xm, lp));
+                        let at = |s: &Stencil<3, MAX_STENCIL_3D>, n: [u32; 3]| {
+                            s.iter().find(|o| o.0 == n).map_or(0.0, |o| o.1)
+                        };
+                        for (n, _, dw) in st.iter() {
+                            let fd = (at(&sp, n) - at(&sm, n)) / (2.0 * e);
+                            assert!((fd - dw[d]).abs() < 1e-5, "{basis:?} {x:?} node {n:?} d{d}: {} vs {fd}", dw[d]);
+                        }
+                    }
+                }
+                // B̄'s volumetric gradients (no aggregation: every cell its own root).
+                let mut stv = st;
+                let (gv, _) = volumetric_operators_in(basis, &g, x, lp, &mut stv, &|c| c, false);
+                for d in 0..3 {
+                    for e in 0..3 {
+                        let sum: f64 = gv[..stv.len]
+                            .iter()
+                            .zip(&stv.nodes)
+                            .map(|(gk, n)| gk[e] * g.position(n.map(|i| i as usize))[d])
+                            .sum();
+                        let want = if d == e { 1.0 } else { 0.0 };
+                        assert!((sum - want).abs() < 1e-12, "{basis:?} {x:?}: Σ x{d} ∂̄S/∂x{e} = {sum}");
+                    }
+                }
+                // Face weights at the point.
+                let f: Stencil<3, MAX_STENCIL_3D> = face_weights_in(basis, &g, x);
+                let fsum: f64 = f.w[..f.len].iter().sum();
+                assert!((fsum - 1.0).abs() < 1e-14, "{basis:?} {x:?}: face weights sum to {fsum}");
+                for d in 0..3 {
+                    let xd: f64 = f.iter().map(|(n, w, _)| w * g.position(n.map(|i| i as usize))[d]).sum();
+                    assert!((xd - x[d]).abs() < 1e-14, "{basis:?} {x:?}: face weights give x{d} = {xd}");
+                }
+            }
+            // A point on the grid plane z = 2.2 (node layer 3): the linear and GIMP weights of
+            // that layer are the plane stencil's (z weight 1 for linear; for GIMP the domain's
+            // share on each side).
+            let (x2, l2) = ([0.74, -0.26], [0.125, 0.0625]);
+            let plane = stencil(basis, &Grid::new([0.0, -0.5], [0.5, 0.25], [3, 2]), x2, l2);
+            let solid: Stencil<3, MAX_STENCIL_3D> = stencil_in(basis, &g, [x2[0], x2[1], 2.2], [l2[0], l2[1], 0.1]);
+            let (wz, nz) = weights_1d(basis, 2.2, 0.1, 1.0, 0.4, 4);
+            for (n, w, dw) in plane.iter() {
+                for &(k, sz, gz) in &wz[..nz] {
+                    let m = solid.iter().find(|o| o.0 == [n[0], n[1], k]).expect("the node is in the 3D stencil");
+                    assert!((m.1 - w * sz).abs() < 1e-15, "{basis:?}: {} vs {}", m.1, w * sz);
+                    assert!((m.2[0] - dw[0] * sz).abs() < 1e-13 && (m.2[2] - w * gz).abs() < 1e-13);
+                }
+            }
+            assert_eq!(solid.len, plane.len * nz);
         }
     }
 }
