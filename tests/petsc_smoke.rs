@@ -378,6 +378,79 @@ fn unused_options_are_reported() -> TestResult {
     Ok(())
 }
 
+/// A three-dimensional DMDA: the ranks' owned slabs cover the grid, the ghosted block's numbering
+/// (x fastest, then y, then z) inverts, the ghost exchange brings every node its owner's values
+/// (each global entry set to its node's number, read back through the local vector), and adding a
+/// local vector of ones counts each node once per rank whose block holds it. Rank-agnostic: run
+/// it on two ranks with `mpirun -n 2 PETSC_SMOKE_BINARY three_dimensional`.
+fn a_three_dimensional_dmda_numbers_and_exchanges_its_nodes() -> TestResult {
+    let comm = Comm::world();
+    let nodes = [5usize, 4, 3];
+    let dm = DmDa::new_3d(comm, nodes, 1, &["a", "b"], None).map_err(e)?;
+    let info = *dm.info();
+    let dof = info.dof;
+    let owned: usize = info.owned_count.iter().product();
+    let mut global = dm.create_global_vector().map_err(e)?;
+    if global.local_size().map_err(e)? != owned * dof {
+        return Err(format!("{owned} owned nodes but a local size of {}", global.local_size().map_err(e)?));
+    }
+    if comm.sum_usize(owned).map_err(e)? != nodes.iter().product::<usize>() {
+        return Err("the owned blocks do not cover the grid".into());
+    }
+    let ranges = dm.ownership().map_err(e)?;
+    if ranges.iter().map(|r| r.len()).product::<usize>() != comm.size()
+        || ranges.iter().zip(nodes).any(|(r, n)| r.iter().sum::<usize>() != n)
+    {
+        return Err(format!("ownership ranges {ranges:?} do not match {} ranks and {nodes:?}", comm.size()));
+    }
+    let g = info.ghosted;
+    let number = |n: [usize; 3]| (n[2] * nodes[1] + n[1]) * nodes[0] + n[0];
+    let ltog = dm.local_to_global();
+    let (mut idx, mut vals) = (Vec::new(), Vec::new());
+    for l in 0..g.len() {
+        let n = g.indices(l);
+        if g.local(n) != Some(l) {
+            return Err(format!("local node {l} is {n:?}, whose local number is {:?}", g.local(n)));
+        }
+        let own = (0..3).all(|d| n[d] >= info.owned_start[d] && n[d] < info.owned_start[d] + info.owned_count[d]);
+        for c in 0..dof {
+            if own {
+                idx.push(ltog[l * dof + c]);
+                vals.push((number(n) * 10 + c) as f64);
+            }
+        }
+    }
+    global.set_values(&idx, &vals, false).map_err(e)?;
+    global.assemble().map_err(e)?;
+    let mut local = dm.create_local_vector().map_err(e)?;
+    dm.global_to_local(&global, &mut local).map_err(e)?;
+    {
+        let lv = local.read().map_err(e)?;
+        for l in 0..g.len() {
+            for c in 0..dof {
+                let want = (number(g.indices(l)) * 10 + c) as f64;
+                if lv[l * dof + c] != want {
+                    return Err(format!(
+                        "local node {l} dof {c}: {} after the exchange, {want} expected",
+                        lv[l * dof + c]
+                    ));
+                }
+            }
+        }
+    }
+    local.set_all(1.0).map_err(e)?;
+    global.set_all(0.0).map_err(e)?;
+    dm.local_to_global_add(&local, &mut global).map_err(e)?;
+    let mut ones = global.duplicate().map_err(e)?;
+    ones.set_all(1.0).map_err(e)?;
+    let total = global.dot(&ones).map_err(e)?;
+    let expected = comm.sum_usize(g.len() * dof).map_err(e)? as f64;
+    if total != expected {
+        return Err(format!("local-to-global added {total}, the ranks' blocks hold {expected} entries"));
+    }
+    Ok(())
+}
+
 fn main() {
     let petsc = match Petsc::initialize(&[], None, "porompm PETSc smoke tests") {
         Ok(p) => p,
@@ -398,6 +471,10 @@ fn main() {
         ),
         ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
         ("unused_options_are_reported", unused_options_are_reported),
+        (
+            "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",
+            a_three_dimensional_dmda_numbers_and_exchanges_its_nodes,
+        ),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = 0;

@@ -164,7 +164,7 @@ mod tests {
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 0.99]],
             jacobian: 0.99,
-            deps: [0.0, -0.01, 0.0, 0.0],
+            deps: [0.0, -0.01, 0.0, 0.0, 0.0, 0.0],
             grad_n: [0.0; 2],
             jbar: None,
             velocity: None,
@@ -177,7 +177,7 @@ mod tests {
         assert!((e.body - (3.0 * 1.0 + 0.5 * 2.0)).abs() < 1e-12, "{e:?}");
         // Shear: σ_xy Δγ_xy.
         let shear = StepResult {
-            deps: [0.0, 0.0, 0.02, 0.0],
+            deps: [0.0, 0.0, 0.02, 0.0, 0.0, 0.0],
             stress: crate::model::soil::plane([0.0, 0.0, 50.0, 0.0]),
             ..step
         };
@@ -206,7 +206,7 @@ mod tests {
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 1.0]],
             jacobian: 1.0,
-            deps: [0.0; 4],
+            deps: [0.0; crate::model::soil::NS],
             grad_n: [0.0; 2],
             jbar: None,
             velocity: None,

@@ -1,5 +1,5 @@
 //! Finite-strain kinematics of one material point over a step, in the updated Lagrangian frame of
-//! the reset grid (plane strain).
+//! the reset grid, in D dimensions (plane strain and axial symmetry with D = 2).
 //!
 //! The grid carries the step's displacement increments Δu_i. With ∇S_i the gradients of the
 //! point's basis functions on the configuration x_n and ∇̄S_i those of B̄'s volumetric part ([000]
@@ -18,9 +18,12 @@
 //! taken on the mid-step configuration x_{n+1/2}: L = H F_h⁻¹ with F_h = I + H/2 (and L_v likewise
 //! from H_v),
 //!   Δε = sym L − ⅓ tr(L) m + ⅓ tr(L_v) m     (m = [1, 1, 0, 1]; B̄: the volumetric part from L_v),
-//!   ω = ½(L_yx − L_xy),  R = (I − ½W)⁻¹(I + ½W), a rotation by θ = 2 atan(ω/2),
-//! and the soil model starts from the rotated stress R σ_n Rᵀ. A rigid rotation by α gives
-//! sym L = 0 and θ = α exactly, so the stress turns with the material to round-off.
+//!   W = ½(L − Lᵀ),  R = (I − ½W)⁻¹(I + ½W)  (the Cayley transform of the mid-step spin),
+//! and the soil model starts from the rotated stress R σ_n Rᵀ. In two dimensions R is the turn by
+//! θ = 2 atan(ω/2), ω = ½(L_yx − L_xy), about z. A rigid rotation Q gives sym L = 0 and R = Q
+//! exactly, so the stress turns with the material to round-off. The strain increment is the
+//! 6-vector of [`crate::model::soil::Stress`] ([xx, yy, γxy, zz, γyz, γzx]); in two dimensions its
+//! zz component is the hoop rate (axial symmetry) or zero, and yz, zx are zero.
 //!
 //! **Geometrically linear steps** (`linear = true`, `analysis.kinematics = "linear_increments"`,
 //! [001] Eqs. 5, 7, 11): the step is small-strain on x_n. Δε = sym H − ⅓ tr H m + ⅓ tr H_v m (the
@@ -38,53 +41,101 @@
 //! plane strain T = 0 and every hoop quantity drops out.
 
 use super::NodeBasis;
-use crate::model::soil::Stress;
+use crate::model::soil::{principal, Stress, NS};
 
 /// A 2 × 2 matrix, rows first.
 pub type M2 = [[f64; 2]; 2];
 
-const I2: M2 = [[1.0, 0.0], [0.0, 1.0]];
+/// A D × D matrix, rows first.
+pub type Mat<const D: usize> = [[f64; D]; D];
 
-fn det(a: &M2) -> f64 {
-    a[0][0] * a[1][1] - a[0][1] * a[1][0]
+/// The identity.
+fn identity<const D: usize>() -> Mat<D> {
+    std::array::from_fn(|i| std::array::from_fn(|j| if i == j { 1.0 } else { 0.0 }))
 }
 
-fn inverse(a: &M2) -> M2 {
-    let d = det(a);
-    [[a[1][1] / d, -a[0][1] / d], [-a[1][0] / d, a[0][0] / d]]
-}
-
-fn mul(a: &M2, b: &M2) -> M2 {
-    let mut c = [[0.0; 2]; 2];
-    for (i, ci) in c.iter_mut().enumerate() {
-        for (j, cij) in ci.iter_mut().enumerate() {
-            *cij = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+/// det a (D = 2 or 3).
+fn det<const D: usize>(a: &Mat<D>) -> f64 {
+    match D {
+        2 => a[0][0] * a[1][1] - a[0][1] * a[1][0],
+        3 => {
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
         }
+        _ => unreachable!("two or three dimensions"),
     }
-    c
 }
 
-/// The product a b of two in-plane matrices.
-pub fn product(a: &M2, b: &M2) -> M2 {
+/// The cofactor matrix of a (det a a⁻ᵀ; D = 2 or 3).
+fn cofactor<const D: usize>(a: &Mat<D>) -> Mat<D> {
+    match D {
+        2 => std::array::from_fn(|i| std::array::from_fn(|j| [[a[1][1], -a[1][0]], [-a[0][1], a[0][0]]][i][j])),
+        3 => std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+                a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]
+            })
+        }),
+        _ => unreachable!("two or three dimensions"),
+    }
+}
+
+/// a⁻¹.
+fn inverse<const D: usize>(a: &Mat<D>) -> Mat<D> {
+    let d = det(a);
+    let c = cofactor(a);
+    std::array::from_fn(|i| std::array::from_fn(|j| c[j][i] / d))
+}
+
+/// a b.
+fn mul<const D: usize>(a: &Mat<D>, b: &Mat<D>) -> Mat<D> {
+    std::array::from_fn(|i| std::array::from_fn(|j| (1..D).fold(a[i][0] * b[0][j], |s, k| s + a[i][k] * b[k][j])))
+}
+
+/// The product a b of two matrices.
+pub fn product<const D: usize>(a: &Mat<D>, b: &Mat<D>) -> Mat<D> {
     mul(a, b)
 }
 
 /// det(a) a⁻ᵀ v, the cofactor matrix of `a` times `v`: a gradient pushed forward by `a` up to the
 /// factor 1/det a (Nanson's normal, a material field's gradient on the new configuration).
-pub fn cofactor_mul(a: &M2, v: [f64; 2]) -> [f64; 2] {
-    [a[1][1] * v[0] - a[1][0] * v[1], -a[0][1] * v[0] + a[0][0] * v[1]]
+pub fn cofactor_mul<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
+    let c = cofactor(a);
+    std::array::from_fn(|i| (1..D).fold(c[i][0] * v[0], |s, k| s + c[i][k] * v[k]))
 }
 
 /// aᵀ v.
-fn mul_t(a: &M2, v: [f64; 2]) -> [f64; 2] {
-    [a[0][0] * v[0] + a[1][0] * v[1], a[0][1] * v[0] + a[1][1] * v[1]]
+fn mul_t<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
+    std::array::from_fn(|j| (1..D).fold(a[0][j] * v[0], |s, k| s + a[k][j] * v[k]))
+}
+
+/// I + s a.
+fn plus_identity<const D: usize>(a: &Mat<D>, s: f64) -> Mat<D> {
+    std::array::from_fn(|i| std::array::from_fn(|j| if i == j { 1.0 + s * a[i][j] } else { s * a[i][j] }))
+}
+
+/// tr a plus, in two dimensions, the out-of-plane (hoop) component `zz`.
+fn trace<const D: usize>(a: &Mat<D>, zz: f64) -> f64 {
+    match D {
+        2 => a[0][0] + a[1][1] + zz,
+        _ => (1..D).fold(a[0][0], |s, k| s + a[k][k]),
+    }
+}
+
+/// The strain vector [xx, yy, γxy, zz, γyz, γzx] of a rate (or increment) `a` with `vol` added to
+/// its normal components; in two dimensions `zz` is its out-of-plane component.
+fn strain_of<const D: usize>(a: &Mat<D>, zz: f64, vol: f64) -> Stress {
+    match D {
+        2 => [a[0][0] + vol, a[1][1] + vol, a[0][1] + a[1][0], zz + vol, 0.0, 0.0],
+        _ => [a[0][0] + vol, a[1][1] + vol, a[0][1] + a[1][0], a[2][2] + vol, a[1][2] + a[2][1], a[2][0] + a[0][2]],
+    }
 }
 
 /// The kinematics of a point for given nodal increments (see the module documentation).
 #[derive(Debug, Clone, Copy)]
-pub struct Kinematics {
+pub struct Kinematics<const D: usize = 2> {
     /// F = I + H.
-    pub f: M2,
+    pub f: Mat<D>,
     /// J = det F.
     pub j: f64,
     /// J − 1, formed from H without the cancellation of det F − 1 (what an implicit F̄ step's
@@ -92,28 +143,32 @@ pub struct Kinematics {
     /// of J beyond 1, and the residual's round-off then swamps its changes).
     pub dj: f64,
     /// F_v = I + H_v.
-    pub fv: M2,
+    pub fv: Mat<D>,
     /// J_v = det F_v: the volume ratio of the step.
     pub jv: f64,
     /// F⁻¹ (the transpose pushes gradients forward).
-    f_inv: M2,
+    f_inv: Mat<D>,
     /// F_v⁻¹.
-    fv_inv: M2,
+    fv_inv: Mat<D>,
     /// F_h⁻¹ = (I + H/2)⁻¹.
-    fh_inv: M2,
+    fh_inv: Mat<D>,
     /// (I + H_v/2)⁻¹.
-    fvh_inv: M2,
+    fvh_inv: Mat<D>,
     /// L = H F_h⁻¹.
-    l: M2,
+    l: Mat<D>,
     /// L_v = H_v F_vh⁻¹.
-    lv: M2,
-    /// Strain increment Δε [xx, yy, γxy, zz].
-    pub deps: [f64; 4],
-    /// ω = ½(L_yx − L_xy).
+    lv: Mat<D>,
+    /// Strain increment Δε [xx, yy, γxy, zz, γyz, γzx].
+    pub deps: Stress,
+    /// ω = ½(L_yx − L_xy) (two dimensions).
     pub omega: f64,
-    /// Rotation angle of the step θ = 2 atan(ω/2) [rad].
+    /// Rotation angle of the step about z, θ = 2 atan(ω/2) [rad] (two dimensions).
     pub theta: f64,
-    /// The hoop stretch F_θθ = 1 + Σ T_i Δu_r,i (1 in plane strain).
+    /// (I − ½W)⁻¹ of the mid-step spin W = ½(L − Lᵀ) (three dimensions; the derivative of R needs it).
+    half_spin_inv: Mat<D>,
+    /// The rotation of the step R = (I − ½W)⁻¹(I + ½W) (three dimensions; in two, the turn by θ).
+    rotation: Mat<D>,
+    /// The hoop stretch F_θθ = 1 + Σ T_i Δu_r,i (1 in plane strain and in three dimensions).
     pub f_hoop: f64,
     /// B̄'s hoop stretch F_v,θθ = 1 + Σ T̄_i Δu_r,i.
     pub fv_hoop: f64,
@@ -128,25 +183,29 @@ pub struct Kinematics {
 /// [`Kinematics::with_projected_volume`]).
 #[derive(Debug, Clone, Copy)]
 struct Projected {
-    /// c = (r/J)^{1/2}, ΔF̄ = c ΔF (r = J̄_{n+1}/J̄_n, the volume ratio of the step the stress sees).
+    /// c = (r/J)^{1/D}, ΔF̄ = c ΔF (r = J̄_{n+1}/J̄_n, the volume ratio of the step the stress sees).
     c: f64,
-    /// a = tr ΔF̄ = c tr ΔF.
+    /// a = I₁(ΔF̄) = tr ΔF̄ = c tr ΔF.
     a: f64,
-    /// ∂ tr L̄/∂a at fixed r.
+    /// b = I₂(ΔF̄) = c² I₂(ΔF) (three dimensions; zero in two).
+    b: f64,
+    /// ∂ tr L̄/∂a at fixed b and r.
     dtr_da: f64,
-    /// d tr L̄/dr at fixed ΔF (through a = (r/J)^{1/2} tr ΔF as well).
+    /// ∂ tr L̄/∂b at fixed a and r (three dimensions).
+    dtr_db: f64,
+    /// d tr L̄/dr at fixed ΔF (through a and b as well).
     dtr_dr: f64,
 }
 
-impl Kinematics {
+impl<const D: usize> Kinematics<D> {
     /// The kinematics for displacement increments `du[k]` at the nodes of `basis`, finite strain
     /// or (`linear`) a geometrically linear step.
-    pub fn new(basis: &[NodeBasis], du: impl Iterator<Item = [f64; 2]>, linear: bool) -> Kinematics {
-        let (mut h, mut hv) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+    pub fn new(basis: &[NodeBasis<D>], du: impl Iterator<Item = [f64; D]>, linear: bool) -> Kinematics<D> {
+        let (mut h, mut hv) = ([[0.0; D]; D], [[0.0; D]; D]);
         let (mut ht, mut hvt) = (0.0, 0.0);
         for (b, u) in basis.iter().zip(du) {
-            for a in 0..2 {
-                for c in 0..2 {
+            for a in 0..D {
+                for c in 0..D {
                     h[a][c] += u[a] * b.g[c];
                     hv[a][c] += u[a] * b.gv[c];
                 }
@@ -154,14 +213,20 @@ impl Kinematics {
             ht += b.t * u[0];
             hvt += b.tv * u[0];
         }
-        let add = |a: &M2, s: f64| [[1.0 + s * a[0][0], s * a[0][1]], [s * a[1][0], 1.0 + s * a[1][1]]];
-        let (f, fv) = (add(&h, 1.0), add(&hv, 1.0));
-        // J − 1 = (1 + d)(1 + H_θθ) − 1 with d = det(I + H) − 1 = tr H + det H.
-        let d = h[0][0] + h[1][1] + (h[0][0] * h[1][1] - h[0][1] * h[1][0]);
+        let (f, fv) = (plus_identity(&h, 1.0), plus_identity(&hv, 1.0));
+        // J − 1 = (1 + d)(1 + H_θθ) − 1 with d = det(I + H) − 1 = tr H + I₂(H) + det H (I₂, the sum
+        // of the principal 2 × 2 minors, only in three dimensions: in two it is det H).
+        let minors = if D == 3 {
+            h[0][0] * h[1][1] - h[0][1] * h[1][0] + h[1][1] * h[2][2] - h[1][2] * h[2][1] + h[0][0] * h[2][2]
+                - h[0][2] * h[2][0]
+        } else {
+            0.0
+        };
+        let d = trace(&h, 0.0) + minors + det(&h);
         let dj = d + ht + d * ht;
         if linear {
-            let tr = h[0][0] + h[1][1] + ht;
-            let trv = hv[0][0] + hv[1][1] + hvt;
+            let tr = trace(&h, ht);
+            let trv = trace(&hv, hvt);
             let vol = (trv - tr) / 3.0;
             return Kinematics {
                 f,
@@ -171,20 +236,28 @@ impl Kinematics {
                 jv: det(&fv) * (1.0 + hvt),
                 f_hoop: 1.0 + ht,
                 fv_hoop: 1.0 + hvt,
-                deps: [h[0][0] + vol, h[1][1] + vol, h[0][1] + h[1][0], ht + vol],
+                deps: strain_of(&h, ht, vol),
                 linear,
                 ..Kinematics::rest()
             };
         }
-        let (fh_inv, fvh_inv) = (inverse(&add(&h, 0.5)), inverse(&add(&hv, 0.5)));
+        let (fh_inv, fvh_inv) = (inverse(&plus_identity(&h, 0.5)), inverse(&plus_identity(&hv, 0.5)));
         let l = mul(&h, &fh_inv);
         let lv = mul(&hv, &fvh_inv);
         let (lt, lvt) = (ht / (1.0 + 0.5 * ht), hvt / (1.0 + 0.5 * hvt));
-        let tr = l[0][0] + l[1][1] + lt;
-        let trv = lv[0][0] + lv[1][1] + lvt;
+        let tr = trace(&l, lt);
+        let trv = trace(&lv, lvt);
         let vol = (trv - tr) / 3.0;
-        let deps = [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], lt + vol];
+        let deps = strain_of(&l, lt, vol);
         let omega = 0.5 * (l[1][0] - l[0][1]);
+        let (half_spin_inv, rotation) = if D == 3 {
+            // W = ½(L − Lᵀ), R = (I − W/2)⁻¹(I + W/2).
+            let w: Mat<D> = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (l[i][j] - l[j][i])));
+            let a_inv = inverse(&plus_identity(&w, -0.5));
+            (a_inv, mul(&a_inv, &plus_identity(&w, 0.5)))
+        } else {
+            (identity(), identity())
+        };
         Kinematics {
             f,
             j: det(&f) * (1.0 + ht),
@@ -200,55 +273,53 @@ impl Kinematics {
             l,
             lv,
             deps,
-            omega,
-            theta: 2.0 * (0.5 * omega).atan(),
+            omega: if D == 2 { omega } else { 0.0 },
+            theta: if D == 2 { 2.0 * (0.5 * omega).atan() } else { 0.0 },
+            half_spin_inv,
+            rotation,
             linear,
             projected: None,
         }
     }
 
-    /// The kinematics with [002]'s F̄ (plane strain, without B̄): the strain increment's
-    /// volumetric part is the mid-step rate of ΔF̄ = c ΔF (F_v = c F, Eq. 27), its deviatoric part
-    /// and the rotation are ΔF's; only the stress sees F̄ ([002] L237): the volume ratio J_v and the
-    /// deformation gradient the point keeps stay ΔF's. c = 1 leaves the kinematics as they are.
-    pub fn with_volume_scale(self, c: f64) -> Kinematics {
+    /// The kinematics with [002]'s F̄ (without B̄ and, in two dimensions, in plane strain): the
+    /// strain increment's volumetric part is the mid-step rate of ΔF̄ = c ΔF (F_v = c F, Eq. 27),
+    /// its deviatoric part and the rotation are ΔF's; only the stress sees F̄ ([002] L237): the
+    /// volume ratio J_v and the deformation gradient the point keeps stay ΔF's. c = 1 leaves the
+    /// kinematics as they are.
+    pub fn with_volume_scale(self, c: f64) -> Kinematics<D> {
         if c == 1.0 || self.linear {
             return self;
         }
-        let fv = [[c * self.f[0][0], c * self.f[0][1]], [c * self.f[1][0], c * self.f[1][1]]];
-        let hv = [[fv[0][0] - 1.0, fv[0][1]], [fv[1][0], fv[1][1] - 1.0]];
-        let fvh_inv = inverse(&[[1.0 + 0.5 * hv[0][0], 0.5 * hv[0][1]], [0.5 * hv[1][0], 1.0 + 0.5 * hv[1][1]]]);
+        let fv: Mat<D> = self.f.map(|r| r.map(|v| c * v));
+        let hv: Mat<D> =
+            std::array::from_fn(|i| std::array::from_fn(|j| if i == j { fv[i][j] - 1.0 } else { fv[i][j] }));
+        let fvh_inv = inverse(&plus_identity(&hv, 0.5));
         let lv = mul(&hv, &fvh_inv);
-        let (tr, trv) = (self.l[0][0] + self.l[1][1], lv[0][0] + lv[1][1]);
+        let (tr, trv) = (trace(&self.l, 0.0), trace(&lv, 0.0));
         let vol = (trv - tr) / 3.0;
-        let l = &self.l;
-        Kinematics {
-            fv,
-            fv_inv: inverse(&fv),
-            fvh_inv,
-            lv,
-            deps: [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol],
-            ..self
-        }
+        Kinematics { fv, fv_inv: inverse(&fv), fvh_inv, lv, deps: strain_of(&self.l, 0.0, vol), ..self }
     }
 
     /// The kinematics of a step without motion.
-    pub fn rest() -> Kinematics {
+    pub fn rest() -> Kinematics<D> {
         Kinematics {
-            f: I2,
+            f: identity(),
             j: 1.0,
             dj: 0.0,
-            fv: I2,
+            fv: identity(),
             jv: 1.0,
-            f_inv: I2,
-            fv_inv: I2,
-            fh_inv: I2,
-            fvh_inv: I2,
-            l: [[0.0; 2]; 2],
-            lv: [[0.0; 2]; 2],
-            deps: [0.0; 4],
+            f_inv: identity(),
+            fv_inv: identity(),
+            fh_inv: identity(),
+            fvh_inv: identity(),
+            l: [[0.0; D]; D],
+            lv: [[0.0; D]; D],
+            deps: [0.0; NS],
             omega: 0.0,
             theta: 0.0,
+            half_spin_inv: identity(),
+            rotation: identity(),
             f_hoop: 1.0,
             fv_hoop: 1.0,
             linear: false,
@@ -256,49 +327,86 @@ impl Kinematics {
         }
     }
 
-    /// The kinematics of an implicit step with [002]'s F̄ (`stabilisation.fbar`, plane strain,
-    /// without B̄, finite strain): the stress sees ΔF̄ = c ΔF whose determinant is the projected
-    /// volume ratio of the step, r = J̄_{n+1}/J̄_n (c = (r/J)^{1/2}, [002] Eq. 27). As in
+    /// The kinematics of an implicit step with [002]'s F̄ (`stabilisation.fbar`, without B̄, finite
+    /// strain; in two dimensions plane strain): the stress sees ΔF̄ = c ΔF whose determinant is the
+    /// projected volume ratio of the step, r = J̄_{n+1}/J̄_n (c = (r/J)^{1/D}, [002] Eq. 27). As in
     /// [`Kinematics::with_volume_scale`], the strain increment's volumetric part is the mid-step
     /// rate of ΔF̄, its deviatoric part and the rotation are ΔF's, and the volume ratio, the
     /// gradients on x_{n+1} and the deformation gradient the point keeps stay ΔF's ([002] L237).
-    /// For a 2 × 2 ΔF̄ with a = tr ΔF̄ the mid-step rate's trace has the closed form
-    /// tr L̄ = tr(H̄ (I + H̄/2)⁻¹) = 4 − 4 (2 + a)/(1 + a + r) = 4 (r − 1)/(1 + a + r) (H̄ = ΔF̄ − I,
-    /// det ΔF̄ = r), which [`Kinematics::deps_derivative`] and
-    /// [`Kinematics::deps_volume_derivative`] differentiate. The caller passes `r_minus_one` = r − 1,
-    /// formed without cancellation, so that the volumetric strain keeps its relative precision at
-    /// small strains. r = J gives c = 1 and the step's own kinematics.
-    pub fn with_projected_volume(self, r_minus_one: f64) -> Kinematics {
-        debug_assert!(!self.linear && self.f_hoop == 1.0, "F̄ is built for finite-strain plane-strain steps");
+    /// With μ_i = λ_i + 1 for the eigenvalues λ_i of ΔF̄, the mid-step rate's trace is
+    /// tr L̄ = Σ 2(λ_i − 1)/(λ_i + 1) = 2D − 4 e_{D−1}(μ)/e_D(μ), a function of ΔF̄'s invariants
+    /// a = tr ΔF̄, b = I₂(ΔF̄) (three dimensions) and r, which [`Kinematics::deps_derivative`] and
+    /// [`Kinematics::deps_volume_derivative`] differentiate:
+    /// in two dimensions tr L̄ = 4 − 4 (2 + a)/(1 + a + r) = 4 (r − 1)/(1 + a + r); in three
+    /// tr L̄ = 6 − 4 (3 + 2a + b)/(1 + a + b + r), its value formed from H̄ = ΔF̄ − I (small at small
+    /// strains). The caller passes `r_minus_one` = r − 1, formed without cancellation, so that the
+    /// volumetric strain keeps its relative precision at small strains. r = J gives c = 1 and the
+    /// step's own kinematics.
+    pub fn with_projected_volume(self, r_minus_one: f64) -> Kinematics<D> {
+        debug_assert!(!self.linear && self.f_hoop == 1.0, "F̄ is built for finite-strain steps without hoop");
         let r = 1.0 + r_minus_one;
-        let c = (r / self.j).sqrt();
-        let a = c * (self.f[0][0] + self.f[1][1]);
-        let den = 1.0 + a + r;
-        let tr_bar = 4.0 * r_minus_one / den;
         let l = &self.l;
-        let vol = (tr_bar - (l[0][0] + l[1][1])) / 3.0;
-        // ∂ tr L̄/∂a = −4(r − 1)/den², ∂ tr L̄/∂r|_a = 4(2 + a)/den² and ∂a/∂r = a/(2r).
-        let dtr_da = -4.0 * r_minus_one / (den * den);
-        let dtr_dr = dtr_da * a / (2.0 * r) + 4.0 * (2.0 + a) / (den * den);
-        Kinematics {
-            deps: [l[0][0] + vol, l[1][1] + vol, l[0][1] + l[1][0], vol],
-            projected: Some(Projected { c, a, dtr_da, dtr_dr }),
-            ..self
+        if D == 2 {
+            let c = (r / self.j).sqrt();
+            let a = c * (self.f[0][0] + self.f[1][1]);
+            let den = 1.0 + a + r;
+            let tr_bar = 4.0 * r_minus_one / den;
+            let vol = (tr_bar - (l[0][0] + l[1][1])) / 3.0;
+            // ∂ tr L̄/∂a = −4(r − 1)/den², ∂ tr L̄/∂r|_a = 4(2 + a)/den² and ∂a/∂r = a/(2r).
+            let dtr_da = -4.0 * r_minus_one / (den * den);
+            let dtr_dr = dtr_da * a / (2.0 * r) + 4.0 * (2.0 + a) / (den * den);
+            let projected = Projected { c, a, b: 0.0, dtr_da, dtr_db: 0.0, dtr_dr };
+            return Kinematics { deps: strain_of(l, 0.0, vol), projected: Some(projected), ..self };
+        }
+        // c − 1 from r/J − 1 = (r − 1 − (J − 1))/J without cancellation: c³ − 1 = x.
+        let x = (r_minus_one - self.dj) / self.j;
+        let c = (1.0 + x).cbrt();
+        let cm1 = x / (c * c + c + 1.0);
+        // H̄ = ΔF̄ − I = (c − 1) I + c H, and tr L̄ = tr(H̄ (I + H̄/2)⁻¹).
+        let hbar: Mat<D> = std::array::from_fn(|i| {
+            std::array::from_fn(|k| {
+                c * (self.f[i][k] - if i == k { 1.0 } else { 0.0 }) + if i == k { cm1 } else { 0.0 }
+            })
+        });
+        let tr_bar = trace(&mul(&hbar, &inverse(&plus_identity(&hbar, 0.5))), 0.0);
+        let vol = (tr_bar - trace(l, 0.0)) / 3.0;
+        let t = trace(&self.f, 0.0);
+        let minors = |m: &Mat<D>| {
+            m[0][0] * m[1][1] - m[0][1] * m[1][0] + m[1][1] * m[2][2] - m[1][2] * m[2][1] + m[0][0] * m[2][2]
+                - m[0][2] * m[2][0]
+        };
+        let (a, b) = (c * t, c * c * minors(&self.f));
+        // e₂(μ) = 3 + 2a + b, e₃(μ) = 1 + a + b + r.
+        let (n, q) = (3.0 + 2.0 * a + b, 1.0 + a + b + r);
+        let q2 = q * q;
+        let (dtr_da, dtr_db, dtr_dr_ab) = (-4.0 * (2.0 * q - n) / q2, -4.0 * (q - n) / q2, 4.0 * n / q2);
+        // ∂c/∂r = c/(3r): ∂a/∂r = a/(3r), ∂b/∂r = 2b/(3r).
+        let dtr_dr = dtr_dr_ab + (dtr_da * a + 2.0 * dtr_db * b) / (3.0 * r);
+        let projected = Projected { c, a, b, dtr_da, dtr_db, dtr_dr };
+        Kinematics { deps: strain_of(l, 0.0, vol), projected: Some(projected), ..self }
+    }
+
+    /// The stress `s` turned by the step's rotation, R s Rᵀ (the start of the objective update).
+    pub fn rotate(&self, s: &Stress) -> Stress {
+        if D == 2 {
+            rotate(s, self.theta)
+        } else {
+            principal::rotate(&std::array::from_fn(|i| std::array::from_fn(|j| self.rotation[i][j])), s)
         }
     }
 
     /// ∂Δε/∂r, the strain increment's derivative with respect to the projected volume ratio of an
     /// implicit F̄ step ([`Kinematics::with_projected_volume`]; zero without it): ⅓ d(tr L̄)/dr m,
-    /// m = [1, 1, 0, 1].
-    pub fn deps_volume_derivative(&self) -> [f64; 4] {
-        let Some(pj) = self.projected else { return [0.0; 4] };
+    /// m = [1, 1, 0, 1, 0, 0].
+    pub fn deps_volume_derivative(&self) -> Stress {
+        let Some(pj) = self.projected else { return [0.0; NS] };
         let d = pj.dtr_dr / 3.0;
-        [d, d, 0.0, d]
+        [d, d, 0.0, d, 0.0, 0.0]
     }
 
     /// The hoop operators of a node on x_{n+1}: (T', T̄') = (T/F_θθ, T̄/F_v,θθ).
     #[inline]
-    pub fn hoop(&self, b: &NodeBasis) -> (f64, f64) {
+    pub fn hoop(&self, b: &NodeBasis<D>) -> (f64, f64) {
         if self.linear {
             return (b.t, b.tv);
         }
@@ -307,63 +415,122 @@ impl Kinematics {
 
     /// The gradients of a node's basis function on x_{n+1}: (∇'S, ∇̄'S) = (F⁻ᵀ∇S, F_v⁻ᵀ∇̄S).
     #[inline]
-    pub fn spatial(&self, b: &NodeBasis) -> ([f64; 2], [f64; 2]) {
+    pub fn spatial(&self, b: &NodeBasis<D>) -> ([f64; D], [f64; D]) {
         (mul_t(&self.f_inv, b.g), mul_t(&self.fv_inv, b.gv))
     }
 
-    /// ∂Δε/∂Δu_l (4 strain components × 2 displacement components) for a node with basis `b`.
+    /// dL/dΔu_l,d for a node with basis `b`: dL = (I − L/2) dH F_h⁻¹ with dH = e_d ⊗ ∇S_l, so
+    /// dL_ac = (I − L/2)_ad (F_h⁻ᵀ∇S_l)_c.
+    fn rate_derivative(&self, b: &NodeBasis<D>, d: usize) -> Mat<D> {
+        let gh = mul_t(&self.fh_inv, b.g);
+        std::array::from_fn(|a| std::array::from_fn(|c| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c]))
+    }
+
+    /// ∂Δε/∂Δu_l (6 strain components × D displacement components) for a node with basis `b`.
     ///
     /// dL = (I − L/2) dH F_h⁻¹ with dH = e_d ⊗ ∇S_l, so dL_ab = (I − L/2)_ad (F_h⁻ᵀ∇S_l)_b; the
     /// same for L_v with ∇̄S_l. The hoop rate L_θθ = H_θθ/(1 + H_θθ/2) has
     /// dL_θθ/dΔu_l,r = T_l/(1 + H_θθ/2)², and L_v,θθ likewise with T̄_l.
-    pub fn deps_derivative(&self, b: &NodeBasis) -> [[f64; 2]; 4] {
-        let gh = mul_t(&self.fh_inv, b.g);
+    pub fn deps_derivative(&self, b: &NodeBasis<D>) -> [[f64; D]; NS] {
         let gvh = mul_t(&self.fvh_inv, b.gv);
         let gs = mul_t(&self.f_inv, b.g);
         let mid = |f: f64| if self.linear { 1.0 } else { 1.0 / (0.5 * (1.0 + f)).powi(2) };
         let (dlt, dlvt) = (b.t * mid(self.f_hoop), b.tv * mid(self.fv_hoop));
         // Column d: the strain increment of a unit increment of component d.
-        let column = |d: usize| -> [f64; 4] {
-            // dL[a][c] = (I − L/2)[a][d] gh[c].
-            let dl = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
+        let column = |d: usize| -> Stress {
+            let dl = self.rate_derivative(b, d);
             let dlv = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.lv[a][d]) * gvh[c];
             let (lt, lvt) = if d == 0 { (dlt, dlvt) } else { (0.0, 0.0) };
-            let tr = dl(0, 0) + dl(1, 1) + lt;
+            let tr = trace(&dl, lt);
             // With an implicit F̄: d tr L̄ = ∂tr L̄/∂a (c ∂tr ΔF − (a/2J) ∂J), ∂tr ΔF/∂Δu_l,d = (∇S_l)_d
             // and ∂J/∂Δu_l,d = J (F⁻ᵀ∇S_l)_d.
             let trv = match self.projected {
+                // ∂c/∂Δu_l,d = −(c/D) ∂J/J; in three dimensions b = c² I₂(ΔF) with
+                // ∂I₂/∂Δu_l,d = tr ΔF (∇S_l)_d − Σ_k ΔF_kd (∇S_l)_k.
+                Some(pj) if D == 3 => {
+                    let f = &self.f;
+                    let dm = trace(f, 0.0) * b.g[d] - (0..D).map(|k| f[k][d] * b.g[k]).sum::<f64>();
+                    pj.dtr_da * (pj.c * b.g[d] - pj.a * gs[d] / 3.0)
+                        + pj.dtr_db * (pj.c * pj.c * dm - 2.0 * pj.b * gs[d] / 3.0)
+                }
                 Some(pj) => pj.dtr_da * (pj.c * b.g[d] - 0.5 * pj.a * gs[d]),
-                None => dlv(0, 0) + dlv(1, 1) + lvt,
+                None => {
+                    let dlv_m: Mat<D> = std::array::from_fn(|a| std::array::from_fn(|c| dlv(a, c)));
+                    trace(&dlv_m, lvt)
+                }
             };
             let vol = (trv - tr) / 3.0;
-            [dl(0, 0) + vol, dl(1, 1) + vol, dl(0, 1) + dl(1, 0), lt + vol]
+            strain_of(&dl, lt, vol)
         };
-        let (c0, c1) = (column(0), column(1));
-        std::array::from_fn(|r| [c0[r], c1[r]])
+        let cols: [Stress; D] = std::array::from_fn(column);
+        std::array::from_fn(|r| std::array::from_fn(|d| cols[d][r]))
     }
 
-    /// ∂θ/∂Δu_l (2 displacement components) for a node with basis `b`.
-    pub fn theta_derivative(&self, b: &NodeBasis) -> [f64; 2] {
+    /// ∂(R σ_n Rᵀ)/∂Δu_l (6 stress components × D displacement components) for a node with basis
+    /// `b`, at the rotated stress `rotated` = R σ_n Rᵀ: dR = (I − W/2)⁻¹ (dW/2)(I + R), so
+    /// d(R σ_n Rᵀ) = Ω σ' − σ' Ω with the spin Ω = dR Rᵀ = (I − W/2)⁻¹ (dW/2)(I + Rᵀ) and
+    /// dW = ½(dL − dLᵀ). (In two dimensions the same is dθ times the derivative of the turn about
+    /// z, [`rotate_derivative`].)
+    pub fn rotated_derivative(&self, b: &NodeBasis<D>, rotated: &Stress) -> [[f64; D]; NS] {
+        let mut out = [[0.0; D]; NS];
         if self.linear {
-            return [0.0; 2];
+            return out;
         }
-        let gh = mul_t(&self.fh_inv, b.g);
-        let factor = 1.0 / (1.0 + 0.25 * self.omega * self.omega);
-        let mut out = [0.0; 2];
-        for (d, o) in out.iter_mut().enumerate() {
-            let dl = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
-            *o = factor * 0.5 * (dl(1, 0) - dl(0, 1));
+        if D == 2 {
+            let (drot, dt) = (rotate_derivative(rotated), self.theta_derivative(b));
+            for (row, v) in out.iter_mut().zip(drot) {
+                for (o, t) in row.iter_mut().zip(dt) {
+                    *o = v * t;
+                }
+            }
+            return out;
+        }
+        let s = principal::tensor(rotated);
+        let r_t: Mat<D> = std::array::from_fn(|i| std::array::from_fn(|j| self.rotation[j][i]));
+        let i_rt = plus_identity(&r_t, 1.0);
+        for d in 0..D {
+            let dl = self.rate_derivative(b, d);
+            let half_dw: Mat<D> = std::array::from_fn(|i| std::array::from_fn(|j| 0.25 * (dl[i][j] - dl[j][i])));
+            let omega = mul(&mul(&self.half_spin_inv, &half_dw), &i_rt);
+            let ds = principal::vector(&std::array::from_fn(|i| {
+                std::array::from_fn(|j| (0..3).map(|k| omega[i][k] * s[k][j] - s[i][k] * omega[k][j]).sum::<f64>())
+            }));
+            for (row, v) in out.iter_mut().zip(ds) {
+                row[d] = v;
+            }
         }
         out
     }
 
-    /// The incremental deformation gradient the particle keeps: F̄ = (J_v/J)^{1/2} F, whose
+    /// ∂θ/∂Δu_l (D displacement components) for a node with basis `b`: the angle about z of a
+    /// two-dimensional step (θ = 2 atan(ω/2), dθ = dω/(1 + ω²/4), dω = ½(dL_yx − dL_xy)).
+    pub fn theta_derivative(&self, b: &NodeBasis<D>) -> [f64; D] {
+        if self.linear {
+            return [0.0; D];
+        }
+        let factor = 1.0 / (1.0 + 0.25 * self.omega * self.omega);
+        std::array::from_fn(|d| {
+            let dl = self.rate_derivative(b, d);
+            factor * 0.5 * (dl[1][0] - dl[0][1])
+        })
+    }
+
+    /// The incremental deformation gradient the particle keeps: F̄ = (J_v/J)^{1/D} F, whose
     /// determinant is J_v (so that the domain and the volume follow the same volume change; in
     /// axial symmetry its in-plane determinant is J_v/F_θθ, the area change of a ring whose
     /// radius grew by F_θθ).
-    pub fn f_bar(&self) -> M2 {
-        let s = if self.j > 0.0 && self.jv > 0.0 { (self.jv / self.j).sqrt() } else { 1.0 };
-        [[self.f[0][0] * s, self.f[0][1] * s], [self.f[1][0] * s, self.f[1][1] * s]]
+    pub fn f_bar(&self) -> Mat<D> {
+        let s = if self.j > 0.0 && self.jv > 0.0 {
+            let ratio = self.jv / self.j;
+            if D == 2 {
+                ratio.sqrt()
+            } else {
+                ratio.cbrt()
+            }
+        } else {
+            1.0
+        };
+        self.f.map(|r| r.map(|v| v * s))
     }
 }
 
@@ -419,15 +586,23 @@ mod tests {
         check_derivatives(&b, &u, |v| Kinematics::new(&b, v.iter().copied(), false));
     }
 
-    /// Asserts that ∂Δε/∂Δu_l and ∂θ/∂Δu_l of the kinematics `at(u)` match central differences at
-    /// the nodal increments `u`, for every node of `b` and both components.
-    fn check_derivatives(b: &[NodeBasis], u: &[[f64; 2]], at: impl Fn(&[[f64; 2]]) -> Kinematics) {
+    /// Asserts that ∂Δε/∂Δu_l, ∂θ/∂Δu_l (two dimensions) and ∂(R σ Rᵀ)/∂Δu_l of the kinematics
+    /// `at(u)` match central differences at the nodal increments `u`, for every node of `b` and
+    /// every component.
+    fn check_derivatives<const D: usize>(
+        b: &[NodeBasis<D>],
+        u: &[[f64; D]],
+        at: impl Fn(&[[f64; D]]) -> Kinematics<D>,
+    ) {
         let k0 = at(u);
+        let sigma = [3.0, -1.0, 0.7, 2.0, if D == 3 { 0.4 } else { 0.0 }, if D == 3 { -1.3 } else { 0.0 }];
+        let rotated = k0.rotate(&sigma);
         let h = 1e-7;
         for l in 0..b.len() {
             let de = k0.deps_derivative(&b[l]);
             let dt = k0.theta_derivative(&b[l]);
-            for d in 0..2 {
+            let dr = k0.rotated_derivative(&b[l], &rotated);
+            for d in 0..D {
                 let shifted = |s: f64| {
                     let mut v = u.to_vec();
                     v[l][d] += s;
@@ -442,9 +617,86 @@ mod tests {
                         der[d]
                     );
                 }
-                let fd = (p.theta - m.theta) / (2.0 * h);
-                assert!((fd - dt[d]).abs() < 1e-7 * (1.0 + fd.abs()), "theta node {l} comp {d}: {fd} vs {}", dt[d]);
+                if D == 2 {
+                    let fd = (p.theta - m.theta) / (2.0 * h);
+                    assert!((fd - dt[d]).abs() < 1e-7 * (1.0 + fd.abs()), "theta node {l} comp {d}: {fd} vs {}", dt[d]);
+                }
+                let (sp, sm) = (p.rotate(&sigma), m.rotate(&sigma));
+                for (r, der) in dr.iter().enumerate() {
+                    let fd = (sp[r] - sm[r]) / (2.0 * h);
+                    assert!(
+                        (fd - der[d]).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "R σ Rᵀ [{r}] node {l} comp {d}: {fd} vs {}",
+                        der[d]
+                    );
+                }
             }
+        }
+    }
+
+    /// A basis of five nodes in three dimensions (distinct deviatoric and volumetric gradients).
+    fn basis_3d() -> Vec<NodeBasis<3>> {
+        (0..5)
+            .map(|k| {
+                let x = k as f64;
+                NodeBasis {
+                    s: 0.2,
+                    g: [(x * 1.3).cos() * 3.0, (x * 0.9).sin() * 2.0, (x * 0.6 + 0.3).cos() * 2.2],
+                    gv: [(x * 1.1).cos() * 2.5, (x * 0.4).sin() * 1.5, (x * 0.8 - 0.2).sin() * 1.8],
+                    t: 0.0,
+                    tv: 0.0,
+                }
+            })
+            .collect()
+    }
+
+    fn du_3d(k: usize, scale: f64) -> [f64; 3] {
+        let x = k as f64;
+        [scale * (0.3 + x * 0.7).sin(), scale * (1.1 * x - 0.2).cos(), scale * (0.5 * x + 0.9).sin()]
+    }
+
+    #[test]
+    fn derivatives_match_central_differences_in_three_dimensions() {
+        let b = basis_3d();
+        for scale in [0.02, 0.2] {
+            let u: Vec<[f64; 3]> = (0..b.len()).map(|k| du_3d(k, scale)).collect();
+            let k = Kinematics::new(&b, u.iter().copied(), false);
+            assert!(k.deps[4].abs() > 1e-3 && k.deps[5].abs() > 1e-3, "{:?}", k.deps);
+            check_derivatives(&b, &u, |v| Kinematics::new(&b, v.iter().copied(), false));
+            // J − 1 without cancellation is det F − 1.
+            assert!((k.dj - (k.j - 1.0)).abs() < 1e-14, "{} vs {}", k.dj, k.j - 1.0);
+            // Geometrically linear: the derivatives are those of sym H, and there is no rotation.
+            check_derivatives(&b, &u, |v| Kinematics::new(&b, v.iter().copied(), true));
+        }
+    }
+
+    /// A rigid rotation Q about a tilted axis: no strain, R = Q to round-off (the Cayley transform
+    /// of the mid-step spin is exact for it), J = 1, and the stress turns with the material.
+    #[test]
+    fn a_rigid_rotation_in_three_dimensions_has_no_strain_and_turns_the_stress() {
+        let corners: Vec<[f64; 3]> =
+            (0..8).map(|c| [(c & 1) as f64, ((c >> 1) & 1) as f64, ((c >> 2) & 1) as f64]).collect();
+        // Trilinear gradients of the cube's centre reproduce a linear field.
+        let b: Vec<NodeBasis<3>> = corners
+            .iter()
+            .map(|x| {
+                let g: [f64; 3] = std::array::from_fn(|d| if x[d] == 0.0 { -0.25 } else { 0.25 });
+                NodeBasis { s: 0.125, g, gv: g, t: 0.0, tv: 0.0 }
+            })
+            .collect();
+        let n = 14f64.sqrt();
+        for alpha in [0.1f64, 0.9, -1.4] {
+            let q = principal::rotation([1.0 / n, -2.0 / n, 3.0 / n], alpha);
+            let u = corners.iter().map(|x| std::array::from_fn(|i| (0..3).map(|k| q[i][k] * x[k]).sum::<f64>() - x[i]));
+            let k = Kinematics::new(&b, u, false);
+            assert!(k.deps.iter().all(|e| e.abs() < 1e-14), "{:?}", k.deps);
+            assert!((k.j - 1.0).abs() < 1e-14 && (k.jv - 1.0).abs() < 1e-14);
+            let s = [3.0, -1.0, 0.7, 2.0, 0.4, -1.3];
+            let (turned, expected) = (k.rotate(&s), principal::rotate(&q, &s));
+            assert!(turned.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-13), "{turned:?} vs {expected:?}");
+            // F̄ keeps the rotation and the volume.
+            let fb = k.f_bar();
+            assert!((0..3).all(|i| (0..3).all(|j| (fb[i][j] - q[i][j]).abs() < 1e-14)));
         }
     }
 
@@ -453,43 +705,55 @@ mod tests {
         basis().into_iter().map(|b| NodeBasis { gv: b.g, t: 0.0, tv: 0.0, ..b }).collect()
     }
 
-    #[test]
-    fn the_projected_volume_is_the_explicit_scale_of_the_increment() {
-        // with_projected_volume(r) is ΔF̄ = c ΔF with c = (r/J)^{1/2}: the same strain increment as
-        // the explicit step's with_volume_scale(c), whose trace is formed by matrix products; and
-        // r = J leaves the step's own kinematics.
-        let b = plane_basis();
-        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
-        let k0 = Kinematics::new(&b, u.iter().copied(), false);
-        for r in [0.93, 1.0, 1.08] {
+    /// Asserts that the implicit F̄ step's projected strain at the increments `u` is the explicit
+    /// scaling's by c = (r/J)^{1/D} for each r of `rs` (to `tol`), with the step's own volume; that
+    /// r = J gives the step's own strain; and that its derivatives in Δu and r at r = 1.04 match
+    /// central differences.
+    fn check_projected<const D: usize>(b: &[NodeBasis<D>], u: &[[f64; D]], rs: &[f64], tol: f64) {
+        let k0 = Kinematics::new(b, u.iter().copied(), false);
+        for &r in rs {
             let proj = k0.with_projected_volume(r - 1.0);
-            let scaled = k0.with_volume_scale((r / k0.j).sqrt());
-            for (a, e) in proj.deps.iter().zip(&scaled.deps) {
-                assert!((a - e).abs() < 1e-14, "{:?} vs {:?}", proj.deps, scaled.deps);
+            let scaled = k0.with_volume_scale((r / k0.j).powf(1.0 / D as f64));
+            for (p, e) in proj.deps.iter().zip(&scaled.deps) {
+                assert!((p - e).abs() < tol, "r {r}: {:?} vs {:?}", proj.deps, scaled.deps);
             }
             assert_eq!(proj.jv, k0.jv, "the volume stays the step's own");
         }
         let own = k0.with_projected_volume(k0.dj);
-        for (a, e) in own.deps.iter().zip(&k0.deps) {
-            assert!((a - e).abs() < 1e-14);
+        for (p, e) in own.deps.iter().zip(&k0.deps) {
+            assert!((p - e).abs() < 1e-14 * (1.0 + e.abs()), "{:?} vs {:?}", own.deps, k0.deps);
         }
-    }
-
-    #[test]
-    fn projected_derivatives_match_central_differences() {
-        let b = plane_basis();
-        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
         let r0 = 1.04;
-        let at = |v: &[[f64; 2]], r: f64| Kinematics::new(&b, v.iter().copied(), false).with_projected_volume(r - 1.0);
-        check_derivatives(&b, &u, |v| at(v, r0));
-        let (k0, h) = (at(&u, r0), 1e-7);
-        let dr = k0.deps_volume_derivative();
-        let (p, m) = (at(&u, r0 + h), at(&u, r0 - h));
+        let at = |v: &[[f64; D]], r: f64| Kinematics::new(b, v.iter().copied(), false).with_projected_volume(r - 1.0);
+        check_derivatives(b, u, |v| at(v, r0));
+        let (k1, h) = (at(u, r0), 1e-7);
+        let dr = k1.deps_volume_derivative();
+        let (p, m) = (at(u, r0 + h), at(u, r0 - h));
         for (row, der) in dr.iter().enumerate() {
             let fd = (p.deps[row] - m.deps[row]) / (2.0 * h);
             assert!((fd - der).abs() < 1e-7 * (1.0 + fd.abs()), "deps[{row}] in r: {fd} vs {der}");
         }
         assert!(dr[0].abs() > 0.1, "the strain sees r: {dr:?}");
+    }
+
+    /// The implicit F̄ in two dimensions (plane strain): with_projected_volume(r) is ΔF̄ = c ΔF
+    /// with c = (r/J)^{1/2}, the same strain increment as the explicit step's
+    /// with_volume_scale(c), whose trace is formed by matrix products; exact derivatives.
+    #[test]
+    fn the_projected_volume_is_the_explicit_scale_of_the_increment_with_exact_derivatives() {
+        let b = plane_basis();
+        let u: Vec<[f64; 2]> = (0..b.len()).map(|k| du(k, 0.03)).collect();
+        check_projected(&b, &u, &[0.93, 1.0, 1.08], 1e-14);
+    }
+
+    /// The implicit F̄ in three dimensions, at small and finite increments, r near 1 included.
+    #[test]
+    fn the_projected_volume_in_three_dimensions_is_the_scaled_increment_with_exact_derivatives() {
+        let b: Vec<NodeBasis<3>> = basis_3d().into_iter().map(|n| NodeBasis { gv: n.g, ..n }).collect();
+        for scale in [1e-4, 0.03] {
+            let u: Vec<[f64; 3]> = (0..b.len()).map(|k| du_3d(k, scale)).collect();
+            check_projected(&b, &u, &[0.93, 1.0, 1.08, 1.0 + 1e-6], 1e-13);
+        }
     }
 
     #[test]

@@ -166,20 +166,26 @@ impl Layout {
     }
 }
 
-/// Basis values of one stencil node for one particle.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct NodeBasis {
+/// Basis values of one stencil node for one particle (two-dimensional unless `D` says otherwise).
+#[derive(Debug, Clone, Copy)]
+pub struct NodeBasis<const D: usize = 2> {
     /// S_i.
     pub s: f64,
     /// ∇S_i (deviatoric part of B̄), on x_n.
-    pub g: [f64; 2],
+    pub g: [f64; D],
     /// ∇̄S_i (volumetric part of B̄; equals `g` without B̄), on x_n.
-    pub gv: [f64; 2],
+    pub gv: [f64; D],
     /// The hoop operator T_i of an axisymmetric analysis (ε_θθ = Σ T_i u_r,i; S_i/r_p for the
     /// planar weights), on x_n; zero in plane strain.
     pub t: f64,
     /// The hoop operator of B̄'s volumetric part (equals `t` without B̄).
     pub tv: f64,
+}
+
+impl<const D: usize> Default for NodeBasis<D> {
+    fn default() -> Self {
+        NodeBasis { s: 0.0, g: [0.0; D], gv: [0.0; D], t: 0.0, tv: 0.0 }
+    }
 }
 
 /// The basis of a whole stencil without B̄, with the hoop operators `hoop` (zero in plane
@@ -691,7 +697,7 @@ impl<'a> Point<'a> {
             // r − 1 = (1 + Σ S ϑ − J̄_n)/J̄_n, without the cancellation of forming r first.
             kin = kin.with_projected_volume((interp.jbar - (part.jbar - 1.0)) / part.jbar);
         }
-        let rotated = kinematics::rotate(&part.stress, kin.theta);
+        let rotated = kin.rotate(&part.stress);
         // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
         let f_bar = kin.f_bar();
@@ -699,7 +705,7 @@ impl<'a> Point<'a> {
         let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
             .finite(&finite_strain::plane(df), &finite_strain::plane(f_new), &part.stress, part.eps_pd, part.dt)
-            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &soil::plane(kin.deps)));
+            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
         let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
         Point {
             basis,
@@ -875,9 +881,9 @@ pub struct StepResult {
     pub f_inc: [[f64; 2]; 2],
     /// Volume ratio of the step, J_v.
     pub jacobian: f64,
-    /// The objective strain increment Δε [xx, yy, γxy, zz] the stress update used (zero for a
-    /// rigid rotation).
-    pub deps: [f64; 4],
+    /// The objective strain increment Δε [xx, yy, γxy, zz, γyz, γzx] the stress update used (zero
+    /// for a rigid rotation).
+    pub deps: Stress,
     /// The porosity gradient ∇n at t_n the step used (two-phase u–p–U; zero otherwise).
     pub grad_n: [f64; 2],
     /// [002]'s projected J̄ at t_{n+1} (`stabilisation.fbar`; `None`: the point keeps its J̄).

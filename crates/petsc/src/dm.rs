@@ -6,80 +6,101 @@ use crate::vector::{VecOps, Vector};
 use crate::{cstring, Comm, Error, Int, Result};
 use petsc_sys as sys;
 
-/// Layout of a 2D DMDA on this rank: owned and ghosted node ranges.
+/// Layout of a DMDA on this rank (two-dimensional unless `D` says otherwise): owned and ghosted
+/// node ranges.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DmDaInfo {
-    /// Global number of nodes in x and y.
-    pub nodes: [usize; 2],
+pub struct DmDaInfo<const D: usize = 2> {
+    /// Global number of nodes in each direction.
+    pub nodes: [usize; D],
     /// Degrees of freedom per node.
     pub dof: usize,
     /// Ghost (stencil) width in nodes.
     pub stencil_width: usize,
-    /// First owned node (i, j) and number of owned nodes in each direction.
-    pub owned_start: [usize; 2],
+    /// First owned node in each direction.
+    pub owned_start: [usize; D],
     /// Number of owned nodes in each direction.
-    pub owned_count: [usize; 2],
+    pub owned_count: [usize; D],
     /// The ghosted block of nodes held in local vectors.
-    pub ghosted: GhostedRange,
+    pub ghosted: GhostedRange<D>,
 }
 
-/// The ghosted node block of this rank: local vectors store nodes `start..start+count` (row-major,
-/// x fastest) with `dof` entries each.
+/// The ghosted node block of this rank: local vectors store nodes `start..start+count` (x fastest,
+/// then y, then z) with `dof` entries each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct GhostedRange {
-    /// First node (i, j) of the block.
-    pub start: [usize; 2],
-    /// Nodes in x and y.
-    pub count: [usize; 2],
+pub struct GhostedRange<const D: usize = 2> {
+    /// First node of the block in each direction.
+    pub start: [usize; D],
+    /// Nodes in each direction.
+    pub count: [usize; D],
     /// Degrees of freedom per node.
     pub dof: usize,
 }
 
-impl GhostedRange {
-    /// Whether global node (i, j) is in the ghosted block.
-    pub fn contains(&self, i: usize, j: usize) -> bool {
-        i >= self.start[0]
-            && j >= self.start[1]
-            && i < self.start[0] + self.count[0]
-            && j < self.start[1] + self.count[1]
+impl<const D: usize> GhostedRange<D> {
+    /// Whether the global node with indices `n` is in the ghosted block.
+    pub fn holds(&self, n: [usize; D]) -> bool {
+        (0..D).all(|d| n[d] >= self.start[d] && n[d] < self.start[d] + self.count[d])
     }
 
-    /// Local (ghosted) node number of global node (i, j); `None` outside the block.
-    pub fn node(&self, i: usize, j: usize) -> Option<usize> {
-        self.contains(i, j).then(|| (j - self.start[1]) * self.count[0] + (i - self.start[0]))
+    /// Local (ghosted) node number of the global node with indices `n`; `None` outside the block.
+    pub fn local(&self, n: [usize; D]) -> Option<usize> {
+        self.holds(n).then(|| (0..D).rev().fold(0, |acc, d| acc * self.count[d] + (n[d] - self.start[d])))
+    }
+
+    /// The global node indices of local node `l`.
+    pub fn indices(&self, mut l: usize) -> [usize; D] {
+        std::array::from_fn(|d| {
+            let i = l % self.count[d];
+            l /= self.count[d];
+            self.start[d] + i
+        })
     }
 
     /// Number of nodes in the block.
     pub fn len(&self) -> usize {
-        self.count[0] * self.count[1]
+        self.count.iter().product()
     }
 
     /// Whether the block is empty.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+}
+
+/// The two-dimensional forms with (i, j) indices.
+impl GhostedRange<2> {
+    /// Whether global node (i, j) is in the ghosted block.
+    pub fn contains(&self, i: usize, j: usize) -> bool {
+        self.holds([i, j])
+    }
+
+    /// Local (ghosted) node number of global node (i, j); `None` outside the block.
+    pub fn node(&self, i: usize, j: usize) -> Option<usize> {
+        self.local([i, j])
+    }
 
     /// Global node (i, j) of local node `l`.
     pub fn ij(&self, l: usize) -> (usize, usize) {
-        (self.start[0] + l % self.count[0], self.start[1] + l / self.count[0])
+        let [i, j] = self.indices(l);
+        (i, j)
     }
 }
 
-/// An owned 2D DMDA, destroyed on drop.
-pub struct DmDa {
+/// An owned DMDA (two-dimensional unless `D` says otherwise), destroyed on drop.
+pub struct DmDa<const D: usize = 2> {
     raw: sys::DM,
-    info: DmDaInfo,
+    info: DmDaInfo<D>,
     local_to_global: Vec<Int>,
 }
 
-impl Drop for DmDa {
+impl<const D: usize> Drop for DmDa<D> {
     fn drop(&mut self) {
         // SAFETY: owned handle, destroyed once (objects referencing it hold their own reference).
         unsafe { sys::DMDestroy(&mut self.raw) };
     }
 }
 
-impl DmDa {
+impl DmDa<2> {
     /// A 2D grid of `nodes[0] × nodes[1]` nodes with `field_names.len()` interlaced dofs per node,
     /// a box stencil of width `stencil_width`, and non-periodic boundaries. Matrices created from it
     /// are only preallocated (no zeros are stored), so their structure is what assembly puts in.
@@ -97,40 +118,98 @@ impl DmDa {
         field_names: &[&str],
         ranges: Option<(&[usize], &[usize])>,
     ) -> Result<DmDa> {
+        DmDa::create(comm, nodes, stencil_width, field_names, ranges.map(|(x, y)| [x, y]))
+    }
+
+    /// Which ranks own the nodes: the number of owned node columns (x) and rows (y) of each rank
+    /// along each direction.
+    pub fn ownership_ranges(&self) -> Result<(Vec<usize>, Vec<usize>)> {
+        let [x, y] = self.ownership()?;
+        Ok((x, y))
+    }
+}
+
+impl DmDa<3> {
+    /// A 3D grid of `nodes[0] × nodes[1] × nodes[2]` nodes, as [`DmDa::new_2d_partitioned`]: the
+    /// number of node layers of each process slab in x, y and z (their product of counts the
+    /// communicator's size; rank a + b m + c m n owns slabs a, b, c), or `None` for PETSc's choice.
+    pub fn new_3d(
+        comm: Comm,
+        nodes: [usize; 3],
+        stencil_width: usize,
+        field_names: &[&str],
+        ranges: Option<[&[usize]; 3]>,
+    ) -> Result<DmDa<3>> {
+        DmDa::create(comm, nodes, stencil_width, field_names, ranges)
+    }
+}
+
+impl<const D: usize> DmDa<D> {
+    /// The DMDA of any dimension (2 or 3; see [`DmDa::new_2d_partitioned`]).
+    fn create(
+        comm: Comm,
+        nodes: [usize; D],
+        stencil_width: usize,
+        field_names: &[&str],
+        ranges: Option<[&[usize]; D]>,
+    ) -> Result<DmDa<D>> {
         if field_names.is_empty() {
             return Err(Error::new("a DMDA needs at least one field"));
         }
-        let lx: Option<Vec<Int>> = ranges.map(|r| r.0.iter().map(|&v| v as Int).collect());
-        let ly: Option<Vec<Int>> = ranges.map(|r| r.1.iter().map(|&v| v as Int).collect());
-        let (m, n) = match (&lx, &ly) {
-            (Some(x), Some(y)) => (x.len() as Int, y.len() as Int),
-            _ => (sys::PETSC_DECIDE as Int, sys::PETSC_DECIDE as Int),
+        let lists: Option<[Vec<Int>; D]> = ranges.map(|r| r.map(|l| l.iter().map(|&v| v as Int).collect()));
+        let procs: [Int; D] = match &lists {
+            Some(l) => std::array::from_fn(|d| l[d].len() as Int),
+            None => [sys::PETSC_DECIDE as Int; D],
         };
+        let list = |d: usize| lists.as_ref().map_or(std::ptr::null(), |l| l[d].as_ptr());
+        let none = sys::DMBoundaryType::DM_BOUNDARY_NONE;
         let mut raw = std::ptr::null_mut();
-        call!(DMDACreate2d(
-            comm.raw(),
-            sys::DMBoundaryType::DM_BOUNDARY_NONE,
-            sys::DMBoundaryType::DM_BOUNDARY_NONE,
-            sys::DMDAStencilType::DMDA_STENCIL_BOX,
-            nodes[0] as Int,
-            nodes[1] as Int,
-            m,
-            n,
-            field_names.len() as Int,
-            stencil_width as Int,
-            lx.as_ref().map_or(std::ptr::null(), |v| v.as_ptr()),
-            ly.as_ref().map_or(std::ptr::null(), |v| v.as_ptr()),
-            &mut raw
-        ))?;
+        match D {
+            2 => call!(DMDACreate2d(
+                comm.raw(),
+                none,
+                none,
+                sys::DMDAStencilType::DMDA_STENCIL_BOX,
+                nodes[0] as Int,
+                nodes[1] as Int,
+                procs[0],
+                procs[1],
+                field_names.len() as Int,
+                stencil_width as Int,
+                list(0),
+                list(1),
+                &mut raw
+            ))?,
+            3 => call!(DMDACreate3d(
+                comm.raw(),
+                none,
+                none,
+                none,
+                sys::DMDAStencilType::DMDA_STENCIL_BOX,
+                nodes[0] as Int,
+                nodes[1] as Int,
+                nodes[2] as Int,
+                procs[0],
+                procs[1],
+                procs[2],
+                field_names.len() as Int,
+                stencil_width as Int,
+                list(0),
+                list(1),
+                list(2),
+                &mut raw
+            ))?,
+            _ => return Err(Error::new("a DMDA has two or three dimensions")),
+        }
         let mut dm = DmDa {
             raw,
             info: DmDaInfo {
                 nodes,
                 dof: field_names.len(),
                 stencil_width,
-                owned_start: [0; 2],
-                owned_count: [0; 2],
-                ghosted: GhostedRange { start: [0; 2], count: [0; 2], dof: field_names.len() },
+                owned_start: [0; D],
+                owned_count: [0; D],
+                ghosted: GhostedRange { start: [0; D], count: [0; D], dof: field_names.len() },
             },
             local_to_global: Vec::new(),
         };
@@ -140,13 +219,15 @@ impl DmDa {
             let c = cstring(name)?;
             call!(DMDASetFieldName(dm.raw, k as Int, c.as_ptr()))?;
         }
-        let (mut xs, mut ys, mut zs, mut xm, mut ym, mut zm): (Int, Int, Int, Int, Int, Int) = (0, 0, 0, 0, 0, 0);
-        call!(DMDAGetCorners(dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm))?;
-        dm.info.owned_start = [xs as usize, ys as usize];
-        dm.info.owned_count = [xm as usize, ym as usize];
-        call!(DMDAGetGhostCorners(dm.raw, &mut xs, &mut ys, &mut zs, &mut xm, &mut ym, &mut zm))?;
-        dm.info.ghosted.start = [xs as usize, ys as usize];
-        dm.info.ghosted.count = [xm as usize, ym as usize];
+        let mut c: [Int; 6] = [0; 6];
+        let [xs, ys, zs, xm, ym, zm] = &mut c;
+        call!(DMDAGetCorners(dm.raw, xs, ys, zs, xm, ym, zm))?;
+        dm.info.owned_start = std::array::from_fn(|d| c[d] as usize);
+        dm.info.owned_count = std::array::from_fn(|d| c[3 + d] as usize);
+        let [xs, ys, zs, xm, ym, zm] = &mut c;
+        call!(DMDAGetGhostCorners(dm.raw, xs, ys, zs, xm, ym, zm))?;
+        dm.info.ghosted.start = std::array::from_fn(|d| c[d] as usize);
+        dm.info.ghosted.count = std::array::from_fn(|d| c[3 + d] as usize);
         let mut ltog = std::ptr::null_mut();
         call!(DMGetLocalToGlobalMapping(dm.raw, &mut ltog))?;
         let mut n: Int = 0;
@@ -159,29 +240,20 @@ impl DmDa {
         Ok(dm)
     }
 
-    /// The layout on this rank.
-    pub fn info(&self) -> &DmDaInfo {
-        &self.info
-    }
-
-    /// Global (PETSc-ordered) index of each local (ghosted) dof: node-major, dof fastest.
-    pub fn local_to_global(&self) -> &[Int] {
-        &self.local_to_global
-    }
-
-    /// Which ranks own the nodes: the number of owned node columns (x) and rows (y) of each rank
-    /// along each direction.
-    pub fn ownership_ranges(&self) -> Result<(Vec<usize>, Vec<usize>)> {
-        let (mut m, mut n, mut p): (Int, Int, Int) = (0, 0, 0);
+    /// Which ranks own the nodes: the number of owned node layers of each process slab along each
+    /// direction.
+    pub fn ownership(&self) -> Result<[Vec<usize>; D]> {
+        let mut procs: [Int; 3] = [0; 3];
+        let [m, n, p] = &mut procs;
         call!(DMDAGetInfo(
             self.raw,
             std::ptr::null_mut(),
             std::ptr::null_mut(),
             std::ptr::null_mut(),
             std::ptr::null_mut(),
-            &mut m,
-            &mut n,
-            &mut p,
+            m,
+            n,
+            p,
             std::ptr::null_mut(),
             std::ptr::null_mut(),
             std::ptr::null_mut(),
@@ -189,17 +261,23 @@ impl DmDa {
             std::ptr::null_mut(),
             std::ptr::null_mut()
         ))?;
-        let (mut lx, mut ly, mut lz): (*const Int, *const Int, *const Int) =
-            (std::ptr::null(), std::ptr::null(), std::ptr::null());
-        call!(DMDAGetOwnershipRanges(self.raw, &mut lx, &mut ly, &mut lz))?;
-        // SAFETY: PETSc returns arrays of length m (x) and n (y).
-        let (x, y) = unsafe {
-            (
-                std::slice::from_raw_parts(lx, m as usize).iter().map(|&v| v as usize).collect(),
-                std::slice::from_raw_parts(ly, n as usize).iter().map(|&v| v as usize).collect(),
-            )
-        };
-        Ok((x, y))
+        let mut lists: [*const Int; 3] = [std::ptr::null(); 3];
+        let [lx, ly, lz] = &mut lists;
+        call!(DMDAGetOwnershipRanges(self.raw, lx, ly, lz))?;
+        // SAFETY: PETSc returns arrays of length m (x), n (y) and p (z, three dimensions).
+        Ok(std::array::from_fn(|d| {
+            unsafe { std::slice::from_raw_parts(lists[d], procs[d] as usize) }.iter().map(|&v| v as usize).collect()
+        }))
+    }
+
+    /// The layout on this rank.
+    pub fn info(&self) -> &DmDaInfo<D> {
+        &self.info
+    }
+
+    /// Global (PETSc-ordered) index of each local (ghosted) dof: node-major, dof fastest.
+    pub fn local_to_global(&self) -> &[Int] {
+        &self.local_to_global
     }
 
     /// A new global vector (owned nodes only, PETSc ordering).
