@@ -419,10 +419,10 @@ impl<const D: usize> Kinematics<D> {
         (mul_t(&self.f_inv, b.g), mul_t(&self.fv_inv, b.gv))
     }
 
-    /// dL/dΔu_l,d for a node with basis `b`: dL = (I − L/2) dH F_h⁻¹ with dH = e_d ⊗ ∇S_l, so
-    /// dL_ac = (I − L/2)_ad (F_h⁻ᵀ∇S_l)_c.
-    fn rate_derivative(&self, b: &NodeBasis<D>, d: usize) -> Mat<D> {
-        let gh = mul_t(&self.fh_inv, b.g);
+    /// dL/dΔu_l,d for a node whose basis has F_h⁻ᵀ∇S_l = `gh`: dL = (I − L/2) dH F_h⁻¹ with
+    /// dH = e_d ⊗ ∇S_l, so dL_ac = (I − L/2)_ad gh_c.
+    #[inline]
+    fn rate_derivative_at(&self, gh: &[f64; D], d: usize) -> Mat<D> {
         std::array::from_fn(|a| std::array::from_fn(|c| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c]))
     }
 
@@ -432,13 +432,14 @@ impl<const D: usize> Kinematics<D> {
     /// same for L_v with ∇̄S_l. The hoop rate L_θθ = H_θθ/(1 + H_θθ/2) has
     /// dL_θθ/dΔu_l,r = T_l/(1 + H_θθ/2)², and L_v,θθ likewise with T̄_l.
     pub fn deps_derivative(&self, b: &NodeBasis<D>) -> [[f64; D]; NS] {
+        let gh = mul_t(&self.fh_inv, b.g);
         let gvh = mul_t(&self.fvh_inv, b.gv);
         let gs = mul_t(&self.f_inv, b.g);
         let mid = |f: f64| if self.linear { 1.0 } else { 1.0 / (0.5 * (1.0 + f)).powi(2) };
         let (dlt, dlvt) = (b.t * mid(self.f_hoop), b.tv * mid(self.fv_hoop));
         // Column d: the strain increment of a unit increment of component d.
         let column = |d: usize| -> Stress {
-            let dl = self.rate_derivative(b, d);
+            let dl = self.rate_derivative_at(&gh, d);
             let dlv = |a: usize, c: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.lv[a][d]) * gvh[c];
             let (lt, lvt) = if d == 0 { (dlt, dlvt) } else { (0.0, 0.0) };
             let tr = trace(&dl, lt);
@@ -454,10 +455,7 @@ impl<const D: usize> Kinematics<D> {
                         + pj.dtr_db * (pj.c * pj.c * dm - 2.0 * pj.b * gs[d] / 3.0)
                 }
                 Some(pj) => pj.dtr_da * (pj.c * b.g[d] - 0.5 * pj.a * gs[d]),
-                None => {
-                    let dlv_m: Mat<D> = std::array::from_fn(|a| std::array::from_fn(|c| dlv(a, c)));
-                    trace(&dlv_m, lvt)
-                }
+                None => (1..D).fold(dlv(0, 0), |s, a| s + dlv(a, a)) + lvt,
             };
             let vol = (trv - tr) / 3.0;
             strain_of(&dl, lt, vol)
@@ -488,8 +486,9 @@ impl<const D: usize> Kinematics<D> {
         let s = principal::tensor(rotated);
         let r_t: Mat<D> = std::array::from_fn(|i| std::array::from_fn(|j| self.rotation[j][i]));
         let i_rt = plus_identity(&r_t, 1.0);
+        let gh = mul_t(&self.fh_inv, b.g);
         for d in 0..D {
-            let dl = self.rate_derivative(b, d);
+            let dl = self.rate_derivative_at(&gh, d);
             let half_dw: Mat<D> = std::array::from_fn(|i| std::array::from_fn(|j| 0.25 * (dl[i][j] - dl[j][i])));
             let omega = mul(&mul(&self.half_spin_inv, &half_dw), &i_rt);
             let ds = principal::vector(&std::array::from_fn(|i| {
@@ -508,11 +507,11 @@ impl<const D: usize> Kinematics<D> {
         if self.linear {
             return [0.0; D];
         }
+        let gh = mul_t(&self.fh_inv, b.g);
         let factor = 1.0 / (1.0 + 0.25 * self.omega * self.omega);
-        std::array::from_fn(|d| {
-            let dl = self.rate_derivative(b, d);
-            factor * 0.5 * (dl[1][0] - dl[0][1])
-        })
+        // dL_ac = (I − L/2)_ad gh_c, of which dω takes dL_yx and dL_xy.
+        let dl = |a: usize, c: usize, d: usize| (if a == d { 1.0 } else { 0.0 } - 0.5 * self.l[a][d]) * gh[c];
+        std::array::from_fn(|d| factor * 0.5 * (dl(1, 0, d) - dl(0, 1, d)))
     }
 
     /// The incremental deformation gradient the particle keeps: F̄ = (J_v/J)^{1/D} F, whose
