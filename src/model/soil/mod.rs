@@ -22,7 +22,7 @@ pub use mohr_coulomb::MohrCoulomb;
 pub use von_mises::VonMises;
 
 use crate::model::finite_strain::M3;
-use principal::{mul6, Principal};
+use principal::Principal;
 
 /// Components of the stress and strain vectors.
 pub const NS: usize = 6;
@@ -181,10 +181,28 @@ impl LinearElastic {
     /// σ + D Δε.
     pub fn trial(&self, stress: &Stress, deps: &Stress) -> Stress {
         let mut s = *stress;
-        for (r, sr) in s.iter_mut().enumerate() {
-            *sr += (0..NS).map(|c| self.d[r][c] * deps[c]).sum::<f64>();
+        // D^e couples [xx, yy, xy, zz] among themselves; yz and zx each only with itself.
+        for (r, sr) in s.iter_mut().enumerate().take(NS_PLANE) {
+            *sr += (0..NS_PLANE).map(|c| self.d[r][c] * deps[c]).sum::<f64>();
+        }
+        for r in NS_PLANE..NS {
+            s[r] += self.d[r][r] * deps[r];
         }
         s
+    }
+
+    /// m D^e, with D^e's structure (see [`LinearElastic::trial`]): the consistent tangent of a
+    /// return whose dσ/dσ_trial is `m`.
+    pub fn right_multiply(&self, m: &Mat6) -> Mat6 {
+        std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if c < NS_PLANE {
+                    (0..NS_PLANE).map(|k| m[r][k] * self.d[k][c]).sum()
+                } else {
+                    m[r][c] * self.d[c][c]
+                }
+            })
+        })
     }
 }
 
@@ -369,7 +387,7 @@ fn isotropic_return(
     let dsdt = p.derivative(&r.stress, &r.tangent);
     StressUpdate {
         stress: p.compose(&r.stress),
-        tangent: mul6(&dsdt, &el.d),
+        tangent: el.right_multiply(&dsdt),
         trial_tangent: dsdt,
         eps_pd: r.eps,
         region: r.region,

@@ -158,17 +158,6 @@ impl Principal {
     }
 }
 
-/// A · B for 6 × 6 matrices.
-pub fn mul6(a: &Mat6, b: &Mat6) -> Mat6 {
-    let mut out = [[0.0; NS]; NS];
-    for (r, row) in out.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v = (0..NS).map(|k| a[r][k] * b[k][c]).sum();
-        }
-    }
-    out
-}
-
 /// R σ Rᵀ of a stress vector under the rotation (or any matrix) `r`.
 pub fn rotate(r: &[[f64; 3]; 3], s: &Stress) -> Stress {
     let t = tensor(s);

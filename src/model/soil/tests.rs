@@ -340,3 +340,22 @@ fn a_general_three_dimensional_state_returns_as_its_rotated_plane_twin() {
         assert!(e < 1e-6, "{:?} {l:?}: tangent error {e:e}", u.region);
     }
 }
+
+/// D^e's structured products (its [xx, yy, xy, zz] block and the two out-of-plane shears apart)
+/// are the full 6 × 6 ones.
+#[test]
+fn the_structured_elastic_products_are_the_full_ones() {
+    let el = LinearElastic::new(3.0e7, 0.35);
+    let m: Mat6 = std::array::from_fn(|r| std::array::from_fn(|c| ((r * 7 + c * 3) as f64 * 0.37).sin()));
+    let v: Stress = std::array::from_fn(|c| (c as f64 * 1.3).cos() * 1e-3);
+    let full = |r: usize, c: usize| (0..NS).map(|k| m[r][k] * el.d[k][c]).sum::<f64>();
+    let product = el.right_multiply(&m);
+    let trial = el.trial(&[0.0; NS], &v);
+    for r in 0..NS {
+        for (c, p) in product[r].iter().enumerate() {
+            assert!((p - full(r, c)).abs() <= 1e-15 * el.d[0][0], "m D [{r}][{c}]");
+        }
+        let dv: f64 = (0..NS).map(|c| el.d[r][c] * v[c]).sum();
+        assert!((trial[r] - dv).abs() <= 1e-15 * el.d[0][0], "D v [{r}]");
+    }
+}
