@@ -69,7 +69,7 @@ fn det<const D: usize>(a: &Mat<D>) -> f64 {
 /// The cofactor matrix of a (det a a⁻ᵀ; D = 2 or 3).
 fn cofactor<const D: usize>(a: &Mat<D>) -> Mat<D> {
     match D {
-        2 => std::array::from_fn(|i| std::array::from_fn(|j| [[a[1][1], -a[1][0]], [-a[0][1], a[0][0]]][i][j])),
+        2 => std::array::from_fn(|i| std::array::from_fn(|j| if i == j { a[1 - i][1 - j] } else { -a[1 - i][1 - j] })),
         3 => std::array::from_fn(|i| {
             std::array::from_fn(|j| {
                 let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);

@@ -193,41 +193,44 @@ impl<const D: usize, const M: usize> Stencil<D, M> {
 /// Up to four (node index, value, derivative) along one direction, and how many.
 type Weights1d = ([(u32, f64, f64); 4], usize);
 
+/// The value and gradient of a product of one-dimensional functions, Π_d v_d and, in direction
+/// d, dv_d Π_{e≠d} v_e (the factors multiplied in the order of the directions).
+fn product_rule<const D: usize>(v: [f64; D], dv: [f64; D]) -> (f64, [f64; D]) {
+    let value = v.iter().skip(1).fold(v[0], |acc, x| acc * x);
+    (value, std::array::from_fn(|d| (0..D).filter(|&e| e != d).fold(dv[d], |acc, e| acc * v[e])))
+}
+
+/// Moves the multi-index `at` to the next combination of `counts[d]` choices per direction, x
+/// fastest; `false` when every combination has been visited (`at` is then back at zero).
+fn next_combination<const D: usize>(at: &mut [usize; D], counts: [usize; D]) -> bool {
+    for d in 0..D {
+        at[d] += 1;
+        if at[d] < counts[d] {
+            return true;
+        }
+        at[d] = 0;
+    }
+    false
+}
+
 /// The tensor product of per-direction lists of (index, value, derivative): every combination,
 /// x fastest, with the product of the values and, in direction d, the derivative in d times the
 /// other directions' values.
 fn tensor_product<const D: usize, const M: usize>(per: &[Weights1d; D]) -> Stencil<D, M> {
     let mut s = Stencil::default();
-    if per.iter().any(|p| p.1 == 0) {
+    let counts = per.map(|p| p.1);
+    if counts.contains(&0) {
         return s;
     }
     let mut at = [0usize; D];
     loop {
         let k = s.len;
-        let (mut w, mut dw) = (1.0, [0.0; D]);
-        for d in 0..D {
-            let (i, v, _) = per[d].0[at[d]];
-            s.nodes[k][d] = i;
-            w = if d == 0 { v } else { w * v };
-        }
-        for (d, g) in dw.iter_mut().enumerate() {
-            *g = (0..D).filter(|&e| e != d).fold(per[d].0[at[d]].2, |acc, e| acc * per[e].0[at[e]].1);
-        }
-        s.w[k] = w;
-        s.dw[k] = dw;
+        let entry = |d: usize| per[d].0[at[d]];
+        s.nodes[k] = std::array::from_fn(|d| entry(d).0);
+        (s.w[k], s.dw[k]) = product_rule(std::array::from_fn(|d| entry(d).1), std::array::from_fn(|d| entry(d).2));
         s.len += 1;
-        // The next combination, x fastest.
-        let mut d = 0;
-        loop {
-            at[d] += 1;
-            if at[d] < per[d].1 {
-                break;
-            }
-            at[d] = 0;
-            d += 1;
-            if d == D {
-                return s;
-            }
+        if !next_combination(&mut at, counts) {
+            return s;
         }
     }
 }
@@ -587,8 +590,9 @@ pub fn volumetric_operators_in<const D: usize, const M: usize>(
         (out, n)
     };
     let per: [([(usize, f64); 3], usize); D] = std::array::from_fn(overlaps);
+    let counts = per.map(|p| p.1);
     let total: f64 = per.iter().map(|(o, n)| o[..*n].iter().map(|a| a.1).sum::<f64>()).product();
-    if total <= 0.0 || per.iter().any(|p| p.1 == 0) {
+    if total <= 0.0 || counts.contains(&0) {
         return (gv, tv);
     }
     let corner_scale = (1u32 << (D - 1)) as f64;
@@ -609,18 +613,8 @@ pub fn volumetric_operators_in<const D: usize, const M: usize>(
             }
             tv[k] += f * centre_hoop;
         }
-        // The next cell, x fastest.
-        let mut d = 0;
-        loop {
-            at[d] += 1;
-            if at[d] < per[d].1 {
-                break;
-            }
-            at[d] = 0;
-            d += 1;
-            if d == D {
-                return (gv, tv);
-            }
+        if !next_combination(&mut at, counts) {
+            return (gv, tv);
         }
     }
 }
@@ -644,8 +638,7 @@ pub fn multilinear<const D: usize>(node: [f64; D], x: [f64; D], side: [f64; D], 
             0.0
         }
     });
-    let value = n.iter().skip(1).fold(n[0], |acc, v| acc * v);
-    (value, std::array::from_fn(|d| (0..D).filter(|&e| e != d).fold(dn[d], |acc, e| acc * n[e])))
+    product_rule(n, dn)
 }
 
 #[cfg(test)]
