@@ -117,7 +117,7 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt = kernels::Point::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                let pt = kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -130,7 +130,7 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt = kernels::Point::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                let pt = kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }

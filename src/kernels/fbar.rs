@@ -22,15 +22,16 @@
 //! size would take, so that Newton's residual norm sees it.
 
 use super::{Point, Scheme};
+use crate::model::finite_strain::{det, embed};
 
 /// Adds the projection rows R_i of one point (see the module documentation), weighted as the
 /// water's mass balance (1; the generalized-α history has none).
-pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     let Some(j) = pt.layout.jbar else { return };
     let nd = pt.layout.nd;
     let part = pt.part;
     // J_p^n ΔJ_p − 1 = (J_p^n − 1) ΔJ_p + (ΔJ_p − 1), the step's part without cancellation.
-    let own = (crate::model::finite_strain::det2(part.def_grad) - 1.0) * pt.kin.j + pt.kin.dj;
+    let own = (det(embed(&part.def_grad)) - 1.0) * pt.kin.j + pt.kin.dj;
     let w = part.fbar_rows * part.volume * nm.w_mass;
     for (i, b) in pt.basis.iter().enumerate() {
         out[i * nd + j] += w * b.s * (pt.jbar_nodes[i] - own);
@@ -40,18 +41,18 @@ pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 /// Adds the projection rows' derivatives: ϑ_i: κ S_ip V_p^n; Δu_l: −κ S_ip V_p^n J_p^n ∂ΔJ/∂Δu_l
 /// with ∂ΔJ/∂Δu_l,d = ΔJ (F⁻ᵀ∇S_l)_d. (The forces' derivatives with respect to ϑ are the effective
 /// stress term's, [`super::stress::tangent_with`].)
-pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     let Some(j) = pt.layout.jbar else { return };
     let (nd, m) = (pt.layout.nd, pt.size());
     let part = pt.part;
     let w = part.fbar_rows * part.volume * nm.w_mass;
-    let j_new = crate::model::finite_strain::det2(part.def_grad) * pt.kin.j;
+    let j_new = det(embed(&part.def_grad)) * pt.kin.j;
     for (i, b) in pt.basis.iter().enumerate() {
         let row = (i * nd + j) * m;
         out[row + i * nd + j] += w * b.s;
         for l in 0..pt.basis.len() {
-            let g = pt.strain_spatial[l].0;
-            for d in 0..2 {
+            let g = pt.strain_operators().0[l].0;
+            for d in 0..D {
                 out[row + l * nd + d] -= w * b.s * j_new * g[d];
             }
         }
@@ -118,7 +119,7 @@ mod tests {
             let zero = vec![0.0; nodes];
             for (basis, ids, part) in &points {
                 let st = states(ids, &zero);
-                let pt = Point::new(basis, &st, part, &model, layout);
+                let pt = Point::<2>::new(basis, &st, part, &model, layout);
                 let m = pt.size();
                 let (mut r, mut t) = (vec![0.0; m], vec![0.0; m * m]);
                 super::residual(&pt, &nm, &mut r);
@@ -135,7 +136,7 @@ mod tests {
             let mut shares = Vec::new();
             for (basis, ids, part) in &points {
                 let st = states(ids, &theta);
-                let pt = Point::new(basis, &st, part, &model, layout);
+                let pt = Point::<2>::new(basis, &st, part, &model, layout);
                 own.push(crate::model::finite_strain::det2(part.def_grad) * pt.kin.j);
                 jbar.push(super::super::StepResult::of(&pt).jbar.expect("an F̄ layout carries J̄"));
                 shares.push(ids.iter().zip(basis).map(|(&n, b)| (n, b.s)).collect::<Vec<_>>());

@@ -7,7 +7,7 @@ use super::Point;
 /// The share of the solid's volumetric strain in the water's balance: 1 − n where the water's
 /// motion is an unknown (u–p–U, [003] Eq. 23b), 1 where the water follows the solid plus its Darcy
 /// flux (u–p, Biot's storage equation).
-fn solid_share(pt: &Point) -> f64 {
+fn solid_share<const D: usize, const M: usize>(pt: &Point<D, M>) -> f64 {
     if pt.layout.w.is_some() {
         1.0 - pt.part.porosity
     } else {
@@ -23,7 +23,7 @@ pub mod continuity {
     use super::super::{Interp, ParticleInput, Point, Scheme};
 
     /// Adds the continuity residual (layouts with a pressure).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
         let n = part.porosity;
@@ -39,14 +39,14 @@ pub mod continuity {
     /// (1 − n) ∇̄·Δu + n ∇̄·ΔU + ∇n·(ΔU − Δu) + Δp/Q = 0 ([003] Eq. 23b with the porosity-gradient
     /// term of [`super::porosity_gradient`]) solved for Δp, with the divergences of the step's
     /// increments on x_n (B̄'s cell-centre divergences where the case asks for B̄).
-    pub fn pointwise_increment(it: &Interp, part: &ParticleInput) -> f64 {
+    pub fn pointwise_increment<const D: usize>(it: &Interp<D>, part: &ParticleInput<D>) -> f64 {
         let n = part.porosity;
-        let relative: f64 = (0..2).map(|c| part.grad_n[c] * (it.dw[c] - it.du[c])).sum();
+        let relative: f64 = (0..D).map(|c| part.grad_n[c] * (it.dw[c] - it.du[c])).sum();
         -((1.0 - n) * it.dvol_u + n * it.dvol_w + relative) / part.inv_q
     }
 
     /// Adds −G₁ᵀ (p–u), −G₂ᵀ (p–U) and −P (p–p, [003] 16i with the sign of Eq. 23b).
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
         let (n, v) = (part.porosity, part.volume * nm.w_mass);
@@ -54,8 +54,9 @@ pub mod continuity {
         for (k, bk) in pt.basis.iter().enumerate() {
             let row = (k * nd + p) * m;
             for (l, bl) in pt.basis.iter().enumerate() {
-                let div = [bl.gv[0] + bl.tv, bl.gv[1]];
-                for c in 0..2 {
+                let mut div = bl.gv;
+                div[0] += bl.tv;
+                for c in 0..D {
                     out[row + l * nd + c] -= fs * bk.s * div[c] * v;
                     if let Some(w) = pt.layout.w {
                         out[row + l * nd + w + c] -= n * bk.s * div[c] * v;
@@ -74,25 +75,25 @@ pub mod continuity {
 /// p); b the body acceleration at t_{n+1}, so that a hydrostatic pressure drives no flow. Tangent
 /// −θΔt V (k/γ_w) ∇S_i·∇S_j (p–p): with −P the negative semi-definite H of Biot's equations.
 pub mod darcy {
-    use super::super::{Point, Scheme};
+    use super::super::{dot, Point, Scheme};
 
     /// Adds the flux residual (u–p layouts under a scheme with flow).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         if nm.flow_dt == 0.0 {
             return;
         }
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
-        let drive: [f64; 2] =
+        let drive: [f64; D] =
             std::array::from_fn(|c| part.grad_p[c] + nm.theta * it.grad_dp[c] - part.water_density * part.body_acc[c]);
         let f = nm.w_mass * nm.flow_dt * part.volume * part.mobility;
         for (k, b) in pt.basis.iter().enumerate() {
-            out[k * nd + p] -= f * (b.g[0] * drive[0] + b.g[1] * drive[1]);
+            out[k * nd + p] -= f * dot(b.g, drive);
         }
     }
 
     /// Adds −θΔt V (k/γ_w) ∇S_i·∇S_j in the p–p block.
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         if nm.flow_dt == 0.0 {
             return;
@@ -101,7 +102,7 @@ pub mod darcy {
         let f = nm.w_mass * nm.flow_dt * nm.theta * part.volume * part.mobility;
         for (k, bk) in pt.basis.iter().enumerate() {
             for (l, bl) in pt.basis.iter().enumerate() {
-                out[(k * nd + p) * m + l * nd + p] -= f * (bk.g[0] * bl.g[0] + bk.g[1] * bl.g[1]);
+                out[(k * nd + p) * m + l * nd + p] -= f * dot(bk.g, bl.g);
             }
         }
     }
@@ -115,13 +116,13 @@ pub mod porosity_gradient {
     use super::super::{Point, Scheme};
 
     /// Adds the ∇n residual (layouts with the water's motion).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
         let gn = part.grad_n;
-        let rel: f64 = (0..2).map(|c| gn[c] * (it.dw[c] - it.du[c])).sum();
+        let rel: f64 = (0..D).map(|c| gn[c] * (it.dw[c] - it.du[c])).sum();
         for (k, b) in pt.basis.iter().enumerate() {
-            for c in 0..2 {
+            for c in 0..D {
                 let f = nm.w_force * b.s * pt.p * gn[c] * part.volume;
                 out[k * nd + c] += f;
                 out[k * nd + w + c] -= f;
@@ -134,12 +135,12 @@ pub mod porosity_gradient {
 
     /// Adds ±S_k S_l ∇n V in u–p, U–p (weight w_f) and p–u, p–U (weight w_mass); without a nodal
     /// pressure (u–U) the momentum terms depend on no unknown.
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let (Some(p), Some(w)) = (pt.layout.p, pt.layout.w) else { return };
         let (nd, m, part) = (pt.layout.nd, pt.size(), pt.part);
         for (k, bk) in pt.basis.iter().enumerate() {
             for (l, bl) in pt.basis.iter().enumerate() {
-                for c in 0..2 {
+                for c in 0..D {
                     let g = bk.s * bl.s * part.grad_n[c] * part.volume;
                     out[(k * nd + c) * m + l * nd + p] += nm.w_force * g;
                     out[(k * nd + w + c) * m + l * nd + p] -= nm.w_force * g;
@@ -167,32 +168,32 @@ pub mod porosity_gradient {
 /// its drainage vanishes as the surface comes near a grid line. Tangent
 /// −w_mass θΔt κ A [−N_i ∇S_j·n + (∇N_i·n + γ/h N_i) N_j] (p–p).
 pub mod drained_face {
-    use super::super::{Point, Scheme};
+    use super::super::{dot, Point, Scheme};
 
     /// Adds the Nitsche terms of the particle's drained faces (u–p layouts under a scheme with flow).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         if nm.flow_dt == 0.0 || pt.faces.is_empty() {
             return;
         }
         let (nd, it, part) = (pt.layout.nd, &pt.interp, pt.part);
-        let drive: [f64; 2] =
+        let drive: [f64; D] =
             std::array::from_fn(|c| part.grad_p[c] + nm.theta * it.grad_dp[c] - part.water_density * part.body_acc[c]);
         for (face, &dp_face) in pt.faces.iter().zip(&pt.face_dp) {
             let n = face.normal;
-            let flux = drive[0] * n[0] + drive[1] * n[1];
+            let flux = dot(drive, n);
             let off = face.offset;
-            let p_face = part.p + part.grad_p[0] * off[0] + part.grad_p[1] * off[1] + nm.theta * dp_face;
+            let p_face = (0..D).fold(part.p, |s, c| s + part.grad_p[c] * off[c]) + nm.theta * dp_face;
             let f = nm.w_mass * nm.flow_dt * part.mobility * face.area;
             for (k, (s, g)) in face.basis.iter().take(pt.basis.len()).enumerate() {
-                let dn = g[0] * n[0] + g[1] * n[1];
+                let dn = dot(*g, n);
                 out[k * nd + p] -= f * (-s * flux + (dn + face.penalty * s) * p_face);
             }
         }
     }
 
     /// Adds the p–p tangent of the Nitsche terms.
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(p) = pt.layout.p else { return };
         if nm.flow_dt == 0.0 || pt.faces.is_empty() {
             return;
@@ -203,9 +204,9 @@ pub mod drained_face {
             let n = face.normal;
             let f = nm.w_mass * nm.flow_dt * nm.theta * part.mobility * face.area;
             for (k, (sk, gk)) in face.basis.iter().take(nn).enumerate() {
-                let dn = gk[0] * n[0] + gk[1] * n[1];
+                let dn = dot(*gk, n);
                 for (l, bl) in pt.basis.iter().enumerate() {
-                    let gn = bl.g[0] * n[0] + bl.g[1] * n[1];
+                    let gn = dot(bl.g, n);
                     let sl = face.basis[l].0;
                     out[(k * nd + p) * m + l * nd + p] -= f * (-sk * gn + (dn + face.penalty * sk) * sl);
                 }

@@ -9,11 +9,11 @@
 use super::{Point, Scheme};
 
 /// Adds the inertia and body-force residual.
-pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     let (nd, part, it) = (pt.layout.nd, pt.part, &pt.interp);
     let (wm, wf) = (nm.w_inertia, nm.w_force);
     for (k, b) in pt.basis.iter().enumerate() {
-        for c in 0..2 {
+        for c in 0..D {
             out[k * nd + c] += b.s * part.mass * (wm * it.a_u[c] - wf * part.body_acc[c]);
             if let Some(w) = pt.layout.w {
                 out[k * nd + w + c] += b.s * part.water_mass * (wm * it.a_w[c] - wf * part.body_acc[c]);
@@ -23,12 +23,12 @@ pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 }
 
 /// Adds w_m a₀ M_u and w_m a₀ M_U.
-pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     let (nd, m) = (pt.layout.nd, pt.size());
     for (k, bk) in pt.basis.iter().enumerate() {
         for (l, bl) in pt.basis.iter().enumerate() {
             let ss = bk.s * bl.s * nm.a0 * nm.w_inertia;
-            for c in 0..2 {
+            for c in 0..D {
                 out[(k * nd + c) * m + l * nd + c] += ss * pt.part.mass;
                 if let Some(w) = pt.layout.w {
                     out[(k * nd + w + c) * m + l * nd + w + c] += ss * pt.part.water_mass;
@@ -47,14 +47,14 @@ pub mod drag {
     use super::super::{Point, Scheme};
 
     /// Adds the drag residual (two-phase layouts only).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
         if nm.explicit {
             return;
         }
         let (nd, it) = (pt.layout.nd, &pt.interp);
         for (k, b) in pt.basis.iter().enumerate() {
-            for c in 0..2 {
+            for c in 0..D {
                 let f = nm.w_force * b.s * pt.part.drag * (it.v_u[c] - it.v_w[c]);
                 out[k * nd + c] += f;
                 out[k * nd + w + c] -= f;
@@ -63,7 +63,7 @@ pub mod drag {
     }
 
     /// Adds w_f a₁ C in the u–u, u–U, U–u and U–U blocks.
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
         if nm.explicit {
             return;
@@ -72,7 +72,7 @@ pub mod drag {
         for (k, bk) in pt.basis.iter().enumerate() {
             for (l, bl) in pt.basis.iter().enumerate() {
                 let c1 = nm.w_force * bk.s * bl.s * nm.a1 * pt.part.drag;
-                for c in 0..2 {
+                for c in 0..D {
                     let (ru, rw) = ((k * nd + c) * m, (k * nd + w + c) * m);
                     let (cu, cw) = (l * nd + c, l * nd + w + c);
                     out[ru + cu] += c1;

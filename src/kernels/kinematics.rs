@@ -167,7 +167,7 @@ pub struct Kinematics<const D: usize = 2> {
     /// (I − ½W)⁻¹ of the mid-step spin W = ½(L − Lᵀ) (three dimensions; the derivative of R needs it).
     half_spin_inv: Mat<D>,
     /// The rotation of the step R = (I − ½W)⁻¹(I + ½W) (three dimensions; in two, the turn by θ).
-    rotation: Mat<D>,
+    pub rotation: Mat<D>,
     /// The hoop stretch F_θθ = 1 + Σ T_i Δu_r,i (1 in plane strain and in three dimensions).
     pub f_hoop: f64,
     /// B̄'s hoop stretch F_v,θθ = 1 + Σ T̄_i Δu_r,i.
@@ -460,7 +460,11 @@ impl<const D: usize> Kinematics<D> {
             let vol = (trv - tr) / 3.0;
             strain_of(&dl, lt, vol)
         };
-        let cols: [Stress; D] = std::array::from_fn(column);
+        // (A loop rather than `from_fn`, whose call of the closure is not inlined.)
+        let mut cols = [[0.0; NS]; D];
+        for (d, col) in cols.iter_mut().enumerate() {
+            *col = column(d);
+        }
         std::array::from_fn(|r| std::array::from_fn(|d| cols[d][r]))
     }
 

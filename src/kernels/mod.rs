@@ -62,12 +62,31 @@ use crate::model::shape::Stencil;
 use crate::model::soil::{self, Constitutive, Stress, StressUpdate};
 pub use kinematics::Kinematics;
 
-/// Largest number of stencil nodes of a particle (4 × 4, see [`crate::model::shape::MAX_STENCIL`]).
+/// Largest number of stencil nodes of a particle in two dimensions (see
+/// [`crate::model::shape::MAX_STENCIL`]): the size of a plane point's per-node scratch.
 pub const MAX_NODES: usize = crate::model::shape::MAX_STENCIL;
-/// Largest number of dofs per node (u–p–U).
+/// Largest number of stencil nodes of a particle in three dimensions (see
+/// [`crate::model::shape::MAX_STENCIL_3D`]).
+pub const MAX_NODES_3D: usize = crate::model::shape::MAX_STENCIL_3D;
+/// Largest number of dofs per node in two dimensions (u–p–U: 2D + 1), the size of a plane
+/// [`NodeState`].
 pub const MAX_DOF: usize = 5;
-/// Largest local block dimension.
+/// Largest number of dofs per node in three dimensions (u–p–U: 2D + 1).
+pub const MAX_DOF_3D: usize = 7;
+/// Largest local block dimension of a plane point.
 pub const MAX_LOCAL: usize = MAX_NODES * MAX_DOF;
+
+/// The number of strain (and stress) components a point of dimension `D` uses: the first four of
+/// [`soil::Stress`] in two dimensions (plane strain or axial symmetry, the fourth the
+/// out-of-plane or hoop component), all six in three.
+#[inline]
+pub const fn strain_rows<const D: usize>() -> usize {
+    if D == 2 {
+        soil::NS_PLANE
+    } else {
+        soil::NS
+    }
+}
 
 /// Component indices within a node of the two-phase layout.
 pub mod dof {
@@ -88,6 +107,8 @@ pub mod dof {
 /// ratio of an implicit F̄ step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Layout {
+    /// The spatial dimension: the solid (and the water) displacement has this many components.
+    pub dim: usize,
     /// Dofs per node.
     pub nd: usize,
     /// Offset of the pore pressure.
@@ -101,21 +122,48 @@ pub struct Layout {
 
 impl Layout {
     /// u (one-phase: total stress or dry).
-    pub const U: Layout = Layout { nd: 2, p: None, w: None, jbar: None };
+    pub const U: Layout = Layout { dim: 2, nd: 2, p: None, w: None, jbar: None };
     /// u–p (the quasi-static Biot system, or undrained static): solid displacement and pore
     /// pressure; the water follows the solid plus its Darcy flux.
-    pub const UP: Layout = Layout { nd: 3, p: Some(dof::P), w: None, jbar: None };
+    pub const UP: Layout = Layout { dim: 2, nd: 3, p: Some(dof::P), w: None, jbar: None };
     /// u–p–U.
-    pub const UPU: Layout = Layout { nd: 5, p: Some(dof::P), w: Some(dof::WX), jbar: None };
+    pub const UPU: Layout = Layout { dim: 2, nd: 5, p: Some(dof::P), w: Some(dof::WX), jbar: None };
     /// u–U (the explicit two-phase system, the "v–w form"): the motion of both phases at the
     /// nodes, the pore pressure at the points (its continuity equation held point by point,
     /// [`flow::continuity::pointwise_increment`]).
-    pub const UW: Layout = Layout { nd: 4, p: None, w: Some(2), jbar: None };
+    pub const UW: Layout = Layout { dim: 2, nd: 4, p: None, w: Some(2), jbar: None };
     /// u with [002]'s F̄ in an implicit step: the solid displacement and the projected volume
     /// ratio ϑ = J̄ − 1 at the nodes ([`fbar`]).
-    pub const U_FBAR: Layout = Layout { nd: 3, p: None, w: None, jbar: Some(2) };
+    pub const U_FBAR: Layout = Layout { dim: 2, nd: 3, p: None, w: None, jbar: Some(2) };
     /// u–p with F̄ (the quasi-static Biot system or an undrained static stage).
-    pub const UP_FBAR: Layout = Layout { nd: 4, p: Some(dof::P), w: None, jbar: Some(3) };
+    pub const UP_FBAR: Layout = Layout { dim: 2, nd: 4, p: Some(dof::P), w: None, jbar: Some(3) };
+
+    /// The layout of the same fields in `dim` dimensions: the solid displacement's `dim`
+    /// components first, then the pore pressure, the water displacement's `dim` components and
+    /// the projected volume ratio, each where the layout has it (the two-dimensional constants
+    /// are `Layout::U.in_dim(2)` and so on).
+    pub const fn in_dim(&self, dim: usize) -> Layout {
+        let mut nd = dim;
+        let p = if self.p.is_some() {
+            nd += 1;
+            Some(nd - 1)
+        } else {
+            None
+        };
+        let w = if self.w.is_some() {
+            nd += dim;
+            Some(nd - dim)
+        } else {
+            None
+        };
+        let jbar = if self.jbar.is_some() {
+            nd += 1;
+            Some(nd - 1)
+        } else {
+            None
+        };
+        Layout { dim, nd, p, w, jbar }
+    }
 
     /// The layout with the projected volume ratio of an implicit F̄ step added (u and u–p only:
     /// `None` for the others).
@@ -129,11 +177,15 @@ impl Layout {
 
     /// The names of the layout's nodal fields, in dof order.
     pub fn field_names(&self) -> &'static [&'static str] {
-        match (self.p, self.w, self.jbar) {
-            (None, Some(_), _) => &["ux", "uy", "Ux", "Uy"],
-            (None, None, Some(_)) => &["ux", "uy", "Jbar"],
-            (Some(_), None, Some(_)) => &["ux", "uy", "p", "Jbar"],
-            _ => &["ux", "uy", "p", "Ux", "Uy"][..self.nd],
+        match (self.dim, self.p, self.w, self.jbar) {
+            (2, None, Some(_), _) => &["ux", "uy", "Ux", "Uy"],
+            (2, None, None, Some(_)) => &["ux", "uy", "Jbar"],
+            (2, Some(_), None, Some(_)) => &["ux", "uy", "p", "Jbar"],
+            (2, ..) => &["ux", "uy", "p", "Ux", "Uy"][..self.nd],
+            (_, None, Some(_), _) => &["ux", "uy", "uz", "Ux", "Uy", "Uz"],
+            (_, None, None, Some(_)) => &["ux", "uy", "uz", "Jbar"],
+            (_, Some(_), None, Some(_)) => &["ux", "uy", "uz", "p", "Jbar"],
+            _ => &["ux", "uy", "uz", "p", "Ux", "Uy", "Uz"][..self.nd],
         }
     }
 
@@ -152,12 +204,12 @@ impl Layout {
     /// The physical fields and their dof offsets: the solid displacement u, then the pore
     /// pressure p and the water displacement U where the system has them.
     pub fn fields(&self) -> Vec<(&'static str, Vec<usize>)> {
-        let mut out = vec![("u", vec![dof::UX, dof::UY])];
+        let mut out = vec![("u", (0..self.dim).collect())];
         if let Some(p) = self.p {
             out.push(("p", vec![p]));
         }
         if let Some(w) = self.w {
-            out.push(("U", vec![w, w + 1]));
+            out.push(("U", (w..w + self.dim).collect()));
         }
         if let Some(j) = self.jbar {
             out.push(("Jbar", vec![j]));
@@ -190,25 +242,35 @@ impl<const D: usize> Default for NodeBasis<D> {
 
 /// The basis of a whole stencil without B̄, with the hoop operators `hoop` (zero in plane
 /// strain), appended to `out`.
-pub fn plain_basis(st: &Stencil, hoop: &[f64], out: &mut Vec<NodeBasis>) {
+pub fn plain_basis<const D: usize, const M: usize>(st: &Stencil<D, M>, hoop: &[f64], out: &mut Vec<NodeBasis<D>>) {
     out.extend((0..st.len).map(|k| NodeBasis { s: st.w[k], g: st.dw[k], gv: st.dw[k], t: hoop[k], tv: hoop[k] }));
 }
 
 /// Nodal values seen by a particle: the increment Δd and its parts a₀Δd, a₁Δd of the acceleration
 /// and velocity at t_{n+1} (the particle adds its predictors).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct NodeState {
+///
+/// `N` is the number of dofs it holds, at least the layout's: [`MAX_DOF`] in two dimensions,
+/// [`MAX_DOF_3D`] in three (a plane point's states are copied per point, so they are not sized
+/// for the largest three-dimensional layout).
+#[derive(Debug, Clone, Copy)]
+pub struct NodeState<const N: usize = MAX_DOF> {
     /// Δd in the node's layout.
-    pub d: [f64; MAX_DOF],
+    pub d: [f64; N],
     /// a₀ Δd.
-    pub a: [f64; MAX_DOF],
+    pub a: [f64; N],
     /// a₁ Δd.
-    pub v: [f64; MAX_DOF],
+    pub v: [f64; N],
 }
 
-impl NodeState {
+impl<const N: usize> Default for NodeState<N> {
+    fn default() -> Self {
+        NodeState { d: [0.0; N], a: [0.0; N], v: [0.0; N] }
+    }
+}
+
+impl<const N: usize> NodeState<N> {
     /// The state of a node with increments `d` under the time scheme `nm`.
-    pub fn new(d: &[f64], nm: &Scheme) -> NodeState {
+    pub fn new(d: &[f64], nm: &Scheme) -> NodeState<N> {
         let mut s = NodeState::default();
         for (c, &x) in d.iter().enumerate() {
             s.d[c] = x;
@@ -219,10 +281,11 @@ impl NodeState {
     }
 }
 
-/// The particle quantities the kernels need (at t_n).
+/// The particle quantities the kernels need (at t_n), in `D` dimensions (two unless it says
+/// otherwise).
 #[derive(Debug, Clone, Copy)]
-pub struct ParticleInput {
-    /// Volume V [m³ per m].
+pub struct ParticleInput<const D: usize = 2> {
+    /// Volume V [m³ per m in two dimensions, m³ in three].
     pub volume: f64,
     /// Porosity n.
     pub porosity: f64,
@@ -239,21 +302,22 @@ pub struct ParticleInput {
     /// Water density ρ_w [kg/m³] (two-phase).
     pub water_density: f64,
     /// Pore-pressure gradient at t_n [Pa/m] (two-phase), carried by the particle.
-    pub grad_p: [f64; 2],
+    pub grad_p: [f64; D],
     /// Effective stress at t_n [Pa].
     pub stress: Stress,
-    /// Deformation gradient at t_n (in-plane; what a hyperelastic model's stress follows).
-    pub def_grad: [[f64; 2]; 2],
+    /// Deformation gradient at t_n (in-plane in two dimensions; what a hyperelastic model's
+    /// stress follows).
+    pub def_grad: [[f64; D]; D],
     /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
     pub eps_pd: f64,
     /// Pore pressure at t_n [Pa].
     pub p: f64,
     /// Body acceleration at t_{n+1} [m/s²].
-    pub body_acc: [f64; 2],
+    pub body_acc: [f64; D],
     /// Porosity gradient ∇n at t_n [1/m] (two-phase).
-    pub grad_n: [f64; 2],
+    pub grad_n: [f64; D],
     /// Newmark predictors of the point.
-    pub pred: Predictors,
+    pub pred: Predictors<D>,
     /// A geometrically linear step (`analysis.kinematics = "linear_increments"`, [001] Eqs. 5, 7,
     /// 11): see [`kinematics`].
     pub linear: bool,
@@ -261,7 +325,7 @@ pub struct ParticleInput {
     /// 1 without it), which the rate-form stress updates see: see
     /// [`kinematics::Kinematics::with_volume_scale`].
     pub fbar: f64,
-    /// The F̄ projection's scale of the point's total deformation, F̄ = s F with s = (J̄/J)^{1/2}
+    /// The F̄ projection's scale of the point's total deformation, F̄ = s F with s = (J̄/J)^{1/D}
     /// ([002] Eq. 18; 1 without it), which a hyperelastic model sees: at the step's start that
     /// of the point's stored J̄ (its stress σ_n), at its end that of the projected J̄_{n+1}.
     pub fbar_total: f64,
@@ -451,38 +515,48 @@ impl Scheme {
 
     /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
     /// at Δd = 0); zero without inertia.
-    pub fn predict(&self, v: [f64; 2], a: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    pub fn predict<const D: usize>(&self, v: [f64; D], a: [f64; D]) -> ([f64; D], [f64; D]) {
         if self.explicit {
             return (a, v);
         }
         if self.a0 == 0.0 {
-            return ([0.0; 2], [0.0; 2]);
+            return ([0.0; D], [0.0; D]);
         }
         let (b, g, dt) = (self.beta, self.gamma, self.dt);
         let pa = |c: usize| -v[c] / (b * dt) - (0.5 / b - 1.0) * a[c];
         let pv = |c: usize| -(g / b - 1.0) * v[c] - (0.5 * g / b - 1.0) * dt * a[c];
-        ([pa(0), pa(1)], [pv(0), pv(1)])
+        let (mut oa, mut ov) = ([0.0; D], [0.0; D]);
+        for c in 0..D {
+            (oa[c], ov[c]) = (pa(c), pv(c));
+        }
+        (oa, ov)
     }
 }
 
 /// Newmark predictors at a material point: the acceleration and velocity at t_{n+1} for a zero
 /// displacement increment.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Predictors {
+#[derive(Debug, Clone, Copy)]
+pub struct Predictors<const D: usize = 2> {
     /// ã_n of the solid [m/s²].
-    pub a_u: [f64; 2],
+    pub a_u: [f64; D],
     /// ṽ_n of the solid [m/s].
-    pub v_u: [f64; 2],
+    pub v_u: [f64; D],
     /// ã_n of the water [m/s²] (two-phase).
-    pub a_w: [f64; 2],
+    pub a_w: [f64; D],
     /// ṽ_n of the water [m/s] (two-phase).
-    pub v_w: [f64; 2],
+    pub v_w: [f64; D],
 }
 
-impl Predictors {
+impl<const D: usize> Default for Predictors<D> {
+    fn default() -> Self {
+        Predictors { a_u: [0.0; D], v_u: [0.0; D], a_w: [0.0; D], v_w: [0.0; D] }
+    }
+}
+
+impl<const D: usize> Predictors<D> {
     /// The predictors for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and accelerations
     /// at t_n (the nodal values interpolated to the point).
-    pub fn new(nm: &Scheme, v_u: [f64; 2], a_u: [f64; 2], v_w: [f64; 2], a_w: [f64; 2]) -> Predictors {
+    pub fn new(nm: &Scheme, v_u: [f64; D], a_u: [f64; D], v_w: [f64; D], a_w: [f64; D]) -> Predictors<D> {
         let (pa_u, pv_u) = nm.predict(v_u, a_u);
         let (pa_w, pv_w) = nm.predict(v_w, a_w);
         Predictors { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
@@ -490,26 +564,46 @@ impl Predictors {
 }
 
 /// B̄ of one node from its deviatoric gradient `g` and volumetric gradient `gv` and, in axial
-/// symmetry, its hoop operators `hoop` = (T, T̄) (zero in plane strain): 4 strain rows
-/// [rr, yy, ry, θθ] × 2 displacement components ([000] Eq. 16): B̄ = B − ⅓ m mᵀB + ⅓ m mᵀB̄_v with
-/// m = [1, 1, 0, 1], the hoop row of B being [T, 0] (`../shared/seeds-001-002.md` Part A2).
+/// symmetry, its hoop operators `hoop` = (T, T̄) (zero in plane strain and in three dimensions):
+/// the strain rows [xx, yy, γxy, zz, γyz, γzx] × D displacement components ([000] Eq. 16):
+/// B̄ = B − ⅓ m mᵀB + ⅓ m mᵀB̄_v with m = [1, 1, 0, 1, 0, 0]. In two dimensions the rows are
+/// [rr, yy, ry, θθ] (the last two zero), the hoop row of B being [T, 0]
+/// (`../shared/seeds-001-002.md` Part A2); in three the zz row of B is [0, 0, ∂_z S] and the shear
+/// rows [0, ∂_z S, ∂_y S] and [∂_z S, 0, ∂_x S].
 #[inline]
-pub fn bbar(g: [f64; 2], gv: [f64; 2], hoop: (f64, f64)) -> [[f64; 2]; 4] {
-    let (gx, gy, vx, vy) = (g[0], g[1], gv[0], gv[1]);
+pub fn bbar<const D: usize>(g: [f64; D], gv: [f64; D], hoop: (f64, f64)) -> [[f64; D]; soil::NS] {
+    let mut out = [[0.0; D]; soil::NS];
     let (tt, tv) = hoop;
     let t = 1.0 / 3.0;
-    // ⅓(mᵀB̄_v − mᵀB): the volumetric correction of every normal row.
-    let corr = [t * (vx + tv - gx - tt), t * (vy - gy)];
-    [[gx + corr[0], corr[1]], [corr[0], gy + corr[1]], [gy, gx], [tt + corr[0], corr[1]]]
+    // ⅓(mᵀB̄_v − mᵀB): the volumetric correction of every normal row (the hoop term radially).
+    let corr: [f64; D] =
+        std::array::from_fn(|d| if d == 0 { t * (gv[0] + tv - g[0] - tt) } else { t * (gv[d] - g[d]) });
+    out[0] = corr;
+    out[0][0] += g[0];
+    out[1] = corr;
+    out[1][1] += g[1];
+    out[2][0] = g[1];
+    out[2][1] = g[0];
+    out[3] = corr;
+    if D == 2 {
+        out[3][0] += tt;
+    } else {
+        out[3][2] += g[2];
+        out[4][1] = g[2];
+        out[4][2] = g[1];
+        out[5][0] = g[2];
+        out[5][2] = g[0];
+    }
+    out
 }
 
 /// Values interpolated to a particle from the nodal increments, with its Newmark predictors.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Interp {
+#[derive(Debug, Clone, Copy)]
+pub struct Interp<const D: usize = 2> {
     /// Solid displacement increment Σ S Δu.
-    pub du: [f64; 2],
+    pub du: [f64; D],
     /// Water displacement increment Σ S ΔU.
-    pub dw: [f64; 2],
+    pub dw: [f64; D],
     /// Pressure increment Σ S Δp.
     pub dp: f64,
     /// Volumetric strain increment of the solid on x_n, ∇̄·Δu = Σ ∇̄S·Δu (+ Σ T̄ Δu_r in axial
@@ -518,21 +612,45 @@ pub struct Interp {
     /// Volumetric strain increment of the water on x_n, ∇̄·ΔU.
     pub dvol_w: f64,
     /// Gradient of the pressure increment on x_n, Σ ∇S Δp.
-    pub grad_dp: [f64; 2],
+    pub grad_dp: [f64; D],
     /// The projected volume ratio's excess at t_{n+1}, J̄_{n+1} − 1 = Σ S ϑ (implicit F̄ steps).
     pub jbar: f64,
     /// Solid acceleration at t_{n+1}.
-    pub a_u: [f64; 2],
+    pub a_u: [f64; D],
     /// Water acceleration at t_{n+1}.
-    pub a_w: [f64; 2],
+    pub a_w: [f64; D],
     /// Solid velocity at t_{n+1}.
-    pub v_u: [f64; 2],
+    pub v_u: [f64; D],
     /// Water velocity at t_{n+1}.
-    pub v_w: [f64; 2],
+    pub v_w: [f64; D],
+}
+
+impl<const D: usize> Default for Interp<D> {
+    fn default() -> Self {
+        let z = [0.0; D];
+        Interp {
+            du: z,
+            dw: z,
+            dp: 0.0,
+            dvol_u: 0.0,
+            dvol_w: 0.0,
+            grad_dp: z,
+            jbar: 0.0,
+            a_u: z,
+            a_w: z,
+            v_u: z,
+            v_w: z,
+        }
+    }
 }
 
 /// Interpolates nodal values to the particle and adds its Newmark predictors.
-pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors, layout: Layout) -> Interp {
+pub fn interpolate<const D: usize, const N: usize>(
+    basis: &[NodeBasis<D>],
+    states: &[NodeState<N>],
+    pred: &Predictors<D>,
+    layout: Layout,
+) -> Interp<D> {
     let mut k = Interp { a_u: pred.a_u, v_u: pred.v_u, ..Interp::default() };
     if layout.w.is_some() {
         k.a_w = pred.a_w;
@@ -540,7 +658,7 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
     }
     for (b, st) in basis.iter().zip(states) {
         k.dvol_u += b.tv * st.d[0];
-        for c in 0..2 {
+        for c in 0..D {
             k.a_u[c] += b.s * st.a[c];
             k.v_u[c] += b.s * st.v[c];
             k.du[c] += b.s * st.d[c];
@@ -548,15 +666,16 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
         }
         if let Some(p) = layout.p {
             k.dp += b.s * st.d[p];
-            k.grad_dp[0] += b.g[0] * st.d[p];
-            k.grad_dp[1] += b.g[1] * st.d[p];
+            for c in 0..D {
+                k.grad_dp[c] += b.g[c] * st.d[p];
+            }
         }
         if let Some(j) = layout.jbar {
             k.jbar += b.s * st.d[j];
         }
         if let Some(w) = layout.w {
             k.dvol_w += b.tv * st.d[w];
-            for c in 0..2 {
+            for c in 0..D {
                 k.dvol_w += b.gv[c] * st.d[w + c];
                 k.a_w[c] += b.s * st.a[w + c];
                 k.v_w[c] += b.s * st.v[w + c];
@@ -569,104 +688,100 @@ pub fn interpolate(basis: &[NodeBasis], states: &[NodeState], pred: &Predictors,
 
 /// Everything the terms need at one particle for the current iterate: the interpolated values, the
 /// kinematics, the gradients on x_{n+1} and the soil model's update from the rotated stress.
+///
+/// `D` is the dimension (two: plane strain or axial symmetry; three) and `M` the number of nodes
+/// its per-node scratch holds, at least the stencil's ([`MAX_NODES`] in two dimensions,
+/// [`MAX_NODES_3D`] in three), so that a plane point does not carry the scratch of the largest
+/// three-dimensional stencil.
 #[derive(Debug, Clone, Copy)]
-pub struct Point<'a> {
+pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     /// The stencil's basis on x_n.
-    pub basis: &'a [NodeBasis],
+    pub basis: &'a [NodeBasis<D>],
     /// The particle at t_n.
-    pub part: &'a ParticleInput,
+    pub part: &'a ParticleInput<D>,
     /// Which dofs the nodes carry.
     pub layout: Layout,
     /// Interpolated increments, velocities and accelerations.
-    pub interp: Interp,
+    pub interp: Interp<D>,
     /// Finite-strain kinematics of the step.
-    pub kin: Kinematics,
+    pub kin: Kinematics<D>,
     /// The effective stress at t_n rotated with the material (Hughes–Winget).
     pub rotated: Stress,
     /// The soil model's update from `rotated` by the strain increment.
     pub upd: StressUpdate,
     /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}.
-    pub spatial: [([f64; 2], [f64; 2]); MAX_NODES],
-    /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain).
-    pub hoop: [(f64, f64); MAX_NODES],
+    pub spatial: [([f64; D], [f64; D]); M],
+    /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain and in three
+    /// dimensions).
+    pub hoop: [(f64, f64); M],
     /// The operators the strain is recovered with (see [`Point::with_recovery`]): the basis
     /// itself, or [001]'s CMPM patch functions; the kinematics and every derivative of them use
     /// these, the forces use `basis`.
-    pub strain: &'a [NodeBasis],
-    /// `spatial` of the strain operators.
-    pub strain_spatial: [([f64; 2], [f64; 2]); MAX_NODES],
-    /// `hoop` of the strain operators.
-    pub strain_hoop: [(f64, f64); MAX_NODES],
+    pub strain: &'a [NodeBasis<D>],
+    /// `spatial` and `hoop` of the strain operators where they are not the basis (see
+    /// [`Point::strain_operators`]; `None`: the basis's own, not copied).
+    recovered: Option<OnNew<D, M>>,
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
     /// particles have none).
-    pub faces: &'a [DrainedFace],
+    pub faces: &'a [DrainedFace<D, M>],
     /// Σ N_j(x_f) Δp_j at each of `faces`.
     pub face_dp: [f64; MAX_FACES],
     /// The nodal ϑ_i = J̄_i − 1 of an implicit F̄ step, per stencil node (zero otherwise).
-    pub jbar_nodes: [f64; MAX_NODES],
+    pub jbar_nodes: [f64; M],
 }
 
+/// A node's gradients (∇'S, ∇̄'S) on x_{n+1}.
+pub type Gradients<const D: usize> = ([f64; D], [f64; D]);
+
+/// The per-node gradients and hoop operators of a point on x_{n+1} ([`Point::spatial`] and
+/// [`Point::hoop`], or their strain operators').
+type OnNew<const D: usize, const M: usize> = ([([f64; D], [f64; D]); M], [(f64, f64); M]);
+
 /// The gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each node of
-/// `basis` and of the strain operators `strain` ([`Point::spatial`], [`Point::hoop`],
-/// [`Point::strain_spatial`], [`Point::strain_hoop`]; the latter a copy when `strain` is `basis`).
-#[allow(clippy::type_complexity)]
-fn on_new_configuration(
-    kin: &Kinematics,
-    basis: &[NodeBasis],
-    strain: &[NodeBasis],
-) -> (
-    [([f64; 2], [f64; 2]); MAX_NODES],
-    [(f64, f64); MAX_NODES],
-    [([f64; 2], [f64; 2]); MAX_NODES],
-    [(f64, f64); MAX_NODES],
-) {
-    let mut spatial = [([0.0; 2], [0.0; 2]); MAX_NODES];
-    let mut hoop = [(0.0, 0.0); MAX_NODES];
-    for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(basis) {
+/// `nodes` ([`Point::spatial`] and [`Point::hoop`], or the strain operators').
+fn on_new_configuration<const D: usize, const M: usize>(kin: &Kinematics<D>, nodes: &[NodeBasis<D>]) -> OnNew<D, M> {
+    assert!(nodes.len() <= M, "a stencil of {} nodes in a point of {M}", nodes.len());
+    let mut spatial = [([0.0; D], [0.0; D]); M];
+    let mut hoop = [(0.0, 0.0); M];
+    for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(nodes) {
         *s = kin.spatial(b);
         *t = kin.hoop(b);
     }
-    let (mut strain_spatial, mut strain_hoop) = (spatial, hoop);
-    if !std::ptr::eq(strain, basis) {
-        for ((s, t), b) in strain_spatial.iter_mut().zip(strain_hoop.iter_mut()).zip(strain) {
-            *s = kin.spatial(b);
-            *t = kin.hoop(b);
-        }
-    }
-    (spatial, hoop, strain_spatial, strain_hoop)
+    (spatial, hoop)
 }
 
-/// Largest number of drained faces of one particle (all four sides of its domain).
-pub const MAX_FACES: usize = 4;
+/// Largest number of drained faces of one particle (all sides of its domain: four in two
+/// dimensions, six in three).
+pub const MAX_FACES: usize = 6;
 
 /// One exposed face of a particle on a drained surface imposed weakly (see
 /// [`flow::drained_face`]), on x_n.
 #[derive(Debug, Clone, Copy)]
-pub struct DrainedFace {
+pub struct DrainedFace<const D: usize = 2, const M: usize = MAX_NODES> {
     /// The face point minus the particle's centre, x_f − x_p [m].
-    pub offset: [f64; 2],
+    pub offset: [f64; D],
     /// The outward unit normal.
-    pub normal: [f64; 2],
-    /// The face's length (its area per unit thickness) [m].
+    pub normal: [f64; D],
+    /// The face's area (its length, the area per unit thickness, in two dimensions) [m²].
     pub area: f64,
     /// Nitsche's penalty γ/h [1/m].
     pub penalty: f64,
-    /// The grid's bilinear shape function N_i and its gradient at the face point, per stencil slot
-    /// (in the order of the particle's basis).
-    pub basis: [(f64, [f64; 2]); MAX_NODES],
+    /// The grid's multilinear shape function N_i and its gradient at the face point, per stencil
+    /// slot (in the order of the particle's basis).
+    pub basis: [(f64, [f64; D]); M],
 }
 
-impl<'a> Point<'a> {
+impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// Evaluates the point for the nodal `states` (same order as `basis`).
-    pub fn new(
-        basis: &'a [NodeBasis],
-        states: &[NodeState],
-        part: &'a ParticleInput,
+    pub fn new<const N: usize>(
+        basis: &'a [NodeBasis<D>],
+        states: &[NodeState<N>],
+        part: &'a ParticleInput<D>,
         model: &Constitutive,
         layout: Layout,
-    ) -> Point<'a> {
+    ) -> Point<'a, D, M> {
         Point::with_recovery(basis, basis, states, part, model, layout)
     }
 
@@ -677,19 +792,20 @@ impl<'a> Point<'a> {
     /// basis, f_i = B̄'_iᵀσ V. [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
     /// passes its patch functions; `strain = basis` is the usual point.
     #[inline]
-    pub fn with_recovery(
-        basis: &'a [NodeBasis],
-        strain: &'a [NodeBasis],
-        states: &[NodeState],
-        part: &'a ParticleInput,
+    pub fn with_recovery<const N: usize>(
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        states: &[NodeState<N>],
+        part: &'a ParticleInput<D>,
         model: &Constitutive,
         layout: Layout,
-    ) -> Point<'a> {
+    ) -> Point<'a, D, M> {
+        debug_assert_eq!(layout.dim, D, "a layout of {} dimensions at a point of {D}", layout.dim);
         let interp = interpolate(basis, states, &part.pred, layout);
-        let mut kin =
-            Kinematics::new(strain, states.iter().map(|s| [s.d[0], s.d[1]]), part.linear).with_volume_scale(part.fbar);
+        let mut kin = Kinematics::new(strain, states.iter().map(|s| std::array::from_fn(|c| s.d[c])), part.linear)
+            .with_volume_scale(part.fbar);
         // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
-        let mut jbar_nodes = [0.0; MAX_NODES];
+        let mut jbar_nodes = [0.0; M];
         if let Some(j) = layout.jbar {
             for (t, st) in jbar_nodes.iter_mut().zip(states.iter().take(basis.len())) {
                 *t = st.d[j];
@@ -704,9 +820,10 @@ impl<'a> Point<'a> {
         let df = f_bar.map(|r| r.map(|v| v * part.fbar));
         let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
-            .finite(&finite_strain::plane(df), &finite_strain::plane(f_new), &part.stress, part.eps_pd, part.dt)
+            .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
-        let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
+        let (spatial, hoop) = on_new_configuration(&kin, basis);
+        let recovered = (!std::ptr::eq(strain, basis)).then(|| on_new_configuration(&kin, strain));
         Point {
             basis,
             part,
@@ -718,8 +835,7 @@ impl<'a> Point<'a> {
             spatial,
             hoop,
             strain,
-            strain_spatial,
-            strain_hoop,
+            recovered,
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
@@ -734,14 +850,15 @@ impl<'a> Point<'a> {
     /// explicit step builds no matrix). The interpolated velocities and accelerations are the
     /// point's predictors, as at Δd = 0.
     pub fn at_start(
-        basis: &'a [NodeBasis],
-        strain: &'a [NodeBasis],
-        part: &'a ParticleInput,
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        part: &'a ParticleInput<D>,
         layout: Layout,
-    ) -> Point<'a> {
-        let interp = interpolate(basis, &[NodeState::default(); MAX_NODES], &part.pred, layout);
+    ) -> Point<'a, D, M> {
+        let interp = interpolate(basis, &[NodeState::<MAX_DOF_3D>::default(); M], &part.pred, layout);
         let kin = Kinematics::rest();
-        let (spatial, hoop, strain_spatial, strain_hoop) = on_new_configuration(&kin, basis, strain);
+        let (spatial, hoop) = on_new_configuration(&kin, basis);
+        let recovered = (!std::ptr::eq(strain, basis)).then(|| on_new_configuration(&kin, strain));
         let zero = [[0.0; soil::NS]; soil::NS];
         Point {
             basis,
@@ -760,19 +877,22 @@ impl<'a> Point<'a> {
             spatial,
             hoop,
             strain,
-            strain_spatial,
-            strain_hoop,
+            recovered,
             p: part.p,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
-            jbar_nodes: [0.0; MAX_NODES],
+            jbar_nodes: [0.0; M],
         }
     }
 
     /// The point with its drained `faces` (at most [`MAX_FACES`]), their pressure increments
     /// interpolated from the same nodal `states`.
     #[inline]
-    pub fn with_faces(mut self, faces: &'a [DrainedFace], states: &[NodeState]) -> Point<'a> {
+    pub fn with_faces<const N: usize>(
+        mut self,
+        faces: &'a [DrainedFace<D, M>],
+        states: &[NodeState<N>],
+    ) -> Point<'a, D, M> {
         let Some(p) = self.layout.p else { return self };
         let faces = &faces[..faces.len().min(MAX_FACES)];
         for (dp, face) in self.face_dp.iter_mut().zip(faces) {
@@ -780,6 +900,17 @@ impl<'a> Point<'a> {
         }
         self.faces = faces;
         self
+    }
+
+    /// The gradients ∇'S, ∇̄'S and hoop operators T', T̄' on x_{n+1} of the strain operators (see
+    /// [`Point::with_recovery`]), per node: the basis's own ([`Point::spatial`], [`Point::hoop`])
+    /// or the recovered ones.
+    #[inline]
+    pub fn strain_operators(&self) -> (&[Gradients<D>], &[(f64, f64)]) {
+        match &self.recovered {
+            Some((s, h)) => (s, h),
+            None => (&self.spatial, &self.hoop),
+        }
     }
 
     /// Number of local dofs (stencil nodes × dofs per node).
@@ -798,6 +929,12 @@ impl<'a> Point<'a> {
     }
 }
 
+/// a · b.
+#[inline]
+pub(crate) fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
+    (1..D).fold(a[0] * b[0], |s, c| s + a[c] * b[c])
+}
+
 /// Which groups of terms a residual evaluation takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Terms {
@@ -811,12 +948,12 @@ pub enum Terms {
 /// The residual block of one particle (length `nn × nd`, node-major): the sum of every term of the
 /// layout (see the module documentation), each weighted as the time scheme `nm` says. `out` is
 /// overwritten.
-pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     residual_terms(pt, nm, Terms::All, out);
 }
 
 /// The residual block of the chosen `terms` (see [`residual`]).
-pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
+pub fn residual_terms<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, terms: Terms, out: &mut [f64]) {
     out[..pt.size()].fill(0.0);
     if terms == Terms::All {
         inertia::residual(pt, nm, out);
@@ -839,13 +976,13 @@ pub fn residual_terms(pt: &Point, nm: &Scheme, terms: Terms, out: &mut [f64]) {
 
 /// The tangent block d(residual)/d(Δd) of one particle, row-major `(nn·nd)²`. Every entry of
 /// `out` is written (the zero couplings too), so the buffer may be reused from particle to particle.
-pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     tangent_with(pt, nm, out, 1.0);
 }
 
 /// [`tangent`] with the skeleton's material stiffness scaled by `material` (see
 /// [`stress::tangent_with`]).
-pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
+pub fn tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
     let m = pt.size();
     out[..m * m].fill(0.0);
     inertia::tangent(pt, nm, out);
@@ -869,33 +1006,33 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
 /// state the converged residual used, so that the stress stored at the particle and the stress in
 /// the residual cannot part ways.
 #[derive(Debug, Clone, Copy)]
-pub struct StepResult {
+pub struct StepResult<const D: usize = 2> {
     /// Interpolated increments, velocities and accelerations.
-    pub interp: Interp,
+    pub interp: Interp<D>,
     /// The effective stress at t_{n+1} from the soil model [Pa] (its tangents are not kept: a
     /// step's results are held for every particle at once).
     pub stress: Stress,
     /// The accumulated deviatoric plastic strain ε̄ at t_{n+1} [-].
     pub eps_pd: f64,
-    /// Incremental deformation gradient the particle keeps, F̄ = (J_v/J)^{1/2} F.
-    pub f_inc: [[f64; 2]; 2],
+    /// Incremental deformation gradient the particle keeps, F̄ = (J_v/J)^{1/D} F.
+    pub f_inc: [[f64; D]; D],
     /// Volume ratio of the step, J_v.
     pub jacobian: f64,
     /// The objective strain increment Δε [xx, yy, γxy, zz, γyz, γzx] the stress update used (zero
     /// for a rigid rotation).
     pub deps: Stress,
     /// The porosity gradient ∇n at t_n the step used (two-phase u–p–U; zero otherwise).
-    pub grad_n: [f64; 2],
+    pub grad_n: [f64; D],
     /// [002]'s projected J̄ at t_{n+1} (`stabilisation.fbar`; `None`: the point keeps its J̄).
     pub jbar: Option<f64>,
     /// The point's velocity after an explicit step whose transfer sets it (XPIC,
     /// `assembly::explicit`); `None`: the stage's own update (FLIP/PIC blend, Newmark, …).
-    pub velocity: Option<[f64; 2]>,
+    pub velocity: Option<[f64; D]>,
 }
 
-impl StepResult {
+impl<const D: usize> StepResult<D> {
     /// The result of the converged point.
-    pub fn of(pt: &Point) -> StepResult {
+    pub fn of<const M: usize>(pt: &Point<D, M>) -> StepResult<D> {
         StepResult {
             interp: pt.interp,
             stress: pt.upd.stress,

@@ -2,18 +2,22 @@
 //! Eq. 16 on x_{n+1}) and the pore pressure's forces on both phases ([`pore_pressure`]).
 //!
 //! Residual in the u rows: f_i = B̄'_iᵀ σ'_{n+1} V_{n+1} = V_{n+1} (dev σ' ∇'S_i + σ'_m ∇̄'S_i) (in
-//! the plane; σ'_m the mean stress including σ'_zz), with ∇' and ∇̄' the gradients on x_{n+1} and
-//! σ'_{n+1} the soil model's update from the rotated stress (see [`super::kinematics`]).
+//! the plane its in-plane part; σ'_m the mean stress including σ'_zz), with ∇' and ∇̄' the
+//! gradients on x_{n+1} and σ'_{n+1} the soil model's update from the rotated stress (see
+//! [`super::kinematics`]). The same code serves two and three dimensions (`D`): a plane point
+//! takes the first four stress components and the 4 × 4 block of the tangents
+//! ([`super::strain_rows`]).
 //!
 //! Its derivative with respect to Δu_l (component d) has three parts:
-//! * material: V_{n+1} B̄'_iᵀ A_l with A_l = ∂σ'/∂Δu_l = T (∂(Rσ_nRᵀ)/∂θ) ∂θ/∂Δu_l + D_alg ∂Δε/∂Δu_l
-//!   (T = ∂σ'/∂σ_trial of the return, D_alg = T D);
+//! * material: V_{n+1} B̄'_iᵀ A_l with A_l = ∂σ'/∂Δu_l = T ∂(Rσ_nRᵀ)/∂Δu_l + D_alg ∂Δε/∂Δu_l
+//!   (T = ∂σ'/∂σ_trial of the return, D_alg = T D; in two dimensions ∂(Rσ_nRᵀ)/∂Δu_l is
+//!   ∂(Rσ_nRᵀ)/∂θ ∂θ/∂Δu_l, in three [`super::kinematics::Kinematics::rotated_derivative`]);
 //! * volume: f_i,c (∇̄'S_l)_d, from ∂J_v/∂Δu_l,d = J_v (∇̄'S_l)_d;
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
 //!
 //! Every derivative with respect to Δu_l goes through node l's strain operators
-//! ([`super::Point::strain`], `strain_spatial`, `strain_hoop`): the basis itself, or [001]'s CMPM
+//! ([`super::Point::strain`], [`super::Point::strain_operators`]): the basis itself, or [001]'s CMPM
 //! patch functions, which recover the strain while the forces keep the basis.
 //!
 //! Axial symmetry adds the hoop stress to the radial force, f_i,r += V_{n+1}(dev σ'_θθ T'_i +
@@ -21,19 +25,29 @@
 //! ∂T'_i/∂Δu_l,r = −T'_i T'_l (T' = T/F_θθ) gives the geometric part
 //! −V_{n+1} (dev σ'_θθ T'_i T'_l + σ'_m T̄'_i T̄'_l) in the r–r entry.
 
-use super::{bbar, kinematics, Point, Scheme};
-use crate::model::soil::Stress;
+use super::kinematics::Mat;
+use super::{bbar, kinematics, strain_rows, Point, Scheme};
+use crate::model::soil::{principal, Stress, NS};
 
-/// In-plane deviatoric stress and the mean stress of a plane state [xx, yy, xy, zz, 0, 0].
-fn split(s: &Stress) -> ([[f64; 2]; 2], f64) {
+/// The deviatoric stress (its in-plane part in two dimensions) and the mean stress (σ_zz
+/// included) of `s`.
+fn split<const D: usize>(s: &Stress) -> (Mat<D>, f64) {
     let pm = (s[0] + s[1] + s[3]) / 3.0;
-    ([[s[0] - pm, s[2]], [s[2], s[1] - pm]], pm)
+    let t = principal::tensor(s);
+    (std::array::from_fn(|i| std::array::from_fn(|j| if i == j { t[i][j] - pm } else { t[i][j] })), pm)
+}
+
+/// dev σ v.
+#[inline]
+fn dev_times<const D: usize>(dev: &Mat<D>, v: [f64; D]) -> [f64; D] {
+    std::array::from_fn(|c| (1..D).fold(dev[c][0] * v[0], |s, d| s + dev[c][d] * v[d]))
 }
 
 /// The force of stress `s` on a node with gradients (g, gv) on x_{n+1}, per unit volume.
 #[inline]
-fn traction(dev: &[[f64; 2]; 2], pm: f64, g: [f64; 2], gv: [f64; 2]) -> [f64; 2] {
-    [dev[0][0] * g[0] + dev[0][1] * g[1] + pm * gv[0], dev[1][0] * g[0] + dev[1][1] * g[1] + pm * gv[1]]
+fn traction<const D: usize>(dev: &Mat<D>, pm: f64, g: [f64; D], gv: [f64; D]) -> [f64; D] {
+    let t = dev_times(dev, g);
+    std::array::from_fn(|c| t[c] + pm * gv[c])
 }
 
 /// The radial force of the hoop stress on a node with hoop operators (T', T̄') on x_{n+1}, per
@@ -44,20 +58,22 @@ fn hoop_force(s: &Stress, pm: f64, hoop: (f64, f64)) -> f64 {
 }
 
 /// Adds the effective-stress residual in the u rows (weight w_f = 1 − α_f).
-pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     let nd = pt.layout.nd;
     let v = pt.volume_new() * nm.w_force;
-    let (dev, pm) = split(&pt.upd.stress);
+    let (dev, pm) = split::<D>(&pt.upd.stress);
     for k in 0..pt.basis.len() {
         let (g, gv) = pt.spatial[k];
-        let t = traction(&dev, pm, g, gv);
-        out[k * nd] += (t[0] + hoop_force(&pt.upd.stress, pm, pt.hoop[k])) * v;
-        out[k * nd + 1] += t[1] * v;
+        let mut t = traction(&dev, pm, g, gv);
+        t[0] += hoop_force(&pt.upd.stress, pm, pt.hoop[k]);
+        for (c, tc) in t.into_iter().enumerate() {
+            out[k * nd + c] += tc * v;
+        }
     }
 }
 
 /// Adds the u–u tangent of the effective-stress term (material, volume and geometric parts).
-pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
     tangent_with(pt, nm, out, 1.0);
 }
 
@@ -65,29 +81,56 @@ pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
 /// tangent; [001]'s modified weights W* scale it by omp/cmp, and its mapped stiffnesses replace
 /// it (0) by their cell kernels ([`super::cell`]). The rotation of the objective update and the
 /// volume and geometric parts are kept.
-pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
+pub fn tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
+    // The per-node scratch holds the point's strain rows only (four in two dimensions).
+    if strain_rows::<D>() == 4 {
+        tangent_in::<D, M, 4>(pt, nm, out, material)
+    } else {
+        tangent_in::<D, M, NS>(pt, nm, out, material)
+    }
+}
+
+/// [`tangent_with`] of a point with `R` strain rows ([`strain_rows`]).
+fn tangent_in<const D: usize, const M: usize, const R: usize>(
+    pt: &Point<D, M>,
+    nm: &Scheme,
+    out: &mut [f64],
+    material: f64,
+) {
     let (nd, m) = (pt.layout.nd, pt.size());
+    let nr = R;
     let v = pt.volume_new() * nm.w_force;
     let s = &pt.upd.stress;
-    let (dev, pm) = split(s);
+    let (dev, pm) = split::<D>(s);
     let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
-    // ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
+    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
     let drot = kinematics::rotate_derivative(&pt.rotated);
-    let t_drot: [f64; 4] = std::array::from_fn(|r| (0..4).map(|q| t_mat[r][q] * drot[q]).sum());
-    // A_l = ∂σ'/∂Δu_l (4 × 2) for every node.
-    let mut a = [[[0.0; 2]; 4]; super::MAX_NODES];
+    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node.
+    let mut a = [[[0.0; D]; R]; M];
     for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
         let de = pt.kin.deps_derivative(bl);
-        let dt = pt.kin.theta_derivative(bl);
-        for r in 0..4 {
-            for d in 0..2 {
-                a[l][r][d] = t_drot[r] * dt[d] + material * (0..4).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+        if D == 2 {
+            let dt = pt.kin.theta_derivative(bl);
+            for r in 0..nr {
+                for d in 0..D {
+                    a[l][r][d] = t_drot[r] * dt[d] + material_part(r, d);
+                }
+            }
+        } else {
+            let dr = pt.kin.rotated_derivative(bl, &pt.rotated);
+            for r in 0..nr {
+                for d in 0..D {
+                    a[l][r][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
+                }
             }
         }
     }
     let dev_tt = s[3] - pm;
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
+    let (strain_spatial, strain_hoop) = pt.strain_operators();
     for k in 0..pt.basis.len() {
         let (gk, gvk) = pt.spatial[k];
         let hk = pt.hoop[k];
@@ -96,14 +139,15 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
         tk[0] += hoop_force(s, pm, hk);
         for l in 0..pt.basis.len() {
             // Derivatives with respect to Δu_l go through the strain operators of node l.
-            let (gl, gvl) = pt.strain_spatial[l];
-            let hl = pt.strain_hoop[l];
-            let dev_gl = [dev[0][0] * gl[0] + dev[0][1] * gl[1], dev[1][0] * gl[0] + dev[1][1] * gl[1]];
-            // ∂J_v/∂Δu_l / J_v: the in-plane divergence and, radially, the hoop term.
-            let djv = [gvl[0] + hl.1, gvl[1]];
-            for c in 0..2 {
-                for d in 0..2 {
-                    let material: f64 = (0..4).map(|r| bk[r][c] * a[l][r][d]).sum();
+            let (gl, gvl) = strain_spatial[l];
+            let hl = strain_hoop[l];
+            let dev_gl = dev_times(&dev, gl);
+            // ∂J_v/∂Δu_l / J_v: the divergence and, radially, the hoop term.
+            let mut djv = gvl;
+            djv[0] += hl.1;
+            for c in 0..D {
+                for d in 0..D {
+                    let material: f64 = (0..nr).map(|r| bk[r][c] * a[l][r][d]).sum();
                     let volume = tk[c] * djv[d];
                     let mut geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
                     if c == 0 && d == 0 {
@@ -119,12 +163,12 @@ pub fn tangent_with(pt: &Point, nm: &Scheme, out: &mut [f64], material: f64) {
     // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
     if let Some(j) = pt.layout.jbar {
         let de = pt.kin.deps_volume_derivative();
-        let dsig: [f64; 4] = std::array::from_fn(|r| (0..4).map(|q| d_alg[r][q] * de[q]).sum::<f64>());
+        let dsig: [f64; NS] = std::array::from_fn(|r| (0..nr).map(|q| d_alg[r][q] * de[q]).sum::<f64>());
         let vj = v * material / pt.part.jbar;
         for k in 0..pt.basis.len() {
             let (gk, gvk) = pt.spatial[k];
             let bk = bbar(gk, gvk, pt.hoop[k]);
-            let force: [f64; 2] = std::array::from_fn(|c| vj * (0..4).map(|r| bk[r][c] * dsig[r]).sum::<f64>());
+            let force: [f64; D] = std::array::from_fn(|c| vj * (0..nr).map(|r| bk[r][c] * dsig[r]).sum::<f64>());
             for (c, f) in force.into_iter().enumerate() {
                 let row = (k * nd + c) * m;
                 for (i, b) in pt.basis.iter().enumerate() {
@@ -143,7 +187,7 @@ pub mod pore_pressure {
     use super::super::{Point, Scheme};
 
     /// The fractions of p carried by the solid and the water equations.
-    fn shares(pt: &Point) -> (f64, f64) {
+    fn shares<const D: usize, const M: usize>(pt: &Point<D, M>) -> (f64, f64) {
         let n = pt.part.porosity;
         if pt.layout.w.is_some() {
             (1.0 - n, n)
@@ -153,7 +197,7 @@ pub mod pore_pressure {
     }
 
     /// Adds the pressure forces (weight w_f).
-    pub fn residual(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         if pt.layout.p.is_none() && pt.p == 0.0 {
             return;
         }
@@ -163,8 +207,9 @@ pub mod pore_pressure {
         for k in 0..pt.basis.len() {
             let (g, tv) = (pt.spatial[k].1, pt.hoop[k].1);
             // The divergence operator on x_{n+1}: ∇̄'S and, radially, the hoop term T̄'.
-            let gv = [g[0] + tv, g[1]];
-            for c in 0..2 {
+            let mut gv = g;
+            gv[0] += tv;
+            for c in 0..D {
                 out[k * nd + c] -= fs * pv * gv[c];
                 if let Some(w) = pt.layout.w {
                     out[k * nd + w + c] -= fw * pv * gv[c];
@@ -174,24 +219,26 @@ pub mod pore_pressure {
     }
 
     /// Adds the u–p and U–p couplings (−G₁, −G₂ on x_{n+1}) and their geometric u–u and U–u parts.
-    pub fn tangent(pt: &Point, nm: &Scheme, out: &mut [f64]) {
+    pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         if pt.layout.p.is_none() && pt.p == 0.0 {
             return;
         }
         let (nd, m) = (pt.layout.nd, pt.size());
+        let (strain_spatial, strain_hoop) = pt.strain_operators();
         let (fs, fw) = shares(pt);
         let v = pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
             let (gvk, tk) = (pt.spatial[k].1, pt.hoop[k].1);
-            let divk = [gvk[0] + tk, gvk[1]];
+            let mut divk = gvk;
+            divk[0] += tk;
             for (l, bl) in pt.basis.iter().enumerate() {
-                let (gvl, tl) = (pt.strain_spatial[l].1, pt.strain_hoop[l].1);
-                for c in 0..2 {
+                let (gvl, tl) = (strain_spatial[l].1, strain_hoop[l].1);
+                for c in 0..D {
                     let ru = (k * nd + c) * m;
                     if let Some(p) = pt.layout.p {
                         out[ru + l * nd + p] -= fs * v * divk[c] * bl.s;
                     }
-                    for d in 0..2 {
+                    for d in 0..D {
                         // ∂(J_v ∇̄'S_k,c)/∂Δu_l,d = J_v (∇̄'S_l,d ∇̄'S_k,c − ∇̄'S_l,c ∇̄'S_k,d); in
                         // axial symmetry the divergence gains T̄' (radially) and J_v's derivative
                         // T̄'_l (radially), whose hoop–hoop parts cancel.

@@ -27,6 +27,15 @@ pub fn plane(f: M2) -> M3 {
     [[f[0][0], f[0][1], 0.0], [f[1][0], f[1][1], 0.0], [0.0, 0.0, 1.0]]
 }
 
+/// The 3 × 3 deformation gradient of a point of dimension `D` (2 or 3): a plane point's
+/// in-plane `f` with F_zz = 1 ([`plane`]), or `f` itself.
+pub fn embed<const D: usize>(f: &[[f64; D]; D]) -> M3 {
+    match D {
+        2 => plane([[f[0][0], f[0][1]], [f[1][0], f[1][1]]]),
+        _ => std::array::from_fn(|i| std::array::from_fn(|j| f[i][j])),
+    }
+}
+
 /// Whether `f` is a plane deformation (F_zz = 1, no out-of-plane shear): what [`plane`] makes.
 pub fn is_plane(f: &M3) -> bool {
     f[0][2] == 0.0 && f[1][2] == 0.0 && f[2][0] == 0.0 && f[2][1] == 0.0 && f[2][2] == 1.0
