@@ -8,6 +8,10 @@
 //! * `soil/linear_elastic`, `soil/mohr_coulomb_plastic`: one stress update per particle; the
 //!   Mohr–Coulomb increment is a shear that yields every particle (checked before timing).
 //! * `patch/recover`: MLSA patch recovery of Δp at every particle.
+//! * `kernels_3d/residual`, `kernels_3d/tangent`, `kernels_3d/gimp_stencil`: the same in three
+//!   dimensions (a two-phase box of 8 × 8 × 8 cells, two particles per cell and direction, so
+//!   3 × 3 × 3-node GIMP stencils with B̄; u–p–U with seven dofs per node), per particle as above,
+//!   the cost per point the estimate of a large three-dimensional run starts from.
 //! * `assembly/residual_and_jacobian`: the residual and Jacobian of one Newton iteration assembled into
 //!   PETSc (`GridSystem::assemble_once`) on the slumping block at its first step.
 //!
@@ -211,6 +215,111 @@ fn particle_kernels(c: &mut Criterion) {
     g.finish();
 }
 
+/// A two-phase elastic box of 8 × 8 × 8 cells (2 × 2 × 2 points per cell) in three dimensions.
+const BOX_3D: &str = r#"
+    [analysis]
+    formulation = "two_phase"
+    [grid]
+    size = [1.0, 1.0, 1.0]
+    cells = [8, 8, 8]
+    [[materials]]
+    name = "soil"
+    porosity = 0.3
+    solid_density = 2650.0
+    water_bulk_modulus = 2.2e9
+    hydraulic_conductivity = 1e-3
+    [materials.model]
+    type = "linear_elastic"
+    young_modulus = 1e7
+    poisson_ratio = 0.3
+    [[bodies]]
+    name = "box"
+    material = "soil"
+    shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }
+    initial_stress = { k0 = 0.5 }
+    [[stages]]
+    name = "load"
+    duration = 0.1
+    dt = 1e-3
+"#;
+
+fn particle_kernels_3d(c: &mut Criterion) {
+    const M: usize = kernels::MAX_NODES_3D;
+    let case = case::parse(BOX_3D, "box_3d", &[]).expect("the 3D box parses");
+    let model = porompm::model::Model::build_solid(&case, |_| true);
+    let ps = &model.particles;
+    let n = ps.len();
+    let stencil = |k: usize| -> Vec<NodeBasis<3>> {
+        let mut st: shape::Stencil<3, M> = shape::stencil_in(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+        let (gv, _) =
+            shape::volumetric_operators_in(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|c| c, false);
+        (0..st.len).map(|m| NodeBasis { s: st.w[m], g: st.dw[m], gv: gv[m], t: 0.0, tv: 0.0 }).collect()
+    };
+    let mut g = group(c, "kernels_3d", n);
+    g.bench_function("gimp_stencil", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                sum += stencil(k)[0].s;
+            }
+            black_box(sum)
+        })
+    });
+    let basis: Vec<Vec<NodeBasis<3>>> = (0..n).map(stencil).collect();
+    let layout = kernels::Layout::UPU.in_dim(3);
+    let nm = kernels::Scheme::of(&model.integration, 1e-3, false);
+    let states: Vec<Vec<NodeState<{ kernels::MAX_DOF_3D }>>> = basis
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            (0..b.len())
+                .map(|m| {
+                    let d: Vec<f64> = (0..layout.nd)
+                        .map(|c| 1e-6 * noise(97 * k + 7 * m + c) * if Some(c) == layout.p { 1e6 } else { 1.0 })
+                        .collect();
+                    NodeState::new(&d, &nm)
+                })
+                .collect()
+        })
+        .collect();
+    let body_acc = vec![[0.0, -9.81, 0.0]; model.n_bodies];
+    let inputs: Vec<kernels::ParticleInput<3>> = (0..n).map(|k| model.particle_input(k, &body_acc)).collect();
+    let soil = &model.materials[0].model;
+    let largest = basis.iter().map(|b| b.len() * layout.nd).max().unwrap_or(0);
+    g.bench_function("residual", |b| {
+        let mut buf = vec![0.0; largest];
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                let m = basis[k].len() * layout.nd;
+                let pt = kernels::Point::<3, M>::new(&basis[k], &states[k], &inputs[k], soil, layout);
+                kernels::residual(&pt, &nm, &mut buf[..m]);
+                sum += buf[0];
+            }
+            black_box(sum)
+        })
+    });
+    g.bench_function("tangent", |b| {
+        let mut block = vec![0.0; largest * largest];
+        b.iter(|| {
+            let mut sum = 0.0;
+            for k in 0..n {
+                let m = basis[k].len() * layout.nd;
+                let pt = kernels::Point::<3, M>::new(&basis[k], &states[k], &inputs[k], soil, layout);
+                kernels::tangent(&pt, &nm, &mut block[..m * m]);
+                sum += block[0];
+            }
+            black_box(sum)
+        })
+    });
+    g.finish();
+    eprintln!(
+        "kernels_3d: {n} material points, {} to {} stencil nodes",
+        basis.iter().map(|b| b.len()).min().unwrap_or(0),
+        basis.iter().map(|b| b.len()).max().unwrap_or(0)
+    );
+}
+
 fn global_assembly(c: &mut Criterion) {
     let case = load("cases/slumping_block.toml", &[]);
     let coll = porompm::parallel::Collective::world();
@@ -244,6 +353,7 @@ fn main() {
     let petsc = petsc::Petsc::initialize(&[], None, "porompm-bench").expect("PETSc initialises");
     let mut c = Criterion::default().configure_from_args();
     particle_kernels(&mut c);
+    particle_kernels_3d(&mut c);
     global_assembly(&mut c);
     c.final_summary();
     drop(petsc);

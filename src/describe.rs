@@ -7,6 +7,9 @@ use std::fmt::Write;
 
 /// A plain-text description of the discrete problem a case defines.
 pub fn describe(case: &Case, label: &str) -> String {
+    if case.dimension() == 3 {
+        return describe_solid(case, label);
+    }
     let model = Model::build(case, |_, _| true);
     let g = &model.grid;
     let nd = model.ndof();
@@ -27,6 +30,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         "geometry: {}",
         match model.geometry {
             shape::Geometry::PlaneStrain => "plane strain (volumes per metre of thickness)".to_string(),
+            shape::Geometry::Solid => "three dimensions (volumes in m³)".to_string(),
             shape::Geometry::Axisymmetric(w) => format!(
                 "axisymmetric about the y axis (x ≡ r; ring volumes 2πrA; hoop strain u_r/r; GIMP weights in r: {w:?}){}",
                 if model.boundaries.iter().any(|b| b.is_axis()) {
@@ -278,5 +282,51 @@ pub fn describe(case: &Case, label: &str) -> String {
             let _ = writeln!(s, "verification: none");
         }
     }
+    s
+}
+
+/// The description of a three-dimensional case: its grid, bodies and material points (it has no
+/// loads or boundaries yet and cannot be run: issue «Three dimensions»).
+fn describe_solid(case: &Case, label: &str) -> String {
+    let model = Model::build_solid(case, |_| true);
+    let g = &model.grid;
+    let ps = &model.particles;
+    let mut s = String::new();
+    let _ = writeln!(s, "case: {label}");
+    let _ = writeln!(s, "dimension: 3 (y vertical; volumes in m³)");
+    let _ = writeln!(s, "formulation: {}", if model.two_phase { "two_phase" } else { "one_phase" });
+    let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
+    let _ = writeln!(
+        s,
+        "grid: {} × {} × {} cells of {:.4} × {:.4} × {:.4} m from ({}, {}, {}), {} nodes",
+        g.cells[0],
+        g.cells[1],
+        g.cells[2],
+        g.h[0],
+        g.h[1],
+        g.h[2],
+        g.origin[0],
+        g.origin[1],
+        g.origin[2],
+        g.node_count()
+    );
+    for (b, body) in case.bodies.iter().enumerate() {
+        let count = ps.body.iter().filter(|&&x| x as usize == b).count();
+        let volume: f64 = (0..ps.len()).filter(|&k| ps.body[k] as usize == b).map(|k| ps.volume[k]).sum();
+        let n = body.particles_per_cell;
+        let [z0, z1] = case.body_depth(body);
+        let _ = writeln!(
+            s,
+            "body `{}`: {count} material points ({n}×{n}×{n} per cell), volume {volume:.6e} m³, z ∈ [{z0}, {z1}] m, \
+             material `{}`",
+            body.name, body.material
+        );
+    }
+    let _ = writeln!(s, "material points: {}", ps.len());
+    let _ = writeln!(
+        s,
+        "loads, boundaries: none (a three-dimensional case has none yet); `porompm run` refuses the case \
+         (issue «Three dimensions», docs/dimensions.md)"
+    );
     s
 }

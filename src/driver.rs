@@ -286,6 +286,18 @@ struct Simulation<'a> {
     balance: (f64, Option<f64>),
 }
 
+/// Whether porompm can run `case`: a three-dimensional case is read, validated and its material
+/// points generated (`porompm check`), but its run does not exist yet (issue «Three dimensions»,
+/// docs/dimensions.md).
+pub fn runnable(case: &crate::case::Case) -> Result<(), String> {
+    if case.dimension() == 3 {
+        return Err("the case is three-dimensional: porompm reads it and generates its material points \
+                    (`porompm check`), but cannot run it yet (issue «Three dimensions», docs/dimensions.md)"
+            .into());
+    }
+    Ok(())
+}
+
 /// Runs a case and returns its summary (also written to `summary.json`).
 pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
     let start = Instant::now();
@@ -437,6 +449,7 @@ impl<'a> Simulation<'a> {
         let case = req.case;
         let coll = req.coll;
         let input = |e: String| RunError::Input(e);
+        runnable(case).map_err(input)?;
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
         let layout = StageAnalysis::of(case, &case.stages[first]).layout;
         let system = GridSystem::new(coll, &crate::model::grid_of(case), layout, None, case.jacobian_stiffness())

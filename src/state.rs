@@ -310,7 +310,7 @@ mod tests {
     fn particles() -> (Case, Particles) {
         let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
         let g = crate::model::grid_of(&c);
-        let ps = Particles::generate(&c, &g, |_, _| true);
+        let ps = Particles::generate(&c, &g, |_| true);
         (c, ps)
     }
 

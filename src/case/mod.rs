@@ -115,7 +115,59 @@ impl Case {
 
     /// Cell size in x and y [m].
     pub fn cell_size(&self) -> [f64; 2] {
-        [self.grid.size[0] / self.grid.cells[0] as f64, self.grid.size[1] / self.grid.cells[1] as f64]
+        self.cell_size_in()
+    }
+
+    /// The dimension of the case: the number of entries of `grid.size` (2 or 3, validated).
+    pub fn dimension(&self) -> usize {
+        self.grid.size.len()
+    }
+
+    /// The grid's origin in the first `D` directions [m] (zero where the case gives none).
+    pub fn origin_in<const D: usize>(&self) -> [f64; D] {
+        std::array::from_fn(|d| self.grid.origin.get(d).copied().unwrap_or(0.0))
+    }
+
+    /// The grid's cells in the first `D` directions.
+    pub fn cells_in<const D: usize>(&self) -> [usize; D] {
+        std::array::from_fn(|d| self.grid.cells.get(d).copied().unwrap_or(1))
+    }
+
+    /// The cell size in the first `D` directions [m].
+    pub fn cell_size_in<const D: usize>(&self) -> [f64; D] {
+        let cells = self.cells_in::<D>();
+        std::array::from_fn(|d| self.grid.size.get(d).copied().unwrap_or(1.0) / cells[d] as f64)
+    }
+
+    /// The grid's origin in x and y [m].
+    pub fn origin(&self) -> [f64; 2] {
+        self.origin_in()
+    }
+
+    /// The grid's cells in x and y.
+    pub fn cells(&self) -> [usize; 2] {
+        self.cells_in()
+    }
+
+    /// The extent [z_min, z_max] of `body` along z in a three-dimensional case [m]: its own, or
+    /// the grid's.
+    pub fn body_depth(&self, body: &Body) -> [f64; 2] {
+        body.z.unwrap_or_else(|| {
+            let z0 = self.grid.origin.get(2).copied().unwrap_or(0.0);
+            [z0, z0 + self.grid.size.get(2).copied().unwrap_or(0.0)]
+        })
+    }
+
+    /// Whether `body` holds the point `p` of a case of dimension `D`: its section holds (x, y) and,
+    /// in three dimensions, its extent along z holds z (bounds included, as the section's).
+    pub fn body_holds<const D: usize>(&self, body: &Body, p: [f64; D]) -> bool {
+        if !body.shape.contains([p[0], p[1]]) {
+            return false;
+        }
+        D == 2 || {
+            let [lo, hi] = self.body_depth(body);
+            p[2] >= lo && p[2] <= hi
+        }
     }
 }
 
@@ -129,14 +181,15 @@ impl Case {
         }
     }
 
-    /// The first body containing `p` (bodies earlier in the file take precedence), if any.
-    pub fn body_at(&self, p: [f64; 2]) -> Option<&Body> {
-        self.bodies.iter().find(|b| b.shape.contains(p))
+    /// The first body containing `p` (bodies earlier in the file take precedence), if any, in a case
+    /// of dimension `D`.
+    pub fn body_at<const D: usize>(&self, p: [f64; D]) -> Option<&Body> {
+        self.bodies.iter().find(|b| self.body_holds(b, p))
     }
 
     /// Mass density of the material at `p` [kg/m³]: the saturated mixture (1 − n)ρ_s + nρ_w, or 0
     /// outside every body.
-    pub fn density_at(&self, p: [f64; 2]) -> f64 {
+    pub fn density_at<const D: usize>(&self, p: [f64; D]) -> f64 {
         self.body_at(p).map_or(0.0, |b| {
             let m = &self.materials[self.material_index(&b.material).expect("validated")];
             (1.0 - m.porosity) * m.solid_density + m.porosity * m.water_density
@@ -145,14 +198,15 @@ impl Case {
 
     /// The top of the material above `p` (the highest point of the bodies on the vertical line
     /// through p, sampled at `dy`), and ∫_y^{top} ρ dy along it [kg/m²].
-    pub fn column_above(&self, p: [f64; 2], dy: f64) -> (f64, f64) {
+    pub fn column_above<const D: usize>(&self, p: [f64; D], dy: f64) -> (f64, f64) {
         let top = self.bodies.iter().map(|b| b.shape.bounds().1[1]).fold(p[1], f64::max);
         let n = ((top - p[1]) / dy).ceil().max(1.0) as usize;
         let h = (top - p[1]) / n as f64;
         let (mut mass, mut surface) = (0.0, p[1]);
         for i in 0..n {
-            let y = p[1] + (i as f64 + 0.5) * h;
-            let rho = self.density_at([p[0], y]);
+            let mut q = p;
+            q[1] = p[1] + (i as f64 + 0.5) * h;
+            let rho = self.density_at(q);
             mass += rho * h;
             if rho > 0.0 {
                 surface = p[1] + (i + 1) as f64 * h;
@@ -317,7 +371,7 @@ mod tests {
             &[Override::parse("grid.cells=[2,20]").unwrap(), Override::parse("stages[0].dt=5e-4").unwrap()],
         )
         .unwrap();
-        assert_eq!(c.grid.cells, [2, 20]);
+        assert_eq!(c.cells(), [2, 20]);
         assert_eq!(c.stages[0].dt(), 5e-4);
         // A stage without its own step takes time.dt.
         let no_dt =

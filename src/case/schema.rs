@@ -169,17 +169,19 @@ pub enum ShapeFunctions {
     Bspline3,
 }
 
-/// A uniform structured background grid.
+/// A uniform structured background grid: two entries per key for a plane (or axisymmetric) case,
+/// three for a three-dimensional one (y is vertical in every dimension: gravity acts along −y, z
+/// is the second horizontal direction).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Grid {
-    /// Lower-left corner [m].
+    /// Lower-left (-back) corner [m]; default: the origin.
     #[serde(default)]
-    pub origin: [f64; 2],
-    /// Extent in x and y [m].
-    pub size: [f64; 2],
-    /// Number of cells in x and y.
-    pub cells: [usize; 2],
+    pub origin: Vec<f64>,
+    /// Extent in x, y (and z) [m].
+    pub size: Vec<f64>,
+    /// Number of cells in x, y (and z).
+    pub cells: Vec<usize>,
 }
 
 /// A material: phase densities, porosity, the water and grain compressibility, the permeability,
@@ -351,8 +353,12 @@ pub struct Body {
     /// Material points per cell and direction (2 gives 2×2 per cell).
     #[serde(default = "default_ppc")]
     pub particles_per_cell: usize,
-    /// The region it occupies at t = 0.
+    /// The region it occupies at t = 0: in three dimensions its section in the x–y plane,
+    /// extruded along z over `z`.
     pub shape: Shape,
+    /// The body's extent [z_min, z_max] along z [m] (three-dimensional cases; default the grid's).
+    #[serde(default)]
+    pub z: Option<[f64; 2]>,
     /// Geostatic initial stress (default: stress-free).
     #[serde(default)]
     pub initial_stress: Option<InitialStress>,

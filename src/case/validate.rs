@@ -179,14 +179,57 @@ fn finite_strain_materials(c: &Case) -> R {
     Ok(())
 }
 
+/// What a three-dimensional case may not ask for yet (issue «Three dimensions»: its grid, bodies,
+/// materials and analysis settings are read and its material points generated; loads, boundaries,
+/// probes, verifications and the two-dimensional options are not three-dimensional yet), and the
+/// space of its points' identifiers.
+fn three_dimensional(c: &Case) -> R {
+    let not_yet = |key: &str| {
+        Err(format!(
+            "key `{key}`: not available in a three-dimensional case yet (issue «Three dimensions», \
+             docs/dimensions.md)"
+        ))
+    };
+    if c.analysis.geometry == Geometry::Axisymmetric {
+        return Err("key `analysis.geometry`: a three-dimensional case has no axial symmetry (give two entries \
+                    per grid key for an axisymmetric one)"
+            .into());
+    }
+    if !c.loads.is_empty() {
+        return not_yet("loads");
+    }
+    if !c.boundaries.is_empty() {
+        return not_yet("boundaries");
+    }
+    if !c.probes.is_empty() {
+        return not_yet("probes");
+    }
+    if c.verification.is_some() {
+        return not_yet("verification");
+    }
+    if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
+        return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
+    }
+    // A point's identifier numbers its sub-cell below bit 48 (at most 8 points per cell and
+    // direction, `Particles::generate`).
+    let sub_cells: f64 = c.grid.cells.iter().map(|&n| 8.0 * n as f64).product();
+    if sub_cells >= (1u64 << 48) as f64 {
+        return Err(format!(
+            "key `grid.cells`: {:?} cells are too many to number the material points of (at most 2^48 / 512 cells)",
+            c.grid.cells
+        ));
+    }
+    Ok(())
+}
+
 fn axisymmetry(c: &Case, tol: f64) -> R {
     if c.analysis.geometry != crate::case::Geometry::Axisymmetric {
         return Ok(());
     }
-    if c.grid.origin[0] < -tol {
+    if c.origin()[0] < -tol {
         return Err(format!(
             "key `grid.origin`: an axisymmetric analysis has x ≡ r ≥ 0, so the grid must start at x ≥ 0 (got {})",
-            c.grid.origin[0]
+            c.origin()[0]
         ));
     }
     if let Some(b) = c.boundaries.iter().find(|b| b.name == crate::model::AXIS) {
@@ -320,15 +363,28 @@ pub fn validate(c: &Case) -> R {
     }
 
     // Grid.
-    finite2("grid.origin", c.grid.origin)?;
-    positive("grid.size[0]", c.grid.size[0])?;
-    positive("grid.size[1]", c.grid.size[1])?;
-    for d in 0..2 {
+    let dim = c.grid.size.len();
+    if dim != 2 && dim != 3 {
+        return Err(format!(
+            "key `grid.size`: two entries (a plane or axisymmetric case) or three (a three-dimensional one), got {dim}"
+        ));
+    }
+    for (key, n) in [("origin", c.grid.origin.len()), ("cells", c.grid.cells.len())] {
+        if n != dim && !(key == "origin" && n == 0) {
+            return Err(format!("key `grid.{key}`: {dim} entries, as `grid.size` has, got {n}"));
+        }
+    }
+    finite2("grid.origin", c.origin())?;
+    for d in 0..dim {
+        positive(&format!("grid.size[{d}]"), c.grid.size[d])?;
         if c.grid.cells[d] == 0 || c.grid.cells[d] > 100_000 {
             return Err(format!("key `grid.cells[{d}]`: must be between 1 and 100000, got {}", c.grid.cells[d]));
         }
     }
-    let lo = c.grid.origin;
+    if dim == 3 {
+        three_dimensional(c)?;
+    }
+    let lo = c.origin();
     let hi = [lo[0] + c.grid.size[0], lo[1] + c.grid.size[1]];
     let h = c.cell_size();
     let tol = [1e-9 * h[0], 1e-9 * h[1]];
@@ -430,6 +486,27 @@ pub fn validate(c: &Case) -> R {
                 }
             }
         }
+        match (dim, b.z) {
+            (2, Some(_)) => {
+                return Err(format!(
+                    "key `bodies[{i}].z`: only a three-dimensional case (three entries in `grid.size`) takes a \
+                     body's extent along z"
+                ))
+            }
+            (3, Some([z0, z1])) => {
+                let (g0, g1) = (c.grid.origin.get(2).copied().unwrap_or(0.0), c.grid.size[2]);
+                let tol = 1e-9 * g1 / c.grid.cells[2] as f64;
+                if !(z0.is_finite() && z1.is_finite() && z0 < z1 && z0 >= g0 - tol && z1 <= g0 + g1 + tol) {
+                    return Err(format!(
+                        "key `bodies[{i}].z`: body `{}` needs z_min < z_max inside the grid's [{g0}, {}], got \
+                         [{z0}, {z1}]",
+                        b.name,
+                        g0 + g1
+                    ));
+                }
+            }
+            _ => {}
+        }
         let (bmin, bmax) = b.shape.bounds();
         if !inside_grid(bmin) || !inside_grid(bmax) {
             return Err(format!(
@@ -499,7 +576,7 @@ pub fn validate(c: &Case) -> R {
             // A region between grid lines fixes nothing: the body it was meant to hold would move
             // freely (a clamp at x = 0 on a grid whose lines miss x = 0). A box holds a node if
             // some grid line of each direction crosses it (`Region::holds_node`, one axis at a time).
-            let crossed = |d: usize| (0..=c.grid.cells[d]).any(|i| r.spans(d, lo[d] + i as f64 * h[d], 1e-9 * h[d]));
+            let crossed = |d: usize| (0..=c.cells()[d]).any(|i| r.spans(d, lo[d] + i as f64 * h[d], 1e-9 * h[d]));
             if !(crossed(0) && crossed(1)) {
                 return Err(format!(
                     "key `boundaries[{i}].region`: holds no grid node (the grid lines lie at x = {} + i·{}, \

@@ -55,7 +55,7 @@ fn identity<const D: usize>() -> Mat<D> {
 }
 
 /// det a (D = 2 or 3).
-fn det<const D: usize>(a: &Mat<D>) -> f64 {
+pub fn det<const D: usize>(a: &Mat<D>) -> f64 {
     match D {
         2 => a[0][0] * a[1][1] - a[0][1] * a[1][0],
         3 => {

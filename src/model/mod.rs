@@ -15,6 +15,7 @@ pub mod shape;
 pub mod soil;
 
 use crate::case::{Case, Formulation, ShapeFunctions, Side};
+use crate::kernels::kinematics::det;
 use crate::kernels::{ParticleInput, StepResult};
 use grid::Grid;
 use loads::{BoundaryDef, LoadDef, LoadTarget};
@@ -22,9 +23,11 @@ use material::Material;
 use particles::Particles;
 use shape::Basis;
 
-/// Everything that describes the continuum and its discretisation on this rank.
+/// Everything that describes the continuum and its discretisation on this rank, in `D` dimensions
+/// (two unless it says otherwise). Its loads and boundaries are still two-dimensional (issue
+/// «Three dimensions», docs/dimensions.md): a three-dimensional model has none yet.
 #[derive(Debug, Clone)]
-pub struct Model {
+pub struct Model<const D: usize = 2> {
     /// u–p–U (true) or u only.
     pub two_phase: bool,
     /// Basis functions.
@@ -33,11 +36,11 @@ pub struct Model {
     /// B-splines).
     pub stretch_domains: bool,
     /// Background grid.
-    pub grid: Grid,
+    pub grid: Grid<D>,
     /// Materials, indexed by `particles.material`.
     pub materials: Vec<Material>,
     /// This rank's material points.
-    pub particles: Particles,
+    pub particles: Particles<D>,
     /// Loads, in case order.
     pub loads: Vec<LoadDef>,
     /// Dirichlet conditions, in case order.
@@ -58,7 +61,7 @@ pub struct Model {
     pub n_bodies: usize,
     /// Factor α of the pressure-projection stabilisation τ = α/G (two-phase), if on.
     pub pressure_projection: Option<f64>,
-    /// Plane strain or axial symmetry (with its particle weights).
+    /// Plane strain or axial symmetry (with its particle weights), or three dimensions.
     pub geometry: shape::Geometry,
     /// The material stiffness of the Newton matrix ([001] §5).
     pub stiffness: crate::case::Stiffness,
@@ -72,6 +75,9 @@ pub struct Model {
 
 /// The geometry of a case.
 pub fn geometry_of(case: &Case) -> shape::Geometry {
+    if case.dimension() == 3 {
+        return shape::Geometry::Solid;
+    }
     match case.analysis.geometry {
         crate::case::Geometry::PlaneStrain => shape::Geometry::PlaneStrain,
         crate::case::Geometry::Axisymmetric => {
@@ -96,9 +102,9 @@ pub fn field_names(two_phase: bool) -> &'static [&'static str] {
     }
 }
 
-/// The background grid of a case.
-pub fn grid_of(case: &Case) -> Grid {
-    Grid::new(case.grid.origin, case.cell_size(), case.grid.cells)
+/// The background grid of a case of dimension `D`.
+pub fn grid_of<const D: usize>(case: &Case) -> Grid<D> {
+    Grid::new(case.origin_in(), case.cell_size_in(), case.cells_in())
 }
 
 /// Position of a dof component in a node's interlaced dofs (ux, uy, p, Ux, Uy).
@@ -136,7 +142,7 @@ impl Model {
     /// Builds the model of `case`, generating particles only in the cells `owned(i, j)`.
     pub fn build(case: &Case, owned: impl Fn(usize, usize) -> bool) -> Model {
         let grid = grid_of(case);
-        let particles = Particles::generate(case, &grid, owned);
+        let particles = Particles::generate(case, &grid, |c| owned(c[0], c[1]));
         let loads = case.loads.iter().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
         let mut boundaries: Vec<BoundaryDef> =
             case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
@@ -144,42 +150,7 @@ impl Model {
         if geometry.axisymmetric() && grid.origin[0].abs() <= 1e-12 * grid.h[0] {
             boundaries.push(BoundaryDef::axis());
         }
-        Model {
-            two_phase: case.analysis.formulation == Formulation::TwoPhase,
-            basis: match case.analysis.shape_functions {
-                ShapeFunctions::Gimp | ShapeFunctions::Ugimp => Basis::Gimp,
-                ShapeFunctions::Linear => Basis::Linear,
-                ShapeFunctions::Bspline2 => Basis::BSpline2,
-                ShapeFunctions::Bspline3 => Basis::BSpline3,
-            },
-            stretch_domains: matches!(
-                case.analysis.shape_functions,
-                ShapeFunctions::Gimp | ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3
-            ),
-            grid,
-            materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
-            particles,
-            loads,
-            boundaries,
-            g: case.analysis.g,
-            integration: case.time_integration.integration(),
-            bbar: case.stabilisation.bbar,
-            fbar: case.stabilisation.fbar,
-            n_bodies: case.bodies.len(),
-            pressure_projection: if case.analysis.formulation == Formulation::TwoPhase {
-                case.stabilisation.pressure_projection
-            } else {
-                None
-            },
-            pressure_update: case.stabilisation.pressure_update,
-            geometry,
-            stiffness: case.stabilisation.stiffness,
-            stress_recovery: case.stabilisation.stress_recovery,
-            linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
-            stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
-            patch_recovery: case.analysis.formulation == Formulation::TwoPhase
-                && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
-        }
+        Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 
     /// Resolves the case's point-wise loads (face tractions) and moving surfaces again on this
@@ -359,9 +330,65 @@ impl Model {
         }
         out
     }
+}
 
+impl Model<3> {
+    /// Builds the model of a three-dimensional `case`, generating particles only in the cells
+    /// `owned(cell)` (no loads or boundaries: a three-dimensional case has none yet).
+    pub fn build_solid(case: &Case, owned: impl Fn([usize; 3]) -> bool) -> Model<3> {
+        let grid = grid_of(case);
+        let particles = Particles::generate(case, &grid, owned);
+        Model::bare(case, grid, particles)
+    }
+}
+
+/// The position `x` as "(x, y)" or "(x, y, z)" with four decimals, for messages.
+fn position<const D: usize>(x: &[f64; D]) -> String {
+    format!("({})", x.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "))
+}
+
+impl<const D: usize> Model<D> {
+    /// The model of `case` on `grid` with `particles`, without loads or boundaries.
+    fn bare(case: &Case, grid: Grid<D>, particles: Particles<D>) -> Model<D> {
+        Model {
+            two_phase: case.analysis.formulation == Formulation::TwoPhase,
+            basis: match case.analysis.shape_functions {
+                ShapeFunctions::Gimp | ShapeFunctions::Ugimp => Basis::Gimp,
+                ShapeFunctions::Linear => Basis::Linear,
+                ShapeFunctions::Bspline2 => Basis::BSpline2,
+                ShapeFunctions::Bspline3 => Basis::BSpline3,
+            },
+            stretch_domains: matches!(
+                case.analysis.shape_functions,
+                ShapeFunctions::Gimp | ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3
+            ),
+            grid,
+            materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
+            particles,
+            loads: Vec::new(),
+            boundaries: Vec::new(),
+            g: case.analysis.g,
+            integration: case.time_integration.integration(),
+            bbar: case.stabilisation.bbar,
+            fbar: case.stabilisation.fbar,
+            n_bodies: case.bodies.len(),
+            pressure_projection: if case.analysis.formulation == Formulation::TwoPhase {
+                case.stabilisation.pressure_projection
+            } else {
+                None
+            },
+            pressure_update: case.stabilisation.pressure_update,
+            geometry: geometry_of(case),
+            stiffness: case.stabilisation.stiffness,
+            stress_recovery: case.stabilisation.stress_recovery,
+            linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
+            stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
+            patch_recovery: case.analysis.formulation == Formulation::TwoPhase
+                && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
+        }
+    }
     /// The area of particle `k` in the (x, y) plane: its volume over the geometry's measure at its
-    /// radius (the volume itself in plane strain) [m²].
+    /// radius (the volume itself in plane strain and in three dimensions) [m² or m³].
     #[inline]
     pub fn area(&self, k: usize) -> f64 {
         self.particles.volume[k] / self.geometry.measure(self.particles.x[k][0])
@@ -404,7 +431,7 @@ impl Model {
 
     /// The kernel input of particle `k` at the start of the step.
     #[inline]
-    pub fn particle_input(&self, idx: usize, body_acc: &[[f64; 2]]) -> ParticleInput {
+    pub fn particle_input(&self, idx: usize, body_acc: &[[f64; D]]) -> ParticleInput<D> {
         let ps = &self.particles;
         let mat = &self.materials[ps.material[idx] as usize];
         let (v, n) = (ps.volume[idx], ps.porosity[idx]);
@@ -429,15 +456,11 @@ impl Model {
             eps_pd: ps.eps_pd[idx],
             p: ps.p[idx],
             body_acc: body_acc[ps.body[idx] as usize],
-            grad_n: [0.0; 2],
+            grad_n: [0.0; D],
             pred: Default::default(),
             linear: self.linear_increments,
             fbar: 1.0,
-            fbar_total: if self.fbar {
-                fbar::scale(ps.jbar[idx], finite_strain::det2(ps.def_grad[idx]), 2)
-            } else {
-                1.0
-            },
+            fbar_total: if self.fbar { fbar::scale(ps.jbar[idx], det(&ps.def_grad[idx]), D) } else { 1.0 },
             dt: 0.0,
             jbar: ps.jbar[idx],
             fbar_rows: 0.0,
@@ -448,7 +471,7 @@ impl Model {
     /// its volume ratio J positive and the porosity it implies ([`Model::porosity_after`]) inside
     /// (0, 1) in a two-phase analysis (a one-phase point keeps its porosity, which may be 0). The
     /// message names the particle and the quantity.
-    pub fn check_step(&self, k: usize, step: &StepResult) -> Result<(), InadmissibleStep> {
+    pub fn check_step(&self, k: usize, step: &StepResult<D>) -> Result<(), InadmissibleStep> {
         if let Some(e) = self.nonfinite(k, step) {
             return Err(e);
         }
@@ -459,8 +482,9 @@ impl Model {
         let porous = !self.two_phase || (n_new > 0.0 && n_new < 1.0);
         if j <= 0.0 || n_new.is_nan() || !porous {
             return Err(InadmissibleStep(format!(
-                "material point {} at ({:.4}, {:.4}) m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
-                ps.id[k], ps.x[k][0], ps.x[k][1]
+                "material point {} at {} m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
+                ps.id[k],
+                position(&ps.x[k])
             )));
         }
         Ok(())
@@ -468,21 +492,22 @@ impl Model {
 
     /// The first quantity of particle `k`'s step that is not finite (NaN or Inf), naming the
     /// particle, if any.
-    pub fn nonfinite(&self, k: usize, step: &StepResult) -> Option<InadmissibleStep> {
+    pub fn nonfinite(&self, k: usize, step: &StepResult<D>) -> Option<InadmissibleStep> {
         let ps = &self.particles;
         let it = &step.interp;
         let j = step.jacobian;
         let finite = [
-            ("displacement increment", it.du[0].is_finite() && it.du[1].is_finite()),
-            ("velocity", it.v_u[0].is_finite() && it.v_u[1].is_finite() && it.a_u.iter().all(|a| a.is_finite())),
+            ("displacement increment", it.du.iter().all(|u| u.is_finite())),
+            ("velocity", it.v_u.iter().all(|v| v.is_finite()) && it.a_u.iter().all(|a| a.is_finite())),
             ("effective stress", step.stress.iter().all(|s| s.is_finite())),
             ("pore pressure increment", it.dp.is_finite()),
             ("volume ratio", j.is_finite()),
         ];
         finite.iter().find(|f| !f.1).map(|(what, _)| {
             InadmissibleStep(format!(
-                "material point {} at ({:.4}, {:.4}) m: its {what} is not finite (NaN or Inf)",
-                ps.id[k], ps.x[k][0], ps.x[k][1]
+                "material point {} at {} m: its {what} is not finite (NaN or Inf)",
+                ps.id[k],
+                position(&ps.x[k])
             ))
         })
     }
@@ -502,7 +527,13 @@ impl Model {
     /// both phases (the Darcy flux is not a particle quantity). The pore-pressure gradient follows
     /// the pressure and the material: ∇p ← ΔF⁻ᵀ(∇p + Σ ∇S Δp) (interpolated on x_n, then carried
     /// to x_{n+1}; it drives the next step's Darcy flux).
-    pub fn update_particle(&mut self, k: usize, step: &StepResult, dp: f64, dt: f64) -> Result<(), InadmissibleStep> {
+    pub fn update_particle(
+        &mut self,
+        k: usize,
+        step: &StepResult<D>,
+        dp: f64,
+        dt: f64,
+    ) -> Result<(), InadmissibleStep> {
         self.check_step(k, step)?;
         let j = step.jacobian;
         let n_new = self.porosity_after(k, j);
@@ -510,7 +541,7 @@ impl Model {
         let it = &step.interp;
         match self.integration {
             crate::kernels::Integration::Dynamic { gamma: g, .. } => {
-                for c in 0..2 {
+                for c in 0..D {
                     ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.a_u[c]);
                     ps.acc[k][c] = it.a_u[c];
                     if self.two_phase {
@@ -525,7 +556,7 @@ impl Model {
                 // step's start (the scheme's predictor, `interp.v_u`); the water's likewise
                 // (Δw_p/Δt and `interp.v_w`). XPIC sets the solid's velocity itself
                 // (`StepResult::velocity`; one-phase only).
-                for c in 0..2 {
+                for c in 0..D {
                     let pic = it.du[c] / dt;
                     let blend = flip * (ps.vel[k][c] + pic - it.v_u[c]) + (1.0 - flip) * pic;
                     let v = step.velocity.map_or(blend, |v| v[c]);
@@ -540,7 +571,7 @@ impl Model {
                 }
             }
             _ => {
-                for c in 0..2 {
+                for c in 0..D {
                     ps.vel[k][c] = it.du[c] / dt;
                     ps.acc[k][c] = 0.0;
                     if self.two_phase {
@@ -553,13 +584,13 @@ impl Model {
         if self.two_phase {
             // The gradient on x_n, Σ ∇S Δp added, then carried to x_{n+1} with the material:
             // ∇_{n+1} p = ΔF⁻ᵀ ∇_n p (the pressure is a material field between steps).
-            let g = [ps.grad_p[k][0] + it.grad_dp[0], ps.grad_p[k][1] + it.grad_dp[1]];
+            let g: [f64; D] = std::array::from_fn(|c| ps.grad_p[k][c] + it.grad_dp[c]);
             let fi = &step.f_inc;
-            let det = fi[0][0] * fi[1][1] - fi[0][1] * fi[1][0];
+            let det = det(fi);
             let m = crate::kernels::kinematics::cofactor_mul(fi, g);
-            ps.grad_p[k] = [m[0] / det, m[1] / det];
+            ps.grad_p[k] = m.map(|v| v / det);
         }
-        for c in 0..2 {
+        for c in 0..D {
             ps.x[k][c] += it.du[c];
             ps.disp[k][c] += it.du[c];
         }
@@ -572,11 +603,13 @@ impl Model {
         ps.porosity[k] = n_new;
         let f = &mut ps.def_grad[k];
         let f_new = crate::kernels::kinematics::product(&step.f_inc, f);
-        match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(finite_strain::plane(f_new), step.jbar) {
+        match self.materials[ps.material[k] as usize].model.fluid_volume_ratio(finite_strain::embed(&f_new), step.jbar)
+        {
             // A fluid point carries its volume ratio only (see `Constitutive::fluid_volume_ratio`).
             Some(jf) => {
-                ps.volume[k] *= jf / finite_strain::det2(*f);
-                *f = [[jf.sqrt(), 0.0], [0.0, jf.sqrt()]];
+                ps.volume[k] *= jf / det(f);
+                let s = if D == 2 { jf.sqrt() } else { jf.cbrt() };
+                *f = std::array::from_fn(|a| std::array::from_fn(|b| if a == b { s } else { 0.0 }));
             }
             None => {
                 ps.volume[k] *= j;
@@ -584,11 +617,178 @@ impl Model {
             }
         }
         if self.stretch_domains {
-            let u = shape::right_stretch(*f);
+            let u = shape::stretch_diagonal(f);
             for (d, lp) in ps.lp[k].iter_mut().enumerate() {
-                *lp = (ps.lp0[k][d] * u[d][d]).min(0.5 * self.grid.h[d]);
+                *lp = (ps.lp0[k][d] * u[d]).min(0.5 * self.grid.h[d]);
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernels::Interp;
+
+    /// The two-phase column of the case tests, with gravity's pore-pressure gradient on its points.
+    fn column() -> Model {
+        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let mut m = Model::build(&c, |_, _| true);
+        m.integration = crate::kernels::Integration::QuasiStatic { theta: 1.0 };
+        for g in m.particles.grad_p.iter_mut() {
+            *g = [300.0, -9.81e3];
+        }
+        m
+    }
+
+    /// The model `m` in three dimensions: its grid, points and domains extruded by one cell of
+    /// `hz` along z, with F_zz = 1 (its loads and boundaries dropped: a three-dimensional model
+    /// has none yet).
+    fn lift(m: &Model, hz: f64) -> Model<3> {
+        let v = |a: [f64; 2], z: f64| [a[0], a[1], z];
+        let ps = &m.particles;
+        let n = ps.len();
+        let mut q = Particles::<3>::default();
+        for k in 0..n {
+            q.push_blank(ps.id[k], ps.body[k], ps.material[k]);
+            q.x[k] = v(ps.x[k], 0.5 * hz);
+            q.x0[k] = v(ps.x0[k], 0.5 * hz);
+            q.lp[k] = v(ps.lp[k], 0.25 * hz);
+            q.lp0[k] = v(ps.lp0[k], 0.25 * hz);
+            let f = ps.def_grad[k];
+            q.def_grad[k] = [[f[0][0], f[0][1], 0.0], [f[1][0], f[1][1], 0.0], [0.0, 0.0, 1.0]];
+            q.volume[k] = ps.volume[k];
+            q.porosity[k] = ps.porosity[k];
+            q.mass[k] = ps.mass[k];
+            q.stress[k] = ps.stress[k];
+            q.p[k] = ps.p[k];
+            q.grad_p[k] = v(ps.grad_p[k], 0.0);
+        }
+        Model {
+            two_phase: m.two_phase,
+            basis: m.basis,
+            stretch_domains: m.stretch_domains,
+            grid: grid::Grid::new(v(m.grid.origin, 0.0), v(m.grid.h, hz), [m.grid.cells[0], m.grid.cells[1], 1]),
+            materials: m.materials.clone(),
+            particles: q,
+            loads: Vec::new(),
+            boundaries: Vec::new(),
+            g: m.g,
+            integration: m.integration,
+            bbar: m.bbar,
+            fbar: m.fbar,
+            patch_recovery: m.patch_recovery,
+            pressure_update: m.pressure_update,
+            n_bodies: m.n_bodies,
+            pressure_projection: m.pressure_projection,
+            geometry: shape::Geometry::Solid,
+            stiffness: m.stiffness,
+            stress_recovery: m.stress_recovery,
+            linear_increments: m.linear_increments,
+            stiffness_in_jacobian: m.stiffness_in_jacobian,
+        }
+    }
+
+    /// A converged step of `D` dimensions with the incremental deformation gradient `f_inc`
+    /// (constant over the body, so Δu = (ΔF − I) x), the pressure gradient's increment `grad_dp`
+    /// and the stress `stress`.
+    fn step<const D: usize>(
+        f_inc: [[f64; D]; D],
+        x: [f64; D],
+        grad_dp: [f64; D],
+        stress: soil::Stress,
+    ) -> StepResult<D> {
+        let du = std::array::from_fn(|a| (0..D).map(|b| f_inc[a][b] * x[b]).sum::<f64>() - x[a]);
+        StepResult {
+            interp: Interp { du, grad_dp, dp: 40.0, ..Interp::default() },
+            stress,
+            eps_pd: 0.01,
+            f_inc,
+            jacobian: det(&f_inc),
+            deps: [0.0; soil::NS],
+            grad_n: [0.0; D],
+            jbar: None,
+            velocity: None,
+        }
+    }
+
+    /// A plane point's update is a three-dimensional point's with F_zz = 1 and Δu_z = 0: position,
+    /// volume, porosity, deformation gradient, domain, velocity and pressure gradient agree to
+    /// round-off.
+    #[test]
+    fn a_plane_update_is_a_three_dimensional_update_without_z() {
+        let mut m2 = column();
+        let mut m3 = lift(&m2, 0.2);
+        let f2 = [[1.01, 0.03], [-0.02, 0.97]];
+        let f3 = [[1.01, 0.03, 0.0], [-0.02, 0.97, 0.0], [0.0, 0.0, 1.0]];
+        let s = soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]);
+        for k in 0..m2.particles.len() {
+            let x2 = m2.particles.x[k];
+            m2.update_particle(k, &step(f2, x2, [10.0, -20.0], s), 40.0, 0.5).unwrap();
+            let x3 = m3.particles.x[k];
+            m3.update_particle(k, &step(f3, x3, [10.0, -20.0, 0.0], s), 40.0, 0.5).unwrap();
+            let (p2, p3) = (&m2.particles, &m3.particles);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * a.abs().max(1.0);
+            for c in 0..2 {
+                assert!(close(p2.x[k][c], p3.x[k][c]) && close(p2.vel[k][c], p3.vel[k][c]), "point {k}");
+                assert!(close(p2.lp[k][c], p3.lp[k][c]) && close(p2.grad_p[k][c], p3.grad_p[k][c]), "point {k}");
+                for d in 0..2 {
+                    assert!(close(p2.def_grad[k][c][d], p3.def_grad[k][c][d]), "point {k}");
+                }
+            }
+            assert!(close(p2.volume[k], p3.volume[k]) && close(p2.porosity[k], p3.porosity[k]), "point {k}");
+            assert_eq!((p3.x[k][2], p3.lp[k][2], p3.def_grad[k][2][2]), (0.1, 0.05, 1.0), "point {k}");
+        }
+    }
+
+    /// A general three-dimensional step: x and the displacement move by Δu, F_{n+1} = ΔF F_n, the
+    /// volume by det ΔF, the porosity by conservation of the grains, the pressure gradient is
+    /// carried with the material (ΔFᵀ ∇p_{n+1} = ∇p_n + Σ∇S Δp), and the domain stretches by the
+    /// diagonal of U = sqrt(FᵀF); a rotation about a tilted axis leaves the domain as it was.
+    #[test]
+    fn a_three_dimensional_update_follows_the_deformation() {
+        let m2 = column();
+        let mut m3 = lift(&m2, 0.2);
+        let df = [[1.02, 0.01, -0.03], [0.015, 0.98, 0.02], [-0.01, 0.025, 1.03]];
+        let s = [-1.0e3, -2.0e3, 150.0, -1.2e3, 80.0, -120.0];
+        let k = 3;
+        let before = m3.particles.clone();
+        let x = before.x[k];
+        let grad_dp = [10.0, -20.0, 30.0];
+        let st = step(df, x, grad_dp, s);
+        m3.update_particle(k, &st, 40.0, 0.5).unwrap();
+        let ps = &m3.particles;
+        let j = det(&df);
+        for c in 0..3 {
+            assert!((ps.x[k][c] - (x[c] + st.interp.du[c])).abs() < 1e-15);
+            // ΔFᵀ ∇p_{n+1} = ∇p_n + Σ ∇S Δp.
+            let back: f64 = (0..3).map(|a| df[a][c] * ps.grad_p[k][a]).sum();
+            assert!((back - (before.grad_p[k][c] + grad_dp[c])).abs() < 1e-9, "∇p: {back}");
+            for d in 0..3 {
+                let want: f64 = (0..3).map(|e| df[c][e] * before.def_grad[k][e][d]).sum();
+                assert!((ps.def_grad[k][c][d] - want).abs() < 1e-15);
+            }
+        }
+        assert!((ps.volume[k] - before.volume[k] * j).abs() < 1e-15 * before.volume[k]);
+        let n0 = before.porosity[k];
+        assert!(((1.0 - ps.porosity[k]) * ps.volume[k] - (1.0 - n0) * before.volume[k]).abs() < 1e-15);
+        assert_eq!(ps.stress[k], s);
+        // The domain: lp0 times the diagonal of U (U² = FᵀF).
+        let u = shape::stretch_diagonal(&ps.def_grad[k]);
+        let c: [[f64; 3]; 3] = std::array::from_fn(|a| {
+            std::array::from_fn(|b| (0..3).map(|e| ps.def_grad[k][e][a] * ps.def_grad[k][e][b]).sum())
+        });
+        for d in 0..3 {
+            assert!((ps.lp[k][d] - before.lp0[k][d] * u[d]).abs() < 1e-15);
+            // U_dd² ≤ C_dd (U_dd² + Σ_{e≠d} U_de² = C_dd) and U_dd is near the stretch's square root.
+            assert!(u[d] * u[d] <= c[d][d] + 1e-14 && (u[d] * u[d] - c[d][d]).abs() < 1e-3, "{u:?} {c:?}");
+        }
+        // A rigid rotation about a tilted axis: U = I.
+        let axis: [f64; 3] = [0.3, -0.5, 0.81];
+        let len: f64 = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let r = soil::principal::rotation(axis.map(|a| a / len), 0.7);
+        let u = shape::stretch_diagonal(&r);
+        assert!(u.iter().all(|v| (v - 1.0).abs() < 1e-14), "{u:?}");
     }
 }

@@ -6,9 +6,10 @@
 use super::grid::Grid;
 use crate::case::{Case, Formulation};
 
-/// All material points held by this rank.
-#[derive(Debug, Clone, Default)]
-pub struct Particles {
+/// All material points held by this rank, in `D` dimensions (two unless it says otherwise: plane
+/// strain or axial symmetry).
+#[derive(Debug, Clone)]
+pub struct Particles<const D: usize = 2> {
     /// Global identifier (stable over the run, unique across ranks).
     pub id: Vec<u64>,
     /// Index of the body it was generated in.
@@ -16,19 +17,20 @@ pub struct Particles {
     /// Index of its material.
     pub material: Vec<u16>,
     /// Position [m].
-    pub x: Vec<[f64; 2]>,
+    pub x: Vec<[f64; D]>,
     /// Position at t = 0 [m].
-    pub x0: Vec<[f64; 2]>,
+    pub x0: Vec<[f64; D]>,
     /// Total solid displacement [m].
-    pub disp: Vec<[f64; 2]>,
+    pub disp: Vec<[f64; D]>,
     /// Half-widths of the GIMP domain l_p [m] (see `ShapeFunctions::Gimp` for how they follow the
     /// deformation).
-    pub lp: Vec<[f64; 2]>,
+    pub lp: Vec<[f64; D]>,
     /// Half-widths of the GIMP domain at t = 0 [m].
-    pub lp0: Vec<[f64; 2]>,
-    /// In-plane deformation gradient F = ∂x/∂X of the solid, rows [[F_xx, F_xy], [F_yx, F_yy]] [-].
-    pub def_grad: Vec<[[f64; 2]; 2]>,
-    /// Volume per metre of thickness [m²·1 m].
+    pub lp0: Vec<[f64; D]>,
+    /// Deformation gradient F = ∂x/∂X of the solid, rows first (in two dimensions the in-plane
+    /// [[F_xx, F_xy], [F_yx, F_yy]]) [-].
+    pub def_grad: Vec<[[f64; D]; D]>,
+    /// Volume [m³; per metre of thickness in plane strain, of the ring in axial symmetry].
     pub volume: Vec<f64>,
     /// Porosity [-].
     pub porosity: Vec<f64>,
@@ -36,13 +38,13 @@ pub struct Particles {
     /// analyses (constant: solid mass is conserved), the mixture's ρV in one-phase analyses.
     pub mass: Vec<f64>,
     /// Solid velocity [m/s].
-    pub vel: Vec<[f64; 2]>,
+    pub vel: Vec<[f64; D]>,
     /// Solid acceleration [m/s²].
-    pub acc: Vec<[f64; 2]>,
+    pub acc: Vec<[f64; D]>,
     /// Water velocity [m/s] (two-phase).
-    pub vel_w: Vec<[f64; 2]>,
+    pub vel_w: Vec<[f64; D]>,
     /// Water acceleration [m/s²] (two-phase).
-    pub acc_w: Vec<[f64; 2]>,
+    pub acc_w: Vec<[f64; D]>,
     /// Effective stress [xx, yy, xy, zz, yz, zx] (total stress in one-phase analyses; yz = zx = 0 in
     /// plane strain and axial symmetry) [Pa].
     pub stress: Vec<crate::model::soil::Stress>,
@@ -54,14 +56,43 @@ pub struct Particles {
     pub eps_pd: Vec<f64>,
     /// Pore-pressure gradient [Pa/m] (two-phase), carried like p: it drives the Darcy flux of the
     /// u–p system from the start of a step.
-    pub grad_p: Vec<[f64; 2]>,
+    pub grad_p: Vec<[f64; D]>,
     /// [002]'s projected volume ratio J̄ = det F̄ (`stabilisation.fbar`, §3 Algorithm 1): the
-    /// stress sees F̄ = (J̄/J)^{1/2} F, while the volume and F follow the point's own motion; 1 at
+    /// stress sees F̄ = (J̄/J)^{1/D} F, while the volume and F follow the point's own motion; 1 at
     /// t = 0 and without F̄ [-].
     pub jbar: Vec<f64>,
 }
 
-impl Particles {
+impl<const D: usize> Default for Particles<D> {
+    fn default() -> Self {
+        Particles {
+            id: Vec::new(),
+            body: Vec::new(),
+            material: Vec::new(),
+            x: Vec::new(),
+            x0: Vec::new(),
+            disp: Vec::new(),
+            lp: Vec::new(),
+            lp0: Vec::new(),
+            def_grad: Vec::new(),
+            volume: Vec::new(),
+            porosity: Vec::new(),
+            mass: Vec::new(),
+            vel: Vec::new(),
+            acc: Vec::new(),
+            vel_w: Vec::new(),
+            acc_w: Vec::new(),
+            stress: Vec::new(),
+            p: Vec::new(),
+            p0: Vec::new(),
+            eps_pd: Vec::new(),
+            grad_p: Vec::new(),
+            jbar: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> Particles<D> {
     /// Number of points.
     pub fn len(&self) -> usize {
         self.x.len()
@@ -78,101 +109,129 @@ impl Particles {
         self.id.push(id);
         self.body.push(body);
         self.material.push(material);
-        self.x.push([0.0; 2]);
-        self.x0.push([0.0; 2]);
-        self.disp.push([0.0; 2]);
-        self.lp.push([0.0; 2]);
-        self.lp0.push([0.0; 2]);
-        self.def_grad.push([[0.0; 2]; 2]);
+        self.x.push([0.0; D]);
+        self.x0.push([0.0; D]);
+        self.disp.push([0.0; D]);
+        self.lp.push([0.0; D]);
+        self.lp0.push([0.0; D]);
+        self.def_grad.push([[0.0; D]; D]);
         self.volume.push(0.0);
         self.porosity.push(0.0);
         self.mass.push(0.0);
-        self.vel.push([0.0; 2]);
-        self.acc.push([0.0; 2]);
-        self.vel_w.push([0.0; 2]);
-        self.acc_w.push([0.0; 2]);
+        self.vel.push([0.0; D]);
+        self.acc.push([0.0; D]);
+        self.vel_w.push([0.0; D]);
+        self.acc_w.push([0.0; D]);
         self.stress.push([0.0; crate::model::soil::NS]);
         self.p.push(0.0);
         self.p0.push(0.0);
         self.eps_pd.push(0.0);
-        self.grad_p.push([0.0; 2]);
+        self.grad_p.push([0.0; D]);
         self.jbar.push(1.0);
     }
+}
 
-    /// Fills the bodies of the case with `n × n` points per cell, keeping those whose cell
-    /// satisfies `owned(cell_i, cell_j)` (the cells of this rank). Points are placed at the centres
-    /// of the n × n sub-cells; a point belongs to the first body that contains it.
-    pub fn generate(case: &Case, grid: &Grid, owned: impl Fn(usize, usize) -> bool) -> Particles {
+impl<const D: usize> Particles<D> {
+    /// Fills the bodies of the case with n^D points per cell (n = `particles_per_cell`), keeping
+    /// those whose cell satisfies `owned(cell)` (the cells of this rank). Points are placed at the
+    /// centres of the sub-cells (moved by the body's `perturbation`); a point belongs to the first
+    /// body that contains it. Cells and their sub-cells are visited x fastest.
+    pub fn generate(case: &Case, grid: &Grid<D>, owned: impl Fn([usize; D]) -> bool) -> Particles<D> {
         let mut ps = Particles::default();
         let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+        let geometry = super::geometry_of(case);
         for (b, body) in case.bodies.iter().enumerate() {
             let mat_index = case.material_index(&body.material).expect("validated");
-            let mat = &case.materials[mat_index];
             let n = body.particles_per_cell;
-            let (lo, hi) = body.shape.bounds();
-            let c0 = grid.cell_of(lo).unwrap_or((0, 0));
-            let c1 = grid.cell_of(hi).unwrap_or((grid.cells[0] - 1, grid.cells[1] - 1));
-            let lp = [grid.h[0] / (2.0 * n as f64), grid.h[1] / (2.0 * n as f64)];
-            let area = grid.h[0] * grid.h[1] / (n * n) as f64;
-            let geometry = super::geometry_of(case);
-            for cj in c0.1..=c1.1 {
-                for ci in c0.0..=c1.0 {
-                    for sj in 0..n {
-                        for si in 0..n {
-                            // Global id from the body and the sub-cell position: unique and independent
-                            // of how cells are distributed over ranks.
-                            let gi = (ci * n + si) as u64;
-                            let gj = (cj * n + sj) as u64;
-                            let id = ((b as u64) << 48) | (gj * (grid.cells[0] * 8) as u64 + gi);
-                            let shake = [jitter(id, 0), jitter(id, 1)].map(|r| body.perturbation * (2.0 * r - 1.0));
-                            let x = [
-                                grid.origin[0] + (ci as f64 + (si as f64 + 0.5 + shake[0]) / n as f64) * grid.h[0],
-                                grid.origin[1] + (cj as f64 + (sj as f64 + 0.5 + shake[1]) / n as f64) * grid.h[1],
-                            ];
-                            let earlier = case.bodies[..b].iter().any(|o| o.shape.contains(x));
-                            if !body.shape.contains(x) || earlier || !owned(ci, cj) {
-                                continue;
-                            }
-                            // The ring's volume 2πr A in axial symmetry.
-                            let vol = area * geometry.measure(x[0]);
-                            let mass = if two_phase {
-                                (1.0 - mat.porosity) * mat.solid_density * vol
-                            } else {
-                                ((1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density) * vol
-                            };
-                            ps.id.push(id);
-                            ps.body.push(b as u16);
-                            ps.material.push(mat_index as u16);
-                            ps.x.push(x);
-                            ps.x0.push(x);
-                            ps.disp.push([0.0; 2]);
-                            ps.lp.push(lp);
-                            ps.lp0.push(lp);
-                            ps.def_grad.push([[1.0, 0.0], [0.0, 1.0]]);
-                            ps.volume.push(vol);
-                            ps.porosity.push(mat.porosity);
-                            ps.mass.push(mass);
-                            ps.vel.push([0.0; 2]);
-                            ps.acc.push([0.0; 2]);
-                            ps.vel_w.push([0.0; 2]);
-                            ps.acc_w.push([0.0; 2]);
-                            let (stress, p, grad_p) = match (&body.initial_stress, &body.uniform_stress) {
-                                (Some(init), _) => geostatic(case, grid, init, x, two_phase),
-                                (None, Some(s)) => (*s, 0.0, [0.0; 2]),
-                                (None, None) => ([0.0; 4], 0.0, [0.0; 2]),
-                            };
-                            ps.grad_p.push(grad_p);
-                            ps.stress.push(crate::model::soil::plane(stress));
-                            ps.p.push(p);
-                            ps.p0.push(p);
-                            ps.eps_pd.push(0.0);
-                            ps.jbar.push(1.0);
-                        }
+            let (lo2, hi2) = body.shape.bounds();
+            let depth = case.body_depth(body);
+            let (lo, hi): ([f64; D], [f64; D]) = (
+                std::array::from_fn(|d| if d < 2 { lo2[d] } else { depth[0] }),
+                std::array::from_fn(|d| if d < 2 { hi2[d] } else { depth[1] }),
+            );
+            let c0 = grid.cell_containing(lo).unwrap_or([0; D]);
+            let c1 = grid.cell_containing(hi).unwrap_or(grid.cells.map(|c| c - 1));
+            let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
+            let volume = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
+            let (mut cell, counts) = (c0, std::array::from_fn(|d| c1[d] - c0[d] + 1));
+            let mut offset = [0; D];
+            loop {
+                for d in 0..D {
+                    cell[d] = c0[d] + offset[d];
+                }
+                let mut sub = [0usize; D];
+                loop {
+                    // Global id from the body and the sub-cell position: unique and independent of
+                    // how cells are distributed over ranks.
+                    let number = (0..D)
+                        .rev()
+                        .fold(0u64, |acc, d| acc * (grid.cells[d] * 8) as u64 + (cell[d] * n + sub[d]) as u64);
+                    let id = ((b as u64) << 48) | number;
+                    let x: [f64; D] = std::array::from_fn(|d| {
+                        let shake = body.perturbation * (2.0 * jitter(id, d as u64) - 1.0);
+                        grid.origin[d] + (cell[d] as f64 + (sub[d] as f64 + 0.5 + shake) / n as f64) * grid.h[d]
+                    });
+                    let earlier = case.bodies[..b].iter().any(|o| case.body_holds(o, x));
+                    if case.body_holds(body, x) && !earlier && owned(cell) {
+                        let vol = volume * geometry.measure(x[0]);
+                        ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), two_phase);
                     }
+                    if !super::shape::next_combination(&mut sub, [n; D]) {
+                        break;
+                    }
+                }
+                if !super::shape::next_combination(&mut offset, counts) {
+                    break;
                 }
             }
         }
         ps
+    }
+
+    /// Appends the point `id` of body `b` (material `mat_index`) at `x` with domain half-widths
+    /// `lp` and volume `vol`, at rest, with the body's initial stress.
+    fn push_point(
+        &mut self,
+        case: &Case,
+        grid: &Grid<D>,
+        (id, b, mat_index): (u64, usize, usize),
+        (x, lp, vol): ([f64; D], [f64; D], f64),
+        two_phase: bool,
+    ) {
+        let (body, mat) = (&case.bodies[b], &case.materials[mat_index]);
+        let mass = if two_phase {
+            (1.0 - mat.porosity) * mat.solid_density * vol
+        } else {
+            ((1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density) * vol
+        };
+        let ps = self;
+        ps.id.push(id);
+        ps.body.push(b as u16);
+        ps.material.push(mat_index as u16);
+        ps.x.push(x);
+        ps.x0.push(x);
+        ps.disp.push([0.0; D]);
+        ps.lp.push(lp);
+        ps.lp0.push(lp);
+        ps.def_grad.push(std::array::from_fn(|a| std::array::from_fn(|c| if a == c { 1.0 } else { 0.0 })));
+        ps.volume.push(vol);
+        ps.porosity.push(mat.porosity);
+        ps.mass.push(mass);
+        ps.vel.push([0.0; D]);
+        ps.acc.push([0.0; D]);
+        ps.vel_w.push([0.0; D]);
+        ps.acc_w.push([0.0; D]);
+        let (stress, p, grad_p) = match (&body.initial_stress, &body.uniform_stress) {
+            (Some(init), _) => geostatic(case, grid, init, x, two_phase),
+            (None, Some(s)) => (*s, 0.0, [0.0; D]),
+            (None, None) => ([0.0; 4], 0.0, [0.0; D]),
+        };
+        ps.grad_p.push(grad_p);
+        ps.stress.push(crate::model::soil::plane(stress));
+        ps.p.push(p);
+        ps.p0.push(p);
+        ps.eps_pd.push(0.0);
+        ps.jbar.push(1.0);
     }
 }
 
@@ -188,13 +247,13 @@ fn jitter(id: u64, stream: u64) -> f64 {
 
 /// The geostatic effective stress, pore pressure and pore-pressure gradient at `x` (see
 /// [`crate::case::InitialStress`]).
-fn geostatic(
+fn geostatic<const D: usize>(
     case: &Case,
-    grid: &Grid,
+    grid: &Grid<D>,
     init: &crate::case::InitialStress,
-    x: [f64; 2],
+    x: [f64; D],
     two_phase: bool,
-) -> ([f64; 4], f64, [f64; 2]) {
+) -> ([f64; 4], f64, [f64; D]) {
     let g = case.analysis.g;
     let (surface, mass) = case.column_above(x, grid.h[1] / 50.0);
     let sigma_v = -g * mass;
@@ -207,9 +266,11 @@ fn geostatic(
             crate::case::WaterTable::Level(y) => y,
         };
         let below = level > x[1];
-        (rho_w * g * (level - x[1]).max(0.0), [0.0, if below { -rho_w * g } else { 0.0 }])
+        let mut grad = [0.0; D];
+        grad[1] = if below { -rho_w * g } else { 0.0 };
+        (rho_w * g * (level - x[1]).max(0.0), grad)
     } else {
-        (0.0, [0.0; 2])
+        (0.0, [0.0; D])
     };
     let sv = sigma_v + p;
     ([init.k0 * sv, sv, 0.0, init.k0 * sv], p, grad_p)
@@ -223,8 +284,8 @@ mod tests {
     #[test]
     fn a_column_is_filled_with_two_by_two_points_per_cell_of_the_right_volume() {
         let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
-        let g = Grid::new([0.0, 0.0], c.cell_size(), c.grid.cells);
-        let ps = Particles::generate(&c, &g, |_, _| true);
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
+        let ps = Particles::generate(&c, &g, |_| true);
         assert_eq!(ps.len(), 40);
         let v: f64 = ps.volume.iter().sum();
         assert!((v - 0.1).abs() < 1e-12);
@@ -234,7 +295,7 @@ mod tests {
         ids.dedup();
         assert_eq!(ids.len(), 40, "ids are unique");
         // Only the cells a rank owns.
-        let half = Particles::generate(&c, &g, |_, j| j < 5);
+        let half = Particles::generate(&c, &g, |c| c[1] < 5);
         assert_eq!(half.len(), 20);
         assert!(half.x.iter().all(|x| x[1] < 0.5));
     }
@@ -248,8 +309,8 @@ mod tests {
                 "shape = { polygon = { vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] } }\n        [[bodies]]\n        name = \"block\"\n        material = \"soil\"\n        particles_per_cell = 1\n        shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }",
             );
         let c = case::parse(&text, "t", &[]).unwrap();
-        let g = Grid::new([0.0, 0.0], c.cell_size(), c.grid.cells);
-        let ps = Particles::generate(&c, &g, |_, _| true);
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
+        let ps = Particles::generate(&c, &g, |_| true);
         let tri: f64 = (0..ps.len()).filter(|&k| ps.body[k] == 0).map(|k| ps.volume[k]).sum();
         // The 2×2 points of the triangle cover half the square up to the staircase along the hypotenuse.
         assert!((tri - 0.5).abs() < 0.05, "triangle area {tri}");
@@ -264,5 +325,94 @@ mod tests {
         ids.sort();
         ids.dedup();
         assert_eq!(ids.len(), ps.len());
+    }
+
+    /// A three-dimensional variant of the case tests' column: a 0.4 × 1.0 × 0.3 m grid of
+    /// 4 × 10 × 3 cells, a body over z ∈ [0, 0.2] and a second one over the whole grid, behind it.
+    fn solid_case(extra: &str) -> Case {
+        let text = crate::case::tests_support::MINIMAL
+            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [0.4, 1.0, 0.3]\n        cells = [4, 10, 3]")
+            .replace(
+                "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+                &format!(
+                    "shape = {{ rectangle = {{ min = [0.0, 0.0], max = [0.4, 1.0] }} }}\n        z = [0.0, 0.2]\n        \
+                     initial_stress = {{ k0 = 0.5 }}\n        {extra}\n        [[bodies]]\n        name = \"rest\"\n        \
+                     material = \"soil\"\n        particles_per_cell = 1\n        \
+                     shape = {{ polygon = {{ vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.5], [0.0, 1.0]] }} }}"
+                ),
+            );
+        case::parse(&text, "t", &[]).unwrap()
+    }
+
+    /// A three-dimensional case's bodies are their sections extruded along z: 2 × 2 × 2 points per
+    /// cell of the box (4 × 10 × 2 cells), volumes h_x h_y h_z / 8 that sum to the box's, the domain
+    /// h/4, unique identifiers; the second body (one point per cell, a trapezoid section over the
+    /// whole depth) fills only the cells the first left; only the owned cells are filled; the
+    /// geostatic stress has σ'_zz = σ'_xx = K₀ σ'_yy and the pore-pressure gradient along −y.
+    #[test]
+    fn a_three_dimensional_case_extrudes_its_bodies_along_z() {
+        let c = solid_case("");
+        assert_eq!(c.dimension(), 3);
+        let m = crate::model::Model::build_solid(&c, |_| true);
+        let ps = &m.particles;
+        let first: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == 0).collect();
+        assert_eq!(first.len(), 4 * 10 * 2 * 8);
+        let v: f64 = first.iter().map(|&k| ps.volume[k]).sum();
+        assert!((v - 0.4 * 1.0 * 0.2).abs() < 1e-14, "{v}");
+        assert!(first.iter().all(|&k| ps.x[k][2] < 0.2 && (ps.lp[k][2] - 0.025).abs() < 1e-15));
+        // The second body: cells of z ∈ [0.2, 0.3] under its sloping top (points at the cell centres).
+        let second: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == 1).collect();
+        let expected = (0..4)
+            .map(|i| (0..10).filter(|&j| (j as f64 + 0.5) * 0.1 <= 1.0 - (i as f64 + 0.5) * 0.125).count())
+            .sum::<usize>();
+        assert_eq!(second.len(), expected);
+        assert!(second.iter().all(|&k| ps.x[k][2] > 0.2 && (ps.volume[k] - 0.1 * 0.1 * 0.1).abs() < 1e-16));
+        let mut ids = ps.id.clone();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), ps.len(), "ids are unique");
+        // The geostatic state of a point of the box at y = 0.025 under 0.975 m of saturated soil.
+        let k = first.iter().copied().find(|&k| (ps.x[k][1] - 0.025).abs() < 1e-12).unwrap();
+        let s = ps.stress[k];
+        assert!(s[1] < 0.0 && (s[0] - 0.5 * s[1]).abs() < 1e-9 * s[1].abs() && s[0] == s[3], "{s:?}");
+        assert!(s[2] == 0.0 && s[4] == 0.0 && s[5] == 0.0);
+        assert!(ps.grad_p[k][0] == 0.0 && ps.grad_p[k][1] < 0.0 && ps.grad_p[k][2] == 0.0);
+        assert!((ps.p[k] - 1000.0 * 9.81 * 0.975).abs() < 1e-6, "{}", ps.p[k]);
+        // Only the owned cells.
+        let front = crate::model::Model::build_solid(&c, |cell| cell[2] == 0);
+        assert!(front.particles.len() == 4 * 10 * 8 && front.particles.x.iter().all(|x| x[2] < 0.1));
+    }
+
+    /// What a three-dimensional case may not have yet is refused with a message naming the key,
+    /// as are a body's `z` in a plane case and grids of the wrong shape.
+    #[test]
+    fn three_dimensional_cases_refuse_what_they_cannot_have_yet() {
+        let base = crate::case::tests_support::MINIMAL;
+        let solid = base.replace(
+            "size = [0.1, 1.0]\n        cells = [1, 10]",
+            "size = [0.1, 1.0, 0.1]\n        cells = [1, 10, 1]",
+        );
+        let cases = [
+            (
+                solid.clone() + "[[boundaries]]\nname = \"base\"\nside = \"y_min\"\nfix = [\"ux\", \"uy\"]\n",
+                "key `boundaries`: not available in a three-dimensional case yet",
+            ),
+            (base.replace("cells = [1, 10]", "cells = [1, 10, 2]"), "key `grid.cells`: 2 entries"),
+            (base.replace("size = [0.1, 1.0]", "size = [0.1, 1.0, 1.0, 1.0]"), "key `grid.size`: two entries"),
+            (
+                base.replace("max = [0.1, 1.0] } }", "max = [0.1, 1.0] } }\n        z = [0.0, 1.0]"),
+                "key `bodies[0].z`: only a three-dimensional case",
+            ),
+            (
+                solid.replace("max = [0.1, 1.0] } }", "max = [0.1, 1.0] } }\n        z = [0.0, 0.2]"),
+                "key `bodies[0].z`: body `column` needs z_min < z_max inside the grid's [0, 0.1]",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = case::parse(&text, "t", &[]).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}\n  does not say: {want}");
+        }
+        assert!(case::parse(&solid, "t", &[]).is_ok());
+        assert!(crate::driver::runnable(&case::parse(&solid, "t", &[]).unwrap()).is_err());
     }
 }

@@ -202,7 +202,7 @@ fn product_rule<const D: usize>(v: [f64; D], dv: [f64; D]) -> (f64, [f64; D]) {
 
 /// Moves the multi-index `at` to the next combination of `counts[d]` choices per direction, x
 /// fastest; `false` when every combination has been visited (`at` is then back at zero).
-fn next_combination<const D: usize>(at: &mut [usize; D], counts: [usize; D]) -> bool {
+pub(crate) fn next_combination<const D: usize>(at: &mut [usize; D], counts: [usize; D]) -> bool {
     for d in 0..D {
         at[d] += 1;
         if at[d] < counts[d] {
@@ -298,6 +298,19 @@ pub fn right_stretch(f: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     [[(c[0][0] + s) / t, c[0][1] / t], [c[1][0] / t, (c[1][1] + s) / t]]
 }
 
+/// The diagonal of the right stretch tensor U = sqrt(FᵀF) of a deformation gradient of any
+/// dimension: [`right_stretch`]'s in two dimensions, through the principal frame of C = FᵀF in
+/// three (U_dd = Σ_k sqrt(λ_k) (e_k)_d²).
+pub fn stretch_diagonal<const D: usize>(f: &[[f64; D]; D]) -> [f64; D] {
+    if D == 2 {
+        let u = right_stretch([[f[0][0], f[0][1]], [f[1][0], f[1][1]]]);
+        return std::array::from_fn(|d| u[d][d]);
+    }
+    let c = |a: usize, b: usize| (0..D).map(|k| f[k][a] * f[k][b]).sum::<f64>();
+    let pr = crate::model::soil::principal::Principal::of(&[c(0, 0), c(1, 1), c(0, 1), c(2, 2), c(1, 2), c(2, 0)]);
+    std::array::from_fn(|d| (0..3).map(|k| pr.values[k].max(0.0).sqrt() * pr.vectors[k][d] * pr.vectors[k][d]).sum())
+}
+
 /// Builds the stencil of a particle at `x` with half-widths `lp` on a grid of any dimension: the
 /// tensor product of [`weights_1d`] in each direction.
 pub fn stencil_in<const D: usize, const M: usize>(
@@ -315,33 +328,36 @@ pub fn stencil(basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> Stencil 
     stencil_in(basis, grid, x, lp)
 }
 
-/// The geometry of an analysis: plane strain, or axial symmetry about the y axis (x ≡ r ≥ 0) with
-/// the particle weights of [`AxisymmetricWeights`].
+/// The geometry of an analysis: plane strain, axial symmetry about the y axis (x ≡ r ≥ 0) with
+/// the particle weights of [`AxisymmetricWeights`], or three dimensions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Geometry {
     /// Plane strain: volumes per metre of thickness, no hoop strain.
     PlaneStrain,
     /// Axial symmetry: ring volumes 2πrA and the hoop strain u_r/r.
     Axisymmetric(AxisymmetricWeights),
+    /// Three dimensions: volumes in m³.
+    Solid,
 }
 
 impl Geometry {
     /// The measure of a unit of (x, y) area or length at radius `r`: 1 in plane strain (per metre
-    /// of thickness), 2πr in axial symmetry (the full ring).
+    /// of thickness) and in three dimensions (where a volume is a volume), 2πr in axial symmetry
+    /// (the full ring).
     #[inline]
     pub fn measure(&self, r: f64) -> f64 {
         match self {
-            Geometry::PlaneStrain => 1.0,
+            Geometry::PlaneStrain | Geometry::Solid => 1.0,
             Geometry::Axisymmetric(_) => std::f64::consts::TAU * r,
         }
     }
 
     /// The measure of the strip x ∈ [lo, hi] (its width, or the area π(hi² − lo²) of the annulus it
-    /// sweeps about the axis): what a one-dimensional column's volume change is divided by to give
-    /// its settlement.
+    /// sweeps about the axis; in three dimensions the width, per metre along z): what a
+    /// one-dimensional column's volume change is divided by to give its settlement.
     pub fn plan_area(&self, lo: f64, hi: f64) -> f64 {
         match self {
-            Geometry::PlaneStrain => hi - lo,
+            Geometry::PlaneStrain | Geometry::Solid => hi - lo,
             Geometry::Axisymmetric(_) => std::f64::consts::PI * (hi * hi - lo * lo),
         }
     }
@@ -356,7 +372,7 @@ impl Geometry {
     /// [`axisymmetric_stencil`]).
     pub fn stencil(&self, basis: Basis, grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (Stencil, [f64; MAX_STENCIL]) {
         match *self {
-            Geometry::PlaneStrain => (stencil(basis, grid, x, lp), [0.0; MAX_STENCIL]),
+            Geometry::PlaneStrain | Geometry::Solid => (stencil(basis, grid, x, lp), [0.0; MAX_STENCIL]),
             Geometry::Axisymmetric(w) => axisymmetric_stencil(basis, w, grid, x, lp),
         }
     }
