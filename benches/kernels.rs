@@ -227,6 +227,7 @@ const BOX_3D: &str = r#"
     porosity = 0.3
     solid_density = 2650.0
     water_bulk_modulus = 2.2e9
+    solid_bulk_modulus = inf
     hydraulic_conductivity = 1e-3
     [materials.model]
     type = "linear_elastic"

@@ -2,14 +2,15 @@
 //!
 //! Every output time `i` adds the HDF5 groups `/particles/<i>` (one dataset per particle field,
 //! n or n × 3 values) and `/grid/<i>` (one dataset per nodal field, n_y × n_x or n_y × n_x × 3
-//! values, x fastest); `/grid/x` and `/grid/y` hold the node coordinates [m]. All ranks write the
+//! values in two dimensions, n_z × n_y × n_x (× 3) in three, x fastest); `/grid/x`, `/grid/y`
+//! (and `/grid/z`) hold the node coordinates [m]. All ranks write the
 //! HDF5 file together (HDF5's MPI-I/O driver): they create its groups and datasets together, and
 //! each writes its own rows: its slab of the particles sorted by id and the block of grid nodes it
 //! owns (see [`Frame`]). No rank holds the fields of all particles, and the file written on any
 //! number of ranks is the one written on one. `fields.xdmf` is a
 //! temporal collection with one spatial collection per output time, holding the particles as a
-//! `Polyvertex` point set and the grid as a `3DCoRectMesh` of one layer of nodes (z = 0) with
-//! `ORIGIN_DXDYDZ` geometry: ParaView 5.11's XDMF reader reads scalars on a `2DCoRectMesh` but
+//! `Polyvertex` point set and the grid as a `3DCoRectMesh` (of one layer of nodes, z = 0, in two
+//! dimensions) with `ORIGIN_DXDYDZ` geometry: ParaView 5.11's XDMF reader reads scalars on a `2DCoRectMesh` but
 //! fails on its vector attributes ("selection + offset not within extent"). The HDF5
 //! file is opened, extended and closed for every output time. The XDMF file is replaced whole
 //! (temporary file, sync, rename) after the first output time, then at most every
@@ -58,15 +59,43 @@ pub struct Field {
     pub values: Values,
 }
 
-/// The structured background grid.
+/// The structured background grid, in three dimensions or (one layer of nodes) in two.
 #[derive(Debug, Clone, Copy)]
 pub struct GridGeometry {
-    /// Lower-left node [m].
-    pub origin: [f64; 2],
+    /// Lower-left (-back) node [m].
+    pub origin: [f64; 3],
     /// Node spacing [m].
-    pub spacing: [f64; 2],
-    /// Nodes in x and y.
-    pub nodes: [usize; 2],
+    pub spacing: [f64; 3],
+    /// Nodes in x, y and z (1 in two dimensions).
+    pub nodes: [usize; 3],
+}
+
+impl GridGeometry {
+    /// The geometry of a grid of dimension `D` (2 or 3) with its lower-left node at `origin`,
+    /// spacing `spacing` and `nodes` nodes per direction.
+    pub fn of<const D: usize>(origin: [f64; D], spacing: [f64; D], nodes: [usize; D]) -> GridGeometry {
+        let pick = |a: &[f64], plane: f64| std::array::from_fn(|d| a.get(d).copied().unwrap_or(plane));
+        GridGeometry {
+            origin: pick(&origin, 0.0),
+            spacing: pick(&spacing, 1.0),
+            nodes: std::array::from_fn(|d| nodes.get(d).copied().unwrap_or(1)),
+        }
+    }
+
+    /// Whether the grid is three-dimensional.
+    fn solid(&self) -> bool {
+        self.nodes[2] > 1
+    }
+
+    /// The shape of a nodal dataset: n_y × n_x in two dimensions, n_z × n_y × n_x in three.
+    fn shape(&self) -> Vec<usize> {
+        let [nx, ny, nz] = self.nodes;
+        if self.solid() {
+            vec![nz, ny, nx]
+        } else {
+            vec![ny, nx]
+        }
+    }
 }
 
 /// One rank's share of the fields of one output time.
@@ -81,8 +110,9 @@ pub struct Frame {
     pub first_particle: usize,
     /// This rank's rows of the particle fields (the first must be `position`, 3 components).
     pub particle_fields: Vec<Field>,
-    /// The block of grid nodes this rank writes: its first node (i, j) and its nodes along x and y.
-    pub node_block: ([usize; 2], [usize; 2]),
+    /// The block of grid nodes this rank writes: its first node (i, j, k) and its nodes along x,
+    /// y and z (k = 0 and one node along z in two dimensions).
+    pub node_block: ([usize; 3], [usize; 3]),
     /// This rank's nodal fields on its block of nodes, x fastest.
     pub grid_fields: Vec<Field>,
 }
@@ -143,7 +173,7 @@ fn write_field(g: &h5::Group, f: &Field, shape: &[usize], start: &[usize], count
 }
 
 /// Writes `v` (row-major, `local` long in each dimension) into `ds` at `start` along its first
-/// one or two dimensions.
+/// one, two or three dimensions.
 pub(super) fn write_block<T: h5::H5Type>(
     ds: &h5::Dataset,
     v: &[T],
@@ -157,6 +187,8 @@ pub(super) fn write_block<T: h5::H5Type>(
         ([a], 2) => ds.write_slice(view, (*a..*a + local[0], ..)),
         ([a, b], 2) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1])),
         ([a, b], 3) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1], ..)),
+        ([a, b, c], 3) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1], *c..*c + local[2])),
+        ([a, b, c], 4) => ds.write_slice(view, (*a..*a + local[0], *b..*b + local[1], *c..*c + local[2], ..)),
         _ => Err(h5::Error::from("unexpected field shape")),
     }
 }
@@ -205,7 +237,8 @@ impl FieldFiles {
             };
             {
                 let g = f.create_group("grid").map_err(fail)?;
-                for (d, name) in ["x", "y"].iter().enumerate() {
+                let names: &[&str] = if grid.solid() { &["x", "y", "z"] } else { &["x", "y"] };
+                for (d, name) in names.iter().enumerate() {
                     let ds = g.new_dataset::<f64>().shape(grid.nodes[d]).create(*name).map_err(fail)?;
                     if writer {
                         ds.write_raw(&coords(d)[..]).map_err(fail)?;
@@ -234,7 +267,7 @@ impl FieldFiles {
     pub fn write(&mut self, frame: &Frame) -> Result<(), String> {
         let i = self.frames;
         let fail = |e: h5::Error| format!("cannot write {}: {e}", self.h5.display());
-        let [nx, ny] = self.grid.nodes;
+        let [nx, ny, nz] = self.grid.nodes;
         if frame.particle_fields.first().map(|f| (f.name, f.components)) != Some(("position", 3)) {
             return Err("the first particle field must be `position` with 3 components".into());
         }
@@ -244,12 +277,12 @@ impl FieldFiles {
                 return Err(format!("particle field `{}` has {} values", f.name, f.values.len()));
             }
         }
-        let ([i0, j0], [ni, nj]) = frame.node_block;
-        if i0 + ni > nx || j0 + nj > ny || frame.first_particle + rows > frame.particles {
+        let ([i0, j0, k0], [ni, nj, nk]) = frame.node_block;
+        if i0 + ni > nx || j0 + nj > ny || k0 + nk > nz || frame.first_particle + rows > frame.particles {
             return Err("this rank's block of the fields lies outside the grid or the particle list".into());
         }
         for f in &frame.grid_fields {
-            if f.values.len() != ni * nj * f.components {
+            if f.values.len() != ni * nj * nk * f.components {
                 return Err(format!("grid field `{}` has {} values", f.name, f.values.len()));
             }
         }
@@ -260,8 +293,10 @@ impl FieldFiles {
                 write_field(&pg, f, &[frame.particles], &[frame.first_particle], &[rows]).map_err(fail)?;
             }
             let gg = file.group("grid").and_then(|g| g.create_group(&i.to_string())).map_err(fail)?;
+            let (start, count) =
+                if self.grid.solid() { (vec![k0, j0, i0], vec![nk, nj, ni]) } else { (vec![j0, i0], vec![nj, ni]) };
             for f in &frame.grid_fields {
-                write_field(&gg, f, &[ny, nx], &[j0, i0], &[nj, ni]).map_err(fail)?;
+                write_field(&gg, f, &self.grid.shape(), &start, &count).map_err(fail)?;
             }
             file.flush().map_err(fail)?;
         }
@@ -291,7 +326,7 @@ impl FieldFiles {
     /// The XDMF grids of output time `i`.
     fn frame_xml(&self, i: usize, frame: &Frame) -> String {
         let h5name = self.h5.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let [nx, ny] = self.grid.nodes;
+        let [nx, ny, nz] = self.grid.nodes;
         let item = |dims: &str, int: bool, path: String| {
             let (ty, prec) = if int { ("Int", 4) } else { ("Float", 8) };
             format!(
@@ -326,17 +361,23 @@ impl FieldFiles {
             }
             s.push_str("      </Grid>\n");
             let _ = writeln!(s, "      <Grid Name=\"grid\" GridType=\"Uniform\">");
-            let _ = writeln!(s, "        <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"1 {ny} {nx}\"/>");
+            let _ = writeln!(s, "        <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{nz} {ny} {nx}\"/>");
             let g = &self.grid;
-            // Order z, y, x; the single layer's spacing in z is arbitrary.
+            // Order z, y, x; in two dimensions the single layer's origin is 0 and its spacing in z
+            // (arbitrary) 1.
+            let (oz, dz) = if g.solid() {
+                (format!("{:.17e}", g.origin[2]), format!("{:.17e}", g.spacing[2]))
+            } else {
+                ("0".to_string(), "1".to_string())
+            };
             let _ = writeln!(
                 s,
-                "        <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">0 {:.17e} {:.17e}</DataItem>\n          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">1 {:.17e} {:.17e}</DataItem>\n        </Geometry>",
+                "        <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">{oz} {:.17e} {:.17e}</DataItem>\n          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">{dz} {:.17e} {:.17e}</DataItem>\n        </Geometry>",
                 g.origin[1], g.origin[0], g.spacing[1], g.spacing[0]
             );
             let base = format!("/grid/{i}");
             for f in &frame.grid_fields {
-                s.push_str(&attribute(f.name, f.components, f.values.is_int(), &base, format!("1 {ny} {nx}")));
+                s.push_str(&attribute(f.name, f.components, f.values.is_int(), &base, format!("{nz} {ny} {nx}")));
             }
             s.push_str("      </Grid>\n    </Grid>\n");
         }
@@ -360,7 +401,7 @@ mod tests {
         let (_lock, world) = crate::io::test_world();
         let dir = std::env::temp_dir().join(format!("porompm-fields-test-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
-        let grid = GridGeometry { origin: [0.0, -1.0], spacing: [0.5, 0.25], nodes: [3, 5] };
+        let grid = GridGeometry::of([0.0, -1.0], [0.5, 0.25], [3, 5]);
         let mut files = FieldFiles::create(&dir, grid, &world, true).unwrap();
         for t in [0.0, 0.5] {
             let frame = Frame {
@@ -372,7 +413,7 @@ mod tests {
                     Field { name: "p", components: 1, values: Values::Real(vec![t, 2.0 * t]) },
                     Field { name: "material_id", components: 1, values: Values::Int(vec![0, 1]) },
                 ],
-                node_block: ([0, 0], [3, 5]),
+                node_block: ([0, 0, 0], [3, 5, 1]),
                 grid_fields: vec![Field { name: "active", components: 1, values: Values::Int(vec![1; 15]) }],
             };
             files.write(&frame).unwrap();
@@ -392,7 +433,7 @@ mod tests {
             particles: 3,
             first_particle: 0,
             particle_fields: vec![],
-            node_block: ([0, 0], [3, 5]),
+            node_block: ([0, 0, 0], [3, 5, 1]),
             grid_fields: vec![],
         };
         assert!(files.write(&bad).unwrap_err().contains("`position`"));
@@ -404,7 +445,7 @@ mod tests {
                 Field { name: "position", components: 3, values: Values::Real(vec![0.0; 9]) },
                 Field { name: "p", components: 1, values: Values::Real(vec![1.0]) },
             ],
-            node_block: ([0, 0], [3, 5]),
+            node_block: ([0, 0, 0], [3, 5, 1]),
             grid_fields: vec![],
         };
         assert!(files.write(&bad).unwrap_err().contains("`p` has 1 values"));
@@ -412,6 +453,53 @@ mod tests {
         assert!(files.write(&bad).unwrap_err().contains("outside"), "rows 2..5 of 3 particles");
         files.finish().unwrap();
         assert_eq!(fs::read_to_string(dir.join("fields.xdmf")).unwrap(), text, "the XDMF file lists complete frames");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A three-dimensional grid: nodal datasets n_z × n_y × n_x, the node coordinates along z, and
+    /// the XDMF mesh with its z extent and origin; a rank's block placed at its (i, j, k).
+    #[test]
+    fn a_three_dimensional_grid_is_written_as_such() {
+        let (_lock, world) = crate::io::test_world();
+        let dir = std::env::temp_dir().join(format!("porompm-fields-3d-test-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let grid = GridGeometry::of([0.0, -1.0, 2.0], [0.5, 0.25, 0.1], [3, 5, 2]);
+        let mut files = FieldFiles::create(&dir, grid, &world, true).unwrap();
+        let frame = Frame {
+            time: 0.0,
+            particles: 1,
+            first_particle: 0,
+            particle_fields: vec![Field {
+                name: "position",
+                components: 3,
+                values: Values::Real(vec![0.1, 0.2, 2.05]),
+            }],
+            node_block: ([1, 0, 1], [2, 5, 1]),
+            grid_fields: vec![
+                Field { name: "active", components: 1, values: Values::Int((0..10).collect()) },
+                Field { name: "du", components: 3, values: Values::Real((0..30).map(f64::from).collect()) },
+            ],
+        };
+        files.write(&frame).unwrap();
+        files.finish().unwrap();
+        let text = fs::read_to_string(dir.join("fields.xdmf")).unwrap();
+        assert!(text.contains("TopologyType=\"3DCoRectMesh\" Dimensions=\"2 5 3\""), "{text}");
+        assert!(text.contains(">2.00000000000000000e0 -1.00000000000000000e0 0.00000000000000000e0<"), "{text}");
+        assert!(text.contains(">1.00000000000000006e-1 2.50000000000000000e-1 5.00000000000000000e-1<"), "{text}");
+        assert!(text.contains("Dimensions=\"2 5 3 3\""), "vector fields are n_z × n_y × n_x × 3");
+        let f = h5::File::open(dir.join("fields.h5")).unwrap();
+        assert_eq!(f.dataset("grid/z").unwrap().read_raw::<f64>().unwrap(), vec![2.0, 2.1]);
+        let active = f.dataset("grid/0/active").unwrap();
+        assert_eq!(active.shape(), vec![2, 5, 3]);
+        let a = active.read_raw::<i32>().unwrap();
+        // The block of nodes i = 1, 2; all j; k = 1, x fastest.
+        assert_eq!((a[15 + 1], a[15 + 2], a[15 + 3 + 1], a[15 + 14]), (0, 1, 2, 9));
+        assert!(a[..15].iter().all(|&v| v == 0));
+        let du = f.dataset("grid/0/du").unwrap();
+        assert_eq!(du.shape(), vec![2, 5, 3, 3]);
+        // A block outside the grid along z is refused.
+        let bad = Frame { node_block: ([0, 0, 1], [3, 5, 2]), ..frame.clone() };
+        assert!(files.write(&bad).unwrap_err().contains("outside"));
         fs::remove_dir_all(&dir).unwrap();
     }
 }
