@@ -65,20 +65,20 @@ pub struct Extension {
 /// `eff_offsets[k]..eff_offsets[k + 1]` of `eff_nodes` (its raw nodes, in the same order, then the
 /// masters of its extended nodes that are not in the raw stencil), and `ext_offsets[k]..` of `ext`.
 #[derive(Debug, Clone, Default)]
-pub struct Stencils {
+pub struct Stencils<const D: usize = 2> {
     pub offsets: Vec<usize>,
     pub nodes: Vec<u32>,
-    pub basis: Vec<NodeBasis>,
+    pub basis: Vec<NodeBasis<D>>,
     pub eff_offsets: Vec<usize>,
     pub eff_nodes: Vec<u32>,
     pub ext_offsets: Vec<usize>,
     pub ext: Vec<Extension>,
     /// The strain-recovery operators of each raw slot (`kernels::Point::with_recovery`), flat
     /// like `basis`; empty when the strain is recovered with the basis itself.
-    pub strain: Vec<NodeBasis>,
+    pub strain: Vec<NodeBasis<D>>,
 }
 
-impl Stencils {
+impl<const D: usize> Stencils<D> {
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.offsets.len().saturating_sub(1)
@@ -90,14 +90,14 @@ impl Stencils {
     }
 
     /// Raw nodes and basis of particle `k`.
-    pub fn get(&self, k: usize) -> (&[u32], &[NodeBasis]) {
+    pub fn get(&self, k: usize) -> (&[u32], &[NodeBasis<D>]) {
         let r = self.offsets[k]..self.offsets[k + 1];
         (&self.nodes[r.clone()], &self.basis[r])
     }
 
     /// The strain-recovery operators of particle `k`'s raw slots: its CMPM patch functions
     /// ([`cmpm_patches`]) or, by default, its basis.
-    pub fn strain_of(&self, k: usize) -> &[NodeBasis] {
+    pub fn strain_of(&self, k: usize) -> &[NodeBasis<D>] {
         let r = self.offsets[k]..self.offsets[k + 1];
         if self.strain.is_empty() {
             &self.basis[r]
@@ -124,79 +124,89 @@ impl Stencils {
 pub const CELL_FILLED_FRACTION: f64 = 0.5;
 
 /// For every cell of the ghosted box, the cell whose volumetric strain it takes in B̄.
-#[derive(Debug, Clone, Default)]
-pub struct CellRoots {
-    start: [usize; 2],
-    count: [usize; 2],
-    root: Vec<(u32, u32)>,
+#[derive(Debug, Clone)]
+pub struct CellRoots<const D: usize = 2> {
+    start: [usize; D],
+    count: [usize; D],
+    root: Vec<[u32; D]>,
 }
 
-impl CellRoots {
+impl<const D: usize> CellRoots<D> {
     /// Every cell its own root.
-    pub fn identity() -> CellRoots {
-        CellRoots::default()
+    pub fn identity() -> CellRoots<D> {
+        CellRoots { start: [0; D], count: [0; D], root: Vec::new() }
     }
 
-    /// The roots from the cells' filled fractions `phi` (per ghosted node (i, j) for cell (i, j),
-    /// summed over ranks): a cell filled below [`CELL_FILLED_FRACTION`] takes the most filled of its
-    /// eight neighbours that is filled above it (ties: the first in row order), if any.
-    pub fn new(ghost: &GhostedRange, cells: [usize; 2], phi: &[f64]) -> CellRoots {
+    /// The roots from the cells' filled fractions `phi` (per ghosted node for the cell whose
+    /// lowest corner it is, summed over ranks): a cell filled below [`CELL_FILLED_FRACTION`] takes
+    /// the most filled of its 3^D − 1 neighbours that is filled above it (ties: the first with x
+    /// fastest), if any.
+    pub fn new(ghost: &GhostedRange<D>, cells: [usize; D], phi: &[f64]) -> CellRoots<D> {
         let n = ghost.len();
-        let at = |i: i64, j: i64| -> Option<f64> {
-            if i < 0 || j < 0 || i as usize >= cells[0] || j as usize >= cells[1] {
+        let at = |c: [i64; D]| -> Option<f64> {
+            if (0..D).any(|d| c[d] < 0 || c[d] as usize >= cells[d]) {
                 return None;
             }
-            ghost.node(i as usize, j as usize).map(|l| phi[l])
+            ghost.local(c.map(|v| v as usize)).map(|l| phi[l])
         };
         let root = (0..n)
             .map(|l| {
-                let (i, j) = ghost.ij(l);
-                let own = at(i as i64, j as i64).unwrap_or(0.0);
+                let own_cell = ghost.indices(l);
+                let here = own_cell.map(|v| v as i64);
+                let own = at(here).unwrap_or(0.0);
                 if own >= CELL_FILLED_FRACTION {
-                    return (i as u32, j as u32);
+                    return own_cell.map(|v| v as u32);
                 }
-                let mut best: Option<((i64, i64), f64)> = None;
-                for dj in -1..=1i64 {
-                    for di in -1..=1i64 {
-                        let (ni, nj) = (i as i64 + di, j as i64 + dj);
-                        if let Some(f) = at(ni, nj).filter(|&f| f >= CELL_FILLED_FRACTION) {
-                            if best.is_none_or(|b| f > b.1) {
-                                best = Some(((ni, nj), f));
-                            }
+                let mut best: Option<([i64; D], f64)> = None;
+                let mut offset = [0usize; D];
+                loop {
+                    let c: [i64; D] = std::array::from_fn(|d| here[d] + offset[d] as i64 - 1);
+                    if let Some(f) = at(c).filter(|&f| f >= CELL_FILLED_FRACTION) {
+                        if best.is_none_or(|b| f > b.1) {
+                            best = Some((c, f));
                         }
                     }
+                    if !crate::model::shape::next_combination(&mut offset, [3; D]) {
+                        break;
+                    }
                 }
-                best.map_or((i as u32, j as u32), |((ni, nj), _)| (ni as u32, nj as u32))
+                best.map_or(own_cell.map(|v| v as u32), |(c, _)| c.map(|v| v as u32))
             })
             .collect();
         CellRoots { start: ghost.start, count: ghost.count, root }
     }
 
-    /// The root of cell (i, j) (itself outside the ghosted box).
-    pub fn root(&self, i: usize, j: usize) -> (usize, usize) {
-        let inside = i >= self.start[0]
-            && j >= self.start[1]
-            && i < self.start[0] + self.count[0]
-            && j < self.start[1] + self.count[1];
+    /// The root of cell `c` (itself outside the ghosted box).
+    pub fn root_of(&self, c: [usize; D]) -> [usize; D] {
+        let inside = (0..D).all(|d| c[d] >= self.start[d] && c[d] < self.start[d] + self.count[d]);
         if !inside || self.root.is_empty() {
-            return (i, j);
+            return c;
         }
-        let r = self.root[(j - self.start[1]) * self.count[0] + (i - self.start[0])];
-        (r.0 as usize, r.1 as usize)
+        let l = (0..D).rev().fold(0, |acc, d| acc * self.count[d] + (c[d] - self.start[d]));
+        self.root[l].map(|v| v as usize)
     }
 }
 
-/// The area of the particles' domains in every cell (their GIMP domains, or their volumes for linear
-/// MPM) as a fraction of the cell, on this rank's particles, per ghosted node (i, j) for cell (i, j).
-pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
+impl CellRoots {
+    /// The root of cell (i, j) (itself outside the ghosted box).
+    pub fn root(&self, i: usize, j: usize) -> (usize, usize) {
+        let [a, b] = self.root_of([i, j]);
+        (a, b)
+    }
+}
+
+/// The area (volume in three dimensions) of the particles' domains in every cell (their GIMP
+/// domains, or their volumes for linear MPM) as a fraction of the cell, on this rank's particles,
+/// per ghosted node for the cell whose lowest corner it is.
+pub fn cell_fractions<const D: usize>(model: &Model<D>, ghost: &GhostedRange<D>) -> Vec<f64> {
     let g = &model.grid;
     let ps = &model.particles;
     let mut out = vec![0.0; ghost.len()];
-    let area = g.h[0] * g.h[1];
+    let area: f64 = g.h.iter().product();
     for k in 0..ps.len() {
         let (x, lp) = (ps.x[k], ps.lp[k]);
         if model.basis == Basis::Linear {
-            if let Some(l) = g.cell_of(x).and_then(|(i, j)| ghost.node(i, j)) {
+            if let Some(l) = g.cell_containing(x).and_then(|c| ghost.local(c)) {
                 out[l] += model.area(k) / area;
             }
             continue;
@@ -214,12 +224,20 @@ pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
                 .collect()
         };
         // The domain's area is scaled to the particle's volume.
-        let scale = model.area(k) / (4.0 * lp[0] * lp[1]);
-        for (cy, ly) in span(1) {
-            for &(cx, lx) in &span(0) {
-                if let Some(l) = ghost.node(cx, cy) {
-                    out[l] += lx * ly * scale / area;
-                }
+        let scale = model.area(k) / lp.iter().fold(1.0, |a, l| a * (2.0 * l));
+        let spans: [Vec<(usize, f64)>; D] = std::array::from_fn(span);
+        if spans.iter().any(|s| s.is_empty()) {
+            continue;
+        }
+        let mut at = [0usize; D];
+        loop {
+            let cell: [usize; D] = std::array::from_fn(|d| spans[d][at[d]].0);
+            if let Some(l) = ghost.local(cell) {
+                let overlap = (1..D).fold(spans[0][at[0]].1, |a, d| a * spans[d][at[d]].1);
+                out[l] += overlap * scale / area;
+            }
+            if !crate::model::shape::next_combination(&mut at, std::array::from_fn(|d| spans[d].len())) {
+                break;
             }
         }
     }
@@ -231,12 +249,12 @@ pub fn cell_fractions(model: &Model, ghost: &GhostedRange) -> Vec<f64> {
 pub struct Crossing {
     /// The particle.
     pub k: usize,
-    /// The side (0: x_min, 1: x_max, 2: y_min, 3: y_max).
+    /// The side (0: x_min, 1: x_max, 2: y_min, 3: y_max, 4: z_min, 5: z_max).
     pub side: usize,
 }
 
 /// The names of the grid's sides, in [`Crossing::side`] order.
-pub const SIDES: [&str; 4] = ["x_min", "x_max", "y_min", "y_max"];
+pub const SIDES: [&str; 6] = ["x_min", "x_max", "y_min", "y_max", "z_min", "z_max"];
 
 /// Builds the raw stencils on x_n (step 1 of a step), and lists the particles whose support
 /// reaches past the grid (GIMP: their domain, beyond round-off; linear and B-splines, whose
@@ -244,44 +262,72 @@ pub const SIDES: [&str; 4] = ["x_min", "x_max", "y_min", "y_max"];
 /// [`check_edges`]. Fails, naming the particle, when a stencil node lies outside this rank's ghost
 /// region or a position is not finite.
 pub fn build(model: &Model, ghost: &GhostedRange, roots: &CellRoots) -> Result<(Stencils, Vec<Crossing>), String> {
+    build_in::<2, { shape::MAX_STENCIL }>(model, ghost, roots)
+}
+
+/// [`build`] in any dimension, with stencils of at most `M` nodes (an axisymmetric model's
+/// stencils are the plane ones with their hoop operators).
+pub fn build_in<const D: usize, const M: usize>(
+    model: &Model<D>,
+    ghost: &GhostedRange<D>,
+    roots: &CellRoots<D>,
+) -> Result<(Stencils<D>, Vec<Crossing>), String> {
     let ps = &model.particles;
     let g = &model.grid;
     let mut out = Stencils { offsets: Vec::with_capacity(ps.len() + 1), ..Default::default() };
     let mut crossings = Vec::new();
     out.offsets.push(0);
     let hi = g.extent_max();
-    let tol = 1e-9 * g.h[0].min(g.h[1]);
+    let tol = 1e-9 * (1..D).fold(g.h[0], |m, d| m.min(g.h[d]));
+    let axisymmetric = model.geometry.axisymmetric();
+    let plane_grid =
+        crate::model::grid::Grid::new([g.origin[0], g.origin[1]], [g.h[0], g.h[1]], [g.cells[0], g.cells[1]]);
     for k in 0..ps.len() {
         let (x, lp) = (ps.x[k], ps.lp[k]);
-        if !(x[0].is_finite() && x[1].is_finite()) {
+        if !x.iter().all(|v| v.is_finite()) {
             return Err(format!("material point {}: its position is not finite (NaN or Inf)", ps.id[k]));
         }
-        let reach = if model.basis == Basis::Gimp { lp } else { [0.0; 2] };
-        let past = [
-            x[0] - reach[0] < g.origin[0] - tol,
-            x[0] + reach[0] > hi[0] + tol,
-            x[1] - reach[1] < g.origin[1] - tol,
-            x[1] + reach[1] > hi[1] + tol,
-        ];
-        for (side, &p) in past.iter().enumerate() {
-            if p {
-                crossings.push(Crossing { k, side });
+        let reach = if model.basis == Basis::Gimp { lp } else { [0.0; D] };
+        for d in 0..D {
+            if x[d] - reach[d] < g.origin[d] - tol {
+                crossings.push(Crossing { k, side: 2 * d });
+            }
+            if x[d] + reach[d] > hi[d] + tol {
+                crossings.push(Crossing { k, side: 2 * d + 1 });
             }
         }
-        let (mut st, hoop) = model.geometry.stencil(model.basis, g, x, lp);
-        let axisymmetric = model.geometry.axisymmetric();
+        let (mut st, hoop): (shape::Stencil<D, M>, [f64; M]) = if axisymmetric {
+            // The axisymmetric stencil with its hoop operators (two dimensions only).
+            let (s2, h2) = model.geometry.stencil(model.basis, &plane_grid, [x[0], x[1]], [lp[0], lp[1]]);
+            let mut st = shape::Stencil::<D, M> { len: s2.len, ..Default::default() };
+            for n in 0..s2.len {
+                st.nodes[n] = std::array::from_fn(|d| s2.nodes[n][d]);
+                st.w[n] = s2.w[n];
+                st.dw[n] = std::array::from_fn(|d| s2.dw[n][d]);
+            }
+            (st, std::array::from_fn(|n| if n < s2.len { h2[n] } else { 0.0 }))
+        } else {
+            (shape::stencil_in(model.basis, g, x, lp), [0.0; M])
+        };
         let gv = model.bbar.then(|| {
-            shape::volumetric_operators(model.basis, g, x, lp, &mut st, &|i, j| roots.root(i, j), axisymmetric)
+            shape::volumetric_operators_in(model.basis, g, x, lp, &mut st, &|c| roots.root_of(c), axisymmetric)
         });
         if st.len == 0 {
-            return Err(format!("material point {} at ({:.4}, {:.4}) m has left the grid", ps.id[k], x[0], x[1]));
+            return Err(format!(
+                "material point {} at {} m has left the grid",
+                ps.id[k],
+                crate::model::position_text(&x)
+            ));
         }
-        for &[i, j] in &st.nodes[..st.len] {
-            let l = ghost.node(i as usize, j as usize).ok_or_else(|| {
+        for n in &st.nodes[..st.len] {
+            let node = n.map(|v| v as usize);
+            let l = ghost.local(node).ok_or_else(|| {
                 format!(
-                    "material point {} at ({:.4}, {:.4}) m reaches node ({i}, {j}) outside this rank's ghost region \
+                    "material point {} at {} m reaches node {} outside this rank's ghost region \
                      (its support is wider than the ghost nodes around its cell allow)",
-                    ps.id[k], x[0], x[1]
+                    ps.id[k],
+                    crate::model::position_text(&x),
+                    crate::model::index_text(&node)
                 )
             })?;
             out.nodes.push(l as u32);
@@ -590,5 +636,65 @@ mod tests {
         let f = |x: [f64; 2]| 0.5 - x[0] + 4.0 * x[1];
         let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();
         assert!((v - f([2.0, 2.0])).abs() < 1e-12);
+    }
+
+    /// The stencils of a three-dimensional model (a body over two of the grid's three z layers,
+    /// GIMP with B̄, every cell of the box filled, the partly filled cells of its sloping top
+    /// taking the volumetric strain of a full neighbour): every point's functions are a partition
+    /// of unity reproducing linear fields (Σ S = 1, Σ ∇S = 0, Σ x_i ⊗ ∇S_i = I and
+    /// Σ x_i ⊗ ∇̄S_i = I), its nodes numbered in the ghosted block; the cell fractions add up to the
+    /// points' volume; points whose domains reach past the grid's planes are listed with their
+    /// sides.
+    #[test]
+    fn three_dimensional_stencils_reproduce_linear_fields() {
+        let text = crate::case::tests_support::MINIMAL
+            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [0.4, 1.0, 0.3]\n        cells = [4, 10, 3]")
+            .replace(
+                "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+                "shape = { polygon = { vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.75], [0.0, 1.0]] } }\n        z = [0.0, 0.2]",
+            )
+            .replace("[analysis]", "[stabilisation]\n        bbar = true\n        [analysis]");
+        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let model = Model::build_solid(&c, |_| true);
+        let g = &model.grid;
+        let ghost = GhostedRange { start: [0; 3], count: g.nodes(), dof: 1 };
+        let phi = cell_fractions(&model, &ghost);
+        let total: f64 = phi.iter().sum::<f64>() * g.h.iter().product::<f64>();
+        let volume: f64 = model.particles.volume.iter().sum();
+        assert!((total - volume).abs() < 1e-12 * volume, "{total} against {volume}");
+        let roots = CellRoots::new(&ghost, g.cells, &phi);
+        // An empty cell above the sloping top (x ∈ [0.3, 0.4], y ∈ [0.8, 0.9]) takes a well-filled
+        // neighbour's strain; a full cell its own.
+        assert_eq!(phi[ghost.local([3, 8, 0]).unwrap()], 0.0);
+        let top = roots.root_of([3, 8, 0]);
+        assert!(top != [3, 8, 0] && phi[ghost.local(top).unwrap()] >= CELL_FILLED_FRACTION, "{top:?}");
+        assert_eq!(roots.root_of([1, 2, 1]), [1, 2, 1]);
+        let (st, crossings) = build_in::<3, { shape::MAX_STENCIL_3D }>(&model, &ghost, &roots).unwrap();
+        assert_eq!(st.len(), model.particles.len());
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
+            let pos: Vec<[f64; 3]> = nodes.iter().map(|&l| g.position(ghost.indices(l as usize))).collect();
+            let sum: f64 = basis.iter().map(|b| b.s).sum();
+            assert!((sum - 1.0).abs() < 1e-13, "point {k}: Σ S = {sum}");
+            for a in 0..3 {
+                let gs: f64 = basis.iter().map(|b| b.g[a]).sum();
+                assert!(gs.abs() < 1e-10, "point {k}: Σ ∂S/∂x{a} = {gs}");
+                for b in 0..3 {
+                    let want = if a == b { 1.0 } else { 0.0 };
+                    let xg: f64 = pos.iter().zip(basis).map(|(x, n)| x[a] * n.g[b]).sum();
+                    let xgv: f64 = pos.iter().zip(basis).map(|(x, n)| x[a] * n.gv[b]).sum();
+                    assert!((xg - want).abs() < 1e-10 && (xgv - want).abs() < 1e-10, "point {k}: {xg} {xgv} ({a}{b})");
+                }
+            }
+        }
+        // Domains end on the grid's planes: none is past them. Moved past x_min and z_max, two are.
+        assert!(crossings.is_empty());
+        let mut moved = model.clone();
+        moved.particles.x[0][0] -= 0.02;
+        let last = moved.particles.len() - 1;
+        moved.particles.x[last][2] = 0.29;
+        let (_, crossings) = build_in::<3, { shape::MAX_STENCIL_3D }>(&moved, &ghost, &roots).unwrap();
+        let sides: Vec<(usize, &str)> = crossings.iter().map(|c| (c.k, SIDES[c.side])).collect();
+        assert_eq!(sides, [(0, "x_min"), (last, "z_max")]);
     }
 }

@@ -343,8 +343,13 @@ impl Model<3> {
 }
 
 /// The position `x` as "(x, y)" or "(x, y, z)" with four decimals, for messages.
-fn position<const D: usize>(x: &[f64; D]) -> String {
+pub(crate) fn position_text<const D: usize>(x: &[f64; D]) -> String {
     format!("({})", x.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "))
+}
+
+/// The grid indices `n` as "(i, j)" or "(i, j, k)", for messages.
+pub(crate) fn index_text<const D: usize>(n: &[usize; D]) -> String {
+    format!("({})", n.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", "))
 }
 
 impl<const D: usize> Model<D> {
@@ -484,7 +489,7 @@ impl<const D: usize> Model<D> {
             return Err(InadmissibleStep(format!(
                 "material point {} at {} m: volume ratio J = {j:.4} gives porosity {n_new:.4}",
                 ps.id[k],
-                position(&ps.x[k])
+                position_text(&ps.x[k])
             )));
         }
         Ok(())
@@ -507,7 +512,7 @@ impl<const D: usize> Model<D> {
             InadmissibleStep(format!(
                 "material point {} at {} m: its {what} is not finite (NaN or Inf)",
                 ps.id[k],
-                position(&ps.x[k])
+                position_text(&ps.x[k])
             ))
         })
     }
