@@ -133,7 +133,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     for j in 0..g.nodes()[1] {
         for i in 0..g.nodes()[0] {
             let f = filled[j * g.nodes()[0] + i];
-            let fixed = model.fixing_boundaries(&first, i, j);
+            let fixed = model.fixing_boundaries(&first, [i, j]);
             unknowns += (0..layout.nd)
                 .filter(|&c| {
                     layout.canonical(c).is_none_or(|k| fixed[k].is_none())
@@ -329,4 +329,28 @@ fn describe_solid(case: &Case, label: &str) -> String {
          (issue «Three dimensions», docs/dimensions.md)"
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    /// `porompm check` of a three-dimensional case: its dimension, grid, bodies with their points
+    /// and volumes, and that it cannot be run yet.
+    #[test]
+    fn a_three_dimensional_case_is_described() {
+        let text = crate::case::tests_support::MINIMAL.replace(
+            "size = [0.1, 1.0]\n        cells = [1, 10]",
+            "size = [0.1, 1.0, 0.2]\n        cells = [1, 10, 2]",
+        );
+        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let d = super::describe(&c, "column_3d.toml");
+        for want in [
+            "dimension: 3",
+            "grid: 1 × 10 × 2 cells",
+            "body `column`: 160 material points (2×2×2 per cell), volume 2.000000e-2 m³",
+            "material points: 160",
+            "`porompm run` refuses the case",
+        ] {
+            assert!(d.contains(want), "{d}\n  does not say: {want}");
+        }
+    }
 }

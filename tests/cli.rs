@@ -727,7 +727,12 @@ fn bad_values_across_the_case_are_named() {
             ),
             ("stabilisation.pressure_projection=1e9", "key `stabilisation.pressure_projection`: must be at most 1e3"),
             ("boundaries.0.side=nowhere", "--set boundaries.0.side: unknown variant `nowhere`"),
-            ("boundaries.0.fix=[\"uz\"]", "--set boundaries.0.fix: unknown variant `uz`"),
+            ("boundaries.0.fix=[\"uw\"]", "--set boundaries.0.fix: unknown variant `uw`"),
+            (
+                "boundaries.0.fix=[\"uz\"]",
+                "key `boundaries[0].fix`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) belongs to \
+                 three-dimensional cases only",
+            ),
             ("loads.0.face=top", "key `loads[0]`: unknown variant `top`"),
             ("loads.0.traction=[nan,0.0]", "key `loads[0].traction`: must be finite"),
             ("analysis.g=-1", "key `analysis.g`: must be a positive number"),

@@ -84,7 +84,7 @@ pub fn build(
     };
     for (l, reached) in phi.iter().enumerate() {
         let (i, j) = ghost.ij(l);
-        let by = model.fixing_boundaries(active, i, j);
+        let by = model.fixing_boundaries(active, [i, j]);
         for c in 0..nd {
             let (q, by_c) = (l * nd + c, layout.canonical(c).and_then(|k| by[k]));
             let b = by_c.or_else(|| (surface[q] > 0.5).then(|| surface[q].round() as usize - 1));

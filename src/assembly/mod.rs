@@ -641,7 +641,7 @@ impl GridSystem {
         Ok((0..self.ghost.len())
             .map(|l| {
                 let (i, j) = self.ghost.ij(l);
-                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, i, j)[p].is_some()
+                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, [i, j])[p].is_some()
             })
             .collect())
     }

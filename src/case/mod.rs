@@ -272,6 +272,22 @@ impl Region {
         (0..2).all(|d| self.spans(d, p[d], 1e-9 * h[d]))
     }
 
+    /// Whether the grid node at `p` of a case of dimension `D` lies in the box: [`Region::holds_node`]
+    /// in x and y and, in three dimensions, its `z` range (all of z without one) with the same
+    /// tolerance.
+    pub fn holds_node_in<const D: usize>(&self, p: [f64; D], h: [f64; D]) -> bool {
+        if !self.holds_node([p[0], p[1]], [h[0], h[1]]) {
+            return false;
+        }
+        match (D, self.z) {
+            (3, Some([lo, hi])) => {
+                let tol = 1e-9 * ((hi - lo).abs() + lo.abs() + hi.abs()) + 1e-15 + 1e-9 * h[2];
+                p[2] >= lo - tol && p[2] <= hi + tol
+            }
+            _ => true,
+        }
+    }
+
     /// Whether coordinate `x` of direction `d` lies in the box's range, with `slack` beyond the
     /// tolerance of [`Region::contains`].
     pub fn spans(&self, d: usize, x: f64, slack: f64) -> bool {
@@ -321,7 +337,7 @@ mod tests {
     /// of 2.8 m: the node meant for x = 0 at −1.8e-15 m), and not the node a cell away.
     #[test]
     fn a_line_region_holds_the_node_on_its_line() {
-        let clamp = Region { min: [0.0, -1.0], max: [0.0, 1.0] };
+        let clamp = Region { min: [0.0, -1.0], max: [0.0, 1.0], z: None };
         let (origin, h) = (-8.4f64, 2.8f64);
         let x = origin + 3.0 * h;
         assert!(x != 0.0 && x.abs() < 1e-14, "{x}");
@@ -387,7 +403,7 @@ mod tests {
         let poly = Shape::Polygon { vertices: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]] };
         assert!(poly.contains([0.5, 0.5]));
         assert!(!poly.contains([1.5, 1.5]));
-        let r = Region { min: [0.0, 1.0], max: [1.0, 1.0] };
+        let r = Region { min: [0.0, 1.0], max: [1.0, 1.0], z: None };
         assert!(r.contains([0.5, 1.0 + 1e-12]));
         assert!(!r.contains([0.5, 1.01]));
     }

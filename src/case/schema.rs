@@ -448,6 +448,9 @@ pub struct Region {
     pub min: [f64; 2],
     /// Upper-right corner [m].
     pub max: [f64; 2],
+    /// Its extent [z_min, z_max] along z in a three-dimensional case [m] (default: all of it).
+    #[serde(default)]
+    pub z: Option<[f64; 2]>,
 }
 
 /// A side of the background grid.
@@ -462,6 +465,29 @@ pub enum Side {
     YMin,
     /// y = origin_y + size_y.
     YMax,
+    /// z = origin_z (three-dimensional cases).
+    ZMin,
+    /// z = origin_z + size_z (three-dimensional cases).
+    ZMax,
+}
+
+impl Side {
+    /// The direction the side is normal to (0: x, 1: y, 2: z).
+    pub fn axis(&self) -> usize {
+        match self {
+            Side::XMin | Side::XMax => 0,
+            Side::YMin | Side::YMax => 1,
+            Side::ZMin | Side::ZMax => 2,
+        }
+    }
+
+    /// The sign of its outward normal along [`Side::axis`].
+    pub fn sign(&self) -> f64 {
+        match self {
+            Side::XMin | Side::YMin | Side::ZMin => -1.0,
+            Side::XMax | Side::YMax | Side::ZMax => 1.0,
+        }
+    }
 }
 
 /// A nodal degree of freedom.
@@ -482,6 +508,12 @@ pub enum Dof {
     /// Water displacement, y.
     #[serde(rename = "Uy")]
     WUy,
+    /// Solid displacement, z (three-dimensional cases).
+    #[serde(rename = "uz")]
+    Uz,
+    /// Water displacement, z (three-dimensional cases).
+    #[serde(rename = "Uz")]
+    WUz,
 }
 
 impl std::fmt::Display for Dof {
@@ -492,6 +524,8 @@ impl std::fmt::Display for Dof {
             Dof::P => "p",
             Dof::WUx => "Ux",
             Dof::WUy => "Uy",
+            Dof::Uz => "uz",
+            Dof::WUz => "Uz",
         })
     }
 }
@@ -523,12 +557,13 @@ pub struct Boundary {
     /// Prescribed displacement [m] of the fixed displacement components: at time t the nodes have
     /// moved by `displacement` × f(t) (f the time function; constant 1 without one). Fixed water
     /// components move with the solid (the boundary is impermeable to flow across it).
+    /// Two components in a plane case, three in a three-dimensional one.
     #[serde(default)]
-    pub displacement: Option<[f64; 2]>,
+    pub displacement: Option<Vec<f64>>,
     /// Prescribed velocity [m/s] of the fixed displacement components, scaled by the time function:
     /// the nodes move by ∫ `velocity` f(t) dt.
     #[serde(default)]
-    pub velocity: Option<[f64; 2]>,
+    pub velocity: Option<Vec<f64>>,
     /// A velocity gradient L [1/s] of a homogeneous flow about `center`, scaled by the time
     /// function with `velocity` (its translation part, default zero): over a step the node at x moves
     /// by (exp(L s) − I)(x − c) + v s with s = ∫ f dt — exactly the step of a uniform deformation

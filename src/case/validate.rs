@@ -179,6 +179,40 @@ fn finite_strain_materials(c: &Case) -> R {
     Ok(())
 }
 
+/// What of boundary `i` belongs to three dimensions only (z sides, `uz`/`Uz`, a region's z range) or
+/// not yet to three dimensions (moving surfaces, velocity gradients).
+fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
+    let b = &c.boundaries[i];
+    let z_side = b.side.is_some_and(|s| s.axis() == 2);
+    let z_dof = b.fix.iter().any(|d| matches!(d, Dof::Uz | Dof::WUz));
+    let z_region = b.region.is_some_and(|r| r.z.is_some());
+    if dim == 2 {
+        for (bad, key) in [(z_side, "side"), (z_dof, "fix"), (z_region, "region.z")] {
+            if bad {
+                return Err(format!(
+                    "key `boundaries[{i}].{key}`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) \
+                     belongs to three-dimensional cases only"
+                ));
+            }
+        }
+        return Ok(());
+    }
+    for (bad, key) in [(b.surface.is_some(), "surface"), (b.velocity_gradient.is_some(), "velocity_gradient")] {
+        if bad {
+            return Err(format!(
+                "key `boundaries[{i}].{key}`: not available in a three-dimensional case yet (issue «Three \
+                 dimensions», docs/dimensions.md)"
+            ));
+        }
+    }
+    if let Some([z0, z1]) = b.region.and_then(|r| r.z) {
+        if !(z0.is_finite() && z1.is_finite() && z0 <= z1) {
+            return Err(format!("key `boundaries[{i}].region.z`: needs finite z_min ≤ z_max, got [{z0}, {z1}]"));
+        }
+    }
+    Ok(())
+}
+
 /// What a three-dimensional case may not ask for yet (issue «Three dimensions»: its grid, bodies,
 /// materials and analysis settings are read and its material points generated; loads, boundaries,
 /// probes, verifications and the two-dimensional options are not three-dimensional yet), and the
@@ -197,9 +231,6 @@ fn three_dimensional(c: &Case) -> R {
     }
     if !c.loads.is_empty() {
         return not_yet("loads");
-    }
-    if !c.boundaries.is_empty() {
-        return not_yet("boundaries");
     }
     if !c.probes.is_empty() {
         return not_yet("probes");
@@ -572,6 +603,7 @@ pub fn validate(c: &Case) -> R {
         if b.fix.is_empty() {
             return Err(format!("key `boundaries[{i}].fix`: list at least one component"));
         }
+        dimension_of_boundary(c, i, dim)?;
         if let Some(r) = &b.region {
             // A region between grid lines fixes nothing: the body it was meant to hold would move
             // freely (a clamp at x = 0 on a grid whose lines miss x = 0). A box holds a node if
@@ -606,13 +638,19 @@ pub fn validate(c: &Case) -> R {
         if let Some(cn) = &b.center {
             finite2(&format!("boundaries[{i}].center"), *cn)?;
         }
-        let motion = b.displacement.or(b.velocity).or(b.velocity_gradient.map(|_| [0.0; 2]));
-        if let Some(m) = motion {
+        let motion = b.displacement.clone().or(b.velocity.clone()).or(b.velocity_gradient.map(|_| vec![0.0; dim]));
+        if let Some(m) = &motion {
             let key = if b.displacement.is_some() { "displacement" } else { "velocity" };
+            if m.len() != dim {
+                return Err(format!(
+                    "key `boundaries[{i}].{key}`: {dim} components in a case of {dim} dimensions, got {}",
+                    m.len()
+                ));
+            }
             if m.iter().any(|v| !v.is_finite()) {
                 return Err(format!("key `boundaries[{i}].{key}`: must be finite"));
             }
-            for (c, dof) in [(0, Dof::Ux), (1, Dof::Uy)] {
+            for (c, dof) in [(0, Dof::Ux), (1, Dof::Uy), (2, Dof::Uz)].into_iter().take(dim) {
                 if m[c] != 0.0 && !b.fix.contains(&dof) {
                     return Err(format!(
                         "key `boundaries[{i}].{key}`: component {c} moves `{dof}`, which `fix` does not list"
@@ -1158,8 +1196,9 @@ pub fn validate(c: &Case) -> R {
                         let Some(b) = c.boundaries.iter().find(|b| &b.name == f) else {
                             return Err(format!("key `verification.footing`: no boundary named `{f}`"));
                         };
-                        let vertical = |v: Option<[f64; 2]>| v.is_some_and(|v| v[1] != 0.0);
-                        if !b.fix.contains(&Dof::Uy) || !(vertical(b.velocity) || vertical(b.displacement)) {
+                        let vertical =
+                            |v: &Option<Vec<f64>>| v.as_ref().is_some_and(|v| v.get(1).is_some_and(|&y| y != 0.0));
+                        if !b.fix.contains(&Dof::Uy) || !(vertical(&b.velocity) || vertical(&b.displacement)) {
                             return Err(format!(
                                 "key `verification.footing`: the boundary `{f}` must fix `uy` and move it vertically \
                                  (`velocity` or `displacement`): its reaction is the footing's load"

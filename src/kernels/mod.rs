@@ -193,10 +193,12 @@ impl Layout {
     /// dof component `c`, the order in which boundaries name what they fix; `None` for the
     /// projected volume ratio, which no boundary fixes.
     pub fn canonical(&self, c: usize) -> Option<usize> {
+        // The full two-phase layout of the same dimension: ux, uy, [uz,] p, Ux, Uy[, Uz].
+        let full = Layout::UPU.in_dim(self.dim);
         match (self.p, self.w, self.jbar) {
             (_, _, Some(j)) if c == j => None,
-            (_, Some(w), _) if c >= w => Some(dof::WX + c - w),
-            (Some(p), _, _) if c == p => Some(dof::P),
+            (_, Some(w), _) if c >= w => full.w.map(|fw| fw + c - w),
+            (Some(p), _, _) if c == p => full.p,
             _ => Some(c),
         }
     }

@@ -122,12 +122,14 @@ pub fn increment_factor(
 
 /// The centre of a particle's `face` and the face's length.
 pub fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
-    match face {
-        Side::XMin => ([x[0] - lp[0], x[1]], 2.0 * lp[1]),
-        Side::XMax => ([x[0] + lp[0], x[1]], 2.0 * lp[1]),
-        Side::YMin => ([x[0], x[1] - lp[1]], 2.0 * lp[0]),
-        Side::YMax => ([x[0], x[1] + lp[1]], 2.0 * lp[0]),
+    let a = face.axis();
+    if a >= 2 {
+        // A z face: none in a plane case (validated).
+        return (x, 0.0);
     }
+    let mut p = x;
+    p[a] += face.sign() * lp[a];
+    (p, 2.0 * lp[1 - a])
 }
 
 /// What a load acts on.
@@ -247,12 +249,13 @@ impl LoadDef {
 /// grid is refined.
 pub fn face_is_exposed(c: &case::Case, x: [f64; 2], lp: [f64; 2], face: Side) -> bool {
     let e = 1.0 + 1e-6;
-    let p = match face {
-        Side::XMin => [x[0] - e * lp[0], x[1]],
-        Side::XMax => [x[0] + e * lp[0], x[1]],
-        Side::YMin => [x[0], x[1] - e * lp[1]],
-        Side::YMax => [x[0], x[1] + e * lp[1]],
-    };
+    let a = face.axis();
+    if a >= 2 {
+        // A z face: none in a plane case (validated).
+        return false;
+    }
+    let mut p = x;
+    p[a] += face.sign() * e * lp[a];
     !c.bodies.iter().any(|b| b.shape.contains(p))
 }
 
@@ -307,15 +310,15 @@ pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)>
         .collect()
 }
 
-/// A prescribed motion of a boundary's fixed displacement components.
+/// A prescribed motion of a boundary's fixed displacement components, in `D` dimensions.
 #[derive(Debug, Clone)]
-pub struct Motion {
+pub struct Motion<const D: usize = 2> {
     /// Whether `vector` is a displacement [m] (true) or a velocity [m/s].
     pub is_displacement: bool,
     /// The displacement or velocity at time-function value 1.
-    pub vector: [f64; 2],
-    /// The velocity gradient L of a homogeneous flow [1/s] and its centre [m].
-    pub gradient: Option<([[f64; 2]; 2], [f64; 2])>,
+    pub vector: [f64; D],
+    /// The velocity gradient L of a homogeneous flow [1/s] and its centre [m] (two dimensions).
+    pub gradient: Option<([[f64; D]; D], [f64; D])>,
     /// The time function.
     pub time_fn: TimeFn,
 }
@@ -338,12 +341,13 @@ pub fn exp2(a: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     [[e * (c + sn * (a[0][0] - s)), e * sn * a[0][1]], [e * sn * a[1][0], e * (c + sn * (a[1][1] - s))]]
 }
 
-impl Motion {
+impl<const D: usize> Motion<D> {
     /// The increment over t0 → t1 of the node at `x` [m]: the uniform increment, plus
-    /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt.
-    pub fn increment_at(&self, x: [f64; 2], t0: f64, t1: f64) -> [f64; 2] {
+    /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt (two dimensions: validation refuses
+    /// a velocity gradient in three).
+    pub fn increment_at(&self, x: [f64; D], t0: f64, t1: f64) -> [f64; D] {
         let mut d = self.increment(t0, t1);
-        if let Some((l, c)) = &self.gradient {
+        if let Some((l, c)) = self.gradient.as_ref().filter(|_| D == 2) {
             let s = self.integral(t0, t1);
             let e = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
             let r = [x[0] - c[0], x[1] - c[1]];
@@ -359,16 +363,16 @@ impl Motion {
     }
 
     /// The prescribed displacement at time `t` [m]: d f(t), or ∫₀ᵗ v f dτ.
-    pub fn displacement_at(&self, t: f64) -> [f64; 2] {
+    pub fn displacement_at(&self, t: f64) -> [f64; D] {
         let s = if self.is_displacement { self.time_fn.eval(t) } else { self.integral(0.0, t) };
-        [self.vector[0] * s, self.vector[1] * s]
+        self.vector.map(|v| v * s)
     }
 
     /// The prescribed displacement over t0 → t1 [m].
-    pub fn increment(&self, t0: f64, t1: f64) -> [f64; 2] {
+    pub fn increment(&self, t0: f64, t1: f64) -> [f64; D] {
         let s =
             if self.is_displacement { self.time_fn.eval(t1) - self.time_fn.eval(t0) } else { self.integral(t0, t1) };
-        [self.vector[0] * s, self.vector[1] * s]
+        self.vector.map(|v| v * s)
     }
 
     /// ∫_{t0}^{t1} f dτ by the composite Simpson rule on 32 intervals (exact for piecewise linear
@@ -385,9 +389,9 @@ impl Motion {
     }
 }
 
-/// A set of Dirichlet conditions.
+/// A set of Dirichlet conditions, in `D` dimensions.
 #[derive(Debug, Clone)]
-pub struct BoundaryDef {
+pub struct BoundaryDef<const D: usize = 2> {
     /// Name from the case.
     pub name: String,
     /// Where.
@@ -403,7 +407,7 @@ pub struct BoundaryDef {
     /// Components fixed.
     pub fix: Vec<Dof>,
     /// Their prescribed motion (none: fixed to zero).
-    pub motion: Option<Motion>,
+    pub motion: Option<Motion<D>>,
 }
 
 impl BoundaryDef {
@@ -419,11 +423,6 @@ impl BoundaryDef {
             fix: vec![Dof::Ux, Dof::WUx],
             motion: None,
         }
-    }
-
-    /// Whether this is the axis of an axisymmetric model.
-    pub fn is_axis(&self) -> bool {
-        self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()
     }
 
     /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
@@ -444,6 +443,25 @@ impl BoundaryDef {
             }
             v
         });
+        BoundaryDef::from_case_in(b, c, surface)
+    }
+
+    /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
+    /// particles, see [`crate::model::Model::surface_fixes`]).
+    pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
+        self.holds_node(grid, [i, j])
+    }
+}
+
+impl<const D: usize> BoundaryDef<D> {
+    /// Whether this is the axis of an axisymmetric model.
+    pub fn is_axis(&self) -> bool {
+        self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()
+    }
+
+    /// From the case, with its moving `surface` resolved on this rank's particles (two
+    /// dimensions; a three-dimensional case has none).
+    pub fn from_case_in(b: &case::Boundary, c: &case::Case, surface: Option<Vec<(usize, Side)>>) -> BoundaryDef<D> {
         let time_fn = || {
             b.time_function
                 .as_ref()
@@ -451,12 +469,25 @@ impl BoundaryDef {
                 .map(TimeFn::from_case)
                 .unwrap_or(TimeFn::Constant(1.0))
         };
-        let gradient = b.velocity_gradient.map(|l| (l, b.center.unwrap_or([0.0; 2])));
-        let motion = match (b.displacement, b.velocity, gradient) {
-            (Some(d), _, _) => Some(Motion { is_displacement: true, vector: d, gradient: None, time_fn: time_fn() }),
-            (None, Some(v), g) => Some(Motion { is_displacement: false, vector: v, gradient: g, time_fn: time_fn() }),
+        let vector = |v: &Vec<f64>| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
+        // A velocity gradient (two dimensions only, validated) about its centre.
+        let gradient = b.velocity_gradient.map(|l| {
+            let centre = b.center.unwrap_or([0.0; 2]);
+            let at = |a: usize, e: usize| if a < 2 && e < 2 { l[a][e] } else { 0.0 };
+            (
+                std::array::from_fn(|a| std::array::from_fn(|e| at(a, e))),
+                std::array::from_fn(|d| if d < 2 { centre[d] } else { 0.0 }),
+            )
+        });
+        let motion = match (&b.displacement, &b.velocity, gradient) {
+            (Some(d), _, _) => {
+                Some(Motion { is_displacement: true, vector: vector(d), gradient: None, time_fn: time_fn() })
+            }
+            (None, Some(v), g) => {
+                Some(Motion { is_displacement: false, vector: vector(v), gradient: g, time_fn: time_fn() })
+            }
             (None, None, Some(g)) => {
-                Some(Motion { is_displacement: false, vector: [0.0; 2], gradient: Some(g), time_fn: time_fn() })
+                Some(Motion { is_displacement: false, vector: [0.0; D], gradient: Some(g), time_fn: time_fn() })
             }
             _ => None,
         };
@@ -471,18 +502,15 @@ impl BoundaryDef {
         }
     }
 
-    /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
-    /// particles, see [`crate::model::Model::surface_fixes`]).
-    pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
+    /// Whether the grid node with indices `n` belongs to it (sides and regions; surfaces are
+    /// resolved per step from the particles, see [`crate::model::Model::surface_fixes`]).
+    pub fn holds_node(&self, grid: &Grid<D>, n: [usize; D]) -> bool {
         if let Some(side) = self.side {
-            return match side {
-                Side::XMin => i == 0,
-                Side::XMax => i == grid.cells[0],
-                Side::YMin => j == 0,
-                Side::YMax => j == grid.cells[1],
-            };
+            let axis = side.axis();
+            // (A z side in a plane case is refused by validation: it holds no node.)
+            return axis < D && n[axis] == if side.sign() < 0.0 { 0 } else { grid.cells[axis] };
         }
-        self.region.is_some_and(|r| r.holds_node(grid.node_position(i, j), grid.h))
+        self.region.is_some_and(|r| r.holds_node_in(grid.position(n), grid.h))
     }
 }
 
@@ -554,7 +582,7 @@ mod tests {
     #[test]
     fn tributary_lengths_sum_to_the_loaded_line() {
         let g = Grid::new([0.0, 0.0], [0.25, 0.25], [8, 4]);
-        let nodes = tributary_nodes(&g, &Region { min: [0.0, 1.0], max: [0.5, 1.0] });
+        let nodes = tributary_nodes(&g, &Region { min: [0.0, 1.0], max: [0.5, 1.0], z: None });
         assert_eq!(nodes.len(), 3);
         let total: f64 = nodes.iter().map(|n| n.2).sum();
         assert!((total - 0.5).abs() < 1e-12);

@@ -44,7 +44,7 @@ pub struct Model<const D: usize = 2> {
     /// Loads, in case order.
     pub loads: Vec<LoadDef>,
     /// Dirichlet conditions, in case order.
-    pub boundaries: Vec<BoundaryDef>,
+    pub boundaries: Vec<BoundaryDef<D>>,
     /// g in Darcy's law [m/s²].
     pub g: f64,
     /// How the current stage treats time (set by the driver at the start of each stage).
@@ -109,13 +109,24 @@ pub fn grid_of<const D: usize>(case: &Case) -> Grid<D> {
 
 /// Position of a dof component in a node's interlaced dofs (ux, uy, p, Ux, Uy).
 pub fn dof_index(d: crate::case::Dof) -> usize {
-    match d {
-        crate::case::Dof::Ux => 0,
-        crate::case::Dof::Uy => 1,
-        crate::case::Dof::P => 2,
-        crate::case::Dof::WUx => 3,
-        crate::case::Dof::WUy => 4,
-    }
+    dof_index_in::<2>(d).unwrap_or(usize::MAX)
+}
+
+/// Position of a dof component in the full two-phase order of dimension `D` (ux, uy, [uz,] p, Ux,
+/// Uy[, Uz]: `Layout::UPU.in_dim(D)`, the order in which boundaries name what they fix); `None`
+/// for a z component in two dimensions.
+pub fn dof_index_in<const D: usize>(d: crate::case::Dof) -> Option<usize> {
+    use crate::case::Dof;
+    Some(match d {
+        Dof::Ux => 0,
+        Dof::Uy => 1,
+        Dof::Uz if D == 3 => 2,
+        Dof::P => D,
+        Dof::WUx => D + 1,
+        Dof::WUy => D + 2,
+        Dof::WUz if D == 3 => D + 3,
+        Dof::Uz | Dof::WUz => return None,
+    })
 }
 
 /// Patch recovery in two-phase analyses when the case does not say. Off, because on the
@@ -186,41 +197,6 @@ impl Model {
         field_names(self.two_phase)
     }
 
-    /// Loads and boundaries active in a stage (all when the stage does not list them).
-    pub fn active(&self, stage: &crate::case::Stage) -> Active {
-        let pick = |names: &Option<Vec<String>>, all: Vec<&str>| -> Vec<usize> {
-            match names {
-                None => (0..all.len()).collect(),
-                Some(ns) => (0..all.len()).filter(|&i| ns.iter().any(|n| n == all[i])).collect(),
-            }
-        };
-        let mut boundaries = pick(&stage.boundaries, self.boundaries.iter().map(|b| b.name.as_str()).collect());
-        // The axis holds in every stage.
-        if let Some(axis) = self.boundaries.iter().position(|b| b.is_axis()) {
-            if !boundaries.contains(&axis) {
-                boundaries.push(axis);
-            }
-        }
-        Active { loads: pick(&stage.loads, self.loads.iter().map(|l| l.name.as_str()).collect()), boundaries }
-    }
-
-    /// For each dof component (ux, uy, p, Ux, Uy) at node (i, j), the first active side or region
-    /// boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are in
-    /// [`Model::surface_fixes`].
-    pub fn fixing_boundaries(&self, active: &Active, i: usize, j: usize) -> [Option<usize>; 5] {
-        let mut by = [None; 5];
-        for &bi in &active.boundaries {
-            let b = &self.boundaries[bi];
-            if b.surface.is_none() && b.contains(&self.grid, i, j) {
-                for d in &b.fix {
-                    let c = dof_index(*d);
-                    by[c] = by[c].or(Some(bi));
-                }
-            }
-        }
-        by
-    }
-
     /// The nodes fixed by the active moving-surface boundaries on the current configuration, with
     /// the boundary's index and the components fixed there. For each surface particle the exposed
     /// face's outward normal turns with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson), and among the
@@ -242,8 +218,8 @@ impl Model {
             let b = &self.boundaries[bi];
             let Some(list) = &b.surface else { continue };
             let mut comps = [false; 5];
-            for d in &b.fix {
-                comps[dof_index(*d)] = true;
+            for c in b.fix.iter().filter_map(|d| dof_index_in::<2>(*d)) {
+                comps[c] = true;
             }
             comps[dof_index(crate::case::Dof::P)] &= !weak_drainage;
             for &(k, face) in list {
@@ -280,12 +256,8 @@ impl Model {
     /// the reference normal n₀ turned with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson).
     pub fn face_normal(&self, k: usize, face: Side) -> [f64; 2] {
         let f = self.particles.def_grad[k];
-        let n0 = match face {
-            Side::XMin => [-1.0, 0.0],
-            Side::XMax => [1.0, 0.0],
-            Side::YMin => [0.0, -1.0],
-            Side::YMax => [0.0, 1.0],
-        };
+        // (A z face has no normal in the plane: validation keeps it out of plane cases.)
+        let n0: [f64; 2] = std::array::from_fn(|d| if d == face.axis() { face.sign() } else { 0.0 });
         // F⁻ᵀ n₀ up to the factor 1/det F.
         let m = crate::kernels::kinematics::cofactor_mul(&f, n0);
         let len = m[0].hypot(m[1]);
@@ -334,11 +306,13 @@ impl Model {
 
 impl Model<3> {
     /// Builds the model of a three-dimensional `case`, generating particles only in the cells
-    /// `owned(cell)` (no loads or boundaries: a three-dimensional case has none yet).
+    /// `owned(cell)` (its side and region boundaries; no loads: a three-dimensional case has none
+    /// yet).
     pub fn build_solid(case: &Case, owned: impl Fn([usize; 3]) -> bool) -> Model<3> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
-        Model::bare(case, grid, particles)
+        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case_in(b, case, None)).collect();
+        Model { boundaries, ..Model::bare(case, grid, particles) }
     }
 }
 
@@ -353,6 +327,41 @@ pub(crate) fn index_text<const D: usize>(n: &[usize; D]) -> String {
 }
 
 impl<const D: usize> Model<D> {
+    /// For each dof component at the grid node with indices `n`, in the full two-phase order of
+    /// the dimension (ux, uy, [uz,] p, Ux, Uy[, Uz]; [`dof_index_in`]), the first active side or
+    /// region boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are
+    /// in [`Model::surface_fixes`].
+    pub fn fixing_boundaries(&self, active: &Active, n: [usize; D]) -> [Option<usize>; crate::kernels::MAX_DOF_3D] {
+        let mut by = [None; crate::kernels::MAX_DOF_3D];
+        for &bi in &active.boundaries {
+            let b = &self.boundaries[bi];
+            if b.surface.is_none() && b.holds_node(&self.grid, n) {
+                for c in b.fix.iter().filter_map(|d| dof_index_in::<D>(*d)) {
+                    by[c] = by[c].or(Some(bi));
+                }
+            }
+        }
+        by
+    }
+
+    /// Loads and boundaries active in a stage (all when the stage does not list them).
+    pub fn active(&self, stage: &crate::case::Stage) -> Active {
+        let pick = |names: &Option<Vec<String>>, all: Vec<&str>| -> Vec<usize> {
+            match names {
+                None => (0..all.len()).collect(),
+                Some(ns) => (0..all.len()).filter(|&i| ns.iter().any(|n| n == all[i])).collect(),
+            }
+        };
+        let mut boundaries = pick(&stage.boundaries, self.boundaries.iter().map(|b| b.name.as_str()).collect());
+        // The axis holds in every stage.
+        if let Some(axis) = self.boundaries.iter().position(|b| b.is_axis()) {
+            if !boundaries.contains(&axis) {
+                boundaries.push(axis);
+            }
+        }
+        Active { loads: pick(&stage.loads, self.loads.iter().map(|l| l.name.as_str()).collect()), boundaries }
+    }
+
     /// The model of `case` on `grid` with `particles`, without loads or boundaries.
     fn bare(case: &Case, grid: Grid<D>, particles: Particles<D>) -> Model<D> {
         Model {

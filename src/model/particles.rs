@@ -394,8 +394,26 @@ mod tests {
         );
         let cases = [
             (
-                solid.clone() + "[[boundaries]]\nname = \"base\"\nside = \"y_min\"\nfix = [\"ux\", \"uy\"]\n",
-                "key `boundaries`: not available in a three-dimensional case yet",
+                solid.clone()
+                    + "[[boundaries]]\nname = \"top\"\nsurface = { body = \"column\", faces = [\"y_max\"] }\nfix = [\"p\"]\n",
+                "key `boundaries[0].surface`: not available in a three-dimensional case yet",
+            ),
+            (
+                solid.clone() + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\", \"uy\"]\ndisplacement = [0.0, -0.1]\n",
+                "key `boundaries[0].displacement`: 3 components in a case of 3 dimensions, got 2",
+            ),
+            (
+                base.to_string() + "[[boundaries]]\nname = \"back\"\nside = \"z_min\"\nfix = [\"ux\"]\n",
+                "key `boundaries[0].side`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) belongs to \
+                 three-dimensional cases only",
+            ),
+            (
+                base.to_string() + "[[boundaries]]\nname = \"base\"\nside = \"y_min\"\nfix = [\"uz\"]\n",
+                "key `boundaries[0].fix`: z",
+            ),
+            (
+                solid.clone() + "[[loads]]\nname = \"g\"\nkind = \"body_force\"\nacceleration = [0.0, -9.81]\n",
+                "key `loads`: not available in a three-dimensional case yet",
             ),
             (base.replace("cells = [1, 10]", "cells = [1, 10, 2]"), "key `grid.cells`: 2 entries"),
             (base.replace("size = [0.1, 1.0]", "size = [0.1, 1.0, 1.0, 1.0]"), "key `grid.size`: two entries"),
@@ -414,5 +432,44 @@ mod tests {
         }
         assert!(case::parse(&solid, "t", &[]).is_ok());
         assert!(crate::driver::runnable(&case::parse(&solid, "t", &[]).unwrap()).is_err());
+    }
+
+    /// A three-dimensional case's side and region boundaries: each grid node is fixed by the first
+    /// boundary (in case order) that holds it and fixes the component (ux, uy, uz, p, Ux, Uy, Uz),
+    /// a region's z range bounds it along z, and a moving boundary's three components move.
+    #[test]
+    fn three_dimensional_boundaries_fix_their_nodes() {
+        let text = crate::case::tests_support::MINIMAL.replace(
+            "size = [0.1, 1.0]\n        cells = [1, 10]",
+            "size = [0.2, 1.0, 0.3]\n        cells = [2, 10, 3]",
+        ) + r#"
+            [[boundaries]]
+            name = "base"
+            side = "y_min"
+            fix = ["ux", "uy", "uz"]
+            [[boundaries]]
+            name = "back"
+            side = "z_min"
+            fix = ["uz", "Uz"]
+            [[boundaries]]
+            name = "top"
+            region = { min = [0.0, 1.0], max = [0.1, 1.0], z = [0.1, 0.2] }
+            fix = ["ux", "uy", "uz", "p"]
+            displacement = [0.001, -0.01, 0.002]
+        "#;
+        let c = case::parse(&text, "t", &[]).unwrap();
+        let m = crate::model::Model::build_solid(&c, |_| true);
+        let active = m.active(&c.stages[0]);
+        // The full order of three dimensions: ux, uy, uz, p, Ux, Uy, Uz.
+        assert_eq!(m.fixing_boundaries(&active, [1, 0, 0]), [Some(0), Some(0), Some(0), None, None, None, Some(1)]);
+        assert_eq!(m.fixing_boundaries(&active, [1, 4, 0]), [None, None, Some(1), None, None, None, Some(1)]);
+        assert_eq!(m.fixing_boundaries(&active, [1, 10, 2]), [Some(2), Some(2), Some(2), Some(2), None, None, None]);
+        // Outside the region's z range, or beyond its x extent.
+        assert_eq!(m.fixing_boundaries(&active, [1, 10, 3]), [None; 7]);
+        assert_eq!(m.fixing_boundaries(&active, [2, 10, 1]), [None; 7]);
+        let motion = m.boundaries[2].motion.as_ref().unwrap();
+        assert_eq!(motion.displacement_at(0.05), [0.001, -0.01, 0.002]);
+        assert_eq!(crate::kernels::Layout::UPU.in_dim(3).canonical(6), Some(6));
+        assert_eq!(crate::kernels::Layout::UP.in_dim(3).canonical(3), Some(3));
     }
 }
