@@ -57,15 +57,16 @@ pub fn carries_unknown(layout: Layout, c: usize, fill: f64, well_fraction: f64) 
 }
 
 /// Builds the dof map from the filled fractions `phi` (per ghosted node, summed over ranks) and the
-/// moving-surface fixes `surface` (per ghosted dof, the boundary index + 1 or 0, maximum over ranks).
+/// moving-surface fixes `surface` (per ghosted dof, the boundary index + 1 or 0, maximum over ranks),
+/// in any dimension.
 #[allow(clippy::too_many_arguments)]
-pub fn build(
-    model: &Model,
+pub fn build<const D: usize>(
+    model: &Model<D>,
     active: &Active,
     (t0, t1): (f64, f64),
-    ghost: &GhostedRange,
-    owned_start: [usize; 2],
-    owned_count: [usize; 2],
+    ghost: &GhostedRange<D>,
+    owned_start: [usize; D],
+    owned_count: [usize; D],
     nd: usize,
     phi: &[f64],
     surface: &[f64],
@@ -83,8 +84,8 @@ pub fn build(
         free_dofs: 0,
     };
     for (l, reached) in phi.iter().enumerate() {
-        let (i, j) = ghost.ij(l);
-        let by = model.fixing_boundaries(active, [i, j]);
+        let node = ghost.indices(l);
+        let by = model.fixing_boundaries(active, node);
         for c in 0..nd {
             let (q, by_c) = (l * nd + c, layout.canonical(c).and_then(|k| by[k]));
             let b = by_c.or_else(|| (surface[q] > 0.5).then(|| surface[q].round() as usize - 1));
@@ -92,27 +93,84 @@ pub fn build(
                 m.boundary[q] = b as u16;
                 // A moving boundary: its solid components and the water's move by its increment.
                 if let Some(motion) = &model.boundaries[b].motion {
-                    let dir = if c < 2 { Some(c) } else { layout.w.and_then(|w| (c >= w).then(|| c - w)) };
-                    if let Some(d) = dir.filter(|&d| d < 2) {
-                        m.value[q] = motion.increment_at(model.grid.node_position(i, j), t0, t1)[d];
+                    let dir = if c < D { Some(c) } else { layout.w.and_then(|w| (c >= w).then(|| c - w)) };
+                    if let Some(d) = dir.filter(|&d| d < D) {
+                        m.value[q] = motion.increment_at(model.grid.position(node), t0, t1)[d];
                     }
                 }
             }
             m.fixed[q] = b.is_some() || !carries_unknown(layout, c, *reached, well_fraction);
         }
     }
-    for jj in 0..owned_count[1] {
-        for ii in 0..owned_count[0] {
-            let l = ghost.node(owned_start[0] + ii, owned_start[1] + jj).expect("owned nodes are ghosted");
-            for c in 0..nd {
-                let o = (jj * owned_count[0] + ii) * nd + c;
-                if m.fixed[l * nd + c] {
-                    m.owned_fixed.push((o, l * nd + c));
-                } else {
-                    m.free_dofs += 1;
-                }
+    // The owned nodes, x fastest, and their place in the owned part of global vectors.
+    let owned: usize = owned_count.iter().product();
+    let mut at = [0usize; D];
+    for node in 0..owned {
+        let l = ghost.local(std::array::from_fn(|d| owned_start[d] + at[d])).expect("owned nodes are ghosted");
+        for c in 0..nd {
+            let o = node * nd + c;
+            if m.fixed[l * nd + c] {
+                m.owned_fixed.push((o, l * nd + c));
+            } else {
+                m.free_dofs += 1;
             }
         }
+        crate::model::shape::next_combination(&mut at, owned_count);
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dof map of a three-dimensional u–p step: the base fixes ux, uy, uz, the back wall uz, a
+    /// moving region at the top ux, uy, uz and p with its step's increment; a barely filled node's
+    /// dofs are fixed; the owned part lists every fixed dof and counts the rest.
+    #[test]
+    fn a_three_dimensional_dof_map_fixes_and_moves_its_boundaries() {
+        let text = crate::case::tests_support::MINIMAL.replace(
+            "size = [0.1, 1.0]\n        cells = [1, 10]",
+            "size = [0.2, 1.0, 0.3]\n        cells = [2, 10, 3]",
+        ) + r#"
+            [[boundaries]]
+            name = "base"
+            side = "y_min"
+            fix = ["ux", "uy", "uz"]
+            [[boundaries]]
+            name = "back"
+            side = "z_min"
+            fix = ["uz"]
+            [[boundaries]]
+            name = "top"
+            region = { min = [0.0, 1.0], max = [0.1, 1.0], z = [0.1, 0.2] }
+            fix = ["ux", "uy", "uz", "p"]
+            velocity = [0.0, -0.01, 0.002]
+        "#;
+        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let m = Model::build_solid(&c, |_| true);
+        let active = m.active(&c.stages[0]);
+        let nodes = m.grid.nodes();
+        let ghost = GhostedRange { start: [0; 3], count: nodes, dof: 4 };
+        let layout = Layout::UP.in_dim(3);
+        let nd = layout.nd;
+        let n = ghost.len();
+        // Every node well filled but one.
+        let lonely = ghost.local([2, 5, 3]).unwrap();
+        let phi: Vec<f64> = (0..n).map(|l| if l == lonely { 0.1 } else { 1.0 }).collect();
+        let map = build(&m, &active, (0.0, 0.5), &ghost, [0; 3], nodes, nd, &phi, &vec![0.0; n * nd], 0.5, layout);
+        let base = (nodes[0] * nodes[2]) * 3;
+        let back = nodes[0] * nodes[1] - nodes[0];
+        // The top region: x ∈ {0, 0.1}, z ∈ {0.1, 0.2} at y = 1: four nodes, four components each.
+        let top = 4 * 4;
+        let fixed = map.fixed.iter().filter(|&&f| f).count();
+        assert_eq!(fixed, base + back + top + nd, "base {base}, back {back}, top {top}, the lonely node");
+        let q = ghost.local([1, 10, 2]).unwrap() * nd;
+        assert_eq!(&map.value[q..q + 4], &[0.0, -0.005, 0.001, 0.0]);
+        assert_eq!(map.boundary[q + 3], 2);
+        assert!(map.boundary_fixed(ghost.local([0, 0, 1]).unwrap(), 2));
+        assert!(map.fixed[lonely * nd..lonely * nd + nd].iter().all(|&f| f));
+        assert_eq!(map.owned_fixed.len(), fixed);
+        assert_eq!(map.free_dofs, n * nd - fixed);
+    }
 }
