@@ -337,10 +337,7 @@ mod tests {
     /// and volumes, and that it cannot be run yet.
     #[test]
     fn a_three_dimensional_case_is_described() {
-        let text = crate::case::tests_support::MINIMAL.replace(
-            "size = [0.1, 1.0]\n        cells = [1, 10]",
-            "size = [0.1, 1.0, 0.2]\n        cells = [1, 10, 2]",
-        );
+        let text = crate::case::tests_support::with_grid("[0.1, 1.0, 0.2]", "[1, 10, 2]");
         let c = crate::case::parse(&text, "t", &[]).unwrap();
         let d = super::describe(&c, "column_3d.toml");
         for want in [

@@ -38,7 +38,8 @@ const fn record_len<const D: usize>() -> usize {
     15 + 3 * D
 }
 
-/// A record's D-vector at `at` as three components (z = 0 in two dimensions).
+/// A record's D-vector at `at` as three components (z = 0 in two dimensions): a particle record's
+/// or a grid node's.
 fn vec3<const D: usize>(r: &[f64], at: usize) -> [f64; 3] {
     std::array::from_fn(|c| if c < D { r[at + c] } else { 0.0 })
 }
@@ -114,16 +115,19 @@ pub fn particle_fields<const D: usize>(model: &Model<D>, coll: &Collective) -> (
 /// [`crate::assembly::GridSystem::owned_node_block`].
 pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Frame {
     let (pf, particles, first_particle) = particle_fields(model, coll);
-    let vec3 = |v: &mut dyn Iterator<Item = [f64; 2]>| -> Vec<f64> { v.flat_map(|a| [a[0], a[1], 0.0]).collect() };
     let d: Vec<&[f64]> = nodes.values.chunks_exact(NODE_VALUES).collect();
     let active = d.iter().map(|v| (v[0] > 0.5) as i32).collect();
     let mut gf = vec![
         Field { name: "active", components: 1, values: Values::Int(active) },
-        Field { name: "du", components: 3, values: Values::Real(vec3(&mut d.iter().map(|v| [v[1], v[2]]))) },
+        Field { name: "du", components: 3, values: Values::Real(d.iter().flat_map(|v| vec3::<2>(v, 1)).collect()) },
     ];
     if model.two_phase {
         gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[3]).collect()) });
-        gf.push(Field { name: "dU", components: 3, values: Values::Real(vec3(&mut d.iter().map(|v| [v[4], v[5]]))) });
+        gf.push(Field {
+            name: "dU",
+            components: 3,
+            values: Values::Real(d.iter().flat_map(|v| vec3::<2>(v, 4)).collect()),
+        });
     }
     gf.push(Field { name: "K_mag", components: 1, values: Values::Real(d.iter().map(|v| v[6]).collect()) });
     gf.push(Field { name: "Fint_mag", components: 1, values: Values::Real(d.iter().map(|v| v[7]).collect()) });
@@ -146,10 +150,7 @@ mod tests {
     #[test]
     fn a_three_dimensional_model_writes_its_third_components() {
         let (_lock, _world) = crate::io::test_world();
-        let text = crate::case::tests_support::MINIMAL.replace(
-            "size = [0.1, 1.0]\n        cells = [1, 10]",
-            "size = [0.1, 1.0, 0.2]\n        cells = [1, 10, 2]",
-        );
+        let text = crate::case::tests_support::with_grid("[0.1, 1.0, 0.2]", "[1, 10, 2]");
         let c = crate::case::parse(&text, "t", &[]).unwrap();
         let mut m = Model::build_solid(&c, |_| true);
         let s = [-1.0e3, -2.0e3, 150.0, -1.2e3, 80.0, -120.0];

@@ -129,24 +129,7 @@ mod tests {
     /// dofs are fixed; the owned part lists every fixed dof and counts the rest.
     #[test]
     fn a_three_dimensional_dof_map_fixes_and_moves_its_boundaries() {
-        let text = crate::case::tests_support::MINIMAL.replace(
-            "size = [0.1, 1.0]\n        cells = [1, 10]",
-            "size = [0.2, 1.0, 0.3]\n        cells = [2, 10, 3]",
-        ) + r#"
-            [[boundaries]]
-            name = "base"
-            side = "y_min"
-            fix = ["ux", "uy", "uz"]
-            [[boundaries]]
-            name = "back"
-            side = "z_min"
-            fix = ["uz"]
-            [[boundaries]]
-            name = "top"
-            region = { min = [0.0, 1.0], max = [0.1, 1.0], z = [0.1, 0.2] }
-            fix = ["ux", "uy", "uz", "p"]
-            velocity = [0.0, -0.01, 0.002]
-        "#;
+        let text = crate::case::tests_support::solid_with_boundaries(r#"["uz"]"#, "velocity = [0.0, -0.01, 0.002]");
         let c = crate::case::parse(&text, "t", &[]).unwrap();
         let m = Model::build_solid(&c, |_| true);
         let active = m.active(&c.stages[0]);

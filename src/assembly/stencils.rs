@@ -647,8 +647,7 @@ mod tests {
     /// sides.
     #[test]
     fn three_dimensional_stencils_reproduce_linear_fields() {
-        let text = crate::case::tests_support::MINIMAL
-            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [0.4, 1.0, 0.3]\n        cells = [4, 10, 3]")
+        let text = crate::case::tests_support::with_grid("[0.4, 1.0, 0.3]", "[4, 10, 3]")
             .replace(
                 "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
                 "shape = { polygon = { vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.75], [0.0, 1.0]] } }\n        z = [0.0, 0.2]",

@@ -326,6 +326,38 @@ pub(crate) mod tests_support {
         duration = 0.1
         dt = 1e-3
     "#;
+
+    /// [`MINIMAL`] on a grid of `size` [m] and `cells` (TOML arrays: two entries, or three for a
+    /// three-dimensional case).
+    pub fn with_grid(size: &str, cells: &str) -> String {
+        MINIMAL
+            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", &format!("size = {size}\n        cells = {cells}"))
+    }
+
+    /// [`MINIMAL`] in three dimensions (0.2 × 1.0 × 0.3 m, 2 × 10 × 3 cells) with a base on
+    /// `y_min` fixing ux, uy and uz, a back wall on `z_min` fixing the components `back_fix`, and
+    /// a region at the top (x ∈ [0, 0.1], z ∈ [0.1, 0.2]) fixing ux, uy, uz and p that moves as
+    /// `motion` says (a `displacement` or `velocity` key).
+    pub fn solid_with_boundaries(back_fix: &str, motion: &str) -> String {
+        with_grid("[0.2, 1.0, 0.3]", "[2, 10, 3]")
+            + &format!(
+                r#"
+            [[boundaries]]
+            name = "base"
+            side = "y_min"
+            fix = ["ux", "uy", "uz"]
+            [[boundaries]]
+            name = "back"
+            side = "z_min"
+            fix = {back_fix}
+            [[boundaries]]
+            name = "top"
+            region = {{ min = [0.0, 1.0], max = [0.1, 1.0], z = [0.1, 0.2] }}
+            fix = ["ux", "uy", "uz", "p"]
+            {motion}
+        "#
+            )
+    }
 }
 
 #[cfg(test)]

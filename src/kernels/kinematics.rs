@@ -105,7 +105,7 @@ pub fn cofactor_mul<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
 }
 
 /// aᵀ v.
-fn mul_t<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
+pub(crate) fn mul_t<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
     std::array::from_fn(|j| (1..D).fold(a[0][j] * v[0], |s, k| s + a[k][j] * v[k]))
 }
 

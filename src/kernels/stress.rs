@@ -37,10 +37,10 @@ fn split<const D: usize>(s: &Stress) -> (Mat<D>, f64) {
     (std::array::from_fn(|i| std::array::from_fn(|j| if i == j { t[i][j] - pm } else { t[i][j] })), pm)
 }
 
-/// dev σ v.
+/// dev σ v (dev σ is symmetric: its transpose's product).
 #[inline]
 fn dev_times<const D: usize>(dev: &Mat<D>, v: [f64; D]) -> [f64; D] {
-    std::array::from_fn(|c| (1..D).fold(dev[c][0] * v[0], |s, d| s + dev[c][d] * v[d]))
+    kinematics::mul_t(dev, v)
 }
 
 /// The force of stress `s` on a node with gradients (g, gv) on x_{n+1}, per unit volume.

@@ -466,6 +466,41 @@ fn the_plastic_sample_really_returns() {
     assert!(pt.kin.theta.abs() > 1e-4, "the sample must rotate: θ = {}", pt.kin.theta);
 }
 
+/// Flips the sign of each non-zero (row field, column field) block of the tangent `t` (nodes of
+/// `nd` dofs) in turn and asserts that the central differences of `res` at `d0` catch it, naming
+/// the term by `what`; returns the number of blocks flipped.
+fn flip_every_block(
+    nd: usize,
+    d0: &[f64],
+    layout: Layout,
+    res: &dyn Fn(&[f64]) -> Vec<f64>,
+    t: &[f64],
+    what: &str,
+) -> usize {
+    let m = d0.len();
+    let mut flipped = 0;
+    for a in 0..nd {
+        for b in 0..nd {
+            let mut wrong = t.to_vec();
+            let mut any = false;
+            for r in (0..m).filter(|r| r % nd == a) {
+                for c in (0..m).filter(|c| c % nd == b) {
+                    any |= wrong[r * m + c] != 0.0;
+                    wrong[r * m + c] = -wrong[r * m + c];
+                }
+            }
+            if !any {
+                continue;
+            }
+            flipped += 1;
+            let blocks = fd_blocks(nd, d0, &steps(layout), res, &wrong);
+            let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
+            assert!(caught, "{what}: a flipped {a}–{b} block passed");
+        }
+    }
+    flipped
+}
+
 /// The check is not blind: a wrong sign in any non-zero block of any term, however small its
 /// entries against the rest of the tangent (p–p ≈ 1e-13, u–u ≈ 1e5 here), fails it.
 #[test]
@@ -492,25 +527,8 @@ fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
         let pt = Point::<2>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
         let mut t = vec![0.0; m * m];
         (term.2)(&pt, &nm, &mut t);
-        for a in 0..nd {
-            for b in 0..nd {
-                let mut wrong = t.clone();
-                let mut any = false;
-                for r in (0..m).filter(|r| r % nd == a) {
-                    for c in (0..m).filter(|c| c % nd == b) {
-                        any |= wrong[r * m + c] != 0.0;
-                        wrong[r * m + c] = -wrong[r * m + c];
-                    }
-                }
-                if !any {
-                    continue;
-                }
-                flipped_blocks += 1;
-                let blocks = fd_blocks(nd, &d0, &steps(layout), &res, &wrong);
-                let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
-                assert!(caught, "{} (nd = {nd}, axisymmetric {hoop}): a flipped {a}–{b} block passed", term.0);
-            }
-        }
+        let what = format!("{} (nd = {nd}, axisymmetric {hoop})", term.0);
+        flipped_blocks += flip_every_block(nd, &d0, layout, &res, &t, &what);
     }
     assert!(flipped_blocks > 120, "only {flipped_blocks} blocks were flipped");
 }
@@ -881,25 +899,7 @@ fn a_wrong_sign_in_any_block_is_caught_in_three_dimensions() {
             let pt = Point::<3, { three::M3 }>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
             let mut t = vec![0.0; m * m];
             (term.2)(&pt, &nm, &mut t);
-            for a in 0..nd {
-                for b in 0..nd {
-                    let mut wrong = t.clone();
-                    let mut any = false;
-                    for r in (0..m).filter(|r| r % nd == a) {
-                        for c in (0..m).filter(|c| c % nd == b) {
-                            any |= wrong[r * m + c] != 0.0;
-                            wrong[r * m + c] = -wrong[r * m + c];
-                        }
-                    }
-                    if !any {
-                        continue;
-                    }
-                    flipped_blocks += 1;
-                    let blocks = fd_blocks(nd, &d0, &steps(layout), &res, &wrong);
-                    let caught = blocks.iter().find(|e| e.row == a && e.col == b).is_some_and(|e| !e.pass());
-                    assert!(caught, "{} ({sname}): a flipped {a}–{b} block passed", term.0);
-                }
-            }
+            flipped_blocks += flip_every_block(nd, &d0, layout, &res, &t, &format!("{} ({sname})", term.0));
         }
     }
     assert!(flipped_blocks > 130, "only {flipped_blocks} blocks were flipped");

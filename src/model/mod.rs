@@ -107,11 +107,6 @@ pub fn grid_of<const D: usize>(case: &Case) -> Grid<D> {
     Grid::new(case.origin_in(), case.cell_size_in(), case.cells_in())
 }
 
-/// Position of a dof component in a node's interlaced dofs (ux, uy, p, Ux, Uy).
-pub fn dof_index(d: crate::case::Dof) -> usize {
-    dof_index_in::<2>(d).unwrap_or(usize::MAX)
-}
-
 /// Position of a dof component in the full two-phase order of dimension `D` (ux, uy, [uz,] p, Ux,
 /// Uy[, Uz]: `Layout::UPU.in_dim(D)`, the order in which boundaries name what they fix); `None`
 /// for a z component in two dimensions.
@@ -221,7 +216,7 @@ impl Model {
             for c in b.fix.iter().filter_map(|d| dof_index_in::<2>(*d)) {
                 comps[c] = true;
             }
-            comps[dof_index(crate::case::Dof::P)] &= !weak_drainage;
+            comps[crate::kernels::dof::P] &= !weak_drainage;
             for &(k, face) in list {
                 let (x, lp) = (self.particles.x[k], self.particles.lp[k]);
                 let n = self.face_normal(k, face);

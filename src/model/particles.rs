@@ -153,12 +153,10 @@ impl<const D: usize> Particles<D> {
             let c1 = grid.cell_containing(hi).unwrap_or(grid.cells.map(|c| c - 1));
             let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
             let volume = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
-            let (mut cell, counts) = (c0, std::array::from_fn(|d| c1[d] - c0[d] + 1));
+            let counts = std::array::from_fn(|d| c1[d] - c0[d] + 1);
             let mut offset = [0; D];
             loop {
-                for d in 0..D {
-                    cell[d] = c0[d] + offset[d];
-                }
+                let cell: [usize; D] = std::array::from_fn(|d| c0[d] + offset[d]);
                 let mut sub = [0usize; D];
                 loop {
                     // Global id from the body and the sub-cell position: unique and independent of
@@ -330,8 +328,7 @@ mod tests {
     /// A three-dimensional variant of the case tests' column: a 0.4 × 1.0 × 0.3 m grid of
     /// 4 × 10 × 3 cells, a body over z ∈ [0, 0.2] and a second one over the whole grid, behind it.
     fn solid_case(extra: &str) -> Case {
-        let text = crate::case::tests_support::MINIMAL
-            .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [0.4, 1.0, 0.3]\n        cells = [4, 10, 3]")
+        let text = crate::case::tests_support::with_grid("[0.4, 1.0, 0.3]", "[4, 10, 3]")
             .replace(
                 "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
                 &format!(
@@ -388,10 +385,7 @@ mod tests {
     #[test]
     fn three_dimensional_cases_refuse_what_they_cannot_have_yet() {
         let base = crate::case::tests_support::MINIMAL;
-        let solid = base.replace(
-            "size = [0.1, 1.0]\n        cells = [1, 10]",
-            "size = [0.1, 1.0, 0.1]\n        cells = [1, 10, 1]",
-        );
+        let solid = crate::case::tests_support::with_grid("[0.1, 1.0, 0.1]", "[1, 10, 1]");
         let cases = [
             (
                 solid.clone()
@@ -439,24 +433,10 @@ mod tests {
     /// a region's z range bounds it along z, and a moving boundary's three components move.
     #[test]
     fn three_dimensional_boundaries_fix_their_nodes() {
-        let text = crate::case::tests_support::MINIMAL.replace(
-            "size = [0.1, 1.0]\n        cells = [1, 10]",
-            "size = [0.2, 1.0, 0.3]\n        cells = [2, 10, 3]",
-        ) + r#"
-            [[boundaries]]
-            name = "base"
-            side = "y_min"
-            fix = ["ux", "uy", "uz"]
-            [[boundaries]]
-            name = "back"
-            side = "z_min"
-            fix = ["uz", "Uz"]
-            [[boundaries]]
-            name = "top"
-            region = { min = [0.0, 1.0], max = [0.1, 1.0], z = [0.1, 0.2] }
-            fix = ["ux", "uy", "uz", "p"]
-            displacement = [0.001, -0.01, 0.002]
-        "#;
+        let text = crate::case::tests_support::solid_with_boundaries(
+            r#"["uz", "Uz"]"#,
+            "displacement = [0.001, -0.01, 0.002]",
+        );
         let c = case::parse(&text, "t", &[]).unwrap();
         let m = crate::model::Model::build_solid(&c, |_| true);
         let active = m.active(&c.stages[0]);
