@@ -31,55 +31,74 @@ pub const DEFAULT_BALANCE_THRESHOLD: f64 = 1.2;
 /// could not, the next attempt waits until the imbalance has grown by this factor.
 pub const BALANCE_GAIN: f64 = 1.1;
 
-/// The distribution of the grid's cells over ranks.
+/// The distribution of the grid's cells over ranks (two-dimensional unless `D` says otherwise).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Owners {
-    /// First node column of each slab along x, and one past the last (length m + 1).
-    x: Vec<usize>,
-    /// First node row of each slab along y, and one past the last (length n + 1).
-    y: Vec<usize>,
+pub struct Owners<const D: usize = 2> {
+    /// Along each direction, the first node layer of each slab and one past the last (length
+    /// slabs + 1).
+    starts: [Vec<usize>; D],
 }
 
-impl Owners {
-    /// From the number of node columns and rows each slab owns (`DMDAGetOwnershipRanges`).
-    pub fn new(counts_x: &[usize], counts_y: &[usize]) -> Owners {
-        let starts = |c: &[usize]| {
+impl<const D: usize> Owners<D> {
+    /// From the number of node layers each slab owns along each direction
+    /// (`DMDAGetOwnershipRanges`).
+    pub fn from_counts(counts: [&[usize]; D]) -> Owners<D> {
+        let starts = counts.map(|c| {
             let mut v = vec![0];
             for &n in c {
                 v.push(v.last().copied().unwrap_or(0) + n);
             }
             v
-        };
-        Owners { x: starts(counts_x), y: starts(counts_y) }
+        });
+        Owners { starts }
     }
 
-    /// The number of node columns and rows of each slab (the inverse of [`Owners::new`]).
-    pub fn counts(&self) -> (Vec<usize>, Vec<usize>) {
-        let c = |s: &[usize]| s.windows(2).map(|w| w[1] - w[0]).collect();
-        (c(&self.x), c(&self.y))
+    /// The number of node layers of each slab along each direction (the inverse of
+    /// [`Owners::from_counts`]).
+    pub fn counts_in(&self) -> [Vec<usize>; D] {
+        std::array::from_fn(|d| self.starts[d].windows(2).map(|w| w[1] - w[0]).collect())
     }
 
     /// One rank owning everything.
-    pub fn single(nodes: [usize; 2]) -> Owners {
-        Owners::new(&[nodes[0]], &[nodes[1]])
+    pub fn single(nodes: [usize; D]) -> Owners<D> {
+        let counts = nodes.map(|n| vec![n]);
+        Owners::from_counts(std::array::from_fn(|d| &counts[d][..]))
     }
 
     /// Number of ranks.
     pub fn ranks(&self) -> usize {
-        (self.x.len() - 1) * (self.y.len() - 1)
+        self.starts.iter().map(|s| s.len() - 1).product()
     }
 
-    /// The rank owning cell (i, j).
-    pub fn rank_of_cell(&self, i: usize, j: usize) -> usize {
+    /// The rank owning the cell with indices `c` (PETSc's ordering: x fastest, then y, then z).
+    pub fn rank_of_cell_in(&self, c: [usize; D]) -> usize {
         let slab = |s: &[usize], k: usize| s[1..].partition_point(|&end| end <= k).min(s.len() - 2);
-        slab(&self.x, i) + slab(&self.y, j) * (self.x.len() - 1)
+        (0..D).rev().fold(0, |acc, d| acc * (self.starts[d].len() - 1) + slab(&self.starts[d], c[d]))
     }
 
     /// The rank owning the cell that holds `x` (a centre outside the grid counts with the nearest
     /// cell: the grid-edge check stops such a run before it is mapped).
-    pub fn rank_of(&self, grid: &Grid, x: [f64; 2]) -> usize {
-        let (i, j) = grid.nearest_cell(x);
-        self.rank_of_cell(i, j)
+    pub fn rank_of(&self, grid: &Grid<D>, x: [f64; D]) -> usize {
+        self.rank_of_cell_in(grid.nearest(x))
+    }
+}
+
+/// The two-dimensional forms.
+impl Owners {
+    /// From the number of node columns and rows each slab owns.
+    pub fn new(counts_x: &[usize], counts_y: &[usize]) -> Owners {
+        Owners::from_counts([counts_x, counts_y])
+    }
+
+    /// The number of node columns and rows of each slab (the inverse of [`Owners::new`]).
+    pub fn counts(&self) -> (Vec<usize>, Vec<usize>) {
+        let [x, y] = self.counts_in();
+        (x, y)
+    }
+
+    /// The rank owning cell (i, j).
+    pub fn rank_of_cell(&self, i: usize, j: usize) -> usize {
+        self.rank_of_cell_in([i, j])
     }
 }
 

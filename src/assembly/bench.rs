@@ -1,6 +1,7 @@
 //! One assembly of the global system without a solve, for benchmarks (`benches/kernels.rs`).
 
 use super::{Assembler, GridSystem};
+use crate::kernels;
 use crate::model::Model;
 use petsc::snes::NonlinearProblem;
 use petsc::{CallbackError, Error, VecOps};
@@ -20,7 +21,15 @@ impl GridSystem {
         let mut seconds = 0.0;
         let GridSystem { dm, x, x_local, f_local, work_global, jac, step, stages, .. } = self;
         let jac = jac.as_mut().ok_or_else(|| Error::new("the step was not prepared"))?;
-        let mut asm = Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly);
+        let mut asm = Assembler::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>::new(
+            dm,
+            model,
+            step,
+            x_local,
+            f_local,
+            &mut seconds,
+            &stages.assembly,
+        );
         asm.residual(&x.as_ref(), &mut work_global.as_ref()).map_err(error)?;
         asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(error)?;
         work_global.norm2()

@@ -4,16 +4,17 @@
 
 use super::stencils::Stencils;
 use super::StepData;
-use crate::kernels::{self, NodeState, MAX_LOCAL, MAX_NODES};
+use crate::kernels::{self, NodeState};
 use crate::model::Model;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
 use petsc::{CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
+use std::marker::PhantomData;
 use std::time::Instant;
 
-/// Largest number of effective nodes of a particle (its raw stencil plus masters of extended
-/// nodes outside it).
-const MAX_EFF: usize = MAX_NODES + 8;
+/// Largest number of effective nodes of a particle beyond its raw stencil of at most M nodes (the
+/// masters of extended nodes outside it).
+const EXTRA_MASTERS: usize = 8;
 
 fn fatal(e: petsc::Error) -> CallbackError {
     CallbackError::Fatal(e.to_string())
@@ -21,7 +22,11 @@ fn fatal(e: petsc::Error) -> CallbackError {
 
 /// The kernel input of particle `k` for the prepared step. Without water dofs the u rows carry
 /// the mixture's mass (the water moves with the solid).
-pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernels::ParticleInput {
+pub(super) fn particle_input<const D: usize, const M: usize>(
+    model: &Model<D>,
+    step: &StepData<D, M>,
+    k: usize,
+) -> kernels::ParticleInput<D> {
     let mut input = model.particle_input(k, &step.body_acc);
     if let Some(g) = step.grad_n.get(k) {
         input.grad_n = *g;
@@ -40,15 +45,19 @@ pub(super) fn particle_input(model: &Model, step: &StepData, k: usize) -> kernel
     input
 }
 
-/// The nodal states of particle `k`'s raw stencil from the ghosted increments `xl`, with the
-/// motion of extended nodes taken from their masters.
+/// The nodal states (of at most N dofs) of particle `k`'s raw stencil (at most M nodes) from the
+/// ghosted increments `xl`, with the motion of extended nodes taken from their masters.
 #[inline]
-pub(super) fn node_states(step: &StepData, k: usize, xl: &[f64]) -> [NodeState; MAX_NODES] {
+pub(super) fn node_states<const D: usize, const M: usize, const N: usize>(
+    step: &StepData<D, M>,
+    k: usize,
+    xl: &[f64],
+) -> [NodeState<N>; M] {
     let nm = step.nm.expect("prepared");
     let nd = step.dofs.nd;
     let (nodes, _) = step.stencils.get(k);
     let eff = step.stencils.effective(k);
-    let mut d = [[0.0; kernels::MAX_DOF]; MAX_NODES];
+    let mut d = [[0.0; N]; M];
     for (n, &node) in nodes.iter().enumerate() {
         let b = node as usize * nd;
         d[n][..nd].copy_from_slice(&xl[b..b + nd]);
@@ -59,7 +68,7 @@ pub(super) fn node_states(step: &StepData, k: usize, xl: &[f64]) -> [NodeState; 
                 (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
         }
     }
-    let mut out = [NodeState::default(); MAX_NODES];
+    let mut out = [NodeState::default(); M];
     for n in 0..nodes.len() {
         out[n] = NodeState::new(&d[n][..nd], &nm);
     }
@@ -68,7 +77,11 @@ pub(super) fn node_states(step: &StepData, k: usize, xl: &[f64]) -> [NodeState; 
 
 /// For every raw local dof of particle `k`, where it goes among the effective dofs: one (dof, 1)
 /// pair, or the masters of an extended component. Returns the number of effective dofs.
-fn transform(step: &StepData, k: usize, out: &mut Vec<Vec<(usize, f64)>>) -> usize {
+fn transform<const D: usize, const M: usize>(
+    step: &StepData<D, M>,
+    k: usize,
+    out: &mut Vec<Vec<(usize, f64)>>,
+) -> usize {
     let nd = step.dofs.nd;
     let (nodes, _) = step.stencils.get(k);
     out.clear();
@@ -82,8 +95,8 @@ fn transform(step: &StepData, k: usize, out: &mut Vec<Vec<(usize, f64)>>) -> usi
     step.stencils.effective(k).len() * nd
 }
 
-/// A range `lo..hi` of ghosted nodes (whole rows of the ghosted grid, so one range of the ghosted
-/// numbering) whose rows of the residual and of the matrix one thread assembles: its dofs
+/// A range `lo..hi` of ghosted nodes (whole layers of the ghosted grid along its last direction:
+/// rows in two dimensions, planes of constant z in three; so one range of the ghosted numbering) whose rows of the residual and of the matrix one thread assembles: its dofs
 /// `lo·nd..hi·nd` of a ghosted vector and its blocks `row_start(lo)..row_start(hi)` of the pattern
 /// (sorted by row). Every particle with an effective node in the band is evaluated by the band's
 /// thread, which adds only the rows of the band; particles near a band's edge are evaluated by both
@@ -101,9 +114,12 @@ impl Band {
     }
 }
 
-/// `n` bands of whole rows of a ghosted grid of `nx × ny` nodes, cut where about equal numbers of
-/// the particles' first rows lie below (fewer bands if there are few rows).
-pub(super) fn bands(st: &Stencils, nx: usize, ny: usize, n: usize) -> Vec<Band> {
+/// `n` bands of whole layers of a ghosted grid of `counts` nodes per direction (layers along the
+/// last direction: rows in two dimensions), cut where about equal numbers of the particles' first
+/// layers lie below (fewer bands if there are few layers).
+pub(super) fn bands<const D: usize>(st: &Stencils<D>, counts: [usize; D], n: usize) -> Vec<Band> {
+    // Nodes per layer and layers.
+    let (nx, ny) = (counts[..D - 1].iter().product::<usize>(), counts[D - 1]);
     let total = (nx * ny) as u32;
     let n = n.min(ny / 4).max(1);
     if n == 1 || st.is_empty() {
@@ -163,16 +179,33 @@ fn run_bands<R: Send>(
     })
 }
 
-/// The particle side of the callbacks: the model and the prepared step (shared by the threads).
-#[derive(Clone, Copy)]
-struct Particles<'a> {
-    model: &'a Model,
-    step: &'a StepData,
+/// The scratch of [`Particles::add_tangent`]: the map of raw to effective dofs, the effective
+/// block, the effective nodes' grid indices.
+struct Scratch<const D: usize> {
+    transform: Vec<Vec<(usize, f64)>>,
+    block: Vec<f64>,
+    indices: Vec<[i64; D]>,
 }
 
-impl Particles<'_> {
+/// The particle side of the callbacks: the model and the prepared step (shared by the threads);
+/// points of dimension D with at most M nodes of at most N dofs.
+struct Particles<'a, const D: usize, const M: usize, const N: usize> {
+    model: &'a Model<D>,
+    step: &'a StepData<D, M>,
+    dofs: PhantomData<[(); N]>,
+}
+
+impl<const D: usize, const M: usize, const N: usize> Clone for Particles<'_, D, M, N> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<const D: usize, const M: usize, const N: usize> Copy for Particles<'_, D, M, N> {}
+
+impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
     /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
-    fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point) -> R) -> R {
+    fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point<D, M>) -> R) -> R {
         self.with_point_of(k, xl, particle_input(self.model, self.step, k), f)
     }
 
@@ -181,26 +214,27 @@ impl Particles<'_> {
         &self,
         k: usize,
         xl: &[f64],
-        input: kernels::ParticleInput,
-        f: impl FnOnce(&kernels::Point) -> R,
+        input: kernels::ParticleInput<D>,
+        f: impl FnOnce(&kernels::Point<D, M>) -> R,
     ) -> R {
         let step = self.step;
         let (nodes, basis) = step.stencils.get(k);
-        let states = node_states(step, k, xl);
+        let states = node_states::<D, M, N>(step, k, xl);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         let strain = step.stencils.strain_of(k);
         let layout = step.layout.expect("prepared");
-        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
+        let pt =
+            kernels::Point::<D, M>::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
         f(&pt.with_faces(step.faces_of(k), &states[..nodes.len()]))
     }
 
     /// Particle `k` at an explicit step's start with the stress it carries
     /// ([`kernels::Point::at_start`]).
-    fn with_point_at_start<R>(&self, k: usize, f: impl FnOnce(&kernels::Point) -> R) -> R {
+    fn with_point_at_start<R>(&self, k: usize, f: impl FnOnce(&kernels::Point<D, M>) -> R) -> R {
         let step = self.step;
         let (_, basis) = step.stencils.get(k);
         let input = particle_input(self.model, step, k);
-        f(&kernels::Point::at_start(basis, step.stencils.strain_of(k), &input, step.layout.expect("prepared")))
+        f(&kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout.expect("prepared")))
     }
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
@@ -224,11 +258,10 @@ impl Particles<'_> {
         let first = band.lo as usize * nd;
         let (nodes, _) = self.step.stencils.get(k);
         let eff = self.step.stencils.effective(k);
-        let mut moved = [false; MAX_LOCAL];
-        for e in self.step.stencils.extensions(k) {
+        let extensions = self.step.stencils.extensions(k);
+        for e in extensions {
             for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
                 let a = e.slot as usize * nd + c;
-                moved[a] = true;
                 for m in 0..e.n as usize {
                     let node = eff[e.masters[m].0 as usize];
                     if band.holds(node) {
@@ -241,8 +274,10 @@ impl Particles<'_> {
             if !band.holds(node) {
                 continue;
             }
+            // The components of this slot that an extension moved to its masters.
+            let moved = extensions.iter().filter(|e| e.slot as usize == n).fold(0u8, |m, e| m | e.mask);
             for c in 0..nd {
-                if !moved[n * nd + c] {
+                if moved & (1 << c) == 0 {
                     f[node as usize * nd + c - first] += r[n * nd + c];
                 }
             }
@@ -258,7 +293,7 @@ impl Particles<'_> {
         f: &mut [f64],
         block: &(impl Fn(usize, &mut [f64]) -> usize + Sync),
     ) -> Option<usize> {
-        let mut buf = [0.0; MAX_LOCAL];
+        let mut buf = vec![0.0; M * N];
         let mut nonfinite = None;
         for k in (0..self.step.stencils.len()).filter(|&k| self.touches(k, band)) {
             let m = block(k, &mut buf);
@@ -276,18 +311,29 @@ impl Particles<'_> {
         let step = self.step;
         let nm = step.nm.expect("prepared");
         let layout = step.layout.expect("prepared");
-        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
-        let mut eff_block = vec![0.0; MAX_EFF * kernels::MAX_DOF * MAX_EFF * kernels::MAX_DOF];
-        let mut tr = Vec::new();
+        let mut block = vec![0.0; M * N * M * N];
+        let max_eff = (M + EXTRA_MASTERS) * N;
+        let mut scratch = Scratch {
+            transform: Vec::new(),
+            block: vec![0.0; max_eff * max_eff],
+            indices: Vec::with_capacity(M + EXTRA_MASTERS),
+        };
         let first = step.pattern.row_start(band.lo);
         for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
             let (nodes, basis) = step.stencils.get(k);
             let input = particle_input(self.model, step, k);
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            let states = node_states(step, k, xl);
+            let states = node_states::<D, M, N>(step, k, xl);
             let strain = step.stencils.strain_of(k);
-            let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout)
-                .with_faces(step.faces_of(k), &states[..nodes.len()]);
+            let pt = kernels::Point::<D, M>::with_recovery(
+                basis,
+                strain,
+                &states[..nodes.len()],
+                &input,
+                &mat.model,
+                layout,
+            )
+            .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             if self.model.stiffness_in_jacobian {
                 kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
@@ -296,7 +342,7 @@ impl Particles<'_> {
                 // The mapped stiffness serves the diagnostics only: the exact tangent.
                 kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
             }
-            self.add_tangent(k, &block, m, &mut tr, &mut eff_block, values, band, first);
+            self.add_tangent(k, &block, m, &mut scratch, values, band, first);
         }
     }
 
@@ -308,14 +354,14 @@ impl Particles<'_> {
         k: usize,
         block: &[f64],
         m: usize,
-        tr: &mut Vec<Vec<(usize, f64)>>,
-        eff_block: &mut [f64],
+        scratch: &mut Scratch<D>,
         values: &mut [f64],
         band: Band,
         first: usize,
     ) {
         let step = self.step;
         let nd = step.dofs.nd;
+        let Scratch { transform: tr, block: eff_block, indices } = scratch;
         let has_ext = !step.stencils.extensions(k).is_empty();
         let eff = step.stencils.effective(k);
         let (me, kb): (usize, &[f64]) = if has_ext {
@@ -340,16 +386,14 @@ impl Particles<'_> {
         };
         let ne = me / nd;
         let pattern = &step.pattern;
-        let mut ij = [(0i64, 0i64); MAX_EFF];
-        for (c, &a) in ij.iter_mut().zip(eff) {
-            *c = pattern.ij(a);
-        }
+        indices.clear();
+        indices.extend(eff.iter().map(|&a| pattern.indices(a)));
         let fixed = &step.dofs.fixed;
         for p in (0..ne).filter(|&p| band.holds(eff[p])) {
             let rp = eff[p] as usize * nd;
             for q in 0..ne {
                 let cq = eff[q] as usize * nd;
-                let base = (pattern.block_at(eff[p], ij[p], eff[q], ij[q]) as usize - first) * nd * nd;
+                let base = (pattern.block_of(eff[p], indices[p], eff[q], indices[q]) as usize - first) * nd * nd;
                 for c1 in 0..nd {
                     if fixed[rp + c1] {
                         continue;
@@ -371,11 +415,16 @@ impl Particles<'_> {
     }
 }
 
-/// The callbacks of one step.
-pub(super) struct Assembler<'a> {
-    dm: &'a DmDa,
-    model: &'a Model,
-    step: &'a StepData,
+/// The callbacks of one step (points of dimension D with at most M nodes of at most N dofs).
+pub(super) struct Assembler<
+    'a,
+    const D: usize = 2,
+    const M: usize = { kernels::MAX_NODES },
+    const N: usize = { kernels::MAX_DOF },
+> {
+    dm: &'a DmDa<D>,
+    model: &'a Model<D>,
+    step: &'a StepData<D, M>,
     x_local: &'a mut Vector,
     f_local: &'a mut Vector,
     seconds: &'a mut f64,
@@ -388,16 +437,16 @@ pub(super) struct Assembler<'a> {
     pub(super) nonfinite: Option<String>,
 }
 
-impl<'a> Assembler<'a> {
+impl<'a, const D: usize, const M: usize, const N: usize> Assembler<'a, D, M, N> {
     pub(super) fn new(
-        dm: &'a DmDa,
-        model: &'a Model,
-        step: &'a StepData,
+        dm: &'a DmDa<D>,
+        model: &'a Model<D>,
+        step: &'a StepData<D, M>,
         x_local: &'a mut Vector,
         f_local: &'a mut Vector,
         seconds: &'a mut f64,
         stage: &'a LogStage,
-    ) -> Assembler<'a> {
+    ) -> Assembler<'a, D, M, N> {
         Assembler {
             dm,
             model,
@@ -414,7 +463,7 @@ impl<'a> Assembler<'a> {
 
     /// The callbacks, also refilling the fixed-stress Schur preconditioner `schur` after each
     /// Jacobian.
-    pub(super) fn with_schur(mut self, schur: Option<&'a mut petsc::SchurUser>) -> Assembler<'a> {
+    pub(super) fn with_schur(mut self, schur: Option<&'a mut petsc::SchurUser>) -> Assembler<'a, D, M, N> {
         self.schur = schur;
         self
     }
@@ -437,8 +486,8 @@ impl<'a> Assembler<'a> {
     }
 
     /// The particle side, for the threads.
-    fn particles(&self) -> Particles<'a> {
-        Particles { model: self.model, step: self.step }
+    fn particles(&self) -> Particles<'a, D, M, N> {
+        Particles { model: self.model, step: self.step, dofs: PhantomData }
     }
 
     /// Names particle `k`, whose residual at `xl` is not finite, and the first of its quantities
@@ -449,8 +498,9 @@ impl<'a> Assembler<'a> {
             None => {
                 let ps = &self.model.particles;
                 format!(
-                    "material point {} at ({:.4}, {:.4}) m: its residual (internal, inertia or flow terms) is not finite (NaN or Inf)",
-                    ps.id[k], ps.x[k][0], ps.x[k][1]
+                    "material point {} at {} m: its residual (internal, inertia or flow terms) is not finite (NaN or Inf)",
+                    ps.id[k],
+                    crate::model::position_text(&ps.x[k])
                 )
             }
         }
@@ -476,9 +526,7 @@ impl<'a> Assembler<'a> {
         // Without a history (Newmark, static, quasi-static) the weighted terms are the terms at
         // t_{n+1}: one pass serves both.
         let weighted = nm.history().is_some();
-        let mut buf = [0.0; MAX_LOCAL];
-        let mut ubuf = [0.0; MAX_LOCAL];
-        let mut fbuf = [0.0; MAX_LOCAL];
+        let (mut buf, mut ubuf, mut fbuf) = (vec![0.0; M * N], vec![0.0; M * N], vec![0.0; M * N]);
         let mut forces = vec![0.0; all.len()];
         let mut unweighted = if weighted { vec![0.0; all.len()] } else { Vec::new() };
         let ps = self.particles();
@@ -487,7 +535,7 @@ impl<'a> Assembler<'a> {
         let at_start = nm.is_explicit();
         debug_assert!(!at_start || xl.iter().all(|&x| x == 0.0));
         for k in 0..step.stencils.len() {
-            let terms = |pt: &kernels::Point| {
+            let terms = |pt: &kernels::Point<D, M>| {
                 let m = pt.size();
                 kernels::residual(pt, &nm, &mut buf[..m]);
                 if weighted {
@@ -530,8 +578,8 @@ impl<'a> Assembler<'a> {
         let step = self.step;
         let plain = step.nm.expect("prepared").unweighted();
         let nd = step.dofs.nd;
-        let mut block = vec![0.0; MAX_LOCAL * MAX_LOCAL];
-        let mut buf = [0.0; MAX_LOCAL];
+        let mut block = vec![0.0; M * N * M * N];
+        let mut buf = vec![0.0; M * N];
         let ps = self.particles();
         for p in 0..step.stencils.len() {
             let (nodes, _) = step.stencils.get(p);
@@ -544,7 +592,7 @@ impl<'a> Assembler<'a> {
                 kernels::stress::residual(pt, &plain, &mut buf[..m]);
                 kernels::stress::pore_pressure::residual(pt, &plain, &mut buf[..m]);
                 for (n, &node) in nodes.iter().enumerate() {
-                    for c in 0..2 {
+                    for c in 0..D {
                         let a = n * nd + c;
                         k[node as usize * nd + c] += block[a * m + a];
                         f[node as usize * nd + c] += buf[a];
@@ -583,7 +631,7 @@ impl<'a> Assembler<'a> {
     fn terms_at_start(
         &self,
         scheme: &kernels::Scheme,
-        body_acc_old: &[[f64; 2]],
+        body_acc_old: &[[f64; D]],
         fext_old: &[f64],
         smooth: bool,
     ) -> Vec<f64> {
@@ -614,7 +662,7 @@ impl<'a> Assembler<'a> {
     /// (its velocity and acceleration at t_n in place of the predictors) weighted by α_m (inertia)
     /// and α_f (forces), minus α_f f_ext,n ([`Self::terms_at_start`] with the history scheme).
     /// Constant over the step's Newton iterations.
-    pub(super) fn history(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+    pub(super) fn history(&self, body_acc_old: &[[f64; D]], fext_old: &[f64]) -> Vec<f64> {
         let hs = self.step.nm.and_then(|nm| nm.history()).expect("a scheme with a history");
         self.terms_at_start(&hs, body_acc_old, fext_old, true)
     }
@@ -627,7 +675,7 @@ impl<'a> Assembler<'a> {
     /// leaves out of balance on the moved configuration is not carried. At the fixed dofs the
     /// terms stay whole, so that the reactions are those of the total stress. Constant over the
     /// step's iterations.
-    pub(super) fn start_out_of_balance(&self, body_acc_old: &[[f64; 2]], fext_old: &[f64]) -> Vec<f64> {
+    pub(super) fn start_out_of_balance(&self, body_acc_old: &[[f64; D]], fext_old: &[f64]) -> Vec<f64> {
         let nm = self.step.nm.expect("prepared");
         let mut out = self.terms_at_start(&nm, body_acc_old, fext_old, false);
         for (v, &fixed) in out.iter_mut().zip(&self.step.dofs.fixed) {
@@ -642,7 +690,7 @@ impl<'a> Assembler<'a> {
     /// filled nodes as the residual is. With `water` (the u–U system: the points' water
     /// velocities), the water's S_ip n ρ_w V_p and momenta at the water's dofs, and the lumped drag
     /// S_ip c_p at the solid's and the water's dofs alike.
-    pub(super) fn lumped_mass_and_momentum(&self, velocities: &[[f64; 2]], water: Option<&[[f64; 2]]>) -> Lumped {
+    pub(super) fn lumped_mass_and_momentum(&self, velocities: &[[f64; D]], water: Option<&[[f64; D]]>) -> Lumped {
         let step = self.step;
         let nd = step.dofs.nd;
         let ng = step.dofs.fixed.len();
@@ -654,7 +702,7 @@ impl<'a> Assembler<'a> {
         };
         let (ps, points) = (self.particles(), &self.model.particles);
         let whole = ps.whole();
-        let (mut m, mut p, mut c) = ([0.0; MAX_LOCAL], [0.0; MAX_LOCAL], [0.0; MAX_LOCAL]);
+        let (mut m, mut p, mut c) = (vec![0.0; M * N], vec![0.0; M * N], vec![0.0; M * N]);
         debug_assert_eq!(velocities.len(), step.stencils.len());
         for (k, v) in velocities.iter().enumerate() {
             let (nodes, basis) = step.stencils.get(k);
@@ -663,12 +711,12 @@ impl<'a> Assembler<'a> {
             p[..len].fill(0.0);
             let (mw, drag) = (self.model.water_mass(k), self.model.drag(k));
             for (n, b) in basis.iter().enumerate() {
-                for c in 0..2 {
+                for c in 0..D {
                     m[n * nd + c] = b.s * points.mass[k];
                     p[n * nd + c] = m[n * nd + c] * v[c];
                 }
                 if let (Some(w), Some(vw)) = (w, water) {
-                    for d in 0..2 {
+                    for d in 0..D {
                         m[n * nd + w + d] = b.s * mw;
                         p[n * nd + w + d] = b.s * mw * vw[k][d];
                         c[n * nd + d] = b.s * drag;
@@ -725,7 +773,7 @@ pub(super) struct Lumped {
     pub drag: Vec<f64>,
 }
 
-impl NonlinearProblem for Assembler<'_> {
+impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Assembler<'_, D, M, N> {
     fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> Result<(), CallbackError> {
         let _stage = self.stage.push().map_err(fatal)?;
         let t0 = Instant::now();

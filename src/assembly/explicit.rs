@@ -189,7 +189,11 @@ impl GridSystem {
         let dj: Vec<f64> = (0..st.len())
             .map(|k| {
                 let (nodes, _) = st.get(k);
-                let states = callbacks::node_states(&self.step, k, &self.step.solution);
+                let states = callbacks::node_states::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>(
+                    &self.step,
+                    k,
+                    &self.step.solution,
+                );
                 Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false).j
             })
             .collect();
@@ -213,7 +217,11 @@ impl GridSystem {
         let own: Vec<f64> = (0..st.len())
             .map(|k| {
                 let (nodes, basis) = st.get(k);
-                let states = callbacks::node_states(&self.step, k, &self.step.solution);
+                let states = callbacks::node_states::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>(
+                    &self.step,
+                    k,
+                    &self.step.solution,
+                );
                 let input = callbacks::particle_input(model, &self.step, k);
                 storage.push(input.volume * input.inv_q);
                 let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout);

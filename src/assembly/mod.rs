@@ -58,16 +58,16 @@ use stencils::{Crossing, Stencils};
 /// Errors of the global system.
 pub type Error = petsc::Error;
 
-/// Per-step data shared by the callbacks.
+/// Per-step data shared by the callbacks (points of dimension D with at most M nodes).
 #[derive(Debug, Default)]
-struct StepData {
+struct StepData<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     nm: Option<kernels::Scheme>,
     /// The step's Δt [s].
     dt: f64,
     layout: Option<Layout>,
     /// Body acceleration at t_{n+1} per body.
-    body_acc: Vec<[f64; 2]>,
-    stencils: Stencils,
+    body_acc: Vec<[f64; D]>,
+    stencils: Stencils<D>,
     dofs: DofMap,
     /// External nodal forces at t_{n+1} (tractions) per ghosted dof, on the nodes that carry them.
     fext: Vec<f64>,
@@ -79,9 +79,9 @@ struct StepData {
     /// Δd at convergence, per ghosted dof (extended motion is not stored here).
     solution: Vec<f64>,
     /// Porosity gradient at each particle at t_n (two-phase).
-    grad_n: Vec<[f64; 2]>,
+    grad_n: Vec<[f64; D]>,
     /// v_u, a_u, v_w, a_w at t_n at each particle, from the nodal projections.
-    smooth: Vec<[[f64; 2]; 4]>,
+    smooth: Vec<[[f64; D]; 4]>,
     /// The norm of the step's force magnitudes over the free dofs (see
     /// `Assembler::force_magnitudes`), summed over ranks [N per m].
     force_scale: f64,
@@ -89,7 +89,7 @@ struct StepData {
     /// `kernels::pressure_projection`).
     projection: Vec<([u32; 4], [[f64; 4]; 4])>,
     /// The matrix pattern (kept from step to step while it covers the particles' pairs).
-    pattern: Pattern,
+    pattern: Pattern<D>,
     /// The bands of node rows the threads assemble (see [`callbacks::Band`]).
     bands: Vec<callbacks::Band>,
     /// The pattern block of every corner pair (a, b) of each pressure-projection cell, 4a + b.
@@ -107,7 +107,7 @@ struct StepData {
     fixed_stress: Vec<f64>,
     /// The drained faces imposed weakly (see [`GridSystem::drained_faces`]) and the particle of
     /// each, in increasing order.
-    faces: Vec<kernels::DrainedFace>,
+    faces: Vec<kernels::DrainedFace<D, M>>,
     face_owner: Vec<usize>,
     /// The material stiffness of the Newton matrix (`stabilisation.stiffness`).
     stiffness: stiffness::MappedStiffness,
@@ -147,9 +147,9 @@ struct StartTerms {
     magnitude: Vec<f64>,
 }
 
-impl StepData {
+impl<const D: usize, const M: usize> StepData<D, M> {
     /// The drained faces of particle `k` (usually none).
-    fn faces_of(&self, k: usize) -> &[kernels::DrainedFace] {
+    fn faces_of(&self, k: usize) -> &[kernels::DrainedFace<D, M>] {
         let lo = self.face_owner.partition_point(|&o| o < k);
         let hi = lo + self.face_owner[lo..].partition_point(|&o| o == k);
         &self.faces[lo..hi]
@@ -191,9 +191,9 @@ pub struct NodeBlock {
 /// its absolute tolerance) cannot see an unsolved pressure equation: a quasi-static step that
 /// starts from the extrapolated increment was accepted with no iteration while its pore pressure
 /// drifted by 0.1 % of the load per step (Terzaghi, Δt = 0.1 s).
-pub fn pressure_scale(model: &Model) -> f64 {
+pub fn pressure_scale<const D: usize>(model: &Model<D>) -> f64 {
     let m = model.materials.iter().map(|m| m.model.elastic().constrained_modulus()).fold(0.0, f64::max);
-    let h = model.grid.h[0].min(model.grid.h[1]);
+    let h = (1..D).fold(model.grid.h[0], |h, d| h.min(model.grid.h[d]));
     if m > 0.0 && h > 0.0 {
         m / h
     } else {
@@ -267,19 +267,19 @@ pub const LINE_SEARCH_RETRY_OPTION: &str = "-porompm_snes_line_search_retry";
 
 /// The forces of a converged step, summed over ranks, for the equilibrium identity and the
 /// boundaries' reactions.
-#[derive(Debug, Clone, Default)]
-pub struct StepForces {
+#[derive(Debug, Clone)]
+pub struct StepForces<const D: usize = 2> {
     /// Σ_i x'_i ⊗ (F_ext,i + R_i − F_inertia,i) over the nodes, with x' = x + Δu the nodes' positions
-    /// at t_{n+1} relative to `origin` (in-plane, rows a, columns b: x_a F_b).
-    pub moment: [[f64; 2]; 2],
+    /// at t_{n+1} relative to `origin` (rows a, columns b: x_a F_b).
+    pub moment: [[f64; D]; D],
     /// The largest of the moments of the external forces, the reactions and the inertia forces
     /// (Frobenius norms), which scales the identity's error.
     pub scale: f64,
     /// The reference point of the moments [m].
-    pub origin: [f64; 2],
+    pub origin: [f64; D],
     /// The reaction of each boundary (index into `Model::boundaries`) on the material: the force
-    /// the fixed dofs of both phases exert [N per m].
-    pub reactions: Vec<[f64; 2]>,
+    /// the fixed dofs of both phases exert [N per m in two dimensions, N in three].
+    pub reactions: Vec<[f64; D]>,
     /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
     /// (trapezoidal; the reactions at t_n are the last step's, none after a new grid system) [J per m].
@@ -292,6 +292,20 @@ pub struct StepForces {
     /// Whether the forces are those of the step's start (an explicit step: σ_n on x_n), so that
     /// ∫σ dV must be taken before the particle update; otherwise at the converged state.
     pub at_start: bool,
+}
+
+impl<const D: usize> Default for StepForces<D> {
+    fn default() -> Self {
+        StepForces {
+            moment: [[0.0; D]; D],
+            scale: 0.0,
+            origin: [0.0; D],
+            reactions: Vec::new(),
+            work: 0.0,
+            field_scales: Vec::new(),
+            at_start: false,
+        }
+    }
 }
 
 /// The PETSc log stages of a run (shown by `-log_view`).
@@ -319,18 +333,24 @@ pub enum Phase {
     Output,
 }
 
-/// The DMDA grid, the solver and the per-step state of the global system.
-pub struct GridSystem {
+/// The DMDA grid, the solver and the per-step state of the global system, on a grid of dimension
+/// D whose points have at most M stencil nodes of at most N dofs (two-dimensional by default;
+/// [`SolidSystem`] in three dimensions).
+pub struct GridSystem<
+    const D: usize = 2,
+    const M: usize = { kernels::MAX_NODES },
+    const N: usize = { kernels::MAX_DOF },
+> {
     comm: Comm,
-    dm: DmDa,
+    dm: DmDa<D>,
     layout: Layout,
-    ghost: GhostedRange,
-    owned_start: [usize; 2],
-    owned_count: [usize; 2],
-    /// Ghosted indices of the owned nodes, row by row.
+    ghost: GhostedRange<D>,
+    owned_start: [usize; D],
+    owned_count: [usize; D],
+    /// Ghosted indices of the owned nodes, x fastest.
     owned_nodes: Vec<u32>,
     /// Which rank owns which cells (the DMDA's ownership ranges).
-    owners: crate::distribution::Owners,
+    owners: crate::distribution::Owners<D>,
     /// Global index of every ghosted dof.
     l2g: Vec<i32>,
     x: Vector,
@@ -363,9 +383,12 @@ pub struct GridSystem {
     /// The owned part of the last accepted step's Δd and its Δt, the predictor of the next step
     /// when the analysis extrapolates (see [`kernels::Integration::extrapolates`]).
     last_increment: Option<(Vec<f64>, f64)>,
-    step: StepData,
+    step: StepData<D, M>,
     stages: Stages,
 }
+
+/// The global system of a three-dimensional grid.
+pub type SolidSystem = GridSystem<3, { kernels::MAX_NODES_3D }, { kernels::MAX_DOF_3D }>;
 
 /// The absolute residual tolerance of a step relative to the norm of its force magnitudes: the
 /// round-off of a residual summed from forces of that size is about 1e-16 of it per dof, so 1e-10
@@ -390,7 +413,7 @@ pub const STENCIL_WIDTH: usize = 3;
 /// without the wiggles.
 pub const NITSCHE_PENALTY: f64 = 4.0;
 
-impl GridSystem {
+impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// Creates the DMDA for the grid and dof layout on the run's communicator, and the SNES with
     /// porompm's defaults, then lets the PETSc options database override them. Defaults: Newton with
     /// full steps, relative residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU by UMFPACK on
@@ -403,25 +426,30 @@ impl GridSystem {
     /// [`newton_iterations`] of the case's `stiffness`.
     pub fn new(
         coll: &Collective,
-        grid: &crate::model::grid::Grid,
+        grid: &crate::model::grid::Grid<D>,
         layout: Layout,
-        partition: Option<&crate::distribution::Owners>,
+        partition: Option<&crate::distribution::Owners<D>>,
         stiffness: crate::case::Stiffness,
-    ) -> Result<GridSystem, Error> {
+    ) -> Result<GridSystem<D, M, N>, Error> {
+        if layout.dim != D {
+            return Err(Error::new(format!(
+                "a grid system of dimension {D} was given a layout of dimension {} (`Layout::in_dim`)",
+                layout.dim
+            )));
+        }
         let comm = Comm::from_raw(coll.communicator().as_raw());
         let names = layout.field_names();
-        let counts = partition.map(|o| o.counts());
-        let ranges = counts.as_ref().map(|(x, y)| (&x[..], &y[..]));
-        let dm = DmDa::new_2d_partitioned(comm, grid.nodes(), STENCIL_WIDTH, names, ranges).map_err(|e| {
+        let counts = partition.map(|o| o.counts_in());
+        let ranges = counts.as_ref().map(|c| std::array::from_fn(|d| &c[d][..]));
+        let dm = DmDa::new_partitioned(comm, grid.nodes(), STENCIL_WIDTH, names, ranges).map_err(|e| {
             if e.message.contains("smaller than stencil width") {
                 Error {
                     message: format!(
-                        "the grid of {} × {} nodes cannot be split over {} ranks: each rank needs at least \
-                         {STENCIL_WIDTH} node columns and rows along every direction the grid is split in (the \
+                        "the grid of {} nodes cannot be split over {} ranks: each rank needs at least \
+                         {STENCIL_WIDTH} node layers along every direction the grid is split in (the \
                          ghost width a GIMP point's support needs); run on fewer ranks or refine the grid \
                          (PETSc: {})",
-                        grid.nodes()[0],
-                        grid.nodes()[1],
+                        grid.nodes().map(|n| n.to_string()).join(" × "),
                         coll.size(),
                         e.message
                     ),
@@ -445,14 +473,13 @@ impl GridSystem {
                 info.ghosted.len() * layout.nd
             )));
         }
-        let (counts_x, counts_y) = dm.ownership_ranges()?;
-        let owners = crate::distribution::Owners::new(&counts_x, &counts_y);
-        let mut owned_nodes = Vec::new();
-        for j in info.owned_start[1]..info.owned_start[1] + info.owned_count[1] {
-            for i in info.owned_start[0]..info.owned_start[0] + info.owned_count[0] {
-                owned_nodes.push(info.ghosted.node(i, j).expect("owned nodes are ghosted") as u32);
-            }
-        }
+        let ranges = dm.ownership()?;
+        let owners = crate::distribution::Owners::from_counts(std::array::from_fn(|d| &ranges[d][..]));
+        // The owned block, x fastest, as global node indices.
+        let owned_block = GhostedRange { start: info.owned_start, count: info.owned_count, dof: 1 };
+        let owned: Vec<[usize; D]> = (0..owned_block.len()).map(|o| owned_block.indices(o)).collect();
+        let owned_nodes: Vec<u32> =
+            owned.iter().map(|&n| info.ghosted.local(n).expect("owned nodes are ghosted") as u32).collect();
         let mut snes = Snes::new(comm)?;
         snes.set_dm(&dm)?;
         snes.set_type("newtonls")?;
@@ -463,14 +490,11 @@ impl GridSystem {
             ksp.set_type("preonly")?;
             let mut pc = ksp.pc()?;
             pc.set_type("lu")?;
-            let grid_dofs = grid.nodes()[0] * grid.nodes()[1] * layout.nd;
+            let grid_dofs = grid.node_count() * layout.nd;
             pc.set_factor_solver_type(default_factor_package(comm, grid_dofs))?;
         }
         snes.set_from_options()?;
-        let positions: Vec<[f64; 2]> = (info.owned_start[1]..info.owned_start[1] + info.owned_count[1])
-            .flat_map(|j| (info.owned_start[0]..info.owned_start[0] + info.owned_count[0]).map(move |i| (i, j)))
-            .map(|(i, j)| grid.node_position(i, j))
-            .collect();
+        let positions: Vec<[f64; D]> = owned.iter().map(|&n| grid.position(n)).collect();
         let first_dof = x.ownership_range()?.0;
         let schur = splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
         // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
@@ -521,17 +545,14 @@ impl GridSystem {
     }
 
     /// Which rank owns which cells (the DMDA's ownership ranges).
-    pub fn owners(&self) -> &crate::distribution::Owners {
+    pub fn owners(&self) -> &crate::distribution::Owners<D> {
         &self.owners
     }
 
-    /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
+    /// Whether this rank owns the node with indices `n`, and with it the cell whose lowest corner
     /// it is.
-    pub fn owns_cell(&self, i: usize, j: usize) -> bool {
-        i >= self.owned_start[0]
-            && i < self.owned_start[0] + self.owned_count[0]
-            && j >= self.owned_start[1]
-            && j < self.owned_start[1] + self.owned_count[1]
+    pub fn owns_cell_in(&self, n: [usize; D]) -> bool {
+        (0..D).all(|d| n[d] >= self.owned_start[d] && n[d] < self.owned_start[d] + self.owned_count[d])
     }
 
     /// Enters a log stage until the guard is dropped.
@@ -552,8 +573,7 @@ impl GridSystem {
 
     /// Total dofs of the grid (all nodes × dofs per node).
     pub fn total_dofs(&self) -> usize {
-        let [nx, ny] = self.dm.info().nodes;
-        nx * ny * self.layout.nd
+        self.dm.info().nodes.iter().product::<usize>() * self.layout.nd
     }
 
     /// The dof layout.
@@ -573,9 +593,9 @@ impl GridSystem {
 
     /// The motion components of the layout (u, and U if there is water).
     fn motion(&self) -> Vec<usize> {
-        let mut m = vec![0, 1];
+        let mut m: Vec<usize> = (0..D).collect();
         if let Some(w) = self.layout.w {
-            m.extend([w, w + 1]);
+            m.extend(w..w + D);
         }
         m
     }
@@ -585,7 +605,7 @@ impl GridSystem {
     /// Collective; every rank returns the same outcome.
     pub fn prepare_step(
         &mut self,
-        model: &Model,
+        model: &Model<D>,
         active: &Active,
         t_new: f64,
         dt: f64,
@@ -601,49 +621,35 @@ impl GridSystem {
         let dofs = self.dof_map(model, active, (t_new - dt, t_new), &nodal, weak, coll)?;
         coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
         if model.stress_recovery == crate::case::StressRecovery::Cmpm {
-            coll.agree(stencils::cmpm_patches(&mut st, model, &self.ghost, &dofs))?;
+            // [001]'s CMPM (plane only: validation keeps it out of three-dimensional cases).
+            if let (Some(plane), Some(st), Some(ghost)) =
+                (model.as_plane(), crate::model::plane_mut::<_, Stencils>(&mut st), crate::model::plane(&self.ghost))
+            {
+                coll.agree(stencils::cmpm_patches(st, plane, ghost, &dofs))?;
+            }
         }
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
-        if weak {
-            (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
-        }
         self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
-        self.step.stiffness =
-            coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
+        if let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) {
+            system.plane_step(plane, active, weak, coll)?;
+        }
         if model.integration.is_explicit() {
             // An explicit step solves nothing: no matrix.
             self.step.pattern = old_pattern;
-            if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
-                if self.layout.w.is_some() {
-                    self.step.drained = self.drained_nodes(model, active).map_err(|e| e.to_string())?;
-                }
-            }
             return Ok(());
         }
         self.matrix_pattern(old_pattern, coll)
     }
 
-    /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
-    /// (see [`explicit`]): a side or region boundary of the stage fixes `p` there, a moving
-    /// surface that fixes `p` reaches it (`Model::surface_fixes`, marks summed over the ranks), or
-    /// the material barely fills it (the drained value of implicit stages' barely filled nodes).
-    fn drained_nodes(&mut self, model: &Model, active: &Active) -> Result<Vec<bool>, Error> {
-        let nd = self.layout.nd;
-        let p = kernels::dof::P;
-        let mut marks = vec![0.0; self.ghost.len() * nd];
-        for ((i, j), _, comps) in model.surface_fixes(active, false) {
-            if let (true, Some(l)) = (comps[p], self.ghost.node(i as usize, j as usize)) {
-                marks[l * nd] = 1.0;
-            }
-        }
-        self.sum_over_ranks(&mut marks)?;
-        Ok((0..self.ghost.len())
-            .map(|l| {
-                let (i, j) = self.ghost.ij(l);
-                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, [i, j])[p].is_some()
-            })
-            .collect())
+    /// The system itself when it is two-dimensional (see [`Model::as_plane`]).
+    fn as_plane_mut(&mut self) -> Option<&mut GridSystem> {
+        crate::model::plane_mut(self)
+    }
+
+    /// [`Self::as_plane_mut`], shared.
+    fn as_plane_ref(&self) -> Option<&GridSystem> {
+        crate::model::plane(self)
     }
 
     /// Step 4: the diagonal of the fixed-stress Schur preconditioner Sp = A_pp + diag(d) of the
@@ -654,7 +660,7 @@ impl GridSystem {
     /// fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible grains, as the
     /// continuity equation assumes), with the sign of A_pp's storage term. Empty without that
     /// preconditioner.
-    fn fixed_stress_diagonal(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
+    fn fixed_stress_diagonal(&mut self, model: &Model<D>) -> Result<Vec<f64>, Error> {
         let (Some(p), true) = (self.layout.p, self.schur.is_some()) else { return Ok(Vec::new()) };
         let nd = self.layout.nd;
         let mut mass = vec![0.0; self.ghost.len() * nd];
@@ -679,7 +685,7 @@ impl GridSystem {
 
     /// Step 1: the stencils on x_n (B̄'s cells first: which cells the material fills, summed over
     /// ranks), and the particles whose support crosses a side of the grid.
-    fn stencils_on_xn(&mut self, model: &Model, coll: &Collective) -> Result<(Stencils, Vec<Crossing>), String> {
+    fn stencils_on_xn(&mut self, model: &Model<D>, coll: &Collective) -> Result<(Stencils<D>, Vec<Crossing>), String> {
         let nd = self.layout.nd;
         let roots = if model.bbar {
             let mut phi = vec![0.0; self.ghost.len() * nd];
@@ -692,7 +698,7 @@ impl GridSystem {
         } else {
             stencils::CellRoots::identity()
         };
-        coll.agree(stencils::build(model, &self.ghost, &roots))
+        coll.agree(stencils::build_in::<D, M>(model, &self.ghost, &roots))
     }
 
     /// Whether a step of `dt` imposes the drained moving surfaces weakly, on the particles' faces
@@ -700,44 +706,9 @@ impl GridSystem {
     /// essential condition. The u–p–U system drains through its water's motion (p = 0 is natural
     /// there) and keeps the pressure fixed at the nodes beyond the surface, as a system without
     /// flow does.
-    fn drains_weakly(&self, model: &Model, dt: f64) -> bool {
+    fn drains_weakly(&self, model: &Model<D>, dt: f64) -> bool {
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
         flow && kernels::Scheme::of(&model.integration, dt, flow).flow_dt > 0.0
-    }
-
-    /// Step 4: the drained faces of this rank's particles with their geometry and the grid's
-    /// bilinear shape functions at the face point, ordered by particle (see
-    /// [`kernels::DrainedFace`]). The gradient is the one on the material's side of a grid line
-    /// through the face point.
-    fn drained_faces(&self, model: &Model, active: &Active) -> Vec<(usize, kernels::DrainedFace)> {
-        let (g, ps) = (&model.grid, &model.particles);
-        let penalty = NITSCHE_PENALTY / g.h[0].min(g.h[1]);
-        model
-            .drained_faces(active)
-            .into_iter()
-            .map(|(k, face)| {
-                let normal = model.face_normal(k, face);
-                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
-                let area = length * model.geometry.measure(xf[0]);
-                let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
-                let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
-                let (nodes, _) = self.step.stencils.get(k);
-                for (b, &node) in basis.iter_mut().zip(nodes) {
-                    let (i, j) = self.ghost.ij(node as usize);
-                    *b = shape::bilinear(g.node_position(i, j), xf, inside, g.h);
-                }
-                (
-                    k,
-                    kernels::DrainedFace {
-                        offset: [xf[0] - ps.x[k][0], xf[1] - ps.x[k][1]],
-                        normal,
-                        area,
-                        penalty,
-                        basis,
-                    },
-                )
-            })
-            .collect()
     }
 
     /// Step 3: the dof map of the step `(t_n, t_{n+1})`. Moving surfaces: per surface boundary, the
@@ -745,7 +716,7 @@ impl GridSystem {
     /// case order. With `weak_drainage` the surfaces fix no pressure (see [`Self::drains_weakly`]).
     fn dof_map(
         &mut self,
-        model: &Model,
+        model: &Model<D>,
         active: &Active,
         times: (f64, f64),
         nodal: &Nodal,
@@ -753,12 +724,13 @@ impl GridSystem {
         coll: &Collective,
     ) -> Result<DofMap, String> {
         let nd = self.layout.nd;
-        let fixes = model.surface_fixes(active, weak_drainage);
+        // Moving surfaces (plane only: validation keeps them out of three-dimensional cases).
+        let fixes = model.as_plane().map(|m| m.surface_fixes(active, weak_drainage)).unwrap_or_default();
         let mut surface = vec![0.0; self.ghost.len() * nd];
         for &bi in active.boundaries.iter().filter(|&&b| model.boundaries[b].surface.is_some()) {
             let mut marks = vec![0.0; self.ghost.len() * nd];
             for ((i, j), _, comps) in fixes.iter().filter(|f| f.1 == bi) {
-                if let Some(l) = self.ghost.node(*i as usize, *j as usize) {
+                if let Some(l) = self.ghost.local(lift([*i as usize, *j as usize])) {
                     for c in (0..nd).filter(|&c| self.layout.canonical(c).is_some_and(|k| comps[k])) {
                         marks[l * nd + c] = 1.0;
                     }
@@ -795,26 +767,31 @@ impl GridSystem {
     #[allow(clippy::too_many_arguments)]
     fn step_data(
         &mut self,
-        model: &Model,
+        model: &Model<D>,
         active: &Active,
         (t_old, t_new): (f64, f64),
-        st: Stencils,
+        st: Stencils<D>,
         dofs: DofMap,
         nodal: &Nodal,
         coll: &Collective,
     ) -> Result<(), String> {
-        let bands = callbacks::bands(&st, self.ghost.count[0], self.ghost.count[1], coll.threads());
+        let bands = callbacks::bands(&st, self.ghost.count, coll.threads());
         let (smooth, grad_n) = self.predictors(model, &st, &dofs, nodal);
-        let projection = self.projection_blocks(model);
-        let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
+        // The pressure projection and the loads (plane only: validation keeps them out of
+        // three-dimensional cases, whose external forces are zero).
+        let plane = model.as_plane().zip(self.as_plane_ref());
+        let projection = plane.map(|(m, s)| s.projection_blocks(m)).unwrap_or_default();
+        let zero = || Ok((vec![0.0; self.ghost.len() * self.layout.nd], AppliedLoads::default()));
+        let forces_at = |t: f64| plane.map_or_else(zero, |(m, s)| s.external_forces(m, active, t, &dofs));
+        let (fext, applied) = coll.agree(forces_at(t_new))?;
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
         let nm = kernels::Scheme::of(&model.integration, t_new - t_old, flow);
-        let fext_old = coll.agree(self.external_forces(model, active, t_old, &dofs))?.0;
+        let fext_old = coll.agree(forces_at(t_old))?.0;
         self.step = StepData {
             nm: Some(nm),
             dt: t_new - t_old,
             layout: Some(self.layout),
-            body_acc: model.body_accelerations(active, t_new),
+            body_acc: body_accelerations(model, active, t_new),
             stencils: st,
             bands,
             dofs,
@@ -831,10 +808,10 @@ impl GridSystem {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
             // static or quasi-static, which have no generalized-α history).
-            let body_acc_old = model.body_accelerations(active, t_old);
+            let body_acc_old = body_accelerations(model, active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.start_out_of_balance(&body_acc_old, &fext_old));
         } else if nm.history().is_some() {
-            let body_acc_old = model.body_accelerations(active, t_old);
+            let body_acc_old = body_accelerations(model, active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
         }
         self.step.fext_old = fext_old;
@@ -859,13 +836,12 @@ impl GridSystem {
 
     /// Step 5: the matrix pattern, kept (`old`) if every rank finds every pair in it, and where the
     /// pressure-projection cells and the fixed dofs' diagonals lie in it.
-    fn matrix_pattern(&mut self, old: Pattern, coll: &Collective) -> Result<(), String> {
+    fn matrix_pattern(&mut self, old: Pattern<D>, coll: &Collective) -> Result<(), String> {
         let nd = self.layout.nd;
         let kept = !old.is_empty() && old.covers(&self.step.stencils);
         let pattern = if coll.any(!kept)? {
-            let [nx, ny] = self.ghost.count;
             let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
-            let p = Pattern::build(&self.step.stencils, &self.owned_nodes, &groups, nx, ny);
+            let p = Pattern::build_in(&self.step.stencils, &self.owned_nodes, &groups, self.ghost.count);
             let (rows, cols) = p.coo(nd, &self.l2g);
             let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());
             self.jac = Some(coll.agree(made)?);
@@ -908,11 +884,12 @@ impl GridSystem {
 
     /// Step 2: nodal masses, momenta and mass-weighted accelerations ([003] Eq. 19), mass-weighted
     /// porosities and filled fractions, summed over ranks.
-    fn project(&mut self, model: &Model, st: &Stencils) -> Result<Nodal, Error> {
+    fn project(&mut self, model: &Model<D>, st: &Stencils<D>) -> Result<Nodal, Error> {
         let nd = self.layout.nd;
         let ng = self.ghost.len() * nd;
         let ps = &model.particles;
-        let cell_area = model.grid.h[0] * model.grid.h[1];
+        // A cell's area (its volume in three dimensions).
+        let cell_area: f64 = model.grid.h.iter().product();
         let (mut mass, mut mom, mut acc) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
         let (mut phi, mut porosity) = (vec![0.0; ng], vec![0.0; ng]);
         for k in 0..st.len() {
@@ -923,7 +900,7 @@ impl GridSystem {
                 let s = nb.s;
                 phi[b] += s * model.area(k) / cell_area;
                 porosity[b] += s * ps.mass[k] * ps.porosity[k];
-                for c in 0..2 {
+                for c in 0..D {
                     mass[b + c] += s * ps.mass[k];
                     mom[b + c] += s * ps.mass[k] * ps.vel[k][c];
                     acc[b + c] += s * ps.mass[k] * ps.acc[k][c];
@@ -955,11 +932,11 @@ impl GridSystem {
     /// has zero velocity and acceleration; an extended node takes its masters'.
     fn predictors(
         &self,
-        model: &Model,
-        st: &Stencils,
+        model: &Model<D>,
+        st: &Stencils<D>,
         dofs: &DofMap,
         nodal: &Nodal,
-    ) -> (Vec<[[f64; 2]; 4]>, Vec<[f64; 2]>) {
+    ) -> (Vec<[[f64; D]; 4]>, Vec<[f64; D]>) {
         let nd = self.layout.nd;
         let value = |l: usize, c: usize, of: &[f64]| -> f64 {
             let q = l * nd + c;
@@ -970,10 +947,10 @@ impl GridSystem {
                 of[q] / nodal.mass[q]
             }
         };
-        // (dof, slot of its velocity in the output, component): solid x, y, then water x, y.
-        let mut comps = vec![(0usize, 0usize, 0usize), (1, 0, 1)];
+        // (dof, slot of its velocity in the output, component): the solid's, then the water's.
+        let mut comps: Vec<(usize, usize, usize)> = (0..D).map(|c| (c, 0, c)).collect();
         if let Some(w) = self.layout.w {
-            comps.extend([(w, 2, 0), (w + 1, 2, 1)]);
+            comps.extend((0..D).map(|c| (w + c, 2, c)));
         }
         let two_phase = self.layout.w.is_some();
         let mut smooth = Vec::with_capacity(st.len());
@@ -982,8 +959,8 @@ impl GridSystem {
             let (nodes, basis) = st.get(k);
             let eff = st.effective(k);
             let ext = st.extensions(k);
-            let mut out = [[0.0; 2]; 4];
-            let mut g = [0.0; 2];
+            let mut out = [[0.0; D]; 4];
+            let mut g = [0.0; D];
             for (slot, (&node, nb)) in nodes.iter().zip(basis).enumerate() {
                 let e = ext.iter().find(|e| e.slot as usize == slot);
                 let of_masters = |f: &dyn Fn(usize) -> f64| -> f64 {
@@ -1003,8 +980,9 @@ impl GridSystem {
                 if two_phase {
                     let n =
                         if e.is_some() { of_masters(&|l| nodal.porosity[l]) } else { nodal.porosity[node as usize] };
-                    g[0] += nb.g[0] * n;
-                    g[1] += nb.g[1] * n;
+                    for (gd, nbd) in g.iter_mut().zip(nb.g) {
+                        *gd += nbd * n;
+                    }
                 }
             }
             smooth.push(out);
@@ -1013,6 +991,454 @@ impl GridSystem {
             }
         }
         (smooth, grad_n)
+    }
+
+    /// The load accounting of a step: the tractions the case applies at t_{n+1} against the forces
+    /// assembled on nodes that carry them (free, or fixed by a boundary, whose reaction then takes
+    /// them). A difference beyond round-off means that part of a load would be lost: an error
+    /// naming the load.
+    fn check_loads(&mut self, applied: &AppliedLoads, t_new: f64, coll: &Collective) -> Result<(), String> {
+        let nd = self.layout.nd;
+        let (applied, names) = (applied.total, &applied.names);
+        if names.is_empty() {
+            return Ok(());
+        }
+        let mut summed = self.step.fext.clone();
+        self.sum_over_ranks(&mut summed).map_err(|e| e.to_string())?;
+        let mut carried = [0.0; 2];
+        let mut magnitude = 0.0f64;
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            for (c, carried_c) in carried.iter_mut().enumerate() {
+                let q = l * nd + c;
+                magnitude = magnitude.max(summed[q].abs());
+                if !self.step.dofs.fixed[q] || self.step.dofs.boundary_fixed(l, c) {
+                    *carried_c += summed[q];
+                }
+            }
+        }
+        let totals = coll.sum(&[applied[0], applied[1], carried[0], carried[1]])?;
+        let scale = coll.max(&[magnitude])?[0].max(totals[0].abs()).max(totals[1].abs());
+        let lost = [totals[0] - totals[2], totals[1] - totals[3]];
+        if lost[0].hypot(lost[1]) > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+            return Err(format!(
+                "at t = {t_new:.6e} s the load(s) {} apply ({:.6e}, {:.6e}) N/m but the grid carries ({:.6e}, {:.6e}) N/m: \
+                 part of the load acts on nodes the material does not fill",
+                names.join(", "),
+                totals[0],
+                totals[1],
+                totals[2],
+                totals[3]
+            ));
+        }
+        Ok(())
+    }
+
+    /// Solves the prepared step by Newton's method from Δd = 0, or, when the analysis extrapolates,
+    /// from the last accepted increment scaled by Δt / Δt_last; every fixed dof starts at its
+    /// prescribed increment. Geometrically linear steps start from Δd = 0: their residual is affine
+    /// in Δd, so the exact tangent needs one iteration from anywhere, and one solve with one of
+    /// [001]'s mapped stiffnesses is then [001]'s K Δu = ΔF.
+    pub fn solve(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
+        if model.integration.is_explicit() {
+            // The explicit update (plane only: validation keeps it out of three-dimensional cases).
+            return match model.as_plane().zip(self.as_plane_mut()) {
+                Some((plane, system)) => system.explicit_update(plane),
+                None => Err(Error::new("the explicit update is not available in three dimensions yet")),
+            };
+        }
+        let _stage = self.stages.solve.push()?;
+        // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.
+        let atol = self.user_atol.max(FORCE_ATOL * self.step.force_scale);
+        self.snes.set_tolerances(Some(atol), None, None, None)?;
+        let mut assembly_seconds = 0.0;
+        let t0 = Instant::now();
+        self.initial_guess(model)?;
+        let (mut out, mut nonfinite) = {
+            let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
+            let out = snes.solve(x, jac, &mut asm)?;
+            (out, asm.nonfinite.take())
+        };
+        // Full Newton steps that diverged are tried once more from the same start with a
+        // backtracking line search, before the driver cuts Δt (see [`LINE_SEARCH_RETRY`]).
+        let mut line_search_retry = false;
+        if !out.converged
+            && DIVERGED_BY_FULL_STEPS.contains(&out.reason_text.as_str())
+            && self.retry_with_line_search
+            && self.snes.type_name()? == "newtonls"
+            && self.snes.line_search_type()? == "basic"
+        {
+            line_search_retry = true;
+            self.initial_guess(model)?;
+            self.snes.set_line_search(LINE_SEARCH_RETRY)?;
+            let retry = {
+                let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
+                snes.solve(x, jac, &mut asm).map(|o| (o, asm.nonfinite.take()))
+            };
+            self.snes.set_line_search("basic")?;
+            let (second, second_nonfinite) = retry?;
+            // A point that was not finite in the first try names the failure only if the second
+            // fails too.
+            nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
+            let (first_newton, first_krylov) = (out.iterations, out.linear_iterations);
+            out = SolveOutcome {
+                iterations: first_newton + second.iterations,
+                linear_iterations: first_krylov + second.linear_iterations,
+                reason_text: if second.converged {
+                    second.reason_text.clone()
+                } else {
+                    format!("{} ({} with a line search)", out.reason_text, second.reason_text)
+                },
+                ..second
+            };
+        }
+        let solve_seconds = t0.elapsed().as_secs_f64();
+        self.dm.global_to_local(&self.x, &mut self.x_local)?;
+        let mut solution = self.x_local.read()?.to_vec();
+        for (q, v) in solution.iter_mut().enumerate() {
+            *v *= self.step.unit(q);
+        }
+        self.step.solution = solution;
+        let components = &out.final_residual_components;
+        let field_residuals = if components.len() == self.layout.nd {
+            let norm = |cs: &[usize]| cs.iter().map(|&c| components[c] * components[c]).sum::<f64>().sqrt();
+            self.layout.fields().iter().map(|(_, cs)| norm(cs)).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(StepSolve {
+            converged: out.converged,
+            reason: out.reason_text,
+            newton_iterations: out.iterations,
+            linear_iterations: out.linear_iterations,
+            residual_history: out.residual_history,
+            domain_error: out.domain_error,
+            nonfinite,
+            assembly_seconds,
+            solve_seconds,
+            field_residuals,
+            field_scales: self.step.field_scales.clone(),
+            linear_field_residuals: out.linear_field_residuals,
+            solver_used: true,
+            line_search_retry,
+        })
+    }
+
+    /// Sets PETSc's solution vector to the step's first iterate: the last accepted increment
+    /// scaled to the new Δt where the stage extrapolates (static and quasi-static), zero
+    /// otherwise, with the prescribed increments at the fixed dofs.
+    fn initial_guess(&mut self, model: &Model<D>) -> Result<(), Error> {
+        let mut x = self.x.write()?;
+        match &self.last_increment {
+            Some((last, dt_last))
+                if model.integration.extrapolates() && !model.linear_increments && last.len() == x.len() =>
+            {
+                let ratio = self.step.dt / dt_last;
+                for (xi, li) in x.iter_mut().zip(last) {
+                    *xi = ratio * li;
+                }
+            }
+            _ => x.fill(0.0),
+        }
+        for &(o, q) in &self.step.dofs.owned_fixed {
+            x[o] = self.step.dofs.value[q] / self.step.unit(q);
+        }
+        Ok(())
+    }
+
+    /// Keeps the increment of the step just accepted (of length `dt`) as the next step's
+    /// predictor.
+    pub fn accept_increment(&mut self, dt: f64) -> Result<(), Error> {
+        self.last_increment = Some((self.x.read()?.to_vec(), dt));
+        Ok(())
+    }
+
+    /// Forgets the last increment: the next step starts from Δd = 0 (a new stage changes the loads
+    /// or the analysis, so the last rate says nothing about the next step).
+    pub fn forget_increment(&mut self) {
+        self.last_increment = None;
+    }
+
+    /// Splits the system into the SNES, its solution vector and matrix, and the callbacks of the
+    /// prepared step (which borrow the rest).
+    fn split<'a>(
+        &'a mut self,
+        model: &'a Model<D>,
+        seconds: &'a mut f64,
+    ) -> Result<(&'a mut Snes, &'a mut Vector, &'a mut Mat, Assembler<'a, D, M, N>), Error> {
+        let GridSystem { dm, x, x_local, f_local, snes, jac, schur, step, stages, .. } = self;
+        let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("the step was not prepared"))?;
+        let asm =
+            Assembler::new(dm, model, step, x_local, f_local, seconds, &stages.assembly).with_schur(schur.as_mut());
+        Ok((snes, x, jac, asm))
+    }
+
+    /// The forces of the converged step (collective): the moment of the external, reaction and
+    /// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
+    /// reaction. Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia"
+    /// is then everything in it but the internal and external forces at t_{n+1} (see
+    /// `Assembler::nodal_terms`).
+    pub fn step_forces(
+        &mut self,
+        model: &Model<D>,
+        coll: &Collective,
+        diagnostics: bool,
+    ) -> Result<StepForces<D>, String> {
+        let nd = self.layout.nd;
+        let ng = self.ghost.len() * nd;
+        let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
+        let (mut stiffness, mut internal) = (vec![0.0; ng], vec![0.0; ng]);
+        // An explicit step's forces are those of its start (σ_n on x_n, [`explicit`]): its balance
+        // is taken there, against the stress before the particle update (`StepForces::at_start`).
+        let at_start = model.integration.is_explicit();
+        let xl = if at_start { vec![0.0; ng] } else { self.step.solution.clone() };
+        if at_start {
+            let start = self.step.start_terms.take().expect("an explicit step's start terms");
+            (all, inertia, magnitude) = (start.all, start.inertia, start.magnitude);
+        }
+        self.with_assembler(model, |asm| {
+            if !at_start {
+                asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
+            }
+            if diagnostics {
+                asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
+            }
+        });
+        if diagnostics {
+            for v in [&mut stiffness, &mut internal] {
+                self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+            }
+            let mag = |v: &[f64], l: usize| v[l * nd..l * nd + D].iter().fold(0.0, |m: f64, x| m.hypot(*x));
+            self.node_diagnostics =
+                self.owned_nodes.iter().map(|&a| [mag(&stiffness, a as usize), mag(&internal, a as usize)]).collect();
+        }
+        let mut fext = self.step.fext.clone();
+        let mut fext_old = self.step.fext_old.clone();
+        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
+            self.sum_over_ranks(v).map_err(|e| e.to_string())?;
+        }
+        // An explicit step's inertia is its lumped nodal update's (already summed over ranks).
+        for (i, m) in inertia.iter_mut().zip(&self.step.explicit_inertia) {
+            *i += m;
+        }
+        let field_scales = self.field_norms(&magnitude, coll)?;
+        let g = &model.grid;
+        let hi = g.extent_max();
+        // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
+        // stress is only defined there).
+        let mut origin: [f64; D] = std::array::from_fn(|d| 0.5 * (g.origin[d] + hi[d]));
+        if model.geometry.axisymmetric() {
+            origin[0] = 0.0;
+        }
+        let nb = model.boundaries.len();
+        // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
+        // boundary (D nb)]
+        let dd = D * D;
+        let mut local = vec![0.0; 4 * dd + 1 + D * nb];
+        let last = std::mem::take(&mut self.last_reactions);
+        let mut reactions = vec![0.0; ng];
+        // (dof component, in-plane direction) of the solid and water motion.
+        let motion: Vec<(usize, usize)> =
+            self.motion().into_iter().map(|c| (c, if c < D { c } else { c - self.layout.w.unwrap_or(0) })).collect();
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            let p = g.position(self.ghost.indices(l));
+            let u = &xl[l * nd..l * nd + D];
+            let xr: [f64; D] = std::array::from_fn(|d| p[d] + u[d] - origin[d]);
+            for &(c, dir) in &motion {
+                let q = l * nd + c;
+                let b = self.step.dofs.boundary[q];
+                let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
+                if (b as usize) < nb {
+                    local[4 * dd + 1 + D * b as usize + dir] += reaction;
+                }
+                reactions[q] = reaction;
+                let reaction_old = last.get(q).copied().unwrap_or(reaction);
+                local[4 * dd] += 0.5 * (fext_old[q] + fext[q] + reaction_old + reaction) * self.step.solution[q];
+                for (row, x) in xr.iter().enumerate() {
+                    let k = row * D + dir;
+                    local[k] += x * (fext[q] + reaction - inertia[q]);
+                    local[dd + k] += x * fext[q];
+                    local[2 * dd + k] += x * reaction;
+                    local[3 * dd + k] += x * inertia[q];
+                }
+            }
+        }
+        self.last_reactions = reactions;
+        let s = coll.sum(&local)?;
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok(StepForces {
+            moment: std::array::from_fn(|a| std::array::from_fn(|b| s[a * D + b])),
+            scale: norm(&s[dd..2 * dd]).max(norm(&s[2 * dd..3 * dd])).max(norm(&s[3 * dd..4 * dd])),
+            origin,
+            reactions: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * b + d])).collect(),
+            work: s[4 * dd],
+            field_scales,
+            at_start,
+        })
+    }
+
+    /// The norm of each field (`Layout::fields`) of the ghosted, rank-summed dof values `v` over
+    /// the free owned dofs, in PETSc's scaling (pressure rows times s) (collective).
+    fn field_norms(&self, v: &[f64], coll: &Collective) -> Result<Vec<f64>, String> {
+        let nd = self.layout.nd;
+        let mut local = vec![0.0; nd];
+        for &a in &self.owned_nodes {
+            for (c, l) in local.iter_mut().enumerate() {
+                let q = a as usize * nd + c;
+                if !self.step.dofs.fixed[q] {
+                    let m = v[q] * self.step.unit(q);
+                    *l += m * m;
+                }
+            }
+        }
+        let squares = coll.sum(&local)?;
+        Ok(self.layout.fields().iter().map(|(_, cs)| cs.iter().map(|&c| squares[c]).sum::<f64>().sqrt()).collect())
+    }
+
+    /// The norm over the free dofs of the prepared step's force magnitudes (collective).
+    fn force_scale_of(&mut self, mags: &mut [f64], coll: &Collective) -> Result<f64, String> {
+        self.sum_over_ranks(mags).map_err(|e| e.to_string())?;
+        self.step.field_scales = self.field_norms(mags, coll)?;
+        Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
+    }
+
+    /// Runs `f` with the callbacks' view of the prepared step (outside the SNES solve: the nodal
+    /// terms, the force magnitudes, the histories of a step's start).
+    fn with_assembler<R>(&mut self, model: &Model<D>, f: impl FnOnce(&Assembler<D, M, N>) -> R) -> R {
+        let mut seconds = 0.0;
+        let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
+        f(&Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly))
+    }
+
+    /// Σ S_ip u_i at particle `k` of a nodal 2-vector field `u` per ghosted dof (barely filled
+    /// nodes extended from their masters).
+    fn interpolated(&self, k: usize, u: &[f64]) -> [f64; D] {
+        let (nodes, basis) = self.step.stencils.get(k);
+        let states = callbacks::node_states::<D, M, N>(&self.step, k, u);
+        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du
+    }
+
+    /// The converged step at particle `k` for the particle update: exactly the point the converged
+    /// residual evaluated.
+    pub fn step_result(&self, model: &Model<D>, k: usize) -> StepResult<D> {
+        let (nodes, basis) = self.step.stencils.get(k);
+        let states = callbacks::node_states::<D, M, N>(&self.step, k, &self.step.solution);
+        let mut input = callbacks::particle_input(model, &self.step, k);
+        // The F̄ projection's scale of an explicit step (only the particle update sees it: the
+        // step's forces are those of its start).
+        let fbar = self.step.fbar_scale.get(k).copied();
+        if let Some([c, s, _]) = fbar {
+            input.fbar = c;
+            input.fbar_total = s;
+        }
+        let mat = &model.materials[model.particles.material[k] as usize];
+        let strain = self.step.stencils.strain_of(k);
+        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
+            .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
+        let mut result = StepResult::of(&pt);
+        if let Some(f) = fbar {
+            result.jbar = Some(f[2]);
+        }
+        if self.layout.w.is_some() && self.layout.p.is_none() {
+            // The u–U system: the nodal pressure's increment, or the point's own.
+            result.interp.dp = match self.step.pressure_increment.get(k) {
+                Some(&dp) => dp,
+                None => kernels::flow::continuity::pointwise_increment(&pt.interp, pt.part),
+            };
+        }
+        if !self.step.xpic_correction.is_empty() {
+            // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
+            let c = self.interpolated(k, &self.step.xpic_correction);
+            let dt = self.step.dt;
+            result.velocity = Some(std::array::from_fn(|d| result.interp.du[d] / dt + c[d]));
+        }
+        result
+    }
+}
+
+/// The parts of the global system that exist only in the plane (validation keeps them out of
+/// three-dimensional cases): moving surfaces and their drained faces, loads, [001]'s mapped
+/// stiffnesses, the pressure projection, the explicit update and the MLSA recovery.
+impl GridSystem {
+    /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
+    /// it is.
+    pub fn owns_cell(&self, i: usize, j: usize) -> bool {
+        self.owns_cell_in([i, j])
+    }
+
+    /// The plane-only parts of a step's data (step 4): Nitsche's drained faces of the moving
+    /// surfaces (`weak`), [001]'s mapped stiffnesses, and the drained nodes of an explicit
+    /// two-phase step with the nodal pore pressure.
+    fn plane_step(&mut self, model: &Model, active: &Active, weak: bool, coll: &Collective) -> Result<(), String> {
+        if weak {
+            (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
+        }
+        self.step.stiffness =
+            coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
+        if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
+            if self.layout.w.is_some() {
+                self.step.drained = self.drained_nodes(model, active).map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
+    /// (see [`explicit`]): a side or region boundary of the stage fixes `p` there, a moving
+    /// surface that fixes `p` reaches it (`Model::surface_fixes`, marks summed over the ranks), or
+    /// the material barely fills it (the drained value of implicit stages' barely filled nodes).
+    fn drained_nodes(&mut self, model: &Model, active: &Active) -> Result<Vec<bool>, Error> {
+        let nd = self.layout.nd;
+        let p = kernels::dof::P;
+        let mut marks = vec![0.0; self.ghost.len() * nd];
+        for ((i, j), _, comps) in model.surface_fixes(active, false) {
+            if let (true, Some(l)) = (comps[p], self.ghost.node(i as usize, j as usize)) {
+                marks[l * nd] = 1.0;
+            }
+        }
+        self.sum_over_ranks(&mut marks)?;
+        Ok((0..self.ghost.len())
+            .map(|l| {
+                let (i, j) = self.ghost.ij(l);
+                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, [i, j])[p].is_some()
+            })
+            .collect())
+    }
+
+    /// Step 4: the drained faces of this rank's particles with their geometry and the grid's
+    /// bilinear shape functions at the face point, ordered by particle (see
+    /// [`kernels::DrainedFace`]). The gradient is the one on the material's side of a grid line
+    /// through the face point.
+    fn drained_faces(&self, model: &Model, active: &Active) -> Vec<(usize, kernels::DrainedFace)> {
+        let (g, ps) = (&model.grid, &model.particles);
+        let penalty = NITSCHE_PENALTY / g.h[0].min(g.h[1]);
+        model
+            .drained_faces(active)
+            .into_iter()
+            .map(|(k, face)| {
+                let normal = model.face_normal(k, face);
+                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
+                let area = length * model.geometry.measure(xf[0]);
+                let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
+                let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
+                let (nodes, _) = self.step.stencils.get(k);
+                for (b, &node) in basis.iter_mut().zip(nodes) {
+                    let (i, j) = self.ghost.ij(node as usize);
+                    *b = shape::bilinear(g.node_position(i, j), xf, inside, g.h);
+                }
+                (
+                    k,
+                    kernels::DrainedFace {
+                        offset: [xf[0] - ps.x[k][0], xf[1] - ps.x[k][1]],
+                        normal,
+                        area,
+                        penalty,
+                        basis,
+                    },
+                )
+            })
+            .collect()
     }
 
     /// Step 4: the pressure-projection blocks, cell by cell over this rank's particles (grouped by
@@ -1162,297 +1588,6 @@ impl GridSystem {
         Ok((fext, applied))
     }
 
-    /// The load accounting of a step: the tractions the case applies at t_{n+1} against the forces
-    /// assembled on nodes that carry them (free, or fixed by a boundary, whose reaction then takes
-    /// them). A difference beyond round-off means that part of a load would be lost: an error
-    /// naming the load.
-    fn check_loads(&mut self, applied: &AppliedLoads, t_new: f64, coll: &Collective) -> Result<(), String> {
-        let nd = self.layout.nd;
-        let (applied, names) = (applied.total, &applied.names);
-        if names.is_empty() {
-            return Ok(());
-        }
-        let mut summed = self.step.fext.clone();
-        self.sum_over_ranks(&mut summed).map_err(|e| e.to_string())?;
-        let mut carried = [0.0; 2];
-        let mut magnitude = 0.0f64;
-        for &a in &self.owned_nodes {
-            let l = a as usize;
-            for (c, carried_c) in carried.iter_mut().enumerate() {
-                let q = l * nd + c;
-                magnitude = magnitude.max(summed[q].abs());
-                if !self.step.dofs.fixed[q] || self.step.dofs.boundary_fixed(l, c) {
-                    *carried_c += summed[q];
-                }
-            }
-        }
-        let totals = coll.sum(&[applied[0], applied[1], carried[0], carried[1]])?;
-        let scale = coll.max(&[magnitude])?[0].max(totals[0].abs()).max(totals[1].abs());
-        let lost = [totals[0] - totals[2], totals[1] - totals[3]];
-        if lost[0].hypot(lost[1]) > 1e-9 * scale.max(f64::MIN_POSITIVE) {
-            return Err(format!(
-                "at t = {t_new:.6e} s the load(s) {} apply ({:.6e}, {:.6e}) N/m but the grid carries ({:.6e}, {:.6e}) N/m: \
-                 part of the load acts on nodes the material does not fill",
-                names.join(", "),
-                totals[0],
-                totals[1],
-                totals[2],
-                totals[3]
-            ));
-        }
-        Ok(())
-    }
-
-    /// Solves the prepared step by Newton's method from Δd = 0, or, when the analysis extrapolates,
-    /// from the last accepted increment scaled by Δt / Δt_last; every fixed dof starts at its
-    /// prescribed increment. Geometrically linear steps start from Δd = 0: their residual is affine
-    /// in Δd, so the exact tangent needs one iteration from anywhere, and one solve with one of
-    /// [001]'s mapped stiffnesses is then [001]'s K Δu = ΔF.
-    pub fn solve(&mut self, model: &Model) -> Result<StepSolve, Error> {
-        if model.integration.is_explicit() {
-            return self.explicit_update(model);
-        }
-        let _stage = self.stages.solve.push()?;
-        // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.
-        let atol = self.user_atol.max(FORCE_ATOL * self.step.force_scale);
-        self.snes.set_tolerances(Some(atol), None, None, None)?;
-        let mut assembly_seconds = 0.0;
-        let t0 = Instant::now();
-        self.initial_guess(model)?;
-        let (mut out, mut nonfinite) = {
-            let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
-            let out = snes.solve(x, jac, &mut asm)?;
-            (out, asm.nonfinite.take())
-        };
-        // Full Newton steps that diverged are tried once more from the same start with a
-        // backtracking line search, before the driver cuts Δt (see [`LINE_SEARCH_RETRY`]).
-        let mut line_search_retry = false;
-        if !out.converged
-            && DIVERGED_BY_FULL_STEPS.contains(&out.reason_text.as_str())
-            && self.retry_with_line_search
-            && self.snes.type_name()? == "newtonls"
-            && self.snes.line_search_type()? == "basic"
-        {
-            line_search_retry = true;
-            self.initial_guess(model)?;
-            self.snes.set_line_search(LINE_SEARCH_RETRY)?;
-            let retry = {
-                let (snes, x, jac, mut asm) = self.split(model, &mut assembly_seconds)?;
-                snes.solve(x, jac, &mut asm).map(|o| (o, asm.nonfinite.take()))
-            };
-            self.snes.set_line_search("basic")?;
-            let (second, second_nonfinite) = retry?;
-            // A point that was not finite in the first try names the failure only if the second
-            // fails too.
-            nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
-            let (first_newton, first_krylov) = (out.iterations, out.linear_iterations);
-            out = SolveOutcome {
-                iterations: first_newton + second.iterations,
-                linear_iterations: first_krylov + second.linear_iterations,
-                reason_text: if second.converged {
-                    second.reason_text.clone()
-                } else {
-                    format!("{} ({} with a line search)", out.reason_text, second.reason_text)
-                },
-                ..second
-            };
-        }
-        let solve_seconds = t0.elapsed().as_secs_f64();
-        self.dm.global_to_local(&self.x, &mut self.x_local)?;
-        let mut solution = self.x_local.read()?.to_vec();
-        for (q, v) in solution.iter_mut().enumerate() {
-            *v *= self.step.unit(q);
-        }
-        self.step.solution = solution;
-        let components = &out.final_residual_components;
-        let field_residuals = if components.len() == self.layout.nd {
-            let norm = |cs: &[usize]| cs.iter().map(|&c| components[c] * components[c]).sum::<f64>().sqrt();
-            self.layout.fields().iter().map(|(_, cs)| norm(cs)).collect()
-        } else {
-            Vec::new()
-        };
-        Ok(StepSolve {
-            converged: out.converged,
-            reason: out.reason_text,
-            newton_iterations: out.iterations,
-            linear_iterations: out.linear_iterations,
-            residual_history: out.residual_history,
-            domain_error: out.domain_error,
-            nonfinite,
-            assembly_seconds,
-            solve_seconds,
-            field_residuals,
-            field_scales: self.step.field_scales.clone(),
-            linear_field_residuals: out.linear_field_residuals,
-            solver_used: true,
-            line_search_retry,
-        })
-    }
-
-    /// Sets PETSc's solution vector to the step's first iterate: the last accepted increment
-    /// scaled to the new Δt where the stage extrapolates (static and quasi-static), zero
-    /// otherwise, with the prescribed increments at the fixed dofs.
-    fn initial_guess(&mut self, model: &Model) -> Result<(), Error> {
-        let mut x = self.x.write()?;
-        match &self.last_increment {
-            Some((last, dt_last))
-                if model.integration.extrapolates() && !model.linear_increments && last.len() == x.len() =>
-            {
-                let ratio = self.step.dt / dt_last;
-                for (xi, li) in x.iter_mut().zip(last) {
-                    *xi = ratio * li;
-                }
-            }
-            _ => x.fill(0.0),
-        }
-        for &(o, q) in &self.step.dofs.owned_fixed {
-            x[o] = self.step.dofs.value[q] / self.step.unit(q);
-        }
-        Ok(())
-    }
-
-    /// Keeps the increment of the step just accepted (of length `dt`) as the next step's
-    /// predictor.
-    pub fn accept_increment(&mut self, dt: f64) -> Result<(), Error> {
-        self.last_increment = Some((self.x.read()?.to_vec(), dt));
-        Ok(())
-    }
-
-    /// Forgets the last increment: the next step starts from Δd = 0 (a new stage changes the loads
-    /// or the analysis, so the last rate says nothing about the next step).
-    pub fn forget_increment(&mut self) {
-        self.last_increment = None;
-    }
-
-    /// Splits the system into the SNES, its solution vector and matrix, and the callbacks of the
-    /// prepared step (which borrow the rest).
-    fn split<'a>(
-        &'a mut self,
-        model: &'a Model,
-        seconds: &'a mut f64,
-    ) -> Result<(&'a mut Snes, &'a mut Vector, &'a mut Mat, Assembler<'a>), Error> {
-        let GridSystem { dm, x, x_local, f_local, snes, jac, schur, step, stages, .. } = self;
-        let jac = jac.as_mut().ok_or_else(|| petsc::Error::new("the step was not prepared"))?;
-        let asm =
-            Assembler::new(dm, model, step, x_local, f_local, seconds, &stages.assembly).with_schur(schur.as_mut());
-        Ok((snes, x, jac, asm))
-    }
-
-    /// The forces of the converged step (collective): the moment of the external, reaction and
-    /// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
-    /// reaction. Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia"
-    /// is then everything in it but the internal and external forces at t_{n+1} (see
-    /// `Assembler::nodal_terms`).
-    pub fn step_forces(&mut self, model: &Model, coll: &Collective, diagnostics: bool) -> Result<StepForces, String> {
-        let nd = self.layout.nd;
-        let ng = self.ghost.len() * nd;
-        let (mut all, mut inertia, mut magnitude) = (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng]);
-        let (mut stiffness, mut internal) = (vec![0.0; ng], vec![0.0; ng]);
-        // An explicit step's forces are those of its start (σ_n on x_n, [`explicit`]): its balance
-        // is taken there, against the stress before the particle update (`StepForces::at_start`).
-        let at_start = model.integration.is_explicit();
-        let xl = if at_start { vec![0.0; ng] } else { self.step.solution.clone() };
-        if at_start {
-            let start = self.step.start_terms.take().expect("an explicit step's start terms");
-            (all, inertia, magnitude) = (start.all, start.inertia, start.magnitude);
-        }
-        self.with_assembler(model, |asm| {
-            if !at_start {
-                asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
-            }
-            if diagnostics {
-                asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
-            }
-        });
-        if diagnostics {
-            for v in [&mut stiffness, &mut internal] {
-                self.sum_over_ranks(v).map_err(|e| e.to_string())?;
-            }
-            let mag = |v: &[f64], l: usize| v[l * nd].hypot(v[l * nd + 1]);
-            self.node_diagnostics =
-                self.owned_nodes.iter().map(|&a| [mag(&stiffness, a as usize), mag(&internal, a as usize)]).collect();
-        }
-        let mut fext = self.step.fext.clone();
-        let mut fext_old = self.step.fext_old.clone();
-        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
-            self.sum_over_ranks(v).map_err(|e| e.to_string())?;
-        }
-        // An explicit step's inertia is its lumped nodal update's (already summed over ranks).
-        for (i, m) in inertia.iter_mut().zip(&self.step.explicit_inertia) {
-            *i += m;
-        }
-        let field_scales = self.field_norms(&magnitude, coll)?;
-        let g = &model.grid;
-        let hi = g.extent_max();
-        // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
-        // stress is only defined there).
-        let centre_x = if model.geometry.axisymmetric() { 0.0 } else { 0.5 * (g.origin[0] + hi[0]) };
-        let origin = [centre_x, 0.5 * (g.origin[1] + hi[1])];
-        let nb = model.boundaries.len();
-        // [total moment (4), external (4), reaction (4), inertia (4), work, reactions per boundary (2 nb)]
-        let mut local = vec![0.0; 17 + 2 * nb];
-        let last = std::mem::take(&mut self.last_reactions);
-        let mut reactions = vec![0.0; ng];
-        // (dof component, in-plane direction) of the solid and water motion.
-        let motion: Vec<(usize, usize)> =
-            self.motion().into_iter().map(|c| (c, if c < 2 { c } else { c - self.layout.w.unwrap_or(0) })).collect();
-        for &a in &self.owned_nodes {
-            let l = a as usize;
-            let (i, j) = self.ghost.ij(l);
-            let p = g.node_position(i, j);
-            let u = &xl[l * nd..l * nd + 2];
-            let xr = [p[0] + u[0] - origin[0], p[1] + u[1] - origin[1]];
-            for &(c, dir) in &motion {
-                let q = l * nd + c;
-                let b = self.step.dofs.boundary[q];
-                let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
-                if (b as usize) < nb {
-                    local[17 + 2 * b as usize + dir] += reaction;
-                }
-                reactions[q] = reaction;
-                let reaction_old = last.get(q).copied().unwrap_or(reaction);
-                local[16] += 0.5 * (fext_old[q] + fext[q] + reaction_old + reaction) * self.step.solution[q];
-                for (row, x) in xr.iter().enumerate() {
-                    let k = row * 2 + dir;
-                    local[k] += x * (fext[q] + reaction - inertia[q]);
-                    local[4 + k] += x * fext[q];
-                    local[8 + k] += x * reaction;
-                    local[12 + k] += x * inertia[q];
-                }
-            }
-        }
-        self.last_reactions = reactions;
-        let s = coll.sum(&local)?;
-        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        Ok(StepForces {
-            moment: [[s[0], s[1]], [s[2], s[3]]],
-            scale: norm(&s[4..8]).max(norm(&s[8..12])).max(norm(&s[12..16])),
-            origin,
-            reactions: (0..nb).map(|b| [s[17 + 2 * b], s[18 + 2 * b]]).collect(),
-            work: s[16],
-            field_scales,
-            at_start,
-        })
-    }
-
-    /// The norm of each field (`Layout::fields`) of the ghosted, rank-summed dof values `v` over
-    /// the free owned dofs, in PETSc's scaling (pressure rows times s) (collective).
-    fn field_norms(&self, v: &[f64], coll: &Collective) -> Result<Vec<f64>, String> {
-        let nd = self.layout.nd;
-        let mut local = vec![0.0; nd];
-        for &a in &self.owned_nodes {
-            for (c, l) in local.iter_mut().enumerate() {
-                let q = a as usize * nd + c;
-                if !self.step.dofs.fixed[q] {
-                    let m = v[q] * self.step.unit(q);
-                    *l += m * m;
-                }
-            }
-        }
-        let squares = coll.sum(&local)?;
-        Ok(self.layout.fields().iter().map(|(_, cs)| cs.iter().map(|&c| squares[c]).sum::<f64>().sqrt()).collect())
-    }
-
     /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
     /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
     /// interpolated increment.
@@ -1597,66 +1732,28 @@ impl GridSystem {
     pub fn carry_node_values(&mut self, values: Vec<f64>) {
         self.carried = values;
     }
+}
 
-    /// The norm over the free dofs of the prepared step's force magnitudes (collective).
-    fn force_scale_of(&mut self, mags: &mut [f64], coll: &Collective) -> Result<f64, String> {
-        self.sum_over_ranks(mags).map_err(|e| e.to_string())?;
-        self.step.field_scales = self.field_norms(mags, coll)?;
-        Ok(self.step.field_scales.iter().map(|x| x * x).sum::<f64>().sqrt())
-    }
+/// The node indices `n` of a plane grid in a grid of dimension D (only called where D = 2: the
+/// plane-only features' nodes reach generic code through it).
+fn lift<const D: usize>(n: [usize; 2]) -> [usize; D] {
+    std::array::from_fn(|d| n[d])
+}
 
-    /// Runs `f` with the callbacks' view of the prepared step (outside the SNES solve: the nodal
-    /// terms, the force magnitudes, the histories of a step's start).
-    fn with_assembler<R>(&mut self, model: &Model, f: impl FnOnce(&Assembler) -> R) -> R {
-        let mut seconds = 0.0;
-        let GridSystem { dm, x_local, f_local, step, stages, .. } = self;
-        f(&Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly))
+/// The body acceleration at time `t` of each body ([`Model::body_accelerations`]; zero in three
+/// dimensions, whose cases have no loads yet).
+fn body_accelerations<const D: usize>(model: &Model<D>, active: &Active, t: f64) -> Vec<[f64; D]> {
+    match model.as_plane() {
+        Some(m) => m.body_accelerations(active, t).into_iter().map(lift_vector).collect(),
+        None => {
+            vec![[0.0; D]; model.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(model.n_bodies)]
+        }
     }
+}
 
-    /// Σ S_ip u_i at particle `k` of a nodal 2-vector field `u` per ghosted dof (barely filled
-    /// nodes extended from their masters).
-    fn interpolated(&self, k: usize, u: &[f64]) -> [f64; 2] {
-        let (nodes, basis) = self.step.stencils.get(k);
-        let states = callbacks::node_states(&self.step, k, u);
-        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du
-    }
-
-    /// The converged step at particle `k` for the particle update: exactly the point the converged
-    /// residual evaluated.
-    pub fn step_result(&self, model: &Model, k: usize) -> StepResult {
-        let (nodes, basis) = self.step.stencils.get(k);
-        let states = callbacks::node_states(&self.step, k, &self.step.solution);
-        let mut input = callbacks::particle_input(model, &self.step, k);
-        // The F̄ projection's scale of an explicit step (only the particle update sees it: the
-        // step's forces are those of its start).
-        let fbar = self.step.fbar_scale.get(k).copied();
-        if let Some([c, s, _]) = fbar {
-            input.fbar = c;
-            input.fbar_total = s;
-        }
-        let mat = &model.materials[model.particles.material[k] as usize];
-        let strain = self.step.stencils.strain_of(k);
-        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
-            .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
-        let mut result = StepResult::of(&pt);
-        if let Some(f) = fbar {
-            result.jbar = Some(f[2]);
-        }
-        if self.layout.w.is_some() && self.layout.p.is_none() {
-            // The u–U system: the nodal pressure's increment, or the point's own.
-            result.interp.dp = match self.step.pressure_increment.get(k) {
-                Some(&dp) => dp,
-                None => kernels::flow::continuity::pointwise_increment(&pt.interp, pt.part),
-            };
-        }
-        if !self.step.xpic_correction.is_empty() {
-            // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
-            let c = self.interpolated(k, &self.step.xpic_correction);
-            let dt = self.step.dt;
-            result.velocity = Some([result.interp.du[0] / dt + c[0], result.interp.du[1] / dt + c[1]]);
-        }
-        result
-    }
+/// A plane vector in dimension D (only called where D = 2).
+fn lift_vector<const D: usize>(v: [f64; 2]) -> [f64; D] {
+    std::array::from_fn(|d| v[d])
 }
 
 /// The tractions of a step as the case applies them (before they are shared out to nodes), on

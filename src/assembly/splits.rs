@@ -33,13 +33,13 @@ use petsc::{Comm, IndexSet, Options, SchurUser, Snes, VecOps, Vector};
 /// user-built Schur preconditioner when the options ask for one (the caller fills it after each
 /// Jacobian); that needs porompm's splits and the u–p system, and asking for it otherwise is an
 /// error naming the option.
-pub(super) fn define(
+pub(super) fn define<const D: usize>(
     snes: &mut Snes,
     comm: Comm,
     coll: &Collective,
     layout: Layout,
     first_dof: usize,
-    positions: &[[f64; 2]],
+    positions: &[[f64; D]],
 ) -> Result<Option<SchurUser>, petsc::Error> {
     let mut ksp = snes.ksp()?;
     let mut pc = ksp.pc()?;
@@ -87,35 +87,66 @@ fn user_defines_splits() -> Result<bool, petsc::Error> {
 }
 
 /// The orthonormal rigid-body modes of the grid for a block of `components` displacement dofs per
-/// node (pairs (x, y), solid then water): the translations along x and y and the rotation about
-/// the nodes' centroid, every pair moving alike (collective).
-fn rigid_body_modes(
+/// node (groups of D, solid then water): the translations along each axis and the rotations about
+/// the nodes' centroid (about z in two dimensions; about x, y and z in three), every group moving
+/// alike (collective). The translations and rotations about the centroid are orthogonal; the three
+/// rotations of a three-dimensional grid are orthonormalised among themselves (Gram–Schmidt, as
+/// PETSc's `MatNullSpaceCreateRigidBody`).
+fn rigid_body_modes<const D: usize>(
     comm: Comm,
     coll: &Collective,
     components: usize,
-    positions: &[[f64; 2]],
+    positions: &[[f64; D]],
 ) -> Result<Vec<Vector>, petsc::Error> {
-    let local = [positions.len() as f64, positions.iter().map(|x| x[0]).sum(), positions.iter().map(|x| x[1]).sum()];
+    let mut local = vec![positions.len() as f64];
+    local.extend((0..D).map(|d| positions.iter().map(|x| x[d]).sum::<f64>()));
     let sums = coll.sum(&local).map_err(petsc::Error::new)?;
-    let centre = [sums[1] / sums[0].max(1.0), sums[2] / sums[0].max(1.0)];
+    let centre: [f64; D] = std::array::from_fn(|d| sums[1 + d] / sums[0].max(1.0));
     let n = positions.len() * components;
-    let pairs = components / 2;
-    let mode = |f: &dyn Fn([f64; 2]) -> [f64; 2]| -> Result<Vector, petsc::Error> {
+    let groups = components / D;
+    let values = |f: &dyn Fn([f64; D]) -> [f64; D]| -> Vec<f64> {
         let mut values = vec![0.0; n];
         for (a, x) in positions.iter().enumerate() {
-            let d = f([x[0] - centre[0], x[1] - centre[1]]);
-            for k in 0..pairs {
-                values[a * components + 2 * k] = d[0];
-                values[a * components + 2 * k + 1] = d[1];
+            let d = f(std::array::from_fn(|c| x[c] - centre[c]));
+            for k in 0..groups {
+                values[a * components + D * k..a * components + D * (k + 1)].copy_from_slice(&d);
             }
         }
-        // Translations and the rotation about the centroid are orthogonal: only normalise.
-        let norm = coll.sum(&[values.iter().map(|v| v * v).sum()]).map_err(petsc::Error::new)?[0].sqrt();
-        let mut v = Vector::new_mpi(comm, n as petsc::Int, petsc::DETERMINE)?;
-        for (w, x) in v.write()?.iter_mut().zip(&values) {
-            *w = x / norm;
-        }
-        Ok(v)
+        values
     };
-    Ok(vec![mode(&|_| [1.0, 0.0])?, mode(&|_| [0.0, 1.0])?, mode(&|r| [-r[1], r[0]])?])
+    let dot = |u: &[f64], v: &[f64]| -> Result<f64, petsc::Error> {
+        Ok(coll.sum(&[u.iter().zip(v).map(|(a, b)| a * b).sum()]).map_err(petsc::Error::new)?[0])
+    };
+    let mut modes: Vec<Vec<f64>> =
+        (0..D).map(|t| values(&|_| std::array::from_fn(|c| if c == t { 1.0 } else { 0.0 }))).collect();
+    // The rotation about axis a: ω × r with ω the unit vector of a (about z in the plane).
+    let axes: &[usize] = if D == 2 { &[2] } else { &[0, 1, 2] };
+    for &a in axes {
+        let mut m = values(&|r| {
+            let r3 = [r[0], r[1], if D == 3 { r[D - 1] } else { 0.0 }];
+            let w = [f64::from(a == 0), f64::from(a == 1), f64::from(a == 2)];
+            let c = [w[1] * r3[2] - w[2] * r3[1], w[2] * r3[0] - w[0] * r3[2], w[0] * r3[1] - w[1] * r3[0]];
+            std::array::from_fn(|d| c[d])
+        });
+        for earlier in &modes[D..] {
+            let along = dot(&m, earlier)?;
+            for (x, e) in m.iter_mut().zip(earlier) {
+                *x -= along * e;
+            }
+        }
+        let norm = dot(&m, &m)?.sqrt();
+        modes.push(m.iter().map(|x| x / norm).collect());
+    }
+    for m in modes.iter_mut().take(D) {
+        let norm = dot(m, m)?.sqrt();
+        m.iter_mut().for_each(|x| *x /= norm);
+    }
+    modes
+        .iter()
+        .map(|m| {
+            let mut v = Vector::new_mpi(comm, n as petsc::Int, petsc::DETERMINE)?;
+            v.write()?.copy_from_slice(m);
+            Ok(v)
+        })
+        .collect()
 }

@@ -351,12 +351,12 @@ pub fn build_in<const D: usize, const M: usize>(
 /// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
 /// as its reaction; on any other side the run must stop, naming the particle, its body, the time
 /// and the side. (Linear MPM and B-splines: a centre outside the grid always stops the run.)
-pub fn check_edges(
-    model: &Model,
-    st: &Stencils,
+pub fn check_edges<const D: usize>(
+    model: &Model<D>,
+    st: &Stencils<D>,
     crossings: &[Crossing],
     dofs: &DofMap,
-    ghost: &GhostedRange,
+    ghost: &GhostedRange<D>,
     t: f64,
     body_names: &[String],
 ) -> Result<(), String> {
@@ -365,27 +365,21 @@ pub fn check_edges(
     for c in crossings {
         let (nodes, _) = st.get(c.k);
         let normal = c.side / 2;
-        let on_side = |l: u32| {
-            let (i, j) = ghost.ij(l as usize);
-            match c.side {
-                0 => i == 0,
-                1 => i == g.cells[0],
-                2 => j == 0,
-                _ => j == g.cells[1],
-            }
-        };
+        let edge = if c.side % 2 == 0 { 0 } else { g.cells[normal] };
+        let on_side = |l: u32| ghost.indices(l as usize)[normal] == edge;
         let wall = model.basis == Basis::Gimp && {
             let side_nodes: Vec<u32> = nodes.iter().copied().filter(|&l| on_side(l)).collect();
             !side_nodes.is_empty() && side_nodes.iter().all(|&l| dofs.boundary_fixed(l as usize, normal))
         };
         if !wall {
-            let x = ps.x[c.k];
             let body = body_names.get(ps.body[c.k] as usize).map_or("?", |s| s.as_str());
             return Err(format!(
-                "at t = {t:.6e} s material point {} of body `{body}` at ({:.4}, {:.4}) m reaches past the grid's {} \
+                "at t = {t:.6e} s material point {} of body `{body}` at {} m reaches past the grid's {} \
                  edge, where no boundary holds it: its support would lose the part beyond the grid, and with it \
                  part of its load; enlarge the grid",
-                ps.id[c.k], x[0], x[1], SIDES[c.side]
+                ps.id[c.k],
+                crate::model::position_text(&ps.x[c.k]),
+                SIDES[c.side]
             ));
         }
     }
@@ -403,38 +397,58 @@ pub fn extension(
     tiny: f64,
     diagonal: bool,
 ) -> Option<ExtensionCoefficients> {
-    let (i, j) = (node.0 as i64, node.1 as i64);
-    let d = [toward[0] - pos[0], toward[1] - pos[1]];
-    let dir = |c: usize| {
-        if d[c] > tiny {
+    let (m, c, n) = extension_in([node.0, node.1], pos, toward, &|a: [i64; 2]| well(a[0], a[1]), tiny, diagonal)?;
+    Some((m.map(|a| (a[0], a[1])), c, n))
+}
+
+/// [`extension`] in any dimension: masters by their grid indices. The rules of the module
+/// documentation, generalised: (1, 2) along the grid line of each axis, the axis on which the
+/// particle lies farthest first; (3) from the triangle of two axes towards the particle,
+/// u_s = u_a + u_b − u_c, the pairs of axes in their order; (4) with B-splines, along the diagonal
+/// of the directions towards the particle. Each reproduces linear fields exactly.
+pub fn extension_in<const D: usize>(
+    node: [usize; D],
+    pos: [f64; D],
+    toward: [f64; D],
+    well: &dyn Fn([i64; D]) -> bool,
+    tiny: f64,
+    diagonal: bool,
+) -> Option<([[i64; D]; MAX_MASTERS], [f64; MAX_MASTERS], usize)> {
+    let n = node.map(|v| v as i64);
+    let d: [f64; D] = std::array::from_fn(|c| toward[c] - pos[c]);
+    let dir: [i64; D] = d.map(|v| {
+        if v > tiny {
             1i64
-        } else if d[c] < -tiny {
+        } else if v < -tiny {
             -1
         } else {
             0
         }
-    };
-    let (dx, dy) = (dir(0), dir(1));
-    let axes = if d[0].abs() >= d[1].abs() { [0usize, 1] } else { [1, 0] };
-    for axis in axes {
-        let (sx, sy) = if axis == 0 { (dx, 0) } else { (0, dy) };
-        if sx == 0 && sy == 0 {
-            continue;
-        }
-        let a = (i + sx, j + sy);
-        let b = (i + 2 * sx, j + 2 * sy);
-        if well(a.0, a.1) && well(b.0, b.1) {
-            return Some(([a, b, (0, 0)], [2.0, -1.0, 0.0], 2));
+    });
+    let step = |s: [i64; D], k: i64| -> [i64; D] { std::array::from_fn(|c| n[c] + k * s[c]) };
+    let unit = |a: usize| -> [i64; D] { std::array::from_fn(|c| if c == a { dir[a] } else { 0 }) };
+    // The axes by decreasing distance to the particle (ties: the lower axis first).
+    let mut axes: [usize; D] = std::array::from_fn(|a| a);
+    axes.sort_by(|&a, &b| d[b].abs().total_cmp(&d[a].abs()));
+    for &axis in axes.iter().filter(|&&a| dir[a] != 0) {
+        let (a, b) = (step(unit(axis), 1), step(unit(axis), 2));
+        if well(a) && well(b) {
+            return Some(([a, b, n], [2.0, -1.0, 0.0], 2));
         }
     }
-    if dx != 0 && dy != 0 {
-        let (a, b, c) = ((i + dx, j), (i, j + dy), (i + dx, j + dy));
-        if well(a.0, a.1) && well(b.0, b.1) && well(c.0, c.1) {
-            return Some(([a, b, c], [1.0, 1.0, -1.0], 3));
+    for p in 0..D {
+        for q in (p + 1..D).filter(|&q| dir[p] != 0 && dir[q] != 0) {
+            let (a, b) = (step(unit(p), 1), step(unit(q), 1));
+            let c: [i64; D] = std::array::from_fn(|k| a[k] + b[k] - n[k]);
+            if well(a) && well(b) && well(c) {
+                return Some(([a, b, c], [1.0, 1.0, -1.0], 3));
+            }
         }
-        let (a, b) = ((i + dx, j + dy), (i + 2 * dx, j + 2 * dy));
-        if diagonal && well(a.0, a.1) && well(b.0, b.1) {
-            return Some(([a, b, (0, 0)], [2.0, -1.0, 0.0], 2));
+    }
+    if diagonal && dir.iter().filter(|&&s| s != 0).count() >= 2 {
+        let (a, b) = (step(dir, 1), step(dir, 2));
+        if well(a) && well(b) {
+            return Some(([a, b, n], [2.0, -1.0, 0.0], 2));
         }
     }
     None
@@ -545,16 +559,22 @@ pub fn cmpm_patches(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs
 
 /// Adds the effective stencils and extensions (step 4 of a step) for the dof map `dofs` and the
 /// motion components `motion` of the layout (u and U).
-pub fn extend(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &DofMap, motion: &[usize]) {
+pub fn extend<const D: usize>(
+    st: &mut Stencils<D>,
+    model: &Model<D>,
+    ghost: &GhostedRange<D>,
+    dofs: &DofMap,
+    motion: &[usize],
+) {
     let ps = &model.particles;
     let g = &model.grid;
-    let is_well = |i: i64, j: i64| -> bool {
-        if i < 0 || j < 0 {
+    let is_well = |n: [i64; D]| -> bool {
+        if n.iter().any(|&v| v < 0) {
             return false;
         }
-        ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
+        ghost.local(n.map(|v| v as usize)).is_some_and(|l| dofs.well[l])
     };
-    let tiny = 1e-9 * g.h[0].min(g.h[1]);
+    let tiny = 1e-9 * g.h.iter().copied().fold(f64::INFINITY, f64::min);
     st.eff_offsets.clear();
     st.eff_nodes.clear();
     st.ext_offsets.clear();
@@ -568,22 +588,22 @@ pub fn extend(st: &mut Stencils, model: &Model, ghost: &GhostedRange, dofs: &Dof
         for (slot, idx) in raw.clone().enumerate() {
             let l = st.nodes[idx] as usize;
             let b = st.basis[idx];
-            if dofs.well[l] || (b.s == 0.0 && b.g == [0.0; 2] && b.gv == [0.0; 2] && b.tv == 0.0) {
+            if dofs.well[l] || (b.s == 0.0 && b.g == [0.0; D] && b.gv == [0.0; D] && b.tv == 0.0) {
                 continue;
             }
             let mask = motion.iter().filter(|&&c| !dofs.boundary_fixed(l, c)).fold(0u8, |m, &c| m | (1 << c));
             if mask == 0 {
                 continue;
             }
-            let (i, j) = ghost.ij(l);
-            let Some((masters, coefs, n)) =
-                extension((i, j), g.node_position(i, j), ps.x[k], &is_well, tiny, model.basis.is_bspline())
+            let n = ghost.indices(l);
+            let Some((masters, coefs, count)) =
+                extension_in(n, g.position(n), ps.x[k], &is_well, tiny, model.basis.is_bspline())
             else {
                 continue;
             };
-            let mut e = Extension { slot: slot as u8, masters: [(0, 0.0); MAX_MASTERS], n: n as u8, mask };
-            for (m, (&(mi, mj), &c)) in masters.iter().zip(&coefs).take(n).enumerate() {
-                let ml = ghost.node(mi as usize, mj as usize).expect("well nodes are ghosted") as u32;
+            let mut e = Extension { slot: slot as u8, masters: [(0, 0.0); MAX_MASTERS], n: count as u8, mask };
+            for (m, (mn, &c)) in masters.iter().zip(&coefs).take(count).enumerate() {
+                let ml = ghost.local(mn.map(|v| v as usize)).expect("well nodes are ghosted") as u32;
                 let pos = match st.eff_nodes[start..].iter().position(|&x| x == ml) {
                     Some(p) => p,
                     None => {
@@ -636,6 +656,44 @@ mod tests {
         let f = |x: [f64; 2]| 0.5 - x[0] + 4.0 * x[1];
         let v: f64 = (0..n).map(|k| c[k] * f(pos(m[k].0, m[k].1))).sum();
         assert!((v - f([2.0, 2.0])).abs() < 1e-12);
+    }
+
+    /// The extension rules in three dimensions: a line along the axis the particle lies farthest
+    /// on, a triangle of two axes when no line has two well-filled nodes (any pair of axes), the
+    /// diagonal with B-splines; each reproduces a linear field of x, y and z at the node.
+    #[test]
+    fn a_three_dimensional_extension_reproduces_linear_fields() {
+        let f = |n: [i64; 3]| 0.3 + 1.1 * n[0] as f64 - 0.7 * n[1] as f64 + 2.3 * n[2] as f64;
+        let check = |node: [usize; 3], toward: [f64; 3], well: &dyn Fn([i64; 3]) -> bool, diagonal: bool| {
+            let pos = node.map(|v| v as f64);
+            let (m, c, n) = extension_in(node, pos, toward, well, 1e-12, diagonal).expect("an extension");
+            assert!(m[..n].iter().all(|&a| well(a)), "{m:?}");
+            let v: f64 = (0..n).map(|k| c[k] * f(m[k])).sum();
+            assert!((v - f(node.map(|x| x as i64))).abs() < 1e-12, "{v} at {node:?}");
+            (m, n)
+        };
+        // A body below z = 2 (k ≤ 2): node (4, 5, 3) reached from (3.9, 5.1, 2.7) extends along z.
+        let below = |a: [i64; 3]| a.iter().all(|&v| v >= 0) && a[2] <= 2;
+        let (m, n) = check([4, 5, 3], [3.9, 5.1, 2.7], &below, false);
+        assert_eq!((n, m[0], m[1]), (2, [4, 5, 2], [4, 5, 1]));
+        // The farthest axis first: from (3.6, 5.1, 2.9), x (−0.4) before z (−0.1); only z is well.
+        let (m, _) = check([4, 5, 3], [3.6, 5.1, 2.9], &below, false);
+        assert_eq!(m[0], [4, 5, 2]);
+        let x_side = |a: [i64; 3]| a.iter().all(|&v| v >= 0) && a[0] <= 3;
+        let (m, _) = check([4, 5, 3], [3.6, 5.1, 2.9], &x_side, false);
+        assert_eq!(m[..2], [[3, 5, 3], [2, 5, 3]]);
+        // Triangles of the pairs (x, y) and (x, z).
+        let xy = |a: [i64; 3]| [[1, 2, 1], [2, 1, 1], [1, 1, 1]].contains(&a);
+        let (m, n) = check([2, 2, 1], [1.9, 1.8, 1.0], &xy, false);
+        assert_eq!((n, m), (3, [[1, 2, 1], [2, 1, 1], [1, 1, 1]]));
+        let xz = |a: [i64; 3]| [[1, 2, 2], [2, 2, 1], [1, 2, 1]].contains(&a);
+        let (_, n) = check([2, 2, 2], [1.8, 1.9, 1.7], &xz, false);
+        assert_eq!(n, 3);
+        // Along the diagonal with B-splines only.
+        let diagonal = |a: [i64; 3]| [[1, 1, 1], [0, 0, 0]].contains(&a);
+        assert!(extension_in([2, 2, 2], [2.0; 3], [1.8, 1.7, 1.9], &diagonal, 1e-12, false).is_none());
+        let (m, _) = check([2, 2, 2], [1.8, 1.7, 1.9], &diagonal, true);
+        assert_eq!(m[..2], [[1, 1, 1], [0, 0, 0]]);
     }
 
     /// The stencils of a three-dimensional model (a body over two of the grid's three z layers,

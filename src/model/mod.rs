@@ -311,6 +311,17 @@ impl Model<3> {
     }
 }
 
+/// `x` as the two-dimensional type `P` when it is one (the same value): dimension-generic code
+/// reaches the features that exist only in the plane through it (see [`Model::as_plane`]).
+pub fn plane<T: 'static, P: 'static>(x: &T) -> Option<&P> {
+    (x as &dyn std::any::Any).downcast_ref::<P>()
+}
+
+/// [`plane`] for a mutable value.
+pub fn plane_mut<T: 'static, P: 'static>(x: &mut T) -> Option<&mut P> {
+    (x as &mut dyn std::any::Any).downcast_mut::<P>()
+}
+
 /// The position `x` as "(x, y)" or "(x, y, z)" with four decimals, for messages.
 pub(crate) fn position_text<const D: usize>(x: &[f64; D]) -> String {
     format!("({})", x.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "))
@@ -322,6 +333,14 @@ pub(crate) fn index_text<const D: usize>(n: &[usize; D]) -> String {
 }
 
 impl<const D: usize> Model<D> {
+    /// The model itself when it is two-dimensional: the features that exist only in the plane
+    /// (moving surfaces, loads, axial symmetry, [001]'s CMPM and mapped stiffnesses, the explicit
+    /// update) are reached through it from dimension-generic code, and validation keeps them out
+    /// of three-dimensional cases.
+    pub fn as_plane(&self) -> Option<&Model> {
+        plane(self)
+    }
+
     /// For each dof component at the grid node with indices `n`, in the full two-phase order of
     /// the dimension (ux, uy, [uz,] p, Ux, Uy[, Uz]; [`dof_index_in`]), the first active side or
     /// region boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are

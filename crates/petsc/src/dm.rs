@@ -145,6 +145,19 @@ impl DmDa<3> {
 }
 
 impl<const D: usize> DmDa<D> {
+    /// A grid of any dimension (2 or 3), as [`DmDa::new_2d_partitioned`] and [`DmDa::new_3d`]: the
+    /// number of node layers of each process slab along each direction, or `None` for PETSc's
+    /// choice.
+    pub fn new_partitioned(
+        comm: Comm,
+        nodes: [usize; D],
+        stencil_width: usize,
+        field_names: &[&str],
+        ranges: Option<[&[usize]; D]>,
+    ) -> Result<DmDa<D>> {
+        DmDa::create(comm, nodes, stencil_width, field_names, ranges)
+    }
+
     /// The DMDA of any dimension (2 or 3; see [`DmDa::new_2d_partitioned`]).
     fn create(
         comm: Comm,

@@ -200,7 +200,7 @@ impl Snes {
     }
 
     /// Attaches a DM (its field names drive `-pc_fieldsplit_*_fields`).
-    pub fn set_dm(&mut self, dm: &crate::DmDa) -> Result<()> {
+    pub fn set_dm<const D: usize>(&mut self, dm: &crate::DmDa<D>) -> Result<()> {
         call!(SNESSetDM(self.raw, dm.raw()))
     }
 

@@ -178,6 +178,12 @@ impl LinearElastic {
         self.lame() + self.shear_modulus()
     }
 
+    /// Bulk modulus K = λ + 2G/3 [Pa]: the mean stress over the volumetric strain in three
+    /// dimensions.
+    pub fn bulk_modulus(&self) -> f64 {
+        self.lame() + 2.0 * self.shear_modulus() / 3.0
+    }
+
     /// σ + D Δε.
     pub fn trial(&self, stress: &Stress, deps: &Stress) -> Stress {
         let mut s = *stress;

@@ -1,0 +1,508 @@
+//! The global system in three dimensions (issue «Three dimensions»), without the driver: steps of
+//! a three-dimensional model prepared, solved by PETSc and taken back to its points through
+//! `porompm::assembly::SolidSystem`, the same code as the plane `GridSystem`.
+//!
+//! * `a_slab_steps_as_its_plane_twin`: a slab one cell thick held between two smooth walls
+//!   (u_z = 0 on both z faces) is a plane-strain body: a consolidating, yielding soil (the u–p
+//!   system with Darcy flow, Mohr–Coulomb, B̄) compressed by a strip at its top steps exactly as
+//!   the plane model of its section, point for point (positions, stresses, pore pressures,
+//!   plastic strain), and its out-of-plane stresses are zero shears and the plane σ_zz.
+//! * `a_block_squeezed_from_three_sides_is_homogeneous`: an elastic block on three rollers
+//!   pressed by a displaced face moves homogeneously, its stresses those of Hooke's law for the
+//!   imposed strain, to round-off, in every point; and the reactions balance.
+//!
+//! Run: `cargo test --release --test three_dimensional_system` (harness-free: PETSc is
+//! initialised once for all tests).
+
+use porompm::analysis::StageAnalysis;
+use porompm::assembly::{GridSystem, SolidSystem, StepForces};
+use porompm::case::{parse, Case};
+use porompm::model::Model;
+use porompm::parallel::Collective;
+
+/// The plane section: a 0.2 m × 0.6 m column of Mohr–Coulomb soil on a fixed base between
+/// smooth walls, drained at its top, pressed down by 3 mm over its left half (a strip footing
+/// on the region x ∈ [0, 0.1]).
+const PLANE: &str = r#"
+[analysis]
+formulation = "two_phase"
+[stabilisation]
+bbar = true
+[grid]
+size = [0.2, 0.8]
+cells = [2, 8]
+[[materials]]
+name = "soil"
+porosity = 0.4
+solid_density = 2650.0
+water_bulk_modulus = 2.2e9
+solid_bulk_modulus = inf
+hydraulic_conductivity = 1e-4
+[materials.model]
+type = "mohr_coulomb"
+young_modulus = 1e7
+poisson_ratio = 0.3
+friction_angle = 25.0
+cohesion = 5e3
+[[bodies]]
+name = "column"
+material = "soil"
+shape = { rectangle = { min = [0.0, 0.0], max = [0.2, 0.6] } }
+[[boundaries]]
+name = "base"
+side = "y_min"
+fix = ["ux", "uy"]
+[[boundaries]]
+name = "left"
+side = "x_min"
+fix = ["ux"]
+[[boundaries]]
+name = "right"
+side = "x_max"
+fix = ["ux"]
+[[boundaries]]
+name = "drained"
+region = { min = [0.0, 0.6], max = [0.2, 0.6] }
+fix = ["p"]
+[[boundaries]]
+name = "strip"
+region = { min = [0.0, 0.6], max = [0.1, 0.6] }
+fix = ["uy"]
+displacement = [0.0, -3e-3]
+time_function = "ramp"
+[[stages]]
+name = "press"
+analysis = "quasi_static"
+duration = 0.03
+dt = 0.01
+[[time_functions]]
+name = "ramp"
+type = "ramp"
+duration = 0.03
+"#;
+
+/// The plane section extruded over z ∈ [0, 0.1] (one cell) between smooth walls on both z faces.
+fn slab() -> String {
+    PLANE
+        .replace("size = [0.2, 0.8]", "size = [0.2, 0.8, 0.1]")
+        .replace("cells = [2, 8]", "cells = [2, 8, 1]")
+        .replace(
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.2, 0.6] } }",
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.2, 0.6] } }\nz = [0.0, 0.1]",
+        )
+        .replace("fix = [\"ux\", \"uy\"]", "fix = [\"ux\", \"uy\", \"uz\"]")
+        .replace(
+            "region = { min = [0.0, 0.6], max = [0.1, 0.6] }",
+            "region = { min = [0.0, 0.6], max = [0.1, 0.6], z = [0.0, 0.1] }",
+        )
+        .replace(
+            "region = { min = [0.0, 0.6], max = [0.2, 0.6] }",
+            "region = { min = [0.0, 0.6], max = [0.2, 0.6], z = [0.0, 0.1] }",
+        )
+        .replace("displacement = [0.0, -3e-3]", "displacement = [0.0, -3e-3, 0.0]")
+        + r#"
+[[boundaries]]
+name = "back"
+side = "z_min"
+fix = ["uz"]
+[[boundaries]]
+name = "front"
+side = "z_max"
+fix = ["uz"]
+"#
+}
+
+fn case_of(text: &str) -> Result<Case, String> {
+    parse(text, "three_dimensional_system", &[]).map_err(|e| e.to_string())
+}
+
+/// The history of a run's points after each step: positions, stresses (6 components), pore
+/// pressures, plastic strains, ids.
+#[derive(Debug, Default)]
+struct Run {
+    x: Vec<Vec<[f64; 3]>>,
+    stress: Vec<Vec<[f64; 6]>>,
+    p: Vec<Vec<f64>>,
+    plastic: Vec<Vec<f64>>,
+    id: Vec<u64>,
+}
+
+/// Runs every step of the first stage of a plane case through `GridSystem`.
+fn run_plane(case: &Case, coll: &Collective) -> Result<(Run, StepForces), String> {
+    let stage = &case.stages[0];
+    let analysis = StageAnalysis::of(case, stage);
+    let grid = porompm::model::grid_of(case);
+    let mut system =
+        GridSystem::new(coll, &grid, analysis.layout, None, case.jacobian_stiffness()).map_err(|e| e.to_string())?;
+    let mut model = Model::build(case, |i, j| system.owns_cell(i, j));
+    model.integration = analysis.integration;
+    let active = model.active(stage);
+    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
+    let (dt, steps) = (stage.dt(), (stage.duration / stage.dt()).round() as usize);
+    let mut run = Run { id: model.particles.id.clone(), ..Run::default() };
+    let mut forces = StepForces::default();
+    for n in 1..=steps {
+        system.prepare_step(&model, &active, n as f64 * dt, dt, coll, &names)?;
+        let out = system.solve(&model).map_err(|e| e.to_string())?;
+        if !out.converged {
+            return Err(format!("the plane step {n} did not converge: {}", out.reason));
+        }
+        system.accept_increment(dt).map_err(|e| e.to_string())?;
+        forces = system.step_forces(&model, coll, false)?;
+        let results: Vec<_> = (0..model.particles.len()).map(|k| system.step_result(&model, k)).collect();
+        for (k, r) in results.iter().enumerate() {
+            model.update_particle(k, r, r.interp.dp, dt).map_err(|e| e.0)?;
+        }
+        let ps = &model.particles;
+        run.x.push(ps.x.iter().map(|x| [x[0], x[1], 0.0]).collect());
+        run.stress.push(ps.stress.clone());
+        run.p.push(ps.p.clone());
+        run.plastic.push(ps.eps_pd.clone());
+    }
+    Ok((run, forces))
+}
+
+/// Runs every step of the first stage of a three-dimensional case through `SolidSystem`.
+fn run_solid(case: &Case, coll: &Collective) -> Result<(Run, Model<3>, StepForces<3>), String> {
+    let stage = &case.stages[0];
+    let analysis = StageAnalysis::of(case, stage);
+    let grid = porompm::model::grid_of(case);
+    let mut system = SolidSystem::new(coll, &grid, analysis.layout.in_dim(3), None, case.jacobian_stiffness())
+        .map_err(|e| e.to_string())?;
+    let mut model = Model::<3>::build_solid(case, |c| system.owns_cell_in(c));
+    model.integration = analysis.integration;
+    let active = model.active(stage);
+    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
+    let (dt, steps) = (stage.dt(), (stage.duration / stage.dt()).round() as usize);
+    let mut run = Run { id: model.particles.id.clone(), ..Run::default() };
+    let mut forces = StepForces::default();
+    for n in 1..=steps {
+        system.prepare_step(&model, &active, n as f64 * dt, dt, coll, &names)?;
+        let out = system.solve(&model).map_err(|e| e.to_string())?;
+        if !out.converged {
+            return Err(format!("the three-dimensional step {n} did not converge: {}", out.reason));
+        }
+        system.accept_increment(dt).map_err(|e| e.to_string())?;
+        forces = system.step_forces(&model, coll, false)?;
+        let results: Vec<_> = (0..model.particles.len()).map(|k| system.step_result(&model, k)).collect();
+        for (k, r) in results.iter().enumerate() {
+            model.update_particle(k, r, r.interp.dp, dt).map_err(|e| e.0)?;
+        }
+        let ps = &model.particles;
+        run.x.push(ps.x.clone());
+        run.stress.push(ps.stress.clone());
+        run.p.push(ps.p.clone());
+        run.plastic.push(ps.eps_pd.clone());
+    }
+    Ok((run, model, forces))
+}
+
+/// The slab against its plane section: three steps without B̄, and the first step with B̄. After a
+/// step with B̄ the deformation gradient a point keeps differs by design, F̄ = (J_v/J)^{1/3} F in
+/// three dimensions (its zz stretch not 1) and (J_v/J)^{1/2} F of the in-plane deformation in the
+/// plane, and so do what follows it: the stretched GIMP domains and the pressure gradient carried
+/// with the material (measured on this slab: 3e-5 of the stresses after three steps).
+fn a_slab_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    let without = |t: &str| t.replace("bbar = true", "bbar = false");
+    let first = |t: &str| t.replace("duration = 0.03\ndt", "duration = 0.01\ndt");
+    compare_slab(&without(PLANE), &without(&slab()), coll)?;
+    compare_slab(&first(PLANE), &first(&slab()), coll)
+}
+
+/// The slab of `solid` steps as the plane section of `plane`, point for point.
+fn compare_slab(plane: &str, solid: &str, coll: &Collective) -> Result<(), String> {
+    let plane_case = case_of(plane)?;
+    let solid_case = case_of(solid)?;
+    let (plane, plane_forces) = run_plane(&plane_case, coll)?;
+    let (solid, model, forces) = run_solid(&solid_case, coll)?;
+    let (in_plane, zz) = forces_against_plane(&model, &forces, &plane_forces, 0.1);
+    let n2 = plane.id.len();
+    if solid.id.len() != 2 * n2 {
+        return Err(format!("{} points in the slab for {n2} in the plane (two layers expected)", solid.id.len()));
+    }
+    // The plane point of each slab point: the one at the same (x, y) at t = 0.
+    let x0 = &model.particles.x0;
+    let plane_model = Model::build(&plane_case, |_, _| true);
+    let twin: Vec<usize> = (0..solid.id.len())
+        .map(|k| {
+            (0..n2)
+                .find(|&q| {
+                    let y = plane_model.particles.x0[q];
+                    (y[0] - x0[k][0]).abs() < 1e-12 && (y[1] - x0[k][1]).abs() < 1e-12
+                })
+                .ok_or_else(|| format!("slab point {} has no plane twin", solid.id[k]))
+        })
+        .collect::<Result<_, _>>()?;
+    let scale_s = plane.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale_p = plane.p.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let yielded = plane.plastic.last().map_or(0, |e| e.iter().filter(|&&v| v > 0.0).count());
+    if yielded == 0 || scale_p <= 0.0 {
+        return Err(format!("the plane run must yield and build pore pressure (yielded {yielded}, p {scale_p})"));
+    }
+    let mut worst = [0.0f64; 4];
+    for step in 0..plane.x.len() {
+        for (k, &q) in twin.iter().enumerate() {
+            let (a, b) = (&solid.stress[step][k], &plane.stress[step][q]);
+            for c in 0..4 {
+                worst[0] = worst[0].max((a[c] - b[c]).abs() / scale_s);
+            }
+            worst[0] = worst[0].max(a[4].abs().max(a[5].abs()) / scale_s);
+            worst[1] = worst[1].max((solid.p[step][k] - plane.p[step][q]).abs() / scale_p);
+            for c in 0..2 {
+                worst[2] = worst[2].max((solid.x[step][k][c] - plane.x[step][q][c]).abs() / 0.1);
+            }
+            worst[2] = worst[2].max((solid.x[step][k][2] - x0[k][2]).abs() / 0.1);
+            worst[3] = worst[3].max((solid.plastic[step][k] - plane.plastic[step][q]).abs());
+        }
+    }
+    println!(
+        "    slab against plane (B̄ {}): {} steps, {yielded} of {n2} plane points yielded; largest differences: stress \
+         {:.1e} (of {scale_s:.3e} Pa), pore pressure {:.1e} (of {scale_p:.3e} Pa), position {:.1e} (of a cell), \
+         plastic strain {:.1e}",
+        plane_case.stabilisation.bbar,
+        plane.x.len(),
+        worst[0],
+        worst[1],
+        worst[2],
+        worst[3]
+    );
+    println!(
+        "    the slab's forces: first moments and reactions in the plane against the section's times its \
+         thickness {in_plane:.1e}; Σ z ⊗ R_z against ∫(σ_zz − p) dV {zz:.1e}"
+    );
+    if worst.iter().any(|&w| w > 1e-9 || w.is_nan()) || !(in_plane < 1e-10 && zz < 1e-9) {
+        return Err(format!("the slab departs from its plane twin: {worst:?}, forces {in_plane:e}, zz {zz:e}"));
+    }
+    Ok(())
+}
+
+/// The slab's step forces against its plane section's: the largest difference of the in-plane
+/// first moments and of the boundaries' in-plane reactions from the section's times the slab's
+/// `thickness` (relative to the largest of them), and of the zz moment (every z force is a
+/// wall's reaction) from ∫(σ_zz − p) dV (relative to the largest moment).
+fn forces_against_plane(model: &Model<3>, forces: &StepForces<3>, plane: &StepForces, thickness: f64) -> (f64, f64) {
+    let scale = plane.moment.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs())) * thickness;
+    let mut in_plane = 0.0f64;
+    for a in 0..2 {
+        for b in 0..2 {
+            in_plane = in_plane.max((forces.moment[a][b] - thickness * plane.moment[a][b]).abs() / scale);
+        }
+    }
+    let r_scale = plane.reactions.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs())) * thickness;
+    for (r3, r2) in forces.reactions.iter().zip(&plane.reactions) {
+        for c in 0..2 {
+            in_plane = in_plane.max((r3[c] - thickness * r2[c]).abs() / r_scale);
+        }
+    }
+    let ps = &model.particles;
+    let zz: f64 = (0..ps.len()).map(|k| (ps.stress[k][3] - ps.p[k]) * ps.volume[k]).sum();
+    (in_plane, (forces.moment[2][2] - zz).abs() / scale)
+}
+
+/// An elastic cube of 0.3 m on rollers at x_min, y_min and z_min, its x_max face displaced by
+/// δ = −1.5 mm, the others free: uniaxial stress, σ_xx = E δ/L, every other stress zero, the
+/// lateral strains −ν δ/L.
+const CUBE: &str = r#"
+[analysis]
+formulation = "one_phase"
+kinematics = "linear_increments"
+[grid]
+size = [0.3, 0.3, 0.3]
+cells = [3, 3, 3]
+[[materials]]
+name = "steel"
+porosity = 0.0
+solid_density = 2000.0
+[materials.model]
+type = "linear_elastic"
+young_modulus = 2e7
+poisson_ratio = 0.3
+[[bodies]]
+name = "cube"
+material = "steel"
+shape = { rectangle = { min = [0.0, 0.0], max = [0.3, 0.3] } }
+z = [0.0, 0.3]
+[[boundaries]]
+name = "x_roller"
+side = "x_min"
+fix = ["ux"]
+[[boundaries]]
+name = "y_roller"
+side = "y_min"
+fix = ["uy"]
+[[boundaries]]
+name = "z_roller"
+side = "z_min"
+fix = ["uz"]
+[[boundaries]]
+name = "press"
+side = "x_max"
+fix = ["ux"]
+displacement = [-1.5e-3, 0.0, 0.0]
+time_function = "ramp"
+[[stages]]
+name = "press"
+analysis = "static"
+duration = 1.0
+dt = 1.0
+[[time_functions]]
+name = "ramp"
+type = "ramp"
+duration = 1.0
+"#;
+
+fn a_block_squeezed_from_three_sides_is_homogeneous(coll: &Collective) -> Result<(), String> {
+    // Geometrically linear: Hooke's law for the imposed strain, exactly.
+    let (run, model, _) = run_solid(&case_of(CUBE)?, coll)?;
+    let (e, nu, l, d) = (2e7, 0.3, 0.3, -1.5e-3);
+    let strain = d / l;
+    let sxx = e * strain;
+    let last = run.stress.len() - 1;
+    let mut worst = [0.0f64; 2];
+    for (k, s) in run.stress[last].iter().enumerate() {
+        let want = [sxx, 0.0, 0.0, 0.0, 0.0, 0.0];
+        for c in 0..6 {
+            worst[0] = worst[0].max((s[c] - want[c]).abs() / sxx.abs());
+        }
+        let x0 = model.particles.x0[k];
+        let u: [f64; 3] = std::array::from_fn(|c| run.x[last][k][c] - x0[c]);
+        let want_u = [strain * x0[0], -nu * strain * x0[1], -nu * strain * x0[2]];
+        for c in 0..3 {
+            worst[1] = worst[1].max((u[c] - want_u[c]).abs() / d.abs());
+        }
+    }
+    println!(
+        "    cube in uniaxial stress: {} points, largest stress error {:.1e} of σ_xx = {sxx:.4e} Pa, displacement \
+         error {:.1e} of δ",
+        run.id.len(),
+        worst[0],
+        worst[1]
+    );
+    if worst.iter().any(|&w| w > 1e-10 || w.is_nan()) {
+        return Err(format!("the cube is not homogeneous: {worst:?}"));
+    }
+    // At finite strain, on the moved configuration: the same homogeneous uniaxial state (σ_xx the
+    // same at every point, the other components zero), the first moment of the loads and
+    // reactions about the grid's centre equal to ∫σ dV (Σ V σ over the points), and the walls'
+    // reactions σ_xx times the face's current area.
+    let (run, model, forces) = run_solid(&case_of(&CUBE.replace("kinematics = \"linear_increments\"\n", ""))?, coll)?;
+    let ps = &model.particles;
+    let sxx = ps.stress[0][0];
+    let spread = ps
+        .stress
+        .iter()
+        .flat_map(|s| (0..6).map(move |c| (s[c] - if c == 0 { sxx } else { 0.0 }).abs()))
+        .fold(0.0, f64::max)
+        / sxx.abs();
+    let mut integral = [[0.0; 3]; 3];
+    for (s, v) in ps.stress.iter().zip(&ps.volume) {
+        let t = [[s[0], s[2], s[5]], [s[2], s[1], s[4]], [s[5], s[4], s[3]]];
+        for a in 0..3 {
+            for b in 0..3 {
+                integral[a][b] += v * t[a][b];
+            }
+        }
+    }
+    let volume: f64 = ps.volume.iter().sum();
+    let scale = (sxx * volume).abs();
+    let moment_error =
+        (0..9).map(|e| (forces.moment[e / 3][e % 3] - integral[e / 3][e % 3]).abs() / scale).fold(0.0, f64::max);
+    // The lateral stretches from a point's motion (homogeneous: x = λ x0 in y and z).
+    let k = ps.len() - 1;
+    let stretch = |c: usize| ps.x[k][c] / ps.x0[k][c];
+    let area = l * stretch(1) * l * stretch(2);
+    let want = [[-sxx * area, 0.0, 0.0], [0.0; 3], [0.0; 3], [sxx * area, 0.0, 0.0]];
+    let reaction_error = forces
+        .reactions
+        .iter()
+        .zip(&want)
+        .flat_map(|(r, w)| (0..3).map(move |c| (r[c] - w[c]).abs() / (sxx * area).abs()))
+        .fold(0.0, f64::max);
+    println!(
+        "    at finite strain: σ_xx = {sxx:.4e} Pa ({:+.2} % from Hooke's), spread {spread:.1e}; Σ x ⊗ (F + R) \
+         against ∫σ dV {moment_error:.1e} of σ_xx V; the walls' reactions {reaction_error:.1e} of σ_xx A",
+        100.0 * (sxx / (e * strain) - 1.0)
+    );
+    if [spread, moment_error, reaction_error].iter().any(|&w| w > 1e-10 || w.is_nan()) || run.id.is_empty() {
+        return Err(format!(
+            "the cube at finite strain: spread {spread:e}, moment {moment_error:e}, reactions {reaction_error:e}"
+        ));
+    }
+    Ok(())
+}
+
+/// The slab's three steps (without B̄) with the iterative strategy of large quasi-static runs
+/// (`petsc_options/fieldsplit-fixed-stress.opts`: GMRES with the Schur field split whose `u` block
+/// carries the three-dimensional rigid-body modes to GAMG and whose Schur complement is the
+/// fixed-stress approximation with the skeleton's bulk modulus) give the direct solver's answer.
+fn the_slab_solves_alike_with_the_fixed_stress_field_split(coll: &Collective) -> Result<(), String> {
+    let case = case_of(&slab().replace("bbar = true", "bbar = false"))?;
+    let (direct, _, _) = run_solid(&case, coll)?;
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("petsc_options/fieldsplit-fixed-stress.opts");
+    let text = std::fs::read_to_string(&file).map_err(|e| e.to_string())?;
+    let names: Vec<&str> =
+        text.lines().filter_map(|l| l.split_whitespace().next()).filter(|w| w.starts_with('-')).collect();
+    let options = petsc::Options::global();
+    let comm = petsc::Comm::from_raw(mpi::traits::AsRaw::as_raw(coll.communicator()));
+    options.insert_file(comm, &file).map_err(|e| e.to_string())?;
+    let iterative = run_solid(&case, coll);
+    for n in &names {
+        options.clear_value(n).map_err(|e| e.to_string())?;
+    }
+    let (iterative, _, _) = iterative?;
+    let scale = direct.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = (0..direct.stress.len())
+        .flat_map(|n| (0..direct.id.len()).map(move |k| (n, k)))
+        .flat_map(|(n, k)| (0..6).map(move |c| (n, k, c)))
+        .map(|(n, k, c)| (direct.stress[n][k][c] - iterative.stress[n][k][c]).abs() / scale)
+        .fold(0.0, f64::max);
+    println!("    fixed-stress field split against LU: largest stress difference {worst:.1e} of {scale:.3e} Pa");
+    if worst > 1e-9 || worst.is_nan() {
+        return Err(format!("the iterative solve departs from the direct one by {worst:e}"));
+    }
+    Ok(())
+}
+
+type TestFn = fn(&Collective) -> Result<(), String>;
+
+fn main() {
+    let petsc = match petsc::Petsc::initialize(&[], None, "porompm three-dimensional system tests") {
+        Ok(p) => p,
+        Err(err) => {
+            eprintln!("cannot initialise PETSc: {err}");
+            std::process::exit(1);
+        }
+    };
+    // Newton to the round-off of the forces (the identities below are checked to 1e-10).
+    if let Err(err) = petsc::Options::global().set_value("-snes_rtol", Some("1e-13")) {
+        eprintln!("cannot set -snes_rtol: {err}");
+        std::process::exit(1);
+    }
+    let coll = Collective::world();
+    let tests: &[(&str, TestFn)] = &[
+        ("a_slab_steps_as_its_plane_twin", a_slab_steps_as_its_plane_twin),
+        ("a_block_squeezed_from_three_sides_is_homogeneous", a_block_squeezed_from_three_sides_is_homogeneous),
+        (
+            "the_slab_solves_alike_with_the_fixed_stress_field_split",
+            the_slab_solves_alike_with_the_fixed_stress_field_split,
+        ),
+    ];
+    let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
+    let (mut ran, mut failed) = (0, 0);
+    for (name, t) in tests {
+        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        ran += 1;
+        match t(&coll) {
+            Ok(()) => println!("test {name} ... ok"),
+            Err(msg) => {
+                failed += 1;
+                println!("test {name} ... FAILED\n    {msg}");
+            }
+        }
+    }
+    drop(petsc);
+    println!("\ntest result: {}. {} passed; {failed} failed", if failed == 0 { "ok" } else { "FAILED" }, ran - failed);
+    std::process::exit(if failed == 0 { 0 } else { 1 });
+}
