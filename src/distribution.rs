@@ -21,7 +21,7 @@ use crate::case::Case;
 use crate::model::grid::Grid;
 use crate::model::Model;
 use crate::parallel::Collective;
-use crate::state::{pack, particles_from_records, RECORD};
+use crate::state::{particles_from_flat, record_len, write_record};
 
 /// The load imbalance (the busiest rank's points over the mean) beyond which a run repartitions
 /// the grid (`porompm run --balance-threshold`).
@@ -178,19 +178,22 @@ fn cuts(w: &[f64], k: usize, min_width: usize) -> Option<Vec<usize>> {
 /// in the points sent here; collective (every rank calls it after the same step). The points stay
 /// sorted by id and the case's point-wise loads and surfaces are resolved again on the new set.
 /// Returns the number of points that left this rank.
-pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collective) -> usize {
+pub fn migrate<const D: usize>(model: &mut Model<D>, case: &Case, owners: &Owners<D>, coll: &Collective) -> usize {
     let me = coll.rank();
     let size = coll.size();
     if size == 1 {
         return 0;
     }
     let ps = &model.particles;
+    let len = record_len(D);
     let dest: Vec<usize> = (0..ps.len()).map(|k| owners.rank_of(&model.grid, ps.x[k])).collect();
     let mut outgoing = vec![Vec::new(); size];
     let mut sent = 0;
+    let mut record = vec![0.0; len];
     for (k, &r) in dest.iter().enumerate() {
         if r != me {
-            outgoing[r].extend_from_slice(&pack(ps, k));
+            write_record(ps, k, &mut record);
+            outgoing[r].extend_from_slice(&record);
             sent += 1;
         }
     }
@@ -198,11 +201,21 @@ pub fn migrate(model: &mut Model, case: &Case, owners: &Owners, coll: &Collectiv
     if sent == 0 && arrived.is_empty() {
         return 0;
     }
-    let mut records: Vec<[f64; RECORD]> = (0..ps.len()).filter(|&k| dest[k] == me).map(|k| pack(ps, k)).collect();
-    records.extend(arrived.chunks_exact(RECORD).map(|c| <[f64; RECORD]>::try_from(c).expect("RECORD values")));
+    let mut records: Vec<Vec<f64>> = (0..ps.len())
+        .filter(|&k| dest[k] == me)
+        .map(|k| {
+            let mut r = vec![0.0; len];
+            write_record(ps, k, &mut r);
+            r
+        })
+        .collect();
+    records.extend(arrived.chunks_exact(len).map(|c| c.to_vec()));
     records.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    model.particles = particles_from_records(&records);
-    model.resolve_targets(case);
+    model.particles = particles_from_flat(&records.concat());
+    // The point-wise loads and moving surfaces (plane only: a three-dimensional case has none yet).
+    if let Some(plane) = crate::model::plane_mut::<_, Model>(model) {
+        plane.resolve_targets(case);
+    }
     sent
 }
 

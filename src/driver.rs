@@ -24,7 +24,7 @@ use crate::assembly::{self, GridSystem, Phase, StepForces};
 use crate::case::{Case, Stage};
 use crate::diagnostics::{energy, Monitor, Warning};
 use crate::io::RunOutput;
-use crate::kernels::{Integration, StepResult};
+use crate::kernels::{Integration, StepResult, MAX_DOF, MAX_DOF_3D, MAX_NODES, MAX_NODES_3D};
 use crate::model::loads::IncrementsFrom;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -247,10 +247,12 @@ struct Probe {
     excess_extreme: f64,
 }
 
-struct Simulation<'a> {
+/// A run on a grid of dimension D whose points have at most M stencil nodes of at most N dofs
+/// (see [`GridSystem`]): the same algorithm in two and three dimensions.
+struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const N: usize = { MAX_DOF }> {
     case: &'a Case,
-    model: Model,
-    system: GridSystem,
+    model: Model<D>,
+    system: GridSystem<D, M, N>,
     check: Option<Box<dyn Check>>,
     probes: Vec<Probe>,
     out: &'a mut RunOutput,
@@ -278,7 +280,7 @@ struct Simulation<'a> {
     /// Names of the bodies (for messages).
     body_names: Vec<String>,
     /// The last converged step's equilibrium error and boundary reactions.
-    equilibrium: (f64, Vec<[f64; 2]>),
+    equilibrium: (f64, Vec<[f64; D]>),
     /// The stability diagnostics.
     monitor: Monitor,
     /// `--balance-threshold`, and the imbalance after the last attempt to repartition (a new
@@ -286,13 +288,24 @@ struct Simulation<'a> {
     balance: (f64, Option<f64>),
 }
 
-/// Whether porompm can run `case`: a three-dimensional case is read, validated and its material
-/// points generated (`porompm check`), but its run does not exist yet (issue «Three dimensions»,
-/// docs/dimensions.md).
-pub fn runnable(case: &crate::case::Case) -> Result<(), String> {
+/// Whether `porompm test-jacobian` can check `case`: a three-dimensional case's tangent is checked
+/// term by term (`kernels::tests`), not yet through the assembled system (issue «Three
+/// dimensions», docs/dimensions.md).
+pub fn jacobian_checkable(case: &crate::case::Case) -> Result<(), String> {
     if case.dimension() == 3 {
-        return Err("the case is three-dimensional: porompm reads it and generates its material points \
-                    (`porompm check`), but cannot run it yet (issue «Three dimensions», docs/dimensions.md)"
+        return Err("the case is three-dimensional: test-jacobian checks two-dimensional cases only (the \
+                    three-dimensional tangents are checked term by term, docs/dimensions.md)"
+            .into());
+    }
+    Ok(())
+}
+
+/// Whether a run of `case` can write checkpoints and restart from them: not yet in three
+/// dimensions (the checkpoint's records are two-dimensional; issue «Three dimensions»).
+pub fn restartable(case: &crate::case::Case) -> Result<(), String> {
+    if case.dimension() == 3 {
+        return Err("the case is three-dimensional: its runs cannot write checkpoints or restart yet (issue \
+                    «Three dimensions», docs/dimensions.md)"
             .into());
     }
     Ok(())
@@ -302,18 +315,9 @@ pub fn runnable(case: &crate::case::Case) -> Result<(), String> {
 pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
     let start = Instant::now();
     let mut summary = Summary::new(req);
-    let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| {
-        let mut sim = Simulation::set_up(req, out, &mut summary)?;
-        let stages = sim.run_stages(&req.case.stages);
-        match stages {
-            Ok(()) => sim.finish(),
-            Err(e) => {
-                // A failed run still reports what its probes and check saw up to the failure
-                // (results, tables, metrics of the events it reached); its status stays `failed`.
-                let _ = sim.finish();
-                Err(e)
-            }
-        }
+    let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| match req.case.dimension() {
+        3 => run_in::<3, { MAX_NODES_3D }, { MAX_DOF_3D }>(req, out, &mut summary),
+        _ => run_in::<2, { MAX_NODES }, { MAX_DOF }>(req, out, &mut summary),
     });
     // The field files' index lists every output time, also of a failed run.
     let indexed = out.finish_fields();
@@ -351,6 +355,25 @@ pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>)
         (Some(e), _) => (summary, Some(e)),
         (None, Err(w)) => (summary, Some(RunError::Failed(w))),
         (None, Ok(())) => (summary, None),
+    }
+}
+
+/// The run of [`run`] in dimension D: set up, the stages, the end.
+fn run_in<const D: usize, const M: usize, const N: usize>(
+    req: &RunRequest,
+    out: &mut RunOutput,
+    summary: &mut Summary,
+) -> Result<(), RunError> {
+    let mut sim = Simulation::<D, M, N>::set_up(req, out, summary)?;
+    let stages = sim.run_stages(&req.case.stages);
+    match stages {
+        Ok(()) => sim.finish(),
+        Err(e) => {
+            // A failed run still reports what its probes and check saw up to the failure
+            // (results, tables, metrics of the events it reached); its status stays `failed`.
+            let _ = sim.finish();
+            Err(e)
+        }
     }
 }
 
@@ -420,9 +443,10 @@ pub fn test_jacobian(
             stiffness.name()
         )));
     }
+    jacobian_checkable(req.case).map_err(RunError::Input)?;
     let mut summary = Summary::new(req);
     let mut out = RunOutput::silent();
-    let mut sim = Simulation::set_up(req, &mut out, &mut summary)?;
+    let mut sim = Simulation::<2>::set_up(req, &mut out, &mut summary)?;
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
     sim.begin_stage(stage)?;
@@ -439,25 +463,34 @@ pub fn test_jacobian(
     Ok((blocks, sim.model.particles.eps_pd.iter().filter(|&&e| e > 0.0).count()))
 }
 
-impl<'a> Simulation<'a> {
+impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N> {
     fn set_up(
         req: &RunRequest<'a>,
         out: &'a mut RunOutput,
         summary: &'a mut Summary,
-    ) -> Result<Simulation<'a>, RunError> {
+    ) -> Result<Simulation<'a, D, M, N>, RunError> {
         let t0 = Instant::now();
         let case = req.case;
         let coll = req.coll;
         let input = |e: String| RunError::Input(e);
-        runnable(case).map_err(input)?;
+        if req.restart.is_some() || req.checkpoint_every > 0 {
+            restartable(case).map_err(input)?;
+        }
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
-        let layout = StageAnalysis::of(case, &case.stages[first]).layout;
-        let system = GridSystem::new(coll, &crate::model::grid_of(case), layout, None, case.jacobian_stiffness())
-            .map_err(|e| input(e.to_string()))?;
+        let layout = StageAnalysis::of(case, &case.stages[first]).layout.in_dim(D);
+        let system =
+            GridSystem::<D, M, N>::new(coll, &crate::model::grid_of(case), layout, None, case.jacobian_stiffness())
+                .map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
-        let model = Model::build(case, |i, j| system.owns_cell(i, j));
+        let model = Model::<D>::of_case(case, |c| system.owns_cell_in(c));
         let n_boundaries = model.boundaries.len();
-        let check = verification::for_case(case, &model, coll).map_err(|e| input(format!("verification: {e}")))?;
+        // The verification checks are plane (validation keeps them out of three-dimensional cases).
+        let check = match model.as_plane() {
+            Some(plane) => {
+                verification::for_case(case, plane, coll).map_err(|e| input(format!("verification: {e}")))?
+            }
+            None => None,
+        };
         let probes = find_probes(case, &model, coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
         summary.grid_dofs = system.total_dofs();
@@ -471,13 +504,12 @@ impl<'a> Simulation<'a> {
         columns.extend(monitor.columns());
         columns.push("load_imbalance".into());
         columns.push("equilibrium_error".into());
+        const AXES: [&str; 3] = ["x", "y", "z"];
         for b in &model.boundaries {
-            columns.push(format!("{}.reaction_x", b.name));
-            columns.push(format!("{}.reaction_y", b.name));
+            columns.extend(AXES[..D].iter().map(|a| format!("{}.reaction_{a}", b.name)));
         }
         for b in model.boundaries.iter().filter(|b| b.motion.is_some()) {
-            columns.push(format!("{}.displacement_x", b.name));
-            columns.push(format!("{}.displacement_y", b.name));
+            columns.extend(AXES[..D].iter().map(|a| format!("{}.displacement_{a}", b.name)));
         }
         if let Some(c) = &check {
             columns.extend(c.columns());
@@ -510,12 +542,12 @@ impl<'a> Simulation<'a> {
             checkpoint_every: req.checkpoint_every,
             interrupt: req.interrupt.clone(),
             body_names: case.bodies.iter().map(|b| b.name.clone()).collect(),
-            equilibrium: (0.0, vec![[0.0; 2]; n_boundaries]),
+            equilibrium: (0.0, vec![[0.0; D]; n_boundaries]),
             monitor,
             balance: (req.balance_threshold, None),
         };
-        let warnings = crate::diagnostics::physics::warnings(case, &sim.model);
-        sim.warn(warnings);
+        let warnings = sim.model.as_plane().map(|m| crate::diagnostics::physics::warnings(case, m));
+        sim.warn(warnings.unwrap_or_default());
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
         } else {
@@ -569,12 +601,14 @@ impl<'a> Simulation<'a> {
                     let diagnostics = self.case.output.fields_every > 0 || nodes_checked;
                     let forces =
                         self.system.step_forces(&self.model, self.coll, diagnostics).map_err(RunError::Failed)?;
-                    if let (Some(c), true) = (self.check.as_mut(), nodes_checked) {
+                    if let (Some(c), true, Some(plane)) = (self.check.as_mut(), nodes_checked, self.model.as_plane()) {
                         let block = self.system.owned_node_block();
-                        c.observe_nodes(&block, &self.model, self.coll).map_err(RunError::Failed)?;
+                        c.observe_nodes(&block, plane, self.coll).map_err(RunError::Failed)?;
                     }
-                    if let Some(c) = self.check.as_mut() {
-                        c.observe_reactions(&forces.reactions);
+                    if let (Some(c), Some(r)) =
+                        (self.check.as_mut(), crate::model::plane::<_, Vec<[f64; 2]>>(&forces.reactions))
+                    {
+                        c.observe_reactions(r);
                     }
                     let before = forces.at_start.then(|| self.stress_integral(&forces));
                     let updated = self.update_particles(&active, dt)?;
@@ -640,13 +674,13 @@ impl<'a> Simulation<'a> {
         let analysis = StageAnalysis::of(self.case, stage);
         self.model.integration = analysis.integration;
         self.system.forget_increment();
-        if self.system.layout() != analysis.layout {
+        let layout = analysis.layout.in_dim(D);
+        if self.system.layout() != layout {
             let grid = crate::model::grid_of(self.case);
             let reused = self.system.reused_patterns;
             let owners = self.system.owners().clone();
-            self.system =
-                GridSystem::new(self.coll, &grid, analysis.layout, Some(&owners), self.case.jacobian_stiffness())
-                    .map_err(|e| RunError::Failed(e.to_string()))?;
+            self.system = GridSystem::new(self.coll, &grid, layout, Some(&owners), self.case.jacobian_stiffness())
+                .map_err(|e| RunError::Failed(e.to_string()))?;
             self.system.reused_patterns = reused;
             self.summary.grid_dofs = self.system.total_dofs();
         }
@@ -762,26 +796,31 @@ impl<'a> Simulation<'a> {
         let t0 = Instant::now();
         let _stage = self.system.phase(Phase::ParticleUpdate).map_err(|e| RunError::Failed(e.to_string()))?;
         let n = self.model.particles.len();
-        let results: Vec<StepResult> = (0..n).map(|k| self.system.step_result(&self.model, k)).collect();
+        let results: Vec<StepResult<D>> = (0..n).map(|k| self.system.step_result(&self.model, k)).collect();
         let bad = results.iter().enumerate().find_map(|(k, r)| self.model.check_step(k, r).err());
         if self.coll.any(bad.is_some()).map_err(RunError::Failed)? {
             return Ok(Err(bad
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
-        let recovered = match (self.model.pressure_update, self.system.layout().p.is_some()) {
-            (crate::case::PressureUpdate::ProjectedTotal, true) => Some(
-                self.system.projected_pressure_increments(&self.model).map_err(|e| RunError::Failed(e.to_string()))?,
-            ),
-            (_, true) if self.model.two_phase && self.model.patch_recovery => {
-                Some(self.system.recovered_pressure_increments(&self.model))
-            }
+        // The projected or recovered pore pressures (plane only: validation keeps them out of
+        // three-dimensional cases).
+        let recovered = match (self.model.as_plane(), crate::model::plane_mut::<_, GridSystem>(&mut self.system)) {
+            (Some(plane), Some(system)) => match (plane.pressure_update, system.layout().p.is_some()) {
+                (crate::case::PressureUpdate::ProjectedTotal, true) => {
+                    Some(system.projected_pressure_increments(plane).map_err(|e| RunError::Failed(e.to_string()))?)
+                }
+                (_, true) if plane.two_phase && plane.patch_recovery => {
+                    Some(system.recovered_pressure_increments(plane))
+                }
+                _ => None,
+            },
             _ => None,
         };
         // The energy terms of a dynamic step need the particles' state at t_n.
         let dynamic = matches!(self.model.integration, Integration::Dynamic { .. });
         let before: Vec<_> = if dynamic {
-            let body_acc = self.model.body_accelerations(active, self.t + dt);
+            let body_acc = self.model.body_accelerations_in(active, self.t + dt);
             let ps = &self.model.particles;
             (0..n).map(|k| (self.model.particle_input(k, &body_acc), ps.vel[k], ps.vel_w[k])).collect()
         } else {
@@ -845,11 +884,13 @@ impl<'a> Simulation<'a> {
         if now <= threshold || last.is_some_and(|l| now < l * crate::distribution::BALANCE_GAIN) {
             return Ok(());
         }
+        // The repartition is plane (a three-dimensional run keeps PETSc's distribution).
+        let Some(plane) = self.model.as_plane() else { return Ok(()) };
         let t0 = Instant::now();
-        let grid = &self.model.grid;
+        let grid = &plane.grid;
         let [nx, ny] = grid.cells;
         let mut hist = vec![0.0; nx * ny];
-        for x in &self.model.particles.x {
+        for x in &plane.particles.x {
             // The cell that decides the point's owner (`Owners::rank_of`).
             let (i, j) = grid.nearest_cell(*x);
             hist[i + j * nx] += 1.0;
@@ -860,12 +901,13 @@ impl<'a> Simulation<'a> {
             self.balance.1 = Some(now);
             return Ok(());
         };
+        let owners: &crate::distribution::Owners<D> = crate::model::plane(&owners).expect("a plane run");
         let reused = self.system.reused_patterns;
         let layout = self.system.layout();
         // The last step's nodal values, for the field output of this step on the new distribution.
         let carried = self.system.global_node_values(self.coll).map_err(RunError::Failed)?;
         self.system =
-            GridSystem::new(self.coll, &self.model.grid, layout, Some(&owners), self.case.jacobian_stiffness())
+            GridSystem::new(self.coll, &self.model.grid, layout, Some(owners), self.case.jacobian_stiffness())
                 .map_err(|e| RunError::Failed(e.to_string()))?;
         self.system.reused_patterns = reused;
         self.system.carry_node_values(carried);
@@ -881,19 +923,23 @@ impl<'a> Simulation<'a> {
     }
 
     /// This rank's share of ∫σ dV (total stress, current configuration; in axial symmetry with
-    /// the hoop stress's share about `forces.origin`), the left side of the equilibrium identity.
-    fn stress_integral(&self, forces: &StepForces) -> [f64; 4] {
+    /// the hoop stress's share about `forces.origin`), the left side of the equilibrium identity,
+    /// row by row (D × D entries).
+    fn stress_integral(&self, forces: &StepForces<D>) -> Vec<f64> {
         let ps = &self.model.particles;
         let axisymmetric = self.model.geometry.axisymmetric();
-        let mut local = [0.0; 4];
+        let mut local = vec![0.0; D * D];
         for k in 0..ps.len() {
             let s = ps.stress[k];
             let p = if self.model.two_phase { ps.p[k] } else { 0.0 };
             let v = ps.volume[k];
-            local[0] += (s[0] - p) * v;
-            local[1] += s[2] * v;
-            local[2] += s[2] * v;
-            local[3] += (s[1] - p) * v;
+            // The stress tensor [xx, xy, xz; yx, yy, yz; zx, zy, zz] from [xx, yy, xy, zz, yz, zx].
+            let t = [[s[0] - p, s[2], s[5]], [s[2], s[1] - p, s[4]], [s[5], s[4], s[3] - p]];
+            for a in 0..D {
+                for b in 0..D {
+                    local[a * D + b] += t[a][b] * v;
+                }
+            }
             if axisymmetric {
                 local[0] += (s[3] - p) * v;
                 local[2] += (ps.x[k][1] - forces.origin[1]) * (s[3] - p) * v / ps.x[k][0];
@@ -914,7 +960,7 @@ impl<'a> Simulation<'a> {
     /// the hoop operator otherwise. An explicit step's forces are those of its start
     /// (`StepForces::at_start`): `before` is then ∫σ dV of the points before their update, and the
     /// identity holds at t_n on x_n with the lumped inertia of the nodal update.
-    fn record_equilibrium(&mut self, forces: &StepForces, before: Option<[f64; 4]>) -> Result<(), RunError> {
+    fn record_equilibrium(&mut self, forces: &StepForces<D>, before: Option<Vec<f64>>) -> Result<(), RunError> {
         let lhs = match before {
             Some(l) => l,
             None => self.stress_integral(forces),
@@ -924,7 +970,7 @@ impl<'a> Simulation<'a> {
             self.monitor.ledger.external += forces.work;
         }
         let m = &forces.moment;
-        let diff = [lhs[0] - m[0][0], lhs[1] - m[0][1], lhs[2] - m[1][0], lhs[3] - m[1][1]];
+        let diff: Vec<f64> = (0..D * D).map(|e| lhs[e] - m[e / D][e % D]).collect();
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let scale = norm(&lhs).max(forces.scale);
         let error = if scale > 0.0 { norm(&diff) / scale } else { 0.0 };
@@ -956,8 +1002,8 @@ impl<'a> Simulation<'a> {
         for m in self.model.boundaries.iter().filter_map(|b| b.motion.as_ref()) {
             row.extend(m.displacement_at(self.t));
         }
-        if let Some(c) = self.check.as_mut() {
-            row.extend(c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?);
+        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
+            row.extend(c.observe(self.t, dt, plane, self.coll).map_err(RunError::Failed)?);
         }
         self.out.history_row(&row).map_err(RunError::Failed)?;
         if self.out.is_writer() {
@@ -970,8 +1016,8 @@ impl<'a> Simulation<'a> {
     /// The check's observation on steps without a history row.
     fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
         update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?;
-        if let Some(c) = self.check.as_mut() {
-            c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?;
+        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
+            c.observe(self.t, dt, plane, self.coll).map_err(RunError::Failed)?;
         }
         Ok(())
     }
@@ -996,9 +1042,9 @@ impl<'a> Simulation<'a> {
                 }
             }
         }
-        if let Some(c) = self.check.as_mut() {
+        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
             // The results after `finish` (which may complete them), also when it fails.
-            let finished = c.finish(&self.model, self.coll);
+            let finished = c.finish(plane, self.coll);
             self.summary.results.extend(c.results());
             let (metrics, tables) = finished.map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
@@ -1099,11 +1145,14 @@ impl<'a> Simulation<'a> {
 
     fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
         let t0 = Instant::now();
-        let ps = &self.model.particles;
+        let Some(plane) = self.model.as_plane() else {
+            return Err(RunError::Failed(restartable(self.case).err().unwrap_or_default()));
+        };
+        let ps = &plane.particles;
         let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
         let slab = self.coll.sorted_slab(&local, state::RECORD);
         let check_state = match self.check.as_ref() {
-            Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
+            Some(c) => c.checkpoint_state(plane, self.coll).map_err(RunError::Failed)?,
             None => None,
         };
         let s = &self.summary;
@@ -1144,14 +1193,16 @@ impl<'a> Simulation<'a> {
             LoadsAt::Start => RunError::Input(m),
             _ => RunError::Failed(m),
         };
-        for li in 0..self.model.loads.len() {
+        // Loads are plane (validation keeps them out of three-dimensional cases).
+        let Some(model) = crate::model::plane_mut::<_, Model>(&mut self.model) else { return Ok(()) };
+        for li in 0..model.loads.len() {
             // Whether a load has increments is the case's: every rank takes the same branch.
-            if self.model.loads[li].increments.is_none() {
+            if model.loads[li].increments.is_none() {
                 continue;
             }
-            let local = self.model.loads[li].face_moments(&self.model.particles, &self.model.geometry);
+            let local = model.loads[li].face_moments(&model.particles, &model.geometry);
             let m = self.coll.sum(&local).map_err(RunError::Failed)?;
-            let load = &mut self.model.loads[li];
+            let load = &mut model.loads[li];
             if m[2] <= 0.0 {
                 return Err(fail(format!(
                     "load `{}`: no loaded face is left to evaluate its increment_factor at",
@@ -1172,6 +1223,7 @@ impl<'a> Simulation<'a> {
     /// its particles, time, counters, probe extremes, check state and step control.
     fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
         let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
+        restartable(self.case).map_err(refuse)?;
         state::check_case(cp, self.case).map_err(refuse)?;
         // The checkpoint's records and the case's points as generated, each redistributed to the
         // same slabs of ids, must match; then every point goes to the rank owning its cell.
@@ -1189,9 +1241,11 @@ impl<'a> Simulation<'a> {
         let flat: Vec<f64> = cp.particles.iter().flatten().copied().collect();
         let records = state::records_of(&self.coll.sorted_slab(&flat, state::RECORD).values);
         self.coll.agree(state::check_points(&records, &generated)).map_err(refuse)?;
-        self.model.particles = state::particles_from_records(&records);
+        self.model.particles = state::particles_from_flat(records.as_flattened());
         crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
-        self.model.resolve_targets(self.case);
+        if let Some(plane) = crate::model::plane_mut::<_, Model>(&mut self.model) {
+            plane.resolve_targets(self.case);
+        }
         self.t = cp.time;
         self.set_load_increments(LoadsAt::Restart(&cp.load_totals))?;
         self.step = cp.step as usize;
@@ -1209,9 +1263,9 @@ impl<'a> Simulation<'a> {
             p.excess_extreme = e;
         }
         let mut note = None;
-        if let Some(c) = self.check.as_mut() {
+        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
             match &cp.check_state {
-                Some(st) => c.restore_state(st, &self.model).map_err(|e| refuse(format!("verification state: {e}")))?,
+                Some(st) => c.restore_state(st, plane).map_err(|e| refuse(format!("verification state: {e}")))?,
                 None => {
                     note = Some(format!(
                     "the verification check keeps no checkpoint state: its metrics use the run from t = {:.6e} s only",
@@ -1351,7 +1405,9 @@ fn probe_fields(two_phase: bool) -> &'static [&'static str] {
     }
 }
 
-fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Probe>, String> {
+/// The probes of the case: each the point nearest its `point` at t = 0 (in the plane: a
+/// three-dimensional case has no probes yet).
+fn find_probes<const D: usize>(case: &Case, model: &Model<D>, coll: &Collective) -> Result<Vec<Probe>, String> {
     let ps = &model.particles;
     let mut out = Vec::new();
     for p in &case.probes {
@@ -1371,7 +1427,11 @@ fn find_probes(case: &Case, model: &Model, coll: &Collective) -> Result<Vec<Prob
 }
 
 /// Updates every probe's values and extremes; returns the values of all probes in order.
-fn update_probes(model: &Model, probes: &mut [Probe], coll: &Collective) -> Result<Vec<f64>, String> {
+fn update_probes<const D: usize>(
+    model: &Model<D>,
+    probes: &mut [Probe],
+    coll: &Collective,
+) -> Result<Vec<f64>, String> {
     let all = probe_values(model, probes, coll)?;
     let nf = probe_fields(model.two_phase).len();
     for (i, pr) in probes.iter_mut().enumerate() {
@@ -1386,7 +1446,7 @@ fn update_probes(model: &Model, probes: &mut [Probe], coll: &Collective) -> Resu
     Ok(all)
 }
 
-fn probe_values(model: &Model, probes: &[Probe], coll: &Collective) -> Result<Vec<f64>, String> {
+fn probe_values<const D: usize>(model: &Model<D>, probes: &[Probe], coll: &Collective) -> Result<Vec<f64>, String> {
     let ps = &model.particles;
     let nf = probe_fields(model.two_phase).len();
     let mut local = vec![0.0; probes.len() * nf];

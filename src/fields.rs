@@ -21,7 +21,7 @@
 //! before the first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's
 //! geometry.
 
-use crate::assembly::{NodeBlock, NODE_VALUES};
+use crate::assembly::{node_values, NodeBlock};
 use crate::io::fields::{Field, Frame, GridGeometry, Values};
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -113,30 +113,32 @@ pub fn particle_fields<const D: usize>(model: &Model<D>, coll: &Collective) -> (
 
 /// This rank's share of the fields at time `t` (collective). `nodes` is this rank's
 /// [`crate::assembly::GridSystem::owned_node_block`].
-pub fn frame(model: &Model, nodes: &NodeBlock, coll: &Collective, t: f64) -> Frame {
+pub fn frame<const D: usize>(model: &Model<D>, nodes: &NodeBlock, coll: &Collective, t: f64) -> Frame {
     let (pf, particles, first_particle) = particle_fields(model, coll);
-    let d: Vec<&[f64]> = nodes.values.chunks_exact(NODE_VALUES).collect();
+    let d: Vec<&[f64]> = nodes.values.chunks_exact(node_values(D)).collect();
     let active = d.iter().map(|v| (v[0] > 0.5) as i32).collect();
+    // The node's values: flag, u (D), p, U (D), K_mag, F^int_mag.
+    let (p, w, k) = (1 + D, 2 + D, 2 + 2 * D);
     let mut gf = vec![
         Field { name: "active", components: 1, values: Values::Int(active) },
-        Field { name: "du", components: 3, values: Values::Real(d.iter().flat_map(|v| vec3::<2>(v, 1)).collect()) },
+        Field { name: "du", components: 3, values: Values::Real(d.iter().flat_map(|v| vec3::<D>(v, 1)).collect()) },
     ];
     if model.two_phase {
-        gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[3]).collect()) });
+        gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[p]).collect()) });
         gf.push(Field {
             name: "dU",
             components: 3,
-            values: Values::Real(d.iter().flat_map(|v| vec3::<2>(v, 4)).collect()),
+            values: Values::Real(d.iter().flat_map(|v| vec3::<D>(v, w)).collect()),
         });
     }
-    gf.push(Field { name: "K_mag", components: 1, values: Values::Real(d.iter().map(|v| v[6]).collect()) });
-    gf.push(Field { name: "Fint_mag", components: 1, values: Values::Real(d.iter().map(|v| v[7]).collect()) });
+    gf.push(Field { name: "K_mag", components: 1, values: Values::Real(d.iter().map(|v| v[k]).collect()) });
+    gf.push(Field { name: "Fint_mag", components: 1, values: Values::Real(d.iter().map(|v| v[k + 1]).collect()) });
     Frame {
         time: t,
         particles,
         first_particle,
         particle_fields: pf,
-        node_block: ([nodes.start[0], nodes.start[1], 0], [nodes.count[0], nodes.count[1], 1]),
+        node_block: (nodes.start, nodes.count),
         grid_fields: gf,
     }
 }

@@ -171,11 +171,15 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
     case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
 
-/// [`load_case`] for a command that runs the case: a three-dimensional case is refused (before
-/// anything is written) until the three-dimensional run exists.
-fn load_runnable_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
+/// [`load_case`] for a command that runs the case, with the check `can` of what the command
+/// needs that a three-dimensional case cannot do yet (refused before anything is written).
+fn load_runnable_case(
+    path: &Path,
+    sets: &[String],
+    can: impl Fn(&case::Case) -> Result<(), String>,
+) -> Result<case::Case, Failure> {
     let c = load_case(path, sets)?;
-    porompm::driver::runnable(&c).map_err(|e| input(format!("{}: {e}", path.display())))?;
+    can(&c).map_err(|e| input(format!("{}: {e}", path.display())))?;
     Ok(c)
 }
 
@@ -206,7 +210,8 @@ fn run(
     cont: Continuation,
     petsc_args: &[String],
 ) -> Result<(), Failure> {
-    let c = load_runnable_case(case_path, sets)?;
+    let continues = cont.checkpoint_every > 0 || cont.restart.is_some();
+    let c = load_runnable_case(case_path, sets, |c| if continues { porompm::driver::restartable(c) } else { Ok(()) })?;
     // Options files: the case's own (relative to the case file), then the command line's.
     let mut files: Vec<PathBuf> = Vec::new();
     if let Some(f) = &c.solver.options_file {
@@ -316,7 +321,7 @@ fn test_jacobian(
     sets: &[String],
     petsc_args: &[String],
 ) -> Result<(), Failure> {
-    let c = load_runnable_case(case_path, sets)?;
+    let c = load_runnable_case(case_path, sets, porompm::driver::jacobian_checkable)?;
     // The fields of the first stage, whose tangent is checked.
     let names = porompm::analysis::StageAnalysis::of(&c, &c.stages[0]).layout.field_names();
     let flip = match flip {

@@ -146,10 +146,25 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
     Ok(())
 }
 
+/// Values per particle record in `d` dimensions: [`RECORD`] in two, and in three the third
+/// component of every position, domain, velocity and pressure gradient and the 3 × 3 deformation
+/// gradient (55).
+pub const fn record_len(d: usize) -> usize {
+    RECORD + (d - 2) * 15
+}
+
 /// The record of particle `k` (ids are exact in f64: they stay below 2⁵³).
 pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
     let mut r = [0.0; RECORD];
+    write_record(ps, k, &mut r);
+    r
+}
+
+/// Writes the record of particle `k` of dimension D into `r` ([`record_len`] values, in the order
+/// of [`PARTICLE_FIELDS`] with D components per vector and D² for F, row by row).
+pub fn write_record<const D: usize>(ps: &Particles<D>, k: usize, r: &mut [f64]) {
     let f = &ps.def_grad[k];
+    let f_rows: Vec<f64> = f.iter().flatten().copied().collect();
     let parts: [&[f64]; 22] = [
         &[ps.id[k] as f64],
         &[ps.body[k] as f64],
@@ -159,7 +174,7 @@ pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
         &ps.disp[k],
         &ps.lp[k],
         &ps.lp0[k],
-        &[f[0][0], f[0][1], f[1][0], f[1][1]],
+        &f_rows,
         &[ps.volume[k]],
         &[ps.porosity[k]],
         &[ps.mass[k]],
@@ -179,11 +194,10 @@ pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
         r[i..i + p.len()].copy_from_slice(p);
         i += p.len();
     }
-    r
 }
 
 /// Overwrites particle `k` with record `r` (same id, body and material, checked by the caller).
-fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
+fn unpack<const D: usize>(ps: &mut Particles<D>, k: usize, r: &[f64]) {
     // The fields after id, body and material, in the order of `PARTICLE_FIELDS`.
     fn take<const N: usize>(rest: &mut impl Iterator<Item = f64>) -> [f64; N] {
         std::array::from_fn(|_| rest.next().expect("RECORD values"))
@@ -195,7 +209,7 @@ fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
     ps.disp[k] = take(rest);
     ps.lp[k] = take(rest);
     ps.lp0[k] = take(rest);
-    ps.def_grad[k] = [take(rest), take(rest)];
+    ps.def_grad[k] = std::array::from_fn(|_| take(rest));
     ps.volume[k] = one(rest);
     ps.porosity[k] = one(rest);
     ps.mass[k] = one(rest);
@@ -213,8 +227,14 @@ fn unpack(ps: &mut Particles, k: usize, r: &[f64; RECORD]) {
 
 /// The points of `records`, in their order (every array from its record).
 pub fn particles_from_records(records: &[[f64; RECORD]]) -> Particles {
+    particles_from_flat(records.as_flattened())
+}
+
+/// The points of dimension D of the records laid end to end in `flat` ([`record_len`] values
+/// each), in their order.
+pub fn particles_from_flat<const D: usize>(flat: &[f64]) -> Particles<D> {
     let mut ps = Particles::default();
-    for r in records {
+    for r in flat.chunks_exact(record_len(D)) {
         ps.push_blank(r[0] as u64, r[1] as u16, r[2] as u16);
         let k = ps.len() - 1;
         unpack(&mut ps, k, r);

@@ -165,18 +165,25 @@ impl<const D: usize, const M: usize> StepData<D, M> {
     }
 }
 
-/// Values per node of a [`NodeBlock`]: whether it is well filled, the step's increments of ux, uy,
-/// p, Ux, Uy (0 where the layout has none), K_mag and F^int_mag.
-pub const NODE_VALUES: usize = 8;
+/// Values per node of a two-dimensional [`NodeBlock`]: whether it is well filled, the step's
+/// increments of ux, uy, p, Ux, Uy (0 where the layout has none), K_mag and F^int_mag.
+pub const NODE_VALUES: usize = node_values(2);
 
-/// The nodes a rank owns: the rectangle of grid nodes `start .. start + count` (i, j) and
-/// [`NODE_VALUES`] values per node, x fastest (see [`GridSystem::owned_node_block`]).
+/// Values per node of a [`NodeBlock`] in `d` dimensions: the well-filled flag, the increments of
+/// the full two-phase layout (ux, uy, [uz,] p, Ux, Uy[, Uz]), K_mag and F^int_mag.
+pub const fn node_values(d: usize) -> usize {
+    2 * d + 4
+}
+
+/// The nodes a rank owns: the box of grid nodes `start .. start + count` (i, j, k; k = 0 and one
+/// layer in two dimensions) and [`node_values`] values per node, x fastest (see
+/// [`GridSystem::owned_node_block`]).
 #[derive(Debug, Clone, Default)]
 pub struct NodeBlock {
-    /// The first owned node (i, j).
-    pub start: [usize; 2],
-    /// The owned nodes along x and y.
-    pub count: [usize; 2],
+    /// The first owned node (i, j, k).
+    pub start: [usize; 3],
+    /// The owned nodes along x, y and z.
+    pub count: [usize; 3],
     /// The values, node by node.
     pub values: Vec<f64>,
 }
@@ -791,7 +798,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             nm: Some(nm),
             dt: t_new - t_old,
             layout: Some(self.layout),
-            body_acc: body_accelerations(model, active, t_new),
+            body_acc: model.body_accelerations_in(active, t_new),
             stencils: st,
             bands,
             dofs,
@@ -808,10 +815,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
             // static or quasi-static, which have no generalized-α history).
-            let body_acc_old = body_accelerations(model, active, t_old);
+            let body_acc_old = model.body_accelerations_in(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.start_out_of_balance(&body_acc_old, &fext_old));
         } else if nm.history().is_some() {
-            let body_acc_old = body_accelerations(model, active, t_old);
+            let body_acc_old = model.body_accelerations_in(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
         }
         self.step.fext_old = fext_old;
@@ -1355,6 +1362,62 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         }
         result
     }
+
+    /// The block of nodes this rank owns and, per node (x fastest), [`node_values`] values: the
+    /// active (well-filled) flag (1 or 0) of the last solve, its nodal increments Δd (ux, uy, [uz,]
+    /// p, Ux, Uy[, Uz]; zeros beyond the dofs of the layout), K_mag and F^int_mag; the carried
+    /// values of a replaced system (or zeros) before the first solve.
+    pub fn owned_node_block(&self) -> NodeBlock {
+        let nd = self.layout.nd;
+        let nv = node_values(D);
+        let names = Layout::UPU.in_dim(D).field_names();
+        let own = self.layout.field_names();
+        let nodes = self.dm.info().nodes;
+        let mut values = Vec::with_capacity(self.owned_nodes.len() * nv);
+        for (o, &a) in self.owned_nodes.iter().enumerate() {
+            let l = a as usize;
+            if self.step.solution.is_empty() {
+                let n = self.ghost.indices(l);
+                let g = (0..D).rev().fold(0, |acc, d| acc * nodes[d] + n[d]) * nv;
+                match self.carried.get(g..g + nv) {
+                    Some(v) => values.extend(v),
+                    None => values.extend(std::iter::repeat_n(0.0, nv)),
+                }
+                continue;
+            }
+            values.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
+            for name in names {
+                let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| self.step.solution[l * nd + c]);
+                values.push(v);
+            }
+            values.extend(self.node_diagnostics.get(o).copied().unwrap_or([0.0; 2]));
+        }
+        NodeBlock { start: lift3(self.owned_start, 0), count: lift3(self.owned_count, 1), values }
+    }
+
+    /// The nodal values of [`Self::owned_node_block`] of every node of the grid (x fastest), summed
+    /// over ranks: what a system that replaces this one on another distribution of the nodes
+    /// carries over ([`Self::carry_node_values`]; collective).
+    pub fn global_node_values(&self, coll: &Collective) -> Result<Vec<f64>, String> {
+        let nodes = self.dm.info().nodes;
+        let nv = node_values(D);
+        let mut all = vec![0.0; nodes.iter().product::<usize>() * nv];
+        let block = self.owned_node_block();
+        let owned = GhostedRange { start: self.owned_start, count: self.owned_count, dof: 1 };
+        for (o, v) in block.values.chunks_exact(nv).enumerate() {
+            let n = owned.indices(o);
+            let g = (0..D).rev().fold(0, |acc, d| acc * nodes[d] + n[d]) * nv;
+            all[g..g + nv].copy_from_slice(v);
+        }
+        coll.sum(&all)
+    }
+
+    /// Takes over the nodal values of the last step of the system this one replaced (from
+    /// [`Self::global_node_values`] on the same grid), for the field output until its own first
+    /// step.
+    pub fn carry_node_values(&mut self, values: Vec<f64>) {
+        self.carried = values;
+    }
 }
 
 /// The parts of the global system that exist only in the plane (validation keeps them out of
@@ -1684,54 +1747,6 @@ impl GridSystem {
             })
             .collect())
     }
-
-    /// The block of nodes this rank owns and, per node (x fastest), 6 values: the active
-    /// (well-filled) flag (1 or 0) of the last solve and its nodal increments Δd (ux, uy, p, Ux,
-    /// Uy; zeros beyond the dofs of the layout); all zero before the first solve.
-    pub fn owned_node_block(&self) -> NodeBlock {
-        let nd = self.layout.nd;
-        let names = Layout::UPU.field_names();
-        let own = self.layout.field_names();
-        let mut values = Vec::with_capacity(self.owned_nodes.len() * NODE_VALUES);
-        for (o, &a) in self.owned_nodes.iter().enumerate() {
-            let l = a as usize;
-            if self.step.solution.is_empty() {
-                let (i, j) = self.ghost.ij(l);
-                let g = (j * self.dm.info().nodes[0] + i) * NODE_VALUES;
-                values.extend(self.carried.get(g..g + NODE_VALUES).unwrap_or(&[0.0; NODE_VALUES]));
-                continue;
-            }
-            values.push(if self.step.dofs.well.get(l).copied().unwrap_or(false) { 1.0 } else { 0.0 });
-            for name in names {
-                let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| self.step.solution[l * nd + c]);
-                values.push(v);
-            }
-            values.extend(self.node_diagnostics.get(o).copied().unwrap_or([0.0; 2]));
-        }
-        NodeBlock { start: self.owned_start, count: self.owned_count, values }
-    }
-
-    /// The nodal values of [`Self::owned_node_block`] of every node of the grid (x fastest), summed
-    /// over ranks: what a system that replaces this one on another distribution of the nodes
-    /// carries over ([`Self::carry_node_values`]; collective).
-    pub fn global_node_values(&self, coll: &Collective) -> Result<Vec<f64>, String> {
-        let [nx, ny] = self.dm.info().nodes;
-        let mut all = vec![0.0; nx * ny * NODE_VALUES];
-        let block = self.owned_node_block();
-        for (o, v) in block.values.chunks_exact(NODE_VALUES).enumerate() {
-            let (i, j) = (block.start[0] + o % block.count[0], block.start[1] + o / block.count[0]);
-            let g = (j * nx + i) * NODE_VALUES;
-            all[g..g + NODE_VALUES].copy_from_slice(v);
-        }
-        coll.sum(&all)
-    }
-
-    /// Takes over the nodal values of the last step of the system this one replaced (from
-    /// [`Self::global_node_values`] on the same grid), for the field output until its own first
-    /// step.
-    pub fn carry_node_values(&mut self, values: Vec<f64>) {
-        self.carried = values;
-    }
 }
 
 /// The node indices `n` of a plane grid in a grid of dimension D (only called where D = 2: the
@@ -1740,20 +1755,9 @@ fn lift<const D: usize>(n: [usize; 2]) -> [usize; D] {
     std::array::from_fn(|d| n[d])
 }
 
-/// The body acceleration at time `t` of each body ([`Model::body_accelerations`]; zero in three
-/// dimensions, whose cases have no loads yet).
-fn body_accelerations<const D: usize>(model: &Model<D>, active: &Active, t: f64) -> Vec<[f64; D]> {
-    match model.as_plane() {
-        Some(m) => m.body_accelerations(active, t).into_iter().map(lift_vector).collect(),
-        None => {
-            vec![[0.0; D]; model.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(model.n_bodies)]
-        }
-    }
-}
-
-/// A plane vector in dimension D (only called where D = 2).
-fn lift_vector<const D: usize>(v: [f64; 2]) -> [f64; D] {
-    std::array::from_fn(|d| v[d])
+/// Grid indices of dimension D as three, `fill` for the missing ones.
+fn lift3<const D: usize>(n: [usize; D], fill: usize) -> [usize; 3] {
+    std::array::from_fn(|d| if d < D { n[d] } else { fill })
 }
 
 /// The tractions of a step as the case applies them (before they are shared out to nodes), on
@@ -1830,16 +1834,20 @@ pub fn petsc_options() -> Result<Vec<String>, Error> {
 /// The solver configuration (KSP and PC types and the factorisation package), for the summary.
 /// The mat-vecs with the whole tangent timed after the linear solves (see `petsc::fields`) and
 /// their total wall time [s] on this rank.
-pub fn timed_matvecs(sys: &GridSystem) -> (usize, f64) {
+pub fn timed_matvecs<const D: usize, const M: usize, const N: usize>(sys: &GridSystem<D, M, N>) -> (usize, f64) {
     sys.snes.timed_matvecs()
 }
 
 /// Whether the linear solver iterates (any KSP but `preonly`).
-pub fn is_iterative(sys: &mut GridSystem) -> Result<bool, Error> {
+pub fn is_iterative<const D: usize, const M: usize, const N: usize>(
+    sys: &mut GridSystem<D, M, N>,
+) -> Result<bool, Error> {
     Ok(sys.snes.ksp()?.type_name()? != "preonly")
 }
 
-pub fn describe_solver(sys: &mut GridSystem) -> Result<String, Error> {
+pub fn describe_solver<const D: usize, const M: usize, const N: usize>(
+    sys: &mut GridSystem<D, M, N>,
+) -> Result<String, Error> {
     let snes_type = sys.snes.type_name()?;
     let lag = sys.snes.lag_jacobian()?;
     let mut ksp = sys.snes.ksp()?;

@@ -241,6 +241,25 @@ fn three_dimensional(c: &Case) -> R {
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
     }
+    if let Some(i) = c.stages.iter().position(|s| s.analysis == crate::case::AnalysisType::DynamicExplicit) {
+        return not_yet(&format!("stages[{i}].analysis = \"dynamic_explicit\""));
+    }
+    let st = &c.stabilisation;
+    if st.pressure_projection.is_some() {
+        return not_yet("stabilisation.pressure_projection");
+    }
+    if st.patch_recovery == Some(true) {
+        return not_yet("stabilisation.patch_recovery");
+    }
+    if st.pressure_update == crate::case::PressureUpdate::ProjectedTotal {
+        return not_yet("stabilisation.pressure_update");
+    }
+    if st.fbar {
+        return not_yet("stabilisation.fbar");
+    }
+    if st.stiffness != crate::case::Stiffness::Particle {
+        return not_yet("stabilisation.stiffness");
+    }
     // A point's identifier numbers its sub-cell below bit 48 (at most 8 points per cell and
     // direction, `Particles::generate`).
     let sub_cells: f64 = c.grid.cells.iter().map(|&n| 8.0 * n as f64).product();

@@ -34,36 +34,42 @@ pub struct ParticleStep {
 /// The stress and body-force work of one particle over a converged step: `before` is its kernel
 /// input at t_n, `step` the converged result, `dp` its pressure increment and `v_after` its volume
 /// at t_{n+1}.
-pub fn particle_step(before: &ParticleInput, step: &StepResult, dp: f64, v_after: f64) -> ParticleStep {
-    // Δε = [xx, yy, γxy, zz] (engineering shear) and the stress's plane components [xx, yy, xy, zz].
+pub fn particle_step<const D: usize>(
+    before: &ParticleInput<D>,
+    step: &StepResult<D>,
+    dp: f64,
+    v_after: f64,
+) -> ParticleStep {
+    // Δε = [xx, yy, γxy, zz, γyz, γzx] (engineering shears) and the stress [xx, yy, xy, zz, yz, zx]:
+    // the first four in two dimensions.
     let de = step.deps;
     let (s0, s1) = (before.stress, step.stress);
     let mean = |a: f64, b: f64| 0.5 * (a + b);
     let v = mean(before.volume, v_after);
-    let effective = (0..4).map(|c| mean(s0[c], s1[c]) * de[c]).sum::<f64>();
+    let effective = (0..crate::kernels::strain_rows::<D>()).map(|c| mean(s0[c], s1[c]) * de[c]).sum::<f64>();
     let n = before.porosity;
     let p = before.p + 0.5 * dp;
     let it = &step.interp;
     let g = step.grad_n;
-    let gradient = g[0] * (it.dw[0] - it.du[0]) + g[1] * (it.dw[1] - it.du[1]);
+    let gradient = (0..D).map(|d| g[d] * (it.dw[d] - it.du[d])).sum::<f64>();
     let water = if before.water_mass > 0.0 { p * ((1.0 - n) * it.dvol_u + n * it.dvol_w + gradient) } else { 0.0 };
     let b = before.body_acc;
-    let body =
-        before.mass * (b[0] * it.du[0] + b[1] * it.du[1]) + before.water_mass * (b[0] * it.dw[0] + b[1] * it.dw[1]);
+    let dot = |u: &[f64; D]| (0..D).map(|d| b[d] * u[d]).sum::<f64>();
+    let body = before.mass * dot(&it.du) + before.water_mass * dot(&it.dw);
     ParticleStep { internal: v * (effective - water), body }
 }
 
 /// Kinetic energy ½ (m |v_s|² + m_w |v_w|²) of a particle [J per m].
-pub fn kinetic(mass: f64, water_mass: f64, v: [f64; 2], v_w: [f64; 2]) -> f64 {
-    0.5 * (mass * (v[0] * v[0] + v[1] * v[1]) + water_mass * (v_w[0] * v_w[0] + v_w[1] * v_w[1]))
+pub fn kinetic<const D: usize>(mass: f64, water_mass: f64, v: [f64; D], v_w: [f64; D]) -> f64 {
+    let square = |u: [f64; D]| (0..D).map(|d| u[d] * u[d]).sum::<f64>();
+    0.5 * (mass * square(v) + water_mass * square(v_w))
 }
 
 /// Darcy dissipation over a step Δt d |w|², w = v_w − v_s at t_{n+1} as interpolated from the
 /// grid (`step.interp`), d = n²γ_w V/k the drag coefficient [J per m].
-pub fn darcy(drag: f64, dt: f64, step: &StepResult) -> f64 {
+pub fn darcy<const D: usize>(drag: f64, dt: f64, step: &StepResult<D>) -> f64 {
     let it = &step.interp;
-    let w = [it.v_w[0] - it.v_u[0], it.v_w[1] - it.v_u[1]];
-    dt * drag * (w[0] * w[0] + w[1] * w[1])
+    dt * drag * (0..D).map(|d| (it.v_w[d] - it.v_u[d]) * (it.v_w[d] - it.v_u[d])).sum::<f64>()
 }
 
 /// The running energy balance of the dynamic steps of a run (every rank holds its particles'

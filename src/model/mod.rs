@@ -341,6 +341,34 @@ impl<const D: usize> Model<D> {
         plane(self)
     }
 
+    /// The model of `case` in its dimension D ([`Model::build`] of a plane case,
+    /// [`Model::build_solid`] of a three-dimensional one), generating particles only in the cells
+    /// `owned(cell)`.
+    pub fn of_case(case: &Case, owned: impl Fn([usize; D]) -> bool) -> Model<D> {
+        // Grid indices of the model's dimension from those of the built one (the same D).
+        fn same<const A: usize, const B: usize>(n: [usize; A]) -> [usize; B] {
+            std::array::from_fn(|d| n[d])
+        }
+        let built: Box<dyn std::any::Any> = if D == 2 {
+            Box::new(Model::build(case, |i, j| owned(same([i, j]))))
+        } else {
+            Box::new(Model::<3>::build_solid(case, |c| owned(same(c))))
+        };
+        *built.downcast::<Model<D>>().expect("a model of two or three dimensions")
+    }
+
+    /// Body acceleration at time `t` of the particles of each body ([`Model::body_accelerations`];
+    /// zero in three dimensions, whose cases have no loads yet) [m/s²].
+    pub fn body_accelerations_in(&self, active: &Active, t: f64) -> Vec<[f64; D]> {
+        match self.as_plane() {
+            Some(m) => m.body_accelerations(active, t).into_iter().map(|a| std::array::from_fn(|d| a[d])).collect(),
+            None => {
+                let bodies = self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(self.n_bodies);
+                vec![[0.0; D]; bodies]
+            }
+        }
+    }
+
     /// For each dof component at the grid node with indices `n`, in the full two-phase order of
     /// the dimension (ux, uy, [uz,] p, Ux, Uy[, Uz]; [`dof_index_in`]), the first active side or
     /// region boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are
@@ -411,7 +439,9 @@ impl<const D: usize> Model<D> {
             stress_recovery: case.stabilisation.stress_recovery,
             linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
             stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
+            // The MLSA recovery is plane: a three-dimensional case takes the interpolated increment.
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
+                && case.dimension() == 2
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
     }
