@@ -285,8 +285,8 @@ pub fn describe(case: &Case, label: &str) -> String {
     s
 }
 
-/// The description of a three-dimensional case: its grid, bodies and material points (it has no
-/// loads or boundaries yet and cannot be run: issue «Three dimensions»).
+/// The description of a three-dimensional case: its grid, bodies and material points, loads,
+/// boundaries (with the nodes each holds) and stages.
 fn describe_solid(case: &Case, label: &str) -> String {
     let model = Model::build_solid(case, |_| true);
     let g = &model.grid;
@@ -323,18 +323,43 @@ fn describe_solid(case: &Case, label: &str) -> String {
         );
     }
     let _ = writeln!(s, "material points: {}", ps.len());
-    let _ = writeln!(
-        s,
-        "loads, boundaries: none (a three-dimensional case has none yet); `porompm run` refuses the case \
-         (issue «Three dimensions», docs/dimensions.md)"
-    );
+    for l in &model.loads {
+        let kind = match case.load(&l.name) {
+            Some(Load::ParticleTraction { traction, .. }) => {
+                format!("particle traction {traction:?} Pa on {} material points", l.size())
+            }
+            Some(Load::BodyForce { acceleration, .. }) => format!("body force {acceleration:?} m/s²"),
+            _ => String::new(),
+        };
+        let _ = writeln!(s, "load `{}`: {kind}", l.name);
+    }
+    for b in &model.boundaries {
+        let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
+        let count = (0..g.node_count()).filter(|&n| b.holds_node(g, g.node_indices(n))).count();
+        let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
+    }
+    for st in &case.stages {
+        let a = model.active(st);
+        let analysis = crate::analysis::StageAnalysis::of(case, st);
+        let _ = writeln!(
+            s,
+            "stage `{}` ({}): {} s in steps of {:.4e} s ({} steps); loads [{}]; boundaries [{}]",
+            st.name,
+            analysis.describe(),
+            st.duration,
+            st.dt(),
+            (st.duration / st.dt()).ceil() as usize,
+            a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
+            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
+        );
+    }
     s
 }
 
 #[cfg(test)]
 mod tests {
     /// `porompm check` of a three-dimensional case: its dimension, grid, bodies with their points
-    /// and volumes, and that it cannot be run yet.
+    /// and volumes, its stage.
     #[test]
     fn a_three_dimensional_case_is_described() {
         let text = crate::case::tests_support::with_grid("[0.1, 1.0, 0.2]", "[1, 10, 2]");
@@ -345,7 +370,7 @@ mod tests {
             "grid: 1 × 10 × 2 cells",
             "body `column`: 160 material points (2×2×2 per cell), volume 2.000000e-2 m³",
             "material points: 160",
-            "`porompm run` refuses the case",
+            "stage `load` (dynamic u–p–U",
         ] {
             assert!(d.contains(want), "{d}\n  does not say: {want}");
         }

@@ -212,10 +212,7 @@ pub fn migrate<const D: usize>(model: &mut Model<D>, case: &Case, owners: &Owner
     records.extend(arrived.chunks_exact(len).map(|c| c.to_vec()));
     records.sort_by(|a, b| a[0].total_cmp(&b[0]));
     model.particles = particles_from_flat(&records.concat());
-    // The point-wise loads and moving surfaces (plane only: a three-dimensional case has none yet).
-    if let Some(plane) = crate::model::plane_mut::<_, Model>(model) {
-        plane.resolve_targets(case);
-    }
+    model.resolve_targets(case);
     sent
 }
 

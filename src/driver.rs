@@ -253,7 +253,7 @@ struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const 
     case: &'a Case,
     model: Model<D>,
     system: GridSystem<D, M, N>,
-    check: Option<Box<dyn Check>>,
+    check: Option<Box<dyn Check<D>>>,
     probes: Vec<Probe>,
     out: &'a mut RunOutput,
     coll: &'a Collective,
@@ -484,13 +484,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::<D>::of_case(case, |c| system.owns_cell_in(c));
         let n_boundaries = model.boundaries.len();
-        // The verification checks are plane (validation keeps them out of three-dimensional cases).
-        let check = match model.as_plane() {
-            Some(plane) => {
-                verification::for_case(case, plane, coll).map_err(|e| input(format!("verification: {e}")))?
-            }
-            None => None,
-        };
+        let check = verification::for_case_in(case, &model, coll).map_err(|e| input(format!("verification: {e}")))?;
         let probes = find_probes(case, &model, coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
         summary.grid_dofs = system.total_dofs();
@@ -601,14 +595,12 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
                     let diagnostics = self.case.output.fields_every > 0 || nodes_checked;
                     let forces =
                         self.system.step_forces(&self.model, self.coll, diagnostics).map_err(RunError::Failed)?;
-                    if let (Some(c), true, Some(plane)) = (self.check.as_mut(), nodes_checked, self.model.as_plane()) {
+                    if let (Some(c), true) = (self.check.as_mut(), nodes_checked) {
                         let block = self.system.owned_node_block();
-                        c.observe_nodes(&block, plane, self.coll).map_err(RunError::Failed)?;
+                        c.observe_nodes(&block, &self.model, self.coll).map_err(RunError::Failed)?;
                     }
-                    if let (Some(c), Some(r)) =
-                        (self.check.as_mut(), crate::model::plane::<_, Vec<[f64; 2]>>(&forces.reactions))
-                    {
-                        c.observe_reactions(r);
+                    if let Some(c) = self.check.as_mut() {
+                        c.observe_reactions(&forces.reactions);
                     }
                     let before = forces.at_start.then(|| self.stress_integral(&forces));
                     let updated = self.update_particles(&active, dt)?;
@@ -820,7 +812,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         // The energy terms of a dynamic step need the particles' state at t_n.
         let dynamic = matches!(self.model.integration, Integration::Dynamic { .. });
         let before: Vec<_> = if dynamic {
-            let body_acc = self.model.body_accelerations_in(active, self.t + dt);
+            let body_acc = self.model.body_accelerations(active, self.t + dt);
             let ps = &self.model.particles;
             (0..n).map(|k| (self.model.particle_input(k, &body_acc), ps.vel[k], ps.vel_w[k])).collect()
         } else {
@@ -1002,8 +994,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         for m in self.model.boundaries.iter().filter_map(|b| b.motion.as_ref()) {
             row.extend(m.displacement_at(self.t));
         }
-        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
-            row.extend(c.observe(self.t, dt, plane, self.coll).map_err(RunError::Failed)?);
+        if let Some(c) = self.check.as_mut() {
+            row.extend(c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?);
         }
         self.out.history_row(&row).map_err(RunError::Failed)?;
         if self.out.is_writer() {
@@ -1016,8 +1008,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
     /// The check's observation on steps without a history row.
     fn observe_only(&mut self, dt: f64) -> Result<(), RunError> {
         update_probes(&self.model, &mut self.probes, self.coll).map_err(RunError::Failed)?;
-        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
-            c.observe(self.t, dt, plane, self.coll).map_err(RunError::Failed)?;
+        if let Some(c) = self.check.as_mut() {
+            c.observe(self.t, dt, &self.model, self.coll).map_err(RunError::Failed)?;
         }
         Ok(())
     }
@@ -1042,9 +1034,9 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
                 }
             }
         }
-        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
+        if let Some(c) = self.check.as_mut() {
             // The results after `finish` (which may complete them), also when it fails.
-            let finished = c.finish(plane, self.coll);
+            let finished = c.finish(&self.model, self.coll);
             self.summary.results.extend(c.results());
             let (metrics, tables) = finished.map_err(RunError::Failed)?;
             self.summary.verification_passed = Some(metrics.iter().all(|m| m.1.pass));
@@ -1152,7 +1144,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
         let slab = self.coll.sorted_slab(&local, state::RECORD);
         let check_state = match self.check.as_ref() {
-            Some(c) => c.checkpoint_state(plane, self.coll).map_err(RunError::Failed)?,
+            Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
             None => None,
         };
         let s = &self.summary;
@@ -1243,9 +1235,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         self.coll.agree(state::check_points(&records, &generated)).map_err(refuse)?;
         self.model.particles = state::particles_from_flat(records.as_flattened());
         crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
-        if let Some(plane) = crate::model::plane_mut::<_, Model>(&mut self.model) {
-            plane.resolve_targets(self.case);
-        }
+        self.model.resolve_targets(self.case);
         self.t = cp.time;
         self.set_load_increments(LoadsAt::Restart(&cp.load_totals))?;
         self.step = cp.step as usize;
@@ -1263,9 +1253,9 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             p.excess_extreme = e;
         }
         let mut note = None;
-        if let (Some(c), Some(plane)) = (self.check.as_mut(), self.model.as_plane()) {
+        if let Some(c) = self.check.as_mut() {
             match &cp.check_state {
-                Some(st) => c.restore_state(st, plane).map_err(|e| refuse(format!("verification state: {e}")))?,
+                Some(st) => c.restore_state(st, &self.model).map_err(|e| refuse(format!("verification state: {e}")))?,
                 None => {
                     note = Some(format!(
                     "the verification check keeps no checkpoint state: its metrics use the run from t = {:.6e} s only",

@@ -236,6 +236,7 @@ gold_tests!(
     slope_sand,
     slumping_block,
     terzaghi,
+    terzaghi_3d,
     terzaghi_explicit,
     vertical_cut,
 );

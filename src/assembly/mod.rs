@@ -788,17 +788,15 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         // three-dimensional cases, whose external forces are zero).
         let plane = model.as_plane().zip(self.as_plane_ref());
         let projection = plane.map(|(m, s)| s.projection_blocks(m)).unwrap_or_default();
-        let zero = || Ok((vec![0.0; self.ghost.len() * self.layout.nd], AppliedLoads::default()));
-        let forces_at = |t: f64| plane.map_or_else(zero, |(m, s)| s.external_forces(m, active, t, &dofs));
-        let (fext, applied) = coll.agree(forces_at(t_new))?;
+        let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
         let nm = kernels::Scheme::of(&model.integration, t_new - t_old, flow);
-        let fext_old = coll.agree(forces_at(t_old))?.0;
+        let fext_old = coll.agree(self.external_forces(model, active, t_old, &dofs))?.0;
         self.step = StepData {
             nm: Some(nm),
             dt: t_new - t_old,
             layout: Some(self.layout),
-            body_acc: model.body_accelerations_in(active, t_new),
+            body_acc: model.body_accelerations(active, t_new),
             stencils: st,
             bands,
             dofs,
@@ -815,10 +813,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
             // static or quasi-static, which have no generalized-α history).
-            let body_acc_old = model.body_accelerations_in(active, t_old);
+            let body_acc_old = model.body_accelerations(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.start_out_of_balance(&body_acc_old, &fext_old));
         } else if nm.history().is_some() {
-            let body_acc_old = model.body_accelerations_in(active, t_old);
+            let body_acc_old = model.body_accelerations(active, t_old);
             self.step.history = self.with_assembler(model, |asm| asm.history(&body_acc_old, &fext_old));
         }
         self.step.fext_old = fext_old;
@@ -1000,11 +998,97 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         (smooth, grad_n)
     }
 
+    /// Step 4: the external forces at t_{n+1} per ghosted dof. A traction's share at a node whose
+    /// motion is extended goes to the node's masters (extended towards the loaded particle); a share
+    /// that no node can carry stays where it is, and [`GridSystem::check_loads`] reports it.
+    /// Returns the nodal forces and, for that check, the total force the loads apply on this rank
+    /// (before it is shared out to nodes). The nodal tractions and line pressures are plane
+    /// ([`GridSystem::plane_load`]).
+    fn external_forces(
+        &self,
+        model: &Model<D>,
+        active: &Active,
+        t_new: f64,
+        dofs: &DofMap,
+    ) -> Result<(Vec<f64>, AppliedLoads<D>), String> {
+        let nd = self.layout.nd;
+        let ps = &model.particles;
+        let g = &model.grid;
+        let mut fext = vec![0.0; self.ghost.len() * nd];
+        let mut applied = AppliedLoads::default();
+        let tiny = 1e-9 * g.h.iter().copied().fold(f64::INFINITY, f64::min);
+        let is_well = |n: [i64; D]| -> bool {
+            n.iter().all(|&v| v >= 0) && self.ghost.local(n.map(|v| v as usize)).is_some_and(|l| dofs.well[l])
+        };
+        let mut add = |l: usize, force: [f64; D], toward: [f64; D]| {
+            for c in 0..D {
+                if dofs.well[l] || dofs.boundary_fixed(l, c) {
+                    fext[l * nd + c] += force[c];
+                    continue;
+                }
+                let n = self.ghost.indices(l);
+                match stencils::extension_in(n, g.position(n), toward, &is_well, tiny, model.basis.is_bspline()) {
+                    Some((masters, coefs, count)) => {
+                        for m in 0..count {
+                            let ml = self.ghost.local(masters[m].map(|v| v as usize)).expect("well");
+                            fext[ml * nd + c] += coefs[m] * force[c];
+                        }
+                    }
+                    None => fext[l * nd + c] += force[c],
+                }
+            }
+        };
+        for &li in &active.loads {
+            let load = &model.loads[li];
+            let f = load.factor(t_new);
+            if !matches!(load.target, LoadTarget::BodyForce { .. }) {
+                applied.names.push(load.name.clone());
+            }
+            match &load.target {
+                LoadTarget::ParticleTraction { particles, face, traction } => {
+                    // The traction acts at the centre of the particle's loaded face (force = traction ×
+                    // current face measure) with the multilinear weights there (see
+                    // shape::face_weights).
+                    for &k in particles {
+                        let (x, lp) = (ps.x[k], ps.lp[k]);
+                        let (point, length) = face_point(*face, x, lp);
+                        // The face's area: its length times the ring's 2πr in axial symmetry.
+                        let length = length * model.geometry.measure(point[0]);
+                        applied.add(std::array::from_fn(|d| traction[d] * f * length));
+                        let w: shape::Stencil<D, M> = shape::face_weights_in(model.basis, g, point);
+                        for (node, s, _) in w.iter() {
+                            let l = self.ghost.local(node.map(|v| v as usize)).ok_or_else(|| {
+                                format!(
+                                    "the traction `{}` on material point {} acts outside this rank's ghost region",
+                                    load.name, ps.id[k]
+                                )
+                            })?;
+                            add(l, std::array::from_fn(|d| s * traction[d] * f * length), x);
+                        }
+                    }
+                }
+                LoadTarget::NodalTraction { .. } | LoadTarget::LinePressure { .. } => {
+                    if let (Some(plane), Some(system)) = (model.as_plane(), self.as_plane_ref()) {
+                        let (forces, totals) = system.plane_load(plane, li, f);
+                        for total in totals {
+                            applied.add(std::array::from_fn(|d| total[d]));
+                        }
+                        for (l, force, toward) in forces {
+                            add(l, std::array::from_fn(|d| force[d]), std::array::from_fn(|d| toward[d]));
+                        }
+                    }
+                }
+                LoadTarget::BodyForce { .. } => {}
+            }
+        }
+        Ok((fext, applied))
+    }
+
     /// The load accounting of a step: the tractions the case applies at t_{n+1} against the forces
     /// assembled on nodes that carry them (free, or fixed by a boundary, whose reaction then takes
     /// them). A difference beyond round-off means that part of a load would be lost: an error
     /// naming the load.
-    fn check_loads(&mut self, applied: &AppliedLoads, t_new: f64, coll: &Collective) -> Result<(), String> {
+    fn check_loads(&mut self, applied: &AppliedLoads<D>, t_new: f64, coll: &Collective) -> Result<(), String> {
         let nd = self.layout.nd;
         let (applied, names) = (applied.total, &applied.names);
         if names.is_empty() {
@@ -1012,7 +1096,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         }
         let mut summed = self.step.fext.clone();
         self.sum_over_ranks(&mut summed).map_err(|e| e.to_string())?;
-        let mut carried = [0.0; 2];
+        let mut carried = [0.0; D];
         let mut magnitude = 0.0f64;
         for &a in &self.owned_nodes {
             let l = a as usize;
@@ -1024,18 +1108,19 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 }
             }
         }
-        let totals = coll.sum(&[applied[0], applied[1], carried[0], carried[1]])?;
-        let scale = coll.max(&[magnitude])?[0].max(totals[0].abs()).max(totals[1].abs());
-        let lost = [totals[0] - totals[2], totals[1] - totals[3]];
-        if lost[0].hypot(lost[1]) > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+        let totals = coll.sum(&[&applied[..], &carried[..]].concat())?;
+        let scale = totals[..D].iter().fold(coll.max(&[magnitude])?[0], |m, t| m.max(t.abs()));
+        let lost = (0..D).fold(0.0f64, |m, d| m.hypot(totals[d] - totals[D + d]));
+        if lost > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+            let vector =
+                |v: &[f64]| format!("({})", v.iter().map(|x| format!("{x:.6e}")).collect::<Vec<_>>().join(", "));
+            let unit = if D == 2 { "N/m" } else { "N" };
             return Err(format!(
-                "at t = {t_new:.6e} s the load(s) {} apply ({:.6e}, {:.6e}) N/m but the grid carries ({:.6e}, {:.6e}) N/m: \
-                 part of the load acts on nodes the material does not fill",
+                "at t = {t_new:.6e} s the load(s) {} apply {} {unit} but the grid carries {} {unit}: part of the load \
+                 acts on nodes the material does not fill",
                 names.join(", "),
-                totals[0],
-                totals[1],
-                totals[2],
-                totals[3]
+                vector(&totals[..D]),
+                vector(&totals[D..])
             ));
         }
         Ok(())
@@ -1430,6 +1515,46 @@ impl GridSystem {
         self.owns_cell_in([i, j])
     }
 
+    /// The shares of load `li` (a nodal traction or a line pressure, plane only) at factor `f`:
+    /// the forces with the ghosted node each goes to and the point an extension reaches towards,
+    /// in the order [`GridSystem::external_forces`] adds them, and the forces the load applies.
+    #[allow(clippy::type_complexity)]
+    fn plane_load(&self, model: &Model, li: usize, f: f64) -> (Vec<(usize, [f64; 2], [f64; 2])>, Vec<[f64; 2]>) {
+        let g = &model.grid;
+        let (mut forces, mut totals) = (Vec::new(), Vec::new());
+        match &model.loads[li].target {
+            LoadTarget::NodalTraction { nodes, traction } => {
+                for &(i, j, trib) in nodes.iter().filter(|&&(i, j, _)| self.owns_cell(i, j)) {
+                    let l = self.ghost.node(i, j).expect("owned");
+                    let trib = trib * model.geometry.measure(g.node_position(i, j)[0]);
+                    let force = [traction[0] * f * trib, traction[1] * f * trib];
+                    totals.push(force);
+                    forces.push((l, force, g.node_position(i, j)));
+                }
+            }
+            LoadTarget::LinePressure { points, pressure } => {
+                // Each Gauss point on the rank owning the cell that holds it.
+                for &(point, force) in points {
+                    if !g.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
+                        continue;
+                    }
+                    let ring = model.geometry.measure(point[0]);
+                    let force = [force[0] * ring, force[1] * ring];
+                    totals.push([force[0] * pressure * f, force[1] * pressure * f]);
+                    // Shares on unfilled nodes are extended from the material's side.
+                    let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
+                    let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
+                    for ([i, j], s, _) in shape::face_weights(model.basis, g, point).iter() {
+                        let l = self.ghost.node(i as usize, j as usize).expect("an owned cell's nodes are ghosted");
+                        forces.push((l, [s * force[0] * pressure * f, s * force[1] * pressure * f], inward));
+                    }
+                }
+            }
+            LoadTarget::ParticleTraction { .. } | LoadTarget::BodyForce { .. } => {}
+        }
+        (forces, totals)
+    }
+
     /// The plane-only parts of a step's data (step 4): Nitsche's drained faces of the moving
     /// surfaces (`weak`), [001]'s mapped stiffnesses, and the drained nodes of an explicit
     /// two-phase step with the nodal pore pressure.
@@ -1544,113 +1669,6 @@ impl GridSystem {
         out
     }
 
-    /// Step 4: the external forces at t_{n+1} per ghosted dof. A traction's share at a node whose
-    /// motion is extended goes to the node's masters (extended towards the loaded particle); a share
-    /// that no node can carry stays where it is, and [`GridSystem::check_loads`] reports it.
-    /// Returns the nodal forces and, for that check, the total force the loads apply on this rank
-    /// (before it is shared out to nodes).
-    fn external_forces(
-        &self,
-        model: &Model,
-        active: &Active,
-        t_new: f64,
-        dofs: &DofMap,
-    ) -> Result<(Vec<f64>, AppliedLoads), String> {
-        let nd = self.layout.nd;
-        let ps = &model.particles;
-        let g = &model.grid;
-        let mut fext = vec![0.0; self.ghost.len() * nd];
-        let mut applied = AppliedLoads::default();
-        let tiny = 1e-9 * g.h[0].min(g.h[1]);
-        let is_well = |i: i64, j: i64| -> bool {
-            i >= 0 && j >= 0 && self.ghost.node(i as usize, j as usize).is_some_and(|l| dofs.well[l])
-        };
-        let mut add = |l: usize, force: [f64; 2], toward: [f64; 2]| {
-            for c in 0..2 {
-                if dofs.well[l] || dofs.boundary_fixed(l, c) {
-                    fext[l * nd + c] += force[c];
-                    continue;
-                }
-                let (i, j) = self.ghost.ij(l);
-                match stencils::extension(
-                    (i, j),
-                    g.node_position(i, j),
-                    toward,
-                    &is_well,
-                    tiny,
-                    model.basis.is_bspline(),
-                ) {
-                    Some((masters, coefs, n)) => {
-                        for m in 0..n {
-                            let ml = self.ghost.node(masters[m].0 as usize, masters[m].1 as usize).expect("well");
-                            fext[ml * nd + c] += coefs[m] * force[c];
-                        }
-                    }
-                    None => fext[l * nd + c] += force[c],
-                }
-            }
-        };
-        for &li in &active.loads {
-            let load = &model.loads[li];
-            let f = load.factor(t_new);
-            if !matches!(load.target, LoadTarget::BodyForce { .. }) {
-                applied.names.push(load.name.clone());
-            }
-            match &load.target {
-                LoadTarget::ParticleTraction { particles, face, traction } => {
-                    // The traction acts at the centre of the particle's loaded face (force = traction ×
-                    // current face length) with the bilinear weights there (see shape::face_weights).
-                    for &k in particles {
-                        let (x, lp) = (ps.x[k], ps.lp[k]);
-                        let (point, length) = face_point(*face, x, lp);
-                        // The face's area: its length times the ring's 2πr in axial symmetry.
-                        let length = length * model.geometry.measure(point[0]);
-                        applied.add([traction[0] * f * length, traction[1] * f * length]);
-                        let w = shape::face_weights(model.basis, g, point);
-                        for ([i, j], s, _) in w.iter() {
-                            let l = self.ghost.node(i as usize, j as usize).ok_or_else(|| {
-                                format!(
-                                    "the traction `{}` on material point {} acts outside this rank's ghost region",
-                                    load.name, ps.id[k]
-                                )
-                            })?;
-                            add(l, [s * traction[0] * f * length, s * traction[1] * f * length], x);
-                        }
-                    }
-                }
-                LoadTarget::NodalTraction { nodes, traction } => {
-                    for &(i, j, trib) in nodes.iter().filter(|&&(i, j, _)| self.owns_cell(i, j)) {
-                        let l = self.ghost.node(i, j).expect("owned");
-                        let trib = trib * model.geometry.measure(g.node_position(i, j)[0]);
-                        let force = [traction[0] * f * trib, traction[1] * f * trib];
-                        applied.add(force);
-                        add(l, force, g.node_position(i, j));
-                    }
-                }
-                LoadTarget::LinePressure { points, pressure } => {
-                    // Each Gauss point on the rank owning the cell that holds it.
-                    for &(point, force) in points {
-                        if !g.cell_of(point).is_some_and(|(i, j)| self.owns_cell(i, j)) {
-                            continue;
-                        }
-                        let ring = model.geometry.measure(point[0]);
-                        let force = [force[0] * ring, force[1] * ring];
-                        applied.add([force[0] * pressure * f, force[1] * pressure * f]);
-                        // Shares on unfilled nodes are extended from the material's side.
-                        let len = force[0].hypot(force[1]).max(f64::MIN_POSITIVE);
-                        let inward = [point[0] + force[0] / len * g.h[0], point[1] + force[1] / len * g.h[1]];
-                        for ([i, j], s, _) in shape::face_weights(model.basis, g, point).iter() {
-                            let l = self.ghost.node(i as usize, j as usize).expect("an owned cell's nodes are ghosted");
-                            add(l, [s * force[0] * pressure * f, s * force[1] * pressure * f], inward);
-                        }
-                    }
-                }
-                LoadTarget::BodyForce { .. } => {}
-            }
-        }
-        Ok((fext, applied))
-    }
-
     /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
     /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
     /// interpolated increment.
@@ -1762,18 +1780,25 @@ fn lift3<const D: usize>(n: [usize; D], fill: usize) -> [usize; 3] {
 
 /// The tractions of a step as the case applies them (before they are shared out to nodes), on
 /// this rank, for [`GridSystem::check_loads`].
-#[derive(Debug, Clone, Default)]
-struct AppliedLoads {
-    /// Total force [N/m].
-    total: [f64; 2],
+#[derive(Debug, Clone)]
+struct AppliedLoads<const D: usize = 2> {
+    /// Total force [N/m in two dimensions, N in three].
+    total: [f64; D],
     /// The traction loads that are active.
     names: Vec<String>,
 }
 
-impl AppliedLoads {
-    fn add(&mut self, force: [f64; 2]) {
-        self.total[0] += force[0];
-        self.total[1] += force[1];
+impl<const D: usize> Default for AppliedLoads<D> {
+    fn default() -> Self {
+        AppliedLoads { total: [0.0; D], names: Vec::new() }
+    }
+}
+
+impl<const D: usize> AppliedLoads<D> {
+    fn add(&mut self, force: [f64; D]) {
+        for (t, f) in self.total.iter_mut().zip(force) {
+            *t += f;
+        }
     }
 }
 

@@ -265,6 +265,21 @@ impl Region {
         (0..2).all(|d| self.spans(d, p[d], 0.0))
     }
 
+    /// Whether point `p` of a case of dimension `D` lies in the box: [`Region::contains`] in x and
+    /// y and, in three dimensions, its `z` range (all of z without one) with the same tolerance.
+    pub fn contains_in<const D: usize>(&self, p: [f64; D]) -> bool {
+        if !self.contains([p[0], p[1]]) {
+            return false;
+        }
+        match (D, self.z) {
+            (3, Some([lo, hi])) => {
+                let tol = 1e-9 * ((hi - lo).abs() + lo.abs() + hi.abs()) + 1e-15;
+                p[2] >= lo - tol && p[2] <= hi + tol
+            }
+            _ => true,
+        }
+    }
+
     /// Whether the grid node at `p` lies in the box: as [`Region::contains`], with a further
     /// 1e-9 of the cell size `h`, the round-off of origin + i h (a line at x = 0 holds the node
     /// computed at −2e-15).

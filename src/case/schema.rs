@@ -601,7 +601,8 @@ pub struct Surface {
 pub enum Load {
     /// A traction [Pa] on one face of the particle domains whose centres lie in `region` at t = 0
     /// and whose face is on the surface of the material (the point just beyond it is outside every
-    /// body), applied at the face centre (force = traction × face length, per metre of thickness).
+    /// body), applied at the face centre (force = traction × the face's length per metre of
+    /// thickness in two dimensions, × its area in three).
     ParticleTraction {
         /// Name used by stages and verification.
         name: String,
@@ -612,8 +613,8 @@ pub enum Load {
         body: Option<String>,
         /// Which face of each particle domain carries it.
         face: Side,
-        /// Traction vector [Pa].
-        traction: [f64; 2],
+        /// Traction vector [Pa]: two components in a plane case, three in a three-dimensional one.
+        traction: Vec<f64>,
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
@@ -638,8 +639,8 @@ pub enum Load {
         name: String,
         /// Nodes carrying it (a row or column of nodes).
         region: Region,
-        /// Traction vector [Pa].
-        traction: [f64; 2],
+        /// Traction vector [Pa] (two components: a plane case only).
+        traction: Vec<f64>,
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
@@ -661,12 +662,14 @@ pub enum Load {
         #[serde(default)]
         time_function: Option<String>,
     },
-    /// A body acceleration [m/s²] on every particle (gravity: [0, -9.81]), acting on both phases.
+    /// A body acceleration [m/s²] on every particle (gravity: [0, -9.81], or [0, -9.81, 0] in three
+    /// dimensions), acting on both phases.
     BodyForce {
         /// Name used by stages.
         name: String,
-        /// Acceleration vector [m/s²].
-        acceleration: [f64; 2],
+        /// Acceleration vector [m/s²]: two components in a plane case, three in a three-dimensional
+        /// one.
+        acceleration: Vec<f64>,
         /// The bodies it acts on (default: all), e.g. a footing whose unit weight is ramped up.
         #[serde(default)]
         bodies: Option<Vec<String>>,
@@ -677,6 +680,16 @@ pub enum Load {
 }
 
 impl Load {
+    /// The `kind` the case file names.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Load::ParticleTraction { .. } => "particle_traction",
+            Load::NodalTraction { .. } => "nodal_traction",
+            Load::LinePressure { .. } => "line_pressure",
+            Load::BodyForce { .. } => "body_force",
+        }
+    }
+
     /// The load's name.
     pub fn name(&self) -> &str {
         match self {

@@ -78,6 +78,18 @@ fn finite2(key: &str, v: [f64; 2]) -> R {
     }
 }
 
+/// A vector of `dim` finite components (one per direction of the grid).
+fn components(key: &str, v: &[f64], dim: usize) -> R {
+    if v.len() != dim {
+        return Err(format!("key `{key}`: {dim} components in a case of {dim} dimensions, got {}", v.len()));
+    }
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("key `{key}`: must be finite, got {v:?}"))
+    }
+}
+
 fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> R {
     let mut seen = HashSet::new();
     for n in names {
@@ -229,14 +241,21 @@ fn three_dimensional(c: &Case) -> R {
                     per grid key for an axisymmetric one)"
             .into());
     }
-    if !c.loads.is_empty() {
-        return not_yet("loads");
+    for (i, l) in c.loads.iter().enumerate() {
+        match l {
+            Load::NodalTraction { .. } | Load::LinePressure { .. } => {
+                return not_yet(&format!("loads[{i}].kind = \"{}\"", l.kind()));
+            }
+            _ if l.increment_factor().is_some() => return not_yet(&format!("loads[{i}].increment_factor")),
+            _ => {}
+        }
     }
     if !c.probes.is_empty() {
         return not_yet("probes");
     }
-    if c.verification.is_some() {
-        return not_yet("verification");
+    match &c.verification {
+        None | Some(Verification::Terzaghi { .. }) => {}
+        Some(v) => return not_yet(&format!("verification.kind = \"{}\"", v.kind())),
     }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
@@ -700,8 +719,8 @@ pub fn validate(c: &Case) -> R {
             }
         }
         match l {
-            Load::ParticleTraction { region, traction, .. } | Load::NodalTraction { region, traction, .. } => {
-                finite2(&format!("loads[{i}].traction"), *traction)?;
+            Load::ParticleTraction { region, traction, .. } => {
+                components(&format!("loads[{i}].traction"), traction, c.dimension())?;
                 finite2(&format!("loads[{i}].region.min"), region.min)?;
                 finite2(&format!("loads[{i}].region.max"), region.max)?;
                 if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
@@ -714,7 +733,23 @@ pub fn validate(c: &Case) -> R {
                         .map_err(|m| format!("key `loads[{i}].increment_factor`: `{e}` at {centre:?}: {m}"))?;
                 }
             }
-            Load::BodyForce { acceleration, .. } => finite2(&format!("loads[{i}].acceleration"), *acceleration)?,
+            Load::NodalTraction { region, traction, .. } => {
+                components(&format!("loads[{i}].traction"), traction, 2)?;
+                finite2(&format!("loads[{i}].region.min"), region.min)?;
+                finite2(&format!("loads[{i}].region.max"), region.max)?;
+                if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
+                    return Err(format!("key `loads[{i}].region`: max must not be below min"));
+                }
+                if let Some(e) = l.increment_factor() {
+                    // Tried where the loaded faces start: the region's centre.
+                    let centre = [0.5 * (region.min[0] + region.max[0]), 0.5 * (region.min[1] + region.max[1])];
+                    crate::model::loads::increment_factor(e, &c.parameters, centre)
+                        .map_err(|m| format!("key `loads[{i}].increment_factor`: `{e}` at {centre:?}: {m}"))?;
+                }
+            }
+            Load::BodyForce { acceleration, .. } => {
+                components(&format!("loads[{i}].acceleration"), acceleration, c.dimension())?
+            }
             Load::LinePressure { points, pressure, .. } => {
                 if points.len() < 2 {
                     return Err(format!("key `loads[{i}].points`: a line needs at least two points"));

@@ -67,15 +67,15 @@ impl TimeFn {
     }
 }
 
-/// A load ready to be applied.
+/// A load ready to be applied (two-dimensional unless `D` says otherwise).
 #[derive(Debug, Clone)]
-pub struct LoadDef {
+pub struct LoadDef<const D: usize = 2> {
     /// Name from the case.
     pub name: String,
     /// Its time function (constant 1 if none).
     pub time_fn: TimeFn,
     /// What it acts on.
-    pub target: LoadTarget,
+    pub target: LoadTarget<D>,
     /// The state of a load whose increments follow the loaded faces (`increment_factor`).
     pub increments: Option<Increments>,
 }
@@ -120,27 +120,29 @@ pub fn increment_factor(
     crate::case::parameters::eval(expr, &vars)
 }
 
-/// The centre of a particle's `face` and the face's length.
-pub fn face_point(face: Side, x: [f64; 2], lp: [f64; 2]) -> ([f64; 2], f64) {
+/// The centre of a particle's `face` and the face's measure: its length in two dimensions (per
+/// metre of thickness), its area in three.
+pub fn face_point<const D: usize>(face: Side, x: [f64; D], lp: [f64; D]) -> ([f64; D], f64) {
     let a = face.axis();
-    if a >= 2 {
+    if a >= D {
         // A z face: none in a plane case (validated).
         return (x, 0.0);
     }
     let mut p = x;
     p[a] += face.sign() * lp[a];
-    (p, 2.0 * lp[1 - a])
+    let measure = if D == 2 { 2.0 * lp[1 - a] } else { (0..D).filter(|&d| d != a).map(|d| 2.0 * lp[d]).product() };
+    (p, measure)
 }
 
-/// What a load acts on.
+/// What a load acts on (in D dimensions; the nodal tractions and line pressures are plane).
 #[derive(Debug, Clone)]
-pub enum LoadTarget {
+pub enum LoadTarget<const D: usize = 2> {
     /// Face tractions on the listed particles (local indices), applied at the face centre.
-    ParticleTraction { particles: Vec<usize>, face: Side, traction: [f64; 2] },
+    ParticleTraction { particles: Vec<usize>, face: Side, traction: [f64; D] },
     /// Forces on grid nodes (i, j, tributary length [m]).
     NodalTraction { nodes: Vec<(usize, usize, f64)>, traction: [f64; 2] },
     /// Body acceleration on the particles of the listed bodies (all if None).
-    BodyForce { acceleration: [f64; 2], bodies: Option<Vec<u16>> },
+    BodyForce { acceleration: [f64; D], bodies: Option<Vec<u16>> },
     /// A pressure on a fixed polyline: its Gauss points with the force per unit pressure there
     /// (weight × length × the unit normal to the left) [m].
     LinePressure { points: Vec<([f64; 2], [f64; 2])>, pressure: f64 },
@@ -149,34 +151,69 @@ pub enum LoadTarget {
 impl LoadDef {
     /// Resolves a case load on this rank's particles and the grid.
     pub fn from_case(l: &case::Load, c: &case::Case, grid: &Grid, particles: &Particles) -> LoadDef {
-        let time_fn =
-            l.time_function().and_then(|n| c.time_function(n)).map(TimeFn::from_case).unwrap_or(TimeFn::Constant(1.0));
+        match l {
+            case::Load::NodalTraction { region, traction, .. } => LoadDef::with_target(
+                l,
+                c,
+                LoadTarget::NodalTraction {
+                    nodes: tributary_nodes(grid, region),
+                    traction: [traction[0], traction[1]],
+                },
+            ),
+            case::Load::LinePressure { points, pressure, .. } => LoadDef::with_target(
+                l,
+                c,
+                LoadTarget::LinePressure { points: line_gauss_points(points), pressure: *pressure },
+            ),
+            _ => LoadDef::from_case_in(l, c, particles).expect("a load of any dimension"),
+        }
+    }
+}
+
+impl<const D: usize> LoadDef<D> {
+    /// Resolves a case load of any dimension on this rank's particles: a face traction or a body
+    /// force (`None` for the plane's nodal tractions and line pressures, which validation keeps
+    /// out of three-dimensional cases).
+    pub fn from_case_in(l: &case::Load, c: &case::Case, particles: &Particles<D>) -> Option<LoadDef<D>> {
+        let vector = |v: &[f64]| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
         let target = match l {
             case::Load::ParticleTraction { region, body, face, traction, .. } => LoadTarget::ParticleTraction {
                 particles: (0..particles.len())
                     .filter(|&k| {
                         let in_body = body.as_ref().is_none_or(|b| c.bodies[particles.body[k] as usize].name == *b);
                         in_body
-                            && region.contains(particles.x0[k])
+                            && region.contains_in(particles.x0[k])
                             && face_is_exposed(c, particles.x0[k], particles.lp0[k], *face)
                     })
                     .collect(),
                 face: *face,
-                traction: *traction,
+                traction: vector(traction),
             },
-            case::Load::NodalTraction { region, traction, .. } => {
-                LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: *traction }
-            }
-            case::Load::LinePressure { points, pressure, .. } => {
-                LoadTarget::LinePressure { points: line_gauss_points(points), pressure: *pressure }
-            }
             case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
-                acceleration: *acceleration,
+                acceleration: vector(acceleration),
                 bodies: bodies
                     .as_ref()
                     .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
             },
+            case::Load::NodalTraction { .. } | case::Load::LinePressure { .. } => return None,
         };
+        Some(LoadDef::with_target(l, c, target))
+    }
+
+    /// Number of particles or nodes it acts on (for `check`).
+    pub fn size(&self) -> usize {
+        match &self.target {
+            LoadTarget::ParticleTraction { particles, .. } => particles.len(),
+            LoadTarget::NodalTraction { nodes, .. } => nodes.len(),
+            LoadTarget::LinePressure { points, .. } => points.len(),
+            LoadTarget::BodyForce { .. } => 0,
+        }
+    }
+
+    /// The load `l` of case `c` acting on `target`, with its time function and increments.
+    fn with_target(l: &case::Load, c: &case::Case, target: LoadTarget<D>) -> LoadDef<D> {
+        let time_fn =
+            l.time_function().and_then(|n| c.time_function(n)).map(TimeFn::from_case).unwrap_or(TimeFn::Constant(1.0));
         let increments = l.increment_factor().map(|e| Increments {
             expr: e.to_string(),
             params: c.parameters.clone(),
@@ -195,7 +232,9 @@ impl LoadDef {
             Some(s) => s.total + (self.time_fn.eval(t) - self.time_fn.eval(s.t_n)) * s.g_n,
         }
     }
+}
 
+impl LoadDef {
     /// This rank's moments of the loaded faces: [Σ a x, Σ a y, Σ a] with a the face's area
     /// (length, times 2πr in axial symmetry); zero unless it is a face traction.
     pub fn face_moments(&self, particles: &Particles, geometry: &super::shape::Geometry) -> [f64; 3] {
@@ -231,32 +270,22 @@ impl LoadDef {
         s.g_n = g;
         Ok(())
     }
-
-    /// Number of particles or nodes it acts on (for `check`).
-    pub fn size(&self) -> usize {
-        match &self.target {
-            LoadTarget::ParticleTraction { particles, .. } => particles.len(),
-            LoadTarget::NodalTraction { nodes, .. } => nodes.len(),
-            LoadTarget::LinePressure { points, .. } => points.len(),
-            LoadTarget::BodyForce { .. } => 0,
-        }
-    }
 }
 
 /// Whether the `face` of a particle domain centred at `x` lies on the surface of the material:
 /// the point just beyond the face centre is outside every body. This selects the outer row of
 /// particles whatever the particle spacing, so a traction region need not be adjusted when the
 /// grid is refined.
-pub fn face_is_exposed(c: &case::Case, x: [f64; 2], lp: [f64; 2], face: Side) -> bool {
+pub fn face_is_exposed<const D: usize>(c: &case::Case, x: [f64; D], lp: [f64; D], face: Side) -> bool {
     let e = 1.0 + 1e-6;
     let a = face.axis();
-    if a >= 2 {
+    if a >= D {
         // A z face: none in a plane case (validated).
         return false;
     }
     let mut p = x;
     p[a] += face.sign() * e * lp[a];
-    !c.bodies.iter().any(|b| b.shape.contains(p))
+    !c.bodies.iter().any(|b| c.body_holds(b, p))
 }
 
 /// The two Gauss points of each segment of a polyline, with the force per unit pressure there:

@@ -24,8 +24,9 @@ use particles::Particles;
 use shape::Basis;
 
 /// Everything that describes the continuum and its discretisation on this rank, in `D` dimensions
-/// (two unless it says otherwise). Its loads and boundaries are still two-dimensional (issue
-/// «Three dimensions», docs/dimensions.md): a three-dimensional model has none yet.
+/// (two unless it says otherwise). A three-dimensional model has face tractions and body forces,
+/// side and region boundaries; the nodal tractions, line pressures and moving surfaces are plane
+/// (issue «Three dimensions», docs/dimensions.md).
 #[derive(Debug, Clone)]
 pub struct Model<const D: usize = 2> {
     /// u–p–U (true) or u only.
@@ -42,7 +43,7 @@ pub struct Model<const D: usize = 2> {
     /// This rank's material points.
     pub particles: Particles<D>,
     /// Loads, in case order.
-    pub loads: Vec<LoadDef>,
+    pub loads: Vec<LoadDef<D>>,
     /// Dirichlet conditions, in case order.
     pub boundaries: Vec<BoundaryDef<D>>,
     /// g in Darcy's law [m/s²].
@@ -159,18 +160,9 @@ impl Model {
         Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 
-    /// Resolves the case's point-wise loads (face tractions) and moving surfaces again on this
-    /// rank's points, after points moved between ranks. Both depend only on what travels with a
-    /// point (its body, and its position and domain at t = 0), so every point keeps its loads.
-    pub fn resolve_targets(&mut self, case: &Case) {
-        for (l, c) in self.loads.iter_mut().zip(&case.loads) {
-            if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
-                // The state of a load with increments is global (the same on every rank): kept.
-                let increments = l.increments.take();
-                *l = LoadDef::from_case(c, case, &self.grid, &self.particles);
-                l.increments = increments;
-            }
-        }
+    /// Resolves the case's moving surfaces again on this rank's points (see
+    /// [`Model::resolve_targets`]).
+    fn resolve_surfaces(&mut self, case: &Case) {
         for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
             if b.surface.is_some() {
                 *b = BoundaryDef::from_case(c, case, &self.particles);
@@ -278,25 +270,6 @@ impl Model {
         out.dedup();
         out
     }
-
-    /// Body acceleration at time `t` of the particles of each body, from the active body-force loads
-    /// [m/s²] (indexed by body).
-    pub fn body_accelerations(&self, active: &Active, t: f64) -> Vec<[f64; 2]> {
-        let nb = self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(self.n_bodies);
-        let mut out = vec![[0.0; 2]; nb];
-        for &i in &active.loads {
-            if let LoadTarget::BodyForce { acceleration, bodies } = &self.loads[i].target {
-                let f = self.loads[i].time_fn.eval(t);
-                for (b, a) in out.iter_mut().enumerate() {
-                    if bodies.as_ref().is_none_or(|l| l.contains(&(b as u16))) {
-                        a[0] += acceleration[0] * f;
-                        a[1] += acceleration[1] * f;
-                    }
-                }
-            }
-        }
-        out
-    }
 }
 
 impl Model<3> {
@@ -307,7 +280,8 @@ impl Model<3> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
         let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case_in(b, case, None)).collect();
-        Model { boundaries, ..Model::bare(case, grid, particles) }
+        let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &particles)).collect();
+        Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 }
 
@@ -357,15 +331,42 @@ impl<const D: usize> Model<D> {
         *built.downcast::<Model<D>>().expect("a model of two or three dimensions")
     }
 
-    /// Body acceleration at time `t` of the particles of each body ([`Model::body_accelerations`];
-    /// zero in three dimensions, whose cases have no loads yet) [m/s²].
-    pub fn body_accelerations_in(&self, active: &Active, t: f64) -> Vec<[f64; D]> {
-        match self.as_plane() {
-            Some(m) => m.body_accelerations(active, t).into_iter().map(|a| std::array::from_fn(|d| a[d])).collect(),
-            None => {
-                let bodies = self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(self.n_bodies);
-                vec![[0.0; D]; bodies]
+    /// Body acceleration at time `t` of the particles of each body, from the active body-force loads
+    /// [m/s²] (indexed by body).
+    pub fn body_accelerations(&self, active: &Active, t: f64) -> Vec<[f64; D]> {
+        let nb = self.particles.body.iter().map(|&b| b as usize + 1).max().unwrap_or(0).max(self.n_bodies);
+        let mut out = vec![[0.0; D]; nb];
+        for &i in &active.loads {
+            if let LoadTarget::BodyForce { acceleration, bodies } = &self.loads[i].target {
+                let f = self.loads[i].time_fn.eval(t);
+                for (b, a) in out.iter_mut().enumerate() {
+                    if bodies.as_ref().is_none_or(|l| l.contains(&(b as u16))) {
+                        for d in 0..D {
+                            a[d] += acceleration[d] * f;
+                        }
+                    }
+                }
             }
+        }
+        out
+    }
+
+    /// Resolves the case's point-wise loads (face tractions) and moving surfaces (plane) again on
+    /// this rank's points, after points moved between ranks. Both depend only on what travels with
+    /// a point (its body, and its position and domain at t = 0), so every point keeps its loads.
+    pub fn resolve_targets(&mut self, case: &Case) {
+        for (l, c) in self.loads.iter_mut().zip(&case.loads) {
+            if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
+                // The state of a load with increments is global (the same on every rank): kept.
+                let increments = l.increments.take();
+                if let Some(resolved) = LoadDef::from_case_in(c, case, &self.particles) {
+                    *l = resolved;
+                }
+                l.increments = increments;
+            }
+        }
+        if let Some(plane) = plane_mut::<_, Model>(self) {
+            plane.resolve_surfaces(case);
         }
     }
 
@@ -701,8 +702,7 @@ mod tests {
     }
 
     /// The model `m` in three dimensions: its grid, points and domains extruded by one cell of
-    /// `hz` along z, with F_zz = 1 (its loads and boundaries dropped: a three-dimensional model
-    /// has none yet).
+    /// `hz` along z, with F_zz = 1 (its loads and boundaries dropped).
     fn lift(m: &Model, hz: f64) -> Model<3> {
         let v = |a: [f64; 2], z: f64| [a[0], a[1], z];
         let ps = &m.particles;

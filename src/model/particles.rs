@@ -407,7 +407,16 @@ mod tests {
             ),
             (
                 solid.clone() + "[[loads]]\nname = \"g\"\nkind = \"body_force\"\nacceleration = [0.0, -9.81]\n",
-                "key `loads`: not available in a three-dimensional case yet",
+                "key `loads[0].acceleration`: 3 components in a case of 3 dimensions, got 2",
+            ),
+            (
+                solid.clone()
+                    + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 1.0], max = [0.1, 1.0] }\ntraction = [0.0, -1.0]\n",
+                "key `loads[0].kind = \"nodal_traction\"`: not available in a three-dimensional case yet",
+            ),
+            (
+                base.to_string() + "[[loads]]\nname = \"g\"\nkind = \"body_force\"\nacceleration = [0.0, -9.81, 0.0]\n",
+                "key `loads[0].acceleration`: 2 components in a case of 2 dimensions, got 3",
             ),
             (base.replace("cells = [1, 10]", "cells = [1, 10, 2]"), "key `grid.cells`: 2 entries"),
             (base.replace("size = [0.1, 1.0]", "size = [0.1, 1.0, 1.0, 1.0]"), "key `grid.size`: two entries"),

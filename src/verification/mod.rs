@@ -77,31 +77,33 @@ pub struct Table {
 /// What a check reports at the end: named metrics, and tables to write.
 pub type Findings = (Vec<(String, Metric)>, Vec<Table>);
 
-/// A comparison of a run with an analytical solution.
-pub trait Check {
+/// A comparison of a run with an analytical solution, on a model of dimension D (two unless it
+/// says otherwise; in three dimensions only the consolidating column, [`for_case_in`]).
+pub trait Check<const D: usize = 2> {
     /// Extra `history.csv` columns this check fills after every step.
     fn columns(&self) -> Vec<String>;
     /// Times the time stepping must land on exactly.
     fn event_times(&self) -> Vec<f64>;
     /// Called after every converged step at time `t`; returns the values of [`Check::columns`].
-    fn observe(&mut self, t: f64, dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String>;
+    fn observe(&mut self, t: f64, dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String>;
     /// The metrics (name, metric) and tables at the end of the run.
-    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String>;
+    fn finish(&mut self, model: &Model<D>, coll: &Collective) -> Result<Findings, String>;
     /// Whether the check reads the nodal diagnostics K_mag and F^int_mag
     /// ([`Check::observe_nodes`]); the run then computes them after every step.
     fn needs_nodes(&self) -> bool {
         false
     }
     /// Called after every converged step, before [`Check::observe`], with each boundary's reaction
-    /// on the material ([f_x, f_y] per `Model::boundaries` entry, summed over ranks) [N per m].
-    fn observe_reactions(&mut self, _reactions: &[[f64; 2]]) {}
+    /// on the material (D components per `Model::boundaries` entry, summed over ranks) [N per m in
+    /// two dimensions, N in three].
+    fn observe_reactions(&mut self, _reactions: &[[f64; D]]) {}
     /// Called after every converged step, before the particle update, with this rank's owned
     /// nodes (`crate::assembly::NodeBlock`, values per node as `crate::assembly::NODE_VALUES`
     /// says) when [`Check::needs_nodes`]; collective.
     fn observe_nodes(
         &mut self,
         _block: &crate::assembly::NodeBlock,
-        _model: &Model,
+        _model: &Model<D>,
         _coll: &Collective,
     ) -> Result<(), String> {
         Ok(())
@@ -123,12 +125,12 @@ pub trait Check {
     /// What the check has gathered so far, the same on every rank (a collective call), for a
     /// checkpoint; `None` if the check cannot keep it (a run restarted from the checkpoint then
     /// computes the check from the restart time on only).
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
         Ok(None)
     }
     /// Continues from a [`Check::checkpoint_state`] of the same case, with this rank's particles
     /// already restored.
-    fn restore_state(&mut self, _state: &[f64], _model: &Model) -> Result<(), String> {
+    fn restore_state(&mut self, _state: &[f64], _model: &Model<D>) -> Result<(), String> {
         Ok(())
     }
 }
@@ -182,12 +184,17 @@ pub(crate) struct Column {
 }
 
 impl Column {
-    fn from_case(c: &Case, model: &Model, body: &str, load: &str) -> Result<Column, String> {
+    /// The column of `body` loaded by `load`; its cross-section is its width in the plane (per metre
+    /// of thickness; a ring's area in axial symmetry) and its width times its depth along z in
+    /// three dimensions.
+    fn from_case<const D: usize>(c: &Case, model: &Model<D>, body: &str, load: &str) -> Result<Column, String> {
         let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
         let b = &c.bodies[bi];
         let (lo, hi) = b.shape.bounds();
         let traction = match c.load(load) {
-            Some(Load::ParticleTraction { traction, .. }) | Some(Load::NodalTraction { traction, .. }) => *traction,
+            Some(Load::ParticleTraction { traction, .. }) | Some(Load::NodalTraction { traction, .. }) => {
+                [traction[0], traction[1]]
+            }
             _ => return Err(format!("verification load `{load}` must be a particle_traction or nodal_traction")),
         };
         let mi = c.material_index(&b.material).expect("validated");
@@ -196,7 +203,13 @@ impl Column {
             body: bi as u16,
             top: hi[1],
             height: hi[1] - lo[1],
-            width: model.geometry.plan_area(lo[0], hi[0]),
+            width: model.geometry.plan_area(lo[0], hi[0])
+                * if D == 3 {
+                    let [z0, z1] = c.body_depth(b);
+                    z1 - z0
+                } else {
+                    1.0
+                },
             x_centre: 0.5 * (lo[0] + hi[0]),
             load: traction[1].abs(),
             constrained_modulus: mat.model.elastic().constrained_modulus(),
@@ -211,9 +224,61 @@ impl Column {
     }
 
     /// Local indices of the column's particles.
-    fn particles<'a>(&'a self, model: &'a Model) -> impl Iterator<Item = usize> + 'a {
+    fn particles<'a, const D: usize>(&'a self, model: &'a Model<D>) -> impl Iterator<Item = usize> + 'a {
         (0..model.particles.len()).filter(move |&k| model.particles.body[k] == self.body)
     }
+}
+
+/// The check the case asks for in dimension D: [`for_case`] in the plane; in three dimensions the
+/// consolidating column against Terzaghi (the one check validation lets a three-dimensional case
+/// ask for).
+pub fn for_case_in<const D: usize>(
+    c: &Case,
+    model: &Model<D>,
+    coll: &Collective,
+) -> Result<Option<Box<dyn Check<D>>>, String> {
+    if let Some(plane) = model.as_plane() {
+        // The same boxed checks, seen as those of dimension D = 2.
+        let checks: Box<dyn std::any::Any> = Box::new(for_case(c, plane, coll)?);
+        return Ok(*checks.downcast::<Option<Box<dyn Check<D>>>>().expect("the checks of a plane model"));
+    }
+    match &c.verification {
+        None => Ok(None),
+        Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
+        Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
+    }
+}
+
+/// The consolidating column of the case's `terzaghi` verification, in any dimension.
+fn terzaghi_check<const D: usize>(c: &Case, model: &Model<D>, coll: &Collective) -> Result<ConsolidationCheck, String> {
+    let Some(Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance }) =
+        &c.verification
+    else {
+        return Err("the case asks for no Terzaghi check".into());
+    };
+    let col = Column::from_case(c, model, body, load)?;
+    let theory = terzaghi::Terzaghi::new(
+        col.load * load_factor(c, load, c.end_time()).abs(),
+        col.height,
+        col.constrained_modulus,
+        col.inv_q,
+        col.conductivity,
+        col.water_density * col.g,
+    );
+    theory.validate()?;
+    let targets = time_factors
+        .iter()
+        .enumerate()
+        .map(|(i, &tv)| Target {
+            label: format!("Tv{}", tv_name(tv)),
+            t: theory.time_for(tv),
+            full: i + 1 == time_factors.len(),
+            result: None,
+            profile: Vec::new(),
+        })
+        .collect();
+    let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
+    ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)
 }
 
 /// The check the case asks for, if any.
@@ -230,31 +295,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
         Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
         Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model, coll)?),
-        Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance } => {
-            let col = Column::from_case(c, model, body, load)?;
-            let theory = terzaghi::Terzaghi::new(
-                col.load * load_factor(c, load, end).abs(),
-                col.height,
-                col.constrained_modulus,
-                col.inv_q,
-                col.conductivity,
-                col.water_density * col.g,
-            );
-            theory.validate()?;
-            let targets = time_factors
-                .iter()
-                .enumerate()
-                .map(|(i, &tv)| Target {
-                    label: format!("Tv{}", tv_name(tv)),
-                    t: theory.time_for(tv),
-                    full: i + 1 == time_factors.len(),
-                    result: None,
-                    profile: Vec::new(),
-                })
-                .collect();
-            let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
-            Box::new(ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)?)
-        }
+        Verification::Terzaghi { .. } => Box::new(terzaghi_check(c, model, coll)?),
         Verification::LargeStrainConsolidation {
             body,
             load,
@@ -436,12 +477,12 @@ pub struct ConsolidationCheck {
 }
 
 impl ConsolidationCheck {
-    fn new(
+    fn new<const D: usize>(
         col: Column,
         theory: Theory,
         targets: Vec<Target>,
         tolerances: (f64, f64, f64),
-        model: &Model,
+        model: &Model<D>,
         coll: &Collective,
     ) -> Result<Self, String> {
         let v0: f64 = col.particles(model).map(|k| model.particles.volume[k]).sum();
@@ -453,13 +494,13 @@ impl ConsolidationCheck {
         Ok(ConsolidationCheck { col, theory, prefix, targets, tolerances, volume0, history: Vec::new() })
     }
 
-    fn settlement(&self, model: &Model, coll: &Collective) -> Result<f64, String> {
+    fn settlement<const D: usize>(&self, model: &Model<D>, coll: &Collective) -> Result<f64, String> {
         let v: f64 = self.col.particles(model).map(|k| model.particles.volume[k]).sum();
         Ok((self.volume0 - coll.sum(&[v])?[0]) / self.col.width)
     }
 }
 
-impl Check for ConsolidationCheck {
+impl<const D: usize> Check<D> for ConsolidationCheck {
     fn columns(&self) -> Vec<String> {
         ["Tv", "settlement", "settlement_analytical", "U_analytical"]
             .iter()
@@ -471,7 +512,7 @@ impl Check for ConsolidationCheck {
         self.targets.iter().map(|t| t.t).collect()
     }
 
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
         let s = self.settlement(model, coll)?;
         let q = self.theory.load();
         for i in 0..self.targets.len() {
@@ -495,7 +536,7 @@ impl Check for ConsolidationCheck {
         Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
     }
 
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
         Ok(Some(
             self.targets
                 .iter()
@@ -507,7 +548,7 @@ impl Check for ConsolidationCheck {
         ))
     }
 
-    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
         if state.len() != 5 * self.targets.len() {
             return Err(format!("{} values for {} consolidation targets", state.len(), self.targets.len()));
         }
@@ -517,7 +558,7 @@ impl Check for ConsolidationCheck {
         Ok(())
     }
 
-    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+    fn finish(&mut self, _model: &Model<D>, _coll: &Collective) -> Result<Findings, String> {
         let (ep_tol, rms_tol, s_tol) = self.tolerances;
         let mut out = Vec::new();
         for tg in &self.targets {
