@@ -188,6 +188,53 @@ fn footing_sd_mesh_and_locking() {
     assert!(with.windows(2).all(|w| w[1] < w[0]), "q_ult/c with B̄ must fall as h falls: {with:?}");
 }
 
+/// The rigid rough square footing on weightless Tresca clay in three dimensions
+/// (`tests/cases/footing_square_3d.toml`, quarter model) at h = B/4 and B/8: N_c = 4 R_y/(B² c) at
+/// its peak and at d/B = 0.1, against 5.91 (Gourvenec et al. 2006; Salgado et al. 2004's bounds
+/// 5.52–6.22), with the cost of each run. N_c must fall as h falls.
+#[test]
+#[ignore]
+fn footing_square_3d_mesh() {
+    let mut text = String::from(
+        "## Rigid rough square footing on Tresca clay (3D, quarter model): N_c against the mesh\n\n\
+         | h / B | points | unknowns | N_c peak | N_c at d/B = 0.1 | ratio of the peak to 5.91 | Newton | wall [s] | peak memory [MiB] |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut peaks = Vec::new();
+    for h in ["0.25", "0.125"] {
+        let label = format!("footing-square-3d-{h}");
+        let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("studies").join(&label);
+        let _ = std::fs::remove_dir_all(&out);
+        let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
+            .args(["run", "tests/cases/footing_square_3d.toml", "--out", out.to_str().unwrap(), "--quiet"])
+            .args(["--set", &format!("parameters.h={h}")])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .expect("porompm runs");
+        assert!(o.status.success(), "{label}: {}", String::from_utf8_lossy(&o.stderr));
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        let (header, rows) = common::read_history(&out);
+        let nc: Vec<f64> =
+            common::column(&header, &rows, "footing.reaction_y").iter().map(|r| -4.0 * r / 1e4).collect();
+        let peak = nc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let last = *nc.last().unwrap();
+        let _ = writeln!(
+            text,
+            "| {} | {} | {} | {peak:.3} | {last:.3} | {:.3} | {} | {:.0} | {:.0} |",
+            h.parse::<f64>().unwrap(),
+            s["particles"],
+            s["dofs"],
+            peak / 5.91,
+            s["snes_iterations"],
+            s["wall_time_s"].as_f64().unwrap(),
+            s["peak_memory_mib"].as_f64().unwrap_or(f64::NAN)
+        );
+        peaks.push(peak);
+    }
+    save("footing_square_3d_mesh.md", &text);
+    assert!(peaks.windows(2).all(|w| w[1] < w[0]), "N_c must fall as h falls: {peaks:?}");
+}
+
 /// The footing near a slope ([000] §4.3, Fig. 18): q/c at d/B = 0.1 and 0.5 for λ = 0, 2, 6 and
 /// level ground. [000] finds q increasing with λ (measured 2026-11-22 at d/B = 0.5: 4.80, 5.58,
 /// 6.99, 9.34).

@@ -43,9 +43,6 @@ pub const REACHED_FRACTION: f64 = 1e-12;
 /// Largest number of master nodes of one extended node.
 pub const MAX_MASTERS: usize = 3;
 
-/// An extension: the masters' (i, j), their coefficients, and how many are used.
-pub type ExtensionCoefficients = ([(i64, i64); MAX_MASTERS], [f64; MAX_MASTERS], usize);
-
 /// How a raw stencil slot's motion is extended: from up to three other nodes.
 #[derive(Debug, Clone, Copy)]
 pub struct Extension {
@@ -386,23 +383,11 @@ pub fn check_edges<const D: usize>(
     Ok(())
 }
 
-/// Coefficients extending node (i, j) from well-filled nodes towards the point `toward` (see the
-/// module documentation); `well(i, j)` says whether a node is well filled (false outside the
-/// ghost region or the grid); `diagonal` allows the fourth rule (B-splines).
-pub fn extension(
-    node: (usize, usize),
-    pos: [f64; 2],
-    toward: [f64; 2],
-    well: &dyn Fn(i64, i64) -> bool,
-    tiny: f64,
-    diagonal: bool,
-) -> Option<ExtensionCoefficients> {
-    let (m, c, n) = extension_in([node.0, node.1], pos, toward, &|a: [i64; 2]| well(a[0], a[1]), tiny, diagonal)?;
-    Some((m.map(|a| (a[0], a[1])), c, n))
-}
-
-/// [`extension`] in any dimension: masters by their grid indices. The rules of the module
-/// documentation, generalised: (1, 2) along the grid line of each axis, the axis on which the
+/// Coefficients extending the node with indices `node` (at `pos`) from well-filled nodes towards
+/// the point `toward` (see the module documentation), in any dimension: the masters' grid indices,
+/// their coefficients and how many are used; `well(n)` says whether a node is well filled (false
+/// outside the ghost region or the grid); `diagonal` allows the fourth rule (B-splines). The rules
+/// of the module documentation, generalised: (1, 2) along the grid line of each axis, the axis on which the
 /// particle lies farthest first; (3) from the triangle of two axes towards the particle,
 /// u_s = u_a + u_b − u_c, the pairs of axes in their order; (4) with B-splines, along the diagonal
 /// of the directions towards the particle. Each reproduces linear fields exactly.
@@ -623,6 +608,20 @@ pub fn extend<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`extension_in`] of plane node (i, j) with `well(i, j)`, the masters as (i, j) pairs.
+    #[allow(clippy::type_complexity)]
+    fn extension(
+        node: (usize, usize),
+        pos: [f64; 2],
+        toward: [f64; 2],
+        well: &dyn Fn(i64, i64) -> bool,
+        tiny: f64,
+        diagonal: bool,
+    ) -> Option<([(i64, i64); MAX_MASTERS], [f64; MAX_MASTERS], usize)> {
+        let (m, c, n) = extension_in([node.0, node.1], pos, toward, &|a: [i64; 2]| well(a[0], a[1]), tiny, diagonal)?;
+        Some((m.map(|a| (a[0], a[1])), c, n))
+    }
 
     #[test]
     fn an_extension_reproduces_linear_fields_and_reaches_towards_the_particle() {
