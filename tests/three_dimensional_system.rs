@@ -15,8 +15,9 @@
 //! initialised once for all tests).
 
 use porompm::analysis::StageAnalysis;
-use porompm::assembly::{GridSystem, SolidSystem, StepForces};
+use porompm::assembly::{GridSystem, StepForces};
 use porompm::case::{parse, Case};
+use porompm::kernels::{MAX_DOF, MAX_DOF_3D, MAX_NODES, MAX_NODES_3D};
 use porompm::model::Model;
 use porompm::parallel::Collective;
 
@@ -162,14 +163,20 @@ struct Run {
     id: Vec<u64>,
 }
 
-/// Runs every step of the first stage of a plane case through `GridSystem`.
-fn run_plane(case: &Case, coll: &Collective) -> Result<(Run, StepForces), String> {
+/// Runs every step of the first stage of a case of dimension D through `GridSystem<D, M, N>`
+/// (positions kept with three components, z = 0 in the plane); returns the run, the model at its
+/// end and the last step's forces.
+fn run_in<const D: usize, const M: usize, const N: usize>(
+    case: &Case,
+    coll: &Collective,
+) -> Result<(Run, Model<D>, StepForces<D>), String> {
     let stage = &case.stages[0];
     let analysis = StageAnalysis::of(case, stage);
     let grid = porompm::model::grid_of(case);
     let mut system =
-        GridSystem::new(coll, &grid, analysis.layout, None, case.jacobian_stiffness()).map_err(|e| e.to_string())?;
-    let mut model = Model::build(case, |i, j| system.owns_cell(i, j));
+        GridSystem::<D, M, N>::new(coll, &grid, analysis.layout.in_dim(D), None, case.jacobian_stiffness())
+            .map_err(|e| e.to_string())?;
+    let mut model = Model::<D>::of_case(case, |c| system.owns_cell_in(c));
     model.integration = analysis.integration;
     let active = model.active(stage);
     let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
@@ -180,7 +187,7 @@ fn run_plane(case: &Case, coll: &Collective) -> Result<(Run, StepForces), String
         system.prepare_step(&model, &active, n as f64 * dt, dt, coll, &names)?;
         let out = system.solve(&model).map_err(|e| e.to_string())?;
         if !out.converged {
-            return Err(format!("the plane step {n} did not converge: {}", out.reason));
+            return Err(format!("step {n} in {D} dimensions did not converge: {}", out.reason));
         }
         system.accept_increment(dt).map_err(|e| e.to_string())?;
         forces = system.step_forces(&model, coll, false)?;
@@ -189,47 +196,41 @@ fn run_plane(case: &Case, coll: &Collective) -> Result<(Run, StepForces), String
             model.update_particle(k, r, r.interp.dp, dt).map_err(|e| e.0)?;
         }
         let ps = &model.particles;
-        run.x.push(ps.x.iter().map(|x| [x[0], x[1], 0.0]).collect());
-        run.stress.push(ps.stress.clone());
-        run.p.push(ps.p.clone());
-        run.plastic.push(ps.eps_pd.clone());
-    }
-    Ok((run, forces))
-}
-
-/// Runs every step of the first stage of a three-dimensional case through `SolidSystem`.
-fn run_solid(case: &Case, coll: &Collective) -> Result<(Run, Model<3>, StepForces<3>), String> {
-    let stage = &case.stages[0];
-    let analysis = StageAnalysis::of(case, stage);
-    let grid = porompm::model::grid_of(case);
-    let mut system = SolidSystem::new(coll, &grid, analysis.layout.in_dim(3), None, case.jacobian_stiffness())
-        .map_err(|e| e.to_string())?;
-    let mut model = Model::<3>::build_solid(case, |c| system.owns_cell_in(c));
-    model.integration = analysis.integration;
-    let active = model.active(stage);
-    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
-    let (dt, steps) = (stage.dt(), (stage.duration / stage.dt()).round() as usize);
-    let mut run = Run { id: model.particles.id.clone(), ..Run::default() };
-    let mut forces = StepForces::default();
-    for n in 1..=steps {
-        system.prepare_step(&model, &active, n as f64 * dt, dt, coll, &names)?;
-        let out = system.solve(&model).map_err(|e| e.to_string())?;
-        if !out.converged {
-            return Err(format!("the three-dimensional step {n} did not converge: {}", out.reason));
-        }
-        system.accept_increment(dt).map_err(|e| e.to_string())?;
-        forces = system.step_forces(&model, coll, false)?;
-        let results: Vec<_> = (0..model.particles.len()).map(|k| system.step_result(&model, k)).collect();
-        for (k, r) in results.iter().enumerate() {
-            model.update_particle(k, r, r.interp.dp, dt).map_err(|e| e.0)?;
-        }
-        let ps = &model.particles;
-        run.x.push(ps.x.clone());
+        run.x.push(ps.x.iter().map(|x| std::array::from_fn(|c| if c < D { x[c] } else { 0.0 })).collect());
         run.stress.push(ps.stress.clone());
         run.p.push(ps.p.clone());
         run.plastic.push(ps.eps_pd.clone());
     }
     Ok((run, model, forces))
+}
+
+/// [`run_in`] of a plane case.
+fn run_plane(case: &Case, coll: &Collective) -> Result<(Run, Model, StepForces), String> {
+    run_in::<2, { MAX_NODES }, { MAX_DOF }>(case, coll)
+}
+
+/// [`run_in`] of a three-dimensional case.
+fn run_solid(case: &Case, coll: &Collective) -> Result<(Run, Model<3>, StepForces<3>), String> {
+    run_in::<3, { MAX_NODES_3D }, { MAX_DOF_3D }>(case, coll)
+}
+
+/// The plane point of each slab point: the one whose initial (x, y) is the slab point's initial x
+/// and its coordinate `vertical` (1 for a slab thin along z, 2 for one thin along y).
+fn twins(plane: &Model, solid: &Model<3>, vertical: usize) -> Result<Vec<usize>, String> {
+    let (p0, s0) = (&plane.particles.x0, &solid.particles.x0);
+    (0..s0.len())
+        .map(|k| {
+            (0..p0.len())
+                .find(|&q| (p0[q][0] - s0[k][0]).abs() < 1e-12 && (p0[q][1] - s0[k][vertical]).abs() < 1e-12)
+                .ok_or_else(|| format!("slab point {} has no plane twin", solid.particles.id[k]))
+        })
+        .collect()
+}
+
+/// The largest stress and pore-pressure magnitudes of a run, the scales of its differences.
+fn scales(run: &Run) -> (f64, f64) {
+    let stress = run.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+    (stress, run.p.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs())))
 }
 
 /// The slab against its plane section: three steps without B̄, and the first step with B̄. After a
@@ -248,28 +249,16 @@ fn a_slab_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
 fn compare_slab(plane: &str, solid: &str, coll: &Collective) -> Result<(), String> {
     let plane_case = case_of(plane)?;
     let solid_case = case_of(solid)?;
-    let (plane, plane_forces) = run_plane(&plane_case, coll)?;
+    let (plane, plane_model, plane_forces) = run_plane(&plane_case, coll)?;
     let (solid, model, forces) = run_solid(&solid_case, coll)?;
     let (in_plane, zz) = forces_against_plane(&model, &forces, &plane_forces, 0.1);
     let n2 = plane.id.len();
     if solid.id.len() != 2 * n2 {
         return Err(format!("{} points in the slab for {n2} in the plane (two layers expected)", solid.id.len()));
     }
-    // The plane point of each slab point: the one at the same (x, y) at t = 0.
     let x0 = &model.particles.x0;
-    let plane_model = Model::build(&plane_case, |_, _| true);
-    let twin: Vec<usize> = (0..solid.id.len())
-        .map(|k| {
-            (0..n2)
-                .find(|&q| {
-                    let y = plane_model.particles.x0[q];
-                    (y[0] - x0[k][0]).abs() < 1e-12 && (y[1] - x0[k][1]).abs() < 1e-12
-                })
-                .ok_or_else(|| format!("slab point {} has no plane twin", solid.id[k]))
-        })
-        .collect::<Result<_, _>>()?;
-    let scale_s = plane.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
-    let scale_p = plane.p.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let twin = twins(&plane_model, &model, 1)?;
+    let (scale_s, scale_p) = scales(&plane);
     let yielded = plane.plastic.last().map_or(0, |e| e.iter().filter(|&&v| v > 0.0).count());
     if yielded == 0 || scale_p <= 0.0 {
         return Err(format!("the plane run must yield and build pore pressure (yielded {yielded}, p {scale_p})"));
@@ -485,7 +474,7 @@ fn the_slab_solves_alike_with_the_fixed_stress_field_split(coll: &Collective) ->
         options.clear_value(n).map_err(|e| e.to_string())?;
     }
     let (iterative, _, _) = iterative?;
-    let scale = direct.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+    let (scale, _) = scales(&direct);
     let worst = (0..direct.stress.len())
         .flat_map(|n| (0..direct.id.len()).map(move |k| (n, k)))
         .flat_map(|(n, k)| (0..6).map(move |c| (n, k, c)))
@@ -505,22 +494,11 @@ fn the_slab_solves_alike_with_the_fixed_stress_field_split(coll: &Collective) ->
 fn a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage(coll: &Collective) -> Result<(), String> {
     let dynamic = |t: &str| t.replace("bbar = true", "bbar = false").replace("quasi_static", "dynamic");
     let plane_case = case_of(&dynamic(PLANE))?;
-    let (plane, _) = run_plane(&plane_case, coll)?;
+    let (plane, plane_model, _) = run_plane(&plane_case, coll)?;
     let (solid, model, _) = run_solid(&case_of(&dynamic(&lying_slab()))?, coll)?;
-    let plane_model = Model::build(&plane_case, |_, _| true);
     let x0 = &model.particles.x0;
-    let twin: Vec<usize> = (0..solid.id.len())
-        .map(|k| {
-            (0..plane.id.len())
-                .find(|&q| {
-                    let y = plane_model.particles.x0[q];
-                    (y[0] - x0[k][0]).abs() < 1e-12 && (y[1] - x0[k][2]).abs() < 1e-12
-                })
-                .ok_or_else(|| format!("slab point {} has no plane twin", solid.id[k]))
-        })
-        .collect::<Result<_, _>>()?;
-    let scale_s = plane.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
-    let scale_p = plane.p.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let twin = twins(&plane_model, &model, 2)?;
+    let (scale_s, scale_p) = scales(&plane);
     let mut worst = [0.0f64; 3];
     for step in 0..plane.x.len() {
         for (k, &q) in twin.iter().enumerate() {

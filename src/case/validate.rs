@@ -719,22 +719,10 @@ pub fn validate(c: &Case) -> R {
             }
         }
         match l {
-            Load::ParticleTraction { region, traction, .. } => {
-                components(&format!("loads[{i}].traction"), traction, c.dimension())?;
-                finite2(&format!("loads[{i}].region.min"), region.min)?;
-                finite2(&format!("loads[{i}].region.max"), region.max)?;
-                if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
-                    return Err(format!("key `loads[{i}].region`: max must not be below min"));
-                }
-                if let Some(e) = l.increment_factor() {
-                    // Tried where the loaded faces start: the region's centre.
-                    let centre = [0.5 * (region.min[0] + region.max[0]), 0.5 * (region.min[1] + region.max[1])];
-                    crate::model::loads::increment_factor(e, &c.parameters, centre)
-                        .map_err(|m| format!("key `loads[{i}].increment_factor`: `{e}` at {centre:?}: {m}"))?;
-                }
-            }
-            Load::NodalTraction { region, traction, .. } => {
-                components(&format!("loads[{i}].traction"), traction, 2)?;
+            Load::ParticleTraction { region, traction, .. } | Load::NodalTraction { region, traction, .. } => {
+                // A nodal traction is plane (refused in three dimensions).
+                let dim = if matches!(l, Load::NodalTraction { .. }) { 2 } else { c.dimension() };
+                components(&format!("loads[{i}].traction"), traction, dim)?;
                 finite2(&format!("loads[{i}].region.min"), region.min)?;
                 finite2(&format!("loads[{i}].region.max"), region.max)?;
                 if region.max[0] < region.min[0] || region.max[1] < region.min[1] {

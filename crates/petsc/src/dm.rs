@@ -118,7 +118,7 @@ impl DmDa<2> {
         field_names: &[&str],
         ranges: Option<(&[usize], &[usize])>,
     ) -> Result<DmDa> {
-        DmDa::create(comm, nodes, stencil_width, field_names, ranges.map(|(x, y)| [x, y]))
+        DmDa::new_partitioned(comm, nodes, stencil_width, field_names, ranges.map(|(x, y)| [x, y]))
     }
 
     /// Which ranks own the nodes: the number of owned node columns (x) and rows (y) of each rank
@@ -140,7 +140,7 @@ impl DmDa<3> {
         field_names: &[&str],
         ranges: Option<[&[usize]; 3]>,
     ) -> Result<DmDa<3>> {
-        DmDa::create(comm, nodes, stencil_width, field_names, ranges)
+        DmDa::new_partitioned(comm, nodes, stencil_width, field_names, ranges)
     }
 }
 
@@ -149,17 +149,6 @@ impl<const D: usize> DmDa<D> {
     /// number of node layers of each process slab along each direction, or `None` for PETSc's
     /// choice.
     pub fn new_partitioned(
-        comm: Comm,
-        nodes: [usize; D],
-        stencil_width: usize,
-        field_names: &[&str],
-        ranges: Option<[&[usize]; D]>,
-    ) -> Result<DmDa<D>> {
-        DmDa::create(comm, nodes, stencil_width, field_names, ranges)
-    }
-
-    /// The DMDA of any dimension (2 or 3; see [`DmDa::new_2d_partitioned`]).
-    fn create(
         comm: Comm,
         nodes: [usize; D],
         stencil_width: usize,
