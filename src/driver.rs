@@ -248,6 +248,10 @@ struct Probe {
 }
 
 /// A run on a grid of dimension D whose points have at most M stencil nodes of at most N dofs
+/// Fraction of its first filled fraction below which a moving boundary's nodes have lost their grip
+/// on the material (see [`Simulation::check_boundary_grip`]).
+const GRIP_FRACTION: f64 = 0.5;
+
 /// (see [`GridSystem`]): the same algorithm in two and three dimensions.
 struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const N: usize = { MAX_DOF }> {
     case: &'a Case,
@@ -262,6 +266,9 @@ struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const 
     step: usize,
     summary: &'a mut Summary,
     options_checked: bool,
+    /// The filled fraction of each moving boundary's nodes when it was first seen, and whether the
+    /// run has warned that the material left them (see [`Simulation::check_boundary_grip`]).
+    boundary_grip: Vec<(Option<f64>, bool)>,
     /// When the running summary.json was last rewritten.
     summary_written: Instant,
     last_newton: (usize, usize),
@@ -527,6 +534,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             step: 0,
             summary,
             options_checked: false,
+            boundary_grip: Vec::new(),
             summary_written: Instant::now(),
             last_newton: (0, 0),
             last_field_residuals: Default::default(),
@@ -704,6 +712,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         self.summary.snes_iterations += solve.newton_iterations;
         self.summary.ksp_iterations += solve.linear_iterations;
         self.last_newton = (solve.newton_iterations, solve.linear_iterations);
+        self.check_boundary_grip();
         if !self.options_checked && solve.solver_used {
             self.options_checked = true;
             self.summary.solver = assembly::describe_solver(&mut self.system).unwrap_or_default();
@@ -1065,6 +1074,42 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             }
         }
         end
+    }
+
+    /// Warns (once per boundary) when the material has moved away from the grid nodes that carry a
+    /// boundary's prescribed motion: their mean filled fraction at the step's start has fallen
+    /// below half of what it was when the boundary was first seen. A boundary on grid nodes stays
+    /// where the grid is; past that point its motion reaches only the points at the edge of the
+    /// nodes' support (a footing pushed into the ground by more than about half a cell loses its
+    /// grip on the soil beneath it, and the load it carries is no longer the footing's).
+    fn check_boundary_grip(&mut self) {
+        let fill = self.system.boundary_fill().to_vec();
+        self.boundary_grip.resize(fill.len(), (None, false));
+        let mut warnings = Vec::new();
+        for (b, f) in fill.iter().enumerate() {
+            let Some(f) = *f else { continue };
+            let (first, warned) = &mut self.boundary_grip[b];
+            let start = *first.get_or_insert(f);
+            if !*warned && start > 0.0 && f < GRIP_FRACTION * start {
+                *warned = true;
+                warnings.push(Warning {
+                    kind: "boundary_detached".into(),
+                    message: format!(
+                        "boundary `{}` prescribes a motion on grid nodes that the material has moved away from: their \
+                         mean filled fraction is {f:.3}, {:.0} % of the {start:.3} it was at first; the motion now \
+                         reaches the material only through the points at the edge of the nodes' support, and the \
+                         reactions past this time are not those of the boundary the case means (move it by less than \
+                         half a cell, or model the pushing body with material points)",
+                        self.model.boundaries[b].name,
+                        100.0 * f / start
+                    ),
+                    time_s: Some(self.t),
+                    value: Some(f / start),
+                    threshold: Some(GRIP_FRACTION),
+                });
+            }
+        }
+        self.warn(warnings);
     }
 
     fn progress(&self, msg: &str) {

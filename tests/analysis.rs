@@ -134,6 +134,30 @@ fn the_static_strip_footing_settles_plastically_in_equilibrium() {
     assert!(newton <= 4 * 50, "{newton} Newton iterations for 50 load steps");
 }
 
+/// A rigid footing on grid nodes (the plane twin of the square footing, h = B/5) reaches Prandtl's
+/// limit pressure before it has moved a tenth of a cell, without a warning; pushed on by half a
+/// cell, the soil beneath moves away from the footing's nodes (the grid stays, the material goes)
+/// and the run warns `boundary_detached` once their filled fraction has halved, with the time.
+#[test]
+fn a_footing_on_grid_nodes_warns_when_the_soil_leaves_them() {
+    let (s, header, rows) = run("tests/cases/footing_strip_nodes.toml", "footing-nodes-k2", &["parameters.k=2"]);
+    let nc = column(&header, &rows, "footing.reaction_y").iter().map(|r| -2.0 * r / 1e4).fold(0.0, f64::max);
+    eprintln!("strip footing on nodes, h = B/5: N_c = {nc:.4} against 2 + π");
+    assert!((nc / (2.0 + std::f64::consts::PI) - 1.0).abs() < 0.03, "N_c = {nc}");
+    assert!(!has_warning(&s, "boundary_detached"), "{}", s["warnings"]);
+    let (s, _, _) = run(
+        "tests/cases/footing_strip_nodes.toml",
+        "footing-nodes-k2-far",
+        &["parameters.k=2", "boundaries.footing.displacement=[0,-0.1]"],
+    );
+    let w = s["warnings"].as_array().unwrap().iter().find(|w| w["kind"] == "boundary_detached").expect("the warning");
+    let (t, ratio) = (w["time_s"].as_f64().unwrap(), w["value"].as_f64().unwrap());
+    eprintln!("pushed to d = h/2: warned at d = {:.3} m (h = 0.2 m), filled fraction {ratio:.3} of the first", 0.1 * t);
+    assert!(w["message"].as_str().unwrap().contains("boundary `footing`"), "{w}");
+    // The first step below half: just below it.
+    assert!(ratio < 0.5 && ratio > 0.45 && (0.1 * t) > 0.02 && (0.1 * t) < 0.1, "{w}");
+}
+
 /// The particle loops run on threads, each assembling a band of node rows from every particle that
 /// reaches it, in particle order: the history is the same to the last digit on one thread and on
 /// three, for a one-phase static footing (B̄, plasticity) and for the two-phase slumping block

@@ -300,6 +300,89 @@ fn compare_slab(plane: &str, solid: &str, coll: &Collective) -> Result<(), Strin
     Ok(())
 }
 
+/// A case of the plane section or of the slab as a one-phase explicit stage (`dynamic_explicit`,
+/// without B̄): no pore pressure, no drained top, smooth walls on the slab's z faces, ten steps of
+/// 2e-4 s (a fifth of the P wave's cell crossing time, 1.2e-3 s) while the strip pushes.
+fn one_phase_explicit(text: &str) -> String {
+    let mut t = text
+        .replace("formulation = \"two_phase\"", "formulation = \"one_phase\"")
+        .replace("bbar = true", "bbar = false")
+        .replace("fix = [\"uz\", \"Uz\"]", "fix = [\"uz\"]")
+        .replace("fix = [\"uy\", \"Uy\"]", "fix = [\"uy\"]")
+        .replace(
+            "analysis = \"quasi_static\"\nduration = 0.03\ndt = 0.01",
+            "analysis = \"dynamic_explicit\"\nduration = 0.002\ndt = 0.0002",
+        );
+    let drained = t.find("name = \"drained\"").expect("the drained top");
+    let start = t[..drained].rfind("[[boundaries]]").expect("its table");
+    let end = drained + t[drained..].find("[[").expect("a table after it");
+    t.replace_range(start..end, "");
+    t
+}
+
+/// The slab in a one-phase explicit stage (the nodal update of `assembly::explicit` in three
+/// dimensions: lumped masses and momenta, the forces of the step's start, the velocity update per
+/// node and direction) steps as its plane section, point for point: stresses, positions and
+/// velocities; so does the slab lying in the (x, z) plane, whose motion is along x and z.
+fn an_explicit_slab_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    explicit_twin(&slab(), 1, coll)?;
+    explicit_twin(&lying_slab(), 2, coll)
+}
+
+/// The explicit one-phase run of the slab `solid` (thin along y when `vertical` is 2) against the
+/// plane section's.
+fn explicit_twin(solid: &str, vertical: usize, coll: &Collective) -> Result<(), String> {
+    let plane_case = case_of(&one_phase_explicit(PLANE))?;
+    let solid_case = case_of(&one_phase_explicit(solid))?;
+    let (plane, plane_model, _) = run_plane(&plane_case, coll)?;
+    let (solid, model, _) = run_solid(&solid_case, coll)?;
+    let twin = twins(&plane_model, &model, vertical)?;
+    let (scale_s, _) = scales(&plane);
+    let speed = plane_model.particles.vel.iter().fold(0.0f64, |m, v| m.max(v[0].abs().max(v[1].abs())));
+    // The slab's axes of the plane's x and y, and the one across it.
+    let (ax, ay, across) = (0, vertical, 3 - vertical);
+    let mut worst = [0.0f64; 3];
+    for step in 0..plane.x.len() {
+        for (k, &q) in twin.iter().enumerate() {
+            let (a, b) = (&solid.stress[step][k], &plane.stress[step][q]);
+            // [xx, yy, xy, zz, yz, zx] of the slab against the plane's [xx, yy, xy, zz].
+            let pairs = if vertical == 1 {
+                [(a[0], b[0]), (a[1], b[1]), (a[2], b[2]), (a[3], b[3]), (a[4], 0.0), (a[5], 0.0)]
+            } else {
+                [(a[0], b[0]), (a[3], b[1]), (a[5], b[2]), (a[1], b[3]), (a[2], 0.0), (a[4], 0.0)]
+            };
+            for (u, v) in pairs {
+                worst[0] = worst[0].max((u - v).abs() / scale_s);
+            }
+            let (xs, xp) = (solid.x[step][k], plane.x[step][q]);
+            worst[1] = worst[1].max(
+                ((xs[ax] - xp[0])
+                    .abs()
+                    .max((xs[ay] - xp[1]).abs())
+                    .max((xs[across] - model.particles.x0[k][across]).abs()))
+                    / 0.1,
+            );
+        }
+    }
+    for (k, &q) in twin.iter().enumerate() {
+        let (v, w) = (model.particles.vel[k], plane_model.particles.vel[q]);
+        worst[2] = worst[2].max(((v[ax] - w[0]).abs().max((v[ay] - w[1]).abs()).max(v[across].abs())) / speed);
+    }
+    println!(
+        "    explicit slab (thin along {}) against plane: {} steps; largest differences: stress {:.1e} (of \
+         {scale_s:.3e} Pa), position {:.1e} (of a cell), velocity {:.1e} (of {speed:.3e} m/s)",
+        ["x", "y", "z"][across],
+        plane.x.len(),
+        worst[0],
+        worst[1],
+        worst[2]
+    );
+    if worst.iter().any(|&w| w > 1e-12 || w.is_nan()) || scale_s <= 0.0 || speed <= 0.0 || plane.x.len() != 10 {
+        return Err(format!("the explicit slab departs from its plane twin: {worst:?}"));
+    }
+    Ok(())
+}
+
 /// The slab's step forces against its plane section's: the largest difference of the in-plane
 /// first moments and of the boundaries' in-plane reactions from the section's times the slab's
 /// `thickness` (relative to the largest of them), and of the zz moment (every z force is a
@@ -462,29 +545,56 @@ fn a_block_squeezed_from_three_sides_is_homogeneous(coll: &Collective) -> Result
 fn the_slab_solves_alike_with_the_fixed_stress_field_split(coll: &Collective) -> Result<(), String> {
     let case = case_of(&slab().replace("bbar = true", "bbar = false"))?;
     let (direct, _, _) = run_solid(&case, coll)?;
-    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("petsc_options/fieldsplit-fixed-stress.opts");
+    let (iterative, _, _) = with_options_file("fieldsplit-fixed-stress.opts", coll, || run_solid(&case, coll))??;
+    let (scale, _) = scales(&direct);
+    let worst = largest_stress_difference(&direct, &iterative) / scale;
+    println!("    fixed-stress field split against LU: largest stress difference {worst:.1e} of {scale:.3e} Pa");
+    if worst > 1e-9 || worst.is_nan() {
+        return Err(format!("the iterative solve departs from the direct one by {worst:e}"));
+    }
+    Ok(())
+}
+
+/// The cube at finite strain (one phase, u only) with the iterative strategy of large solid runs
+/// (`petsc_options/gamg-solid.opts`: GMRES with GAMG, whose aggregates come from the six rigid-body
+/// modes attached to the tangent) gives the direct solver's answer.
+fn the_cube_solves_alike_with_gamg(coll: &Collective) -> Result<(), String> {
+    let case = case_of(&CUBE.replace("linear_increments", "finite_strain"))?;
+    let (direct, _, _) = run_solid(&case, coll)?;
+    let (iterative, _, _) = with_options_file("gamg-solid.opts", coll, || run_solid(&case, coll))??;
+    let scale = direct.stress.iter().flatten().flat_map(|s| s.iter()).fold(0.0f64, |a, b| a.max(b.abs()));
+    let worst = largest_stress_difference(&direct, &iterative) / scale;
+    println!("    GAMG against LU: largest stress difference {worst:.1e} of {scale:.3e} Pa");
+    if worst > 1e-9 || worst.is_nan() || scale == 0.0 {
+        return Err(format!("the iterative solve departs from the direct one by {worst:e}"));
+    }
+    Ok(())
+}
+
+/// The largest difference between two runs' stresses, over steps, points and components [Pa].
+fn largest_stress_difference(a: &Run, b: &Run) -> f64 {
+    (0..a.stress.len())
+        .flat_map(|n| (0..a.id.len()).map(move |k| (n, k)))
+        .flat_map(|(n, k)| (0..6).map(move |c| (n, k, c)))
+        .map(|(n, k, c)| (a.stress[n][k][c] - b.stress[n][k][c]).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Runs `f` with the options of `petsc_options/<name>` in PETSc's database, and takes them out
+/// again afterwards.
+fn with_options_file<T>(name: &str, coll: &Collective, f: impl FnOnce() -> T) -> Result<T, String> {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("petsc_options").join(name);
     let text = std::fs::read_to_string(&file).map_err(|e| e.to_string())?;
     let names: Vec<&str> =
         text.lines().filter_map(|l| l.split_whitespace().next()).filter(|w| w.starts_with('-')).collect();
     let options = petsc::Options::global();
     let comm = petsc::Comm::from_raw(mpi::traits::AsRaw::as_raw(coll.communicator()));
     options.insert_file(comm, &file).map_err(|e| e.to_string())?;
-    let iterative = run_solid(&case, coll);
+    let out = f();
     for n in &names {
         options.clear_value(n).map_err(|e| e.to_string())?;
     }
-    let (iterative, _, _) = iterative?;
-    let (scale, _) = scales(&direct);
-    let worst = (0..direct.stress.len())
-        .flat_map(|n| (0..direct.id.len()).map(move |k| (n, k)))
-        .flat_map(|(n, k)| (0..6).map(move |c| (n, k, c)))
-        .map(|(n, k, c)| (direct.stress[n][k][c] - iterative.stress[n][k][c]).abs() / scale)
-        .fold(0.0, f64::max);
-    println!("    fixed-stress field split against LU: largest stress difference {worst:.1e} of {scale:.3e} Pa");
-    if worst > 1e-9 || worst.is_nan() {
-        return Err(format!("the iterative solve departs from the direct one by {worst:e}"));
-    }
-    Ok(())
+    Ok(out)
 }
 
 /// The slab lying in the (x, z) plane (its thin direction y, `lying_slab`) in a dynamic stage
@@ -555,6 +665,8 @@ fn main() {
             "the_slab_solves_alike_with_the_fixed_stress_field_split",
             the_slab_solves_alike_with_the_fixed_stress_field_split,
         ),
+        ("the_cube_solves_alike_with_gamg", the_cube_solves_alike_with_gamg),
+        ("an_explicit_slab_steps_as_its_plane_twin", an_explicit_slab_steps_as_its_plane_twin),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let (mut ran, mut failed) = (0, 0);

@@ -67,9 +67,11 @@ use crate::kernels::{self, Integration};
 use crate::model::finite_strain::det2;
 use crate::model::{fbar, Model};
 
-impl GridSystem {
-    /// The explicit step's nodal update (see the module documentation); always "converged".
-    pub(super) fn explicit_update(&mut self, model: &Model) -> Result<StepSolve, Error> {
+impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
+    /// The explicit step's nodal update (see the module documentation), in any dimension; always
+    /// "converged". F̄'s projection and the pore pressure of the u–U system are plane only for now
+    /// (validation keeps them out of three-dimensional cases).
+    pub(super) fn explicit_update(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
         let t0 = std::time::Instant::now();
         let Integration::Explicit { damping, xpic, .. } = model.integration else {
             unreachable!("explicit_update is only called for explicit stages")
@@ -95,7 +97,7 @@ impl GridSystem {
         // the drag; one-phase nodes have no water dof.
         let water_offset = self.layout.w;
         let pairs =
-            (0..self.ghost.len()).flat_map(|l| (0..2).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
+            (0..self.ghost.len()).flat_map(|l| (0..D).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
         for (qs, qw) in pairs {
             let phase = |q: usize| {
                 let v0 = if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 };
@@ -123,11 +125,18 @@ impl GridSystem {
         self.step.explicit_inertia = inertia;
         self.step.xpic_correction =
             if xpic > 0 { self.xpic_correction(model, xpic, &lumped.mass, &lumped.momentum)? } else { Vec::new() };
-        if model.fbar {
-            self.step.fbar_scale = self.fbar_scales(model)?;
-        }
-        if !self.step.drained.is_empty() {
-            self.step.pressure_increment = self.nodal_pressure_increments(model)?;
+        if model.fbar || !self.step.drained.is_empty() {
+            let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) else {
+                return Err(Error::new(
+                    "the explicit F̄ projection and pore pressure are not available in three dimensions yet",
+                ));
+            };
+            if plane.fbar {
+                system.step.fbar_scale = system.fbar_scales(plane)?;
+            }
+            if !system.step.drained.is_empty() {
+                system.step.pressure_increment = system.nodal_pressure_increments(plane)?;
+            }
         }
         let seconds = t0.elapsed().as_secs_f64();
         Ok(StepSolve {
@@ -151,7 +160,7 @@ impl GridSystem {
     /// XPIC(m)'s nodal field w − v^n (see the module documentation) from the step's lumped mass and
     /// momentum (summed over the ranks), per ghosted dof; zero at fixed dofs and where there is no
     /// mass.
-    fn xpic_correction(&mut self, model: &Model, m: u8, mass: &[f64], momentum: &[f64]) -> Result<Vec<f64>, Error> {
+    fn xpic_correction(&mut self, model: &Model<D>, m: u8, mass: &[f64], momentum: &[f64]) -> Result<Vec<f64>, Error> {
         let velocity = |mass: &[f64], momentum: &[f64]| -> Vec<f64> {
             mass.iter().zip(momentum).map(|(m, p)| if *m > 0.0 { p / m } else { 0.0 }).collect()
         };
@@ -162,7 +171,7 @@ impl GridSystem {
             binomial *= f64::from(m - k + 1) / f64::from(k);
             if k > 1 {
                 // S⁺S u: u at the points, their momenta back to the nodes.
-                let at_points: Vec<[f64; 2]> =
+                let at_points: Vec<[f64; D]> =
                     (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u)).collect();
                 let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points, None));
                 for v in [&mut lumped.mass, &mut lumped.momentum] {
@@ -179,6 +188,35 @@ impl GridSystem {
         Ok((0..w.len()).map(|q| if fixed[q] || mass[q] <= 0.0 { 0.0 } else { w[q] - v0[q] }).collect())
     }
 
+    /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
+    /// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
+    /// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
+    fn project_weighted(&mut self, weight: &[f64], q: &[f64], zero: &[bool]) -> Result<Vec<f64>, Error> {
+        let (nd, nn) = (self.layout.nd, self.ghost.len());
+        let st = &self.step.stencils;
+        let shares: Vec<Vec<(usize, f64)>> = (0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect()
+            })
+            .collect();
+        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), weight[k], q[k])));
+        // The nodal sums over ranks (the first component's slot of each node).
+        let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
+        for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
+            for (l, v) in local.iter().enumerate() {
+                sum[l * nd] = *v;
+            }
+            self.sum_over_ranks(sum)?;
+        }
+        let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
+        let weighted: Vec<f64> =
+            (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
+        Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
+    }
+}
+
+impl GridSystem {
     /// [002]'s projection for the step's nodal increments (see the module documentation): the
     /// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
     /// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/2} of the in-plane increment (Eq. 27, J̄_p^n the point's
@@ -239,33 +277,6 @@ impl GridSystem {
     /// the ranks).
     fn project_per_point(&mut self, model: &Model, q: &[f64]) -> Result<Vec<f64>, Error> {
         self.project_weighted(&model.particles.volume[..q.len()], q, &[])
-    }
-
-    /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
-    /// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
-    /// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
-    fn project_weighted(&mut self, weight: &[f64], q: &[f64], zero: &[bool]) -> Result<Vec<f64>, Error> {
-        let (nd, nn) = (self.layout.nd, self.ghost.len());
-        let st = &self.step.stencils;
-        let shares: Vec<Vec<(usize, f64)>> = (0..st.len())
-            .map(|k| {
-                let (nodes, basis) = st.get(k);
-                nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect()
-            })
-            .collect();
-        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), weight[k], q[k])));
-        // The nodal sums over ranks (the first component's slot of each node).
-        let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
-        for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
-            for (l, v) in local.iter().enumerate() {
-                sum[l * nd] = *v;
-            }
-            self.sum_over_ranks(sum)?;
-        }
-        let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
-        let weighted: Vec<f64> =
-            (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
-        Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
     }
 }
 

@@ -367,6 +367,11 @@ pub struct GridSystem<
     work_global: Vector,
     snes: Snes,
     jac: Option<Mat>,
+    /// The rigid-body modes of the grid, attached to every Jacobian of a system whose unknowns are
+    /// all displacements (see [`splits::displacement_near_null_space`]); empty otherwise.
+    near_null: Vec<Vector>,
+    /// The mean filled fraction of each moving boundary's nodes at the current step's start.
+    boundary_fill: Vec<Option<f64>>,
     /// The fixed-stress Schur preconditioner, when the options ask for one (see [`splits`]).
     schur: Option<petsc::SchurUser>,
     /// The reactions per ghosted dof of the last converged step (for the work of the next).
@@ -504,6 +509,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let positions: Vec<[f64; D]> = owned.iter().map(|&n| grid.position(n)).collect();
         let first_dof = x.ownership_range()?.0;
         let schur = splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
+        let near_null = splits::displacement_near_null_space(comm, coll, layout, &positions)?;
         // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
         // post-solve hook it would replace).
         if !snes.uses_eisenstat_walker()? {
@@ -538,6 +544,8 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             snes,
             jac: None,
             schur,
+            near_null,
+            boundary_fill: Vec::new(),
             user_atol,
             retry_with_line_search,
             last_reactions: Vec::new(),
@@ -627,6 +635,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let weak = self.drains_weakly(model, dt);
         let dofs = self.dof_map(model, active, (t_new - dt, t_new), &nodal, weak, coll)?;
         coll.agree(stencils::check_edges(model, &st, &crossings, &dofs, &self.ghost, t_new - dt, body_names))?;
+        self.boundary_fill = self.moving_boundary_fill(model, &dofs, &nodal.phi, coll)?;
         if model.stress_recovery == crate::case::StressRecovery::Cmpm {
             // [001]'s CMPM (plane only: validation keeps it out of three-dimensional cases).
             if let (Some(plane), Some(st), Some(ghost)) =
@@ -767,6 +776,49 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         Ok(dofs)
     }
 
+    /// The mean filled fraction φ of the nodes of each boundary that prescribes a motion (None for
+    /// the others, and for a boundary without nodes): how much material the nodes that carry the
+    /// motion reach at the step's start (collective). A boundary on grid nodes stays where the grid
+    /// is, while the material it pushes moves on: once the material has moved by about half a cell,
+    /// the nodes reach only the points at the edge of their support, and the motion no longer acts
+    /// on the material as the boundary means it to (the driver warns, see `Simulation::step`).
+    fn moving_boundary_fill(
+        &self,
+        model: &Model<D>,
+        dofs: &DofMap,
+        phi: &[f64],
+        coll: &Collective,
+    ) -> Result<Vec<Option<f64>>, String> {
+        let nb = model.boundaries.len();
+        let moving: Vec<bool> = model
+            .boundaries
+            .iter()
+            .map(|b| b.motion.as_ref().is_some_and(|m| m.gradient.is_some() || m.vector.iter().any(|&v| v != 0.0)))
+            .collect();
+        let nd = self.layout.nd;
+        let mut local = vec![0.0; 2 * nb];
+        for &a in &self.owned_nodes {
+            let l = a as usize;
+            for c in 0..nd {
+                let b = dofs.boundary[l * nd + c] as usize;
+                // Each boundary once per node: at its first fixed component.
+                let first = (0..c).all(|e| dofs.boundary[l * nd + e] as usize != b);
+                if b < nb && moving[b] && first {
+                    local[2 * b] += phi[l];
+                    local[2 * b + 1] += 1.0;
+                }
+            }
+        }
+        let s = coll.sum(&local)?;
+        Ok((0..nb).map(|b| (moving[b] && s[2 * b + 1] > 0.0).then(|| s[2 * b] / s[2 * b + 1])).collect())
+    }
+
+    /// The mean filled fraction of the nodes of each boundary that prescribes a motion, at the
+    /// start of the current step (see [`GridSystem::moving_boundary_fill`]).
+    pub fn boundary_fill(&self) -> &[Option<f64>] {
+        &self.boundary_fill
+    }
+
     /// Step 4: the data the callbacks use (`self.step`), from the effective stencils `st` and the dof map: the
     /// threads' bands, the predictors, porosity gradients, pressure-projection blocks, external
     /// loads (checked against what the nodes carry), the generalized-α history and the force
@@ -848,8 +900,13 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
             let p = Pattern::build_in(&self.step.stencils, &self.owned_nodes, &groups, self.ghost.count);
             let (rows, cols) = p.coo(nd, &self.l2g);
-            let made = self.dm.create_matrix_coo(&rows, &cols).map_err(|e| e.to_string());
-            self.jac = Some(coll.agree(made)?);
+            let made = self.dm.create_matrix_coo(&rows, &cols).and_then(|mut jac| {
+                if !self.near_null.is_empty() {
+                    jac.set_near_null_space(self.comm, &self.near_null)?;
+                }
+                Ok(jac)
+            });
+            self.jac = Some(coll.agree(made.map_err(|e| e.to_string()))?);
             if let Some(schur) = &mut self.schur {
                 schur.forget();
             }
@@ -1133,11 +1190,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// [001]'s mapped stiffnesses is then [001]'s K Δu = ΔF.
     pub fn solve(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
         if model.integration.is_explicit() {
-            // The explicit update (plane only: validation keeps it out of three-dimensional cases).
-            return match model.as_plane().zip(self.as_plane_mut()) {
-                Some((plane, system)) => system.explicit_update(plane),
-                None => Err(Error::new("the explicit update is not available in three dimensions yet")),
-            };
+            return self.explicit_update(model);
         }
         let _stage = self.stages.solve.push()?;
         // A floor under the relative test: FORCE_ATOL of the step's force magnitudes.

@@ -78,6 +78,23 @@ pub(super) fn define<const D: usize>(
     Ok(None)
 }
 
+/// The rigid-body modes of the grid as the near-null space of a system whose unknowns are all
+/// displacements (the one-phase solid, u; the two phases' motions, u–U), for the Jacobian itself
+/// (`MatSetNearNullSpace`): GAMG then builds its aggregates from them whatever the options, as it
+/// does for the `u` split of the coupled systems. Empty for a system with a pore pressure or a
+/// projected volume ratio among its unknowns (their splits carry the modes, see [`define`]).
+pub(super) fn displacement_near_null_space<const D: usize>(
+    comm: Comm,
+    coll: &Collective,
+    layout: Layout,
+    positions: &[[f64; D]],
+) -> Result<Vec<Vector>, petsc::Error> {
+    if layout.p.is_some() || layout.jbar.is_some() {
+        return Ok(Vec::new());
+    }
+    rigid_body_modes(comm, coll, layout.nd, positions)
+}
+
 /// The PETSc option that chooses the Schur preconditioner (`user`: porompm's fixed-stress one).
 const SCHUR_USER_OPTION: &str = "pc_fieldsplit_schur_precondition";
 
@@ -87,20 +104,40 @@ fn user_defines_splits() -> Result<bool, petsc::Error> {
 }
 
 /// The orthonormal rigid-body modes of the grid for a block of `components` displacement dofs per
-/// node (groups of D, solid then water): the translations along each axis and the rotations about
-/// the nodes' centroid (about z in two dimensions; about x, y and z in three), every group moving
-/// alike (collective). The translations and rotations about the centroid are orthogonal; the three
-/// rotations of a three-dimensional grid are orthonormalised among themselves (Gram–Schmidt, as
-/// PETSc's `MatNullSpaceCreateRigidBody`).
+/// node (groups of D, solid then water) as PETSc vectors (collective; see [`rigid_body_mode_values`]).
 fn rigid_body_modes<const D: usize>(
     comm: Comm,
     coll: &Collective,
     components: usize,
     positions: &[[f64; D]],
 ) -> Result<Vec<Vector>, petsc::Error> {
+    let modes = rigid_body_mode_values(components, positions, |v| coll.sum(v)).map_err(petsc::Error::new)?;
+    let n = positions.len() * components;
+    modes
+        .iter()
+        .map(|m| {
+            let mut v = Vector::new_mpi(comm, n as petsc::Int, petsc::DETERMINE)?;
+            v.write()?.copy_from_slice(m);
+            Ok(v)
+        })
+        .collect()
+}
+
+/// The values on this rank's `positions` of the orthonormal rigid-body modes of the grid for a
+/// block of `components` displacement dofs per node (groups of D, solid then water): the
+/// translations along each axis and the rotations about the nodes' centroid (about z in two
+/// dimensions; about x, y and z in three), every group moving alike. `sum` adds values over the
+/// ranks. The translations and rotations about the centroid are orthogonal; the three rotations of
+/// a three-dimensional grid are orthonormalised among themselves (Gram–Schmidt, as PETSc's
+/// `MatNullSpaceCreateRigidBody`).
+fn rigid_body_mode_values<const D: usize>(
+    components: usize,
+    positions: &[[f64; D]],
+    sum: impl Fn(&[f64]) -> Result<Vec<f64>, String>,
+) -> Result<Vec<Vec<f64>>, String> {
     let mut local = vec![positions.len() as f64];
     local.extend((0..D).map(|d| positions.iter().map(|x| x[d]).sum::<f64>()));
-    let sums = coll.sum(&local).map_err(petsc::Error::new)?;
+    let sums = sum(&local)?;
     let centre: [f64; D] = std::array::from_fn(|d| sums[1 + d] / sums[0].max(1.0));
     let n = positions.len() * components;
     let groups = components / D;
@@ -114,9 +151,8 @@ fn rigid_body_modes<const D: usize>(
         }
         values
     };
-    let dot = |u: &[f64], v: &[f64]| -> Result<f64, petsc::Error> {
-        Ok(coll.sum(&[u.iter().zip(v).map(|(a, b)| a * b).sum()]).map_err(petsc::Error::new)?[0])
-    };
+    let dot =
+        |u: &[f64], v: &[f64]| -> Result<f64, String> { Ok(sum(&[u.iter().zip(v).map(|(a, b)| a * b).sum()])?[0]) };
     let mut modes: Vec<Vec<f64>> =
         (0..D).map(|t| values(&|_| std::array::from_fn(|c| if c == t { 1.0 } else { 0.0 }))).collect();
     // The rotation about axis a: ω × r with ω the unit vector of a (about z in the plane).
@@ -141,12 +177,40 @@ fn rigid_body_modes<const D: usize>(
         let norm = dot(m, m)?.sqrt();
         m.iter_mut().for_each(|x| *x /= norm);
     }
-    modes
-        .iter()
-        .map(|m| {
-            let mut v = Vector::new_mpi(comm, n as petsc::Int, petsc::DETERMINE)?;
-            v.write()?.copy_from_slice(m);
-            Ok(v)
-        })
-        .collect()
+    Ok(modes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The modes of a 3D grid block (solid and water groups) are orthonormal and rigid: each moves
+    /// every pair of nodes without stretching the segment between them, (u_a − u_b)·(x_a − x_b) = 0
+    /// (a rotation's sign or axis written wrongly stretches it), in each group alike.
+    #[test]
+    fn three_dimensional_rigid_body_modes_are_orthonormal_and_rigid() {
+        let positions: Vec<[f64; 3]> = (0..27)
+            .map(|i| [(i % 3) as f64 * 0.5 + 1.0, ((i / 3) % 3) as f64 * 0.25, (i / 9) as f64 * 0.4 - 2.0])
+            .collect();
+        let modes = rigid_body_mode_values(6, &positions, |v| Ok(v.to_vec())).unwrap();
+        assert_eq!(modes.len(), 6);
+        for (i, a) in modes.iter().enumerate() {
+            for (j, b) in modes.iter().enumerate() {
+                let d: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+                assert!((d - f64::from(i == j)).abs() < 1e-12, "modes {i}, {j}: {d}");
+            }
+            for g in [0, 3] {
+                let u = |n: usize| [a[n * 6 + g], a[n * 6 + g + 1], a[n * 6 + g + 2]];
+                for p in 0..positions.len() {
+                    for q in 0..p {
+                        let stretch: f64 =
+                            (0..3).map(|c| (u(p)[c] - u(q)[c]) * (positions[p][c] - positions[q][c])).sum();
+                        assert!(stretch.abs() < 1e-12, "mode {i} stretches ({p}, {q}) by {stretch}");
+                    }
+                }
+            }
+        }
+        // The rotations are not the translations: each moves two nodes differently.
+        assert!(modes[3..].iter().all(|m| (m[0] - m[6 * 26]).abs() + (m[1] - m[6 * 26 + 1]).abs() > 1e-3));
+    }
 }

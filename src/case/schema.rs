@@ -1248,8 +1248,8 @@ pub enum Verification {
         #[serde(default = "default_column_tol")]
         settlement_tolerance: f64,
     },
-    /// Load–settlement of a strip footing and its bearing capacity ([000] §4.1, §4.3; see
-    /// `verification::bearing`).
+    /// Load–settlement of a strip (or, in three dimensions, a rectangular) footing and its bearing
+    /// capacity ([000] §4.1, §4.3; see `verification::bearing`).
     BearingCapacity {
         /// The soil body (its cohesion normalises the pressure).
         soil: String,
@@ -1264,11 +1264,16 @@ pub enum Verification {
         footing: Option<String>,
         /// Width carrying the load in the model [m] (the half-width in a half model).
         loaded_width: f64,
+        /// In three dimensions, the loaded area's extent along z in the model [m] (the half-length
+        /// of a footing in a quarter model): the pressure is the force over
+        /// `loaded_width` × `loaded_depth`. Two-dimensional cases do not take it.
+        #[serde(default)]
+        loaded_depth: Option<f64>,
         /// Footing breadth B [m] (normalises the settlement).
         breadth: f64,
         /// The settlement is the downward displacement of the material point nearest to this point
-        /// at t = 0 [m].
-        settlement_point: [f64; 2],
+        /// at t = 0 [m] (one coordinate per dimension).
+        settlement_point: Vec<f64>,
         /// d/B at which q_ult is read for the metric `bearing_capacity_ratio` (a load-controlled
         /// footing; give this or `plateau`, or neither for no metric).
         #[serde(default)]

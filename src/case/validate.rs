@@ -254,14 +254,21 @@ fn three_dimensional(c: &Case) -> R {
         return not_yet("probes");
     }
     match &c.verification {
-        None | Some(Verification::Terzaghi { .. }) => {}
+        None | Some(Verification::Terzaghi { .. } | Verification::BearingCapacity { .. }) => {}
         Some(v) => return not_yet(&format!("verification.kind = \"{}\"", v.kind())),
     }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
     }
     if let Some(i) = c.stages.iter().position(|s| s.analysis == crate::case::AnalysisType::DynamicExplicit) {
-        return not_yet(&format!("stages[{i}].analysis = \"dynamic_explicit\""));
+        // The explicit update runs in any dimension for one phase; the u–U system's pore pressure
+        // is plane only for now.
+        if c.analysis.formulation != Formulation::OnePhase {
+            return Err(format!(
+                "key `stages[{i}].analysis`: a two_phase `dynamic_explicit` stage is not available in a \
+                 three-dimensional case yet (one_phase is; issue «Three dimensions», docs/dimensions.md)"
+            ));
+        }
     }
     let st = &c.stabilisation;
     if st.pressure_projection.is_some() {
@@ -1192,6 +1199,7 @@ pub fn validate(c: &Case) -> R {
                 soil,
                 load,
                 loaded_width,
+                loaded_depth,
                 breadth,
                 settlement_point,
                 failure_settlement,
@@ -1204,6 +1212,20 @@ pub fn validate(c: &Case) -> R {
                 footing,
             } => {
                 positive("verification.loaded_width", *loaded_width)?;
+                match (loaded_depth, c.dimension()) {
+                    (Some(d), 3) => positive("verification.loaded_depth", *d)?,
+                    (None, 3) => {
+                        return Err("key `verification.loaded_depth`: a three-dimensional footing needs the loaded \
+                                    area's extent along z"
+                            .into())
+                    }
+                    (Some(_), _) => {
+                        return Err("key `verification.loaded_depth`: only a three-dimensional case takes it \
+                                    (a plane footing's pressure is its force per unit length over `loaded_width`)"
+                            .into())
+                    }
+                    (None, _) => {}
+                }
                 if let Some([from, to]) = plateau {
                     if !(*from >= 0.0 && to > from && to.is_finite()) {
                         return Err(format!(
@@ -1220,7 +1242,7 @@ pub fn validate(c: &Case) -> R {
                     positive("verification.stop_settlement", *s)?;
                 }
                 positive("verification.breadth", *breadth)?;
-                finite2("verification.settlement_point", *settlement_point)?;
+                components("verification.settlement_point", settlement_point, c.dimension())?;
                 if let Some(f) = failure_settlement {
                     positive("verification.failure_settlement", *f)?;
                 }

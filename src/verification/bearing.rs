@@ -1,12 +1,13 @@
-//! Bearing capacity of a strip footing: the load–settlement curve of a run and the ultimate
-//! pressure read from it ([000] §4.1, §4.3).
+//! Bearing capacity of a strip footing (or, in three dimensions, a rectangular one): the
+//! load–settlement curve of a run and the ultimate pressure read from it ([000] §4.1, §4.3).
 //!
 //! Every step the check records the footing pressure q and the settlement d:
 //! * q is the applied pressure: |traction_y| f(t) for a traction load, or, for a body force acting on
 //!   a footing body ([000] §4.1.2: a footing of increasing unit weight), the weight of that body's
 //!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest), or,
 //!   for a rigid footing pushed in under displacement control (a boundary moving its nodes,
-//!   [002] §4.2), the boundary's downward reaction on the soil over the loaded width, −R_y / w;
+//!   [002] §4.2), the boundary's downward reaction on the soil over the loaded width, −R_y / w
+//!   (over the loaded area w × `loaded_depth` in three dimensions);
 //! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0,
 //!   counted from the last observation before the load starts (q = 0), so that a gravity stage
 //!   before the loading does not count as settlement.
@@ -25,8 +26,8 @@ use crate::case::{Case, Load, SoilModel};
 use crate::model::Model;
 use crate::parallel::Collective;
 
-/// The load–settlement check.
-pub struct BearingCheck {
+/// The load–settlement check, of a footing in D dimensions.
+pub struct BearingCheck<const D: usize = 2> {
     load: LoadKind,
     time_fn: crate::model::loads::TimeFn,
     cohesion: f64,
@@ -41,8 +42,8 @@ pub struct BearingCheck {
     stop_at: Option<f64>,
     /// Downward displacement of the point while q = 0 [m].
     baseline: f64,
-    /// The footing boundary's last reaction [N per m] (a displacement-controlled footing).
-    reaction: [f64; 2],
+    /// The footing boundary's last reaction [N per m; N in 3D] (a displacement-controlled footing).
+    reaction: [f64; D],
     /// (t, d/B, q/c) per step.
     curve: Vec<[f64; 3]>,
 }
@@ -50,9 +51,9 @@ pub struct BearingCheck {
 enum LoadKind {
     /// |traction_y| [Pa].
     Traction(f64),
-    /// |b_y| [m/s²], bodies, loaded width [m].
+    /// |b_y| [m/s²], bodies, loaded width [m] (area [m²] in 3D).
     Weight(f64, Vec<u16>, f64),
-    /// The index of the footing's boundary in `Model::boundaries`, loaded width [m].
+    /// The index of the footing's boundary in `Model::boundaries`, loaded width [m] (area [m²] in 3D).
     Reaction(usize, f64),
 }
 
@@ -72,10 +73,12 @@ pub struct BearingSpec<'a> {
     pub load: Loading<'a>,
     /// Loaded width in the model [m].
     pub loaded_width: f64,
+    /// Loaded extent along z in the model [m] (three dimensions).
+    pub loaded_depth: Option<f64>,
     /// Footing breadth B [m].
     pub breadth: f64,
     /// Where the settlement is measured at t = 0.
-    pub settlement_point: [f64; 2],
+    pub settlement_point: &'a [f64],
     /// d/B at which q_ult is read.
     pub failure_settlement: Option<f64>,
     /// d/B range over which q is averaged for q_ult.
@@ -92,9 +95,10 @@ pub struct BearingSpec<'a> {
     pub stop_settlement: Option<f64>,
 }
 
-impl BearingCheck {
-    /// Builds the check from the case.
-    pub fn new(c: &Case, model: &Model, coll: &Collective, spec: &BearingSpec) -> Result<BearingCheck, String> {
+impl<const D: usize> BearingCheck<D> {
+    /// Builds the check from the case. The pressure is the force over the loaded width (per unit
+    /// length in the plane) or over the loaded width × depth (three dimensions).
+    pub fn new(c: &Case, model: &Model<D>, coll: &Collective, spec: &BearingSpec) -> Result<BearingCheck<D>, String> {
         let soil = c.body(spec.soil).ok_or(format!("no body `{}`", spec.soil))?;
         let mat = c.material(&soil.material).expect("validated");
         let cohesion = match &mat.model {
@@ -108,18 +112,22 @@ impl BearingCheck {
         if cohesion <= 0.0 {
             return Err("the bearing capacity check normalises by the cohesion, which must be positive".into());
         }
+        let loaded = spec.loaded_width * spec.loaded_depth.unwrap_or(1.0);
         let (load, time_fn) = match spec.load {
             Loading::Footing(name) => {
                 let b = model.boundaries.iter().position(|b| b.name == name).ok_or(format!("no boundary `{name}`"))?;
-                (LoadKind::Reaction(b, spec.loaded_width), crate::model::loads::TimeFn::Constant(1.0))
+                (LoadKind::Reaction(b, loaded), crate::model::loads::TimeFn::Constant(1.0))
             }
-            Loading::Load(name) => load_of(c, name, spec.loaded_width)?,
+            Loading::Load(name) => load_of(c, name, loaded)?,
         };
+        if spec.settlement_point.len() != D {
+            return Err(format!("the settlement point needs {D} coordinates, got {}", spec.settlement_point.len()));
+        }
         // The material point nearest to the settlement point (over all ranks).
         let ps = &model.particles;
         let local: Vec<f64> = (0..ps.len())
             .flat_map(|k| {
-                let d = (ps.x0[k][0] - spec.settlement_point[0]).hypot(ps.x0[k][1] - spec.settlement_point[1]);
+                let d = (0..D).map(|c| (ps.x0[k][c] - spec.settlement_point[c]).powi(2)).sum::<f64>().sqrt();
                 [d, ps.id[k] as f64]
             })
             .collect();
@@ -142,12 +150,12 @@ impl BearingCheck {
             report_loads: spec.report_loads.to_vec(),
             stop_at: spec.stop_settlement,
             baseline: 0.0,
-            reaction: [0.0; 2],
+            reaction: [0.0; D],
             curve: Vec::new(),
         })
     }
 
-    fn pressure(&self, t: f64, model: &Model, coll: &Collective) -> Result<f64, String> {
+    fn pressure(&self, t: f64, model: &Model<D>, coll: &Collective) -> Result<f64, String> {
         let f = self.time_fn.eval(t);
         Ok(match &self.load {
             LoadKind::Traction(q) => q * f,
@@ -212,7 +220,7 @@ fn load_of(c: &Case, name: &str, width: f64) -> Result<(LoadKind, crate::model::
     Ok((load, time_fn))
 }
 
-impl Check for BearingCheck {
+impl<const D: usize> Check<D> for BearingCheck<D> {
     fn columns(&self) -> Vec<String> {
         ["bearing.q", "bearing.q_over_c", "bearing.d_over_B"].iter().map(|s| s.to_string()).collect()
     }
@@ -221,13 +229,13 @@ impl Check for BearingCheck {
         Vec::new()
     }
 
-    fn observe_reactions(&mut self, reactions: &[[f64; 2]]) {
+    fn observe_reactions(&mut self, reactions: &[[f64; D]]) {
         if let LoadKind::Reaction(b, _) = self.load {
             self.reaction = reactions[b];
         }
     }
 
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
         let q = self.pressure(t, model, coll)?;
         let ps = &model.particles;
         let local: f64 = (0..ps.len()).find(|&k| ps.id[k] == self.point_id).map_or(0.0, |k| -ps.disp[k][1]);
@@ -246,7 +254,7 @@ impl Check for BearingCheck {
         Ok(vec![q, row[2], row[1]])
     }
 
-    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+    fn finish(&mut self, _model: &Model<D>, _coll: &Collective) -> Result<Findings, String> {
         // q_ult/c and how it was read (NaN when the curve never got there), by the settlement at
         // failure or by the plateau's mean.
         let read = match (self.failure, self.plateau) {
@@ -301,25 +309,26 @@ impl Check for BearingCheck {
         vec![super::figures::load_settlement(&self.curve, self.reference)]
     }
 
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        // [baseline, reaction_x, reaction_y, rows…]: the reaction of the last step is the footing's
-        // load when the run restarts.
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        // [baseline, reaction (D), rows…]: the reaction of the last step is the footing's load when
+        // the run restarts.
         Ok(Some(
-            [self.baseline, self.reaction[0], self.reaction[1]]
-                .into_iter()
+            std::iter::once(self.baseline)
+                .chain(self.reaction.iter().copied())
                 .chain(self.curve.iter().flatten().copied())
                 .collect(),
         ))
     }
 
-    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
-        let [baseline, rx, ry, rows @ ..] = state else {
+    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
+        if state.len() < 1 + D {
             return Err("a load-settlement state without its baseline and reaction".into());
-        };
+        }
+        let (baseline, reaction, rows) = (state[0], &state[1..1 + D], &state[1 + D..]);
         if !rows.len().is_multiple_of(3) {
             return Err(format!("{} values do not make rows of a load-settlement curve", rows.len()));
         }
-        (self.baseline, self.reaction) = (*baseline, [*rx, *ry]);
+        (self.baseline, self.reaction) = (baseline, std::array::from_fn(|c| reaction[c]));
         self.curve = rows.chunks(3).map(|r| [r[0], r[1], r[2]]).collect();
         Ok(())
     }

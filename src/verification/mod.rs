@@ -245,8 +245,60 @@ pub fn for_case_in<const D: usize>(
     match &c.verification {
         None => Ok(None),
         Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
+        Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
         Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
     }
+}
+
+/// The footing of the case's `bearing_capacity` verification, in any dimension.
+fn bearing_check<const D: usize>(
+    c: &Case,
+    model: &Model<D>,
+    coll: &Collective,
+) -> Result<bearing::BearingCheck<D>, String> {
+    let Some(Verification::BearingCapacity {
+        soil,
+        load,
+        loaded_width,
+        loaded_depth,
+        breadth,
+        settlement_point,
+        failure_settlement,
+        plateau,
+        reference,
+        tolerance,
+        report_settlements,
+        report_loads,
+        stop_settlement,
+        footing,
+    }) = &c.verification
+    else {
+        return Err("the case asks for no bearing capacity check".into());
+    };
+    bearing::BearingCheck::new(
+        c,
+        model,
+        coll,
+        &bearing::BearingSpec {
+            soil,
+            load: match (load, footing) {
+                (_, Some(f)) => bearing::Loading::Footing(f),
+                (Some(l), None) => bearing::Loading::Load(l),
+                (None, None) => return Err("give the bearing check a `load` or a `footing`".into()),
+            },
+            loaded_width: *loaded_width,
+            loaded_depth: *loaded_depth,
+            breadth: *breadth,
+            settlement_point,
+            failure_settlement: *failure_settlement,
+            plateau: *plateau,
+            reference: *reference,
+            tolerance: *tolerance,
+            report_settlements,
+            report_loads,
+            stop_settlement: *stop_settlement,
+        },
+    )
 }
 
 /// The consolidating column of the case's `terzaghi` verification, in any dimension.
@@ -354,43 +406,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
                 *settlement_tolerance,
             )?)
         }
-        Verification::BearingCapacity {
-            soil,
-            load,
-            loaded_width,
-            breadth,
-            settlement_point,
-            failure_settlement,
-            plateau,
-            reference,
-            tolerance,
-            report_settlements,
-            report_loads,
-            stop_settlement,
-            footing,
-        } => Box::new(bearing::BearingCheck::new(
-            c,
-            model,
-            coll,
-            &bearing::BearingSpec {
-                soil,
-                load: match (load, footing) {
-                    (_, Some(f)) => bearing::Loading::Footing(f),
-                    (Some(l), None) => bearing::Loading::Load(l),
-                    (None, None) => unreachable!("validated"),
-                },
-                loaded_width: *loaded_width,
-                breadth: *breadth,
-                settlement_point: *settlement_point,
-                failure_settlement: *failure_settlement,
-                plateau: *plateau,
-                reference: *reference,
-                tolerance: *tolerance,
-                report_settlements,
-                report_loads,
-                stop_settlement: *stop_settlement,
-            },
-        )?),
+        Verification::BearingCapacity { .. } => Box::new(bearing_check(c, model, coll)?),
         Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
             let col = Column::from_case(c, model, body, load)?;
             Box::new(shock::ShockCheck::new(col, *probe_depth, *fast_tolerance, *slow_tolerance, model, coll)?)

@@ -165,6 +165,18 @@ pub trait MatOps {
         Ok(MatStats { nonzeros: info.nz_used, memory_bytes: info.memory })
     }
 
+    /// Attaches a near-null space (e.g. the rigid-body modes of an elastic body), which algebraic
+    /// multigrid (GAMG) uses to build its coarse spaces (`MatSetNearNullSpace`). The vectors must
+    /// be orthonormal; the matrix keeps its own reference to the space.
+    fn set_near_null_space(&mut self, comm: crate::Comm, vectors: &[crate::Vector]) -> Result<()> {
+        let raw: Vec<sys::Vec> = vectors.iter().map(|v| v.raw).collect();
+        let mut sp: sys::MatNullSpace = std::ptr::null_mut();
+        call!(MatNullSpaceCreate(comm.raw(), sys::PetscBool::PETSC_FALSE, raw.len() as Int, raw.as_ptr(), &mut sp))?;
+        let set = call!(MatSetNearNullSpace(self.raw(), sp));
+        call!(MatNullSpaceDestroy(&mut sp))?;
+        set
+    }
+
     /// Gives the matrix a name.
     fn set_name(&mut self, name: &str) -> Result<()> {
         crate::set_object_name(self.raw() as sys::PetscObject, name)
