@@ -96,6 +96,12 @@ fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
         &["stages.0.analysis=dynamic_explicit"],
         "a two_phase `dynamic_explicit` stage is not available in a three-dimensional case yet",
     );
+    common::assert_refused(
+        "tests/cases/cube_3d.toml",
+        &dir,
+        &["stabilisation.fbar=true", "analysis.kinematics=finite_strain"],
+        "the implicit F̄ of stage `press` is not available in a three-dimensional case yet",
+    );
     // The footing's bearing check: a 3D loaded area needs its extent along z; a plane one has none.
     common::assert_refused(
         "tests/cases/footing_square_3d.toml",

@@ -62,15 +62,15 @@
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
 use super::{callbacks, Error, GridSystem, StepSolve};
+use crate::kernels::kinematics::det;
 use crate::kernels::kinematics::Kinematics;
 use crate::kernels::{self, Integration};
-use crate::model::finite_strain::det2;
 use crate::model::{fbar, Model};
 
 impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// The explicit step's nodal update (see the module documentation), in any dimension; always
-    /// "converged". F̄'s projection and the pore pressure of the u–U system are plane only for now
-    /// (validation keeps them out of three-dimensional cases).
+    /// "converged". The pore pressure of the u–U system is plane only for now (validation keeps it
+    /// out of three-dimensional cases).
     pub(super) fn explicit_update(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
         let t0 = std::time::Instant::now();
         let Integration::Explicit { damping, xpic, .. } = model.integration else {
@@ -125,18 +125,14 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         self.step.explicit_inertia = inertia;
         self.step.xpic_correction =
             if xpic > 0 { self.xpic_correction(model, xpic, &lumped.mass, &lumped.momentum)? } else { Vec::new() };
-        if model.fbar || !self.step.drained.is_empty() {
+        if model.fbar {
+            self.step.fbar_scale = self.fbar_scales(model)?;
+        }
+        if !self.step.drained.is_empty() {
             let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) else {
-                return Err(Error::new(
-                    "the explicit F̄ projection and pore pressure are not available in three dimensions yet",
-                ));
+                return Err(Error::new("the explicit pore pressure is not available in three dimensions yet"));
             };
-            if plane.fbar {
-                system.step.fbar_scale = system.fbar_scales(plane)?;
-            }
-            if !system.step.drained.is_empty() {
-                system.step.pressure_increment = system.nodal_pressure_increments(plane)?;
-            }
+            system.step.pressure_increment = system.nodal_pressure_increments(plane)?;
         }
         let seconds = t0.elapsed().as_secs_f64();
         Ok(StepSolve {
@@ -188,6 +184,39 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         Ok((0..w.len()).map(|q| if fixed[q] || mass[q] <= 0.0 { 0.0 } else { w[q] - v0[q] }).collect())
     }
 
+    /// [002]'s projection for the step's nodal increments (see the module documentation): the
+    /// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
+    /// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/D} of the increment (Eq. 27, the in-plane block in
+    /// plane strain; J̄_p^n the point's stored value) and s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/D} of the
+    /// total deformation (Eq. 18).
+    fn fbar_scales(&mut self, model: &Model<D>) -> Result<Vec<[f64; 3]>, Error> {
+        let (st, ps) = (&self.step.stencils, &model.particles);
+        // Per point: ΔJ.
+        let dj: Vec<f64> = (0..st.len())
+            .map(|k| {
+                let (nodes, _) = st.get(k);
+                let states = callbacks::node_states::<D, M, N>(&self.step, k, &self.step.solution);
+                let d = states[..nodes.len()].iter().map(|s| std::array::from_fn(|c| s.d[c]));
+                Kinematics::new(st.strain_of(k), d, false).j
+            })
+            .collect();
+        let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();
+        let projected = self.project_per_point(model, &own)?;
+        Ok((0..own.len())
+            .map(|k| {
+                let p = projected[k];
+                [fbar::scale(p, ps.jbar[k] * dj[k], D), fbar::scale(p, own[k], D), p]
+            })
+            .collect())
+    }
+
+    /// The volume-weighted projection Π(q) of a per-point quantity `q` (this rank's points) on the
+    /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
+    /// the ranks).
+    fn project_per_point(&mut self, model: &Model<D>, q: &[f64]) -> Result<Vec<f64>, Error> {
+        self.project_weighted(&model.particles.volume[..q.len()], q, &[])
+    }
+
     /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
     /// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
     /// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
@@ -217,34 +246,6 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
 }
 
 impl GridSystem {
-    /// [002]'s projection for the step's nodal increments (see the module documentation): the
-    /// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
-    /// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/2} of the in-plane increment (Eq. 27, J̄_p^n the point's
-    /// stored value) and s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/2} of the total deformation (Eq. 18).
-    fn fbar_scales(&mut self, model: &Model) -> Result<Vec<[f64; 3]>, Error> {
-        let (st, ps) = (&self.step.stencils, &model.particles);
-        // Per point: ΔJ.
-        let dj: Vec<f64> = (0..st.len())
-            .map(|k| {
-                let (nodes, _) = st.get(k);
-                let states = callbacks::node_states::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>(
-                    &self.step,
-                    k,
-                    &self.step.solution,
-                );
-                Kinematics::new(st.strain_of(k), states[..nodes.len()].iter().map(|s| [s.d[0], s.d[1]]), false).j
-            })
-            .collect();
-        let own: Vec<f64> = (0..dj.len()).map(|k| det2(ps.def_grad[k]) * dj[k]).collect();
-        let projected = self.project_per_point(model, &own)?;
-        Ok((0..own.len())
-            .map(|k| {
-                let p = projected[k];
-                [fbar::scale(p, ps.jbar[k] * dj[k], 2), fbar::scale(p, own[k], 2), p]
-            })
-            .collect())
-    }
-
     /// The nodal pore pressure's increment at each point of a two-phase step (see the module
     /// documentation): the points' own increments Δp_p of the step's solution, their lumped
     /// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
@@ -270,13 +271,6 @@ impl GridSystem {
         let out = self.project_weighted(&storage, &own, &drained);
         self.step.drained = drained;
         out
-    }
-
-    /// The volume-weighted projection Π(q) of a per-point quantity `q` (this rank's points) on the
-    /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
-    /// the ranks).
-    fn project_per_point(&mut self, model: &Model, q: &[f64]) -> Result<Vec<f64>, Error> {
-        self.project_weighted(&model.particles.volume[..q.len()], q, &[])
     }
 }
 
