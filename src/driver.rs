@@ -247,11 +247,11 @@ struct Probe {
     excess_extreme: f64,
 }
 
-/// A run on a grid of dimension D whose points have at most M stencil nodes of at most N dofs
 /// Fraction of its first filled fraction below which a moving boundary's nodes have lost their grip
 /// on the material (see [`Simulation::check_boundary_grip`]).
 const GRIP_FRACTION: f64 = 0.5;
 
+/// A run on a grid of dimension D whose points have at most M stencil nodes of at most N dofs
 /// (see [`GridSystem`]): the same algorithm in two and three dimensions.
 struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const N: usize = { MAX_DOF }> {
     case: &'a Case,

@@ -62,8 +62,7 @@
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
 use super::{callbacks, Error, GridSystem, StepSolve};
-use crate::kernels::kinematics::det;
-use crate::kernels::kinematics::Kinematics;
+use crate::kernels::kinematics::{det, Kinematics};
 use crate::kernels::{self, Integration};
 use crate::model::{fbar, Model};
 

@@ -781,7 +781,8 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// motion reach at the step's start (collective). A boundary on grid nodes stays where the grid
     /// is, while the material it pushes moves on: once the material has moved by about half a cell,
     /// the nodes reach only the points at the edge of their support, and the motion no longer acts
-    /// on the material as the boundary means it to (the driver warns, see `Simulation::step`).
+    /// on the material as the boundary means it to (the driver warns, see
+    /// `Simulation::check_boundary_grip`).
     fn moving_boundary_fill(
         &self,
         model: &Model<D>,
@@ -795,6 +796,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             .iter()
             .map(|b| b.motion.as_ref().is_some_and(|m| m.gradient.is_some() || m.vector.iter().any(|&v| v != 0.0)))
             .collect();
+        if !moving.contains(&true) {
+            // No boundary moves (every rank has the same boundaries): nothing to reduce.
+            return Ok(vec![None; nb]);
+        }
         let nd = self.layout.nd;
         let mut local = vec![0.0; 2 * nb];
         for &a in &self.owned_nodes {
