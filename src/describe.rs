@@ -199,20 +199,9 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     for st in &case.stages {
         let a = model.active(st);
-        let analysis = crate::analysis::StageAnalysis::of(case, st);
-        // An explicit stage's step is its stable step where that is the smaller.
-        let dt = analysis.dt_limit.map_or(st.dt(), |l| l.min(st.dt()));
-        let _ = writeln!(
-            s,
-            "stage `{}` ({}): {} s in steps of {:.4e} s ({} steps); loads [{}]; boundaries [{}]",
-            st.name,
-            analysis.describe(),
-            st.duration,
-            dt,
-            (st.duration / dt).ceil() as usize,
-            a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
-            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
-        );
+        let loads = a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>();
+        let boundaries = a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>();
+        let _ = writeln!(s, "{}", stage_line(case, st, &loads, &boundaries));
     }
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
     let _ = writeln!(
@@ -340,20 +329,29 @@ fn describe_solid(case: &Case, label: &str) -> String {
     }
     for st in &case.stages {
         let a = model.active(st);
-        let analysis = crate::analysis::StageAnalysis::of(case, st);
-        let _ = writeln!(
-            s,
-            "stage `{}` ({}): {} s in steps of {:.4e} s ({} steps); loads [{}]; boundaries [{}]",
-            st.name,
-            analysis.describe(),
-            st.duration,
-            st.dt(),
-            (st.duration / st.dt()).ceil() as usize,
-            a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>().join(", "),
-            a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>().join(", "),
-        );
+        let loads = a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>();
+        let boundaries = a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>();
+        let _ = writeln!(s, "{}", stage_line(case, st, &loads, &boundaries));
     }
     s
+}
+
+/// The line of a stage: its analysis, duration and step (an explicit stage's stable step where
+/// that is the smaller), its strength reduction, its loads and boundaries.
+fn stage_line(case: &Case, st: &crate::case::Stage, loads: &[&str], boundaries: &[&str]) -> String {
+    let analysis = crate::analysis::StageAnalysis::of(case, st);
+    let dt = analysis.dt_limit.map_or(st.dt(), |l| l.min(st.dt()));
+    let reduction = st.strength_reduction.map_or(String::new(), |f| format!("; peak strengths divided by {f}"));
+    format!(
+        "stage `{}` ({}): {} s in steps of {:.4e} s ({} steps){reduction}; loads [{}]; boundaries [{}]",
+        st.name,
+        analysis.describe(),
+        st.duration,
+        dt,
+        (st.duration / dt).ceil() as usize,
+        loads.join(", "),
+        boundaries.join(", "),
+    )
 }
 
 #[cfg(test)]

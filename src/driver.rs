@@ -668,11 +668,13 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         Ok(())
     }
 
-    /// Sets the stage's analysis type up: its time treatment on the model and, when its unknowns
-    /// per node differ from the last stage's, a new grid system (DMDA, matrix, SNES) for them.
+    /// Sets the stage's analysis type up: its time treatment and its materials' strengths on the
+    /// model and, when its unknowns per node differ from the last stage's, a new grid system
+    /// (DMDA, matrix, SNES) for them.
     fn begin_stage(&mut self, stage: &Stage) -> Result<StageAnalysis, RunError> {
         let analysis = StageAnalysis::of(self.case, stage);
         self.model.integration = analysis.integration;
+        self.model.take_stage_materials(self.case, stage);
         self.system.forget_increment();
         let layout = analysis.layout.in_dim(D);
         if self.system.layout() != layout {
@@ -1527,6 +1529,7 @@ mod tests {
             drainage: None,
             dt_max: None,
             explicit: None,
+            strength_reduction: None,
         }
     }
 

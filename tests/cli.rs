@@ -774,3 +774,23 @@ fn check_lists_the_physics_warnings() {
         assert!(o.status.success() && out.contains(kind), "{sets:?}: {out}");
     }
 }
+
+/// A stage's strength reduction and the run-out check refuse what they cannot use, naming the key.
+#[test]
+fn strength_reduction_and_runout_input_is_refused_with_a_clear_message() {
+    assert_sets_refused(
+        "cases/landslide_3d.toml",
+        &[
+            (
+                "stages.failure.strength_reduction=0",
+                "key `stages.failure.strength_reduction`: the strength reduction factor F = 0",
+            ),
+            ("stages.failure.strength_reduction=1000", "must lie in (0, 100]"),
+            ("verification.trigger_stage=nowhere", "key `verification.trigger_stage`: no stage named `nowhere`"),
+            ("verification.snapshot_times=[9.0]", "key `verification.snapshot_times`: 9 s is not within"),
+            ("verification.spray_fraction=0.5", "key `verification.spray_fraction`: must be in [0, 0.05]"),
+            ("verification.standing_speed=0", "verification.standing_speed"),
+            ("verification.body=rock", "key `verification.body`: no body named `rock`"),
+        ],
+    );
+}

@@ -106,9 +106,9 @@ fn kind(key: &str) -> &'static str {
     }
     let last = key.rsplit('.').next().unwrap();
     match last {
-        "ux" | "uy" | "displacement_x" | "displacement_y" | "settlement" => "displacement",
+        "ux" | "uy" | "uz" | "displacement_x" | "displacement_y" | "displacement_z" | "settlement" => "displacement",
         "sxx" | "syy" | "sxy" | "p" | "p_excess" | "q" => "stress",
-        "reaction_x" | "reaction_y" => "force",
+        "reaction_x" | "reaction_y" | "reaction_z" => "force",
         _ => "other",
     }
 }
@@ -227,6 +227,7 @@ gold_tests!(
     hollow_cylinder,
     hollow_cylinder_increments,
     lame_cylinder,
+    landslide_3d,
     large_strain_consolidation,
     patch_test,
     rigid_rotation,

@@ -16,7 +16,14 @@
 //! 5. the step's nodal increments Δu_i = Δt v_i^{n+1}, from which the particle update (the same
 //!    as the implicit steps': position, F, volume, the objective stress update from ∇Δu; Eqs.
 //!    14–17) and the FLIP/PIC velocity update of `Model::update_particle` ([002] Eqs. 11–13)
-//!    follow;
+//!    follow. The FLIP increment Σ S_ip (v_i^{n+1} − v_i^n) takes the v_i^n of this update (the
+//!    lumped momentum over the lumped mass, zero where a boundary holds the component still,
+//!    `StepData::start_velocity`), not the predictors' nodal velocities of the raw projection:
+//!    the two differ at the nodes to which barely filled nodes hand their shares, and a FLIP
+//!    increment formed with the raw ones added that difference to the points' velocities at every
+//!    step, an instability that grew faster the smaller the step (the landslide's inclined face
+//!    at ν = 0.499 with F̄ blew up within 0.1 s in three dimensions, and in two with a well-filled
+//!    threshold of 0.03);
 //! 6. with `stabilisation.fbar`, [002]'s projection between the two (Eqs. 18–21, 27): each
 //!    point's own volume ratio J_p^n ΔJ_p (J_p^n = det F_p, ΔJ_p of the step) is projected,
 //!    J̄_p^{n+1} = Π(J^n ΔJ)_p (the nodal sums of V_p^n and V_p^n J_p^n ΔJ_p, `model::fbar`,
@@ -120,6 +127,19 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 }
             }
         }
+        // The velocities of the step's start the FLIP update subtracts: the lumped ones, zero
+        // where a boundary holds the component still.
+        self.step.start_velocity = (0..ng)
+            .map(|q| {
+                let (l, c) = (q / nd, q % nd);
+                let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
+                if still || mass[q] <= 0.0 {
+                    0.0
+                } else {
+                    momentum[q] / mass[q]
+                }
+            })
+            .collect();
         self.step.solution = solution;
         self.step.explicit_inertia = inertia;
         self.step.xpic_correction =
@@ -167,7 +187,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             if k > 1 {
                 // S⁺S u: u at the points, their momenta back to the nodes.
                 let at_points: Vec<[f64; D]> =
-                    (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u)).collect();
+                    (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u).du).collect();
                 let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points, None));
                 for v in [&mut lumped.mass, &mut lumped.momentum] {
                     self.sum_over_ranks(v)?;

@@ -125,6 +125,10 @@ struct StepData<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// An explicit XPIC step: the nodal field w − v^n its points' velocities take (see
     /// [`explicit`]), per ghosted dof; empty otherwise.
     xpic_correction: Vec<f64>,
+    /// An explicit step: the nodal velocities v_i^n of its grid update, per ghosted dof (the
+    /// lumped momentum over the lumped mass, zero where a boundary holds the component still),
+    /// from which the FLIP update takes Σ S_ip v_i^n (see [`explicit`]); empty otherwise.
+    start_velocity: Vec<f64>,
     /// A two-phase explicit step with the nodal pore pressure: whether each ghosted node is
     /// drained (a boundary fixes `p` there, or the material barely fills it; see [`explicit`]);
     /// empty otherwise.
@@ -1461,12 +1465,12 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         f(&Assembler::new(dm, model, step, x_local, f_local, &mut seconds, &stages.assembly))
     }
 
-    /// Σ S_ip u_i at particle `k` of a nodal 2-vector field `u` per ghosted dof (barely filled
-    /// nodes extended from their masters).
-    fn interpolated(&self, k: usize, u: &[f64]) -> [f64; D] {
+    /// Σ S_ip u_i at particle `k` of a nodal field `u` per ghosted dof (barely filled nodes
+    /// extended from their masters): its solid components (`du`) and water components (`dw`).
+    fn interpolated(&self, k: usize, u: &[f64]) -> kernels::Interp<D> {
         let (nodes, basis) = self.step.stencils.get(k);
         let states = callbacks::node_states::<D, M, N>(&self.step, k, u);
-        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout).du
+        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout)
     }
 
     /// The converged step at particle `k` for the particle update: exactly the point the converged
@@ -1497,9 +1501,17 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 None => kernels::flow::continuity::pointwise_increment(&pt.interp, pt.part),
             };
         }
+        if !self.step.start_velocity.is_empty() {
+            // An explicit step's FLIP increment Σ S (v_i^{n+1} − v_i^n) takes the v_i^n of its
+            // own grid update (the predictors' nodal velocities are those of the raw projection,
+            // without the barely filled nodes' shares moved to their masters).
+            let v = self.interpolated(k, &self.step.start_velocity);
+            result.interp.v_u = v.du;
+            result.interp.v_w = v.dw;
+        }
         if !self.step.xpic_correction.is_empty() {
             // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
-            let c = self.interpolated(k, &self.step.xpic_correction);
+            let c = self.interpolated(k, &self.step.xpic_correction).du;
             let dt = self.step.dt;
             result.velocity = Some(std::array::from_fn(|d| result.interp.du[d] / dt + c[d]));
         }

@@ -216,6 +216,39 @@ impl Case {
     }
 }
 
+impl SoilModel {
+    /// The model with its peak strength divided by the strength reduction factor `f` (a stage's
+    /// `strength_reduction`): c_p/f, φ' = atan(tan φ/f) with the dilation angles at most φ', the
+    /// residual strength at most the reduced peak; the stiffness unchanged. Models without a
+    /// strength (elastic, neo-Hookean, fluid) are returned as they are.
+    pub fn with_strength_reduced(&self, f: f64) -> SoilModel {
+        let mut m = self.clone();
+        match &mut m {
+            SoilModel::MohrCoulomb {
+                friction_angle,
+                cohesion,
+                residual_cohesion,
+                dilation_angle,
+                critical_dilation_angle,
+                ..
+            } => {
+                *cohesion /= f;
+                *friction_angle = (friction_angle.to_radians().tan() / f).atan().to_degrees();
+                *dilation_angle = dilation_angle.min(*friction_angle);
+                *critical_dilation_angle = critical_dilation_angle.map(|psi| psi.min(*friction_angle));
+                *residual_cohesion = residual_cohesion.map(|cr| cr.min(*cohesion));
+            }
+            SoilModel::VonMises { cohesion, residual_cohesion, .. }
+            | SoilModel::HenckyJ2 { cohesion, residual_cohesion, .. } => {
+                *cohesion /= f;
+                *residual_cohesion = residual_cohesion.map(|cr| cr.min(*cohesion));
+            }
+            SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } | SoilModel::NewtonianFluid { .. } => {}
+        }
+        m
+    }
+}
+
 impl Shape {
     /// Bounding box (min, max) [m].
     pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
@@ -453,5 +486,61 @@ mod tests {
         let r = Region { min: [0.0, 1.0], max: [1.0, 1.0], z: None };
         assert!(r.contains([0.5, 1.0 + 1e-12]));
         assert!(!r.contains([0.5, 1.01]));
+    }
+
+    /// A strength reduction factor F divides c_p and tan φ, keeps ψ ≤ φ' and c_r ≤ c_p/F, leaves
+    /// the stiffness and a residual below the reduced peak alone, and leaves models without a
+    /// strength unchanged.
+    #[test]
+    fn a_strength_reduction_divides_the_peak_strength() {
+        let mc = SoilModel::MohrCoulomb {
+            young_modulus: 1e7,
+            poisson_ratio: 0.3,
+            friction_angle: 30.0,
+            cohesion: 10e3,
+            residual_cohesion: Some(8e3),
+            softening_strain: Some(0.1),
+            dilation_angle: 25.0,
+            critical_dilation_angle: Some(5.0),
+            dilation_decay: 0.0,
+            tension_cutoff: None,
+        };
+        let SoilModel::MohrCoulomb {
+            young_modulus,
+            friction_angle,
+            cohesion,
+            residual_cohesion,
+            dilation_angle,
+            critical_dilation_angle,
+            ..
+        } = mc.with_strength_reduced(2.0)
+        else {
+            unreachable!()
+        };
+        assert_eq!(young_modulus, 1e7);
+        assert_eq!(cohesion, 5e3);
+        let phi = (30f64.to_radians().tan() / 2.0).atan().to_degrees();
+        assert!((friction_angle - phi).abs() < 1e-12 && (phi - 16.102).abs() < 1e-3, "{friction_angle}");
+        assert_eq!(dilation_angle, friction_angle);
+        assert_eq!(critical_dilation_angle, Some(5.0));
+        assert_eq!(residual_cohesion, Some(5e3));
+        let hj = SoilModel::HenckyJ2 {
+            young_modulus: 25e6,
+            poisson_ratio: 0.499,
+            cohesion: 28868.0,
+            residual_cohesion: Some(1732.0),
+            softening_rate: 5.0,
+        };
+        let SoilModel::HenckyJ2 { cohesion, residual_cohesion, softening_rate, .. } = hj.with_strength_reduced(1.65)
+        else {
+            unreachable!()
+        };
+        assert!((cohesion - 28868.0 / 1.65).abs() < 1e-9);
+        assert_eq!((residual_cohesion, softening_rate), (Some(1732.0), 5.0));
+        let el = SoilModel::LinearElastic { young_modulus: 1e6, poisson_ratio: 0.3 };
+        assert!(matches!(
+            el.with_strength_reduced(3.0),
+            SoilModel::LinearElastic { young_modulus, poisson_ratio } if young_modulus == 1e6 && poisson_ratio == 0.3
+        ));
     }
 }

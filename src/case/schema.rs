@@ -970,6 +970,16 @@ pub struct Stage {
     /// The explicit integrator's settings of a `dynamic_explicit` stage (defaults if absent).
     #[serde(default)]
     pub explicit: Option<Explicit>,
+    /// The strength reduction factor F of this stage, ≥ 1 (default 1: the case's strengths): from
+    /// the stage's start every material's peak strength is the case's divided by F (c_p/F, and
+    /// φ' = atan(tan φ/F) with ψ ≤ φ'), as in the strength reduction of slope analyses (Griffiths &
+    /// Lane 1999; [002] §4.4 triggers its landslide with F = 1.65 on the peak strength). Residual
+    /// strengths stay as given unless above the reduced peak, where they take it. Each stage
+    /// reduces the case's strengths afresh (factors do not compound); the points keep their stress
+    /// and accumulated plastic strain, so a point beyond the reduced strength returns to it in its
+    /// next update [-].
+    #[serde(default)]
+    pub strength_reduction: Option<f64>,
 }
 
 /// Settings of the explicit integrator ([002] §2.2, §4; seeds-001-002.md Parts C1 and C5).
@@ -1479,6 +1489,40 @@ pub enum Verification {
         #[serde(default = "default_spray")]
         spray_fraction: f64,
     },
+    /// The run-out of a slope that fails after a trigger ([002] §4.4, the landslide; Part E item
+    /// 16 of `../shared/seeds-001-002.md`). Before the trigger stage the slope must stand (its
+    /// front advances by at most `standing_advance` and no point moves faster than
+    /// `standing_speed` at the trigger); the body's mass must keep. From the trigger on, the front
+    /// (the leading edge along +x with at most `spray_fraction` of the mass ahead of it, as the
+    /// dam break's), its advance R(t) (the run-out), the foremost point, the centre of mass, the
+    /// largest accumulated plastic strain and the rearmost point that has failed are followed.
+    /// There is no reference solution ([002]: "there is no reference solution"): the run-out is a
+    /// result, compared between runs by `make study-landslide`.
+    Runout {
+        /// The sliding body (its material moves along +x).
+        body: String,
+        /// The stage whose start triggers the failure (e.g. by its `strength_reduction`); the
+        /// run-out counts from the front's position then.
+        trigger_stage: String,
+        /// Largest accepted advance of the front before the trigger (the slope stands) [m].
+        #[serde(default = "default_standing_advance")]
+        standing_advance: f64,
+        /// Largest accepted speed of any point of the body at the trigger [m/s].
+        #[serde(default = "default_standing_speed")]
+        standing_speed: f64,
+        /// Times after the trigger at which the run-out is reported as a result (`runout_t<τ>`,
+        /// the stepping lands on them) [s].
+        #[serde(default)]
+        snapshot_times: Vec<f64>,
+        /// Accumulated plastic strain ε̄ beyond which a point counts as failed (the rearmost
+        /// failed point marks the retrogression of the failure) [-].
+        #[serde(default = "default_failed_strain")]
+        failed_strain: f64,
+        /// The share of the body's mass that may lie ahead of the front, in [0, 0.05] (default
+        /// 1e-3) [-].
+        #[serde(default = "default_runout_spray")]
+        spray_fraction: f64,
+    },
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35).
     ShockWave {
         /// The column body.
@@ -1513,8 +1557,25 @@ impl Verification {
             Verification::ShockWave { .. } => "shock_wave",
             Verification::CookMembrane { .. } => "cook_membrane",
             Verification::DamBreak { .. } => "dam_break",
+            Verification::Runout { .. } => "runout",
         }
     }
+}
+
+fn default_standing_advance() -> f64 {
+    0.05
+}
+
+fn default_standing_speed() -> f64 {
+    0.01
+}
+
+fn default_failed_strain() -> f64 {
+    0.5
+}
+
+fn default_runout_spray() -> f64 {
+    1.0e-3
 }
 
 /// Tolerances of the hollow cylinder's step-by-step comparison (the innermost column of points,

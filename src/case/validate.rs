@@ -254,7 +254,8 @@ fn three_dimensional(c: &Case) -> R {
         return not_yet("probes");
     }
     match &c.verification {
-        None | Some(Verification::Terzaghi { .. } | Verification::BearingCapacity { .. }) => {}
+        None
+        | Some(Verification::Terzaghi { .. } | Verification::BearingCapacity { .. } | Verification::Runout { .. }) => {}
         Some(v) => return not_yet(&format!("verification.kind = \"{}\"", v.kind())),
     }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
@@ -912,6 +913,15 @@ pub fn validate(c: &Case) -> R {
         } else if s.explicit.is_some() {
             return Err(format!("key `{}`: only a dynamic_explicit stage takes `explicit`", key("explicit")));
         }
+        if let Some(f) = s.strength_reduction {
+            if !(f > 0.0 && f <= 100.0) {
+                return Err(format!(
+                    "key `{}`: the strength reduction factor F = {f} must lie in (0, 100] (the strengths are \
+                     divided by F)",
+                    key("strength_reduction")
+                ));
+            }
+        }
         if s.time_integration.is_some() && s.analysis != super::AnalysisType::Dynamic {
             return Err(format!("key `{}`: only a dynamic stage takes `time_integration`", key("time_integration")));
         }
@@ -1046,6 +1056,40 @@ pub fn validate(c: &Case) -> R {
                 }
                 if two_phase {
                     return Err("key `verification`: Cook's membrane is for a one_phase analysis".into());
+                }
+                return Ok(());
+            }
+            Verification::Runout {
+                body,
+                trigger_stage,
+                standing_advance,
+                standing_speed,
+                snapshot_times,
+                failed_strain,
+                spray_fraction,
+            } => {
+                positive("verification.standing_advance", *standing_advance)?;
+                positive("verification.standing_speed", *standing_speed)?;
+                positive("verification.failed_strain", *failed_strain)?;
+                if !(0.0..=0.05).contains(spray_fraction) {
+                    return Err(format!(
+                        "key `verification.spray_fraction`: must be in [0, 0.05], got {spray_fraction}"
+                    ));
+                }
+                if c.body(body).is_none() {
+                    return Err(format!("key `verification.body`: no body named `{body}`"));
+                }
+                let Some(s) = c.stages.iter().position(|s| &s.name == trigger_stage) else {
+                    return Err(format!("key `verification.trigger_stage`: no stage named `{trigger_stage}`"));
+                };
+                let after: f64 = c.stages[s..].iter().map(|s| s.duration).sum();
+                if let Some(t) = snapshot_times.iter().find(|&&t| !(t > 0.0 && t <= after * (1.0 + 1e-12))) {
+                    return Err(format!(
+                        "key `verification.snapshot_times`: {t} s is not within the {after} s after the trigger"
+                    ));
+                }
+                if two_phase {
+                    return Err("key `verification`: the run-out check is for a one_phase analysis".into());
                 }
                 return Ok(());
             }

@@ -387,6 +387,12 @@ impl<const D: usize> Model<D> {
         by
     }
 
+    /// Takes the materials of `stage`: the case's, with the stage's strength reduction factor
+    /// (`strength_reduction`, default 1) applied to their peak strengths.
+    pub fn take_stage_materials(&mut self, case: &Case, stage: &crate::case::Stage) {
+        self.materials = materials_of(case, stage.strength_reduction.unwrap_or(1.0));
+    }
+
     /// Loads and boundaries active in a stage (all when the stage does not list them).
     pub fn active(&self, stage: &crate::case::Stage) -> Active {
         let pick = |names: &Option<Vec<String>>, all: Vec<&str>| -> Vec<usize> {
@@ -420,7 +426,7 @@ impl<const D: usize> Model<D> {
                 ShapeFunctions::Gimp | ShapeFunctions::Bspline2 | ShapeFunctions::Bspline3
             ),
             grid,
-            materials: case.materials.iter().map(|m| Material::from_case(m, case.analysis.formulation)).collect(),
+            materials: materials_of(case, 1.0),
             particles,
             loads: Vec::new(),
             boundaries: Vec::new(),
@@ -612,7 +618,8 @@ impl<const D: usize> Model<D> {
             crate::kernels::Integration::Explicit { flip, .. } => {
                 // [002] Eqs. 11–13: FLIP v_p + Σ S (v_i^{n+1} − v_i^n) blended with PIC Σ S v_i^{n+1};
                 // Σ S v_i^{n+1} = Δu_p/Δt, and Σ S v_i^n is the interpolated nodal velocity of the
-                // step's start (the scheme's predictor, `interp.v_u`); the water's likewise
+                // grid update's start (`interp.v_u`, set by `GridSystem::step_result` from the
+                // lumped velocities, `assembly::explicit`); the water's likewise
                 // (Δw_p/Δt and `interp.v_w`). XPIC sets the solid's velocity itself
                 // (`StepResult::velocity`; one-phase only).
                 for c in 0..D {
@@ -685,6 +692,22 @@ impl<const D: usize> Model<D> {
     }
 }
 
+/// The solver's materials of `case` with their peak strengths divided by the strength reduction
+/// factor `f` ([`crate::case::SoilModel::with_strength_reduced`]; 1 gives the case's).
+pub fn materials_of(case: &Case, f: f64) -> Vec<Material> {
+    case.materials
+        .iter()
+        .map(|m| {
+            if f == 1.0 {
+                Material::from_case(m, case.analysis.formulation)
+            } else {
+                let reduced = crate::case::Material { model: m.model.with_strength_reduced(f), ..m.clone() };
+                Material::from_case(&reduced, case.analysis.formulation)
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -699,6 +722,38 @@ mod tests {
             *g = [300.0, -9.81e3];
         }
         m
+    }
+
+    /// A stage's strength reduction factor divides the peak strength of the model's materials from
+    /// its start, and a stage without one takes the case's strength back (factors do not compound).
+    #[test]
+    fn a_stage_takes_its_strength_reduction_and_the_next_gives_it_back() {
+        let sets: Vec<crate::case::Override> = [
+            "materials.soil.model={ type = \"mohr_coulomb\", young_modulus = 1.0e7, poisson_ratio = 0.3, \
+             friction_angle = 30.0, cohesion = 1.0e4 }",
+            "stages.load.strength_reduction=2.0",
+        ]
+        .iter()
+        .map(|s| crate::case::Override::parse(s).unwrap())
+        .collect();
+        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
+        let mut m = Model::build(&c, |_, _| true);
+        let strength = |m: &Model| match &m.materials[0].model {
+            crate::model::soil::Constitutive::MohrCoulomb(_, mc) => (mc.cohesion, mc.phi.tan()),
+            _ => unreachable!(),
+        };
+        assert_eq!(strength(&m), (1.0e4, 30f64.to_radians().tan()));
+        m.take_stage_materials(&c, &c.stages[0]);
+        let (cu, tan_phi) = strength(&m);
+        assert_eq!(cu, 5.0e3);
+        assert!((tan_phi - 30f64.to_radians().tan() / 2.0).abs() < 1e-15);
+        for _ in 0..2 {
+            m.take_stage_materials(&c, &c.stages[0]);
+        }
+        assert_eq!(strength(&m).0, 5.0e3, "the factor does not compound");
+        let plain = crate::case::Stage { strength_reduction: None, ..c.stages[0].clone() };
+        m.take_stage_materials(&c, &plain);
+        assert_eq!(strength(&m).0, 1.0e4);
     }
 
     /// The model `m` in three dimensions: its grid, points and domains extruded by one cell of

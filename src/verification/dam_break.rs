@@ -134,9 +134,6 @@ pub struct DamBreakCheck {
     tip: f64,
 }
 
-/// Bins per cell of the mass histogram the front is read from.
-const FRONT_BINS: usize = 20;
-
 impl DamBreakCheck {
     /// The check of a `dam_break` verification (its case validated); collective.
     pub fn new(c: &Case, model: &Model, coll: &Collective) -> Result<DamBreakCheck, String> {
@@ -299,19 +296,6 @@ impl Check for DamBreakCheck {
 
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let ps = &model.particles;
-        // The mass by the x of the points' leading edges in bins of FRONT_BINS per cell, then
-        // the total mass and its first moment; summed over the ranks.
-        let (x0, width) = (model.grid.origin[0], model.grid.h[0] / FRONT_BINS as f64);
-        let bins = model.grid.cells[0] * FRONT_BINS + 1;
-        let mut hist = vec![0.0; bins + 2];
-        let mut tip = f64::NEG_INFINITY;
-        for k in (0..ps.len()).filter(|&k| ps.body[k] == self.body) {
-            let edge = ps.x[k][0] + ps.lp0[k][0];
-            hist[(((edge - x0) / width).floor().max(0.0) as usize).min(bins - 1)] += ps.mass[k];
-            hist[bins] += ps.mass[k];
-            hist[bins + 1] += ps.mass[k] * ps.x[k][0];
-            tip = tip.max(edge);
-        }
         if std::env::var("PORO_DEBUG_DAM").is_ok() {
             if let Some(k) = (0..ps.len())
                 .max_by(|&a, &b| ps.vel[a][0].hypot(ps.vel[a][1]).total_cmp(&ps.vel[b][0].hypot(ps.vel[b][1])))
@@ -329,25 +313,11 @@ impl Check for DamBreakCheck {
                 );
             }
         }
-        let hist = coll.sum(&hist)?;
-        let (mass, moment) = (hist[bins], hist[bins + 1]);
-        self.tip = coll.max(&[tip])?[0] - self.back;
-        // The front: the upper edge of the bin where the mass ahead first exceeds the spray (by
-        // more than round-off: points of equal mass can make the mass ahead equal the spray, and
-        // the sums over the ranks must not decide the bin).
-        let mut ahead = 0.0;
-        let mut front = x0;
-        for b in (0..bins).rev() {
-            ahead += hist[b];
-            if ahead > self.spray * mass * (1.0 + 1e-9) {
-                front = x0 + (b + 1) as f64 * width;
-                break;
-            }
-        }
-        let z = front - self.back;
-        let sums = [mass, moment];
-        let xc = sums[1] / sums[0] - self.back;
-        self.mass_change = self.mass_change.max((sums[0] / self.mass0 - 1.0).abs());
+        let f = super::runout::Front::of(model, self.body, self.spray, coll)?;
+        self.tip = f.tip - self.back;
+        let z = f.front - self.back;
+        let xc = f.centre - self.back;
+        self.mass_change = self.mass_change.max((f.mass / self.mass0 - 1.0).abs());
         let eps = 1e-9 * self.release.max(1e-300);
         if self.at_release.is_none() && t >= self.release - eps {
             self.settle(model, coll)?;

@@ -29,6 +29,7 @@ pub mod figures;
 pub mod hollow_cylinder;
 pub mod lame;
 pub mod patch;
+pub mod runout;
 pub mod shock;
 pub mod stiffness_map;
 pub mod terzaghi;
@@ -246,6 +247,7 @@ pub fn for_case_in<const D: usize>(
         None => Ok(None),
         Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
         Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
+        Some(Verification::Runout { .. }) => Ok(Some(Box::new(runout::RunoutCheck::new(c, model, coll)?))),
         Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
     }
 }
@@ -347,6 +349,7 @@ pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box
         Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
         Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
         Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model, coll)?),
+        Verification::Runout { .. } => Box::new(runout::RunoutCheck::new(c, model, coll)?),
         Verification::Terzaghi { .. } => Box::new(terzaghi_check(c, model, coll)?),
         Verification::LargeStrainConsolidation {
             body,
@@ -1044,6 +1047,10 @@ pub fn describe(v: &case::Verification) -> String {
             "dam break ([002] §4.3): the hydrostatic pressure at the end of stage `{settle_stage}`, the mass, the \
              front's advance against the shallow-water speed 2√(gH){}",
             experiment.as_ref().map_or(String::new(), |e| format!(", the front against `{e}`"))
+        ),
+        Verification::Runout { trigger_stage, .. } => format!(
+            "run-out of a slope failing from stage `{trigger_stage}` on ([002] §4.4): the slope standing before it, \
+             the mass, the front's advance (no reference solution)"
         ),
         Verification::StiffnessMap { center, radius, .. } => format!(
             "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",
