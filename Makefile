@@ -45,7 +45,7 @@ study-dam: build
 study-footing-3d: build
 	cargo test --release --locked --test studies footing_square_3d_finest -- --ignored --nocapture
 
-# [002]'s landslide, reconstructed (Part E item 16; four runs on two ranks, about 90 minutes): the
+# [002]'s landslide, reconstructed (Part E item 16; four runs on two ranks, about an hour): the
 # run-outs of F̄ and standard MPM with uGIMP and B-splines against item 16's assertions.
 study-landslide: build
 	cargo test --release --locked --test studies landslide_item_16 -- --ignored --nocapture

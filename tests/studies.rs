@@ -766,7 +766,7 @@ fn implicit_against_explicit_footing() {
 /// ran out farther than the slope is high; docs/cases_3d_plan.md had proposed 2H before any run,
 /// and the plane section's F̄ run-outs came out at 9.0 and 8.7 m). The
 /// paper's run-outs (29.96, 29.29, 0.0055 and 19.07 m) belong to its lost geometry and are
-/// printed beside ours, not asserted. On two ranks; about an hour and a half.
+/// printed beside ours, not asserted. On two ranks; about an hour (F̄-uGIMP: 834 s).
 #[test]
 #[ignore]
 fn landslide_item_16() {
