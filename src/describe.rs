@@ -198,10 +198,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes{ignored}", b.name, fix.join(", "));
     }
     for st in &case.stages {
-        let a = model.active(st);
-        let loads = a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>();
-        let boundaries = a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>();
-        let _ = writeln!(s, "{}", stage_line(case, st, &loads, &boundaries));
+        let _ = writeln!(s, "{}", stage_line(case, &model, st));
     }
     let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
     let _ = writeln!(
@@ -328,17 +325,17 @@ fn describe_solid(case: &Case, label: &str) -> String {
         let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
     }
     for st in &case.stages {
-        let a = model.active(st);
-        let loads = a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect::<Vec<_>>();
-        let boundaries = a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect::<Vec<_>>();
-        let _ = writeln!(s, "{}", stage_line(case, st, &loads, &boundaries));
+        let _ = writeln!(s, "{}", stage_line(case, &model, st));
     }
     s
 }
 
 /// The line of a stage: its analysis, duration and step (an explicit stage's stable step where
-/// that is the smaller), its strength reduction, its loads and boundaries.
-fn stage_line(case: &Case, st: &crate::case::Stage, loads: &[&str], boundaries: &[&str]) -> String {
+/// that is the smaller), its strength reduction, its active loads and boundaries.
+fn stage_line<const D: usize>(case: &Case, model: &Model<D>, st: &crate::case::Stage) -> String {
+    let a = model.active(st);
+    let loads: Vec<&str> = a.loads.iter().map(|&i| model.loads[i].name.as_str()).collect();
+    let boundaries: Vec<&str> = a.boundaries.iter().map(|&i| model.boundaries[i].name.as_str()).collect();
     let analysis = crate::analysis::StageAnalysis::of(case, st);
     let dt = analysis.dt_limit.map_or(st.dt(), |l| l.min(st.dt()));
     let reduction = st.strength_reduction.map_or(String::new(), |f| format!("; peak strengths divided by {f}"));

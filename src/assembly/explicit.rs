@@ -129,17 +129,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         }
         // The velocities of the step's start the FLIP update subtracts: the lumped ones, zero
         // where a boundary holds the component still.
-        self.step.start_velocity = (0..ng)
-            .map(|q| {
-                let (l, c) = (q / nd, q % nd);
-                let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
-                if still || mass[q] <= 0.0 {
-                    0.0
-                } else {
-                    momentum[q] / mass[q]
-                }
-            })
-            .collect();
+        self.step.start_velocity = (0..ng).map(|q| super::start_value(model, dofs, q, mass, momentum)).collect();
         self.step.solution = solution;
         self.step.explicit_inertia = inertia;
         self.step.xpic_correction =

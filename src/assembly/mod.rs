@@ -1008,16 +1008,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         dofs: &DofMap,
         nodal: &Nodal,
     ) -> (Vec<[[f64; D]; 4]>, Vec<[f64; D]>) {
-        let nd = self.layout.nd;
-        let value = |l: usize, c: usize, of: &[f64]| -> f64 {
-            let q = l * nd + c;
-            let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
-            if still || nodal.mass[q] <= 0.0 {
-                0.0
-            } else {
-                of[q] / nodal.mass[q]
-            }
-        };
+        let value = |l: usize, c: usize, of: &[f64]| start_value(model, dofs, l * dofs.nd + c, &nodal.mass, of);
         // (dof, slot of its velocity in the output, component): the solid's, then the water's.
         let mut comps: Vec<(usize, usize, usize)> = (0..D).map(|c| (c, 0, c)).collect();
         if let Some(w) = self.layout.w {
@@ -1834,6 +1825,20 @@ impl GridSystem {
                 nodes.iter().zip(basis).map(|(&n, nb)| nb.s * total[n as usize]).sum::<f64>() - ps.p[k]
             })
             .collect())
+    }
+}
+
+/// A nodal value of a step's start at ghosted dof `q`, the lumped sum `of` over the lumped
+/// `mass` (a velocity or an acceleration): zero where a boundary holds the component still (fixed
+/// without a prescribed motion) or where no point gives the node mass. The Newmark predictors and
+/// an explicit step's FLIP update take their nodal values alike (each from its own lumping).
+fn start_value<const D: usize>(model: &Model<D>, dofs: &DofMap, q: usize, mass: &[f64], of: &[f64]) -> f64 {
+    let (l, c) = (q / dofs.nd, q % dofs.nd);
+    let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
+    if still || mass[q] <= 0.0 {
+        0.0
+    } else {
+        of[q] / mass[q]
     }
 }
 
