@@ -295,29 +295,6 @@ struct Simulation<'a, const D: usize = 2, const M: usize = { MAX_NODES }, const 
     balance: (f64, Option<f64>),
 }
 
-/// Whether `porompm test-jacobian` can check `case`: a three-dimensional case's tangent is checked
-/// term by term (`kernels::tests`), not yet through the assembled system (issue «Three
-/// dimensions», docs/dimensions.md).
-pub fn jacobian_checkable(case: &crate::case::Case) -> Result<(), String> {
-    if case.dimension() == 3 {
-        return Err("the case is three-dimensional: test-jacobian checks two-dimensional cases only (the \
-                    three-dimensional tangents are checked term by term, docs/dimensions.md)"
-            .into());
-    }
-    Ok(())
-}
-
-/// Whether a run of `case` can write checkpoints and restart from them: not yet in three
-/// dimensions (the checkpoint's records are two-dimensional; issue «Three dimensions»).
-pub fn restartable(case: &crate::case::Case) -> Result<(), String> {
-    if case.dimension() == 3 {
-        return Err("the case is three-dimensional: its runs cannot write checkpoints or restart yet (issue \
-                    «Three dimensions», docs/dimensions.md)"
-            .into());
-    }
-    Ok(())
-}
-
 /// Runs a case and returns its summary (also written to `summary.json`).
 pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
     let start = Instant::now();
@@ -450,10 +427,21 @@ pub fn test_jacobian(
             stiffness.name()
         )));
     }
-    jacobian_checkable(req.case).map_err(RunError::Input)?;
+    match req.case.dimension() {
+        3 => test_jacobian_in::<3, { MAX_NODES_3D }, { MAX_DOF_3D }>(req, steps, flip),
+        _ => test_jacobian_in::<2, { MAX_NODES }, { MAX_DOF }>(req, steps, flip),
+    }
+}
+
+/// [`test_jacobian`] in dimension D.
+fn test_jacobian_in<const D: usize, const M: usize, const N: usize>(
+    req: &RunRequest,
+    steps: usize,
+    flip: Option<(usize, usize)>,
+) -> Result<(Vec<assembly::BlockCheck>, usize), RunError> {
     let mut summary = Summary::new(req);
     let mut out = RunOutput::silent();
-    let mut sim = Simulation::<2>::set_up(req, &mut out, &mut summary)?;
+    let mut sim = Simulation::<D, M, N>::set_up(req, &mut out, &mut summary)?;
     let stage = &req.case.stages[0];
     let active = sim.model.active(stage);
     sim.begin_stage(stage)?;
@@ -480,9 +468,6 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         let case = req.case;
         let coll = req.coll;
         let input = |e: String| RunError::Input(e);
-        if req.restart.is_some() || req.checkpoint_every > 0 {
-            restartable(case).map_err(input)?;
-        }
         let first = req.restart.as_ref().map_or(0, |(_, cp)| cp.stage as usize).min(case.stages.len() - 1);
         let layout = StageAnalysis::of(case, &case.stages[first]).layout.in_dim(D);
         let system =
@@ -498,7 +483,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         let mut columns: Vec<String> =
             ["time", "step", "dt", "newton_iterations", "linear_iterations"].map(String::from).to_vec();
         for p in &probes {
-            columns.extend(probe_fields(model.two_phase).iter().map(|f| format!("{}.{f}", p.name)));
+            columns.extend(probe_fields(model.two_phase, D).iter().map(|f| format!("{}.{f}", p.name)));
         }
         let dynamic = case.stages.iter().any(|s| s.analysis == crate::case::AnalysisType::Dynamic);
         let monitor = Monitor::new(model.two_phase, dynamic);
@@ -1035,8 +1020,10 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         self.warn(warnings);
         let _stage = self.system.phase(Phase::Output).map_err(|e| RunError::Failed(e.to_string()))?;
         for pr in &self.probes {
-            if pr.last.len() >= 4 {
-                self.summary.results.insert(format!("{}.displacement", pr.name), pr.last[2].hypot(pr.last[3]));
+            if pr.last.len() >= 2 * D {
+                // |u| from the displacement's D components (after the position's D).
+                let u = pr.last[D..2 * D].iter().fold(0.0f64, |m, c| m.hypot(*c));
+                self.summary.results.insert(format!("{}.displacement", pr.name), u);
             }
             if self.model.two_phase {
                 self.summary.results.insert(format!("{}.excess_p_peak", pr.name), pr.excess_extreme);
@@ -1184,12 +1171,13 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
 
     fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
         let t0 = Instant::now();
-        let Some(plane) = self.model.as_plane() else {
-            return Err(RunError::Failed(restartable(self.case).err().unwrap_or_default()));
-        };
-        let ps = &plane.particles;
-        let local: Vec<f64> = (0..ps.len()).flat_map(|k| state::pack(ps, k)).collect();
-        let slab = self.coll.sorted_slab(&local, state::RECORD);
+        let ps = &self.model.particles;
+        let len = state::record_len(D);
+        let mut local = vec![0.0; ps.len() * len];
+        for (k, r) in local.chunks_exact_mut(len).enumerate() {
+            state::write_record(ps, k, r);
+        }
+        let slab = self.coll.sorted_slab(&local, len);
         let check_state = match self.check.as_ref() {
             Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
             None => None,
@@ -1214,7 +1202,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             probe_extremes: self.probes.iter().map(|p| p.excess_extreme).collect(),
             load_totals: self.model.loads.iter().map(|l| l.increments.as_ref().map_or(0.0, |s| s.total)).collect(),
             check_state,
-            particles: state::records_of(&slab.values),
+            dim: D,
+            particles: slab.values,
             first: slab.offset as u64,
             total: slab.total as u64,
         };
@@ -1262,7 +1251,6 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
     /// its particles, time, counters, probe extremes, check state and step control.
     fn restore(&mut self, label: &str, cp: &Checkpoint) -> Result<(), RunError> {
         let refuse = |why: String| RunError::Input(format!("cannot restart from checkpoint {label}: {why}"));
-        restartable(self.case).map_err(refuse)?;
         state::check_case(cp, self.case).map_err(refuse)?;
         // The checkpoint's records and the case's points as generated, each redistributed to the
         // same slabs of ids, must match; then every point goes to the rank owning its cell.
@@ -1277,10 +1265,9 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             (0..ps.len()).flat_map(|k| [ps.id[k] as f64, ps.body[k] as f64, ps.material[k] as f64]).collect();
         let generated = self.coll.sorted_slab(&generated, 3).values;
         let generated: Vec<[f64; 3]> = generated.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let flat: Vec<f64> = cp.particles.iter().flatten().copied().collect();
-        let records = state::records_of(&self.coll.sorted_slab(&flat, state::RECORD).values);
-        self.coll.agree(state::check_points(&records, &generated)).map_err(refuse)?;
-        self.model.particles = state::particles_from_flat(records.as_flattened());
+        let records = self.coll.sorted_slab(&cp.particles, state::record_len(D)).values;
+        self.coll.agree(state::check_points(&records, D, &generated)).map_err(refuse)?;
+        self.model.particles = state::particles_from_flat(&records);
         crate::distribution::migrate(&mut self.model, self.case, self.system.owners(), self.coll);
         self.model.resolve_targets(self.case);
         self.t = cp.time;
@@ -1434,23 +1421,32 @@ const PROBE_FIGURES: &[(&str, &str, f64, &str)] = &[
     ("ux", "horizontal displacement [mm]", 1e3, "horizontal_displacement"),
 ];
 
-fn probe_fields(two_phase: bool) -> &'static [&'static str] {
-    if two_phase {
-        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "eps_pd", "p", "p_excess"]
+/// The history columns of a probe in dimension `dim`: its position, displacement and velocity
+/// (D components each), its stresses (the plane's xx, yy, xy; in three dimensions also zz, yz,
+/// zx, in `Particles::stress` order), its plastic strain, and in two-phase runs its pore pressure
+/// and excess pore pressure (last).
+fn probe_fields(two_phase: bool, dim: usize) -> Vec<&'static str> {
+    let mut fields = if dim == 3 {
+        vec!["x", "y", "z", "ux", "uy", "uz", "vx", "vy", "vz", "sxx", "syy", "sxy", "szz", "syz", "szx", "eps_pd"]
     } else {
-        &["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "eps_pd"]
+        vec!["x", "y", "ux", "uy", "vx", "vy", "sxx", "syy", "sxy", "eps_pd"]
+    };
+    if two_phase {
+        fields.extend(["p", "p_excess"]);
     }
+    fields
 }
 
-/// The probes of the case: each the point nearest its `point` at t = 0 (in the plane: a
-/// three-dimensional case has no probes yet).
+/// The probes of the case: each the point nearest its `point` at t = 0 (the lowest identifier
+/// among equally near ones), in any dimension.
 fn find_probes<const D: usize>(case: &Case, model: &Model<D>, coll: &Collective) -> Result<Vec<Probe>, String> {
     let ps = &model.particles;
     let mut out = Vec::new();
     for p in &case.probes {
         let local: Vec<f64> = (0..ps.len())
             .flat_map(|k| {
-                [((ps.x0[k][0] - p.point[0]).powi(2) + (ps.x0[k][1] - p.point[1]).powi(2)).sqrt(), ps.id[k] as f64]
+                let distance = (0..D).map(|d| (ps.x0[k][d] - p.point[d]).powi(2)).sum::<f64>().sqrt();
+                [distance, ps.id[k] as f64]
             })
             .collect();
         let all = coll.gather(&local)?;
@@ -1470,7 +1466,7 @@ fn update_probes<const D: usize>(
     coll: &Collective,
 ) -> Result<Vec<f64>, String> {
     let all = probe_values(model, probes, coll)?;
-    let nf = probe_fields(model.two_phase).len();
+    let nf = probe_fields(model.two_phase, D).len();
     for (i, pr) in probes.iter_mut().enumerate() {
         pr.last = all[i * nf..(i + 1) * nf].to_vec();
         if model.two_phase {
@@ -1485,26 +1481,19 @@ fn update_probes<const D: usize>(
 
 fn probe_values<const D: usize>(model: &Model<D>, probes: &[Probe], coll: &Collective) -> Result<Vec<f64>, String> {
     let ps = &model.particles;
-    let nf = probe_fields(model.two_phase).len();
+    let nf = probe_fields(model.two_phase, D).len();
+    // The plane's xx, yy, xy; in three dimensions all six ([xx, yy, xy, zz, yz, zx]).
+    let stresses = if D == 3 { 6 } else { 3 };
     let mut local = vec![0.0; probes.len() * nf];
     for (i, pr) in probes.iter().enumerate() {
         if let Some(k) = (0..ps.len()).find(|&k| ps.id[k] == pr.id) {
-            let s = ps.stress[k];
-            let v = [
-                ps.x[k][0],
-                ps.x[k][1],
-                ps.disp[k][0],
-                ps.disp[k][1],
-                ps.vel[k][0],
-                ps.vel[k][1],
-                s[0],
-                s[1],
-                s[2],
-                ps.eps_pd[k],
-                ps.p[k],
-                ps.p[k] - ps.p0[k],
-            ];
-            local[i * nf..(i + 1) * nf].copy_from_slice(&v[..nf]);
+            let mut v = Vec::with_capacity(nf);
+            v.extend(ps.x[k].iter().chain(&ps.disp[k]).chain(&ps.vel[k]).chain(&ps.stress[k][..stresses]));
+            v.push(ps.eps_pd[k]);
+            if model.two_phase {
+                v.extend([ps.p[k], ps.p[k] - ps.p0[k]]);
+            }
+            local[i * nf..(i + 1) * nf].copy_from_slice(&v);
         }
     }
     coll.sum(&local)

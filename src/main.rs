@@ -171,18 +171,6 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
     case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
 
-/// [`load_case`] for a command that runs the case, with the check `can` of what the command
-/// needs that a three-dimensional case cannot do yet (refused before anything is written).
-fn load_runnable_case(
-    path: &Path,
-    sets: &[String],
-    can: impl Fn(&case::Case) -> Result<(), String>,
-) -> Result<case::Case, Failure> {
-    let c = load_case(path, sets)?;
-    can(&c).map_err(|e| input(format!("{}: {e}", path.display())))?;
-    Ok(c)
-}
-
 /// Checkpointing, restart and distribution settings of `porompm run`.
 struct Continuation<'a> {
     checkpoint_every: usize,
@@ -210,8 +198,7 @@ fn run(
     cont: Continuation,
     petsc_args: &[String],
 ) -> Result<(), Failure> {
-    let continues = cont.checkpoint_every > 0 || cont.restart.is_some();
-    let c = load_runnable_case(case_path, sets, |c| if continues { porompm::driver::restartable(c) } else { Ok(()) })?;
+    let c = load_case(case_path, sets)?;
     // Options files: the case's own (relative to the case file), then the command line's.
     let mut files: Vec<PathBuf> = Vec::new();
     if let Some(f) = &c.solver.options_file {
@@ -321,9 +308,9 @@ fn test_jacobian(
     sets: &[String],
     petsc_args: &[String],
 ) -> Result<(), Failure> {
-    let c = load_runnable_case(case_path, sets, porompm::driver::jacobian_checkable)?;
-    // The fields of the first stage, whose tangent is checked.
-    let names = porompm::analysis::StageAnalysis::of(&c, &c.stages[0]).layout.field_names();
+    let c = load_case(case_path, sets)?;
+    // The fields of the first stage, whose tangent is checked, in the case's dimension.
+    let names = porompm::analysis::StageAnalysis::of(&c, &c.stages[0]).layout.in_dim(c.dimension()).field_names();
     let flip = match flip {
         None => None,
         Some(f) => {

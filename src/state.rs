@@ -19,33 +19,37 @@ use crate::model::particles::Particles;
 /// Version of the checkpoint layout; a file of another version is refused.
 pub const FORMAT_VERSION: u64 = 8;
 
-/// The particle arrays of a checkpoint: (name, components), in the order of [`pack`].
-pub const PARTICLE_FIELDS: [(&str, usize); 22] = [
-    ("id", 1),
-    ("body", 1),
-    ("material", 1),
-    ("x", 2),
-    ("x0", 2),
-    ("disp", 2),
-    ("lp", 2),
-    ("lp0", 2),
-    ("def_grad", 4),
-    ("volume", 1),
-    ("porosity", 1),
-    ("mass", 1),
-    ("vel", 2),
-    ("acc", 2),
-    ("vel_w", 2),
-    ("acc_w", 2),
-    ("stress", 6),
-    ("p", 1),
-    ("p0", 1),
-    ("eps_pd", 1),
-    ("grad_p", 2),
-    ("jbar", 1),
-];
+/// The particle arrays of a checkpoint of points in `dim` dimensions: (name, components), in the
+/// order of [`write_record`]: `dim` components per vector, dim² for F (row by row), six stresses.
+pub fn particle_fields(dim: usize) -> [(&'static str, usize); 22] {
+    let (v, f) = (dim, dim * dim);
+    [
+        ("id", 1),
+        ("body", 1),
+        ("material", 1),
+        ("x", v),
+        ("x0", v),
+        ("disp", v),
+        ("lp", v),
+        ("lp0", v),
+        ("def_grad", f),
+        ("volume", 1),
+        ("porosity", 1),
+        ("mass", 1),
+        ("vel", v),
+        ("acc", v),
+        ("vel_w", v),
+        ("acc_w", v),
+        ("stress", 6),
+        ("p", 1),
+        ("p0", 1),
+        ("eps_pd", 1),
+        ("grad_p", v),
+        ("jbar", 1),
+    ]
+}
 
-/// Values per particle record (the sum of [`PARTICLE_FIELDS`]' components).
+/// Values per particle record in two dimensions (the sum of [`particle_fields`]`(2)`'s components).
 pub const RECORD: usize = 40;
 
 /// `summary.json`'s `restarted_from`: the checkpoint a run continued from.
@@ -88,9 +92,12 @@ pub struct Checkpoint {
     pub load_totals: Vec<f64>,
     /// The verification check's own state (`None`: the check keeps none).
     pub check_state: Option<Vec<f64>>,
-    /// This rank's slab of the particle records ([`pack`]) of all ranks sorted by id: records
-    /// `first .. first + particles.len()` of `total` (every rank writes and reads its own slab).
-    pub particles: Vec<[f64; RECORD]>,
+    /// The dimension of the run's points (2 or 3): a record holds [`record_len`]`(dim)` values.
+    pub dim: usize,
+    /// This rank's slab of the particle records ([`write_record`]) of all ranks sorted by id, laid
+    /// end to end: records `first .. first + n` of `total` (every rank writes and reads its own
+    /// slab; [`Checkpoint::records`]).
+    pub particles: Vec<f64>,
     /// The position of this rank's first record in the id-sorted list.
     pub first: u64,
     /// The number of records of all ranks.
@@ -142,6 +149,9 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
         || cp.load_totals.len() != case.loads.len()
     {
         return Err("its stage, probes or loads do not match the case".into());
+    }
+    if cp.dim != case.dimension() {
+        return Err(format!("its points are {}-dimensional, this case's {}-dimensional", cp.dim, case.dimension()));
     }
     Ok(())
 }
@@ -225,11 +235,6 @@ fn unpack<const D: usize>(ps: &mut Particles<D>, k: usize, r: &[f64]) {
     ps.jbar[k] = one(rest);
 }
 
-/// The points of `records`, in their order (every array from its record).
-pub fn particles_from_records(records: &[[f64; RECORD]]) -> Particles {
-    particles_from_flat(records.as_flattened())
-}
-
 /// The points of dimension D of the records laid end to end in `flat` ([`record_len`] values
 /// each), in their order.
 pub fn particles_from_flat<const D: usize>(flat: &[f64]) -> Particles<D> {
@@ -242,15 +247,11 @@ pub fn particles_from_flat<const D: usize>(flat: &[f64]) -> Particles<D> {
     ps
 }
 
-/// Records laid end to end, as arrays.
-pub fn records_of(flat: &[f64]) -> Vec<[f64; RECORD]> {
-    flat.chunks_exact(RECORD).map(|c| c.try_into().expect("RECORD values")).collect()
-}
-
-/// Whether the records of a checkpoint (a slab of the id-sorted list) are the case's points
-/// `generated` (`[id, body, material]`, the same slab of the case's points as generated): the same
-/// ids, each of the same body and material.
-pub fn check_points(records: &[[f64; RECORD]], generated: &[[f64; 3]]) -> Result<(), String> {
+/// Whether the records of a checkpoint (a slab of the id-sorted list, [`record_len`]`(dim)` values
+/// each, laid end to end) are the case's points `generated` (`[id, body, material]`, the same slab
+/// of the case's points as generated): the same ids, each of the same body and material.
+pub fn check_points(records: &[f64], dim: usize, generated: &[[f64; 3]]) -> Result<(), String> {
+    let records: Vec<&[f64]> = records.chunks_exact(record_len(dim)).collect();
     for (r, g) in records.iter().zip(generated) {
         if r[0] != g[0] {
             let id = r[0].min(g[0]) as u64;
@@ -267,11 +268,16 @@ pub fn check_points(records: &[[f64; RECORD]], generated: &[[f64; 3]]) -> Result
 }
 
 impl Checkpoint {
+    /// This rank's records, [`record_len`]`(dim)` values each.
+    pub fn records(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.particles.chunks_exact(record_len(self.dim))
+    }
+
     /// This rank's share of the particles' checksum: the wrapping sum over its records of a hash of
     /// each record's position in the id-sorted list and its values. The shares of all ranks add up
     /// (wrapping) to the same sum whatever the number of ranks; a swapped or changed record changes it.
     pub fn records_hash(&self) -> u64 {
-        self.particles.iter().enumerate().fold(0u64, |sum, (k, r)| {
+        self.records().enumerate().fold(0u64, |sum, (k, r)| {
             let mut h = Fnv::new();
             h.u64(self.first + k as u64);
             for &v in r {
@@ -336,7 +342,8 @@ mod tests {
 
     #[test]
     fn records_round_trip_every_particle_array() {
-        assert_eq!(PARTICLE_FIELDS.iter().map(|f| f.1).sum::<usize>(), RECORD);
+        assert_eq!(particle_fields(2).iter().map(|f| f.1).sum::<usize>(), RECORD);
+        assert_eq!(particle_fields(3).iter().map(|f| f.1).sum::<usize>(), record_len(3));
         let (_, mut ps) = particles();
         // Give every array a distinct value so that a swapped slot would show.
         let k = 3;
@@ -367,19 +374,57 @@ mod tests {
         let mut records: Vec<[f64; RECORD]> = (0..ps.len()).rev().map(|k| pack(&ps, k)).collect();
         records.sort_by(|a, b| a[0].total_cmp(&b[0]));
         let flat: Vec<f64> = records.iter().flatten().copied().collect();
-        assert_eq!(records_of(&flat), records);
-        let back = particles_from_records(&records);
+        let back = particles_from_flat::<2>(&flat);
         assert_eq!(format!("{back:?}"), format!("{ps:?}"));
         // The case's points, as generated, against the checkpoint's.
         let (_, fresh) = particles();
         let generated: Vec<[f64; 3]> =
             (0..fresh.len()).map(|k| [fresh.id[k] as f64, fresh.body[k] as f64, fresh.material[k] as f64]).collect();
-        check_points(&records, &generated).unwrap();
-        assert!(check_points(&records, &generated[1..]).unwrap_err().contains("material point 0 is in only one"));
-        assert!(check_points(&records[..39], &generated).unwrap_err().contains("not those of this case"));
+        check_points(&flat, 2, &generated).unwrap();
+        assert!(check_points(&flat, 2, &generated[1..]).unwrap_err().contains("material point 0 is in only one"));
+        assert!(check_points(&flat[..39 * RECORD], 2, &generated).unwrap_err().contains("not those of this case"));
         let mut other = generated.clone();
         other[3][1] = 1.0;
-        assert!(check_points(&records, &other).unwrap_err().contains("another body"));
+        assert!(check_points(&flat, 2, &other).unwrap_err().contains("another body"));
+    }
+
+    /// Three-dimensional records ([`record_len`]`(3)` = 55 values) hold every array with its z
+    /// components and the 3 × 3 F.
+    #[test]
+    fn three_dimensional_records_round_trip_every_particle_array() {
+        let c = case::parse(&crate::case::tests_support::with_grid("[0.2, 1.0, 0.3]", "[2, 10, 3]"), "t", &[]).unwrap();
+        let mut ps = Particles::<3>::generate(&c, &crate::model::grid_of(&c), |_| true);
+        let mut v = 0.5;
+        let mut next = || {
+            v += 1.25;
+            v
+        };
+        for k in [0, 7] {
+            for a in [&mut ps.x, &mut ps.x0, &mut ps.disp, &mut ps.lp, &mut ps.lp0, &mut ps.vel, &mut ps.acc] {
+                a[k] = std::array::from_fn(|_| next());
+            }
+            for a in [&mut ps.vel_w, &mut ps.acc_w, &mut ps.grad_p] {
+                a[k] = std::array::from_fn(|_| next());
+            }
+            ps.def_grad[k] = std::array::from_fn(|_| std::array::from_fn(|_| next()));
+            ps.stress[k] = std::array::from_fn(|_| next());
+            for a in [&mut ps.volume, &mut ps.porosity, &mut ps.mass, &mut ps.p, &mut ps.p0, &mut ps.eps_pd] {
+                a[k] = next();
+            }
+            ps.jbar[k] = next();
+        }
+        let len = record_len(3);
+        let mut flat = vec![0.0; ps.len() * len];
+        for (k, r) in flat.chunks_exact_mut(len).enumerate() {
+            write_record(&ps, k, r);
+        }
+        assert_eq!(flat[len + 3..len + 6], ps.x[1]);
+        let back = particles_from_flat::<3>(&flat);
+        assert_eq!(format!("{back:?}"), format!("{ps:?}"));
+        let generated: Vec<[f64; 3]> =
+            (0..ps.len()).map(|k| [ps.id[k] as f64, ps.body[k] as f64, ps.material[k] as f64]).collect();
+        check_points(&flat, 3, &generated).unwrap();
+        assert!(check_points(&flat, 2, &generated).is_err(), "read as plane records");
     }
 
     #[test]
@@ -397,24 +442,26 @@ mod tests {
             probe_extremes: vec![1.0],
             load_totals: vec![0.5],
             check_state: Some(vec![2.0]),
-            particles: (0..ps.len()).map(|k| pack(&ps, k)).collect(),
+            dim: 2,
+            particles: (0..ps.len()).flat_map(|k| pack(&ps, k)).collect(),
             first: 0,
             total: ps.len() as u64,
         };
         let sum = |c: &Checkpoint| c.checksum(c.records_hash());
         let mut other = cp.clone();
-        other.particles[5][32] += 1e-12;
+        other.particles[5 * RECORD + 32] += 1e-12;
         assert_ne!(sum(&cp), sum(&other));
         let mut other = cp.clone();
-        other.particles.swap(3, 4);
+        let (third, fourth) = other.particles.split_at_mut(4 * RECORD);
+        third[3 * RECORD..].swap_with_slice(&mut fourth[..RECORD]);
         assert_ne!(sum(&cp), sum(&other), "records in another order");
         let mut other = cp.clone();
         other.check_state = None;
         assert_ne!(sum(&cp), sum(&other));
         // Split into two slabs (two ranks), the shares add up to the whole's.
         let (mut a, mut b) = (cp.clone(), cp.clone());
-        a.particles.truncate(15);
-        b.particles.drain(..15);
+        a.particles.truncate(15 * RECORD);
+        b.particles.drain(..15 * RECORD);
         b.first = 15;
         assert_eq!(a.records_hash().wrapping_add(b.records_hash()), cp.records_hash());
         // The output table does not change the fingerprint; the physics does.

@@ -7,6 +7,9 @@
 //!   system with Darcy flow, Mohr–Coulomb, B̄) compressed by a strip at its top steps exactly as
 //!   the plane model of its section, point for point (positions, stresses, pore pressures,
 //!   plastic strain), and its out-of-plane stresses are zero shears and the plane σ_zz.
+//! * `a_two_phase_explicit_slab_steps_as_its_plane_twin`: the slab (standing, and lying in the
+//!   (x, z) plane) in a two-phase explicit stage, with the points' own pore pressure and with the
+//!   nodal one drained at the top, steps as its plane section point for point.
 //! * `a_block_squeezed_from_three_sides_is_homogeneous`: an elastic block on three rollers
 //!   pressed by a displaced face moves homogeneously, its stresses those of Hooke's law for the
 //!   imposed strain, to round-off, in every point; and the reactions balance.
@@ -673,6 +676,86 @@ fn a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage(coll: &Collective) ->
     Ok(())
 }
 
+/// A case of the plane section or of a slab as a two-phase explicit stage (`dynamic_explicit`,
+/// the u–U system, without B̄): ten steps of 2e-5 s (a third of the fast P wave's cell crossing
+/// time, about 6e-5 s) while the strip pushes. With `nodal`, the pore pressure from the lumped
+/// continuity equation at the nodes (`explicit.pore_pressure = "nodal"`, drained at the top);
+/// otherwise each point's own increment, which fixes no pressure (no drained top).
+fn two_phase_explicit(text: &str, nodal: bool) -> String {
+    let explicit = if nodal { "\nexplicit = { pore_pressure = \"nodal\" }" } else { "" };
+    let mut t = text.replace("bbar = true", "bbar = false").replace(
+        "analysis = \"quasi_static\"\nduration = 0.03\ndt = 0.01",
+        &format!("analysis = \"dynamic_explicit\"\nduration = 0.0002\ndt = 0.00002{explicit}"),
+    );
+    if !nodal {
+        let drained = t.find("name = \"drained\"").expect("the drained top");
+        let start = t[..drained].rfind("[[boundaries]]").expect("its table");
+        let end = drained + t[drained..].find("[[").expect("a table after it");
+        t.replace_range(start..end, "");
+    }
+    t
+}
+
+/// The slab in a two-phase explicit stage (the u–U system of `assembly::explicit` in three
+/// dimensions: both phases' lumped masses and momenta, the drag per node and direction, the pore
+/// pressure of each point or of the nodes' lumped continuity equation with the drained nodes of
+/// the top) steps as its plane section, point for point: stresses, pore pressures, positions and
+/// both phases' velocities; so does the slab lying in the (x, z) plane.
+fn a_two_phase_explicit_slab_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    for nodal in [false, true] {
+        for (solid, vertical) in [(slab(), 1), (lying_slab(), 2)] {
+            let (plane, plane_model, _) = run_plane(&case_of(&two_phase_explicit(PLANE, nodal))?, coll)?;
+            let (run, model, _) = run_solid(&case_of(&two_phase_explicit(&solid, nodal))?, coll)?;
+            let twin = twins(&plane_model, &model, vertical)?;
+            let (scale_s, scale_p) = scales(&plane);
+            let (ax, ay, across) = (0, vertical, 3 - vertical);
+            let speed = |v: &[[f64; 2]]| v.iter().fold(0.0f64, |m, v| m.max(v[0].abs().max(v[1].abs())));
+            let (ps, pp) = (&model.particles, &plane_model.particles);
+            let speeds = [speed(&pp.vel), speed(&pp.vel_w)];
+            let mut worst = [0.0f64; 4];
+            for step in 0..plane.x.len() {
+                for (k, &q) in twin.iter().enumerate() {
+                    let difference = stress_difference(&run.stress[step][k], &plane.stress[step][q], vertical);
+                    worst[0] = worst[0].max(difference / scale_s);
+                    worst[1] = worst[1].max((run.p[step][k] - plane.p[step][q]).abs() / scale_p);
+                    let (xs, xp) = (run.x[step][k], plane.x[step][q]);
+                    let off = (xs[across] - ps.x0[k][across]).abs();
+                    worst[2] = worst[2].max((xs[ax] - xp[0]).abs().max((xs[ay] - xp[1]).abs()).max(off) / 0.1);
+                }
+            }
+            for (k, &q) in twin.iter().enumerate() {
+                for (v, w, s) in [(ps.vel[k], pp.vel[q], speeds[0]), (ps.vel_w[k], pp.vel_w[q], speeds[1])] {
+                    let d = (v[ax] - w[0]).abs().max((v[ay] - w[1]).abs()).max(v[across].abs());
+                    worst[3] = worst[3].max(d / s);
+                }
+            }
+            println!(
+                "    two-phase explicit slab (thin along {}, {} pore pressure) against plane: {} steps; largest \
+                 differences: stress {:.1e} (of {scale_s:.3e} Pa), pore pressure {:.1e} (of {scale_p:.3e} Pa), \
+                 position {:.1e} (of a cell), velocities {:.1e} (of {:.3e} and {:.3e} m/s)",
+                ["x", "y", "z"][across],
+                if nodal { "nodal" } else { "pointwise" },
+                plane.x.len(),
+                worst[0],
+                worst[1],
+                worst[2],
+                worst[3],
+                speeds[0],
+                speeds[1]
+            );
+            if worst.iter().any(|&w| w > 1e-12 || w.is_nan())
+                || scale_s <= 0.0
+                || scale_p <= 0.0
+                || speeds.iter().any(|&s| s <= 0.0)
+                || plane.x.len() != 10
+            {
+                return Err(format!("the two-phase explicit slab departs from its plane twin: {worst:?}"));
+            }
+        }
+    }
+    Ok(())
+}
+
 type TestFn = fn(&Collective) -> Result<(), String>;
 
 fn main() {
@@ -706,6 +789,7 @@ fn main() {
             "an_explicit_slab_with_fbar_conserves_the_projected_volume",
             an_explicit_slab_with_fbar_conserves_the_projected_volume,
         ),
+        ("a_two_phase_explicit_slab_steps_as_its_plane_twin", a_two_phase_explicit_slab_steps_as_its_plane_twin),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let (mut ran, mut failed) = (0, 0);

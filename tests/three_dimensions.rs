@@ -54,6 +54,57 @@ fn a_cube_in_uniaxial_stress_runs_on_one_and_two_ranks() {
     }
 }
 
+/// The square footing at its coarsest mesh (k = 2, h = B/5) with [002]'s implicit F̄ instead of B̄,
+/// on two ranks: N_c = 5.808, within 2 % of 5.91 already at this mesh (B̄ 5.146, 13 % low; without
+/// either the soil locks, 8.30; F̄ measured 5.805 and 5.800 at k = 3 and 4), with the equilibrium
+/// identity to 1e-5 of the loads.
+#[test]
+fn the_square_footing_with_fbar_is_within_five_percent_at_the_coarsest_mesh() {
+    let dir = std::env::temp_dir().join("porompm-footing3d-fbar");
+    let sets = set_args(&["parameters.k=2", "stabilisation={fbar=true}"]);
+    let r = run_case_on(2, "tests/cases/footing_square_3d.toml", &dir, &sets);
+    assert!(r.completed(), "{}", r.stderr());
+    let ratio = &r.summary["verification"]["bearing_capacity_ratio"];
+    let nc = ratio["value"].as_f64().unwrap() * 5.91;
+    eprintln!("square footing with F̄, k = 2, two ranks: N_c = {nc:.4}");
+    assert!((nc - 5.808).abs() < 0.01 && ratio["pass"] == true, "{ratio}");
+    assert!(r.summary["equilibrium_error"].as_f64().unwrap() < 1e-5, "{}", r.summary["equilibrium_error"]);
+}
+
+/// [002]'s implicit F̄ in three dimensions (the projected volume ratio as a nodal unknown,
+/// `kernels::fbar`, scaling the increment by (J̄/J)^{1/3}) passes the patch test on two ranks: the
+/// cube in uniaxial stress at finite strain deforms homogeneously, so J̄ = J at every point, and
+/// its reactions with F̄ are those without it to the Newton tolerance, at ν = 0.3 and at ν = 0.499,
+/// with the equilibrium identity on the moved configuration.
+#[test]
+fn the_implicit_fbar_passes_the_patch_test_in_three_dimensions() {
+    for nu in ["0.3", "0.499"] {
+        let reactions = |fbar: bool| {
+            let dir = std::env::temp_dir().join(format!("porompm-cube3d-fbar-{nu}-{fbar}"));
+            let mut args = set_args(&[
+                "analysis.kinematics=finite_strain",
+                &format!("materials.solid.model.poisson_ratio={nu}"),
+                &format!("stabilisation.fbar={fbar}"),
+                "stabilisation.bbar=false",
+            ]);
+            args.extend(["--", "-snes_rtol", "1e-12"].map(String::from));
+            let r = run_case_on(2, "tests/cases/cube_3d.toml", &dir, &args);
+            assert!(r.completed(), "ν = {nu}, F̄ {fbar}: {}", r.stderr());
+            let error = *r.column("equilibrium_error").last().expect("a row");
+            assert!(error < 1e-10, "ν = {nu}, F̄ {fbar}: the equilibrium identity {error}");
+            ["press.reaction_x", "x_roller.reaction_x", "y_roller.reaction_y", "z_roller.reaction_z"]
+                .map(|c| *r.column(c).last().expect("a row"))
+        };
+        let (with, without) = (reactions(true), reactions(false));
+        eprintln!("cube at ν = {nu}: reactions with F̄ {with:?}, without {without:?}");
+        let scale = without[0].abs();
+        assert!(scale > 0.0);
+        for (a, b) in with.iter().zip(&without) {
+            assert!((a - b).abs() <= 1e-9 * scale, "ν = {nu}: {a} with F̄, {b} without");
+        }
+    }
+}
+
 /// The square footing at its coarsest mesh (k = 2, h = B/5; `tests/cases/footing_square_3d.toml`)
 /// on one and two ranks: the bearing check's pressure is the footing's reaction over its quarter
 /// area (q_over_c_max = max −R_y/((B/2)² c) from history.csv, to its ten digits), its N_c is where the
@@ -83,24 +134,128 @@ fn the_square_footing_runs_alike_on_one_and_two_ranks() {
     }
 }
 
+/// The consolidating prism of `cases/terzaghi_3d.toml` by explicit steps (the u–U system with the
+/// nodal pore pressure, the stage of `cases/terzaghi_explicit.toml`) on two ranks: its sides hold
+/// plane strain, so its Terzaghi metrics are the plane explicit column's (one rank) to round-off
+/// (e_p's over √2: [003] Eq. 33 divides by the number of points, and the prism has two layers),
+/// over the same 24 411 steps, and so are its probes' histories (their z motion and shear
+/// stresses zero); its pore pressure at T_v = 0.5 is within 1e-2 of the series.
+#[test]
+fn the_prism_consolidates_by_explicit_steps_as_the_plane_column() {
+    let plane =
+        run_case("cases/terzaghi_explicit.toml", &std::env::temp_dir().join("porompm-terzaghi-explicit-2d"), &[]);
+    assert!(plane.completed(), "{}", plane.stderr());
+    let sets = [
+        "stages.0.analysis=dynamic_explicit",
+        "stages.0.explicit={cfl=0.5, pore_pressure=\"nodal\"}",
+        "output.history_every=100",
+    ];
+    let dir = std::env::temp_dir().join("porompm-terzaghi-explicit-3d");
+    let solid = run_case_on(2, "cases/terzaghi_3d.toml", &dir, &set_args(&sets));
+    assert!(solid.completed(), "{}", solid.stderr());
+    assert_eq!(solid.summary["steps"], plane.summary["steps"]);
+    let names: Vec<String> =
+        plane.summary["verification"].as_object().expect("the plane metrics").keys().cloned().collect();
+    assert!(names.iter().any(|n| n == "e_p_Tv0.5"), "{names:?}");
+    // [003] Eq. 33 divides the root of the sum of squares by the number of points, and the prism
+    // has two layers of the plane's points: its e_p is the plane's over √2.
+    let points = |r: &common::Run| r.summary["particles"].as_f64().expect("a count");
+    let layers = points(&solid) / points(&plane);
+    assert_eq!(layers, 2.0);
+    for name in &names {
+        let (a, b) = (metric(&plane.summary, name), metric(&solid.summary, name));
+        let b = if name.starts_with("e_p_") { b * layers.sqrt() } else { b };
+        eprintln!("{name}: plane {a:.6e}, prism {b:.6e}");
+        // The settlement's relative error is a difference of nearly equal settlements, which the
+        // two ranks' sums in another order leave equal to 1e-9 of themselves.
+        let tol = if name.starts_with("settlement") { 1e-9 } else { 1e-9 * a.abs() };
+        assert!((a - b).abs() <= tol, "{name}: plane {a}, prism {b}");
+    }
+    assert!(metric(&solid.summary, "e_p_Tv0.5") < 1e-2);
+    // The probes follow the same points: the plane's columns row for row, the z ones at rest.
+    for probe in ["base", "middle"] {
+        for column in ["p_excess", "uy", "vy", "syy", "y"] {
+            let (a, b) = (plane.column(&format!("{probe}.{column}")), solid.column(&format!("{probe}.{column}")));
+            assert_eq!(a.len(), b.len(), "{probe}.{column}");
+            let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(scale > 0.0, "{probe}.{column} moves");
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() <= 1e-9 * scale, "{probe}.{column}: plane {x}, prism {y}");
+            }
+        }
+        for column in ["uz", "vz", "syz", "szx"] {
+            let worst = solid.column(&format!("{probe}.{column}")).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(worst < 1e-12, "{probe}.{column}: {worst}");
+        }
+    }
+}
+
+/// A three-dimensional run restarts from its checkpoint as a plane one does: the consolidating
+/// prism on two ranks writes a checkpoint at step 350 of 600 (its points' records with three
+/// components per vector); restarted from it on one rank, it ends with the uninterrupted run's
+/// Terzaghi metrics (T_v = 0.1 passed before the checkpoint, restored with the check's state;
+/// T_v = 0.5 after it), Newton iterations and probes' final values, to 1e-10. The plane column's
+/// checkpoint is refused by the prism.
+#[test]
+fn a_three_dimensional_run_restarts_from_its_checkpoint() {
+    let full = std::env::temp_dir().join("porompm-terzaghi3d-restart-full");
+    let a = run_case_on(2, "cases/terzaghi_3d.toml", &full, &["--checkpoint-every".into(), "350".into()]);
+    assert!(a.completed(), "{}", a.stderr());
+    let cp = full.join("checkpoint.h5");
+    let x = hdf5_metno::File::open(&cp).expect("the checkpoint").dataset("particles/x").expect("x").shape();
+    assert_eq!(x, [80, 3]);
+    let again = std::env::temp_dir().join("porompm-terzaghi3d-restart-again");
+    let b = run_case("cases/terzaghi_3d.toml", &again, &["--restart".into(), cp.display().to_string()]);
+    assert!(b.completed(), "{}", b.stderr());
+    assert_eq!(b.summary["restarted_from"]["step"], 350);
+    assert_eq!(a.summary["steps"], b.summary["steps"]);
+    assert_eq!(a.summary["snes_iterations"], b.summary["snes_iterations"]);
+    for m in ["e_p_Tv0.1", "e_p_Tv0.5", "p_rms_error_Tv0.5"] {
+        let (x, y) = (metric(&a.summary, m), metric(&b.summary, m));
+        assert!((x - y).abs() <= 1e-10 * x.abs(), "{m}: {x} uninterrupted, {y} restarted");
+    }
+    // The settlement's relative error, a difference of nearly equal settlements: to 1e-10 of the
+    // settlement (the two ranks' sums and the one rank's run in another order).
+    let (x, y) = (metric(&a.summary, "settlement_rel_error_Tv0.5"), metric(&b.summary, "settlement_rel_error_Tv0.5"));
+    assert!((x - y).abs() <= 1e-10, "the settlement's error: {x} uninterrupted, {y} restarted");
+    for r in ["middle.excess_p_final", "base.displacement"] {
+        let (x, y) = (a.summary["results"][r].as_f64().unwrap(), b.summary["results"][r].as_f64().unwrap());
+        assert!((x - y).abs() <= 1e-10 * x.abs(), "{r}: {x} uninterrupted, {y} restarted");
+    }
+    let plane = std::env::temp_dir().join("porompm-terzaghi2d-for-3d-restart");
+    let p = run_case("cases/terzaghi.toml", &plane, &["--checkpoint-every".into(), "350".into()]);
+    assert!(p.completed(), "{}", p.stderr());
+    let wrong = run_case(
+        "cases/terzaghi_3d.toml",
+        &std::env::temp_dir().join("porompm-terzaghi3d-wrong-restart"),
+        &["--restart".into(), plane.join("checkpoint.h5").display().to_string()],
+    );
+    assert_eq!(wrong.output.status.code(), Some(2), "{}", wrong.stderr());
+    assert!(wrong.stderr().contains("written by a different case"), "{}", wrong.stderr());
+}
+
 /// What a three-dimensional run cannot do yet is refused before anything runs, naming it.
 #[test]
 fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
     let dir = std::env::temp_dir().join("porompm-cube3d-refused");
-    let r = run_case("tests/cases/cube_3d.toml", &dir, &["--checkpoint-every".into(), "1".into()]);
-    assert_eq!(r.output.status.code(), Some(2), "{}", r.stderr());
-    assert!(r.stderr().contains("cannot write checkpoints or restart yet"), "{}", r.stderr());
+    // A probe takes one coordinate per dimension, inside the grid.
     common::assert_refused(
         "cases/terzaghi_3d.toml",
         &dir,
-        &["stages.0.analysis=dynamic_explicit"],
-        "a two_phase `dynamic_explicit` stage is not available in a three-dimensional case yet",
+        &["probes=[{name=\"top\", point=[0.05, 0.95]}]"],
+        "key `probes[0].point`: 3 components in a case of 3 dimensions, got 2",
     );
     common::assert_refused(
-        "tests/cases/cube_3d.toml",
+        "cases/terzaghi_3d.toml",
         &dir,
-        &["stabilisation.fbar=true", "analysis.kinematics=finite_strain"],
-        "the implicit F̄ of stage `press` is not available in a three-dimensional case yet",
+        &["probes=[{name=\"top\", point=[0.05, 0.95, 0.2]}]"],
+        "key `probes[0].point`: [0.05, 0.95, 0.2] is outside the grid",
+    );
+    common::assert_refused(
+        "cases/terzaghi_3d.toml",
+        &dir,
+        &["stabilisation.patch_recovery=true"],
+        "key `stabilisation.patch_recovery`: not available in a three-dimensional case yet",
     );
     // The footing's bearing check: a 3D loaded area needs its extent along z; a plane one has none.
     common::assert_refused(
@@ -129,13 +284,82 @@ fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
         &["verification.settlement_point=[0,1]"],
         "key `verification.settlement_point`: 3 components",
     );
+}
+
+/// `porompm test-jacobian` with `args`: its status and standard output.
+fn test_jacobian(args: &[&str]) -> (Option<i32>, String) {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .args(["test-jacobian", "tests/cases/cube_3d.toml"])
+        .arg("test-jacobian")
+        .args(args)
         .current_dir(common::root())
         .output()
         .expect("porompm runs");
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("test-jacobian checks two-dimensional cases only"));
+    let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    (o.status.code(), text)
+}
+
+/// The number of block rows of a test-jacobian table.
+fn blocks(text: &str) -> usize {
+    text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count()
+}
+
+/// The assembled three-dimensional tangents against central differences of the assembled residual,
+/// block by block (`porompm test-jacobian`, one rank): a consolidating block's u–p–U system after
+/// three steps (7 × 7 blocks, every one of them exercised), the square footing's plastic Tresca soil
+/// (h = B/3) with B̄ after six steps (3 × 3 blocks, points yielded) and with the implicit F̄ after
+/// nine (4 × 4 blocks with the projected volume ratio); each within 1e-6. A flipped sign in one
+/// block of each (p–ux, uy–ux, Jbar–uz) is caught.
+#[test]
+fn the_three_dimensional_tangents_match_finite_differences_block_by_block() {
+    // A block of consolidating soil in a corner of a larger grid (walls at x_min and z_min only),
+    // loaded on a quarter of its top: it deforms in three dimensions.
+    let prism = [
+        "cases/terzaghi_3d.toml",
+        "--steps",
+        "3",
+        "--set",
+        "probes=[]",
+        "--set",
+        "grid.size=[0.3,0.5,0.3]",
+        "--set",
+        "grid.cells=[3,5,3]",
+        "--set",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.2,0.4]}}",
+        "--set",
+        "bodies[0].z=[0.0,0.2]",
+        "--set",
+        "loads[0].region={min=[0.0,0.2],max=[0.1,0.4],z=[0.0,0.1]}",
+        "--set",
+        "stages.0.boundaries=[\"base\",\"left\",\"back\",\"drained_top\"]",
+    ];
+    assert_tangent_checked(&prism, 49, "p,ux");
+
+    let coarse = ["tests/cases/footing_square_3d.toml", "--set", "parameters.k=1"];
+    let text = assert_tangent_checked(&[&coarse[..], &["--steps", "6"]].concat(), 9, "uy,ux");
+    let yielded: usize = text
+        .lines()
+        .find_map(|l| l.strip_prefix("material points that have yielded: "))
+        .and_then(|n| n.trim().parse().ok())
+        .expect("the count of yielded points");
+    assert!(yielded > 0, "the plastic tangent takes part: {text}");
+
+    // After nine steps (269 points yielded): after three the u–Jbar columns differ from the central
+    // differences by 1.2e-6 of their scale, after six by 1.3e-6, where the differences' own noise
+    // is (the elastic soil's u–Jbar columns: 4e-7; the plane F̄'s: 2.5e-7).
+    let fbar = [&coarse[..], &["--steps", "9", "--set", "stabilisation={fbar=true}"]].concat();
+    assert_tangent_checked(&fbar, 16, "Jbar,uz");
+}
+
+/// Checks that `porompm test-jacobian ARGS` passes with `n_blocks` blocks within 1e-6 and fails with
+/// the block `flip` (ROW,COL) negated; returns the passing run's output.
+fn assert_tangent_checked(args: &[&str], n_blocks: usize, flip: &str) -> String {
+    let (code, text) = test_jacobian(args);
+    assert_eq!(code, Some(0), "{text}");
+    assert_eq!(blocks(&text), n_blocks, "{text}");
+    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+    let (code, flipped) = test_jacobian(&[args, &["--flip-block", flip]].concat());
+    assert_eq!(code, Some(1), "the flipped {flip} block: {flipped}");
+    text
 }
 
 /// [002]'s landslide (cases/landslide_3d.toml) on a prism one 0.5 m cell wide: the first 0.1 s of

@@ -21,7 +21,7 @@ use petsc::VecOps;
 /// Agreement of one field-pair block of the assembled tangent with finite differences.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct BlockCheck {
-    /// Row field (`ux`, `uy`, `p`, `Ux`, `Uy`).
+    /// Row field (`ux`, `uy`, [`uz`,] `p`, `Ux`, `Uy`[, `Uz`], `Jbar`: `Layout::field_names`).
     pub row: &'static str,
     /// Column field.
     pub col: &'static str,
@@ -33,15 +33,15 @@ pub struct BlockCheck {
     pub relative_error: f64,
 }
 
-impl GridSystem {
+impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// Compares the assembled tangent of the prepared step with central finite differences of the
     /// assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
     /// converged increment of this step). `flip` negates one (row field, column field) block of
     /// the assembled tangent first, to show that the check sees it. One rank only (it builds the
-    /// dense FD Jacobian: small cases only).
+    /// dense FD Jacobian: small cases only); any dimension.
     pub fn jacobian_check(
         &mut self,
-        model: &Model,
+        model: &Model<D>,
         fraction: f64,
         flip: Option<(usize, usize)>,
     ) -> Result<Vec<BlockCheck>, super::Error> {
@@ -50,7 +50,7 @@ impl GridSystem {
         }
         let nd = self.layout.nd;
         let p = self.layout.p;
-        let h_cell = model.grid.h[0].min(model.grid.h[1]);
+        let h_cell = model.grid.h.iter().fold(f64::INFINITY, |m, &h| m.min(h));
         let names = self.layout.field_names();
         // A realistic iterate: part of this step's converged increment.
         self.solve(model)?;

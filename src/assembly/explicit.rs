@@ -75,8 +75,7 @@ use crate::model::{fbar, Model};
 
 impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// The explicit step's nodal update (see the module documentation), in any dimension; always
-    /// "converged". The pore pressure of the u–U system is plane only for now (validation keeps it
-    /// out of three-dimensional cases).
+    /// "converged".
     pub(super) fn explicit_update(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
         let t0 = std::time::Instant::now();
         let Integration::Explicit { damping, xpic, .. } = model.integration else {
@@ -138,10 +137,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             self.step.fbar_scale = self.fbar_scales(model)?;
         }
         if !self.step.drained.is_empty() {
-            let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) else {
-                return Err(Error::new("the explicit pore pressure is not available in three dimensions yet"));
-            };
-            system.step.pressure_increment = system.nodal_pressure_increments(plane)?;
+            self.step.pressure_increment = self.nodal_pressure_increments(model)?;
         }
         let seconds = t0.elapsed().as_secs_f64();
         Ok(StepSolve {
@@ -160,6 +156,29 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             solver_used: false,
             line_search_retry: false,
         })
+    }
+
+    /// The nodal pore pressure's increment at each point of a two-phase step (see the module
+    /// documentation): the points' own increments Δp_p of the step's solution, their lumped
+    /// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
+    /// drained nodes), and Σ_i S_ip Δp_i at each point.
+    fn nodal_pressure_increments(&mut self, model: &Model<D>) -> Result<Vec<f64>, Error> {
+        let st = &self.step.stencils;
+        let mut storage = Vec::with_capacity(st.len());
+        let own: Vec<f64> = (0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                let states = callbacks::node_states::<D, M, N>(&self.step, k, &self.step.solution);
+                let input = callbacks::particle_input(model, &self.step, k);
+                storage.push(input.volume * input.inv_q);
+                let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout);
+                kernels::flow::continuity::pointwise_increment(&it, &input)
+            })
+            .collect();
+        let drained = std::mem::take(&mut self.step.drained);
+        let out = self.project_weighted(&storage, &own, &drained);
+        self.step.drained = drained;
+        out
     }
 
     /// XPIC(m)'s nodal field w − v^n (see the module documentation) from the step's lumped mass and
@@ -251,35 +270,6 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let weighted: Vec<f64> =
             (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
         Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
-    }
-}
-
-impl GridSystem {
-    /// The nodal pore pressure's increment at each point of a two-phase step (see the module
-    /// documentation): the points' own increments Δp_p of the step's solution, their lumped
-    /// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
-    /// drained nodes), and Σ_i S_ip Δp_i at each point.
-    fn nodal_pressure_increments(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
-        let st = &self.step.stencils;
-        let mut storage = Vec::with_capacity(st.len());
-        let own: Vec<f64> = (0..st.len())
-            .map(|k| {
-                let (nodes, basis) = st.get(k);
-                let states = callbacks::node_states::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>(
-                    &self.step,
-                    k,
-                    &self.step.solution,
-                );
-                let input = callbacks::particle_input(model, &self.step, k);
-                storage.push(input.volume * input.inv_q);
-                let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout);
-                kernels::flow::continuity::pointwise_increment(&it, &input)
-            })
-            .collect();
-        let drained = std::mem::take(&mut self.step.drained);
-        let out = self.project_weighted(&storage, &own, &drained);
-        self.step.drained = drained;
-        out
     }
 }
 

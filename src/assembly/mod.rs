@@ -654,6 +654,11 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         if let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) {
             system.plane_step(plane, active, weak, coll)?;
         }
+        if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
+            if self.layout.w.is_some() {
+                self.step.drained = self.drained_nodes(model, active).map_err(|e| e.to_string())?;
+            }
+        }
         if model.integration.is_explicit() {
             // An explicit step solves nothing: no matrix.
             self.step.pattern = old_pattern;
@@ -670,6 +675,30 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// [`Self::as_plane_mut`], shared.
     fn as_plane_ref(&self) -> Option<&GridSystem> {
         crate::model::plane(self)
+    }
+
+    /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
+    /// (see [`explicit`]), in any dimension: a side or region boundary of the stage fixes `p`
+    /// there, a moving surface that fixes `p` reaches it (plane only; marks summed over the
+    /// ranks), or the material barely fills it (the drained value of implicit stages' barely
+    /// filled nodes).
+    fn drained_nodes(&mut self, model: &Model<D>, active: &Active) -> Result<Vec<bool>, Error> {
+        let nd = self.layout.nd;
+        let p = crate::model::dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");
+        let mut marks = vec![0.0; self.ghost.len() * nd];
+        if let (Some(plane), Some(system)) = (model.as_plane(), self.as_plane_ref()) {
+            for l in system.surface_drained_nodes(plane, active) {
+                marks[l * nd] = 1.0;
+            }
+        }
+        self.sum_over_ranks(&mut marks)?;
+        Ok((0..self.ghost.len())
+            .map(|l| {
+                marks[l * nd] > 0.0
+                    || !self.step.dofs.well[l]
+                    || model.fixing_boundaries(active, self.ghost.indices(l))[p].is_some()
+            })
+            .collect())
     }
 
     /// Step 4: the diagonal of the fixed-stress Schur preconditioner Sp = A_pp + diag(d) of the
@@ -1617,42 +1646,26 @@ impl GridSystem {
     }
 
     /// The plane-only parts of a step's data (step 4): Nitsche's drained faces of the moving
-    /// surfaces (`weak`), [001]'s mapped stiffnesses, and the drained nodes of an explicit
-    /// two-phase step with the nodal pore pressure.
+    /// surfaces (`weak`) and [001]'s mapped stiffnesses.
     fn plane_step(&mut self, model: &Model, active: &Active, weak: bool, coll: &Collective) -> Result<(), String> {
         if weak {
             (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
         }
         self.step.stiffness =
             coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
-        if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
-            if self.layout.w.is_some() {
-                self.step.drained = self.drained_nodes(model, active).map_err(|e| e.to_string())?;
-            }
-        }
         Ok(())
     }
 
-    /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
-    /// (see [`explicit`]): a side or region boundary of the stage fixes `p` there, a moving
-    /// surface that fixes `p` reaches it (`Model::surface_fixes`, marks summed over the ranks), or
-    /// the material barely fills it (the drained value of implicit stages' barely filled nodes).
-    fn drained_nodes(&mut self, model: &Model, active: &Active) -> Result<Vec<bool>, Error> {
-        let nd = self.layout.nd;
+    /// The ghosted nodes a moving surface that fixes `p` reaches (`Model::surface_fixes`), for the
+    /// drained nodes of an explicit two-phase step ([`GridSystem::drained_nodes`]).
+    fn surface_drained_nodes(&self, model: &Model, active: &Active) -> Vec<usize> {
         let p = kernels::dof::P;
-        let mut marks = vec![0.0; self.ghost.len() * nd];
-        for ((i, j), _, comps) in model.surface_fixes(active, false) {
-            if let (true, Some(l)) = (comps[p], self.ghost.node(i as usize, j as usize)) {
-                marks[l * nd] = 1.0;
-            }
-        }
-        self.sum_over_ranks(&mut marks)?;
-        Ok((0..self.ghost.len())
-            .map(|l| {
-                let (i, j) = self.ghost.ij(l);
-                marks[l * nd] > 0.0 || !self.step.dofs.well[l] || model.fixing_boundaries(active, [i, j])[p].is_some()
-            })
-            .collect())
+        model
+            .surface_fixes(active, false)
+            .into_iter()
+            .filter(|(_, _, comps)| comps[p])
+            .filter_map(|((i, j), _, _)| self.ghost.node(i as usize, j as usize))
+            .collect()
     }
 
     /// Step 4: the drained faces of this rank's particles with their geometry and the grid's

@@ -1202,8 +1202,8 @@ impl Default for Output {
 pub struct Probe {
     /// Column prefix in history.csv.
     pub name: String,
-    /// Position at t = 0 [m].
-    pub point: [f64; 2],
+    /// Position at t = 0 [m]: one component per dimension of the case (x, y[, z]).
+    pub point: Vec<f64>,
 }
 
 /// The analytical reference of a case.

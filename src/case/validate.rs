@@ -250,9 +250,6 @@ fn three_dimensional(c: &Case) -> R {
             _ => {}
         }
     }
-    if !c.probes.is_empty() {
-        return not_yet("probes");
-    }
     match &c.verification {
         None
         | Some(Verification::Terzaghi { .. } | Verification::BearingCapacity { .. } | Verification::Runout { .. }) => {}
@@ -260,16 +257,6 @@ fn three_dimensional(c: &Case) -> R {
     }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
-    }
-    if let Some(i) = c.stages.iter().position(|s| s.analysis == crate::case::AnalysisType::DynamicExplicit) {
-        // The explicit update runs in any dimension for one phase; the u–U system's pore pressure
-        // is plane only for now.
-        if c.analysis.formulation != Formulation::OnePhase {
-            return Err(format!(
-                "key `stages[{i}].analysis`: a two_phase `dynamic_explicit` stage is not available in a \
-                 three-dimensional case yet (one_phase is; issue «Three dimensions», docs/dimensions.md)"
-            ));
-        }
     }
     let st = &c.stabilisation;
     if st.pressure_projection.is_some() {
@@ -280,18 +267,6 @@ fn three_dimensional(c: &Case) -> R {
     }
     if st.pressure_update == crate::case::PressureUpdate::ProjectedTotal {
         return not_yet("stabilisation.pressure_update");
-    }
-    if st.fbar {
-        // [002]'s projection of explicit steps runs in any dimension; the implicit F̄ (its
-        // projected volume ratio as a nodal unknown) is plane only for now.
-        if let Some(s) = c.stages.iter().find(|s| s.analysis != crate::case::AnalysisType::DynamicExplicit) {
-            return Err(format!(
-                "key `stabilisation.fbar`: the implicit F̄ of stage `{}` is not available in a three-dimensional \
-                 case yet (the F̄ projection of dynamic_explicit stages is; issue «Three dimensions», \
-                 docs/dimensions.md)",
-                s.name
-            ));
-        }
     }
     if st.stiffness != crate::case::Stiffness::Particle {
         return not_yet("stabilisation.stiffness");
@@ -942,8 +917,13 @@ pub fn validate(c: &Case) -> R {
     // Probes.
     unique("probes", c.probes.iter().map(|p| p.name.as_str()))?;
     for (i, p) in c.probes.iter().enumerate() {
-        finite2(&format!("probes[{i}].point"), p.point)?;
-        if !inside_grid(p.point) {
+        components(&format!("probes[{i}].point"), &p.point, dim)?;
+        let inside = (0..dim).all(|d| {
+            let (o, tol) =
+                (c.grid.origin.get(d).copied().unwrap_or(0.0), 1e-9 * c.grid.size[d] / c.grid.cells[d] as f64);
+            p.point[d] >= o - tol && p.point[d] <= o + c.grid.size[d] + tol
+        });
+        if !inside {
             return Err(format!("key `probes[{i}].point`: {:?} is outside the grid", p.point));
         }
     }

@@ -5,7 +5,8 @@
 //! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
 //! iterations, matrix-structure reuses, line-search retries), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
 //! `load_totals`, `check_state`, and one dataset per
-//! particle array under `/particles` (n × components, SI units, sorted by id).
+//! particle array under `/particles` (n × components, SI units, sorted by id; the points' dimension
+//! is the number of components of `x`, 2 or 3, and sets every vector's and F's, `state::particle_fields`).
 //!
 //! All ranks write and read the file together (HDF5's MPI-I/O driver): each writes the slab of the
 //! id-sorted particle records it holds and reads back an equal share of the rows; no rank holds the
@@ -18,7 +19,7 @@
 //! checkpoint in place and at most a stray `.tmp`. On reading, a file without `complete`, of
 //! another format version, or whose content does not match its checksum is refused.
 
-use crate::state::{Checkpoint, PARTICLE_FIELDS, RECORD};
+use crate::state::{particle_fields, record_len, Checkpoint};
 use hdf5_metno as h5;
 use hdf5_metno::types::VarLenUnicode;
 use mpi::collective::SystemOperation;
@@ -106,12 +107,12 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         dataset_f64(&f, "check_state", &[state.len()], &state)?;
         {
             let g = f.create_group("particles")?;
-            let (n, rows, first) = (cp.total as usize, cp.particles.len(), cp.first as usize);
+            let (n, rows, first) = (cp.total as usize, cp.records().len(), cp.first as usize);
             let mut offset = 0;
-            for (name, comps) in PARTICLE_FIELDS {
+            for (name, comps) in particle_fields(cp.dim) {
                 let ds = g.new_dataset::<f64>().shape([n, comps]).create(name)?;
                 if rows > 0 {
-                    let data: Vec<f64> = cp.particles.iter().flat_map(|r| r[offset..offset + comps].to_vec()).collect();
+                    let data: Vec<f64> = cp.records().flat_map(|r| r[offset..offset + comps].to_vec()).collect();
                     super::fields::write_block(&ds, &data, &[first], &[rows, comps])?;
                 }
                 offset += comps;
@@ -192,9 +193,14 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
     let has_state = u("has_check_state").map_err(corrupt)? == 1;
     let state = vec_f64("check_state").map_err(corrupt)?;
     let g = f.group("particles").map_err(corrupt)?;
+    // The points' dimension: the components of their positions.
+    let dim = g.dataset("x").map_err(corrupt)?.shape().get(1).copied().unwrap_or(0);
+    if !(2..=3).contains(&dim) {
+        return Err(format!("checkpoint {name}: particle array `x` has {dim} components (2 or 3 expected)"));
+    }
     let mut datasets = Vec::new();
     let mut n = None;
-    for (field, comps) in PARTICLE_FIELDS {
+    for (field, comps) in particle_fields(dim) {
         let d = g.dataset(field).map_err(corrupt)?;
         let shape = d.shape();
         if shape.len() != 2 || shape[1] != comps || n.is_some_and(|n| n != shape[0]) {
@@ -214,17 +220,15 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
         };
         columns.push(column);
     }
-    let particles = (0..b - a)
-        .map(|k| {
-            let mut r = [0.0; RECORD];
-            let mut o = 0;
-            for (c, (_, comps)) in columns.iter().zip(PARTICLE_FIELDS) {
-                r[o..o + comps].copy_from_slice(&c[k * comps..(k + 1) * comps]);
-                o += comps;
-            }
-            r
-        })
-        .collect();
+    let len = record_len(dim);
+    let mut particles = vec![0.0; (b - a) * len];
+    for (k, r) in particles.chunks_exact_mut(len).enumerate() {
+        let mut o = 0;
+        for (c, (_, comps)) in columns.iter().zip(particle_fields(dim)) {
+            r[o..o + comps].copy_from_slice(&c[k * comps..(k + 1) * comps]);
+            o += comps;
+        }
+    }
     let cp = Checkpoint {
         case_fingerprint: u("case_fingerprint").map_err(corrupt)?,
         time: x("time").map_err(corrupt)?,
@@ -237,6 +241,7 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
         probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
         load_totals: vec_f64("load_totals").map_err(corrupt)?,
         check_state: has_state.then_some(state),
+        dim,
         particles,
         first: a as u64,
         total: n as u64,
@@ -249,13 +254,11 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
 mod tests {
     use super::*;
 
-    fn sample() -> Checkpoint {
-        let mut r = [0.0; RECORD];
-        for (i, v) in r.iter_mut().enumerate() {
-            *v = i as f64 * 0.5 + 1.0 / 3.0;
-        }
-        let mut r2 = r;
-        r2[0] = 99.0;
+    /// A checkpoint of two points of dimension `dim`.
+    fn sample(dim: usize) -> Checkpoint {
+        let len = record_len(dim);
+        let mut particles: Vec<f64> = (0..2 * len).map(|i| (i % len) as f64 * 0.5 + 1.0 / 3.0).collect();
+        particles[len] = 99.0;
         Checkpoint {
             case_fingerprint: 0xdead_beef_0123,
             time: 0.3 + 1e-17,
@@ -268,7 +271,8 @@ mod tests {
             probe_extremes: vec![-12.5, 3.0],
             load_totals: vec![0.25, 1.0 / 3.0],
             check_state: Some(vec![1.0, 2.0]),
-            particles: vec![r, r2],
+            dim,
+            particles,
             first: 0,
             total: 2,
         }
@@ -280,12 +284,19 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("porompm-cp-test-{}", std::process::id()));
         fs::create_dir_all(&dir).unwrap();
         let path = dir.join("checkpoint.h5");
-        let cp = sample();
+        // Three-dimensional points: 55 values each, the vectors with three components.
+        let cp = sample(3);
+        write(&path, &cp, &world, true).unwrap();
+        let back = read(&path, &world).unwrap();
+        assert_eq!((back.dim, &back.particles), (3, &cp.particles));
+        let x = h5::File::open(&path).unwrap().dataset("particles/x").unwrap().shape();
+        assert_eq!(x, [2, 3]);
+        let cp = sample(2);
         write(&path, &cp, &world, true).unwrap();
         assert!(!dir.join("checkpoint.h5.tmp").exists());
         let back = read(&path, &world).unwrap();
         assert_eq!(back.checksum(back.records_hash()), cp.checksum(cp.records_hash()));
-        assert_eq!((back.first, back.total), (0, 2));
+        assert_eq!((back.first, back.total, back.dim), (0, 2, 2));
         assert_eq!(back.particles, cp.particles);
         assert_eq!(back.time.to_bits(), cp.time.to_bits());
         assert!(back.diagnostics[0].is_nan() && back.diagnostics[1] == 0.5 && back.check_state == cp.check_state);
