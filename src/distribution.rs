@@ -112,31 +112,42 @@ pub fn imbalance(counts: &[f64]) -> f64 {
     counts.iter().copied().fold(0.0, f64::max) / (total / counts.len() as f64)
 }
 
-/// A distribution of the cells over `ranks` ranks that balances the points: `hist` holds the
-/// number of points per cell (i + j nx, summed over ranks). Every tensor grid of slabs m × n = ranks
-/// is tried, its x cuts balancing the points per cell column and its y cuts the points per cell
-/// row, and the one whose busiest rank holds the fewest points is returned with its imbalance.
-/// Every slab keeps at least `min_width` node columns or rows (the DMDA's stencil width).
-pub fn balanced(hist: &[f64], cells: [usize; 2], ranks: usize, min_width: usize) -> Option<(Owners, f64)> {
-    let (nx, ny) = (cells[0], cells[1]);
-    let mut columns = vec![0.0; nx];
-    let mut rows = vec![0.0; ny];
-    for j in 0..ny {
-        for i in 0..nx {
-            columns[i] += hist[i + j * nx];
-            rows[j] += hist[i + j * nx];
+/// A distribution of the cells over `ranks` ranks that balances the points, in any dimension:
+/// `hist` holds the number of points per cell (x fastest: i + j nx [+ k nx ny], summed over
+/// ranks). Every tensor grid of slabs m × n [× l] = ranks is tried (m, then n, ascending), its cuts
+/// along each direction balancing the points per cell layer across that direction, and the one
+/// whose busiest rank holds the fewest points is returned with its imbalance (the first of equals).
+/// Every slab keeps at least `min_width` node layers (the DMDA's stencil width).
+pub fn balanced<const D: usize>(
+    hist: &[f64],
+    cells: [usize; D],
+    ranks: usize,
+    min_width: usize,
+) -> Option<(Owners<D>, f64)> {
+    // The cell of flat index `c` (x fastest).
+    let cell = |mut c: usize| -> [usize; D] {
+        std::array::from_fn(|d| {
+            let i = c % cells[d];
+            c /= cells[d];
+            i
+        })
+    };
+    let mut layers: [Vec<f64>; D] = std::array::from_fn(|d| vec![0.0; cells[d]]);
+    for (c, &w) in hist.iter().enumerate() {
+        let at = cell(c);
+        for d in 0..D {
+            layers[d][at[d]] += w;
         }
     }
-    let mut best: Option<(Owners, f64)> = None;
-    for m in (1..=ranks).filter(|m| ranks.is_multiple_of(*m)) {
-        let n = ranks / m;
-        let (Some(cx), Some(cy)) = (cuts(&columns, m, min_width), cuts(&rows, n, min_width)) else { continue };
-        let owners = Owners::new(&cx, &cy);
+    let mut best: Option<(Owners<D>, f64)> = None;
+    for split in splits::<D>(ranks) {
+        let Some(counts) = (0..D).map(|d| cuts(&layers[d], split[d], min_width)).collect::<Option<Vec<_>>>() else {
+            continue;
+        };
+        let owners = Owners::from_counts(std::array::from_fn(|d| &counts[d][..]));
         let mut per_rank = vec![0.0; ranks];
-        for j in 0..ny {
-            for i in 0..nx {
-                per_rank[owners.rank_of_cell(i, j)] += hist[i + j * nx];
-            }
+        for (c, &w) in hist.iter().enumerate() {
+            per_rank[owners.rank_of_cell_in(cell(c))] += w;
         }
         let im = imbalance(&per_rank);
         if best.as_ref().is_none_or(|b| im < b.1) {
@@ -146,11 +157,32 @@ pub fn balanced(hist: &[f64], cells: [usize; 2], ranks: usize, min_width: usize)
     best
 }
 
+/// Every way of writing `ranks` as a product of D slab counts, the first count ascending, then the
+/// second.
+fn splits<const D: usize>(ranks: usize) -> Vec<[usize; D]> {
+    let divisors = |n: usize| (1..=n).filter(move |m| n.is_multiple_of(*m));
+    let mut out = Vec::new();
+    for m in divisors(ranks) {
+        if D == 2 {
+            out.push(std::array::from_fn(|d| if d == 0 { m } else { ranks / m }));
+            continue;
+        }
+        for n in divisors(ranks / m) {
+            out.push(std::array::from_fn(|d| [m, n, ranks / (m * n)][d]));
+        }
+    }
+    out
+}
+
 /// Node counts of `k` slabs along one direction (cells `w.len()`, nodes one more) whose shares of
 /// the weights `w` per cell are as equal as the cells allow, each at least `min_width` nodes; None
-/// if the nodes are too few.
+/// if the nodes are too few. One slab takes every node, however few (the DMDA asks for the
+/// stencil width only of a direction it splits: a column one cell wide has two nodes across).
 fn cuts(w: &[f64], k: usize, min_width: usize) -> Option<Vec<usize>> {
     let nodes = w.len() + 1;
+    if k == 1 {
+        return Some(vec![nodes]);
+    }
     if k * min_width > nodes {
         return None;
     }
@@ -266,6 +298,33 @@ mod tests {
         assert!(cx.iter().chain(&cy).all(|&c| c >= 2));
     }
 
+    /// In three dimensions: 8 × 8 × 8 cells with every point in the 4 × 4 × 2 cells of a corner and
+    /// 4 ranks: PETSc's even split would give them all to one rank; the balanced split shares them
+    /// out evenly (2 × 2 × 1 slabs), trying every m × n × l = 4.
+    #[test]
+    fn a_crowded_corner_is_shared_out_in_three_dimensions() {
+        assert_eq!(splits::<3>(4), vec![[1, 1, 4], [1, 2, 2], [1, 4, 1], [2, 1, 2], [2, 2, 1], [4, 1, 1]]);
+        assert_eq!(splits::<2>(6), vec![[1, 6], [2, 3], [3, 2], [6, 1]]);
+        let cells = [8, 8, 8];
+        let flat = |i: usize, j: usize, k: usize| i + 8 * (j + 8 * k);
+        let mut hist = vec![0.0; 512];
+        for k in 0..2 {
+            for j in 0..4 {
+                for i in 0..4 {
+                    hist[flat(i, j, k)] = 3.0;
+                }
+            }
+        }
+        let (o, im) = balanced(&hist, cells, 4, 2).unwrap();
+        assert!(im <= 1.0 + 1e-12, "imbalance {im} with {:?}", o.counts_in());
+        let mut per = [0.0; 4];
+        for (c, &w) in hist.iter().enumerate() {
+            per[o.rank_of_cell_in([c % 8, (c / 8) % 8, c / 64])] += w;
+        }
+        assert_eq!(per, [24.0; 4]);
+        assert!(o.counts_in().iter().all(|c| c.iter().sum::<usize>() == 9 && c.iter().all(|&n| n >= 2)));
+    }
+
     #[test]
     fn slabs_keep_the_stencil_width_and_too_few_nodes_give_none() {
         // All the weight in one cell: the cuts cannot split it, every slab keeps two nodes.
@@ -274,6 +333,7 @@ mod tests {
         assert_eq!(c.iter().sum::<usize>(), 7);
         assert!(c.iter().all(|&n| n >= 2), "{c:?}");
         assert!(cuts(&w, 4, 2).is_none(), "4 slabs of 2 nodes need 8 nodes");
+        assert_eq!(cuts(&[1.0], 1, 3), Some(vec![2]), "one slab of a column one cell wide");
         // Uniform weights over 9 cells: 4 and 5 cells (the last slab also holds the last node).
         let even = cuts(&[1.0; 9], 2, 2).unwrap();
         assert!(even == vec![4, 6] || even == vec![5, 5], "{even:?}");

@@ -533,8 +533,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             monitor,
             balance: (req.balance_threshold, None),
         };
-        let warnings = sim.model.as_plane().map(|m| crate::diagnostics::physics::warnings(case, m));
-        sim.warn(warnings.unwrap_or_default());
+        let warnings = crate::diagnostics::physics::warnings(case, &sim.model);
+        sim.warn(warnings);
         if let Some((label, cp)) = &req.restart {
             sim.restore(label, cp)?;
         } else {
@@ -872,16 +872,13 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         if now <= threshold || last.is_some_and(|l| now < l * crate::distribution::BALANCE_GAIN) {
             return Ok(());
         }
-        // The repartition is plane (a three-dimensional run keeps PETSc's distribution).
-        let Some(plane) = self.model.as_plane() else { return Ok(()) };
         let t0 = Instant::now();
-        let grid = &plane.grid;
-        let [nx, ny] = grid.cells;
-        let mut hist = vec![0.0; nx * ny];
-        for x in &plane.particles.x {
-            // The cell that decides the point's owner (`Owners::rank_of`).
-            let (i, j) = grid.nearest_cell(*x);
-            hist[i + j * nx] += 1.0;
+        let grid = &self.model.grid;
+        let mut hist = vec![0.0; grid.cells.iter().product()];
+        for x in &self.model.particles.x {
+            // The cell that decides the point's owner (`Owners::rank_of`), x fastest.
+            let c = grid.nearest(*x);
+            hist[(0..D).rev().fold(0, |acc, d| acc * grid.cells[d] + c[d])] += 1.0;
         }
         let hist = self.coll.sum(&hist).map_err(RunError::Failed)?;
         let proposal = crate::distribution::balanced(&hist, grid.cells, self.coll.size(), assembly::STENCIL_WIDTH);
@@ -889,7 +886,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             self.balance.1 = Some(now);
             return Ok(());
         };
-        let owners: &crate::distribution::Owners<D> = crate::model::plane(&owners).expect("a plane run");
+        let owners = &owners;
         let reused = self.system.reused_patterns;
         let layout = self.system.layout();
         // The last step's nodal values, for the field output of this step on the new distribution.

@@ -139,7 +139,7 @@ fn the_square_footing_runs_alike_on_one_and_two_ranks() {
 /// plane strain, so its Terzaghi metrics are the plane explicit column's (one rank) to round-off
 /// (e_p's over √2: [003] Eq. 33 divides by the number of points, and the prism has two layers),
 /// over the same 24 411 steps, and so are its probes' histories (their z motion and shear
-/// stresses zero); its pore pressure at T_v = 0.5 is within 1e-2 of the series.
+/// stresses zero) and the checkerboard and oscillation indices of its pore pressure; its pore pressure at T_v = 0.5 is within 1e-2 of the series.
 #[test]
 fn the_prism_consolidates_by_explicit_steps_as_the_plane_column() {
     let plane =
@@ -172,6 +172,15 @@ fn the_prism_consolidates_by_explicit_steps_as_the_plane_column() {
         assert!((a - b).abs() <= tol, "{name}: plane {a}, prism {b}");
     }
     assert!(metric(&solid.summary, "e_p_Tv0.5") < 1e-2);
+    // The checkerboard fit of the pore pressure (3 × 3 × 3 cells; the prism's two layers of points
+    // do not spread across a cell along z, so its fit is the plane's with every point twice).
+    for column in ["checkerboard_index", "pressure_oscillation_index"] {
+        let (a, b) = (plane.column(column), solid.column(column));
+        assert!(a.iter().any(|&v| v > 0.0) && a.len() == b.len(), "{column}: {a:?}");
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-12), "{column}: plane {x}, prism {y}");
+        }
+    }
     // The probes follow the same points: the plane's columns row for row, the z ones at rest.
     for probe in ["base", "middle"] {
         for column in ["p_excess", "uy", "vy", "syy", "y"] {
@@ -232,6 +241,50 @@ fn a_three_dimensional_run_restarts_from_its_checkpoint() {
     );
     assert_eq!(wrong.output.status.code(), Some(2), "{}", wrong.stderr());
     assert!(wrong.stderr().contains("written by a different case"), "{}", wrong.stderr());
+}
+
+/// The cube's case as a bar of 1 × 1 × 6 cells in uniaxial stress along x, on a grid of 1 × 2 × 12
+/// cells (its points in the lower half along z): only z can be split over two ranks (the other
+/// directions have too few nodes for two slabs of the stencil width), and PETSc's even split leaves
+/// one rank without a point (imbalance 2). With the default threshold the run repartitions the
+/// grid after its first step (`distribution::balanced` in three dimensions, from the points per
+/// cell in all three directions: a split that ignored z would give a rank two of the six cell
+/// layers), the imbalance is 1 after it, and the reactions are those of the run that never
+/// repartitions.
+#[test]
+fn a_three_dimensional_grid_is_repartitioned_when_the_points_crowd_onto_one_rank() {
+    let sets = [
+        "grid.size=[0.05,0.1,0.6]",
+        "grid.cells=[1,2,12]",
+        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.05,0.05]}}",
+        "bodies[0].z=[0.0,0.3]",
+        "stages.0.dt=0.25",
+        "output.fields_every=0",
+    ];
+    let run = |label: &str, extra: &[&str]| {
+        let mut args = set_args(&sets);
+        args.extend(extra.iter().map(|a| a.to_string()));
+        let r = run_case_on(2, "tests/cases/cube_3d.toml", &std::env::temp_dir().join(label), &args);
+        assert!(r.completed(), "{label}: {}", r.stderr());
+        r
+    };
+    let fixed = run("porompm-cube3d-balance-never", &["--balance-threshold", "inf"]);
+    let balanced = run("porompm-cube3d-balance-default", &[]);
+    let (never, after) = (fixed.column("load_imbalance"), balanced.column("load_imbalance"));
+    eprintln!("cube on two ranks: imbalance {never:?} without repartitioning, {after:?} with");
+    assert_eq!(fixed.summary["repartitions"], 0);
+    assert!(never.iter().all(|&i| i >= 1.9), "PETSc's split leaves a rank idle: {never:?}");
+    assert!(balanced.summary["repartitions"].as_u64().unwrap() >= 1);
+    assert!(after[1..].iter().all(|&i| i <= 1.2), "after the first step: {after:?}");
+    // Every reaction against the load's scale (the rollers across carry nothing but round-off).
+    let scale = fixed.column("press.reaction_x").iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0);
+    for name in ["press.reaction_x", "x_roller.reaction_x", "y_roller.reaction_y", "z_roller.reaction_z"] {
+        let (a, b) = (fixed.column(name), balanced.column(name));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-9 * scale, "{name}: {x} without, {y} with repartitioning");
+        }
+    }
 }
 
 /// What a three-dimensional run cannot do yet is refused before anything runs, naming it.

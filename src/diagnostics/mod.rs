@@ -141,10 +141,7 @@ impl Monitor {
     /// raises for the first time. The stress scale of the oscillation index is the largest
     /// principal total stress magnitude |σ' − p I| over the particles (the load a footing or a
     /// column carries, the overburden of a slope), so a spurious pressure is measured against what
-    /// the soil carries and not against itself.
-    ///
-    /// The checkerboard fit is plane: in three dimensions its index and the oscillation index are
-    /// NaN (not measured) and the pore-pressure range is.
+    /// the soil carries and not against itself. The checkerboard fit runs in any dimension.
     pub fn row<const D: usize>(
         &mut self,
         model: &Model<D>,
@@ -155,10 +152,7 @@ impl Monitor {
         let mut values = Vec::new();
         let mut warnings = Vec::new();
         if self.two_phase {
-            let fit = match (model.as_plane(), crate::model::plane(owners)) {
-                (Some(plane), Some(owners)) => crate::verification::checkerboard::pressure_fit(plane, owners, coll)?,
-                _ => crate::verification::checkerboard::Fit { index: f64::NAN, max_deviation: f64::NAN },
-            };
+            let fit = crate::verification::checkerboard::pressure_fit(model, owners, coll)?;
             let ps = &model.particles;
             let (mut lo, mut hi, mut scale) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
             for k in 0..ps.len() {

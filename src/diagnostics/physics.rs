@@ -55,12 +55,12 @@ pub const CONSOLIDATION_SHARE: f64 = 0.25;
 pub const COURANT_LIMIT: f64 = 1.0;
 
 /// The warnings of a case (its model built).
-pub fn warnings(case: &Case, model: &Model) -> Vec<Warning> {
+pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
     let mut out = Vec::new();
     let warn = |out: &mut Vec<Warning>, kind: &str, message: String| {
         out.push(Warning { kind: kind.into(), message, time_s: None, value: None, threshold: None })
     };
-    let h = model.grid.h[0].min(model.grid.h[1]);
+    let h = model.grid.h.iter().fold(f64::INFINITY, |m, &h| m.min(h));
     if !model.bbar && !model.fbar {
         for (i, m) in model.materials.iter().enumerate() {
             let nu = m.model.elastic().poisson;
@@ -164,7 +164,7 @@ pub fn warnings(case: &Case, model: &Model) -> Vec<Warning> {
         }
     }
     if model.two_phase {
-        let extent = (0..2).map(|d| model.grid.h[d] * model.grid.cells[d] as f64).fold(0.0, f64::max);
+        let extent = (0..D).map(|d| model.grid.h[d] * model.grid.cells[d] as f64).fold(0.0, f64::max);
         for (s, stage) in case.stages.iter().enumerate().filter(|(_, s)| s.analysis == AnalysisType::Dynamic) {
             // The fastest consolidation of the materials.
             let t_c = model

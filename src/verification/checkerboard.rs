@@ -3,9 +3,10 @@
 //! The equal-order u–p–U discretisation can let the nodal pressures alternate (±A from node to node,
 //! [003] Fig. 12); interpolated to the material points this shows as a pattern that changes sign from
 //! one point to the next within and across cells. To separate it from the smooth field, the pore
-//! pressures of the particles in the 3 × 3 cells around each cell are fitted by least squares with a
-//! quadratic polynomial in the offsets from the cell centre (directions in which the particles do not
-//! spread, e.g. across a column one cell wide, get no terms). For every particle of the centre cell the
+//! pressures of the particles in the 3 × 3 cells (3 × 3 × 3 in three dimensions) around each cell
+//! are fitted by least squares with a quadratic polynomial in the offsets from the cell centre
+//! (directions in which the particles do not spread, e.g. across a column one cell wide, get no
+//! terms). For every particle of the centre cell the
 //! fit gives its smooth part s_k and the residual its alternating part r_k = p_k − s_k. The index is
 //!   I = sqrt( Σ r_k² / Σ s_k² )
 //! over all particles whose neighbourhood has enough points for the fit. A field that is locally
@@ -25,31 +26,49 @@ pub struct Fit {
     pub max_deviation: f64,
 }
 
-/// The checkerboard fit of the current pore pressures (zero when there is no pressure). Each
-/// body is fitted on its own: a jump of the pressure between bodies (a footing on saturated soil)
-/// is not an oscillation. Collective and distributed: a rank fits the cells it owns (`owners`),
-/// for which it receives the points of the neighbouring cells other ranks hold (a halo one cell
-/// wide), and the sums are added over the ranks; no rank gathers the points of all.
-pub fn pressure_fit(model: &Model, owners: &Owners, coll: &Collective) -> Result<Fit, String> {
+/// A point of the fit: x, y, z (0 in the plane), its value and its body.
+type FitPoint = [f64; 5];
+
+/// A cell of the fit: (i, j, k) (k = 0 in the plane) and the body.
+type FitCell = (i64, i64, i64, i64);
+
+/// The checkerboard fit of the current pore pressures (zero when there is no pressure), in any
+/// dimension (in three the neighbourhood is 3 × 3 × 3 cells and the polynomial quadratic in the
+/// three offsets). Each body is fitted on its own: a jump of the pressure between bodies (a footing
+/// on saturated soil) is not an oscillation. Collective and distributed: a rank fits the cells it
+/// owns (`owners`), for which it receives the points of the neighbouring cells other ranks hold (a
+/// halo one cell wide), and the sums are added over the ranks; no rank gathers the points of all.
+pub fn pressure_fit<const D: usize>(model: &Model<D>, owners: &Owners<D>, coll: &Collective) -> Result<Fit, String> {
     let ps = &model.particles;
-    let (origin, h, [nx, ny]) = (model.grid.origin, model.grid.h, model.grid.cells);
-    let owner =
-        |i: i64, j: i64| owners.rank_of_cell(i.clamp(0, nx as i64 - 1) as usize, j.clamp(0, ny as i64 - 1) as usize);
+    let g = &model.grid;
+    // In the plane the third direction is one cell of unit size at z = 0.
+    let (origin, h) = (pad(g.origin), std::array::from_fn(|d| if d < D { g.h[d] } else { 1.0 }));
+    let cells: [i64; 3] = std::array::from_fn(|d| if d < D { g.cells[d] as i64 } else { 1 });
+    let owner = |c: [i64; 3]| owners.rank_of_cell_in(std::array::from_fn(|d| c[d].clamp(0, cells[d] - 1) as usize));
     let me = coll.rank();
-    let mut points: Vec<[f64; 4]> =
-        (0..ps.len()).map(|k| [ps.x[k][0], ps.x[k][1], ps.p[k], ps.body[k] as f64]).collect();
+    let mut points: Vec<FitPoint> = (0..ps.len())
+        .map(|k| {
+            let x = pad(ps.x[k]);
+            [x[0], x[1], x[2], ps.p[k], ps.body[k] as f64]
+        })
+        .collect();
     if coll.size() > 1 {
         let mut outgoing = vec![Vec::new(); coll.size()];
-        let mut to = Vec::with_capacity(9);
+        let mut to = Vec::with_capacity(27);
+        let reach = if D == 3 { 1 } else { 0 };
         for p in &points {
-            let (i, j, _) = cell_of(p, origin, h);
+            let (i, j, k, _) = cell_of(p, origin, h);
             to.clear();
-            for (di, dj) in (-1..=1).flat_map(|dj| (-1..=1).map(move |di| (di, dj))) {
-                let (a, b) = (i + di, j + dj);
-                if a >= 0 && b >= 0 && a < nx as i64 && b < ny as i64 {
-                    let r = owner(a, b);
-                    if r != me && !to.contains(&r) {
-                        to.push(r);
+            for dk in -reach..=reach {
+                for dj in -1..=1 {
+                    for di in -1..=1 {
+                        let c = [i + di, j + dj, k + dk];
+                        if (0..3).all(|d| c[d] >= 0 && c[d] < cells[d]) {
+                            let r = owner(c);
+                            if r != me && !to.contains(&r) {
+                                to.push(r);
+                            }
+                        }
                     }
                 }
             }
@@ -57,83 +76,95 @@ pub fn pressure_fit(model: &Model, owners: &Owners, coll: &Collective) -> Result
                 outgoing[r].extend_from_slice(p);
             }
         }
-        points.extend(coll.exchange(&outgoing).chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+        points.extend(coll.exchange(&outgoing).chunks_exact(5).map(|c| [c[0], c[1], c[2], c[3], c[4]]));
     }
-    let local = sums_of(&points, origin, h, |i, j| owner(i, j) == me);
+    let local = sums_of(&points, origin, h, |c| owner(c) == me);
     let sums = coll.sum(&[local.0, local.1])?;
     let worst = coll.max(&[local.2])?[0];
     Ok(Fit { index: if sums[1] <= 0.0 { 0.0 } else { (sums[0] / sums[1]).sqrt() }, max_deviation: worst })
 }
 
-/// The cell (i, j) of point `p` = `[x, y, p, body]`, and its body.
-fn cell_of(p: &[f64; 4], origin: [f64; 2], h: [f64; 2]) -> (i64, i64, i64) {
-    (((p[0] - origin[0]) / h[0]).floor() as i64, ((p[1] - origin[1]) / h[1]).floor() as i64, p[3] as i64)
+/// A D-vector with three components (zero beyond D).
+fn pad<const D: usize>(v: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|d| if d < D { v[d] } else { 0.0 })
 }
 
-/// The fit of point values `[x, y, p, body]` binned on cells of size `h` from `origin`, each
+/// The cell (i, j, k) of point `p` and its body (k = 0 in the plane, whose z and origin are 0
+/// and whose `h[2]` is 1).
+fn cell_of(p: &FitPoint, origin: [f64; 3], h: [f64; 3]) -> FitCell {
+    let at = |d: usize| ((p[d] - origin[d]) / h[d]).floor() as i64;
+    (at(0), at(1), at(2), p[4] as i64)
+}
+
+/// The fit of plane point values `[x, y, p, body]` binned on cells of size `h` from `origin`, each
 /// body's points apart.
 pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
-    let (r2, s2, worst) = sums_of(points, origin, h, |_, _| true);
+    let points: Vec<FitPoint> = points.iter().map(|p| [p[0], p[1], 0.0, p[2], p[3]]).collect();
+    let (r2, s2, worst) = sums_of(&points, pad(origin), [h[0], h[1], 1.0], |_| true);
     Fit { index: if s2 <= 0.0 { 0.0 } else { (r2 / s2).sqrt() }, max_deviation: worst }
 }
 
-/// Σ r_k², Σ s_k² and max |r_k| over the points of the cells (i, j) for which `evaluate` holds.
-fn sums_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2], evaluate: impl Fn(i64, i64) -> bool) -> (f64, f64, f64) {
-    let mut bins: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+/// Σ r_k², Σ s_k² and max |r_k| over the points of the cells for which `evaluate` holds. The
+/// polynomial of a cell has, for each direction in which its neighbourhood's points spread, a
+/// linear and a quadratic term, and a cross term for each pair of such directions (in the plane:
+/// 1, x, x², y, y², xy).
+fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn([i64; 3]) -> bool) -> (f64, f64, f64) {
+    let mut bins: HashMap<FitCell, Vec<usize>> = HashMap::new();
     for (k, p) in points.iter().enumerate() {
         bins.entry(cell_of(p, origin, h)).or_default().push(k);
     }
     let (mut r2, mut s2, mut worst) = (0.0, 0.0, 0.0f64);
-    for (&(i, j, body), members) in bins.iter().filter(|((i, j, _), _)| evaluate(*i, *j)) {
-        let centre = [origin[0] + (i as f64 + 0.5) * h[0], origin[1] + (j as f64 + 0.5) * h[1]];
-        let local = |p: &[f64; 4]| [(p[0] - centre[0]) / h[0], (p[1] - centre[1]) / h[1]];
+    for (&(i, j, k, body), members) in bins.iter().filter(|((i, j, k, _), _)| evaluate([*i, *j, *k])) {
+        let centre: [f64; 3] = std::array::from_fn(|d| origin[d] + ([i, j, k][d] as f64 + 0.5) * h[d]);
+        let local = |p: &FitPoint| -> [f64; 3] { std::array::from_fn(|d| (p[d] - centre[d]) / h[d]) };
         let mut nb: Vec<usize> = Vec::new();
-        for dj in -1..=1 {
-            for di in -1..=1 {
-                if let Some(v) = bins.get(&(i + di, j + dj, body)) {
-                    nb.extend(v);
+        for dk in -1..=1 {
+            for dj in -1..=1 {
+                for di in -1..=1 {
+                    if let Some(v) = bins.get(&(i + di, j + dj, k + dk, body)) {
+                        nb.extend(v);
+                    }
                 }
             }
         }
         let spread = |d: usize| {
-            let v: Vec<f64> = nb.iter().map(|&k| local(&points[k])[d]).collect();
+            let v: Vec<f64> = nb.iter().map(|&n| local(&points[n])[d]).collect();
             v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min) > 1.0
         };
-        let (ux, uy) = (spread(0), spread(1));
-        let basis = |q: [f64; 2]| -> Vec<f64> {
+        let spreads: Vec<usize> = (0..3).filter(|&d| spread(d)).collect();
+        let basis = |q: [f64; 3]| -> Vec<f64> {
             let mut b = vec![1.0];
-            if ux {
-                b.extend([q[0], q[0] * q[0]]);
+            for &d in &spreads {
+                b.extend([q[d], q[d] * q[d]]);
             }
-            if uy {
-                b.extend([q[1], q[1] * q[1]]);
-            }
-            if ux && uy {
-                b.push(q[0] * q[1]);
+            for (a, &d) in spreads.iter().enumerate() {
+                for &e in &spreads[a + 1..] {
+                    b.push(q[d] * q[e]);
+                }
             }
             b
         };
-        let m = basis([0.0, 0.0]).len();
+        let m = basis([0.0; 3]).len();
         if nb.len() < m + 2 {
             continue;
         }
         let mut a = vec![0.0; m * m];
         let mut rhs = vec![0.0; m];
-        for &k in &nb {
-            let q = basis(local(&points[k]));
+        for &n in &nb {
+            let q = basis(local(&points[n]));
             for r in 0..m {
-                rhs[r] += q[r] * points[k][2];
+                rhs[r] += q[r] * points[n][3];
                 for c in 0..m {
                     a[r * m + c] += q[r] * q[c];
                 }
             }
         }
         let Some(coef) = solve(&mut a, &mut rhs, m) else { continue };
-        for &k in members {
-            let s: f64 = basis(local(&points[k])).iter().zip(&coef).map(|(q, c)| q * c).sum();
-            r2 += (points[k][2] - s).powi(2);
+        for &n in members {
+            let s: f64 = basis(local(&points[n])).iter().zip(&coef).map(|(q, c)| q * c).sum();
+            r2 += (points[n][3] - s).powi(2);
             s2 += s * s;
-            worst = worst.max((points[k][2] - s).abs());
+            worst = worst.max((points[n][3] - s).abs());
         }
     }
     (r2, s2, worst)
@@ -228,6 +259,36 @@ mod tests {
         // The same jump inside one body is one.
         let one: Vec<[f64; 4]> = two.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect();
         assert!(fit_of(&one, o, h).max_deviation > 1.0);
+    }
+
+    /// In three dimensions (2 points per cell and direction on 6 × 5 × 4 cells of 0.5 × 0.25 × 0.4):
+    /// a quadratic field in x, y and z scores 0, ±1 alternating from point to point on 10 about 0.1.
+    #[test]
+    fn three_dimensional_fields_are_fitted_over_their_neighbourhood_of_cells() {
+        let (o, h) = ([0.0; 3], [0.5, 0.25, 0.4]);
+        let field = |f: &dyn Fn([f64; 3], i64) -> f64| -> Vec<FitPoint> {
+            let mut v = Vec::new();
+            for k in 0..8i64 {
+                for j in 0..10i64 {
+                    for i in 0..12i64 {
+                        let x = [(i as f64 + 0.5) * 0.25, (j as f64 + 0.5) * 0.125, (k as f64 + 0.5) * 0.2];
+                        v.push([x[0], x[1], x[2], f(x, i + j + k), 0.0]);
+                    }
+                }
+            }
+            v
+        };
+        let index = |pts: &[FitPoint]| {
+            let (r2, s2, _) = sums_of(pts, o, h, |_| true);
+            (r2 / s2).sqrt()
+        };
+        let smooth = field(&|x, _| 5.0 + 2.0 * x[0] - 3.0 * x[1] + x[2] * x[2] + x[0] * x[2] - x[1] * x[2]);
+        assert!(index(&smooth) < 1e-12, "{}", index(&smooth));
+        let cb = index(&field(&|_, n| 10.0 + if n % 2 == 0 { 1.0 } else { -1.0 }));
+        assert!((cb - 0.1).abs() < 0.01, "{cb}");
+        // Binned without z (one layer of huge cells along z: no z terms) the xz and yz parts remain.
+        let (r2, s2, _) = sums_of(&smooth, o, [0.5, 0.25, 1e9], |_| true);
+        assert!((r2 / s2).sqrt() > 1e-3);
     }
 
     #[test]
