@@ -225,10 +225,10 @@ fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
     Ok(())
 }
 
-/// What a three-dimensional case may not ask for yet (issue «Three dimensions»: its grid, bodies,
-/// materials and analysis settings are read and its material points generated; loads, boundaries,
-/// probes, verifications and the two-dimensional options are not three-dimensional yet), and the
-/// space of its points' identifiers.
+/// What a three-dimensional case may not ask for yet (issue «Three dimensions»: nodal tractions,
+/// line pressures and increment factors, the plane benchmarks' checks, [001]'s CMPM and mapped
+/// stiffnesses, the pressure projection, patch recovery and the projected total pressure update;
+/// moving surfaces are refused with the boundaries), and the space of its points' identifiers.
 fn three_dimensional(c: &Case) -> R {
     let not_yet = |key: &str| {
         Err(format!(
