@@ -9,7 +9,7 @@
 //! lies in its rank's ghost region of width three.
 //!
 //! After every accepted step the points whose centre left this rank's cells are packed into
-//! records ([`crate::state::pack`]: every per-point array, so stress, internal variables, F,
+//! records ([`crate::state::write_record`]: every per-point array, so stress, internal variables, F,
 //! volumes, pressures and velocities move with them) and sent directly to their new owner in one
 //! personalised all-to-all exchange, however far they moved. A rank's points are kept sorted by
 //! id, so the order (and with it every sum over a rank's points) does not depend on how the
@@ -124,14 +124,8 @@ pub fn balanced<const D: usize>(
     ranks: usize,
     min_width: usize,
 ) -> Option<(Owners<D>, f64)> {
-    // The cell of flat index `c` (x fastest).
-    let cell = |mut c: usize| -> [usize; D] {
-        std::array::from_fn(|d| {
-            let i = c % cells[d];
-            c /= cells[d];
-            i
-        })
-    };
+    // The cell of flat index `c` (x fastest, `Grid::cell_number`).
+    let cell = |c: usize| crate::model::grid::indices_of(cells, c);
     let mut layers: [Vec<f64>; D] = std::array::from_fn(|d| vec![0.0; cells[d]]);
     for (c, &w) in hist.iter().enumerate() {
         let at = cell(c);

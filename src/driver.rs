@@ -877,8 +877,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
         let mut hist = vec![0.0; grid.cells.iter().product()];
         for x in &self.model.particles.x {
             // The cell that decides the point's owner (`Owners::rank_of`), x fastest.
-            let c = grid.nearest(*x);
-            hist[(0..D).rev().fold(0, |acc, d| acc * grid.cells[d] + c[d])] += 1.0;
+            hist[grid.cell_number(grid.nearest(*x))] += 1.0;
         }
         let hist = self.coll.sum(&hist).map_err(RunError::Failed)?;
         let proposal = crate::distribution::balanced(&hist, grid.cells, self.coll.size(), assembly::STENCIL_WIDTH);
@@ -1168,13 +1167,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
 
     fn write_checkpoint(&mut self, stage_index: usize, control: &StepControl) -> Result<(), RunError> {
         let t0 = Instant::now();
-        let ps = &self.model.particles;
-        let len = state::record_len(D);
-        let mut local = vec![0.0; ps.len() * len];
-        for (k, r) in local.chunks_exact_mut(len).enumerate() {
-            state::write_record(ps, k, r);
-        }
-        let slab = self.coll.sorted_slab(&local, len);
+        let local = state::records_of(&self.model.particles);
+        let slab = self.coll.sorted_slab(&local, state::record_len(D));
         let check_state = match self.check.as_ref() {
             Some(c) => c.checkpoint_state(&self.model, self.coll).map_err(RunError::Failed)?,
             None => None,

@@ -163,15 +163,20 @@ pub const fn record_len(d: usize) -> usize {
     RECORD + (d - 2) * 15
 }
 
-/// The record of particle `k` (ids are exact in f64: they stay below 2⁵³).
-pub fn pack(ps: &Particles, k: usize) -> [f64; RECORD] {
-    let mut r = [0.0; RECORD];
-    write_record(ps, k, &mut r);
-    r
+/// The records of all points of `ps`, laid end to end in their order ([`record_len`]`(D)` values
+/// each; [`particles_from_flat`]'s inverse).
+pub fn records_of<const D: usize>(ps: &Particles<D>) -> Vec<f64> {
+    let len = record_len(D);
+    let mut flat = vec![0.0; ps.len() * len];
+    for (k, r) in flat.chunks_exact_mut(len).enumerate() {
+        write_record(ps, k, r);
+    }
+    flat
 }
 
 /// Writes the record of particle `k` of dimension D into `r` ([`record_len`] values, in the order
-/// of [`PARTICLE_FIELDS`] with D components per vector and D² for F, row by row).
+/// of [`particle_fields`]`(D)`: D components per vector and D² for F, row by row; ids are exact in
+/// f64, they stay below 2⁵³).
 pub fn write_record<const D: usize>(ps: &Particles<D>, k: usize, r: &mut [f64]) {
     let f = &ps.def_grad[k];
     let f_rows: Vec<f64> = f.iter().flatten().copied().collect();
@@ -208,7 +213,7 @@ pub fn write_record<const D: usize>(ps: &Particles<D>, k: usize, r: &mut [f64]) 
 
 /// Overwrites particle `k` with record `r` (same id, body and material, checked by the caller).
 fn unpack<const D: usize>(ps: &mut Particles<D>, k: usize, r: &[f64]) {
-    // The fields after id, body and material, in the order of `PARTICLE_FIELDS`.
+    // The fields after id, body and material, in the order of `particle_fields`.
     fn take<const N: usize>(rest: &mut impl Iterator<Item = f64>) -> [f64; N] {
         std::array::from_fn(|_| rest.next().expect("RECORD values"))
     }
@@ -371,9 +376,7 @@ mod tests {
         ps.eps_pd[k] = next();
         ps.grad_p[k] = [next(), next()];
         ps.jbar[k] = next();
-        let mut records: Vec<[f64; RECORD]> = (0..ps.len()).rev().map(|k| pack(&ps, k)).collect();
-        records.sort_by(|a, b| a[0].total_cmp(&b[0]));
-        let flat: Vec<f64> = records.iter().flatten().copied().collect();
+        let flat = records_of(&ps);
         let back = particles_from_flat::<2>(&flat);
         assert_eq!(format!("{back:?}"), format!("{ps:?}"));
         // The case's points, as generated, against the checkpoint's.
@@ -414,10 +417,7 @@ mod tests {
             ps.jbar[k] = next();
         }
         let len = record_len(3);
-        let mut flat = vec![0.0; ps.len() * len];
-        for (k, r) in flat.chunks_exact_mut(len).enumerate() {
-            write_record(&ps, k, r);
-        }
+        let flat = records_of(&ps);
         assert_eq!(flat[len + 3..len + 6], ps.x[1]);
         let back = particles_from_flat::<3>(&flat);
         assert_eq!(format!("{back:?}"), format!("{ps:?}"));
@@ -443,7 +443,7 @@ mod tests {
             load_totals: vec![0.5],
             check_state: Some(vec![2.0]),
             dim: 2,
-            particles: (0..ps.len()).flat_map(|k| pack(&ps, k)).collect(),
+            particles: records_of(&ps),
             first: 0,
             total: ps.len() as u64,
         };

@@ -50,7 +50,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         }
         let nd = self.layout.nd;
         let p = self.layout.p;
-        let h_cell = model.grid.h.iter().fold(f64::INFINITY, |m, &h| m.min(h));
+        let h_cell = model.grid.h_min();
         let names = self.layout.field_names();
         // A realistic iterate: part of this step's converged increment.
         self.solve(model)?;

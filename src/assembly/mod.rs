@@ -680,21 +680,22 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
     /// (see [`explicit`]), in any dimension: a side or region boundary of the stage fixes `p`
     /// there, a moving surface that fixes `p` reaches it (plane only; marks summed over the
-    /// ranks), or the material barely fills it (the drained value of implicit stages' barely
-    /// filled nodes).
+    /// ranks, a collective every rank of a plane run takes), or the material barely fills it (the
+    /// drained value of implicit stages' barely filled nodes).
     fn drained_nodes(&mut self, model: &Model<D>, active: &Active) -> Result<Vec<bool>, Error> {
         let nd = self.layout.nd;
         let p = crate::model::dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");
-        let mut marks = vec![0.0; self.ghost.len() * nd];
+        let mut marks = Vec::new();
         if let (Some(plane), Some(system)) = (model.as_plane(), self.as_plane_ref()) {
+            marks = vec![0.0; self.ghost.len() * nd];
             for l in system.surface_drained_nodes(plane, active) {
                 marks[l * nd] = 1.0;
             }
+            self.sum_over_ranks(&mut marks)?;
         }
-        self.sum_over_ranks(&mut marks)?;
         Ok((0..self.ghost.len())
             .map(|l| {
-                marks[l * nd] > 0.0
+                marks.get(l * nd).is_some_and(|&m| m > 0.0)
                     || !self.step.dofs.well[l]
                     || model.fixing_boundaries(active, self.ghost.indices(l))[p].is_some()
             })
@@ -1553,7 +1554,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             let l = a as usize;
             if self.step.solution.is_empty() {
                 let n = self.ghost.indices(l);
-                let g = (0..D).rev().fold(0, |acc, d| acc * nodes[d] + n[d]) * nv;
+                let g = crate::model::grid::flat_number(nodes, n) * nv;
                 match self.carried.get(g..g + nv) {
                     Some(v) => values.extend(v),
                     None => values.extend(std::iter::repeat_n(0.0, nv)),
@@ -1581,7 +1582,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let owned = GhostedRange { start: self.owned_start, count: self.owned_count, dof: 1 };
         for (o, v) in block.values.chunks_exact(nv).enumerate() {
             let n = owned.indices(o);
-            let g = (0..D).rev().fold(0, |acc, d| acc * nodes[d] + n[d]) * nv;
+            let g = crate::model::grid::flat_number(nodes, n) * nv;
             all[g..g + nv].copy_from_slice(v);
         }
         coll.sum(&all)
@@ -1674,7 +1675,7 @@ impl GridSystem {
     /// through the face point.
     fn drained_faces(&self, model: &Model, active: &Active) -> Vec<(usize, kernels::DrainedFace)> {
         let (g, ps) = (&model.grid, &model.particles);
-        let penalty = NITSCHE_PENALTY / g.h[0].min(g.h[1]);
+        let penalty = NITSCHE_PENALTY / g.h_min();
         model
             .drained_faces(active)
             .into_iter()

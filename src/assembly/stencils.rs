@@ -179,7 +179,7 @@ impl<const D: usize> CellRoots<D> {
         if !inside || self.root.is_empty() {
             return c;
         }
-        let l = (0..D).rev().fold(0, |acc, d| acc * self.count[d] + (c[d] - self.start[d]));
+        let l = crate::model::grid::flat_number(self.count, std::array::from_fn(|d| c[d] - self.start[d]));
         self.root[l].map(|v| v as usize)
     }
 }

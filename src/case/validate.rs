@@ -445,11 +445,13 @@ pub fn validate(c: &Case) -> R {
     if dim == 3 {
         three_dimensional(c)?;
     }
-    let lo = c.origin();
-    let hi = [lo[0] + c.grid.size[0], lo[1] + c.grid.size[1]];
-    let h = c.cell_size();
-    let tol = [1e-9 * h[0], 1e-9 * h[1]];
-    let inside_grid = |p: [f64; 2]| (0..2).all(|d| p[d] >= lo[d] - tol[d] && p[d] <= hi[d] + tol[d]);
+    // The grid's bounds (beyond the case's dimension unused), and whether a point with a
+    // coordinate per direction (a plane section's two, or a case's D) lies within them.
+    let lo = c.origin_in::<3>();
+    let h = c.cell_size_in::<3>();
+    let hi: [f64; 3] = std::array::from_fn(|d| lo[d] + c.grid.size.get(d).copied().unwrap_or(1.0));
+    let tol = h.map(|h| 1e-9 * h);
+    let inside_grid = |p: &[f64]| p.iter().enumerate().all(|(d, &x)| x >= lo[d] - tol[d] && x <= hi[d] + tol[d]);
     axisymmetry(c, tol[0])?;
 
     // Materials.
@@ -569,10 +571,12 @@ pub fn validate(c: &Case) -> R {
             _ => {}
         }
         let (bmin, bmax) = b.shape.bounds();
-        if !inside_grid(bmin) || !inside_grid(bmax) {
+        if !inside_grid(&bmin) || !inside_grid(&bmax) {
             return Err(format!(
-                "key `bodies[{i}].shape`: body `{}` ({bmin:?} .. {bmax:?}) reaches outside the grid ({lo:?} .. {hi:?}); particles outside the grid are not allowed",
-                b.name
+                "key `bodies[{i}].shape`: body `{}` ({bmin:?} .. {bmax:?}) reaches outside the grid ({:?} .. {:?}); particles outside the grid are not allowed",
+                b.name,
+                &lo[..2],
+                &hi[..2]
             ));
         }
     }
@@ -736,7 +740,7 @@ pub fn validate(c: &Case) -> R {
                 }
                 for (j, p) in points.iter().enumerate() {
                     finite2(&format!("loads[{i}].points[{j}]"), *p)?;
-                    if !inside_grid(*p) {
+                    if !inside_grid(p) {
                         return Err(format!("key `loads[{i}].points[{j}]`: {p:?} is outside the grid"));
                     }
                 }
@@ -918,12 +922,7 @@ pub fn validate(c: &Case) -> R {
     unique("probes", c.probes.iter().map(|p| p.name.as_str()))?;
     for (i, p) in c.probes.iter().enumerate() {
         components(&format!("probes[{i}].point"), &p.point, dim)?;
-        let inside = (0..dim).all(|d| {
-            let (o, tol) =
-                (c.grid.origin.get(d).copied().unwrap_or(0.0), 1e-9 * c.grid.size[d] / c.grid.cells[d] as f64);
-            p.point[d] >= o - tol && p.point[d] <= o + c.grid.size[d] + tol
-        });
-        if !inside {
+        if !inside_grid(&p.point) {
             return Err(format!("key `probes[{i}].point`: {:?} is outside the grid", p.point));
         }
     }

@@ -60,7 +60,7 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
     let warn = |out: &mut Vec<Warning>, kind: &str, message: String| {
         out.push(Warning { kind: kind.into(), message, time_s: None, value: None, threshold: None })
     };
-    let h = model.grid.h.iter().fold(f64::INFINITY, |m, &h| m.min(h));
+    let h = model.grid.h_min();
     if !model.bbar && !model.fbar {
         for (i, m) in model.materials.iter().enumerate() {
             let nu = m.model.elastic().poisson;

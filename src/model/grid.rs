@@ -30,18 +30,23 @@ impl<const D: usize> Grid<D> {
 
     /// The flat number of the node with indices `n` (x fastest).
     pub fn node_number(&self, n: [usize; D]) -> usize {
-        let nodes = self.nodes();
-        (0..D).rev().fold(0, |acc, d| acc * nodes[d] + n[d])
+        flat_number(self.nodes(), n)
     }
 
     /// The indices of the node with flat number `k` ([`Grid::node_number`]'s inverse).
-    pub fn node_indices(&self, mut k: usize) -> [usize; D] {
-        let nodes = self.nodes();
-        std::array::from_fn(|d| {
-            let i = k % nodes[d];
-            k /= nodes[d];
-            i
-        })
+    pub fn node_indices(&self, k: usize) -> [usize; D] {
+        indices_of(self.nodes(), k)
+    }
+
+    /// The flat number of the cell with indices `c` (x fastest), as [`Grid::node_number`] numbers
+    /// the nodes.
+    pub fn cell_number(&self, c: [usize; D]) -> usize {
+        flat_number(self.cells, c)
+    }
+
+    /// The smallest cell size of the directions [m].
+    pub fn h_min(&self) -> f64 {
+        self.h.iter().fold(f64::INFINITY, |m, &h| m.min(h))
     }
 
     /// Position of the node with indices `n` [m].
@@ -87,6 +92,20 @@ impl<const D: usize> Grid<D> {
     pub fn extent_max(&self) -> [f64; D] {
         std::array::from_fn(|d| self.origin[d] + self.cells[d] as f64 * self.h[d])
     }
+}
+
+/// The flat number, x fastest, of indices `n` in a block of `counts` per direction.
+pub fn flat_number<const D: usize>(counts: [usize; D], n: [usize; D]) -> usize {
+    (0..D).rev().fold(0, |acc, d| acc * counts[d] + n[d])
+}
+
+/// The indices of flat number `k` in a block of `counts` per direction ([`flat_number`]'s inverse).
+pub fn indices_of<const D: usize>(counts: [usize; D], mut k: usize) -> [usize; D] {
+    std::array::from_fn(|d| {
+        let i = k % counts[d];
+        k /= counts[d];
+        i
+    })
 }
 
 /// The two-dimensional forms with (i, j) indices, which the plane code uses.

@@ -200,7 +200,7 @@ impl Model {
     ///   would otherwise widen the footing by a cell as soon as the point moves towards it.
     pub fn surface_fixes(&self, active: &Active, weak_drainage: bool) -> Vec<((u32, u32), usize, [bool; 5])> {
         let mut out = Vec::new();
-        let tol = 1e-9 * self.grid.h[0].min(self.grid.h[1]);
+        let tol = 1e-9 * self.grid.h_min();
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
             let Some(list) = &b.surface else { continue };
