@@ -262,7 +262,8 @@ mod tests {
     }
 
     /// In three dimensions (2 points per cell and direction on 6 × 5 × 4 cells of 0.5 × 0.25 × 0.4):
-    /// a quadratic field in x, y and z scores 0, ±1 alternating from point to point on 10 about 0.1.
+    /// a quadratic field in x, y and z (with all three cross terms) scores 0, ±1 alternating from
+    /// point to point on 10 about 0.1.
     #[test]
     fn three_dimensional_fields_are_fitted_over_their_neighbourhood_of_cells() {
         let (o, h) = ([0.0; 3], [0.5, 0.25, 0.4]);
@@ -282,7 +283,8 @@ mod tests {
             let (r2, s2, _) = sums_of(pts, o, h, |_| true);
             (r2 / s2).sqrt()
         };
-        let smooth = field(&|x, _| 5.0 + 2.0 * x[0] - 3.0 * x[1] + x[2] * x[2] + x[0] * x[2] - x[1] * x[2]);
+        let smooth =
+            field(&|x, _| 5.0 + 2.0 * x[0] - 3.0 * x[1] + x[2] * x[2] + 0.5 * x[0] * x[1] + x[0] * x[2] - x[1] * x[2]);
         assert!(index(&smooth) < 1e-12, "{}", index(&smooth));
         let cb = index(&field(&|_, n| 10.0 + if n % 2 == 0 { 1.0 } else { -1.0 }));
         assert!((cb - 0.1).abs() < 0.01, "{cb}");
