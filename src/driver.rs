@@ -791,18 +791,18 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
-        // The projected or recovered pore pressures (plane only: validation keeps them out of
-        // three-dimensional cases).
-        let recovered = match (self.model.as_plane(), crate::model::plane_mut::<_, GridSystem>(&mut self.system)) {
-            (Some(plane), Some(system)) => match (plane.pressure_update, system.layout().p.is_some()) {
-                (crate::case::PressureUpdate::ProjectedTotal, true) => {
-                    Some(system.projected_pressure_increments(plane).map_err(|e| RunError::Failed(e.to_string()))?)
+        // The projected or recovered pore pressures (the MLSA recovery is plane: validation keeps
+        // it out of three-dimensional cases).
+        let recovered = match (self.model.pressure_update, self.system.layout().p.is_some()) {
+            (crate::case::PressureUpdate::ProjectedTotal, true) => Some(
+                self.system.projected_pressure_increments(&self.model).map_err(|e| RunError::Failed(e.to_string()))?,
+            ),
+            (_, true) if self.model.two_phase && self.model.patch_recovery => {
+                match (self.model.as_plane(), crate::model::plane_mut::<_, GridSystem>(&mut self.system)) {
+                    (Some(plane), Some(system)) => Some(system.recovered_pressure_increments(plane)),
+                    _ => None,
                 }
-                (_, true) if plane.two_phase && plane.patch_recovery => {
-                    Some(system.recovered_pressure_increments(plane))
-                }
-                _ => None,
-            },
+            }
             _ => None,
         };
         // The energy terms of a dynamic step need the particles' state at t_n.
@@ -1212,8 +1212,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             LoadsAt::Start => RunError::Input(m),
             _ => RunError::Failed(m),
         };
-        // Loads are plane (validation keeps them out of three-dimensional cases).
-        let Some(model) = crate::model::plane_mut::<_, Model>(&mut self.model) else { return Ok(()) };
+        let model = &mut self.model;
         for li in 0..model.loads.len() {
             // Whether a load has increments is the case's: every rank takes the same branch.
             if model.loads[li].increments.is_none() {
@@ -1222,7 +1221,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
             let local = model.loads[li].face_moments(&model.particles, &model.geometry);
             let m = self.coll.sum(&local).map_err(RunError::Failed)?;
             let load = &mut model.loads[li];
-            if m[2] <= 0.0 {
+            if m[D] <= 0.0 {
                 return Err(fail(format!(
                     "load `{}`: no loaded face is left to evaluate its increment_factor at",
                     load.name
@@ -1233,7 +1232,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
                 LoadsAt::Accepted => IncrementsFrom::Accepted,
                 LoadsAt::Restart(totals) => IncrementsFrom::Checkpoint(totals[li]),
             };
-            load.set_increments(self.t, [m[0] / m[2], m[1] / m[2]], from).map_err(fail)?;
+            load.set_increments(self.t, std::array::from_fn(|d| m[d] / m[D]), from).map_err(fail)?;
         }
         Ok(())
     }

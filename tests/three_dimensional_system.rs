@@ -7,6 +7,10 @@
 //!   system with Darcy flow, Mohr–Coulomb, B̄) compressed by a strip at its top steps exactly as
 //!   the plane model of its section, point for point (positions, stresses, pore pressures,
 //!   plastic strain), and its out-of-plane stresses are zero shears and the plane σ_zz.
+//! * `a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin`: so does the slab pressed by a
+//!   nodal traction on its top face, the section by one on its top line.
+//! * `a_slab_with_the_pressure_projection_steps_as_its_plane_twin`: so does the slab with the
+//!   pressure projection, its cells' blocks over eight trilinear functions.
 //! * `a_two_phase_explicit_slab_steps_as_its_plane_twin`: the slab (standing, and lying in the
 //!   (x, z) plane) in a two-phase explicit stage, with the points' own pore pressure and with the
 //!   nodal one drained at the top, steps as its plane section point for point.
@@ -90,7 +94,12 @@ duration = 0.03
 /// both z faces (u_z = U_z = 0: in the u–p–U system a face whose water is free is drained, p = 0
 /// being its natural condition).
 fn slab() -> String {
-    PLANE
+    slab_of(PLANE)
+}
+
+/// The plane section `plane` (the text of [`PLANE`], perhaps changed) extruded as [`slab`].
+fn slab_of(plane: &str) -> String {
+    plane
         .replace("size = [0.2, 0.8]", "size = [0.2, 0.8, 0.1]")
         .replace("cells = [2, 8]", "cells = [2, 8, 1]")
         .replace(
@@ -107,6 +116,7 @@ fn slab() -> String {
             "region = { min = [0.0, 0.6], max = [0.2, 0.6], z = [0.0, 0.1] }",
         )
         .replace("displacement = [0.0, -3e-3]", "displacement = [0.0, -3e-3, 0.0]")
+        .replace("traction = [0.0, -4e4]", "traction = [0.0, -4e4, 0.0]")
         + r#"
 [[boundaries]]
 name = "back"
@@ -266,6 +276,51 @@ fn a_slab_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
     let first = |t: &str| t.replace("duration = 0.03\ndt", "duration = 0.01\ndt");
     compare_slab(&without(PLANE), &without(&slab()), coll)?;
     compare_slab(&first(PLANE), &first(&slab()), coll)
+}
+
+/// The plane section pressed by a nodal traction of 40 kPa over the strip's line of nodes (ramped
+/// over the three steps) instead of the strip's displacement.
+fn pressed_by_nodes() -> String {
+    PLANE.replace(
+        "[[boundaries]]\nname = \"strip\"\nregion = { min = [0.0, 0.6], max = [0.1, 0.6] }\nfix = [\"uy\"]\n\
+         displacement = [0.0, -3e-3]\ntime_function = \"ramp\"\n",
+        "[[loads]]\nname = \"strip\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 0.6], max = [0.1, 0.6] }\n\
+         traction = [0.0, -4e4]\ntime_function = \"ramp\"\n",
+    )
+}
+
+/// The slab pressed by a nodal traction on its top face steps as its plane section pressed by one
+/// on its top line (B̄ off, three steps): the nodes of the slab's loaded face each stand for the
+/// product of their tributary lengths along x and z (`model::loads::tributary_nodes`), so the
+/// slab's loads are the section's times its thickness, and so are its first moments and
+/// reactions.
+fn a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    let plane = pressed_by_nodes().replace("bbar = true", "bbar = false");
+    if !plane.contains("nodal_traction") {
+        return Err("the strip's displacement was not replaced by a nodal traction".into());
+    }
+    compare_slab(&plane, &slab_of(&plane), coll)
+}
+
+/// The slab with the pressure projection (`stabilisation.pressure_projection = 2`, B̄ off, three
+/// steps) steps as its plane section with it: a cell's block S over its eight trilinear functions
+/// (`GridSystem::projection_cells`) sees in the slab's pressure, constant along z, what the four
+/// bilinear ones see in the section's. The projection moves the section's pore pressures (by more
+/// than 1e-3 of their largest), so the comparison sees it.
+fn a_slab_with_the_pressure_projection_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    let without = PLANE.replace("bbar = true", "bbar = false");
+    let with = without.replace("bbar = false", "bbar = false\npressure_projection = 2.0");
+    let (plain, _, _) = run_plane(&case_of(&without)?, coll)?;
+    let (projected, _, _) = run_plane(&case_of(&with)?, coll)?;
+    let (_, scale_p) = scales(&plain);
+    let moved =
+        plain.p.iter().flatten().zip(projected.p.iter().flatten()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+            / scale_p;
+    println!("    the projection moves the section's pore pressures by {moved:.2e} of {scale_p:.3e} Pa");
+    if moved.is_nan() || moved < 1e-3 {
+        return Err(format!("the pressure projection barely moves the section's pore pressures: {moved:e}"));
+    }
+    compare_slab(&with, &slab_of(&with), coll)
 }
 
 /// The slab of `solid` steps as the plane section of `plane`, point for point.
@@ -774,6 +829,14 @@ fn main() {
     let coll = Collective::world();
     let tests: &[(&str, TestFn)] = &[
         ("a_slab_steps_as_its_plane_twin", a_slab_steps_as_its_plane_twin),
+        (
+            "a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin",
+            a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin,
+        ),
+        (
+            "a_slab_with_the_pressure_projection_steps_as_its_plane_twin",
+            a_slab_with_the_pressure_projection_steps_as_its_plane_twin,
+        ),
         ("a_block_squeezed_from_three_sides_is_homogeneous", a_block_squeezed_from_three_sides_is_homogeneous),
         (
             "a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage",

@@ -54,6 +54,48 @@ fn a_cube_in_uniaxial_stress_runs_on_one_and_two_ranks() {
     }
 }
 
+/// The cube's loads in three dimensions, on one and two ranks (`tests/cases/cube_3d.toml` without its
+/// pushed face): a face traction of 100 kPa on the face x = 0.3 m over z ∈ [0, 0.1] whose increment
+/// is scaled by `increment_factor = "2 + 10 * z"`, evaluated at the loaded faces' mean centre
+/// (z̄ = 0.05 m, ȳ = 0.15 m: g = 2.5), and a nodal traction of 10 kPa on the nodes of the face
+/// y = 0.3 m (each standing for its tributary area). The rollers carry them: 1e5 × 0.03 × 2.5 =
+/// 7.5 kN along x and 1e4 × 0.09 = 900 N along y, to 1e-10.
+#[test]
+fn a_cube_carries_a_face_traction_with_increments_and_a_nodal_traction() {
+    let text = std::fs::read_to_string("tests/cases/cube_3d.toml").expect("the cube's case");
+    let press = "[[boundaries]]\nname = \"press\"\nside = \"x_max\"\nfix = [\"ux\"]\n\
+                 displacement = [-1.5e-3, 0.0, 0.0]  # m\ntime_function = \"ramp\"\n";
+    assert!(text.contains(press), "the cube's pushed face");
+    let loads = r#"[[loads]]
+name = "side"
+kind = "particle_traction"
+region = { min = [0.25, 0.0], max = [0.3, 0.3], z = [0.0, 0.1] }
+face = "x_max"
+traction = [-1.0e5, 0.0, 0.0]
+time_function = "ramp"
+increment_factor = "2 + 10 * z"
+
+[[loads]]
+name = "top"
+kind = "nodal_traction"
+region = { min = [0.0, 0.3], max = [0.3, 0.3] }
+traction = [0.0, -1.0e4, 0.0]
+time_function = "ramp"
+"#;
+    let case = std::env::temp_dir().join("porompm-cube3d-loads.toml");
+    std::fs::write(&case, text.replace(press, loads)).expect("the case written");
+    for ranks in [1, 2] {
+        let dir = std::env::temp_dir().join(format!("porompm-cube3d-loads-{ranks}"));
+        let r = run_case_on(ranks, &case.display().to_string(), &dir, &[]);
+        assert!(r.completed(), "{ranks} ranks: {}", r.stderr());
+        let last = |name: &str| *r.column(name).last().expect("a row");
+        let (x, y) = (last("x_roller.reaction_x"), last("y_roller.reaction_y"));
+        println!("{ranks} rank(s): the rollers carry {x:.10e} N along x and {y:.10e} N along y");
+        assert!((x - 7500.0).abs() < 1e-10 * 7500.0, "{ranks} ranks: x_roller carries {x}, not 7500 N");
+        assert!((y - 900.0).abs() < 1e-10 * 900.0, "{ranks} ranks: y_roller carries {y}, not 900 N");
+    }
+}
+
 /// The square footing at its coarsest mesh (k = 2, h = B/5) with [002]'s implicit F̄ instead of B̄,
 /// on two ranks: N_c = 5.808, within 2 % of 5.91 already at this mesh (B̄ 5.146, 13 % low; without
 /// either the soil locks, 8.30; F̄ measured 5.805 and 5.800 at k = 3 and 4), with the equilibrium
@@ -195,6 +237,47 @@ fn the_prism_consolidates_by_explicit_steps_as_the_plane_column() {
         for column in ["uz", "vz", "syz", "szx"] {
             let worst = solid.column(&format!("{probe}.{column}")).iter().fold(0.0f64, |m, v| m.max(v.abs()));
             assert!(worst < 1e-12, "{probe}.{column}: {worst}");
+        }
+    }
+}
+
+/// The consolidating prism with the projected total pressure update
+/// (`stabilisation.pressure_update = "projected_total"`: each point's pressure the interpolation of
+/// the L² projection of the points' pressures plus the step's increment, a CG solve on a DMDA of
+/// the system's dimension and distribution) on two ranks consolidates as the plane column with it
+/// on one: its Terzaghi metrics the column's to 1e-10 (e_p's over √2, as by explicit steps), and its
+/// probes' pore pressures row for row. The update moves the prism's metrics (p_rms_error at T_v =
+/// 0.5 by 1.2 % from the default update's), so the comparison sees it.
+#[test]
+fn the_prism_with_the_projected_total_pressure_update_consolidates_as_the_plane_column() {
+    let sets = set_args(&["stabilisation.pressure_update=projected_total"]);
+    let plane = run_case("cases/terzaghi.toml", &std::env::temp_dir().join("porompm-terzaghi-projected-2d"), &sets);
+    assert!(plane.completed(), "{}", plane.stderr());
+    let solid =
+        run_case_on(2, "cases/terzaghi_3d.toml", &std::env::temp_dir().join("porompm-terzaghi-projected-3d"), &sets);
+    assert!(solid.completed(), "{}", solid.stderr());
+    let default = run_case("cases/terzaghi_3d.toml", &std::env::temp_dir().join("porompm-terzaghi-default-3d"), &[]);
+    assert!(default.completed(), "{}", default.stderr());
+    let names: Vec<String> =
+        plane.summary["verification"].as_object().expect("the plane metrics").keys().cloned().collect();
+    assert!(names.iter().any(|n| n == "p_rms_error_Tv0.5"), "{names:?}");
+    for name in &names {
+        let (a, b) = (metric(&plane.summary, name), metric(&solid.summary, name));
+        let b = if name.starts_with("e_p_") { b * 2f64.sqrt() } else { b };
+        eprintln!("{name}: plane {a:.10e}, prism {b:.10e}");
+        // The metrics are errors relative to the load's pressure (or the settlement): the CG of the
+        // projection (relative tolerance 1e-12) on two ranks leaves them equal to 1e-10 of it.
+        assert!((a - b).abs() <= 1e-10, "{name}: plane {a}, prism {b}");
+    }
+    let (with, without) = (metric(&solid.summary, "p_rms_error_Tv0.5"), metric(&default.summary, "p_rms_error_Tv0.5"));
+    eprintln!("p_rms_error_Tv0.5: {with:.6e} projected, {without:.6e} by default");
+    assert!((with - without).abs() > 1e-3 * without, "the projected update does not move the prism's pressures");
+    for probe in ["base", "middle"] {
+        let (a, b) = (plane.column(&format!("{probe}.p_excess")), solid.column(&format!("{probe}.p_excess")));
+        assert_eq!(a.len(), b.len(), "{probe}.p_excess");
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-8 * scale, "{probe}.p_excess: plane {x}, prism {y}");
         }
     }
 }

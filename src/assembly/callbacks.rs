@@ -737,7 +737,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Assembler<'a, D, M, N> 
     fn add_projection(&self, xl: &[f64], f: &mut [f64]) {
         let Some(p) = self.step.layout.and_then(|l| l.p) else { return };
         let nd = self.step.dofs.nd;
-        for (nodes, s) in &self.step.projection {
+        for cell in &self.step.projection {
+            let (nodes, s, c) = (&cell.nodes, &cell.s, cell.nodes.len());
             for (a, &na) in nodes.iter().enumerate() {
                 let ra = na as usize * nd + p;
                 if self.step.dofs.fixed[ra] {
@@ -751,7 +752,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Assembler<'a, D, M, N> 
                         if self.step.dofs.fixed[q] {
                             0.0
                         } else {
-                            s[a][b] * xl[q]
+                            s[a * c + b] * xl[q]
                         }
                     })
                     .sum();
@@ -833,12 +834,13 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Assemb
             |band, v| ps.tangent_band(band, v, &xl),
         );
         if let Some(p) = layout.p {
-            for ((nodes, s), blocks) in step.projection.iter().zip(&step.projection_blocks) {
-                for (a, &na) in nodes.iter().enumerate() {
-                    for (b, &nb) in nodes.iter().enumerate() {
+            for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
+                let c = cell.nodes.len();
+                for (a, &na) in cell.nodes.iter().enumerate() {
+                    for (b, &nb) in cell.nodes.iter().enumerate() {
                         let (ra, cb) = (na as usize * nd + p, nb as usize * nd + p);
                         if !step.dofs.fixed[ra] && !step.dofs.fixed[cb] {
-                            values[blocks[a * 4 + b] as usize * nd * nd + p * nd + p] -= s[a][b];
+                            values[blocks[a * c + b] as usize * nd * nd + p * nd + p] -= cell.s[a * c + b];
                         }
                     }
                 }

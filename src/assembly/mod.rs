@@ -58,6 +58,14 @@ use stencils::{Crossing, Stencils};
 /// Errors of the global system.
 pub type Error = petsc::Error;
 
+/// A cell of the pressure projection: its 2^D corner nodes (ghosted numbers, x fastest) and the
+/// C × C block S of `kernels::pressure_projection`, row by row.
+#[derive(Debug, Clone, Default)]
+struct ProjectionCell {
+    nodes: Vec<u32>,
+    s: Vec<f64>,
+}
+
 /// Per-step data shared by the callbacks (points of dimension D with at most M nodes).
 #[derive(Debug, Default)]
 struct StepData<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
@@ -85,15 +93,15 @@ struct StepData<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// The norm of the step's force magnitudes over the free dofs (see
     /// `Assembler::force_magnitudes`), summed over ranks [N per m].
     force_scale: f64,
-    /// Pressure-projection blocks: a cell's four nodes and the 4 × 4 block S (see
-    /// `kernels::pressure_projection`).
-    projection: Vec<([u32; 4], [[f64; 4]; 4])>,
+    /// Pressure-projection cells (see [`ProjectionCell`]).
+    projection: Vec<ProjectionCell>,
     /// The matrix pattern (kept from step to step while it covers the particles' pairs).
     pattern: Pattern<D>,
     /// The bands of node rows the threads assemble (see [`callbacks::Band`]).
     bands: Vec<callbacks::Band>,
-    /// The pattern block of every corner pair (a, b) of each pressure-projection cell, 4a + b.
-    projection_blocks: Vec<[u32; 16]>,
+    /// The pattern block of every corner pair (a, b) of each pressure-projection cell, C a + b for
+    /// its C corners.
+    projection_blocks: Vec<Vec<u32>>,
     /// (diagonal block, component) of every owned fixed dof.
     fixed_diagonals: Vec<(u32, usize)>,
     /// The pressure unknown's scale s [Pa/m] (see [`pressure_scale`]): PETSc sees Δp / s, and the
@@ -393,7 +401,7 @@ pub struct GridSystem<
     /// ([`LINE_SEARCH_RETRY`]; off with `-porompm_snes_line_search_retry false`).
     retry_with_line_search: bool,
     /// The one-field DMDA and CG solver of the pressure's L² projection (built on first use).
-    l2_projection: Option<(DmDa, Ksp)>,
+    l2_projection: Option<(DmDa<D>, Ksp)>,
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
     /// The owned part of the last accepted step's Δd and its Δt, the predictor of the next step
@@ -875,10 +883,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     ) -> Result<(), String> {
         let bands = callbacks::bands(&st, self.ghost.count, coll.threads());
         let (smooth, grad_n) = self.predictors(model, &st, &dofs, nodal);
-        // The pressure projection and the loads (plane only: validation keeps them out of
-        // three-dimensional cases, whose external forces are zero).
-        let plane = model.as_plane().zip(self.as_plane_ref());
-        let projection = plane.map(|(m, s)| s.projection_blocks(m)).unwrap_or_default();
+        let projection = self.projection_cells(model);
         let (fext, applied) = coll.agree(self.external_forces(model, active, t_new, &dofs))?;
         let flow = self.layout.p.is_some() && self.layout.w.is_none();
         let nm = kernels::Scheme::of(&model.integration, t_new - t_old, flow);
@@ -936,7 +941,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let nd = self.layout.nd;
         let kept = !old.is_empty() && old.covers(&self.step.stencils);
         let pattern = if coll.any(!kept)? {
-            let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|(n, _)| n.to_vec()).collect();
+            let groups: Vec<Vec<u32>> = self.step.projection.iter().map(|c| c.nodes.clone()).collect();
             let p = Pattern::build_in(&self.step.stencils, &self.owned_nodes, &groups, self.ghost.count);
             let (rows, cols) = p.coo(nd, &self.l2g);
             let made = self.dm.create_matrix_coo(&rows, &cols).and_then(|mut jac| {
@@ -954,18 +959,13 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             self.reused_patterns += 1;
             old
         };
-        let projection_blocks: Option<Vec<[u32; 16]>> = self
+        let projection_blocks: Option<Vec<Vec<u32>>> = self
             .step
             .projection
             .iter()
-            .map(|(nodes, _)| {
-                let mut b = [0u32; 16];
-                for (a, &na) in nodes.iter().enumerate() {
-                    for (c, &nc) in nodes.iter().enumerate() {
-                        b[a * 4 + c] = pattern.block(na, nc)?;
-                    }
-                }
-                Some(b)
+            .map(|cell| {
+                let pattern = &pattern;
+                cell.nodes.iter().flat_map(|&na| cell.nodes.iter().map(move |&nc| pattern.block(na, nc))).collect()
             })
             .collect();
         self.step.projection_blocks =
@@ -1085,11 +1085,146 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         (smooth, grad_n)
     }
 
+    /// Pore-pressure increments that make each particle's pressure the interpolation of the total
+    /// nodal field, p_{n+1} = Σ S_i (P_i + Δp_i) (`stabilisation.pressure_update =
+    /// "projected_total"`). P is the consistent L² projection of the particles' pressures p_n onto
+    /// the nodal functions: M P = b with M_ij = Σ_p V_p S_ip S_jp and b_i = Σ_p V_p S_ip p_p, solved
+    /// by CG with Jacobi (options prefix `pressure_projection_`, relative tolerance 1e-12). A
+    /// pressure field the nodes represent comes back unchanged (no smoothing, unlike a lumped
+    /// projection), and what they cannot represent is dropped instead of accumulating on the
+    /// particles. Nodes no particle reaches get P = 0 (a regularisation of 1e-12 of a cell's area
+    /// on every diagonal). Collective; in any dimension.
+    pub fn projected_pressure_increments(&mut self, model: &Model<D>) -> Result<Vec<f64>, Error> {
+        let nd = self.layout.nd;
+        let pc = self.layout.p.expect("a pressure");
+        if self.l2_projection.is_none() {
+            // The same distribution of the nodes as the system's DMDA.
+            let counts = self.owners.counts_in();
+            let ranges: [&[usize]; D] = std::array::from_fn(|d| &counts[d][..]);
+            let dm = DmDa::new_partitioned(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"], Some(ranges))?;
+            let mut ksp = Ksp::new(self.comm)?;
+            ksp.set_prefix("pressure_projection_")?;
+            ksp.set_type("cg")?;
+            ksp.pc()?.set_type("jacobi")?;
+            ksp.set_tolerances(Some(1e-12), Some(0.0), Some(10_000))?;
+            ksp.set_from_options()?;
+            self.l2_projection = Some((dm, ksp));
+        }
+        let (dm1, ksp) = self.l2_projection.as_mut().expect("built above");
+        let pattern = &self.step.pattern;
+        let (rows, cols) = pattern.coo(1, dm1.local_to_global());
+        let mut mat = dm1.create_matrix_coo(&rows, &cols)?;
+        let mut values = vec![0.0; pattern.len()];
+        let ng = self.ghost.len();
+        let mut b = vec![0.0; ng];
+        let ps = &model.particles;
+        let st = &self.step.stencils;
+        for k in 0..st.len() {
+            let (nodes, basis) = st.get(k);
+            for (&a, ba) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
+                let w = ps.volume[k] * ba.s;
+                b[a as usize] += w * ps.p[k];
+                let ia = pattern.indices(a);
+                for (&c, bc) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
+                    values[pattern.block_of(a, ia, c, pattern.indices(c)) as usize] += w * bc.s;
+                }
+            }
+        }
+        let eps = model.grid.h.iter().fold(1e-12, |e, h| e * h);
+        for &a in &self.owned_nodes {
+            values[pattern.block(a, a).expect("owned diagonal blocks are listed") as usize] += eps;
+        }
+        mat.set_values_coo(&values, false)?;
+        let mut b_local = dm1.create_local_vector()?;
+        b_local.write()?.copy_from_slice(&b);
+        let mut b_global = dm1.create_global_vector()?;
+        b_global.set_all(0.0)?;
+        dm1.local_to_global_add(&b_local, &mut b_global)?;
+        let mut p_global = dm1.create_global_vector()?;
+        ksp.set_operators(&mat, &mat)?;
+        let out = ksp.solve(&b_global, &mut p_global)?;
+        if out.reason <= 0 {
+            return Err(Error::new(format!(
+                "the L² projection of the pore pressure (stabilisation.pressure_update = \"projected_total\") did not \
+                 converge: {} after {} CG iterations",
+                out.reason_text, out.iterations
+            )));
+        }
+        let mut p_local = dm1.create_local_vector()?;
+        dm1.global_to_local(&p_global, &mut p_local)?;
+        let total: Vec<f64> = {
+            let pl = p_local.read()?;
+            (0..ng).map(|l| pl[l] + self.step.solution[l * nd + pc]).collect()
+        };
+        Ok((0..st.len())
+            .map(|k| {
+                let (nodes, basis) = st.get(k);
+                nodes.iter().zip(basis).map(|(&n, nb)| nb.s * total[n as usize]).sum::<f64>() - ps.p[k]
+            })
+            .collect())
+    }
+
+    /// Step 4: the pressure-projection cells, over this rank's particles grouped by the cell
+    /// holding their centre (`kernels::pressure_projection` with the cell's 2^D multilinear
+    /// functions at the points, weights α/G V); none without a pressure or a projection, and none
+    /// for a cell whose corners are not all ghosted.
+    fn projection_cells(&self, model: &Model<D>) -> Vec<ProjectionCell> {
+        let mut out = Vec::new();
+        let (Some(_), Some(alpha)) = (self.layout.p, model.pressure_projection) else { return out };
+        let g = &model.grid;
+        let ps = &model.particles;
+        let mut cells: std::collections::BTreeMap<[usize; D], Vec<usize>> = Default::default();
+        for k in 0..ps.len() {
+            if let Some(c) = g.cell_containing(ps.x[k]) {
+                cells.entry(c).or_default().push(k);
+            }
+        }
+        let corners = 1usize << D;
+        // Corner m of a cell: its bit d says whether the corner is the upper node along d.
+        let upper = |m: usize, d: usize| (m >> d) & 1 == 1;
+        for (c, members) in cells {
+            let Some(nodes) = (0..corners)
+                .map(|m| {
+                    let n: [usize; D] = std::array::from_fn(|d| c[d] + upper(m, d) as usize);
+                    self.ghost.local(n).map(|l| l as u32)
+                })
+                .collect::<Option<Vec<u32>>>()
+            else {
+                continue;
+            };
+            let o = g.position(c);
+            // The multilinear functions at each point (the unused corners of a plane cell zero).
+            let n: Vec<[f64; 8]> = members
+                .iter()
+                .map(|&k| {
+                    let x: [f64; D] = std::array::from_fn(|d| (ps.x[k][d] - o[d]) / g.h[d]);
+                    std::array::from_fn(|m| {
+                        if m >= corners {
+                            return 0.0;
+                        }
+                        (0..D).fold(1.0, |acc, d| acc * if upper(m, d) { x[d] } else { 1.0 - x[d] })
+                    })
+                })
+                .collect();
+            let w: Vec<f64> = members
+                .iter()
+                .map(|&k| {
+                    let shear = model.materials[ps.material[k] as usize].model.elastic().shear_modulus();
+                    alpha / shear * ps.volume[k]
+                })
+                .collect();
+            let s = kernels::pressure_projection(&n, &w);
+            let s = (0..corners).flat_map(|a| (0..corners).map(move |b| s[a][b])).collect();
+            out.push(ProjectionCell { nodes, s });
+        }
+        out
+    }
+
     /// Step 4: the external forces at t_{n+1} per ghosted dof. A traction's share at a node whose
     /// motion is extended goes to the node's masters (extended towards the loaded particle); a share
     /// that no node can carry stays where it is, and [`GridSystem::check_loads`] reports it.
     /// Returns the nodal forces and, for that check, the total force the loads apply on this rank
-    /// (before it is shared out to nodes). The nodal tractions and line pressures are plane
+    /// (before it is shared out to nodes). The line pressures are plane
     /// ([`GridSystem::plane_load`]).
     fn external_forces(
         &self,
@@ -1154,7 +1289,18 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                         }
                     }
                 }
-                LoadTarget::NodalTraction { .. } | LoadTarget::LinePressure { .. } => {
+                LoadTarget::NodalTraction { nodes, traction } => {
+                    // Each node's share on the rank owning it (the cell it is the lower corner of).
+                    for &(n, measure) in nodes.iter().filter(|(n, _)| self.owns_cell_in(*n)) {
+                        let l = self.ghost.local(n).expect("an owned node is ghosted");
+                        let x = g.position(n);
+                        let measure = measure * model.geometry.measure(x[0]);
+                        let force = std::array::from_fn(|d| traction[d] * f * measure);
+                        applied.add(force);
+                        add(l, force, x);
+                    }
+                }
+                LoadTarget::LinePressure { .. } => {
                     if let (Some(plane), Some(system)) = (model.as_plane(), self.as_plane_ref()) {
                         let (forces, totals) = system.plane_load(plane, li, f);
                         for total in totals {
@@ -1597,8 +1743,8 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
 }
 
 /// The parts of the global system that exist only in the plane (validation keeps them out of
-/// three-dimensional cases): moving surfaces and their drained faces, loads, [001]'s mapped
-/// stiffnesses, the pressure projection, the explicit update and the MLSA recovery.
+/// three-dimensional cases): moving surfaces and their drained faces, line pressures, [001]'s mapped
+/// stiffnesses and the MLSA recovery.
 impl GridSystem {
     /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
     /// it is.
@@ -1606,23 +1752,14 @@ impl GridSystem {
         self.owns_cell_in([i, j])
     }
 
-    /// The shares of load `li` (a nodal traction or a line pressure, plane only) at factor `f`:
-    /// the forces with the ghosted node each goes to and the point an extension reaches towards,
-    /// in the order [`GridSystem::external_forces`] adds them, and the forces the load applies.
+    /// The shares of load `li` (a line pressure, plane only) at factor `f`: the forces with the
+    /// ghosted node each goes to and the point an extension reaches towards, in the order
+    /// [`GridSystem::external_forces`] adds them, and the forces the load applies.
     #[allow(clippy::type_complexity)]
     fn plane_load(&self, model: &Model, li: usize, f: f64) -> (Vec<(usize, [f64; 2], [f64; 2])>, Vec<[f64; 2]>) {
         let g = &model.grid;
         let (mut forces, mut totals) = (Vec::new(), Vec::new());
         match &model.loads[li].target {
-            LoadTarget::NodalTraction { nodes, traction } => {
-                for &(i, j, trib) in nodes.iter().filter(|&&(i, j, _)| self.owns_cell(i, j)) {
-                    let l = self.ghost.node(i, j).expect("owned");
-                    let trib = trib * model.geometry.measure(g.node_position(i, j)[0]);
-                    let force = [traction[0] * f * trib, traction[1] * f * trib];
-                    totals.push(force);
-                    forces.push((l, force, g.node_position(i, j)));
-                }
-            }
             LoadTarget::LinePressure { points, pressure } => {
                 // Each Gauss point on the rank owning the cell that holds it.
                 for &(point, force) in points {
@@ -1641,7 +1778,7 @@ impl GridSystem {
                     }
                 }
             }
-            LoadTarget::ParticleTraction { .. } | LoadTarget::BodyForce { .. } => {}
+            LoadTarget::ParticleTraction { .. } | LoadTarget::NodalTraction { .. } | LoadTarget::BodyForce { .. } => {}
         }
         (forces, totals)
     }
@@ -1704,46 +1841,6 @@ impl GridSystem {
             .collect()
     }
 
-    /// Step 4: the pressure-projection blocks, cell by cell over this rank's particles (grouped by
-    /// the cell holding their centre).
-    fn projection_blocks(&self, model: &Model) -> Vec<([u32; 4], [[f64; 4]; 4])> {
-        let mut out = Vec::new();
-        let (Some(_), Some(alpha)) = (self.layout.p, model.pressure_projection) else { return out };
-        let g = &model.grid;
-        let ps = &model.particles;
-        let mut cells: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
-        for k in 0..ps.len() {
-            if let Some(c) = g.cell_of(ps.x[k]) {
-                cells.entry(c).or_default().push(k);
-            }
-        }
-        for ((ci, cj), members) in cells {
-            let corners = [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)];
-            let Some(nodes) =
-                corners.iter().map(|&(i, j)| self.ghost.node(i, j).map(|l| l as u32)).collect::<Option<Vec<u32>>>()
-            else {
-                continue;
-            };
-            let o = g.node_position(ci, cj);
-            let n: Vec<[f64; 4]> = members
-                .iter()
-                .map(|&k| {
-                    let (x, y) = ((ps.x[k][0] - o[0]) / g.h[0], (ps.x[k][1] - o[1]) / g.h[1]);
-                    [(1.0 - x) * (1.0 - y), x * (1.0 - y), (1.0 - x) * y, x * y]
-                })
-                .collect();
-            let w: Vec<f64> = members
-                .iter()
-                .map(|&k| {
-                    let shear = model.materials[ps.material[k] as usize].model.elastic().shear_modulus();
-                    alpha / shear * ps.volume[k]
-                })
-                .collect();
-            out.push(([nodes[0], nodes[1], nodes[2], nodes[3]], kernels::pressure_projection(&n, &w)));
-        }
-        out
-    }
-
     /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
     /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
     /// interpolated increment.
@@ -1761,84 +1858,6 @@ impl GridSystem {
         (0..model.particles.len())
             .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).interp.dp))
             .collect()
-    }
-
-    /// Pore-pressure increments that make each particle's pressure the interpolation of the total
-    /// nodal field, p_{n+1} = Σ S_i (P_i + Δp_i) (`stabilisation.pressure_update =
-    /// "projected_total"`). P is the consistent L² projection of the particles' pressures p_n onto
-    /// the nodal functions: M P = b with M_ij = Σ_p V_p S_ip S_jp and b_i = Σ_p V_p S_ip p_p, solved
-    /// by CG with Jacobi (options prefix `pressure_projection_`, relative tolerance 1e-12). A
-    /// pressure field the nodes represent comes back unchanged (no smoothing, unlike a lumped
-    /// projection), and what they cannot represent is dropped instead of accumulating on the
-    /// particles. Nodes no particle reaches get P = 0 (a regularisation of 1e-12 of a cell's area
-    /// on every diagonal). Collective.
-    pub fn projected_pressure_increments(&mut self, model: &Model) -> Result<Vec<f64>, Error> {
-        let nd = self.layout.nd;
-        let pc = self.layout.p.expect("a pressure");
-        if self.l2_projection.is_none() {
-            // The same distribution of the nodes as the system's DMDA.
-            let (x, y) = self.owners.counts();
-            let dm = DmDa::new_2d_partitioned(self.comm, self.dm.info().nodes, STENCIL_WIDTH, &["p"], Some((&x, &y)))?;
-            let mut ksp = Ksp::new(self.comm)?;
-            ksp.set_prefix("pressure_projection_")?;
-            ksp.set_type("cg")?;
-            ksp.pc()?.set_type("jacobi")?;
-            ksp.set_tolerances(Some(1e-12), Some(0.0), Some(10_000))?;
-            ksp.set_from_options()?;
-            self.l2_projection = Some((dm, ksp));
-        }
-        let (dm1, ksp) = self.l2_projection.as_mut().expect("built above");
-        let pattern = &self.step.pattern;
-        let (rows, cols) = pattern.coo(1, dm1.local_to_global());
-        let mut mat = dm1.create_matrix_coo(&rows, &cols)?;
-        let mut values = vec![0.0; pattern.len()];
-        let ng = self.ghost.len();
-        let mut b = vec![0.0; ng];
-        let ps = &model.particles;
-        let st = &self.step.stencils;
-        for k in 0..st.len() {
-            let (nodes, basis) = st.get(k);
-            for (&a, ba) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
-                let w = ps.volume[k] * ba.s;
-                b[a as usize] += w * ps.p[k];
-                let ija = pattern.ij(a);
-                for (&c, bc) in nodes.iter().zip(basis).filter(|(_, nb)| nb.s != 0.0) {
-                    values[pattern.block_at(a, ija, c, pattern.ij(c)) as usize] += w * bc.s;
-                }
-            }
-        }
-        let eps = 1e-12 * model.grid.h[0] * model.grid.h[1];
-        for &a in &self.owned_nodes {
-            values[pattern.block(a, a).expect("owned diagonal blocks are listed") as usize] += eps;
-        }
-        mat.set_values_coo(&values, false)?;
-        let mut b_local = dm1.create_local_vector()?;
-        b_local.write()?.copy_from_slice(&b);
-        let mut b_global = dm1.create_global_vector()?;
-        b_global.set_all(0.0)?;
-        dm1.local_to_global_add(&b_local, &mut b_global)?;
-        let mut p_global = dm1.create_global_vector()?;
-        ksp.set_operators(&mat, &mat)?;
-        let out = ksp.solve(&b_global, &mut p_global)?;
-        if out.reason <= 0 {
-            return Err(Error::new(format!(
-                "the L² projection of the pore pressure (stabilisation.pressure_update = \"projected_total\") did not \
-                 converge: {} after {} CG iterations",
-                out.reason_text, out.iterations
-            )));
-        }
-        let mut p_local = dm1.create_local_vector()?;
-        dm1.global_to_local(&p_global, &mut p_local)?;
-        let total: Vec<f64> = {
-            let pl = p_local.read()?;
-            (0..ng).map(|l| pl[l] + self.step.solution[l * nd + pc]).collect()
-        };
-        Ok((0..st.len())
-            .map(|k| {
-                let (nodes, basis) = st.get(k);
-                nodes.iter().zip(basis).map(|(&n, nb)| nb.s * total[n as usize]).sum::<f64>() - ps.p[k]
-            })
-            .collect())
     }
 }
 

@@ -304,12 +304,18 @@ impl Region {
         if !self.contains([p[0], p[1]]) {
             return false;
         }
-        match (D, self.z) {
-            (3, Some([lo, hi])) => {
+        D < 3 || self.spans_z(p[2])
+    }
+
+    /// Whether `z` lies in the box's `z` range (all of z without one), with the tolerance of
+    /// [`Region::contains`].
+    pub fn spans_z(&self, z: f64) -> bool {
+        match self.z {
+            Some([lo, hi]) => {
                 let tol = 1e-9 * ((hi - lo).abs() + lo.abs() + hi.abs()) + 1e-15;
-                p[2] >= lo - tol && p[2] <= hi + tol
+                z >= lo - tol && z <= hi + tol
             }
-            _ => true,
+            None => true,
         }
     }
 

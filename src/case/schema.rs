@@ -618,10 +618,11 @@ pub enum Load {
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
-        /// An expression in `x` and `y` [m] (and the case's parameters) that scales each step's
-        /// increment of the load by where the loaded faces are at the start of the step: over the
-        /// step from t_n to t_{n+1} the traction grows by `traction` × (f(t_{n+1}) − f(t_n)) ×
-        /// g(x̄_n, ȳ_n), with x̄_n, ȳ_n the area-weighted mean centre of the loaded faces at t_n.
+        /// An expression in `x` and `y` [m] (and `z` in a three-dimensional case, and the case's
+        /// parameters) that scales each step's increment of the load by where the loaded faces are
+        /// at the start of the step: over the step from t_n to t_{n+1} the traction grows by
+        /// `traction` × (f(t_{n+1}) − f(t_n)) × g(x̄_n, ȳ_n[, z̄_n]), with (x̄_n, ȳ_n[, z̄_n]) the
+        /// area-weighted mean centre of the loaded faces at t_n.
         /// The total is the sum of the increments, each applied where the surface was (e.g.
         /// [001]'s internal pressure re-evaluated at the current inner radius,
         /// `"A / x^2 + 2 * C"`). Written without the leading `=` (it is evaluated during the run,
@@ -629,23 +630,26 @@ pub enum Load {
         #[serde(default)]
         increment_factor: Option<String>,
     },
-    /// A traction [Pa] along the line of grid nodes inside `region`, each node taking its
-    /// tributary length of the line. The load stays on that grid line: when the loaded surface moves
+    /// A traction [Pa] on the line (plane) or surface (three dimensions) of grid nodes inside
+    /// `region`, each node taking its tributary length of the line or the product of its tributary
+    /// lengths along the surface. The load stays on that grid line: when the loaded surface moves
     /// off it by δ, the stress of the particles in the cell below is too large by about h/(h − δ)
     /// (the force passes through a partly filled cell). Use a `particle_traction`, which follows the
     /// surface, when the surface moves by more than a small fraction of a cell.
     NodalTraction {
         /// Name used by stages and verification.
         name: String,
-        /// Nodes carrying it (a row or column of nodes).
+        /// Nodes carrying it: a row or column of nodes in the plane, a layer of nodes in three
+        /// dimensions (one node thick in one direction, validated).
         region: Region,
-        /// Traction vector [Pa] (two components: a plane case only).
+        /// Traction vector [Pa]: two components in a plane case, three in a three-dimensional one.
         traction: Vec<f64>,
         /// Name of the time function scaling it.
         #[serde(default)]
         time_function: Option<String>,
     },
-    /// A pressure [Pa] on a polyline fixed in space (e.g. the inside of a cylinder), pushing the
+    /// A pressure [Pa] on a polyline fixed in space (e.g. the inside of a cylinder; plane and
+    /// axisymmetric cases only), pushing the
     /// material that lies on the left of the direction of travel along `points`: the force per
     /// metre is p n with n the unit normal to the left. It is integrated along each segment with
     /// two Gauss points and distributed with the bilinear hat functions of the cell holding each

@@ -225,9 +225,9 @@ fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
     Ok(())
 }
 
-/// What a three-dimensional case may not ask for yet (issue «Three dimensions»: nodal tractions,
-/// line pressures and increment factors, the plane benchmarks' checks, [001]'s CMPM and mapped
-/// stiffnesses, the pressure projection, patch recovery and the projected total pressure update;
+/// What a three-dimensional case may not ask for (line pressures, which are plane by nature) or
+/// not yet (issue «Three dimensions»: the plane benchmarks' checks, [001]'s CMPM and mapped
+/// stiffnesses and patch recovery;
 /// moving surfaces are refused with the boundaries), and the space of its points' identifiers.
 fn three_dimensional(c: &Case) -> R {
     let not_yet = |key: &str| {
@@ -242,12 +242,11 @@ fn three_dimensional(c: &Case) -> R {
             .into());
     }
     for (i, l) in c.loads.iter().enumerate() {
-        match l {
-            Load::NodalTraction { .. } | Load::LinePressure { .. } => {
-                return not_yet(&format!("loads[{i}].kind = \"{}\"", l.kind()));
-            }
-            _ if l.increment_factor().is_some() => return not_yet(&format!("loads[{i}].increment_factor")),
-            _ => {}
+        if matches!(l, Load::LinePressure { .. }) {
+            return Err(format!(
+                "key `loads[{i}].kind = \"line_pressure\"`: a line pressure acts on a plane polyline; a \
+                 three-dimensional case loads a surface with a `particle_traction` or a `nodal_traction`"
+            ));
         }
     }
     match &c.verification {
@@ -259,14 +258,8 @@ fn three_dimensional(c: &Case) -> R {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
     }
     let st = &c.stabilisation;
-    if st.pressure_projection.is_some() {
-        return not_yet("stabilisation.pressure_projection");
-    }
     if st.patch_recovery == Some(true) {
         return not_yet("stabilisation.patch_recovery");
-    }
-    if st.pressure_update == crate::case::PressureUpdate::ProjectedTotal {
-        return not_yet("stabilisation.pressure_update");
     }
     if st.stiffness != crate::case::Stiffness::Particle {
         return not_yet("stabilisation.stiffness");
@@ -278,6 +271,50 @@ fn three_dimensional(c: &Case) -> R {
         return Err(format!(
             "key `grid.cells`: {:?} cells are too many to number the material points of (at most 2^48 / 512 cells)",
             c.grid.cells
+        ));
+    }
+    Ok(())
+}
+
+/// Whether the grid nodes inside a nodal traction's `region` form what it loads: a line of the
+/// plane's grid or a surface of a three-dimensional one (the nodes of a box are a block of the grid;
+/// it must be one node thick in exactly one direction, and more than one node wide in the others,
+/// or the tributary measures of `model::loads::tributary_nodes` would be zero or counted twice).
+fn nodal_line(c: &Case, region: &crate::case::Region) -> R {
+    let dim = c.dimension();
+    let (origin, h, cells) = (c.origin_in::<3>(), c.cell_size_in::<3>(), c.cells_in::<3>());
+    let counts: Vec<usize> = (0..dim)
+        .map(|d| {
+            (0..=cells[d])
+                .filter(|&i| {
+                    let x = origin[d] + i as f64 * h[d];
+                    if d == 2 {
+                        region.spans_z(x)
+                    } else {
+                        region.spans(d, x, 0.0)
+                    }
+                })
+                .count()
+        })
+        .collect();
+    let what = if dim == 2 { "a line" } else { "a surface" };
+    if counts.contains(&0) {
+        return Err("holds no grid node".into());
+    }
+    let thin = counts.iter().filter(|&&n| n == 1).count();
+    if thin != 1 {
+        return Err(format!(
+            "the grid nodes inside it must form {what} of the grid (one node thick in one direction), but it holds \
+             {} nodes along x, y{} ({})",
+            counts.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", "),
+            if dim == 3 { ", z" } else { "" },
+            if thin == 0 {
+                "a block"
+            } else if dim == 3 && thin == 2 {
+                "a line"
+            } else {
+                "a single node"
+            }
         ));
     }
     Ok(())
@@ -716,18 +753,25 @@ pub fn validate(c: &Case) -> R {
         }
         match l {
             Load::ParticleTraction { region, traction, .. } | Load::NodalTraction { region, traction, .. } => {
-                // A nodal traction is plane (refused in three dimensions).
-                let dim = if matches!(l, Load::NodalTraction { .. }) { 2 } else { c.dimension() };
-                components(&format!("loads[{i}].traction"), traction, dim)?;
+                components(&format!("loads[{i}].traction"), traction, c.dimension())?;
                 finite2(&format!("loads[{i}].region.min"), region.min)?;
                 finite2(&format!("loads[{i}].region.max"), region.max)?;
                 if region.max[0] < region.min[0] || region.max[1] < region.min[1] {
                     return Err(format!("key `loads[{i}].region`: max must not be below min"));
                 }
+                if matches!(l, Load::NodalTraction { .. }) {
+                    nodal_line(c, region).map_err(|m| format!("key `loads[{i}].region`: {m}"))?;
+                }
                 if let Some(e) = l.increment_factor() {
-                    // Tried where the loaded faces start: the region's centre.
-                    let centre = [0.5 * (region.min[0] + region.max[0]), 0.5 * (region.min[1] + region.max[1])];
-                    crate::model::loads::increment_factor(e, &c.parameters, centre)
+                    // Tried where the loaded faces start: the region's centre (its z range's, or
+                    // the grid's, in three dimensions).
+                    let mut centre = vec![0.5 * (region.min[0] + region.max[0]), 0.5 * (region.min[1] + region.max[1])];
+                    if c.dimension() == 3 {
+                        let z0 = c.origin_in::<3>()[2];
+                        let [lo, hi] = region.z.unwrap_or([z0, z0 + c.grid.size[2]]);
+                        centre.push(0.5 * (lo + hi));
+                    }
+                    crate::model::loads::increment_factor(e, &c.parameters, &centre)
                         .map_err(|m| format!("key `loads[{i}].increment_factor`: `{e}` at {centre:?}: {m}"))?;
                 }
             }

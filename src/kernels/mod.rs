@@ -1051,26 +1051,27 @@ impl<const D: usize> StepResult<D> {
 
 /// Pressure-projection stabilisation of one cell (Bochev & Dohrmann 2006; Dohrmann & Bochev 2004,
 /// for equal-order pressures): S_kl = Σ_p w_p (N_k(x_p) − N̄_k)(N_l(x_p) − N̄_l) over the material
-/// points p of the cell, with N the cell's four bilinear functions at the points, w_p = τ_p V_p and
-/// N̄ the w-weighted cell averages. Δpᵀ S Δp penalises the part of the pressure increment that is
-/// not constant in the cell, which the volumetric coupling of equal-order (and B̄) interpolation
+/// points p of the cell, with N the cell's C multilinear functions at the points (four bilinear
+/// ones in the plane, eight trilinear ones in three dimensions), w_p = τ_p V_p and N̄ the
+/// w-weighted cell averages. Δpᵀ S Δp penalises the part of the pressure increment that is not
+/// constant in the cell, which the volumetric coupling of equal-order (and B̄) interpolation
 /// cannot see; it vanishes for a cell-wise constant field. The caller subtracts S Δp from the
 /// continuity rows (the sign of −P).
-pub fn pressure_projection(n: &[[f64; 4]], w: &[f64]) -> [[f64; 4]; 4] {
+pub fn pressure_projection<const C: usize>(n: &[[f64; C]], w: &[f64]) -> [[f64; C]; C] {
     let total: f64 = w.iter().sum();
-    let mut out = [[0.0; 4]; 4];
+    let mut out = [[0.0; C]; C];
     if total <= 0.0 {
         return out;
     }
-    let mut mean = [0.0; 4];
+    let mut mean = [0.0; C];
     for (np, wp) in n.iter().zip(w) {
-        for k in 0..4 {
+        for k in 0..C {
             mean[k] += wp * np[k] / total;
         }
     }
     for (np, wp) in n.iter().zip(w) {
-        for k in 0..4 {
-            for l in 0..4 {
+        for k in 0..C {
+            for l in 0..C {
                 out[k][l] += wp * (np[k] - mean[k]) * (np[l] - mean[l]);
             }
         }

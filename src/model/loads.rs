@@ -108,15 +108,16 @@ pub enum IncrementsFrom {
     Accepted,
 }
 
-/// The value of an `increment_factor` expression at `at` = (x, y) [m].
+/// The value of an `increment_factor` expression at `at` = (x, y) or (x, y, z) [m].
 pub fn increment_factor(
     expr: &str,
     params: &std::collections::BTreeMap<String, f64>,
-    at: [f64; 2],
+    at: &[f64],
 ) -> Result<f64, String> {
     let mut vars: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.clone(), *v)).collect();
-    vars.push(("x".into(), at[0]));
-    vars.push(("y".into(), at[1]));
+    for (name, v) in ["x", "y", "z"].iter().zip(at) {
+        vars.push((name.to_string(), *v));
+    }
     crate::case::parameters::eval(expr, &vars)
 }
 
@@ -134,13 +135,14 @@ pub fn face_point<const D: usize>(face: Side, x: [f64; D], lp: [f64; D]) -> ([f6
     (p, measure)
 }
 
-/// What a load acts on (in D dimensions; the nodal tractions and line pressures are plane).
+/// What a load acts on (in D dimensions; the line pressures are plane).
 #[derive(Debug, Clone)]
 pub enum LoadTarget<const D: usize = 2> {
     /// Face tractions on the listed particles (local indices), applied at the face centre.
     ParticleTraction { particles: Vec<usize>, face: Side, traction: [f64; D] },
-    /// Forces on grid nodes (i, j, tributary length [m]).
-    NodalTraction { nodes: Vec<(usize, usize, f64)>, traction: [f64; 2] },
+    /// Forces on grid nodes: their indices and the measure of the loaded line (plane, [m]) or
+    /// surface (three dimensions, [m²]) each stands for ([`tributary_nodes`]).
+    NodalTraction { nodes: Vec<([usize; D], f64)>, traction: [f64; D] },
     /// Body acceleration on the particles of the listed bodies (all if None).
     BodyForce { acceleration: [f64; D], bodies: Option<Vec<u16>> },
     /// A pressure on a fixed polyline: its Gauss points with the force per unit pressure there
@@ -152,29 +154,26 @@ impl LoadDef {
     /// Resolves a case load on this rank's particles and the grid.
     pub fn from_case(l: &case::Load, c: &case::Case, grid: &Grid, particles: &Particles) -> LoadDef {
         match l {
-            case::Load::NodalTraction { region, traction, .. } => LoadDef::with_target(
-                l,
-                c,
-                LoadTarget::NodalTraction {
-                    nodes: tributary_nodes(grid, region),
-                    traction: [traction[0], traction[1]],
-                },
-            ),
             case::Load::LinePressure { points, pressure, .. } => LoadDef::with_target(
                 l,
                 c,
                 LoadTarget::LinePressure { points: line_gauss_points(points), pressure: *pressure },
             ),
-            _ => LoadDef::from_case_in(l, c, particles).expect("a load of any dimension"),
+            _ => LoadDef::from_case_in(l, c, grid, particles).expect("a load of any dimension"),
         }
     }
 }
 
 impl<const D: usize> LoadDef<D> {
-    /// Resolves a case load of any dimension on this rank's particles: a face traction or a body
-    /// force (`None` for the plane's nodal tractions and line pressures, which validation keeps
-    /// out of three-dimensional cases).
-    pub fn from_case_in(l: &case::Load, c: &case::Case, particles: &Particles<D>) -> Option<LoadDef<D>> {
+    /// Resolves a case load of any dimension on this rank's particles and the grid: a face
+    /// traction, a nodal traction or a body force (`None` for the plane's line pressures, which
+    /// validation keeps out of three-dimensional cases).
+    pub fn from_case_in(
+        l: &case::Load,
+        c: &case::Case,
+        grid: &Grid<D>,
+        particles: &Particles<D>,
+    ) -> Option<LoadDef<D>> {
         let vector = |v: &[f64]| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
         let target = match l {
             case::Load::ParticleTraction { region, body, face, traction, .. } => LoadTarget::ParticleTraction {
@@ -189,13 +188,16 @@ impl<const D: usize> LoadDef<D> {
                 face: *face,
                 traction: vector(traction),
             },
+            case::Load::NodalTraction { region, traction, .. } => {
+                LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: vector(traction) }
+            }
             case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
                 acceleration: vector(acceleration),
                 bodies: bodies
                     .as_ref()
                     .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
             },
-            case::Load::NodalTraction { .. } | case::Load::LinePressure { .. } => return None,
+            case::Load::LinePressure { .. } => return None,
         };
         Some(LoadDef::with_target(l, c, target))
     }
@@ -234,18 +236,20 @@ impl<const D: usize> LoadDef<D> {
     }
 }
 
-impl LoadDef {
-    /// This rank's moments of the loaded faces: [Σ a x, Σ a y, Σ a] with a the face's area
-    /// (length, times 2πr in axial symmetry); zero unless it is a face traction.
-    pub fn face_moments(&self, particles: &Particles, geometry: &super::shape::Geometry) -> [f64; 3] {
-        let mut m = [0.0; 3];
+impl<const D: usize> LoadDef<D> {
+    /// This rank's moments of the loaded faces: [Σ a x, Σ a y, (Σ a z,) Σ a] with a the face's
+    /// area (its length in the plane, times 2πr in axial symmetry); zero unless it is a face
+    /// traction.
+    pub fn face_moments(&self, particles: &Particles<D>, geometry: &super::shape::Geometry) -> Vec<f64> {
+        let mut m = vec![0.0; D + 1];
         if let LoadTarget::ParticleTraction { particles: ks, face, .. } = &self.target {
             for &k in ks {
-                let (point, length) = face_point(*face, particles.x[k], particles.lp[k]);
-                let a = length * geometry.measure(point[0]);
-                m[0] += a * point[0];
-                m[1] += a * point[1];
-                m[2] += a;
+                let (point, measure) = face_point(*face, particles.x[k], particles.lp[k]);
+                let a = measure * geometry.measure(point[0]);
+                for d in 0..D {
+                    m[d] += a * point[d];
+                }
+                m[D] += a;
             }
         }
         m
@@ -255,9 +259,9 @@ impl LoadDef {
     /// faces' mean centre now (from all ranks' [`Self::face_moments`]); `total` becomes f(t) g at
     /// the run's start, the checkpoint's total on a restart, or the step's factor at t at the end
     /// of an accepted step.
-    pub fn set_increments(&mut self, t: f64, centre: [f64; 2], from: IncrementsFrom) -> Result<(), String> {
+    pub fn set_increments(&mut self, t: f64, centre: [f64; D], from: IncrementsFrom) -> Result<(), String> {
         let Some(s) = &self.increments else { return Ok(()) };
-        let g = increment_factor(&s.expr, &s.params, centre)
+        let g = increment_factor(&s.expr, &s.params, &centre)
             .map_err(|e| format!("load `{}`: increment_factor `{}` at {centre:?}: {e}", self.name, s.expr))?;
         let total = match from {
             IncrementsFrom::Start => self.time_fn.eval(t) * g,
@@ -307,36 +311,42 @@ pub fn line_gauss_points(points: &[[f64; 2]]) -> Vec<([f64; 2], [f64; 2])> {
     out
 }
 
-/// Grid nodes inside `region`, with the length of line each stands for: half the distance to its
-/// neighbours along the line (the line is along the direction in which the nodes spread most).
-pub fn tributary_nodes(grid: &Grid, region: &Region) -> Vec<(usize, usize, f64)> {
-    let [nx, ny] = grid.nodes();
-    let mut sel: Vec<(usize, usize)> = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if region.contains(grid.node_position(i, j)) {
-                sel.push((i, j));
-            }
-        }
-    }
+/// Grid nodes inside `region`, each with the measure of the loaded line or surface it stands for:
+/// the line (plane) or surface (three dimensions) spreads along the D − 1 directions in which the
+/// nodes spread most, and along each of them a node takes half the distance to its neighbours
+/// (the nodes of a box form a block of the grid, so the surface's share is the product of the
+/// lines'). The nodes are ordered along the direction of largest spread.
+pub fn tributary_nodes<const D: usize>(grid: &Grid<D>, region: &Region) -> Vec<([usize; D], f64)> {
+    let mut sel: Vec<[usize; D]> = (0..grid.node_count())
+        .map(|k| grid.node_indices(k))
+        .filter(|&n| region.contains_in(grid.position(n)))
+        .collect();
     if sel.is_empty() {
         return Vec::new();
     }
-    let spread = |d: usize| {
-        let v: Vec<f64> = sel.iter().map(|&(i, j)| grid.node_position(i, j)[d]).collect();
-        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min)
+    // The indices the nodes take along each direction, and the spread of their positions.
+    let lines: [Vec<usize>; D] = std::array::from_fn(|d| {
+        let mut v: Vec<usize> = sel.iter().map(|n| n[d]).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    });
+    let position = |d: usize, i: usize| grid.origin[d] + i as f64 * grid.h[d];
+    let spread = |d: usize| position(d, *lines[d].last().expect("a node")) - position(d, lines[d][0]);
+    // The directions by decreasing spread (the lower direction first on a tie).
+    let mut dirs: Vec<usize> = (0..D).collect();
+    dirs.sort_by(|&a, &b| spread(b).total_cmp(&spread(a)));
+    let along = &dirs[..D - 1];
+    let share = |d: usize, i: usize| {
+        let line = &lines[d];
+        let k = line.binary_search(&i).expect("a selected index");
+        let left = if k > 0 { (position(d, line[k]) - position(d, line[k - 1])) / 2.0 } else { 0.0 };
+        let right = if k + 1 < line.len() { (position(d, line[k + 1]) - position(d, line[k])) / 2.0 } else { 0.0 };
+        left + right
     };
-    let dir = if spread(0) >= spread(1) { 0 } else { 1 };
-    let coord = |n: &(usize, usize)| grid.node_position(n.0, n.1)[dir];
-    sel.sort_by(|a, b| coord(a).total_cmp(&coord(b)));
-    let m = sel.len();
-    (0..m)
-        .map(|k| {
-            let left = if k > 0 { (coord(&sel[k]) - coord(&sel[k - 1])) / 2.0 } else { 0.0 };
-            let right = if k + 1 < m { (coord(&sel[k + 1]) - coord(&sel[k])) / 2.0 } else { 0.0 };
-            (sel[k].0, sel[k].1, left + right)
-        })
-        .collect()
+    let main = along[0];
+    sel.sort_by(|a, b| position(main, a[main]).total_cmp(&position(main, b[main])));
+    sel.into_iter().map(|n| (n, along.iter().map(|&d| share(d, n[d])).product())).collect()
 }
 
 /// A prescribed motion of a boundary's fixed displacement components, in `D` dimensions.
@@ -613,9 +623,33 @@ mod tests {
         let g = Grid::new([0.0, 0.0], [0.25, 0.25], [8, 4]);
         let nodes = tributary_nodes(&g, &Region { min: [0.0, 1.0], max: [0.5, 1.0], z: None });
         assert_eq!(nodes.len(), 3);
-        let total: f64 = nodes.iter().map(|n| n.2).sum();
+        let total: f64 = nodes.iter().map(|n| n.1).sum();
         assert!((total - 0.5).abs() < 1e-12);
-        assert_eq!(nodes[0].2, 0.125);
-        assert_eq!(nodes[1].2, 0.25);
+        assert_eq!(nodes[0], ([0, 4], 0.125));
+        assert_eq!(nodes[1], ([1, 4], 0.25));
+    }
+
+    /// In three dimensions a nodal traction's nodes stand for a surface: a node's share is the
+    /// product of its tributary lengths along the surface's two directions (a quarter cell face at a
+    /// corner, half at an edge, a whole face inside), whichever direction the surface faces.
+    #[test]
+    fn tributary_areas_sum_to_the_loaded_surface() {
+        let g = Grid::new([0.0, 0.0, 0.0], [0.25, 0.5, 0.125], [8, 4, 8]);
+        // The top (y = 2) over x ∈ [0, 0.5] and z ∈ [0, 0.25]: 3 × 3 nodes.
+        let top = tributary_nodes(&g, &Region { min: [0.0, 2.0], max: [0.5, 2.0], z: Some([0.0, 0.25]) });
+        assert_eq!(top.len(), 9);
+        let share = |n: [usize; 3]| top.iter().find(|(m, _)| *m == n).map(|(_, a)| *a);
+        assert_eq!(share([0, 4, 0]), Some(0.125 * 0.0625));
+        assert_eq!(share([1, 4, 0]), Some(0.25 * 0.0625));
+        assert_eq!(share([1, 4, 1]), Some(0.25 * 0.125));
+        let total: f64 = top.iter().map(|n| n.1).sum();
+        assert!((total - 0.5 * 0.25).abs() < 1e-15, "{total}");
+        // Ordered along x, the direction of largest spread.
+        assert!(top.windows(2).all(|w| w[0].0[0] <= w[1].0[0]));
+        // A side face x = 2 over y ∈ [0, 1] and z ∈ [0.5, 1]: 3 × 5 nodes, area 0.5.
+        let side = tributary_nodes(&g, &Region { min: [2.0, 0.0], max: [2.0, 1.0], z: Some([0.5, 1.0]) });
+        assert_eq!(side.len(), 15);
+        let total: f64 = side.iter().map(|n| n.1).sum();
+        assert!((total - 0.5).abs() < 1e-15, "{total}");
     }
 }

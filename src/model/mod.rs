@@ -274,13 +274,12 @@ impl Model {
 
 impl Model<3> {
     /// Builds the model of a three-dimensional `case`, generating particles only in the cells
-    /// `owned(cell)` (its side and region boundaries; no loads: a three-dimensional case has none
-    /// yet).
+    /// `owned(cell)`, with its side and region boundaries and its loads.
     pub fn build_solid(case: &Case, owned: impl Fn([usize; 3]) -> bool) -> Model<3> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
         let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case_in(b, case, None)).collect();
-        let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &particles)).collect();
+        let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
         Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 }
@@ -359,7 +358,7 @@ impl<const D: usize> Model<D> {
             if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
                 // The state of a load with increments is global (the same on every rank): kept.
                 let increments = l.increments.take();
-                if let Some(resolved) = LoadDef::from_case_in(c, case, &self.particles) {
+                if let Some(resolved) = LoadDef::from_case_in(c, case, &self.grid, &self.particles) {
                     *l = resolved;
                 }
                 l.increments = increments;

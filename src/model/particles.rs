@@ -412,7 +412,28 @@ mod tests {
             (
                 solid.clone()
                     + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 1.0], max = [0.1, 1.0] }\ntraction = [0.0, -1.0]\n",
-                "key `loads[0].kind = \"nodal_traction\"`: not available in a three-dimensional case yet",
+                "key `loads[0].traction`: 3 components in a case of 3 dimensions, got 2",
+            ),
+            (
+                solid.clone()
+                    + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 1.0], max = [0.1, 1.0], z = [0.0, 0.0] }\ntraction = [0.0, -1.0, 0.0]\n",
+                "key `loads[0].region`: the grid nodes inside it must form a surface of the grid (one node thick in one \
+                 direction), but it holds 2, 1, 1 nodes along x, y, z (a line)",
+            ),
+            (
+                base.to_string()
+                    + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 0.9], max = [0.1, 1.0] }\ntraction = [0.0, -1.0]\n",
+                "key `loads[0].region`: the grid nodes inside it must form a line of the grid (one node thick in one \
+                 direction), but it holds 2, 2 nodes along x, y (a block)",
+            ),
+            (
+                base.to_string()
+                    + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.02, 0.9], max = [0.08, 1.0] }\ntraction = [0.0, -1.0]\n",
+                "key `loads[0].region`: holds no grid node",
+            ),
+            (
+                solid.clone() + "[[loads]]\nname = \"q\"\nkind = \"line_pressure\"\npoints = [[0.0, 1.0], [0.1, 1.0]]\npressure = 1.0\n",
+                "key `loads[0].kind = \"line_pressure\"`: a line pressure acts on a plane polyline",
             ),
             (
                 base.to_string() + "[[loads]]\nname = \"g\"\nkind = \"body_force\"\nacceleration = [0.0, -9.81, 0.0]\n",
@@ -434,6 +455,16 @@ mod tests {
             assert!(e.contains(want), "{e}\n  does not say: {want}");
         }
         assert!(case::parse(&solid, "t", &[]).is_ok());
+        // A nodal traction on the top face, and a face traction whose increments follow the
+        // loaded faces with an expression in z, are three-dimensional loads.
+        let loaded = solid.clone()
+            + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 1.0], max = [0.1, 1.0] }\ntraction = [0.0, -1.0, 0.0]\n"
+            + "[[loads]]\nname = \"t\"\nkind = \"particle_traction\"\nregion = { min = [0.0, 0.9], max = [0.1, 1.0] }\nface = \"y_max\"\ntraction = [0.0, -1.0, 0.0]\nincrement_factor = \"1 + z\"\n";
+        assert!(case::parse(&loaded, "t", &[]).is_ok(), "{:?}", case::parse(&loaded, "t", &[]).err());
+        let plane_z = base.to_string()
+            + "[[loads]]\nname = \"t\"\nkind = \"particle_traction\"\nregion = { min = [0.0, 0.9], max = [0.1, 1.0] }\nface = \"y_max\"\ntraction = [0.0, -1.0]\nincrement_factor = \"1 + z\"\n";
+        let e = case::parse(&plane_z, "t", &[]).unwrap_err().to_string();
+        assert!(e.contains("key `loads[0].increment_factor`: `1 + z`"), "{e}");
     }
 
     /// A three-dimensional case's side and region boundaries: each grid node is fixed by the first

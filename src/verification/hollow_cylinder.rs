@@ -170,7 +170,7 @@ impl HollowCylinderCheck {
     /// Δf; g ≡ 1 without an `increment_factor`).
     fn pressure(&self, f0: f64, t: f64, x: [f64; 2]) -> Result<f64, String> {
         let g = match &self.factor {
-            Some((e, params)) => crate::model::loads::increment_factor(e, params, [self.theory.a, x[1]])?,
+            Some((e, params)) => crate::model::loads::increment_factor(e, params, &[self.theory.a, x[1]])?,
             None => 1.0,
         };
         Ok(self.theory.p * (self.time_fn.eval(t) - f0) * g)
