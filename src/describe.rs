@@ -165,25 +165,8 @@ pub fn describe(case: &Case, label: &str) -> String {
     }
     for (bi, b) in model.boundaries.iter().enumerate() {
         let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
-        if let Some(list) = &b.surface {
-            // Resolved per step; at t = 0 from the particles' faces.
-            let only = crate::model::Active { loads: Vec::new(), boundaries: vec![bi] };
-            let mut nodes: Vec<(u32, u32)> = model.surface_fixes(&only, false).into_iter().map(|(n, _, _)| n).collect();
-            nodes.sort_unstable();
-            nodes.dedup();
-            let weak = if b.fix.contains(&crate::case::Dof::P) {
-                "; in quasi-static stages p = 0 on the faces themselves (Nitsche), not at the nodes"
-            } else {
-                ""
-            };
-            let _ = writeln!(
-                s,
-                "boundary `{}`: {} fixed on a moving surface of {} particle faces ({} nodes at t = 0{weak})",
-                b.name,
-                fix.join(", "),
-                list.len(),
-                nodes.len()
-            );
+        if let Some(line) = surface_line(&model, bi, &fix) {
+            let _ = writeln!(s, "{line}");
             continue;
         }
         let count = (0..g.nodes()[1])
@@ -314,13 +297,20 @@ fn describe_solid(case: &Case, label: &str) -> String {
             Some(Load::ParticleTraction { traction, .. }) => {
                 format!("particle traction {traction:?} Pa on {} material points", l.size())
             }
+            Some(Load::NodalTraction { traction, .. }) => {
+                format!("nodal traction {traction:?} Pa on {} nodes", l.size())
+            }
             Some(Load::BodyForce { acceleration, .. }) => format!("body force {acceleration:?} m/s²"),
             _ => String::new(),
         };
         let _ = writeln!(s, "load `{}`: {kind}", l.name);
     }
-    for b in &model.boundaries {
+    for (bi, b) in model.boundaries.iter().enumerate() {
         let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
+        if let Some(line) = surface_line(&model, bi, &fix) {
+            let _ = writeln!(s, "{line}");
+            continue;
+        }
         let count = (0..g.node_count()).filter(|&n| b.holds_node(g, g.node_indices(n))).count();
         let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes", b.name, fix.join(", "));
     }
@@ -328,6 +318,29 @@ fn describe_solid(case: &Case, label: &str) -> String {
         let _ = writeln!(s, "{}", stage_line(case, &model, st));
     }
     s
+}
+
+/// The line of boundary `bi` if it is a moving surface (resolved per step; at t = 0 from the
+/// particles' faces), with its fixed components `fix`.
+fn surface_line<const D: usize>(model: &Model<D>, bi: usize, fix: &[String]) -> Option<String> {
+    let b = &model.boundaries[bi];
+    let list = b.surface.as_ref()?;
+    let only = crate::model::Active { loads: Vec::new(), boundaries: vec![bi] };
+    let mut nodes: Vec<[u32; D]> = model.surface_fixes(&only, false).into_iter().map(|(n, _, _)| n).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let weak = if b.fix.contains(&crate::case::Dof::P) {
+        "; in quasi-static stages p = 0 on the faces themselves (Nitsche), not at the nodes"
+    } else {
+        ""
+    };
+    Some(format!(
+        "boundary `{}`: {} fixed on a moving surface of {} particle faces ({} nodes at t = 0{weak})",
+        b.name,
+        fix.join(", "),
+        list.len(),
+        nodes.len()
+    ))
 }
 
 /// The line of a stage: its analysis, duration and step (an explicit stage's stable step where

@@ -791,17 +791,13 @@ impl<'a, const D: usize, const M: usize, const N: usize> Simulation<'a, D, M, N>
                 .map(|e| e.0)
                 .unwrap_or_else(|| "a material point on another rank became inadmissible".into())));
         }
-        // The projected or recovered pore pressures (the MLSA recovery is plane: validation keeps
-        // it out of three-dimensional cases).
+        // The projected or recovered pore pressures.
         let recovered = match (self.model.pressure_update, self.system.layout().p.is_some()) {
             (crate::case::PressureUpdate::ProjectedTotal, true) => Some(
                 self.system.projected_pressure_increments(&self.model).map_err(|e| RunError::Failed(e.to_string()))?,
             ),
             (_, true) if self.model.two_phase && self.model.patch_recovery => {
-                match (self.model.as_plane(), crate::model::plane_mut::<_, GridSystem>(&mut self.system)) {
-                    (Some(plane), Some(system)) => Some(system.recovered_pressure_increments(plane)),
-                    _ => None,
-                }
+                Some(self.system.recovered_pressure_increments(&self.model))
             }
             _ => None,
         };

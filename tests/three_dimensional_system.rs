@@ -11,6 +11,8 @@
 //!   nodal traction on its top face, the section by one on its top line.
 //! * `a_slab_with_the_pressure_projection_steps_as_its_plane_twin`: so does the slab with the
 //!   pressure projection, its cells' blocks over eight trilinear functions.
+//! * `a_slab_with_moving_surfaces_steps_as_its_plane_twin`: so does the slab drained and pressed
+//!   through moving surfaces on its top faces (Nitsche's drained faces in three dimensions).
 //! * `a_two_phase_explicit_slab_steps_as_its_plane_twin`: the slab (standing, and lying in the
 //!   (x, z) plane) in a two-phase explicit stage, with the points' own pore pressure and with the
 //!   nodal one drained at the top, steps as its plane section point for point.
@@ -133,7 +135,20 @@ fix = ["uz", "Uz"]
 /// impermeable walls on both y faces: the plane's y is the slab's z, so that the slab's motion is
 /// along x and z.
 fn lying_slab() -> String {
-    PLANE
+    lying_slab_of(PLANE)
+}
+
+/// The plane section `plane` (the text of [`PLANE`], perhaps changed) laid in the (x, z) plane as
+/// [`lying_slab`]; moving surfaces on the section's top faces move to the slab's z_max faces.
+fn lying_slab_of(plane: &str) -> String {
+    plane
+        .replace(
+            "surface = { body = \"column\", faces = [\"y_max\"], region = { min = [0.0, 0.5], max = [0.1, 0.6] } }\n\
+             fix = [\"uy\"]",
+            "surface = { body = \"column\", faces = [\"z_max\"], region = { min = [0.0, 0.0], max = [0.1, 0.1], z = \
+             [0.5, 0.6] } }\nfix = [\"uz\"]",
+        )
+        .replace("faces = [\"y_max\"]", "faces = [\"z_max\"]")
         .replace("size = [0.2, 0.8]", "size = [0.2, 0.1, 0.8]")
         .replace("cells = [2, 8]", "cells = [2, 1, 8]")
         .replace(
@@ -321,6 +336,75 @@ fn a_slab_with_the_pressure_projection_steps_as_its_plane_twin(coll: &Collective
         return Err(format!("the pressure projection barely moves the section's pore pressures: {moved:e}"));
     }
     compare_slab(&with, &slab_of(&with), coll)
+}
+
+/// The plane section with its top drained and pressed through moving surfaces instead of grid
+/// regions: `p = 0` on the exposed top faces of the column (imposed weakly, by Nitsche's terms on
+/// the faces, in these quasi-static steps of the u–p system with flow), and the strip's
+/// displacement on the top faces of the points under x ∈ [0, 0.1] (fixed at the nodes of their
+/// stencils on the face's side, within the region's extent along x).
+fn with_moving_surfaces() -> String {
+    PLANE
+        .replace(
+            "name = \"drained\"\nregion = { min = [0.0, 0.6], max = [0.2, 0.6] }",
+            "name = \"drained\"\nsurface = { body = \"column\", faces = [\"y_max\"] }",
+        )
+        .replace(
+            "name = \"strip\"\nregion = { min = [0.0, 0.6], max = [0.1, 0.6] }",
+            "name = \"strip\"\nsurface = { body = \"column\", faces = [\"y_max\"], region = { min = [0.0, 0.5], max = [0.1, 0.6] } }",
+        )
+}
+
+/// The slab drained and pressed through moving surfaces on its top faces steps as its plane
+/// section drained and pressed through the same surfaces (B̄ off, three steps): the surfaces'
+/// fixed nodes (`Model::surface_fixes`: the faces' normals turned with the material, the nodes on
+/// the face's side, the region's extent along x and, in the slab, along z) and Nitsche's drained
+/// faces (`GridSystem::drained_faces`: the trilinear functions at the face points, the faces'
+/// areas) in three dimensions; and so does the slab lying in the (x, z) plane, whose surfaces are
+/// its z_max faces (normals along z, the strip's region with a z range).
+fn a_slab_with_moving_surfaces_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
+    let plane = with_moving_surfaces().replace("bbar = true", "bbar = false");
+    if plane.matches("surface = ").count() != 2 {
+        return Err("the drained top and the strip were not both replaced by moving surfaces".into());
+    }
+    compare_slab(&plane, &slab_of(&plane), coll)?;
+    let lying = lying_slab_of(&plane);
+    if lying.matches("faces = [\"z_max\"]").count() != 2 {
+        return Err("the lying slab's surfaces are not its z_max faces".into());
+    }
+    compare_lying(&plane, &lying, "moving surfaces", coll)
+}
+
+/// The slab lying in the (x, z) plane, `solid`, steps as the plane section of `plane`, point for
+/// point: stresses, pore pressures and positions (the plane's y the slab's z, its y at rest), to
+/// 1e-9 of their largest (of a cell for positions).
+fn compare_lying(plane: &str, solid: &str, label: &str, coll: &Collective) -> Result<(), String> {
+    let (plane, plane_model, _) = run_plane(&case_of(plane)?, coll)?;
+    let (solid, model, _) = run_solid(&case_of(solid)?, coll)?;
+    let twin = twins(&plane_model, &model, 2)?;
+    let (scale_s, scale_p) = scales(&plane);
+    let mut worst = [0.0f64; 3];
+    for step in 0..plane.x.len() {
+        for (k, &q) in twin.iter().enumerate() {
+            worst[0] = worst[0].max(stress_difference(&solid.stress[step][k], &plane.stress[step][q], 2) / scale_s);
+            worst[1] = worst[1].max((solid.p[step][k] - plane.p[step][q]).abs() / scale_p);
+            let (xs, xp) = (solid.x[step][k], plane.x[step][q]);
+            let across = (xs[1] - model.particles.x0[k][1]).abs();
+            worst[2] = worst[2].max((xs[0] - xp[0]).abs().max((xs[2] - xp[1]).abs()).max(across) / 0.1);
+        }
+    }
+    println!(
+        "    lying slab against plane ({label}): {} steps; largest differences: stress {:.1e} (of {scale_s:.3e} Pa), \
+         pore pressure {:.1e} (of {scale_p:.3e} Pa), position {:.1e} (of a cell)",
+        plane.x.len(),
+        worst[0],
+        worst[1],
+        worst[2]
+    );
+    if worst.iter().any(|&w| w > 1e-9 || w.is_nan()) || scale_p <= 0.0 {
+        return Err(format!("the lying slab departs from its plane twin: {worst:?}"));
+    }
+    Ok(())
 }
 
 /// The slab of `solid` steps as the plane section of `plane`, point for point.
@@ -701,34 +785,7 @@ fn with_options_file<T>(name: &str, coll: &Collective, f: impl FnOnce() -> T) ->
 /// carry its motion, which the slab between z walls leaves at zero.
 fn a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage(coll: &Collective) -> Result<(), String> {
     let dynamic = |t: &str| t.replace("bbar = true", "bbar = false").replace("quasi_static", "dynamic");
-    let plane_case = case_of(&dynamic(PLANE))?;
-    let (plane, plane_model, _) = run_plane(&plane_case, coll)?;
-    let (solid, model, _) = run_solid(&case_of(&dynamic(&lying_slab()))?, coll)?;
-    let x0 = &model.particles.x0;
-    let twin = twins(&plane_model, &model, 2)?;
-    let (scale_s, scale_p) = scales(&plane);
-    let mut worst = [0.0f64; 3];
-    for step in 0..plane.x.len() {
-        for (k, &q) in twin.iter().enumerate() {
-            worst[0] = worst[0].max(stress_difference(&solid.stress[step][k], &plane.stress[step][q], 2) / scale_s);
-            worst[1] = worst[1].max((solid.p[step][k] - plane.p[step][q]).abs() / scale_p);
-            let (xs, xp) = (solid.x[step][k], plane.x[step][q]);
-            worst[2] =
-                worst[2].max(((xs[0] - xp[0]).abs().max((xs[2] - xp[1]).abs()) / 0.1).max((xs[1] - x0[k][1]).abs()));
-        }
-    }
-    println!(
-        "    lying slab against plane (dynamic): {} steps; largest differences: stress {:.1e} (of {scale_s:.3e} Pa), \
-         pore pressure {:.1e} (of {scale_p:.3e} Pa), position {:.1e} (of a cell)",
-        plane.x.len(),
-        worst[0],
-        worst[1],
-        worst[2]
-    );
-    if worst.iter().any(|&w| w > 1e-9 || w.is_nan()) || scale_p <= 0.0 {
-        return Err(format!("the lying slab departs from its plane twin: {worst:?}"));
-    }
-    Ok(())
+    compare_lying(&dynamic(PLANE), &dynamic(&lying_slab()), "dynamic", coll)
 }
 
 /// A case of the plane section or of a slab as a two-phase explicit stage (`dynamic_explicit`,
@@ -837,6 +894,7 @@ fn main() {
             "a_slab_with_the_pressure_projection_steps_as_its_plane_twin",
             a_slab_with_the_pressure_projection_steps_as_its_plane_twin,
         ),
+        ("a_slab_with_moving_surfaces_steps_as_its_plane_twin", a_slab_with_moving_surfaces_steps_as_its_plane_twin),
         ("a_block_squeezed_from_three_sides_is_homogeneous", a_block_squeezed_from_three_sides_is_homogeneous),
         (
             "a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage",

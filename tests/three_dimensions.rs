@@ -245,18 +245,37 @@ fn the_prism_consolidates_by_explicit_steps_as_the_plane_column() {
 /// (`stabilisation.pressure_update = "projected_total"`: each point's pressure the interpolation of
 /// the L² projection of the points' pressures plus the step's increment, a CG solve on a DMDA of
 /// the system's dimension and distribution) on two ranks consolidates as the plane column with it
-/// on one: its Terzaghi metrics the column's to 1e-10 (e_p's over √2, as by explicit steps), and its
-/// probes' pore pressures row for row. The update moves the prism's metrics (p_rms_error at T_v =
-/// 0.5 by 1.2 % from the default update's), so the comparison sees it.
+/// on one (see [`prism_as_column`]). The update moves the prism's p_rms_error at T_v = 0.5 by 1.2 %
+/// from the default update's.
 #[test]
 fn the_prism_with_the_projected_total_pressure_update_consolidates_as_the_plane_column() {
-    let sets = set_args(&["stabilisation.pressure_update=projected_total"]);
-    let plane = run_case("cases/terzaghi.toml", &std::env::temp_dir().join("porompm-terzaghi-projected-2d"), &sets);
+    prism_as_column("stabilisation.pressure_update=projected_total", "projected");
+}
+
+/// The consolidating prism with [003]'s MLSA patch recovery of the pore-pressure increments
+/// (`stabilisation.patch_recovery = true`: linear fits over the active cells around each node,
+/// `model::patch` in D dimensions; the prism, one cell wide along x and z, fits along y only, as
+/// the column does) on two ranks consolidates as the plane column with it on one (see
+/// [`prism_as_column`]).
+#[test]
+fn the_prism_with_patch_recovery_consolidates_as_the_plane_column() {
+    prism_as_column("stabilisation.patch_recovery=true", "recovered");
+}
+
+/// `cases/terzaghi_3d.toml` with the override `set` on two ranks against `cases/terzaghi.toml` with
+/// it on one: the Terzaghi metrics equal to 1e-10 (errors relative to the load's pressure or the
+/// settlement; e_p's over √2: [003] Eq. 33 divides by the number of points, and the prism has two
+/// layers of the column's) and the probes' pore pressures row for row to 1e-8 of their largest;
+/// and `set` moves the prism's p_rms_error at T_v = 0.5 by more than 1e-3 of itself, so the
+/// comparison sees it.
+fn prism_as_column(set: &str, label: &str) {
+    let sets = set_args(&[set]);
+    let dir = |d: &str| std::env::temp_dir().join(format!("porompm-terzaghi-{label}-{d}"));
+    let plane = run_case("cases/terzaghi.toml", &dir("2d"), &sets);
     assert!(plane.completed(), "{}", plane.stderr());
-    let solid =
-        run_case_on(2, "cases/terzaghi_3d.toml", &std::env::temp_dir().join("porompm-terzaghi-projected-3d"), &sets);
+    let solid = run_case_on(2, "cases/terzaghi_3d.toml", &dir("3d"), &sets);
     assert!(solid.completed(), "{}", solid.stderr());
-    let default = run_case("cases/terzaghi_3d.toml", &std::env::temp_dir().join("porompm-terzaghi-default-3d"), &[]);
+    let default = run_case("cases/terzaghi_3d.toml", &dir("default"), &[]);
     assert!(default.completed(), "{}", default.stderr());
     let names: Vec<String> =
         plane.summary["verification"].as_object().expect("the plane metrics").keys().cloned().collect();
@@ -264,20 +283,18 @@ fn the_prism_with_the_projected_total_pressure_update_consolidates_as_the_plane_
     for name in &names {
         let (a, b) = (metric(&plane.summary, name), metric(&solid.summary, name));
         let b = if name.starts_with("e_p_") { b * 2f64.sqrt() } else { b };
-        eprintln!("{name}: plane {a:.10e}, prism {b:.10e}");
-        // The metrics are errors relative to the load's pressure (or the settlement): the CG of the
-        // projection (relative tolerance 1e-12) on two ranks leaves them equal to 1e-10 of it.
-        assert!((a - b).abs() <= 1e-10, "{name}: plane {a}, prism {b}");
+        eprintln!("{label}: {name}: plane {a:.10e}, prism {b:.10e}");
+        assert!((a - b).abs() <= 1e-10, "{set}: {name}: plane {a}, prism {b}");
     }
     let (with, without) = (metric(&solid.summary, "p_rms_error_Tv0.5"), metric(&default.summary, "p_rms_error_Tv0.5"));
-    eprintln!("p_rms_error_Tv0.5: {with:.6e} projected, {without:.6e} by default");
-    assert!((with - without).abs() > 1e-3 * without, "the projected update does not move the prism's pressures");
+    eprintln!("{label}: p_rms_error_Tv0.5 {with:.6e} with `{set}`, {without:.6e} without");
+    assert!((with - without).abs() > 1e-3 * without, "`{set}` does not move the prism's pressures");
     for probe in ["base", "middle"] {
         let (a, b) = (plane.column(&format!("{probe}.p_excess")), solid.column(&format!("{probe}.p_excess")));
         assert_eq!(a.len(), b.len(), "{probe}.p_excess");
         let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (x, y) in a.iter().zip(&b) {
-            assert!((x - y).abs() <= 1e-8 * scale, "{probe}.p_excess: plane {x}, prism {y}");
+            assert!((x - y).abs() <= 1e-8 * scale, "{set}: {probe}.p_excess: plane {x}, prism {y}");
         }
     }
 }
@@ -390,8 +407,14 @@ fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
     common::assert_refused(
         "cases/terzaghi_3d.toml",
         &dir,
-        &["stabilisation.patch_recovery=true"],
-        "key `stabilisation.patch_recovery`: not available in a three-dimensional case yet",
+        &["stabilisation.stiffness=\"gauss_mapping\""],
+        "key `stabilisation.stiffness`: not available in a three-dimensional case yet",
+    );
+    common::assert_refused(
+        "cases/terzaghi_3d.toml",
+        &dir,
+        &["loads=[{name=\"q\", kind=\"line_pressure\", points=[[0.0, 1.0], [0.1, 1.0]], pressure=1.0}]"],
+        "a line pressure acts on a plane polyline",
     );
     // The footing's bearing check: a 3D loaded area needs its extent along z; a plane one has none.
     common::assert_refused(

@@ -659,8 +659,11 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
         self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
+        if weak {
+            (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
+        }
         if let Some((plane, system)) = model.as_plane().zip(self.as_plane_mut()) {
-            system.plane_step(plane, active, weak, coll)?;
+            system.plane_step(plane, coll)?;
         }
         if let kernels::Integration::Explicit { pointwise_pressure: false, .. } = model.integration {
             if self.layout.w.is_some() {
@@ -694,9 +697,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let nd = self.layout.nd;
         let p = crate::model::dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");
         let mut marks = Vec::new();
-        if let (Some(plane), Some(system)) = (model.as_plane(), self.as_plane_ref()) {
+        // Whether a boundary is a moving surface is the case's: every rank takes the same branch.
+        if active.boundaries.iter().any(|&b| model.boundaries[b].surface.is_some()) {
             marks = vec![0.0; self.ghost.len() * nd];
-            for l in system.surface_drained_nodes(plane, active) {
+            for l in self.surface_drained_nodes(model, active) {
                 marks[l * nd] = 1.0;
             }
             self.sum_over_ranks(&mut marks)?;
@@ -782,13 +786,12 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         coll: &Collective,
     ) -> Result<DofMap, String> {
         let nd = self.layout.nd;
-        // Moving surfaces (plane only: validation keeps them out of three-dimensional cases).
-        let fixes = model.as_plane().map(|m| m.surface_fixes(active, weak_drainage)).unwrap_or_default();
+        let fixes = model.surface_fixes(active, weak_drainage);
         let mut surface = vec![0.0; self.ghost.len() * nd];
         for &bi in active.boundaries.iter().filter(|&&b| model.boundaries[b].surface.is_some()) {
             let mut marks = vec![0.0; self.ghost.len() * nd];
-            for ((i, j), _, comps) in fixes.iter().filter(|f| f.1 == bi) {
-                if let Some(l) = self.ghost.local(lift([*i as usize, *j as usize])) {
+            for (n, _, comps) in fixes.iter().filter(|f| f.1 == bi) {
+                if let Some(l) = self.ghost.local(n.map(|v| v as usize)) {
                     for c in (0..nd).filter(|&c| self.layout.canonical(c).is_some_and(|k| comps[k])) {
                         marks[l * nd + c] = 1.0;
                     }
@@ -1162,6 +1165,64 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 nodes.iter().zip(basis).map(|(&n, nb)| nb.s * total[n as usize]).sum::<f64>() - ps.p[k]
             })
             .collect())
+    }
+
+    /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
+    /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
+    /// interpolated increment.
+    pub fn recovered_pressure_increments(&self, model: &Model<D>) -> Vec<f64> {
+        let nd = self.layout.nd;
+        let p = self.layout.p.expect("a pressure");
+        let dp: Vec<f64> = (0..self.ghost.len()).map(|l| self.step.solution[l * nd + p]).collect();
+        let field = crate::model::patch::PatchField {
+            grid: &model.grid,
+            start: self.ghost.start,
+            count: self.ghost.count,
+            dp: &dp,
+            active: &self.step.dofs.well,
+        };
+        (0..model.particles.len())
+            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).interp.dp))
+            .collect()
+    }
+
+    /// The ghosted nodes a moving surface that fixes `p` reaches (`Model::surface_fixes`), for the
+    /// drained nodes of an explicit two-phase step ([`GridSystem::drained_nodes`]).
+    fn surface_drained_nodes(&self, model: &Model<D>, active: &Active) -> Vec<usize> {
+        let p = crate::model::dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");
+        model
+            .surface_fixes(active, false)
+            .into_iter()
+            .filter(|(_, _, comps)| comps[p])
+            .filter_map(|(n, _, _)| self.ghost.local(n.map(|v| v as usize)))
+            .collect()
+    }
+
+    /// Step 4: the drained faces of this rank's particles with their geometry and the grid's
+    /// multilinear shape functions at the face point, ordered by particle (see
+    /// [`kernels::DrainedFace`]). The gradient is the one on the material's side of a grid line
+    /// through the face point.
+    fn drained_faces(&self, model: &Model<D>, active: &Active) -> Vec<(usize, kernels::DrainedFace<D, M>)> {
+        let (g, ps) = (&model.grid, &model.particles);
+        let penalty = NITSCHE_PENALTY / g.h_min();
+        model
+            .drained_faces(active)
+            .into_iter()
+            .map(|(k, face)| {
+                let normal = model.face_normal(k, face);
+                let (xf, measure) = face_point(face, ps.x[k], ps.lp[k]);
+                let area = measure * model.geometry.measure(xf[0]);
+                let inside: [f64; D] = std::array::from_fn(|d| xf[d] - 1e-9 * g.h[d] * normal[d]);
+                let mut basis = [(0.0, [0.0; D]); M];
+                let (nodes, _) = self.step.stencils.get(k);
+                for (b, &node) in basis.iter_mut().zip(nodes) {
+                    let n = self.ghost.indices(node as usize);
+                    *b = shape::multilinear(g.position(n), xf, inside, g.h);
+                }
+                let offset = std::array::from_fn(|d| xf[d] - ps.x[k][d]);
+                (k, kernels::DrainedFace { offset, normal, area, penalty, basis })
+            })
+            .collect()
     }
 
     /// Step 4: the pressure-projection cells, over this rank's particles grouped by the cell
@@ -1743,8 +1804,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
 }
 
 /// The parts of the global system that exist only in the plane (validation keeps them out of
-/// three-dimensional cases): moving surfaces and their drained faces, line pressures, [001]'s mapped
-/// stiffnesses and the MLSA recovery.
+/// three-dimensional cases): line pressures and [001]'s mapped stiffnesses.
 impl GridSystem {
     /// Whether this rank owns node (i, j), and with it cell (i, j), the cell whose lower-left node
     /// it is.
@@ -1783,81 +1843,11 @@ impl GridSystem {
         (forces, totals)
     }
 
-    /// The plane-only parts of a step's data (step 4): Nitsche's drained faces of the moving
-    /// surfaces (`weak`) and [001]'s mapped stiffnesses.
-    fn plane_step(&mut self, model: &Model, active: &Active, weak: bool, coll: &Collective) -> Result<(), String> {
-        if weak {
-            (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
-        }
+    /// The plane-only part of a step's data (step 4): [001]'s mapped stiffnesses.
+    fn plane_step(&mut self, model: &Model, coll: &Collective) -> Result<(), String> {
         self.step.stiffness =
             coll.agree(stiffness::MappedStiffness::prepare(model, &self.ghost, &self.step.stencils))?;
         Ok(())
-    }
-
-    /// The ghosted nodes a moving surface that fixes `p` reaches (`Model::surface_fixes`), for the
-    /// drained nodes of an explicit two-phase step ([`GridSystem::drained_nodes`]).
-    fn surface_drained_nodes(&self, model: &Model, active: &Active) -> Vec<usize> {
-        let p = kernels::dof::P;
-        model
-            .surface_fixes(active, false)
-            .into_iter()
-            .filter(|(_, _, comps)| comps[p])
-            .filter_map(|((i, j), _, _)| self.ghost.node(i as usize, j as usize))
-            .collect()
-    }
-
-    /// Step 4: the drained faces of this rank's particles with their geometry and the grid's
-    /// bilinear shape functions at the face point, ordered by particle (see
-    /// [`kernels::DrainedFace`]). The gradient is the one on the material's side of a grid line
-    /// through the face point.
-    fn drained_faces(&self, model: &Model, active: &Active) -> Vec<(usize, kernels::DrainedFace)> {
-        let (g, ps) = (&model.grid, &model.particles);
-        let penalty = NITSCHE_PENALTY / g.h_min();
-        model
-            .drained_faces(active)
-            .into_iter()
-            .map(|(k, face)| {
-                let normal = model.face_normal(k, face);
-                let (xf, length) = face_point(face, ps.x[k], ps.lp[k]);
-                let area = length * model.geometry.measure(xf[0]);
-                let inside = [xf[0] - 1e-9 * g.h[0] * normal[0], xf[1] - 1e-9 * g.h[1] * normal[1]];
-                let mut basis = [(0.0, [0.0; 2]); kernels::MAX_NODES];
-                let (nodes, _) = self.step.stencils.get(k);
-                for (b, &node) in basis.iter_mut().zip(nodes) {
-                    let (i, j) = self.ghost.ij(node as usize);
-                    *b = shape::bilinear(g.node_position(i, j), xf, inside, g.h);
-                }
-                (
-                    k,
-                    kernels::DrainedFace {
-                        offset: [xf[0] - ps.x[k][0], xf[1] - ps.x[k][1]],
-                        normal,
-                        area,
-                        penalty,
-                        basis,
-                    },
-                )
-            })
-            .collect()
-    }
-
-    /// Pore-pressure increments of the converged step recovered at every particle by MLSA patches
-    /// ([003] §3.3; see [`crate::model::patch`]); a particle without any active cell near it keeps the
-    /// interpolated increment.
-    pub fn recovered_pressure_increments(&self, model: &Model) -> Vec<f64> {
-        let nd = self.layout.nd;
-        let p = self.layout.p.expect("a pressure");
-        let dp: Vec<f64> = (0..self.ghost.len()).map(|l| self.step.solution[l * nd + p]).collect();
-        let field = crate::model::patch::PatchField {
-            grid: &model.grid,
-            start: self.ghost.start,
-            count: self.ghost.count,
-            dp: &dp,
-            active: &self.step.dofs.well,
-        };
-        (0..model.particles.len())
-            .map(|k| field.recover(model.particles.x[k]).unwrap_or_else(|| self.step_result(model, k).interp.dp))
-            .collect()
     }
 }
 
@@ -1873,12 +1863,6 @@ fn start_value<const D: usize>(model: &Model<D>, dofs: &DofMap, q: usize, mass: 
     } else {
         of[q] / mass[q]
     }
-}
-
-/// The node indices `n` of a plane grid in a grid of dimension D (only called where D = 2: the
-/// plane-only features' nodes reach generic code through it).
-fn lift<const D: usize>(n: [usize; 2]) -> [usize; D] {
-    std::array::from_fn(|d| n[d])
 }
 
 /// Grid indices of dimension D as three, `fill` for the missing ones.

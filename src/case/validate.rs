@@ -191,35 +191,43 @@ fn finite_strain_materials(c: &Case) -> R {
     Ok(())
 }
 
-/// What of boundary `i` belongs to three dimensions only (z sides, `uz`/`Uz`, a region's z range) or
-/// not yet to three dimensions (moving surfaces, velocity gradients).
+/// What of boundary `i` belongs to three dimensions only (z sides, `uz`/`Uz`, a region's z range, a
+/// surface's z faces) or not yet to three dimensions (velocity gradients).
 fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
     let b = &c.boundaries[i];
     let z_side = b.side.is_some_and(|s| s.axis() == 2);
     let z_dof = b.fix.iter().any(|d| matches!(d, Dof::Uz | Dof::WUz));
     let z_region = b.region.is_some_and(|r| r.z.is_some());
+    let z_face = b.surface.as_ref().is_some_and(|sf| sf.faces.iter().any(|f| f.axis() == 2));
+    let z_surface_region = b.surface.as_ref().and_then(|sf| sf.region).is_some_and(|r| r.z.is_some());
     if dim == 2 {
-        for (bad, key) in [(z_side, "side"), (z_dof, "fix"), (z_region, "region.z")] {
+        for (bad, key) in [
+            (z_side, "side"),
+            (z_dof, "fix"),
+            (z_region, "region.z"),
+            (z_face, "surface.faces"),
+            (z_surface_region, "surface.region.z"),
+        ] {
             if bad {
                 return Err(format!(
-                    "key `boundaries[{i}].{key}`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) \
+                    "key `boundaries[{i}].{key}`: z (a `z_min`/`z_max` side or face, `uz`/`Uz`, a region's `z`) \
                      belongs to three-dimensional cases only"
                 ));
             }
         }
         return Ok(());
     }
-    for (bad, key) in [(b.surface.is_some(), "surface"), (b.velocity_gradient.is_some(), "velocity_gradient")] {
-        if bad {
-            return Err(format!(
-                "key `boundaries[{i}].{key}`: not available in a three-dimensional case yet (issue «Three \
-                 dimensions», docs/dimensions.md)"
-            ));
-        }
+    if b.velocity_gradient.is_some() {
+        return Err(format!(
+            "key `boundaries[{i}].velocity_gradient`: not available in a three-dimensional case yet (issue «Three \
+             dimensions», docs/dimensions.md)"
+        ));
     }
-    if let Some([z0, z1]) = b.region.and_then(|r| r.z) {
-        if !(z0.is_finite() && z1.is_finite() && z0 <= z1) {
-            return Err(format!("key `boundaries[{i}].region.z`: needs finite z_min ≤ z_max, got [{z0}, {z1}]"));
+    for (r, key) in [(b.region, "region.z"), (b.surface.as_ref().and_then(|sf| sf.region), "surface.region.z")] {
+        if let Some([z0, z1]) = r.and_then(|r| r.z) {
+            if !(z0.is_finite() && z1.is_finite() && z0 <= z1) {
+                return Err(format!("key `boundaries[{i}].{key}`: needs finite z_min ≤ z_max, got [{z0}, {z1}]"));
+            }
         }
     }
     Ok(())
@@ -227,8 +235,8 @@ fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
 
 /// What a three-dimensional case may not ask for (line pressures, which are plane by nature) or
 /// not yet (issue «Three dimensions»: the plane benchmarks' checks, [001]'s CMPM and mapped
-/// stiffnesses and patch recovery;
-/// moving surfaces are refused with the boundaries), and the space of its points' identifiers.
+/// stiffnesses; velocity gradients are refused with the boundaries), and the space of its points'
+/// identifiers.
 fn three_dimensional(c: &Case) -> R {
     let not_yet = |key: &str| {
         Err(format!(
@@ -258,9 +266,6 @@ fn three_dimensional(c: &Case) -> R {
         return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
     }
     let st = &c.stabilisation;
-    if st.patch_recovery == Some(true) {
-        return not_yet("stabilisation.patch_recovery");
-    }
     if st.stiffness != crate::case::Stiffness::Particle {
         return not_yet("stabilisation.stiffness");
     }

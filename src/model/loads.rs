@@ -440,8 +440,9 @@ pub struct BoundaryDef<const D: usize = 2> {
     /// Or the moving surface of a body: (local particle index, exposed face) pairs.
     pub surface: Option<Vec<(usize, Side)>>,
     /// The surface's region, if it has one: only the nodes within its extent along each face
-    /// (x for a y face, y for an x face) are fixed, so that a footing's edge stays where the
-    /// region puts it when the points next to the edge move.
+    /// (along the face's other directions: x for a y face in the plane, x and z in three
+    /// dimensions) are fixed, so that a footing's edge stays where the region puts it when the
+    /// points next to the edge move.
     pub surface_span: Option<Region>,
     /// Components fixed.
     pub fix: Vec<Dof>,
@@ -464,27 +465,6 @@ impl BoundaryDef {
         }
     }
 
-    /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
-    /// surface's region if it has one, whose face in a listed direction is exposed at t = 0).
-    pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles) -> BoundaryDef {
-        let surface = b.surface.as_ref().map(|sf| {
-            let body = c.body_index(&sf.body).expect("validated") as u16;
-            let mut v = Vec::new();
-            for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
-                if sf.region.is_some_and(|r| !r.contains(particles.x0[k])) {
-                    continue;
-                }
-                for &f in &sf.faces {
-                    if face_is_exposed(c, particles.x0[k], particles.lp0[k], f) {
-                        v.push((k, f));
-                    }
-                }
-            }
-            v
-        });
-        BoundaryDef::from_case_in(b, c, surface)
-    }
-
     /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
     /// particles, see [`crate::model::Model::surface_fixes`]).
     pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
@@ -498,8 +478,28 @@ impl<const D: usize> BoundaryDef<D> {
         self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()
     }
 
-    /// From the case, with its moving `surface` resolved on this rank's particles (two
-    /// dimensions; a three-dimensional case has none).
+    /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
+    /// surface's region if it has one, whose face in a listed direction is exposed at t = 0).
+    pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles<D>) -> BoundaryDef<D> {
+        let surface = b.surface.as_ref().map(|sf| {
+            let body = c.body_index(&sf.body).expect("validated") as u16;
+            let mut v = Vec::new();
+            for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
+                if sf.region.is_some_and(|r| !r.contains_in(particles.x0[k])) {
+                    continue;
+                }
+                for &f in &sf.faces {
+                    if face_is_exposed(c, particles.x0[k], particles.lp0[k], f) {
+                        v.push((k, f));
+                    }
+                }
+            }
+            v
+        });
+        BoundaryDef::from_case_in(b, c, surface)
+    }
+
+    /// From the case, with its moving `surface` resolved on this rank's particles.
     pub fn from_case_in(b: &case::Boundary, c: &case::Case, surface: Option<Vec<(usize, Side)>>) -> BoundaryDef<D> {
         let time_fn = || {
             b.time_function

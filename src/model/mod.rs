@@ -24,9 +24,9 @@ use particles::Particles;
 use shape::Basis;
 
 /// Everything that describes the continuum and its discretisation on this rank, in `D` dimensions
-/// (two unless it says otherwise). A three-dimensional model has face tractions and body forces,
-/// side and region boundaries; the nodal tractions, line pressures and moving surfaces are plane
-/// (issue «Three dimensions», docs/dimensions.md).
+/// (two unless it says otherwise). A three-dimensional model has face and nodal tractions and body
+/// forces, side, region and moving-surface boundaries; the line pressures are plane (issue «Three
+/// dimensions», docs/dimensions.md).
 #[derive(Debug, Clone)]
 pub struct Model<const D: usize = 2> {
     /// u–p–U (true) or u only.
@@ -145,6 +145,25 @@ pub struct Active {
 #[derive(Debug, Clone, PartialEq)]
 pub struct InadmissibleStep(pub String);
 
+/// The components a moving surface can fix at a node: the full two-phase layout of three
+/// dimensions (ux, uy, uz, p, Ux, Uy, Uz; a plane surface uses the first five, ux, uy, p, Ux, Uy).
+pub const SURFACE_COMPONENTS: usize = 7;
+
+/// A node a moving surface fixes ([`Model::surface_fixes`]): its grid indices, the boundary's
+/// index and the components fixed there (in the order of [`dof_index_in`]).
+pub type SurfaceFix<const D: usize> = ([u32; D], usize, [bool; SURFACE_COMPONENTS]);
+
+/// Whether the node at `node` lies within the surface region `r` along the directions of `face`
+/// other than its normal (x for a y face in the plane; in three dimensions also z, within the
+/// region's `z` range if it has one), with tolerance `tol`.
+fn spans_along_face<const D: usize>(r: &crate::case::Region, face: Side, node: [f64; D], tol: f64) -> bool {
+    (0..D).filter(|&t| t != face.axis()).all(|t| match (t, r.z) {
+        (2, None) => true,
+        (2, Some([lo, hi])) => node[2] >= lo - tol && node[2] <= hi + tol,
+        _ => node[t] >= r.min[t] - tol && node[t] <= r.max[t] + tol,
+    })
+}
+
 impl Model {
     /// Builds the model of `case`, generating particles only in the cells `owned(i, j)`.
     pub fn build(case: &Case, owned: impl Fn(usize, usize) -> bool) -> Model {
@@ -160,16 +179,6 @@ impl Model {
         Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 
-    /// Resolves the case's moving surfaces again on this rank's points (see
-    /// [`Model::resolve_targets`]).
-    fn resolve_surfaces(&mut self, case: &Case) {
-        for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
-            if b.surface.is_some() {
-                *b = BoundaryDef::from_case(c, case, &self.particles);
-            }
-        }
-    }
-
     /// Dofs per node.
     pub fn ndof(&self) -> usize {
         if self.two_phase {
@@ -183,93 +192,6 @@ impl Model {
     pub fn field_names(&self) -> &'static [&'static str] {
         field_names(self.two_phase)
     }
-
-    /// The nodes fixed by the active moving-surface boundaries on the current configuration, with
-    /// the boundary's index and the components fixed there. For each surface particle the exposed
-    /// face's outward normal turns with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson), and among the
-    /// nodes of its stencil with a non-zero weight:
-    /// * the pore pressure (a drained surface) is fixed at the nodes on or beyond the face,
-    ///   (x_i − x_p)·n ≥ l_p(n) (the domain's extent along n), so that no node inside the material is
-    ///   drained (draining nodes up to l_p inside made the large-strain column fail);
-    /// * the motion (a wall, a platen, a patch's boundary) is prescribed at the nodes on the face's
-    ///   side of the particle, (x_i − x_p)·n ≥ 0: they include the well-filled node just inside a
-    ///   face that has moved past a grid line, which carries the boundary's reaction (the nodes
-    ///   beyond the face alone are barely filled and cannot);
-    /// * with a region on the surface, only the nodes within the region's extent along the face:
-    ///   the stencil of a point next to a footing's edge reaches the node beyond the edge, which
-    ///   would otherwise widen the footing by a cell as soon as the point moves towards it.
-    pub fn surface_fixes(&self, active: &Active, weak_drainage: bool) -> Vec<((u32, u32), usize, [bool; 5])> {
-        let mut out = Vec::new();
-        let tol = 1e-9 * self.grid.h_min();
-        for &bi in &active.boundaries {
-            let b = &self.boundaries[bi];
-            let Some(list) = &b.surface else { continue };
-            let mut comps = [false; 5];
-            for c in b.fix.iter().filter_map(|d| dof_index_in::<2>(*d)) {
-                comps[c] = true;
-            }
-            comps[crate::kernels::dof::P] &= !weak_drainage;
-            for &(k, face) in list {
-                let (x, lp) = (self.particles.x[k], self.particles.lp[k]);
-                let n = self.face_normal(k, face);
-                let extent = n[0].abs() * lp[0] + n[1].abs() * lp[1];
-                let st = shape::stencil(self.basis, &self.grid, x, lp);
-                for ([i, j], w, _) in st.iter() {
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    let node = self.grid.node_position(i as usize, j as usize);
-                    if let Some(r) = &b.surface_span {
-                        let t = if matches!(face, Side::YMin | Side::YMax) { 0 } else { 1 };
-                        if node[t] < r.min[t] - tol || node[t] > r.max[t] + tol {
-                            continue;
-                        }
-                    }
-                    let along = (node[0] - x[0]) * n[0] + (node[1] - x[1]) * n[1];
-                    let mut c = [false; 5];
-                    for d in 0..5 {
-                        c[d] = comps[d] && if d == 2 { along >= extent - tol } else { along >= -tol };
-                    }
-                    if c.iter().any(|&v| v) {
-                        out.push(((i, j), bi, c));
-                    }
-                }
-            }
-        }
-        out
-    }
-
-    /// The outward unit normal of particle `k`'s exposed `face` on the current configuration:
-    /// the reference normal n₀ turned with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson).
-    pub fn face_normal(&self, k: usize, face: Side) -> [f64; 2] {
-        let f = self.particles.def_grad[k];
-        // (A z face has no normal in the plane: validation keeps it out of plane cases.)
-        let n0: [f64; 2] = std::array::from_fn(|d| if d == face.axis() { face.sign() } else { 0.0 });
-        // F⁻ᵀ n₀ up to the factor 1/det F.
-        let m = crate::kernels::kinematics::cofactor_mul(&f, n0);
-        let len = m[0].hypot(m[1]);
-        if len > 0.0 {
-            [m[0] / len, m[1] / len]
-        } else {
-            n0
-        }
-    }
-
-    /// The exposed faces of the particles on the active moving surfaces that drain (fix `p`),
-    /// each once, ordered by particle.
-    pub fn drained_faces(&self, active: &Active) -> Vec<(usize, Side)> {
-        let mut out: Vec<(usize, Side)> = active
-            .boundaries
-            .iter()
-            .map(|&bi| &self.boundaries[bi])
-            .filter(|b| b.fix.contains(&crate::case::Dof::P))
-            .filter_map(|b| b.surface.as_ref())
-            .flat_map(|list| list.iter().copied())
-            .collect();
-        out.sort_by_key(|&(k, face)| (k, face as u8));
-        out.dedup();
-        out
-    }
 }
 
 impl Model<3> {
@@ -278,7 +200,7 @@ impl Model<3> {
     pub fn build_solid(case: &Case, owned: impl Fn([usize; 3]) -> bool) -> Model<3> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
-        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case_in(b, case, None)).collect();
+        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
         let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
         Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
@@ -306,6 +228,103 @@ pub(crate) fn index_text<const D: usize>(n: &[usize; D]) -> String {
 }
 
 impl<const D: usize> Model<D> {
+    /// Resolves the case's moving surfaces again on this rank's points (see
+    /// [`Model::resolve_targets`]).
+    fn resolve_surfaces(&mut self, case: &Case) {
+        for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
+            if b.surface.is_some() {
+                *b = BoundaryDef::from_case(c, case, &self.particles);
+            }
+        }
+    }
+
+    /// The nodes fixed by the active moving-surface boundaries on the current configuration, with
+    /// the boundary's index and the components fixed there. For each surface particle the exposed
+    /// face's outward normal turns with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson), and among the
+    /// nodes of its stencil with a non-zero weight:
+    /// * the pore pressure (a drained surface) is fixed at the nodes on or beyond the face,
+    ///   (x_i − x_p)·n ≥ l_p(n) (the domain's extent along n), so that no node inside the material is
+    ///   drained (draining nodes up to l_p inside made the large-strain column fail);
+    /// * the motion (a wall, a platen, a patch's boundary) is prescribed at the nodes on the face's
+    ///   side of the particle, (x_i − x_p)·n ≥ 0: they include the well-filled node just inside a
+    ///   face that has moved past a grid line, which carries the boundary's reaction (the nodes
+    ///   beyond the face alone are barely filled and cannot);
+    /// * with a region on the surface, only the nodes within the region's extent along the face:
+    ///   the stencil of a point next to a footing's edge reaches the node beyond the edge, which
+    ///   would otherwise widen the footing by a cell as soon as the point moves towards it.
+    pub fn surface_fixes(&self, active: &Active, weak_drainage: bool) -> Vec<SurfaceFix<D>> {
+        let mut out = Vec::new();
+        let tol = 1e-9 * self.grid.h_min();
+        let p = dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");
+        let nc = 2 * D + 1;
+        for &bi in &active.boundaries {
+            let b = &self.boundaries[bi];
+            let Some(list) = &b.surface else { continue };
+            let mut comps = [false; SURFACE_COMPONENTS];
+            for c in b.fix.iter().filter_map(|d| dof_index_in::<D>(*d)) {
+                comps[c] = true;
+            }
+            comps[p] &= !weak_drainage;
+            for &(k, face) in list {
+                let (x, lp) = (self.particles.x[k], self.particles.lp[k]);
+                let n = self.face_normal(k, face);
+                let extent = (1..D).fold(n[0].abs() * lp[0], |e, d| e + n[d].abs() * lp[d]);
+                let st: shape::Stencil<D, { crate::kernels::MAX_NODES_3D }> =
+                    shape::stencil_in(self.basis, &self.grid, x, lp);
+                for (node_indices, w, _) in st.iter() {
+                    if w <= 0.0 {
+                        continue;
+                    }
+                    let node = self.grid.position(node_indices.map(|v| v as usize));
+                    if b.surface_span.is_some_and(|r| !spans_along_face(&r, face, node, tol)) {
+                        continue;
+                    }
+                    let along = (1..D).fold((node[0] - x[0]) * n[0], |a, d| a + (node[d] - x[d]) * n[d]);
+                    let mut c = [false; SURFACE_COMPONENTS];
+                    for d in 0..nc {
+                        c[d] = comps[d] && if d == p { along >= extent - tol } else { along >= -tol };
+                    }
+                    if c.iter().any(|&v| v) {
+                        out.push((node_indices, bi, c));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The outward unit normal of particle `k`'s exposed `face` on the current configuration:
+    /// the reference normal n₀ turned with the material, n = F⁻ᵀn₀/|F⁻ᵀn₀| (Nanson).
+    pub fn face_normal(&self, k: usize, face: Side) -> [f64; D] {
+        let f = self.particles.def_grad[k];
+        // (A z face has no normal in the plane: validation keeps it out of plane cases.)
+        let n0: [f64; D] = std::array::from_fn(|d| if d == face.axis() { face.sign() } else { 0.0 });
+        // F⁻ᵀ n₀ up to the factor 1/det F.
+        let m = crate::kernels::kinematics::cofactor_mul(&f, n0);
+        let len = if D == 2 { m[0].hypot(m[1]) } else { m.iter().map(|v| v * v).sum::<f64>().sqrt() };
+        if len > 0.0 {
+            m.map(|v| v / len)
+        } else {
+            n0
+        }
+    }
+
+    /// The exposed faces of the particles on the active moving surfaces that drain (fix `p`),
+    /// each once, ordered by particle.
+    pub fn drained_faces(&self, active: &Active) -> Vec<(usize, Side)> {
+        let mut out: Vec<(usize, Side)> = active
+            .boundaries
+            .iter()
+            .map(|&bi| &self.boundaries[bi])
+            .filter(|b| b.fix.contains(&crate::case::Dof::P))
+            .filter_map(|b| b.surface.as_ref())
+            .flat_map(|list| list.iter().copied())
+            .collect();
+        out.sort_by_key(|&(k, face)| (k, face as u8));
+        out.dedup();
+        out
+    }
+
     /// The model itself when it is two-dimensional: the features that exist only in the plane
     /// (moving surfaces, loads, axial symmetry, [001]'s CMPM and mapped stiffnesses, the explicit
     /// update) are reached through it from dimension-generic code, and validation keeps them out
@@ -350,7 +369,7 @@ impl<const D: usize> Model<D> {
         out
     }
 
-    /// Resolves the case's point-wise loads (face tractions) and moving surfaces (plane) again on
+    /// Resolves the case's point-wise loads (face tractions) and moving surfaces again on
     /// this rank's points, after points moved between ranks. Both depend only on what travels with
     /// a point (its body, and its position and domain at t = 0), so every point keeps its loads.
     pub fn resolve_targets(&mut self, case: &Case) {
@@ -364,9 +383,7 @@ impl<const D: usize> Model<D> {
                 l.increments = increments;
             }
         }
-        if let Some(plane) = plane_mut::<_, Model>(self) {
-            plane.resolve_surfaces(case);
-        }
+        self.resolve_surfaces(case);
     }
 
     /// For each dof component at the grid node with indices `n`, in the full two-phase order of
@@ -445,9 +462,7 @@ impl<const D: usize> Model<D> {
             stress_recovery: case.stabilisation.stress_recovery,
             linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
             stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
-            // The MLSA recovery is plane: a three-dimensional case takes the interpolated increment.
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
-                && case.dimension() == 2
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
     }

@@ -389,8 +389,13 @@ mod tests {
         let cases = [
             (
                 solid.clone()
-                    + "[[boundaries]]\nname = \"top\"\nsurface = { body = \"column\", faces = [\"y_max\"] }\nfix = [\"p\"]\n",
-                "key `boundaries[0].surface`: not available in a three-dimensional case yet",
+                    + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\"]\nvelocity_gradient = [[0.0, 1.0], [0.0, 0.0]]\n",
+                "key `boundaries[0].velocity_gradient`: not available in a three-dimensional case yet",
+            ),
+            (
+                base.to_string()
+                    + "[[boundaries]]\nname = \"front\"\nsurface = { body = \"column\", faces = [\"z_max\"] }\nfix = [\"ux\"]\n",
+                "key `boundaries[0].surface.faces`: z",
             ),
             (
                 solid.clone() + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\", \"uy\"]\ndisplacement = [0.0, -0.1]\n",
@@ -398,7 +403,7 @@ mod tests {
             ),
             (
                 base.to_string() + "[[boundaries]]\nname = \"back\"\nside = \"z_min\"\nfix = [\"ux\"]\n",
-                "key `boundaries[0].side`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) belongs to \
+                "key `boundaries[0].side`: z (a `z_min`/`z_max` side or face, `uz`/`Uz`, a region's `z`) belongs to \
                  three-dimensional cases only",
             ),
             (
