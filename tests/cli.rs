@@ -730,7 +730,7 @@ fn bad_values_across_the_case_are_named() {
             ("boundaries.0.fix=[\"uw\"]", "--set boundaries.0.fix: unknown variant `uw`"),
             (
                 "boundaries.0.fix=[\"uz\"]",
-                "key `boundaries[0].fix`: z (a `z_min`/`z_max` side, `uz`/`Uz`, a region's `z`) belongs to \
+                "key `boundaries[0].fix`: z (a `z_min`/`z_max` side or face, `uz`/`Uz`, a region's `z`) belongs to \
                  three-dimensional cases only",
             ),
             ("loads.0.face=top", "key `loads[0]`: unknown variant `top`"),

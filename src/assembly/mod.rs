@@ -690,9 +690,9 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
 
     /// Which ghosted nodes are drained in a two-phase explicit step with the nodal pore pressure
     /// (see [`explicit`]), in any dimension: a side or region boundary of the stage fixes `p`
-    /// there, a moving surface that fixes `p` reaches it (plane only; marks summed over the
-    /// ranks, a collective every rank of a plane run takes), or the material barely fills it (the
-    /// drained value of implicit stages' barely filled nodes).
+    /// there, a moving surface that fixes `p` reaches it (marks summed over the ranks, a
+    /// collective every rank takes when a moving surface is active), or the material barely fills
+    /// it (the drained value of implicit stages' barely filled nodes).
     fn drained_nodes(&mut self, model: &Model<D>, active: &Active) -> Result<Vec<bool>, Error> {
         let nd = self.layout.nd;
         let p = crate::model::dof_index_in::<D>(crate::case::Dof::P).expect("p has a place in every dimension");

@@ -326,9 +326,8 @@ impl<const D: usize> Model<D> {
     }
 
     /// The model itself when it is two-dimensional: the features that exist only in the plane
-    /// (moving surfaces, loads, axial symmetry, [001]'s CMPM and mapped stiffnesses, the explicit
-    /// update) are reached through it from dimension-generic code, and validation keeps them out
-    /// of three-dimensional cases.
+    /// (line pressures, axial symmetry, [001]'s CMPM and mapped stiffnesses) are reached through it
+    /// from dimension-generic code, and validation keeps them out of three-dimensional cases.
     pub fn as_plane(&self) -> Option<&Model> {
         plane(self)
     }
