@@ -285,23 +285,9 @@ fn three_dimensional(c: &Case) -> R {
 /// plane's grid or a surface of a three-dimensional one (the nodes of a box are a block of the grid;
 /// it must be one node thick in exactly one direction, and more than one node wide in the others,
 /// or the tributary measures of `model::loads::tributary_nodes` would be zero or counted twice).
-fn nodal_line(c: &Case, region: &crate::case::Region) -> R {
+fn nodal_layer(c: &Case, region: &crate::case::Region) -> R {
     let dim = c.dimension();
-    let (origin, h, cells) = (c.origin_in::<3>(), c.cell_size_in::<3>(), c.cells_in::<3>());
-    let counts: Vec<usize> = (0..dim)
-        .map(|d| {
-            (0..=cells[d])
-                .filter(|&i| {
-                    let x = origin[d] + i as f64 * h[d];
-                    if d == 2 {
-                        region.spans_z(x)
-                    } else {
-                        region.spans(d, x, 0.0)
-                    }
-                })
-                .count()
-        })
-        .collect();
+    let counts: Vec<usize> = (0..dim).map(|d| grid_lines_in(c, region, d, 0.0)).collect();
     let what = if dim == 2 { "a line" } else { "a surface" };
     if counts.contains(&0) {
         return Err("holds no grid node".into());
@@ -323,6 +309,23 @@ fn nodal_line(c: &Case, region: &crate::case::Region) -> R {
         ));
     }
     Ok(())
+}
+
+/// How many of the grid's lines across direction `d` (its node positions along `d`) lie in the box
+/// `region` (with `slack` [m] beyond its tolerance in x and y; along z the region's `z` range, all
+/// of it without one).
+fn grid_lines_in(c: &Case, region: &crate::case::Region, d: usize, slack: f64) -> usize {
+    let (origin, h, cells) = (c.origin_in::<3>(), c.cell_size_in::<3>(), c.cells_in::<3>());
+    (0..=cells[d])
+        .filter(|&i| {
+            let x = origin[d] + i as f64 * h[d];
+            if d == 2 {
+                region.spans_z(x)
+            } else {
+                region.spans(d, x, slack)
+            }
+        })
+        .count()
 }
 
 fn axisymmetry(c: &Case, tol: f64) -> R {
@@ -684,7 +687,7 @@ pub fn validate(c: &Case) -> R {
             // A region between grid lines fixes nothing: the body it was meant to hold would move
             // freely (a clamp at x = 0 on a grid whose lines miss x = 0). A box holds a node if
             // some grid line of each direction crosses it (`Region::holds_node`, one axis at a time).
-            let crossed = |d: usize| (0..=c.cells()[d]).any(|i| r.spans(d, lo[d] + i as f64 * h[d], 1e-9 * h[d]));
+            let crossed = |d: usize| grid_lines_in(c, r, d, 1e-9 * h[d]) > 0;
             if !(crossed(0) && crossed(1)) {
                 return Err(format!(
                     "key `boundaries[{i}].region`: holds no grid node (the grid lines lie at x = {} + i·{}, \
@@ -765,7 +768,7 @@ pub fn validate(c: &Case) -> R {
                     return Err(format!("key `loads[{i}].region`: max must not be below min"));
                 }
                 if matches!(l, Load::NodalTraction { .. }) {
-                    nodal_line(c, region).map_err(|m| format!("key `loads[{i}].region`: {m}"))?;
+                    nodal_layer(c, region).map_err(|m| format!("key `loads[{i}].region`: {m}"))?;
                 }
                 if let Some(e) = l.increment_factor() {
                     // Tried where the loaded faces start: the region's centre (its z range's, or

@@ -234,9 +234,6 @@ impl<const D: usize> LoadDef<D> {
             Some(s) => s.total + (self.time_fn.eval(t) - self.time_fn.eval(s.t_n)) * s.g_n,
         }
     }
-}
-
-impl<const D: usize> LoadDef<D> {
     /// This rank's moments of the loaded faces: [Σ a x, Σ a y, (Σ a z,) Σ a] with a the face's
     /// area (its length in the plane, times 2πr in axial symmetry); zero unless it is a face
     /// traction.
