@@ -363,9 +363,10 @@ pub struct Body {
     #[serde(default)]
     pub initial_stress: Option<InitialStress>,
     /// A uniform initial effective stress [xx, yy, xy, zz] [Pa] (tension positive), instead of a
-    /// geostatic one (e.g. for patch tests and rigid-rotation checks).
+    /// geostatic one (e.g. for patch tests and rigid-rotation checks); a three-dimensional case may
+    /// give the two other shears too, [xx, yy, xy, zz, yz, zx].
     #[serde(default)]
-    pub uniform_stress: Option<[f64; 4]>,
+    pub uniform_stress: Option<Vec<f64>>,
     /// Displacement of every material point from the centre of its sub-cell, as a fraction of the
     /// point spacing in each direction, drawn from a fixed pseudo-random sequence keyed by the
     /// point's id (the same on any number of ranks); 0 ≤ value < 0.5 (default 0: a regular
@@ -471,6 +472,14 @@ pub enum Side {
     ZMax,
 }
 
+impl Body {
+    /// The `uniform_stress` as a stress vector [xx, yy, xy, zz, yz, zx] [Pa] (the shears it does
+    /// not give are zero).
+    pub fn uniform_stress_vector(&self) -> Option<[f64; 6]> {
+        self.uniform_stress.as_ref().map(|s| std::array::from_fn(|c| s.get(c).copied().unwrap_or(0.0)))
+    }
+}
+
 impl Side {
     /// The direction the side is normal to (0: x, 1: y, 2: z).
     pub fn axis(&self) -> usize {
@@ -567,12 +576,14 @@ pub struct Boundary {
     /// A velocity gradient L [1/s] of a homogeneous flow about `center`, scaled by the time
     /// function with `velocity` (its translation part, default zero): over a step the node at x moves
     /// by (exp(L s) − I)(x − c) + v s with s = ∫ f dt — exactly the step of a uniform deformation
-    /// (e.g. a rigid rotation ω: L = [[0, −ω], [ω, 0]]).
+    /// (e.g. a rigid rotation ω: L = [[0, −ω], [ω, 0]]). Rows L_ij = ∂v_i/∂x_j: two rows of two in a
+    /// plane case, three rows of three in a three-dimensional one.
     #[serde(default)]
-    pub velocity_gradient: Option<[[f64; 2]; 2]>,
-    /// Centre c of the `velocity_gradient`'s flow [m] (default: the origin).
+    pub velocity_gradient: Option<Vec<Vec<f64>>>,
+    /// Centre c of the `velocity_gradient`'s flow [m] (default: the origin); one coordinate per
+    /// dimension.
     #[serde(default)]
-    pub center: Option<[f64; 2]>,
+    pub center: Option<Vec<f64>>,
     /// Name of the time function scaling `displacement`, `velocity` or `velocity_gradient`.
     #[serde(default)]
     pub time_function: Option<String>,

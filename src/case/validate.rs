@@ -192,7 +192,7 @@ fn finite_strain_materials(c: &Case) -> R {
 }
 
 /// What of boundary `i` belongs to three dimensions only (z sides, `uz`/`Uz`, a region's z range, a
-/// surface's z faces) or not yet to three dimensions (velocity gradients).
+/// surface's z faces).
 fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
     let b = &c.boundaries[i];
     let z_side = b.side.is_some_and(|s| s.axis() == 2);
@@ -217,12 +217,6 @@ fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
         }
         return Ok(());
     }
-    if b.velocity_gradient.is_some() {
-        return Err(format!(
-            "key `boundaries[{i}].velocity_gradient`: not available in a three-dimensional case yet (issue «Three \
-             dimensions», docs/dimensions.md)"
-        ));
-    }
     for (r, key) in [(b.region, "region.z"), (b.surface.as_ref().and_then(|sf| sf.region), "surface.region.z")] {
         if let Some([z0, z1]) = r.and_then(|r| r.z) {
             if !(z0.is_finite() && z1.is_finite() && z0 <= z1) {
@@ -235,8 +229,7 @@ fn dimension_of_boundary(c: &Case, i: usize, dim: usize) -> R {
 
 /// What a three-dimensional case may not ask for (line pressures, which are plane by nature) or
 /// not yet (issue «Three dimensions»: the plane benchmarks' checks, [001]'s CMPM and mapped
-/// stiffnesses; velocity gradients are refused with the boundaries), and the space of its points'
-/// identifiers.
+/// stiffnesses), and the space of its points' identifiers.
 fn three_dimensional(c: &Case) -> R {
     let not_yet = |key: &str| {
         Err(format!(
@@ -259,7 +252,12 @@ fn three_dimensional(c: &Case) -> R {
     }
     match &c.verification {
         None
-        | Some(Verification::Terzaghi { .. } | Verification::BearingCapacity { .. } | Verification::Runout { .. }) => {}
+        | Some(
+            Verification::Terzaghi { .. }
+            | Verification::BearingCapacity { .. }
+            | Verification::Runout { .. }
+            | Verification::Patch { .. },
+        ) => {}
         Some(v) => return not_yet(&format!("verification.kind = \"{}\"", v.kind())),
     }
     if c.stabilisation.stress_recovery == crate::case::StressRecovery::Cmpm {
@@ -582,6 +580,13 @@ pub fn validate(c: &Case) -> R {
             if b.initial_stress.is_some() {
                 return Err(format!("key `bodies[{i}]`: give `initial_stress` or `uniform_stress`, not both"));
             }
+            if !(s.len() == 4 || (dim == 3 && s.len() == 6)) {
+                return Err(format!(
+                    "key `bodies[{i}].uniform_stress`: four entries [xx, yy, xy, zz]{}, got {}",
+                    if dim == 3 { " or six [xx, yy, xy, zz, yz, zx]" } else { " in a plane case" },
+                    s.len()
+                ));
+            }
             if s.iter().any(|v| !v.is_finite()) {
                 return Err(format!("key `bodies[{i}].uniform_stress`: must be finite"));
             }
@@ -705,19 +710,37 @@ pub fn validate(c: &Case) -> R {
                     "key `boundaries[{i}].velocity_gradient`: goes with `velocity`, not `displacement`"
                 ));
             }
+            if l.len() != dim || l.iter().any(|row| row.len() != dim) {
+                return Err(format!(
+                    "key `boundaries[{i}].velocity_gradient`: {dim} rows of {dim} entries (∂v_i/∂x_j) in a case of \
+                     {dim} dimensions, got {:?}",
+                    l.iter().map(Vec::len).collect::<Vec<_>>()
+                ));
+            }
             if l.iter().flatten().any(|v| !v.is_finite()) {
                 return Err(format!("key `boundaries[{i}].velocity_gradient`: must be finite"));
             }
-            if !(b.fix.contains(&Dof::Ux) && b.fix.contains(&Dof::Uy)) {
+            let moved = [Dof::Ux, Dof::Uy, Dof::Uz];
+            if !moved[..dim].iter().all(|d| b.fix.contains(d)) {
                 return Err(format!(
-                    "key `boundaries[{i}].velocity_gradient`: moves both `ux` and `uy`, so `fix` must list them"
+                    "key `boundaries[{i}].velocity_gradient`: moves every displacement component, so `fix` must \
+                     list {}",
+                    moved[..dim].iter().map(|d| format!("`{d}`")).collect::<Vec<_>>().join(", ")
                 ));
             }
         }
         if let Some(cn) = &b.center {
-            finite2(&format!("boundaries[{i}].center"), *cn)?;
+            if b.velocity_gradient.is_none() {
+                return Err(format!("key `boundaries[{i}].center`: is the centre of a `velocity_gradient`, not given"));
+            }
+            if cn.len() != dim || cn.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "key `boundaries[{i}].center`: {dim} finite coordinates in a case of {dim} dimensions, got {cn:?}"
+                ));
+            }
         }
-        let motion = b.displacement.clone().or(b.velocity.clone()).or(b.velocity_gradient.map(|_| vec![0.0; dim]));
+        let motion =
+            b.displacement.clone().or(b.velocity.clone()).or(b.velocity_gradient.as_ref().map(|_| vec![0.0; dim]));
         if let Some(m) = &motion {
             let key = if b.displacement.is_some() { "displacement" } else { "velocity" };
             if m.len() != dim {

@@ -353,44 +353,30 @@ pub struct Motion<const D: usize = 2> {
     pub is_displacement: bool,
     /// The displacement or velocity at time-function value 1.
     pub vector: [f64; D],
-    /// The velocity gradient L of a homogeneous flow [1/s] and its centre [m] (two dimensions).
+    /// The velocity gradient L of a homogeneous flow [1/s] and its centre [m].
     pub gradient: Option<([[f64; D]; D], [f64; D])>,
     /// The time function.
     pub time_fn: TimeFn,
 }
 
-/// exp(A) of a 2 × 2 matrix, in closed form: with s = tr A/2 and δ = ((a − d)/2)² + bc,
-/// exp(A) = e^s (C I + S (A − sI)) with C = cosh √δ, S = sinh √δ/√δ (cos and sin for δ < 0).
-pub fn exp2(a: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
-    let s = 0.5 * (a[0][0] + a[1][1]);
-    let delta = 0.25 * (a[0][0] - a[1][1]).powi(2) + a[0][1] * a[1][0];
-    let (c, sn) = if delta.abs() < 1e-12 {
-        (1.0 + 0.5 * delta, 1.0 + delta / 6.0)
-    } else if delta > 0.0 {
-        let q = delta.sqrt();
-        (q.cosh(), q.sinh() / q)
-    } else {
-        let q = (-delta).sqrt();
-        (q.cos(), q.sin() / q)
-    };
-    let e = s.exp();
-    [[e * (c + sn * (a[0][0] - s)), e * sn * a[0][1]], [e * sn * a[1][0], e * (c + sn * (a[1][1] - s))]]
-}
-
 impl<const D: usize> Motion<D> {
     /// The increment over t0 → t1 of the node at `x` [m]: the uniform increment, plus
-    /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt (two dimensions: validation refuses
-    /// a velocity gradient in three).
+    /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt.
     pub fn increment_at(&self, x: [f64; D], t0: f64, t1: f64) -> [f64; D] {
         let mut d = self.increment(t0, t1);
-        if let Some((l, c)) = self.gradient.as_ref().filter(|_| D == 2) {
-            let s = self.integral(t0, t1);
-            let e = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
-            let r = [x[0] - c[0], x[1] - c[1]];
-            d[0] += (e[0][0] - 1.0) * r[0] + e[0][1] * r[1];
-            d[1] += e[1][0] * r[0] + (e[1][1] - 1.0) * r[1];
+        if let Some((l, c)) = &self.gradient {
+            let e = self.flow(l, self.integral(t0, t1));
+            let r: [f64; D] = std::array::from_fn(|b| x[b] - c[b]);
+            for (a, da) in d.iter_mut().enumerate() {
+                *da += (0..D).map(|b| (e[a][b] - if a == b { 1.0 } else { 0.0 }) * r[b]).sum::<f64>();
+            }
         }
         d
+    }
+
+    /// exp(L s): the deformation gradient of the homogeneous flow `l` at flow parameter `s`.
+    pub fn flow(&self, l: &[[f64; D]; D], s: f64) -> [[f64; D]; D] {
+        crate::model::linalg::expm(l.map(|row| row.map(|v| v * s)))
     }
 
     /// ∫₀ᵗ f dτ: the argument of the flow's exponential at `t`.
@@ -506,14 +492,10 @@ impl<const D: usize> BoundaryDef<D> {
                 .unwrap_or(TimeFn::Constant(1.0))
         };
         let vector = |v: &Vec<f64>| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
-        // A velocity gradient (two dimensions only, validated) about its centre.
-        let gradient = b.velocity_gradient.map(|l| {
-            let centre = b.center.unwrap_or([0.0; 2]);
-            let at = |a: usize, e: usize| if a < 2 && e < 2 { l[a][e] } else { 0.0 };
-            (
-                std::array::from_fn(|a| std::array::from_fn(|e| at(a, e))),
-                std::array::from_fn(|d| if d < 2 { centre[d] } else { 0.0 }),
-            )
+        // A velocity gradient (D × D, validated) about its centre (default the origin).
+        let gradient = b.velocity_gradient.as_ref().map(|l| {
+            let centre = b.center.clone().unwrap_or_default();
+            (std::array::from_fn(|a| vector(&l[a])), std::array::from_fn(|d| centre.get(d).copied().unwrap_or(0.0)))
         });
         let motion = match (&b.displacement, &b.velocity, gradient) {
             (Some(d), _, _) => {

@@ -219,13 +219,16 @@ impl<const D: usize> Particles<D> {
         ps.acc.push([0.0; D]);
         ps.vel_w.push([0.0; D]);
         ps.acc_w.push([0.0; D]);
-        let (stress, p, grad_p) = match (&body.initial_stress, &body.uniform_stress) {
-            (Some(init), _) => geostatic(case, grid, init, x, two_phase),
-            (None, Some(s)) => (*s, 0.0, [0.0; D]),
-            (None, None) => ([0.0; 4], 0.0, [0.0; D]),
+        let (stress, p, grad_p) = match (&body.initial_stress, body.uniform_stress_vector()) {
+            (Some(init), _) => {
+                let (s, p, grad_p) = geostatic(case, grid, init, x, two_phase);
+                (crate::model::soil::plane(s), p, grad_p)
+            }
+            (None, Some(s)) => (s, 0.0, [0.0; D]),
+            (None, None) => ([0.0; 6], 0.0, [0.0; D]),
         };
         ps.grad_p.push(grad_p);
-        ps.stress.push(crate::model::soil::plane(stress));
+        ps.stress.push(stress);
         ps.p.push(p);
         ps.p0.push(p);
         ps.eps_pd.push(0.0);
@@ -390,7 +393,30 @@ mod tests {
             (
                 solid.clone()
                     + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\"]\nvelocity_gradient = [[0.0, 1.0], [0.0, 0.0]]\n",
-                "key `boundaries[0].velocity_gradient`: not available in a three-dimensional case yet",
+                "key `boundaries[0].velocity_gradient`: 3 rows of 3 entries (∂v_i/∂x_j) in a case of 3 dimensions",
+            ),
+            (
+                solid.clone()
+                    + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\", \"uy\"]\nvelocity_gradient = [[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]\n",
+                "key `boundaries[0].velocity_gradient`: moves every displacement component, so `fix` must list `ux`, \
+                 `uy`, `uz`",
+            ),
+            (
+                solid.clone()
+                    + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\", \"uy\", \"uz\"]\nvelocity_gradient = [[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]\ncenter = [0.0, 0.5]\n",
+                "key `boundaries[0].center`: 3 finite coordinates in a case of 3 dimensions, got [0.0, 0.5]",
+            ),
+            (
+                base.to_string() + "[[boundaries]]\nname = \"top\"\nside = \"y_max\"\nfix = [\"ux\"]\ncenter = [0.0, 0.5]\n",
+                "key `boundaries[0].center`: is the centre of a `velocity_gradient`, not given",
+            ),
+            (
+                base.replace("shape = { rectangle", "uniform_stress = [1.0, 2.0, 0.0, 1.0, 0.5, 0.0]\n        shape = { rectangle"),
+                "key `bodies[0].uniform_stress`: four entries [xx, yy, xy, zz] in a plane case, got 6",
+            ),
+            (
+                solid.replace("shape = { rectangle", "uniform_stress = [1.0, 2.0, 0.0]\n        shape = { rectangle"),
+                "key `bodies[0].uniform_stress`: four entries [xx, yy, xy, zz] or six [xx, yy, xy, zz, yz, zx], got 3",
             ),
             (
                 base.to_string()

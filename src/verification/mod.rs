@@ -79,7 +79,7 @@ pub struct Table {
 pub type Findings = (Vec<(String, Metric)>, Vec<Table>);
 
 /// A comparison of a run with an analytical solution, on a model of dimension D (two unless it
-/// says otherwise; in three dimensions only the consolidating column, [`for_case_in`]).
+/// says otherwise; in three dimensions the checks of [`for_case_in`]).
 pub trait Check<const D: usize = 2> {
     /// Extra `history.csv` columns this check fills after every step.
     fn columns(&self) -> Vec<String>;
@@ -231,8 +231,8 @@ impl Column {
 }
 
 /// The check the case asks for in dimension D: [`for_case`] in the plane; in three dimensions the
-/// consolidating column against Terzaghi (the one check validation lets a three-dimensional case
-/// ask for).
+/// checks validation lets a three-dimensional case ask for (the consolidating column against
+/// Terzaghi, the bearing capacity, the run-out and the patch test).
 pub fn for_case_in<const D: usize>(
     c: &Case,
     model: &Model<D>,
@@ -248,6 +248,7 @@ pub fn for_case_in<const D: usize>(
         Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
         Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
         Some(Verification::Runout { .. }) => Ok(Some(Box::new(runout::RunoutCheck::new(c, model, coll)?))),
+        Some(Verification::Patch { .. }) => Ok(Some(Box::new(patch::PatchCheck::new(c, model)?))),
         Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
     }
 }

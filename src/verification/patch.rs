@@ -13,15 +13,17 @@
 
 use super::{Check, Findings, Metric};
 use crate::case::{Case, SoilModel, Verification};
-use crate::model::loads::{exp2, Motion};
-use crate::model::soil::{self, LinearElastic, Stress, NS};
+use crate::model::finite_strain::{embed, mul, M3};
+use crate::model::loads::Motion;
+use crate::model::soil::principal::{self, Principal};
+use crate::model::soil::{LinearElastic, Stress, NS};
 use crate::model::Model;
 use crate::parallel::Collective;
 
-/// The patch check of a case.
-pub struct PatchCheck {
+/// The patch check of a case of dimension `D`.
+pub struct PatchCheck<const D: usize = 2> {
     body: u16,
-    motion: Motion,
+    motion: Motion<D>,
     elastic: LinearElastic,
     /// A neo-Hookean body's model (its σ* is the model's stress of F).
     hyperelastic: Option<crate::model::finite_strain::NeoHookean>,
@@ -37,17 +39,19 @@ fn norm(s: &Stress) -> f64 {
     (s[0] * s[0] + s[1] * s[1] + s[3] * s[3] + 2.0 * (s[2] * s[2] + s[4] * s[4] + s[5] * s[5])).sqrt()
 }
 
-/// Eigen-decomposition of a symmetric 2 × 2 matrix: (values, unit eigenvector of the first).
-fn eig_sym(a: [[f64; 2]; 2]) -> ([f64; 2], [f64; 2]) {
-    let m = 0.5 * (a[0][0] + a[1][1]);
-    let r = (0.25 * (a[0][0] - a[1][1]).powi(2) + a[0][1] * a[0][1]).sqrt();
-    let theta = 0.5 * (2.0 * a[0][1]).atan2(a[0][0] - a[1][1]);
-    ([m + r, m - r], [theta.cos(), theta.sin()])
+/// ln V and R of the polar decomposition F = V R: V² = F Fᵀ diagonalised (its principal values
+/// and directions), ln V = Σ ½ ln λ_i e_i e_iᵀ and R = V⁻¹ F with V⁻¹ = Σ λ_i^{−1/2} e_i e_iᵀ.
+fn log_stretch_and_rotation(f: &M3) -> (Stress, M3) {
+    let ft: M3 = std::array::from_fn(|i| std::array::from_fn(|k| f[k][i]));
+    let b = Principal::of(&principal::vector(&mul(*f, ft)));
+    let ln_v = b.compose(&b.values.map(|l| 0.5 * l.ln()));
+    let v_inv = principal::tensor(&b.compose(&b.values.map(|l| 1.0 / l.sqrt())));
+    (ln_v, mul(v_inv, *f))
 }
 
-impl PatchCheck {
+impl<const D: usize> PatchCheck<D> {
     /// The check of a `patch` verification.
-    pub fn new(c: &Case, model: &Model) -> Result<PatchCheck, String> {
+    pub fn new(c: &Case, model: &Model<D>) -> Result<PatchCheck<D>, String> {
         let Some(Verification::Patch { body, boundary, spread_tolerance, tolerance }) = &c.verification else {
             return Err("not a patch verification".into());
         };
@@ -75,50 +79,37 @@ impl PatchCheck {
             motion,
             elastic,
             hyperelastic,
-            initial: soil::plane(b.uniform_stress.unwrap_or([0.0; 4])),
+            initial: b.uniform_stress_vector().unwrap_or([0.0; NS]),
             spread_tolerance: *spread_tolerance,
             tolerance: *tolerance,
             last: (f64::NAN, f64::NAN, 0.0),
         })
     }
 
-    /// σ* at time `t` (see the module documentation).
+    /// σ* at time `t` (see the module documentation): the initial stress turned by R, plus the
+    /// elastic stress of the logarithmic strain ln V (engineering shears), F = exp(L s) = V R.
     pub fn theory(&self, t: f64) -> Stress {
         let Some((l, _)) = &self.motion.gradient else { return self.initial };
-        let s = self.motion.flow_parameter(t);
-        let f = exp2([[l[0][0] * s, l[0][1] * s], [l[1][0] * s, l[1][1] * s]]);
+        let f = embed(&self.motion.flow(l, self.motion.flow_parameter(t)));
         if let Some(h) = &self.hyperelastic {
-            return h.stress(crate::model::finite_strain::plane(f)).unwrap_or([f64::NAN; NS]);
+            return h.stress(f).unwrap_or([f64::NAN; NS]);
         }
-        // F Fᵀ = V², ln V from its eigen-decomposition; R = V⁻¹ F.
-        let b = [
-            [f[0][0] * f[0][0] + f[0][1] * f[0][1], f[0][0] * f[1][0] + f[0][1] * f[1][1]],
-            [f[1][0] * f[0][0] + f[1][1] * f[0][1], f[1][0] * f[1][0] + f[1][1] * f[1][1]],
-        ];
-        let (lam, e) = eig_sym(b);
-        let (l1, l2) = (0.5 * lam[0].ln(), 0.5 * lam[1].ln());
-        let (v1, v2) = (lam[0].sqrt(), lam[1].sqrt());
-        let p = [[e[0] * e[0], e[0] * e[1]], [e[0] * e[1], e[1] * e[1]]];
-        let q = [[1.0 - p[0][0], -p[0][1]], [-p[1][0], 1.0 - p[1][1]]];
-        let ln_v = [[l1 * p[0][0] + l2 * q[0][0], l1 * p[0][1] + l2 * q[0][1]], [0.0, l1 * p[1][1] + l2 * q[1][1]]];
-        let v_inv = [
-            [p[0][0] / v1 + q[0][0] / v2, p[0][1] / v1 + q[0][1] / v2],
-            [p[1][0] / v1 + q[1][0] / v2, p[1][1] / v1 + q[1][1] / v2],
-        ];
-        let r = [
-            [v_inv[0][0] * f[0][0] + v_inv[0][1] * f[1][0], v_inv[0][0] * f[0][1] + v_inv[0][1] * f[1][1]],
-            [v_inv[1][0] * f[0][0] + v_inv[1][1] * f[1][0], v_inv[1][0] * f[0][1] + v_inv[1][1] * f[1][1]],
-        ];
-        let theta = r[1][0].atan2(r[0][0]);
-        let mut s = crate::kernels::kinematics::rotate(&self.initial, theta);
-        let eps = soil::plane([ln_v[0][0], ln_v[1][1], 2.0 * ln_v[0][1], 0.0]);
+        let (ln_v, r) = log_stretch_and_rotation(&f);
+        let mut s = principal::rotate(&r, &self.initial);
+        let eps: Stress = std::array::from_fn(|c| {
+            if principal::TENSOR_INDEX[c].0 == principal::TENSOR_INDEX[c].1 {
+                ln_v[c]
+            } else {
+                2.0 * ln_v[c]
+            }
+        });
         for (i, si) in s.iter_mut().enumerate() {
             *si += (0..NS).map(|j| self.elastic.d[i][j] * eps[j]).sum::<f64>();
         }
         s
     }
 
-    fn measure(&self, model: &Model, coll: &Collective) -> Result<(f64, Stress), String> {
+    fn measure(&self, model: &Model<D>, coll: &Collective) -> Result<(f64, Stress), String> {
         let ps = &model.particles;
         let mine: Vec<usize> = (0..ps.len()).filter(|&k| ps.body[k] == self.body).collect();
         let mut local = [0.0; NS + 1];
@@ -139,7 +130,7 @@ impl PatchCheck {
     }
 }
 
-impl Check for PatchCheck {
+impl<const D: usize> Check<D> for PatchCheck<D> {
     fn columns(&self) -> Vec<String> {
         vec!["patch.stress_spread".into(), "patch.stress_rel_error".into()]
     }
@@ -148,7 +139,7 @@ impl Check for PatchCheck {
         Vec::new()
     }
 
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
         let (spread, mean) = self.measure(model, coll)?;
         let theory = self.theory(t);
         let d: Stress = std::array::from_fn(|c| mean[c] - theory[c]);
@@ -157,7 +148,7 @@ impl Check for PatchCheck {
         Ok(vec![spread, error])
     }
 
-    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+    fn finish(&mut self, _model: &Model<D>, _coll: &Collective) -> Result<Findings, String> {
         let (spread, error, t) = self.last;
         let theory = self.theory(t);
         Ok((
@@ -172,8 +163,12 @@ impl Check for PatchCheck {
                         error,
                         self.tolerance,
                         format!(
-                            "‖σ̄ − σ*‖/‖σ*‖ at t = {t:.6e} s, σ* = [{:.6e}, {:.6e}, {:.6e}, {:.6e}] Pa",
-                            theory[0], theory[1], theory[2], theory[3]
+                            "‖σ̄ − σ*‖/‖σ*‖ at t = {t:.6e} s, σ* = [{}] Pa",
+                            theory[..if D == 3 { NS } else { 4 }]
+                                .iter()
+                                .map(|v| format!("{v:.6e}"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
                         ),
                     ),
                 ),
@@ -182,11 +177,11 @@ impl Check for PatchCheck {
         ))
     }
 
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
         Ok(Some(vec![self.last.0, self.last.1, self.last.2]))
     }
 
-    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
         if let [a, b, c] = state {
             self.last = (*a, *b, *c);
             Ok(())
@@ -200,34 +195,86 @@ impl Check for PatchCheck {
 mod tests {
     use super::*;
     use crate::model::loads::TimeFn;
+    use crate::model::soil;
 
-    fn check(l: [[f64; 2]; 2], initial: [f64; 4]) -> PatchCheck {
+    fn check<const D: usize>(l: [[f64; D]; D], initial: Stress) -> PatchCheck<D> {
         PatchCheck {
             body: 0,
             motion: Motion {
                 is_displacement: false,
-                vector: [0.0; 2],
-                gradient: Some((l, [0.0; 2])),
+                vector: [0.0; D],
+                gradient: Some((l, [0.0; D])),
                 time_fn: TimeFn::Constant(1.0),
             },
             elastic: LinearElastic::new(1e6, 0.3),
             hyperelastic: None,
-            initial: soil::plane(initial),
+            initial,
             spread_tolerance: 1e-9,
             tolerance: 1e-6,
             last: (0.0, 0.0, 0.0),
         }
     }
 
+    fn close(a: &Stress, b: &Stress, tol: f64) -> bool {
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol)
+    }
+
     #[test]
     fn the_reference_of_a_rotation_and_of_a_stretch() {
         // A quarter turn turns the stress.
         let w = std::f64::consts::FRAC_PI_2;
-        let s = check([[0.0, -w], [w, 0.0]], [3.0, 1.0, 0.5, 2.0]).theory(1.0);
+        let s = check([[0.0, -w], [w, 0.0]], soil::plane([3.0, 1.0, 0.5, 2.0])).theory(1.0);
         assert!((s[0] - 1.0).abs() < 1e-12 && (s[1] - 3.0).abs() < 1e-12 && (s[2] + 0.5).abs() < 1e-12);
         // A stretch along x: ε_xx = ln λ, plane strain.
-        let s = check([[1e-3, 0.0], [0.0, 0.0]], [0.0; 4]).theory(1.0);
+        let s = check([[1e-3, 0.0], [0.0, 0.0]], [0.0; NS]).theory(1.0);
         let el = LinearElastic::new(1e6, 0.3);
         assert!((s[0] - el.d[0][0] * 1e-3).abs() < 1e-9 && (s[1] - el.d[1][0] * 1e-3).abs() < 1e-9);
+    }
+
+    /// In three dimensions: a turn about a skew axis turns the full stress (R σ₀ Rᵀ with Rodrigues'
+    /// R), a stretch along z gives ε_zz = ln λ, a plane flow embedded in three dimensions gives the
+    /// plane reference, and a flow of stretch and spin together is R σ₀ Rᵀ + D ln V (checked
+    /// against V and R rebuilt: V R = F, V symmetric, R orthogonal).
+    #[test]
+    fn the_reference_in_three_dimensions() {
+        let sigma0: Stress = [3.0, 1.0, 0.5, 2.0, -0.7, 0.4];
+        let axis = [2.0f64, -1.0, 2.0].map(|v| v / 3.0);
+        let angle = 0.9;
+        let w = [[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]];
+        let s = check(w.map(|r| r.map(|v| v * angle)), sigma0).theory(1.0);
+        let turned = principal::rotate(&principal::rotation(axis, angle), &sigma0);
+        // ln V of a rotation is round-off (1e-16), times E = 1e6 Pa.
+        assert!(close(&s, &turned, 1e-8), "{s:?} against {turned:?}");
+
+        let s = check([[0.0; 3], [0.0; 3], [0.0, 0.0, 2e-3]], [0.0; NS]).theory(1.0);
+        let el = LinearElastic::new(1e6, 0.3);
+        let expected: Stress = std::array::from_fn(|c| el.d[c][3] * 2e-3);
+        assert!(close(&s, &expected, 1e-9), "{s:?} against {expected:?}");
+
+        let plane = [[1e-3, 3e-4], [-2e-4, -5e-4]];
+        let s2 = check(plane, soil::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
+        let s3 =
+            check([[1e-3, 3e-4, 0.0], [-2e-4, -5e-4, 0.0], [0.0; 3]], soil::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
+        assert!(close(&s2, &s3, 1e-9), "{s2:?} against {s3:?}");
+
+        let l = [[0.02, -0.3, 0.1], [0.25, -0.01, 0.05], [-0.08, 0.15, 0.03]];
+        let f = embed(&crate::model::linalg::expm(l));
+        let (ln_v, r) = log_stretch_and_rotation(&f);
+        let rt: M3 = std::array::from_fn(|i| std::array::from_fn(|k| r[k][i]));
+        let rrt = mul(r, rt);
+        let v = Principal::of(&ln_v);
+        let v = principal::tensor(&v.compose(&v.values.map(f64::exp)));
+        let vr = mul(v, r);
+        for i in 0..3 {
+            for k in 0..3 {
+                assert!((rrt[i][k] - if i == k { 1.0 } else { 0.0 }).abs() < 1e-14, "R Rᵀ {rrt:?}");
+                assert!((vr[i][k] - f[i][k]).abs() < 1e-14, "V R {vr:?} against F {f:?}");
+            }
+        }
+        let s = check(l, sigma0).theory(1.0);
+        let eps: Stress = [ln_v[0], ln_v[1], 2.0 * ln_v[2], ln_v[3], 2.0 * ln_v[4], 2.0 * ln_v[5]];
+        let turned = principal::rotate(&r, &sigma0);
+        let expected: Stress = std::array::from_fn(|c| turned[c] + (0..NS).map(|j| el.d[c][j] * eps[j]).sum::<f64>());
+        assert!(close(&s, &expected, 1e-9), "{s:?} against {expected:?}");
     }
 }
