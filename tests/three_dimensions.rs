@@ -582,10 +582,9 @@ fn the_kinematic_patch_test_holds_in_three_dimensions() {
         assert!(r.completed(), "{label}: {}", r.stderr());
         assert_eq!(r.summary["particles"], 512, "{label}");
         let (spread, err) = (metric(&r.summary, "stress_spread"), metric(&r.summary, "stress_rel_error"));
-        // With F̄ and GIMP or uGIMP on the regular arrangement the spread grows from 1e-14 at the
-        // first step to 3.2e-12–3.9e-12 at the tenth, as the block's faces leave the grid lines and
-        // the nodes beyond them take sliver weights: their J̄ comes out of the projection over
-        // tiny masses (the plane patch 1.1e-15; 5e-15–7e-15 perturbed, or with the other bases).
+        // With F̄ and GIMP or uGIMP on the regular arrangement the spread grows step by step, from
+        // 1e-14 at the first step to 3.2e-12–3.9e-12 at the tenth (the plane patch: 1.1e-15; the
+        // perturbed arrangement and the other bases: 5e-15–7e-15). Its cause is not established.
         let bound = if fbar { 1e-11 } else { 1e-12 };
         assert!(spread <= bound, "{label}: stress spread {spread:e}");
         // The Hughes–Winget increments sum to ln V up to (|L|Δt)²/12 per step.

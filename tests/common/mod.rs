@@ -37,9 +37,17 @@ impl Run {
     }
 }
 
+/// The machine's cores, shared by the tests of one test binary: a one-rank run holds them for
+/// reading (two may run side by side, as the test harness runs two tests at a time on two cores), a
+/// run on several ranks for writing, alone. Two or three ranks beside another run oversubscribe
+/// the cores, and the ranks, waiting on each other, slow down several times (cases/footing_ld.toml
+/// on three ranks: 12 s alone, 49 s beside a one-rank run).
+pub static CORES: std::sync::RwLock<()> = std::sync::RwLock::new(());
+
 /// Runs `porompm run CASE --out DIR --quiet` with `args` after it (e.g. `--set` pairs, an options
 /// file, PETSc options after `--`) into `dir`, emptied first.
 pub fn run_case(case: &str, dir: &Path, args: &[String]) -> Run {
+    let _cores = CORES.read().unwrap_or_else(|e| e.into_inner());
     let _ = std::fs::remove_dir_all(dir);
     let mut all =
         vec!["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()];
@@ -90,12 +98,14 @@ pub fn metric(s: &Value, name: &str) -> f64 {
     s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
 }
 
-/// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`; one rank
-/// runs the binary directly), with a 600 s limit so that a hang fails the test instead of holding it.
+/// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`, alone on
+/// the [`CORES`]; one rank runs the binary directly), with a 600 s limit so that a hang fails the
+/// test instead of holding it.
 pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run {
     if ranks == 1 {
         return run_case(case, dir, args);
     }
+    let _cores = CORES.write().unwrap_or_else(|e| e.into_inner());
     let _ = std::fs::remove_dir_all(dir);
     let np = ranks.to_string();
     let mut all: Vec<String> = ["600", "mpirun", "--oversubscribe", "-n", np.as_str(), env!("CARGO_BIN_EXE_porompm")]
