@@ -86,9 +86,7 @@ pub fn expm<const D: usize>(a: [[f64; D]; D]) -> [[f64; D]; D] {
     }
     let scale = f64::powi(2.0, -squarings);
     let x: [[f64; D]; D] = a.map(|row| row.map(|v| v * scale));
-    let mul = |p: &[[f64; D]; D], q: &[[f64; D]; D]| -> [[f64; D]; D] {
-        std::array::from_fn(|i| std::array::from_fn(|k| (0..D).map(|m| p[i][m] * q[m][k]).sum()))
-    };
+    let mul = crate::kernels::kinematics::product::<D>;
     let mut sum: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|k| if i == k { 1.0 } else { 0.0 }));
     let mut term = sum;
     for n in 1..=30 {
@@ -124,11 +122,6 @@ mod tests {
         // The regularised solve gives the minimum-norm solution of the consistent singular system.
         let x = solve_regularised(s, [1.0, 2.0, 0.0], 2).unwrap();
         assert!((x[0] - 0.2).abs() < 1e-6 && (x[1] - 0.4).abs() < 1e-6, "{x:?}");
-    }
-
-    /// A 3 × 3 product, for the exponential's identities.
-    fn mul3(p: &[[f64; 3]; 3], q: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-        std::array::from_fn(|i| std::array::from_fn(|k| (0..3).map(|m| p[i][m] * q[m][k]).sum()))
     }
 
     fn max_diff(p: &[[f64; 3]; 3], q: &[[f64; 3]; 3]) -> f64 {
@@ -167,7 +160,8 @@ mod tests {
         let a = [[0.4, 1.2, -0.3], [-0.9, 0.1, 0.8], [0.6, -0.5, -0.7]];
         let (p, m) = (expm(a), expm(a.map(|r| r.map(|v| -v))));
         let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        assert!(max_diff(&mul3(&p, &m), &id) < 1e-14, "{:?}", mul3(&p, &m));
+        let pm = crate::model::finite_strain::mul(p, m);
+        assert!(max_diff(&pm, &id) < 1e-14, "{pm:?}");
         let det = crate::model::finite_strain::det(p);
         assert!((det - (0.4f64 + 0.1 - 0.7).exp()).abs() < 1e-14, "det {det}");
     }

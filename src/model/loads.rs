@@ -364,8 +364,7 @@ impl<const D: usize> Motion<D> {
     /// (exp(L s) − I)(x − c) for a homogeneous flow, s = ∫ f dt.
     pub fn increment_at(&self, x: [f64; D], t0: f64, t1: f64) -> [f64; D] {
         let mut d = self.increment(t0, t1);
-        if let Some((l, c)) = &self.gradient {
-            let e = self.flow(l, self.integral(t0, t1));
+        if let (Some((_, c)), Some(e)) = (&self.gradient, self.flow(self.integral(t0, t1))) {
             let r: [f64; D] = std::array::from_fn(|b| x[b] - c[b]);
             for (a, da) in d.iter_mut().enumerate() {
                 *da += (0..D).map(|b| (e[a][b] - if a == b { 1.0 } else { 0.0 }) * r[b]).sum::<f64>();
@@ -374,9 +373,10 @@ impl<const D: usize> Motion<D> {
         d
     }
 
-    /// exp(L s): the deformation gradient of the homogeneous flow `l` at flow parameter `s`.
-    pub fn flow(&self, l: &[[f64; D]; D], s: f64) -> [[f64; D]; D] {
-        crate::model::linalg::expm(l.map(|row| row.map(|v| v * s)))
+    /// exp(L s): the deformation gradient of the motion's homogeneous flow at flow parameter `s`
+    /// (None without a velocity gradient).
+    pub fn flow(&self, s: f64) -> Option<[[f64; D]; D]> {
+        self.gradient.as_ref().map(|(l, _)| crate::model::linalg::expm(l.map(|row| row.map(|v| v * s))))
     }
 
     /// ∫₀ᵗ f dτ: the argument of the flow's exponential at `t`.

@@ -89,8 +89,8 @@ impl<const D: usize> PatchCheck<D> {
     /// σ* at time `t` (see the module documentation): the initial stress turned by R, plus the
     /// elastic stress of the logarithmic strain ln V (engineering shears), F = exp(L s) = V R.
     pub fn theory(&self, t: f64) -> Stress {
-        let Some((l, _)) = &self.motion.gradient else { return self.initial };
-        let f = embed(&self.motion.flow(l, self.motion.flow_parameter(t)));
+        let Some(f) = self.motion.flow(self.motion.flow_parameter(t)) else { return self.initial };
+        let f = embed(&f);
         if let Some(h) = &self.hyperelastic {
             return h.stress(f).unwrap_or([f64::NAN; NS]);
         }
