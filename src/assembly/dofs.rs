@@ -45,12 +45,15 @@ impl DofMap {
 /// Whether component `c` of a node that the material fills to `fill` (a fraction of a cell) is an
 /// unknown where no boundary fixes it: every component of a well-filled node (above
 /// `well_fraction`); and the projected volume ratio of an implicit F̄ step wherever points reach
-/// the node at all (above [`super::REACHED_FRACTION`]), since it is [002]'s average over the points
-/// that reach it, however few (its row's diagonal is κ Σ_p S_ip V_p), unlike the motion, which is
-/// extended, and the pressure, which is drained.
+/// the node at all (a fill above zero), since it is [002]'s average over the points that reach it,
+/// however few (its row's diagonal is κ Σ_p S_ip V_p), unlike the motion, which is extended, and the
+/// pressure, which is drained. No threshold above zero: a point's J̄ = 1 + Σ_i S_ip ϑ_i needs ϑ at
+/// every node with S_ip ≠ 0, and a node whose share is dropped costs the patch test its exactness
+/// (in three dimensions a corner node beyond a cube is reached by a sliver ∝ δ³, and a threshold of
+/// 1e-12 of a cell let the spread of the F̄ patch grow to 4e-12).
 pub fn carries_unknown(layout: Layout, c: usize, fill: f64, well_fraction: f64) -> bool {
     if Some(c) == layout.jbar {
-        fill > super::REACHED_FRACTION
+        fill > 0.0
     } else {
         fill > well_fraction
     }

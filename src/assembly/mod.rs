@@ -37,7 +37,7 @@ pub mod stencils;
 mod stiffness;
 
 pub use check::BlockCheck;
-pub use stencils::{REACHED_FRACTION, WELL_FILLED_FRACTION};
+pub use stencils::WELL_FILLED_FRACTION;
 
 use crate::kernels::{self, Layout, StepResult};
 use crate::model::loads::{face_point, LoadTarget};

@@ -36,10 +36,6 @@ use petsc::GhostedRange;
 /// unknowns of its own (see the module documentation).
 pub const WELL_FILLED_FRACTION: f64 = 1e-2;
 
-/// Fraction of a cell's area above which the points reach a node at all: an implicit F̄ step's
-/// projected volume ratio is an unknown there (`kernels::fbar`, `dofs::build`).
-pub const REACHED_FRACTION: f64 = 1e-12;
-
 /// Largest number of master nodes of one extended node.
 pub const MAX_MASTERS: usize = 3;
 
