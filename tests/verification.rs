@@ -1,7 +1,9 @@
 //! Verification against analytical solutions, with stated tolerances (the case files' targets):
-//! every case family runs with the default solver and with `direct-lu.opts` and
-//! `fieldsplit-schur.opts`, meets its targets with each, and the strategies agree on every metric
-//! within solver tolerance. Each run is the real binary in its own process.
+//! every case family meets its targets with the default solver and with `direct-lu.opts` and
+//! `fieldsplit-schur.opts`, and the strategies agree on every metric within solver tolerance. The
+//! default solver's run is the one `tests/gold.rs` makes and pins (each metric's value and pass
+//! flag, [`common::gold_run`]), so it is read from the gold file rather than run twice. Each run is
+//! the real binary in its own process.
 
 mod common;
 
@@ -44,18 +46,20 @@ fn metrics(s: &Value) -> BTreeMap<String, (f64, bool, f64)> {
         .collect()
 }
 
-/// Runs `case` with the three strategies; every metric in `expected` must exist, meet its target
+/// Checks `case` with the three strategies: the default run as the gold file pins it, then
+/// `direct-lu` and `fieldsplit-schur` runs; every metric in `expected` must exist, meet its target
 /// with each strategy, and agree across strategies to `agree` (metrics are normalised errors, so an
-/// absolute bound is the solver tolerance carried through).
-fn family(case: &str, sets: &[&str], expected: &[&str], agree: f64) -> BTreeMap<String, (f64, bool, f64)> {
-    let reference = metrics(&run(case, &format!("{case}-default"), None, sets));
+/// absolute bound is the solver tolerance carried through). Returns the default's metrics.
+fn family(case: &str, expected: &[&str], agree: f64) -> BTreeMap<String, (f64, bool)> {
+    let reference = common::gold_run(case).metrics;
     let names: Vec<&str> = reference.keys().map(String::as_str).collect();
     assert_eq!(names, expected, "{case}: metric names");
-    for (name, (v, pass, tol)) in &reference {
-        assert!(*pass, "{case} (default solver): {name} = {v:e} exceeds {tol:e}");
+    for (name, (v, pass)) in &reference {
+        assert!(*pass, "{case} (default solver, gold run): {name} = {v:e} misses its target");
     }
     for strategy in ["direct-lu", "fieldsplit-schur"] {
-        let m = metrics(&run(case, &format!("{case}-{strategy}"), Some(strategy), sets));
+        let m = metrics(&run(case, &format!("{case}-{strategy}"), Some(strategy), &[]));
+        assert_eq!(m.keys().collect::<Vec<_>>(), reference.keys().collect::<Vec<_>>(), "{case} ({strategy})");
         for (name, (v, pass, tol)) in &m {
             assert!(*pass, "{case} ({strategy}): {name} = {v:e} exceeds {tol:e}");
             let r = reference[name].0;
@@ -69,7 +73,6 @@ fn family(case: &str, sets: &[&str], expected: &[&str], agree: f64) -> BTreeMap<
 fn terzaghi_consolidation_meets_its_targets_with_every_strategy() {
     let m = family(
         "terzaghi",
-        &[],
         &["e_p_Tv0.1", "e_p_Tv0.5", "p_rms_error_Tv0.1", "p_rms_error_Tv0.5", "settlement_rel_error_Tv0.5"],
         1e-6,
     );
@@ -79,25 +82,25 @@ fn terzaghi_consolidation_meets_its_targets_with_every_strategy() {
 
 #[test]
 fn harmonic_column_zone1_meets_five_percent() {
-    let m = family("harmonic_column_zone1", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    let m = family("harmonic_column_zone1", &["p_amplitude_max_rel_error"], 1e-5);
     assert!(m["p_amplitude_max_rel_error"].0 <= 0.05);
 }
 
 #[test]
 fn harmonic_column_zone2_meets_five_percent() {
-    let m = family("harmonic_column_zone2", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    let m = family("harmonic_column_zone2", &["p_amplitude_max_rel_error"], 1e-5);
     assert!(m["p_amplitude_max_rel_error"].0 <= 0.05);
 }
 
 #[test]
 fn harmonic_column_zone3_meets_ten_percent() {
-    let m = family("harmonic_column_zone3", &[], &["p_amplitude_max_rel_error"], 1e-5);
+    let m = family("harmonic_column_zone3", &["p_amplitude_max_rel_error"], 1e-5);
     assert!(m["p_amplitude_max_rel_error"].0 <= 0.10);
 }
 
 #[test]
 fn shock_wave_at_high_permeability_shows_both_waves_on_time() {
-    let m = family("shock_wave", &[], &["fast_wave_arrival_rel_error", "slow_wave_arrival_rel_error"], 1e-5);
+    let m = family("shock_wave", &["fast_wave_arrival_rel_error", "slow_wave_arrival_rel_error"], 1e-5);
     assert!(m["fast_wave_arrival_rel_error"].0 <= 0.02);
     assert!(m["slow_wave_arrival_rel_error"].0 <= 0.05);
 }
@@ -114,20 +117,19 @@ fn shock_wave_at_low_permeability_shows_the_fast_wave_only() {
 #[test]
 fn elastic_column_one_phase_two_stages_meets_the_static_solution() {
     // One-phase (ux, uy) layout: the fieldsplit strategy, which splits the two-phase fields, does not
-    // apply; the direct ones must agree.
-    let reference = metrics(&run("elastic_column", "elastic_column-default", None, &[]));
+    // apply; the direct ones must agree with the default run (as its gold file pins it).
+    let reference = common::gold_run("elastic_column").metrics;
     assert_eq!(
         reference.keys().map(String::as_str).collect::<Vec<_>>(),
         ["settlement_rel_error", "stress_max_rel_error"]
     );
-    for strategy in [None, Some("direct-lu"), Some("direct-ldlt")] {
-        let m = match strategy {
-            None => reference.clone(),
-            Some(s) => metrics(&run("elastic_column", &format!("elastic_column-{s}"), Some(s), &[])),
-        };
+    assert!(reference.values().all(|m| m.1), "the default run misses a target: {reference:?}");
+    for strategy in ["direct-lu", "direct-ldlt"] {
+        let m = metrics(&run("elastic_column", &format!("elastic_column-{strategy}"), Some(strategy), &[]));
+        assert_eq!(m.len(), reference.len(), "{strategy}");
         for (name, (v, pass, tol)) in &m {
-            assert!(*pass, "{strategy:?}: {name} = {v:e} exceeds {tol:e}");
-            assert!((v - reference[name].0).abs() <= 1e-6, "{strategy:?}: {name} differs");
+            assert!(*pass, "{strategy}: {name} = {v:e} exceeds {tol:e}");
+            assert!((v - reference[name].0).abs() <= 1e-6, "{strategy}: {name} differs");
         }
     }
     assert!(reference["stress_max_rel_error"].0 <= 0.01 && reference["settlement_rel_error"].0 <= 0.01);
@@ -137,12 +139,8 @@ fn elastic_column_one_phase_two_stages_meets_the_static_solution() {
 fn large_strain_consolidation_meets_three_percent_at_ten_cells() {
     // [003] §4.2 against Xie & Leo (2004): the target is a settlement error at U_s = 0.5 of at
     // most 3 % at 10 cells (the refinement to 20 and 40 cells is in `make study`).
-    let m = family(
-        "large_strain_consolidation",
-        &[],
-        &["e_p_Us0.5", "p_rms_error_Us0.5", "settlement_rel_error_Us0.5"],
-        1e-5,
-    );
+    let m =
+        family("large_strain_consolidation", &["e_p_Us0.5", "p_rms_error_Us0.5", "settlement_rel_error_Us0.5"], 1e-5);
     assert!(m["settlement_rel_error_Us0.5"].0 <= 0.03);
 }
 
@@ -184,18 +182,15 @@ fn footing_sd_converges_towards_prandtl_with_bbar_and_locks_without() {
     // approaches 2 + π under refinement: measured (q_ult/c)/(2 + π) = 1.183 / 1.098 / 1.057 at
     // h = 0.5 / 0.25 / 0.1 m (order ≈ 0.9 then 0.6; the case's target, 6 % at h = 0.25 m, is not
     // met and the run reports it as FAIL; see docs/verification.md). Here: the error must fall by
-    // at least 1.6× from h = 0.5 to 0.25 m (1.87× measured) and each run's pass flag must agree
-    // with its value; the values themselves are pinned by the gold test. Without B̄ the nearly
+    // at least 1.6× from h = 0.5 to 0.25 m (1.87× measured) and the coarse run's pass flag must
+    // agree with its value; the default run's value and flag are pinned by the gold test. Without B̄ the nearly
     // incompressible plastic flow locks: no failure up to q/c = 7.
     let coarse = run("footing_sd", "footing_sd-h0.5", None, &["parameters.h=0.5"]);
-    let with = run("footing_sd", "footing_sd-bbar", None, &[]);
-    let m = |s: &Value| {
-        let b = &s["verification"]["bearing_capacity_ratio"];
-        let (v, tol) = (b["value"].as_f64().unwrap(), b["tolerance"].as_f64().unwrap());
-        assert_eq!(b["pass"].as_bool().unwrap(), (v - 1.0).abs() <= tol, "pass flag of {v}");
-        v
-    };
-    let (r05, r025) = (m(&coarse), m(&with));
+    let b = &coarse["verification"]["bearing_capacity_ratio"];
+    let (r05, tol) = (b["value"].as_f64().unwrap(), b["tolerance"].as_f64().unwrap());
+    assert_eq!(b["pass"].as_bool().unwrap(), (r05 - 1.0).abs() <= tol, "pass flag of {r05}");
+    // The default run (h = 0.25 m), as its gold file pins it (its pass flag too).
+    let r025 = common::gold_run("footing_sd").metrics["bearing_capacity_ratio"].0;
     assert!(r025 > 1.0 && (r05 - 1.0) >= 1.6 * (r025 - 1.0), "q_ult/c/(2 + π) = {r05} at h = 0.5 m, {r025} at 0.25 m");
     let without = run("footing_sd", "footing_sd-nobbar", None, &["stabilisation.bbar=false"]);
     let q_max = result(&without, "q_over_c_max");
@@ -212,7 +207,8 @@ fn slope_clay_runs_out_with_bbar_and_locks_without() {
     // [000] §4.2.1: released after the gravity stage, the softening clay slope fails; with B̄ its toe
     // runs out about twice as far as without (0.36 and 0.17 m measured), where the isochoric plastic
     // flow locks.
-    let with = result(&run("slope_clay", "slope_clay-bbar", None, &[]), "toe.displacement");
+    // With B̄: the default run, as its gold file pins it.
+    let with = common::gold_run("slope_clay").results["toe.displacement"];
     let without =
         result(&run("slope_clay", "slope_clay-nobbar", None, &["stabilisation.bbar=false"]), "toe.displacement");
     assert!(with > 0.25, "toe run-out with B̄: {with} m");

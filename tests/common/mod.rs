@@ -140,3 +140,41 @@ pub fn csv_fields(line: &str) -> Vec<String> {
     fields.push(cur);
     fields
 }
+
+/// A case's default run as its gold file (`cases/gold/<case>.json`) pins it: each verification
+/// metric's value and pass flag, and each `results` value. `tests/gold.rs` runs the case with
+/// exactly these overrides on one, two and three ranks and fails if any of these numbers moves
+/// beyond round-off, so a test that needs the default run of a case whose gold file has no overrides
+/// reads it here instead of running it again.
+pub struct GoldRun {
+    /// Verification metric → (value, whether it meets its target).
+    pub metrics: std::collections::BTreeMap<String, (f64, bool)>,
+    /// `results` entry → value (NaN where the run wrote none).
+    pub results: std::collections::BTreeMap<String, f64>,
+}
+
+/// The gold default run of `case` (see [`GoldRun`]); panics unless its gold file runs the case as
+/// shipped (no `sets`).
+pub fn gold_run(case: &str) -> GoldRun {
+    let path = root().join("cases/gold").join(format!("{case}.json"));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("gold file")).expect("gold JSON");
+    assert!(
+        v["sets"].as_array().is_some_and(|s| s.is_empty()),
+        "{}: the gold run has overrides, so it is not the case's default run",
+        path.display()
+    );
+    let values = v["values"].as_object().expect("gold values");
+    let number = |k: &str| values.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+    let mut metrics = std::collections::BTreeMap::new();
+    let mut results = std::collections::BTreeMap::new();
+    for k in values.keys() {
+        if let Some(name) = k.strip_prefix("verification.") {
+            let pass = values.get(&format!("pass.{name}")).and_then(Value::as_f64);
+            let pass = pass.unwrap_or_else(|| panic!("{}: no pass.{name}", path.display())) == 1.0;
+            metrics.insert(name.to_string(), (number(k), pass));
+        } else if let Some(name) = k.strip_prefix("results.") {
+            results.insert(name.to_string(), number(k));
+        }
+    }
+    GoldRun { metrics, results }
+}
