@@ -25,45 +25,11 @@
 
 mod common;
 
-use common::root;
+use common::{gold_path, read_gold, root, Gold};
 use serde_json::{json, Map, Value};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn gold_path(case: &str) -> PathBuf {
-    root().join("cases/gold").join(format!("{case}.json"))
-}
-
-/// A gold file: how the case is run, its tolerance, its governing parameters and its values.
-struct Gold {
-    sets: Vec<String>,
-    rtol: f64,
-    governing: Vec<String>,
-    values: BTreeMap<String, Option<f64>>,
-    /// An absolute floor under every comparison but the exact ones (0 for the gold test itself).
-    floor: f64,
-}
-
-fn read_gold(case: &str) -> Gold {
-    let path = gold_path(case);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (every case needs a gold file: `make gold` writes it)", path.display()));
-    let v: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let strings = |k: &str| -> Vec<String> {
-        v[k].as_array().map(|a| a.iter().map(|s| s.as_str().unwrap().to_string()).collect()).unwrap_or_default()
-    };
-    Gold {
-        sets: strings("sets"),
-        rtol: v["rtol"].as_f64().unwrap_or_else(|| panic!("{}: no rtol", path.display())),
-        governing: strings("governing"),
-        values: v["values"]
-            .as_object()
-            .map(|o| o.iter().map(|(k, x)| (k.clone(), x.as_f64())).collect())
-            .unwrap_or_default(),
-        floor: 0.0,
-    }
-}
 
 fn write_gold(case: &str, gold: &Gold) {
     let values: Map<String, Value> =

@@ -183,8 +183,8 @@ fn footing_sd_converges_towards_prandtl_with_bbar_and_locks_without() {
     // h = 0.5 / 0.25 / 0.1 m (order ≈ 0.9 then 0.6; the case's target, 6 % at h = 0.25 m, is not
     // met and the run reports it as FAIL; see docs/verification.md). Here: the error must fall by
     // at least 1.6× from h = 0.5 to 0.25 m (1.87× measured) and the coarse run's pass flag must
-    // agree with its value; the default run's value and flag are pinned by the gold test. Without B̄ the nearly
-    // incompressible plastic flow locks: no failure up to q/c = 7.
+    // agree with its value; the default run's value and flag are pinned by the gold test. Without
+    // B̄ the nearly incompressible plastic flow locks: no failure up to q/c = 7.
     let coarse = run("footing_sd", "footing_sd-h0.5", None, &["parameters.h=0.5"]);
     let b = &coarse["verification"]["bearing_capacity_ratio"];
     let (r05, tol) = (b["value"].as_f64().unwrap(), b["tolerance"].as_f64().unwrap());

@@ -141,11 +141,46 @@ pub fn csv_fields(line: &str) -> Vec<String> {
     fields
 }
 
-/// A case's default run as its gold file (`cases/gold/<case>.json`) pins it: each verification
-/// metric's value and pass flag, and each `results` value. `tests/gold.rs` runs the case with
-/// exactly these overrides on one, two and three ranks and fails if any of these numbers moves
-/// beyond round-off, so a test that needs the default run of a case whose gold file has no overrides
-/// reads it here instead of running it again.
+/// The gold file of `case`, `cases/gold/<case>.json` (written and compared by `tests/gold.rs`).
+pub fn gold_path(case: &str) -> PathBuf {
+    root().join("cases/gold").join(format!("{case}.json"))
+}
+
+/// A gold file: how the case is run, its tolerance, its governing parameters and its values.
+pub struct Gold {
+    pub sets: Vec<String>,
+    pub rtol: f64,
+    pub governing: Vec<String>,
+    pub values: std::collections::BTreeMap<String, Option<f64>>,
+    /// An absolute floor under every comparison but the exact ones (0 for the gold test itself).
+    pub floor: f64,
+}
+
+/// Reads the gold file of `case` (see [`Gold`]).
+pub fn read_gold(case: &str) -> Gold {
+    let path = gold_path(case);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (every case needs a gold file: `make gold` writes it)", path.display()));
+    let v: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let strings = |k: &str| -> Vec<String> {
+        v[k].as_array().map(|a| a.iter().map(|s| s.as_str().unwrap().to_string()).collect()).unwrap_or_default()
+    };
+    Gold {
+        sets: strings("sets"),
+        rtol: v["rtol"].as_f64().unwrap_or_else(|| panic!("{}: no rtol", path.display())),
+        governing: strings("governing"),
+        values: v["values"]
+            .as_object()
+            .map(|o| o.iter().map(|(k, x)| (k.clone(), x.as_f64())).collect())
+            .unwrap_or_default(),
+        floor: 0.0,
+    }
+}
+
+/// A case's default run as its gold file pins it: each verification metric's value and pass flag,
+/// and each `results` value. `tests/gold.rs` runs the case with exactly these overrides on one and
+/// two ranks and fails if any of these numbers moves beyond round-off, so a test that needs the
+/// default run of a case whose gold file has no overrides reads it here instead of running it again.
 pub struct GoldRun {
     /// Verification metric → (value, whether it meets its target).
     pub metrics: std::collections::BTreeMap<String, (f64, bool)>,
@@ -156,21 +191,15 @@ pub struct GoldRun {
 /// The gold default run of `case` (see [`GoldRun`]); panics unless its gold file runs the case as
 /// shipped (no `sets`).
 pub fn gold_run(case: &str) -> GoldRun {
-    let path = root().join("cases/gold").join(format!("{case}.json"));
-    let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("gold file")).expect("gold JSON");
-    assert!(
-        v["sets"].as_array().is_some_and(|s| s.is_empty()),
-        "{}: the gold run has overrides, so it is not the case's default run",
-        path.display()
-    );
-    let values = v["values"].as_object().expect("gold values");
-    let number = |k: &str| values.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+    let gold = read_gold(case);
+    assert!(gold.sets.is_empty(), "{case}: the gold run has overrides, so it is not the case's default run");
+    let number = |k: &str| gold.values.get(k).copied().flatten().unwrap_or(f64::NAN);
     let mut metrics = std::collections::BTreeMap::new();
     let mut results = std::collections::BTreeMap::new();
-    for k in values.keys() {
+    for k in gold.values.keys() {
         if let Some(name) = k.strip_prefix("verification.") {
-            let pass = values.get(&format!("pass.{name}")).and_then(Value::as_f64);
-            let pass = pass.unwrap_or_else(|| panic!("{}: no pass.{name}", path.display())) == 1.0;
+            let pass = gold.values.get(&format!("pass.{name}")).copied().flatten();
+            let pass = pass.unwrap_or_else(|| panic!("{case}: no pass.{name} in its gold file")) == 1.0;
             metrics.insert(name.to_string(), (number(k), pass));
         } else if let Some(name) = k.strip_prefix("results.") {
             results.insert(name.to_string(), number(k));
