@@ -57,20 +57,18 @@ pub(super) fn node_states<const D: usize, const M: usize, const N: usize>(
     let nd = step.dofs.nd;
     let (nodes, _) = step.stencils.get(k);
     let eff = step.stencils.effective(k);
-    let mut d = [[0.0; N]; M];
-    for (n, &node) in nodes.iter().enumerate() {
+    let mut out = [NodeState::default(); M];
+    for (s, &node) in out.iter_mut().zip(nodes) {
         let b = node as usize * nd;
-        d[n][..nd].copy_from_slice(&xl[b..b + nd]);
+        *s = NodeState::new(&xl[b..b + nd], &nm);
     }
     for e in step.stencils.extensions(k) {
         for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
-            d[e.slot as usize][c] =
+            let x: f64 =
                 (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
+            let s = &mut out[e.slot as usize];
+            (s.d[c], s.a[c], s.v[c]) = (x, nm.a0 * x, nm.a1 * x);
         }
-    }
-    let mut out = [NodeState::default(); M];
-    for n in 0..nodes.len() {
-        out[n] = NodeState::new(&d[n][..nd], &nm);
     }
     out
 }

@@ -251,13 +251,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     fn project_weighted(&mut self, weight: &[f64], q: &[f64], zero: &[bool]) -> Result<Vec<f64>, Error> {
         let (nd, nn) = (self.layout.nd, self.ghost.len());
         let st = &self.step.stencils;
-        let shares: Vec<Vec<(usize, f64)>> = (0..st.len())
-            .map(|k| {
-                let (nodes, basis) = st.get(k);
-                nodes.iter().zip(basis).map(|(&n, b)| (n as usize, b.s)).collect()
-            })
-            .collect();
-        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares[k].as_slice(), weight[k], q[k])));
+        // Each point's (node, S) pairs, flat like the stencils (`offsets[k]..offsets[k + 1]`).
+        let flat: Vec<(usize, f64)> = st.nodes.iter().zip(&st.basis).map(|(&n, b)| (n as usize, b.s)).collect();
+        let shares = |st: &super::stencils::Stencils<D>, k: usize| &flat[st.offsets[k]..st.offsets[k + 1]];
+        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares(st, k), weight[k], q[k])));
         // The nodal sums over ranks (the first component's slot of each node).
         let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
         for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
@@ -269,7 +266,8 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
         let weighted: Vec<f64> =
             (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
-        Ok(shares.iter().map(|sh| fbar::gather(sh, &volume, &weighted)).collect())
+        let st = &self.step.stencils;
+        Ok((0..st.len()).map(|k| fbar::gather(shares(st, k), &volume, &weighted)).collect())
     }
 }
 

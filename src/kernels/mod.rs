@@ -264,6 +264,11 @@ pub struct NodeState<const N: usize = MAX_DOF> {
     pub v: [f64; N],
 }
 
+/// The nodal states of a step's start (Δd = 0) for the largest stencil of any dimension, shared
+/// so that an explicit step's points do not build a zero array each ([`Point::at_start`]).
+static AT_REST: [NodeState<MAX_DOF_3D>; MAX_NODES_3D] =
+    [NodeState { d: [0.0; MAX_DOF_3D], a: [0.0; MAX_DOF_3D], v: [0.0; MAX_DOF_3D] }; MAX_NODES_3D];
+
 impl<const N: usize> Default for NodeState<N> {
     fn default() -> Self {
         NodeState { d: [0.0; N], a: [0.0; N], v: [0.0; N] }
@@ -857,7 +862,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         part: &'a ParticleInput<D>,
         layout: Layout,
     ) -> Point<'a, D, M> {
-        let interp = interpolate(basis, &[NodeState::<MAX_DOF_3D>::default(); M], &part.pred, layout);
+        let interp = interpolate(basis, &AT_REST[..basis.len()], &part.pred, layout);
         let kin = Kinematics::rest();
         let (spatial, hoop) = on_new_configuration(&kin, basis);
         let recovered = (!std::ptr::eq(strain, basis)).then(|| on_new_configuration(&kin, strain));
