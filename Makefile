@@ -5,7 +5,7 @@ export PATH := $(HOME)/.cargo/bin:$(PATH)
 CASE ?= cases/terzaghi.toml
 OUT  ?= out/terzaghi
 
-.PHONY: setup build run test study study-cook study-footing study-footing-3d study-dam study-landslide gold gold-table bench bench-scaling bench-solvers maps lint clean
+.PHONY: setup build run test study study-cook study-footing study-footing-3d study-dam study-landslide gold gold-table bench bench-scaling bench-solvers study-mgr maps lint clean
 
 setup:
 	@bash scripts/setup.sh
@@ -74,6 +74,12 @@ bench-scaling: build
 # (target/bench/solvers.md; about 90 minutes; SIZES, RANKS, STRATEGIES, RUNS, STEPS choose; docs/solvers.md).
 bench-solvers: build
 	python3 scripts/bench_solvers.py
+
+# hypre's multigrid reduction (MGR, through a shell preconditioner in scripts/mgr_study.c) against
+# the Schur field split on the dynamic u–p–U tangent at three grids (target/studies/mgr.md; about
+# 15 minutes on one core; GRIDS and VARIANTS choose; docs/solvers.md).
+study-mgr: build
+	scripts/mgr_study.sh
 
 # The colour maps of docs/stress_maps.md (docs/figures/*.png) from fresh runs; about two minutes.
 maps: build
