@@ -15,7 +15,8 @@
 use crate::distribution::Owners;
 use crate::model::Model;
 use crate::parallel::Collective;
-use std::collections::HashMap;
+use std::cmp::Ordering;
+use std::collections::BTreeMap;
 
 /// How the pore pressures deviate from their local smooth fit.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -109,9 +110,16 @@ pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
 /// linear and a quadratic term, and a cross term for each pair of such directions (in the plane:
 /// 1, x, x², y, y², xy).
 fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn([i64; 3]) -> bool) -> (f64, f64, f64) {
-    let mut bins: HashMap<FitCell, Vec<usize>> = HashMap::new();
-    for (k, p) in points.iter().enumerate() {
-        bins.entry(cell_of(p, origin, h)).or_default().push(k);
+    // The cells in order and each cell's points sorted by position (then value and body), so that
+    // the sums, and the index to its last bit, do not depend on the order the points came in
+    // (a hash map's order changes from run to run; the ranks' halos arrive in any order).
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| {
+        points[a].iter().zip(&points[b]).map(|(x, y)| x.total_cmp(y)).find(|o| o.is_ne()).unwrap_or(Ordering::Equal)
+    });
+    let mut bins: BTreeMap<FitCell, Vec<usize>> = BTreeMap::new();
+    for k in order {
+        bins.entry(cell_of(&points[k], origin, h)).or_default().push(k);
     }
     let (mut r2, mut s2, mut worst) = (0.0, 0.0, 0.0f64);
     for (&(i, j, k, body), members) in bins.iter().filter(|((i, j, k, _), _)| evaluate([*i, *j, *k])) {
@@ -291,6 +299,26 @@ mod tests {
         // Binned without z (one layer of huge cells along z: no z terms) the xz and yz parts remain.
         let (r2, s2, _) = sums_of(&smooth, o, [0.5, 0.25, 1e9], |_| true);
         assert!((r2 / s2).sqrt() > 1e-3);
+    }
+
+    #[test]
+    fn the_fit_does_not_depend_on_the_order_of_the_points() {
+        // A field with a boundary layer and a pattern, so that the sums carry round-off.
+        let (o, h) = ([0.0, 0.0], [0.5, 0.25]);
+        let field = points(|x, y, i, j| {
+            10.0 * (1.0 - (-(2.0 - y) / 0.375).exp()) + 0.3 * x * x + if (i + j) % 2 == 0 { 0.1 } else { -0.1 }
+        });
+        let first = fit_of3(&field, o, h);
+        let mut shuffled = field.clone();
+        for k in 0..shuffled.len() {
+            shuffled.swap(k, (k * 7919 + 13) % field.len());
+        }
+        let reversed: Vec<[f64; 3]> = field.iter().rev().copied().collect();
+        for (name, other) in [("shuffled", &shuffled), ("reversed", &reversed), ("again", &field)] {
+            let fit = fit_of3(other, o, h);
+            assert_eq!(fit.index.to_bits(), first.index.to_bits(), "{name}: {fit:?} against {first:?}");
+            assert_eq!(fit.max_deviation.to_bits(), first.max_deviation.to_bits(), "{name}");
+        }
     }
 
     #[test]
