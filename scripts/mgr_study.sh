@@ -23,7 +23,7 @@ split="-use_mgr 0 -pc_type fieldsplit -pc_fieldsplit_block_size 5 -pc_fieldsplit
     -fieldsplit_0_pc_gamg_agg_nsmooths 1 -fieldsplit_1_ksp_type preonly -fieldsplit_1_pc_type hypre
     -fieldsplit_1_pc_hypre_boomeramg_coarsen_type HMIS -fieldsplit_1_pc_hypre_boomeramg_interp_type ext+i
     -fieldsplit_1_pc_hypre_boomeramg_P_max 4 -fieldsplit_1_pc_hypre_boomeramg_agg_nl 1"
-table="$out/../mgr.md"
+table=target/studies/mgr.md
 echo "| grid | preconditioner | result |" > "$table"
 echo "|---|---|---|" >> "$table"
 for g in $grids; do

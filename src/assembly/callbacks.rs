@@ -66,8 +66,7 @@ pub(super) fn node_states<const D: usize, const M: usize, const N: usize>(
         for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
             let x: f64 =
                 (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
-            let s = &mut out[e.slot as usize];
-            (s.d[c], s.a[c], s.v[c]) = (x, nm.a0 * x, nm.a1 * x);
+            out[e.slot as usize].set(c, x, &nm);
         }
     }
     out

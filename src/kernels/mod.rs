@@ -280,11 +280,15 @@ impl<const N: usize> NodeState<N> {
     pub fn new(d: &[f64], nm: &Scheme) -> NodeState<N> {
         let mut s = NodeState::default();
         for (c, &x) in d.iter().enumerate() {
-            s.d[c] = x;
-            s.a[c] = nm.a0 * x;
-            s.v[c] = nm.a1 * x;
+            s.set(c, x, nm);
         }
         s
+    }
+
+    /// Sets component `c` to the increment `x` under the time scheme `nm` (with its a₀x and a₁x).
+    #[inline]
+    pub fn set(&mut self, c: usize, x: f64, nm: &Scheme) {
+        (self.d[c], self.a[c], self.v[c]) = (x, nm.a0 * x, nm.a1 * x);
     }
 }
 
