@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The figures of docs/stress_maps.md: porompm's own colour maps (the plots/ of each run) of K_mag on
 # the rotated block for every stiffness option of [001], and of σ_m and K_mag on the vertical cut
-# with regular MPM and with DM-GC. Writes docs/figures/*.png; about two minutes on two cores.
+# with regular MPM, with DM-GC and with DM-G's double-mapped force and strain. Writes
+# docs/figures/*.png; about three minutes on two cores.
 # Usage: scripts/stress_maps.sh [path/to/porompm] (default target/release/porompm).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,10 +31,15 @@ run cut-mpm-ksponly cases/vertical_cut.toml "${short[@]}" -- -snes_type ksponly
 run cut-dmgc-ksponly cases/vertical_cut.toml "${short[@]}" --set stabilisation.stiffness=double_mapping_gimp \
     --set stabilisation.stress_recovery=cmpm -- -snes_type ksponly
 run cut-mpm-newton cases/vertical_cut.toml
+# DM-G with the double-mapped force and strain, Newton on its exact tangent, to 1.0 m.
+run cut-pair-newton cases/vertical_cut.toml --set stabilisation.stiffness=double_mapping_gimp \
+    --set stabilisation.internal_force=mapped --set stabilisation.stress_recovery=mapped \
+    --set stabilisation.mapped_stiffness=diagnostics
 for m in sigma_m k_mag; do
     cp "$out/cut-mpm-ksponly/plots/${m}_toe_0.1m.png" "$fig/cut_${m}_mpm_one_solve_0.1m.png"
     cp "$out/cut-dmgc-ksponly/plots/${m}_toe_0.1m.png" "$fig/cut_${m}_dmgc_one_solve_0.1m.png"
     cp "$out/cut-mpm-newton/plots/${m}_toe_1m.png" "$fig/cut_${m}_mpm_newton_1m.png"
+    cp "$out/cut-pair-newton/plots/${m}_toe_1m.png" "$fig/cut_${m}_mapped_pair_newton_1m.png"
 done
 for d in "$out"/cut-*; do
     echo "$(basename "$d"): $(python3 -c "import json,sys; s=json.load(open(sys.argv[1])); r=s['results']; print(s['status'], {k: round(v, 4) for k, v in r.items() if 'roughness' in k or 'toe_' in k or 'checker' in k}, round(s['wall_time_s'], 1), 's')" "$d/summary.json")"

@@ -230,8 +230,16 @@ pub fn describe(case: &Case, label: &str) -> String {
         match model.stress_recovery {
             crate::case::StressRecovery::Basis => "the basis functions' gradients",
             crate::case::StressRecovery::Cmpm => "CMPM patch functions ([001] Eqs. 22–23, corrected)",
+            crate::case::StressRecovery::Mapped => "the double-mapped operators (the forces' transpose)",
         }
     );
+    if model.internal_force == crate::case::InternalForce::Mapped {
+        let _ = writeln!(
+            s,
+            "internal force: double-mapped to the cells' Gauss points with the weights of {}",
+            model.stiffness.name()
+        );
+    }
     let _ = writeln!(
         s,
         "solver: {}",

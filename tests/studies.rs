@@ -327,6 +327,65 @@ fn slope_sand_dilatancy() {
 /// tip within 3 % of 0.2765 m for both bases; closer on the fine grid than on the coarse one;
 /// standard MPM below F̄ at each resolution; F̄'s chequerboard index of σ_m at most a third of
 /// the standard one on the finest grid (printed for each; on 1 m cells the B-splines' is 0.34).
+/// [001]'s vertical cut to 1.0 m of toe displacement (Part E items 10 and 11), Newton on the exact
+/// tangent: regular MPM (the case as shipped) and DM-G with the double-mapped internal force and
+/// its transpose as the strain (`stabilisation.internal_force = "mapped"`, `stress_recovery =
+/// "mapped"`, the mapped stiffness for the K_mag diagnostic): both reach 1.0 m; the pair's K_mag
+/// roughness is at most a fifth of MPM's and its σ_m chequerboard index below MPM's at 0.1 and
+/// 1.0 m. F^int_mag's roughness and σ_m's total variation at B and C are reported, not asserted:
+/// [001]'s ratios (≤ 1/3) are not reached by any variant (docs/stiffness.md). DM-GC itself (CMPM
+/// strain) does not reach 1.0 m: a point inverts at 0.73 m with the basis's forces and at 0.05 m
+/// with the mapped ones. About 2 minutes.
+#[test]
+#[ignore]
+fn vertical_cut_items_10_and_11() {
+    let mut text = String::from(
+        "## The vertical cut to 1.0 m of toe displacement ([001] §7.2, Part E items 10–11)\n\n\
+         | method | toe [m] | K_mag rough. 0.1 / 1.0 m | F^int_mag rough. 0.1 / 1.0 m | σ_m chequerboard 0.1 / 1.0 m | Σ|Δσ_m| B / C [kPa] | ε̄ max | equilibrium error | Newton its | wall [s] |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let pair = [
+        "stabilisation.stiffness=double_mapping_gimp",
+        "stabilisation.internal_force=mapped",
+        "stabilisation.stress_recovery=mapped",
+        "stabilisation.mapped_stiffness=diagnostics",
+    ];
+    let mut rows = Vec::new();
+    for (label, sets) in [("regular MPM (GIMP)", &[][..]), ("DM-G, mapped force and strain", &pair[..])] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let s = run_case("vertical_cut", &format!("cut-{}", rows.len()), &sets);
+        let r = |k: &str| result(&s, k);
+        let _ = writeln!(
+            text,
+            "| {label} | {:.3} | {:.4} / {:.4} | {:.4} / {:.4} | {:.4} / {:.4} | {:.1} / {:.1} | {:.2} | {:.1e} | {} | {:.0} |",
+            r("toe_displacement"),
+            r("k_mag_roughness_at_0.1"),
+            r("k_mag_roughness_at_1"),
+            r("fint_mag_roughness_at_0.1"),
+            r("fint_mag_roughness_at_1"),
+            r("sigma_m_checkerboard_at_0.1"),
+            r("sigma_m_checkerboard_at_1"),
+            r("sigma_m_variation_B") / 1e3,
+            r("sigma_m_variation_C") / 1e3,
+            r("eps_pd_max"),
+            s["equilibrium_error"].as_f64().unwrap_or(f64::NAN),
+            s["snes_iterations"],
+            s["wall_time_s"].as_f64().unwrap()
+        );
+        rows.push(s);
+    }
+    save("vertical_cut.md", &text);
+    let (mpm, dmg) = (&rows[0], &rows[1]);
+    for s in [mpm, dmg] {
+        assert!(result(s, "toe_displacement") >= 1.0, "toe at {}", result(s, "toe_displacement"));
+    }
+    for at in ["0.1", "1"] {
+        let (k, c) = (format!("k_mag_roughness_at_{at}"), format!("sigma_m_checkerboard_at_{at}"));
+        assert!(result(dmg, &k) <= 0.2 * result(mpm, &k), "{k}: {} against {}", result(dmg, &k), result(mpm, &k));
+        assert!(result(dmg, &c) < result(mpm, &c), "{c}: {} against {}", result(dmg, &c), result(mpm, &c));
+    }
+}
+
 /// Runs on two ranks. The 0.5 m runs last 400 s: at 200 s the membrane still swings about its
 /// rest state by ±0.3 % with the 55 s period (less PIC dissipation on the finer cells), and the
 /// check's at-rest metric fails (measured 1.09 %). Each 1 m run takes about 7 minutes, each 0.5 m

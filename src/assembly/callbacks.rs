@@ -222,7 +222,7 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
         let layout = step.layout.expect("prepared");
         let pt =
             kernels::Point::<D, M>::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
-        f(&pt.with_faces(step.faces_of(k), &states[..nodes.len()]))
+        f(&pt.with_forces(step.stencils.forces_of(k)).with_faces(step.faces_of(k), &states[..nodes.len()]))
     }
 
     /// Particle `k` at an explicit step's start with the stress it carries
@@ -231,7 +231,9 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
         let step = self.step;
         let (_, basis) = step.stencils.get(k);
         let input = particle_input(self.model, step, k);
-        f(&kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout.expect("prepared")))
+        let pt =
+            kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout.expect("prepared"));
+        f(&pt.with_forces(step.stencils.forces_of(k)))
     }
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
@@ -330,6 +332,7 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
                 &mat.model,
                 layout,
             )
+            .with_forces(step.stencils.forces_of(k))
             .with_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             if self.model.stiffness_in_jacobian {

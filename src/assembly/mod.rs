@@ -656,6 +656,19 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 coll.agree(stencils::cmpm_patches(st, plane, ghost, &dofs))?;
             }
         }
+        if model.internal_force == crate::case::InternalForce::Mapped {
+            // [001]'s double-mapped internal force (plane, one-phase: validation), before any term
+            // of the step is evaluated.
+            if let (Some(plane), Some(st), Some(ghost)) =
+                (model.as_plane(), crate::model::plane_mut::<_, Stencils>(&mut st), crate::model::plane(&self.ghost))
+            {
+                coll.agree(stiffness::mapped_forces(plane, ghost, st))?;
+                if model.stress_recovery == crate::case::StressRecovery::Mapped {
+                    // The strain's operators are the forces' (validation: no CMPM patches here).
+                    st.strain = st.forces.clone();
+                }
+            }
+        }
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
         self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
@@ -1717,6 +1730,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let mat = &model.materials[model.particles.material[k] as usize];
         let strain = self.step.stencils.strain_of(k);
         let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
+            .with_forces(self.step.stencils.forces_of(k))
             .with_faces(self.step.faces_of(k), &states[..nodes.len()]);
         let mut result = StepResult::of(&pt);
         if let Some(f) = fbar {

@@ -69,6 +69,9 @@ pub struct Stencils<const D: usize = 2> {
     /// The strain-recovery operators of each raw slot (`kernels::Point::with_recovery`), flat
     /// like `basis`; empty when the strain is recovered with the basis itself.
     pub strain: Vec<NodeBasis<D>>,
+    /// The force operators of each raw slot (`kernels::Point::with_forces`, [001]'s double-mapped
+    /// internal force), flat like `basis`; empty when the forces are integrated with the basis.
+    pub forces: Vec<NodeBasis<D>>,
 }
 
 impl<const D: usize> Stencils<D> {
@@ -96,6 +99,16 @@ impl<const D: usize> Stencils<D> {
             &self.basis[r]
         } else {
             &self.strain[r]
+        }
+    }
+
+    /// The force operators of particle `k`'s raw slots: its double-mapped ones, or none (an empty
+    /// slice: its basis).
+    pub fn forces_of(&self, k: usize) -> &[NodeBasis<D>] {
+        if self.forces.is_empty() {
+            &[]
+        } else {
+            &self.forces[self.offsets[k]..self.offsets[k + 1]]
         }
     }
 

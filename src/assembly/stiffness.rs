@@ -30,7 +30,8 @@
 
 use super::stencils::Stencils;
 use crate::case::Stiffness;
-use crate::kernels::cell::{mapped_stiffness, q4, CellGeometry, Moduli};
+use crate::kernels::cell::{mapped_force_operators, mapped_stiffness, q4, CellGeometry, Moduli};
+use crate::kernels::NodeBasis;
 use crate::model::{shape, soil, Model};
 use petsc::GhostedRange;
 
@@ -58,6 +59,91 @@ pub(super) struct MappedStiffness {
     offsets: Vec<usize>,
 }
 
+/// The cells each point maps to under a mapped stiffness, with their weights (shared by the
+/// stiffness and the double-mapped forces, so that both map alike).
+struct Mapping<'a> {
+    model: &'a Model,
+    ghost: &'a GhostedRange,
+    /// cmp: the points whose centre is in each cell, keyed by the cell's lower-left node.
+    count: Vec<u32>,
+}
+
+impl<'a> Mapping<'a> {
+    fn new(model: &'a Model, ghost: &'a GhostedRange) -> Mapping<'a> {
+        let mut m = Mapping { model, ghost, count: vec![0; ghost.len()] };
+        for k in 0..model.particles.len() {
+            if let Some(l) = m.cell_key(k) {
+                m.count[l] += 1;
+            }
+        }
+        m
+    }
+
+    /// The ghosted node of the lower-left corner of point `k`'s cell.
+    fn cell_key(&self, k: usize) -> Option<usize> {
+        let g = &self.model.grid;
+        g.cell_of(self.model.particles.x[k]).and_then(|(i, j)| self.ghost.node(i, j))
+    }
+
+    /// W*_p / W_p = omp/cmp ([001] Eq. 15).
+    fn w_star(&self, k: usize) -> f64 {
+        let (g, ps) = (&self.model.grid, &self.model.particles);
+        let omp = (g.h[0] * g.h[1] / (4.0 * ps.lp0[k][0] * ps.lp0[k][1])).round();
+        self.cell_key(k).map_or(1.0, |l| omp / self.count[l].max(1) as f64)
+    }
+
+    /// The factor of point `k`'s own material tangent and the cells it maps to with its weights
+    /// w_i W_p of their nodes.
+    fn of(&self, k: usize) -> Result<(f64, Vec<CellWeights>), String> {
+        let (model, g, ps) = (self.model, &self.model.grid, &self.model.particles);
+        let w_p = model.area(k) / (g.h[0] * g.h[1] / 4.0);
+        Ok(match model.stiffness {
+            Stiffness::Particle => (1.0, Vec::new()),
+            Stiffness::WStar => (self.w_star(k), Vec::new()),
+            Stiffness::GaussMapping | Stiffness::DoubleMapping => {
+                let (i, j) = g.cell_of(ps.x[k]).ok_or_else(|| outside(model, k))?;
+                let xi = g.local_coordinates((i, j), ps.x[k]);
+                let w = if model.stiffness == Stiffness::DoubleMapping { self.w_star(k) * w_p } else { w_p };
+                (0.0, vec![((i, j), q4(xi, g.h).0.map(|n| n * w))])
+            }
+            Stiffness::DoubleMappingGimp => {
+                let (list, n) = shape::local_gimp(g, ps.x[k], ps.lp[k]);
+                let cells = list[..n].iter().map(|&((i, j), w)| ((i as usize, j as usize), w.map(|s| s * w_p)));
+                (0.0, cells.collect())
+            }
+        })
+    }
+
+    /// The cell (`i`, `j`) as the cell kernels see it.
+    fn geometry(&self, (i, j): (usize, usize)) -> CellGeometry {
+        let g = &self.model.grid;
+        CellGeometry {
+            h: g.h,
+            lo: g.node_position(i, j),
+            bbar: self.model.bbar,
+            axisymmetric: self.model.geometry.axisymmetric(),
+        }
+    }
+
+    /// The slots in point `k`'s stencil `nodes` of the four nodes of cell (`i`, `j`), in
+    /// `kernels::cell`'s order.
+    fn slots(&self, k: usize, nodes: &[u32], (i, j): (usize, usize)) -> Result<[u8; 4], String> {
+        let mut slots = [0u8; 4];
+        for (s, (di, dj)) in slots.iter_mut().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {
+            let l = self.ghost.node(i + di, j + dj).ok_or_else(|| outside(self.model, k))?;
+            *s = nodes.iter().position(|&n| n as usize == l).ok_or_else(|| {
+                format!(
+                    "material point {}: node ({}, {}) of a cell it maps its stiffness or force to is not in its stencil",
+                    self.model.particles.id[k],
+                    i + di,
+                    j + dj
+                )
+            })? as u8;
+        }
+        Ok(slots)
+    }
+}
+
 impl MappedStiffness {
     /// The shares of this rank's points for the model's option (empty for `particle`).
     pub(super) fn prepare(model: &Model, ghost: &GhostedRange, st: &Stencils) -> Result<MappedStiffness, String> {
@@ -65,62 +151,18 @@ impl MappedStiffness {
         if model.stiffness == Stiffness::Particle {
             return Ok(out);
         }
-        let (g, ps) = (&model.grid, &model.particles);
-        let jac = g.h[0] * g.h[1] / 4.0;
-        // cmp: the points whose centre is in each cell, keyed by the cell's lower-left node.
-        let mut count = vec![0u32; ghost.len()];
-        let cell_key = |k: usize| g.cell_of(ps.x[k]).and_then(|(i, j)| ghost.node(i, j));
-        for k in 0..ps.len() {
-            if let Some(l) = cell_key(k) {
-                count[l] += 1;
-            }
-        }
-        let w_star = |k: usize| -> f64 {
-            let omp = (g.h[0] * g.h[1] / (4.0 * ps.lp0[k][0] * ps.lp0[k][1])).round();
-            cell_key(k).map_or(1.0, |l| omp / count[l].max(1) as f64)
-        };
-        let geometry = |i: usize, j: usize| CellGeometry {
-            h: g.h,
-            lo: g.node_position(i, j),
-            bbar: model.bbar,
-            axisymmetric: model.geometry.axisymmetric(),
-        };
+        let mapping = Mapping::new(model, ghost);
+        let ps = &model.particles;
         out.offsets.push(0);
         for k in 0..ps.len() {
-            let w_p = model.area(k) / jac;
-            let (factor, cells): (f64, Vec<CellWeights>) = match model.stiffness {
-                Stiffness::Particle => unreachable!("handled above"),
-                Stiffness::WStar => (w_star(k), Vec::new()),
-                Stiffness::GaussMapping | Stiffness::DoubleMapping => {
-                    let (i, j) = g.cell_of(ps.x[k]).ok_or_else(|| outside(model, k))?;
-                    let xi = g.local_coordinates((i, j), ps.x[k]);
-                    let w = if model.stiffness == Stiffness::DoubleMapping { w_star(k) * w_p } else { w_p };
-                    (0.0, vec![((i, j), q4(xi, g.h).0.map(|n| n * w))])
-                }
-                Stiffness::DoubleMappingGimp => {
-                    let (list, n) = shape::local_gimp(g, ps.x[k], ps.lp[k]);
-                    let cells = list[..n].iter().map(|&((i, j), w)| ((i as usize, j as usize), w.map(|s| s * w_p)));
-                    (0.0, cells.collect())
-                }
-            };
+            let (factor, cells) = mapping.of(k)?;
             out.material.push(factor);
             let (nodes, _) = st.get(k);
             let d: &Moduli = &soil::plane_block(&model.materials[ps.material[k] as usize].model.elastic().d);
-            for ((i, j), weights) in cells {
-                let mut slots = [0u8; 4];
-                for (s, (di, dj)) in slots.iter_mut().zip([(0, 0), (1, 0), (0, 1), (1, 1)]) {
-                    let l = ghost.node(i + di, j + dj).ok_or_else(|| outside(model, k))?;
-                    *s = nodes.iter().position(|&n| n as usize == l).ok_or_else(|| {
-                        format!(
-                            "material point {}: node ({}, {}) of a cell it maps its stiffness to is not in its stencil",
-                            ps.id[k],
-                            i + di,
-                            j + dj
-                        )
-                    })? as u8;
-                }
+            for (cell, weights) in cells {
+                let slots = mapping.slots(k, nodes, cell)?;
                 let d_nodes: [Moduli; 4] = std::array::from_fn(|n| d.map(|row| row.map(|v| v * weights[n])));
-                out.shares.push(Share { slots, ke: mapped_stiffness(&geometry(i, j), &d_nodes) });
+                out.shares.push(Share { slots, ke: mapped_stiffness(&mapping.geometry(cell), &d_nodes) });
             }
             out.offsets.push(out.shares.len());
         }
@@ -150,6 +192,38 @@ impl MappedStiffness {
             }
         }
     }
+}
+
+/// [001]'s double-mapped internal force (`stabilisation.internal_force = "mapped"`): each point's
+/// force operators per raw stencil slot (`Stencils::forces`), Σ over the cells it maps to of
+/// `kernels::cell::mapped_force_operators` with the weights of the mapped stiffness, per unit of
+/// the point's volume V_n (what `kernels::Point::with_forces` takes). A point's stress then acts
+/// on the nodes as the stiffness's share of it would (the same cells and weights); the residual's
+/// terms and their exact tangent follow unchanged (`kernels::stress`).
+pub(super) fn mapped_forces(model: &Model, ghost: &GhostedRange, st: &mut Stencils) -> Result<(), String> {
+    let mapping = Mapping::new(model, ghost);
+    let mut forces = vec![NodeBasis::default(); st.basis.len()];
+    for k in 0..st.len() {
+        let (_, cells) = mapping.of(k)?;
+        let (nodes, _) = st.get(k);
+        let first = st.offsets[k];
+        let v = model.particles.volume[k];
+        for (cell, weights) in cells {
+            let slots = mapping.slots(k, nodes, cell)?;
+            for (&slot, op) in slots.iter().zip(mapped_force_operators(&mapping.geometry(cell), weights)) {
+                let f = &mut forces[first + slot as usize];
+                f.s += op.s / v;
+                f.t += op.t / v;
+                f.tv += op.tv / v;
+                for d in 0..2 {
+                    f.g[d] += op.g[d] / v;
+                    f.gv[d] += op.gv[d] / v;
+                }
+            }
+        }
+    }
+    st.forces = forces;
+    Ok(())
 }
 
 /// The error of a point whose cell is not on this rank's grid.

@@ -856,10 +856,35 @@ pub struct Stabilisation {
     /// `basis` (the default: with the gradients of the point's basis functions, as its forces are
     /// integrated) or `cmpm` (composite MPM: the higher-order Lagrange patch functions of [001]
     /// Eqs. 22–23 (corrected) over the point's cell and its well-filled neighbours, cubic, quadratic
-    /// or linear per direction; one-phase, without B̄). The residual keeps the basis for the forces
-    /// and its tangent stays exact.
+    /// or linear per direction; one-phase, without B̄) or `mapped` (with the double-mapped
+    /// operators of `internal_force = "mapped"`, which it needs: each point's strain is the
+    /// finite-element strain of the cells it maps to, averaged over their Gauss points with the
+    /// point's weights there, the transpose of its forces, so that the point's force and strain
+    /// are one Galerkin pair and its tangent is symmetric). The residual keeps the basis for the
+    /// forces unless `internal_force` says otherwise, and its tangent stays exact.
     #[serde(default)]
     pub stress_recovery: StressRecovery,
+    /// How the skeleton's internal force is integrated (`../shared/seeds-001-002.md` Part A8,
+    /// step 2): `particle` (the default: at the points with the basis's gradients, F_i = Σ_p
+    /// B_i(x_p)ᵀ σ_p V_p) or `mapped` (double-mapped like the stiffness: each point's stress goes to
+    /// the nodes of the cells it maps to with the weights of `stabilisation.stiffness`, σ_i^e =
+    /// Σ_p w_ip W_p σ_p, from there to the cell's 2 × 2 Gauss points, σ_g = Σ_i N_i(x_g) σ_i^e, and
+    /// F_e = Σ_g B_gᵀ σ_g |J|, as [001] Eqs. 16–20 map D_p). Needs a mapped `stiffness`
+    /// (`gauss_mapping`, `double_mapping` or `double_mapping_gimp`), a one-phase plane case
+    /// without B-splines; the residual and its exact tangent change together.
+    #[serde(default)]
+    pub internal_force: InternalForce,
+}
+
+/// How the skeleton's internal force is integrated (see [`Stabilisation::internal_force`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InternalForce {
+    /// At the material points with the basis's gradients.
+    #[default]
+    Particle,
+    /// Double-mapped to the cells' Gauss points with the mapped stiffness's weights.
+    Mapped,
 }
 
 impl Stiffness {
@@ -884,6 +909,9 @@ pub enum StressRecovery {
     Basis,
     /// With [001]'s CMPM patch functions.
     Cmpm,
+    /// With the double-mapped force operators (`internal_force = "mapped"`), so that the strain
+    /// operator is the forces' transpose.
+    Mapped,
 }
 
 /// Where a mapped stiffness serves (see [`Stabilisation::mapped_stiffness`]).

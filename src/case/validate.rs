@@ -465,6 +465,26 @@ pub fn validate(c: &Case) -> R {
             );
         }
     }
+    if c.stabilisation.internal_force == InternalForce::Mapped {
+        if !matches!(
+            c.stabilisation.stiffness,
+            Stiffness::GaussMapping | Stiffness::DoubleMapping | Stiffness::DoubleMappingGimp
+        ) {
+            return Err(format!(
+                "key `stabilisation.internal_force`: `mapped` maps the points' stresses with the weights of a                  mapped stiffness, and `stabilisation.stiffness` is `{}`; choose `gauss_mapping`,                  `double_mapping` or `double_mapping_gimp`",
+                c.stabilisation.stiffness.name()
+            ));
+        }
+        if two_phase {
+            return Err("key `stabilisation.internal_force`: `mapped` is for one_phase analyses ([001] is \
+                        one-phase; the pore pressure's forces and the continuity equation keep the basis)"
+                .into());
+        }
+    } else if c.stabilisation.stress_recovery == StressRecovery::Mapped {
+        return Err("key `stabilisation.stress_recovery`: `mapped` recovers the strain with the double-mapped \
+                    force operators; set `stabilisation.internal_force = \"mapped\"` too"
+            .into());
+    }
 
     // Grid.
     let dim = c.grid.size.len();

@@ -127,9 +127,47 @@ pub fn mapped_stiffness(cell: &CellGeometry, d_nodes: &[Moduli; 4]) -> [[f64; 8]
     k
 }
 
+/// The double-mapped internal force's operators of one material point on one cell
+/// (`stabilisation.internal_force = "mapped"`, `../shared/seeds-001-002.md` Part A8 step 2): the
+/// point's stress goes to the cell's nodes with its `weights` w_i W_p (σ_i^e = Σ_p w_ip W_p σ_p, as
+/// [001] Eqs. 16 and 20 map D_p), to the Gauss points (σ_g = Σ_i N_i(x_g) σ_i^e, Eq. 17) and the
+/// force is integrated there, F_k = Σ_g B_k(x_g)ᵀ σ_g |J| m(r_g). Linear in σ_p, so with the
+/// point's share ω_g = Σ_i N_i(x_g) w_i W_p |J| m(r_g) of Gauss point g it is F_k = Ĝ_kᵀ σ_p with,
+/// for each node k of the cell, `g` = Σ_g ω_g ∇N_k(x_g), `gv` its volumetric part (from the cell
+/// centre with B̄), `t` = Σ_g ω_g N_k(x_g)/r_g and `tv` (0.25/r_c with B̄) the hoop operators (zero
+/// in plane strain), and `s` = Σ_g ω_g N_k(x_g): integrated operators, a volume times those of
+/// [`super::NodeBasis`], whose own `s` they do not replace. Σ_k `s` = Σ_g ω_g, the point's volume
+/// inside the cell when its weights are those of a partition of unity.
+pub fn mapped_force_operators(cell: &CellGeometry, weights: [f64; 4]) -> [super::NodeBasis<2>; 4] {
+    let h = cell.h;
+    let det = h[0] * h[1] / 4.0;
+    let rc = cell.lo[0] + 0.5 * h[0];
+    let (_, gc) = q4([0.0, 0.0], h);
+    let mut out = [super::NodeBasis::<2>::default(); 4];
+    for xi in GAUSS_2X2 {
+        let (n, g) = q4(xi, h);
+        let rg = cell.lo[0] + 0.5 * h[0] * (1.0 + xi[0]);
+        let (measure, hoop, hoop_c) =
+            if cell.axisymmetric { (std::f64::consts::TAU * rg, 1.0 / rg, 0.25 / rc) } else { (1.0, 0.0, 0.0) };
+        let omega = n.iter().zip(&weights).map(|(a, b)| a * b).sum::<f64>() * det * measure;
+        for (k, o) in out.iter_mut().enumerate() {
+            let gv = if cell.bbar { gc[k] } else { g[k] };
+            o.s += omega * n[k];
+            for d in 0..2 {
+                o.g[d] += omega * g[k][d];
+                o.gv[d] += omega * gv[d];
+            }
+            o.t += omega * n[k] * hoop;
+            o.tv += omega * if cell.bbar { hoop_c } else { n[k] * hoop };
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernels::NodeBasis;
     use crate::model::grid::Grid;
     use crate::model::shape::{self, Basis};
     use std::collections::HashMap;
@@ -235,6 +273,145 @@ mod tests {
             .filter(|&((i, j), _)| (i as f64 - 20.0).hypot(j as f64 - 20.0) <= 7.0)
             .map(|(_, k)| k[0].hypot(k[1]))
             .collect()
+    }
+
+    /// The double-mapped force operators of one point (DM-G weights) summed over the cells it
+    /// maps to, per node (i, j): Σ_cells `mapped_force_operators`.
+    fn mapped_operators(grid: &Grid, cell: CellGeometry, x: [f64; 2], lp: [f64; 2]) -> HashMap<(u32, u32), NodeBasis> {
+        let w_p = 4.0 * lp[0] * lp[1] / (grid.h[0] * grid.h[1] / 4.0);
+        let (list, n) = shape::local_gimp(grid, x, lp);
+        let mut out: HashMap<(u32, u32), NodeBasis> = HashMap::new();
+        for &((ci, cj), w) in &list[..n] {
+            let geometry = CellGeometry { lo: [ci as f64 * grid.h[0], cj as f64 * grid.h[1]], ..cell };
+            let ops = mapped_force_operators(&geometry, w.map(|v| v * w_p));
+            for (node, op) in [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)].into_iter().zip(ops) {
+                let e = out.entry(node).or_default();
+                e.s += op.s;
+                e.t += op.t;
+                e.tv += op.tv;
+                for d in 0..2 {
+                    e.g[d] += op.g[d];
+                    e.gv[d] += op.gv[d];
+                }
+            }
+        }
+        out
+    }
+
+    /// A block of 2 × 2 points per cell that fills whole cells: the double-mapped forces of a
+    /// uniform stress are GIMP's, Σ_p ∇S_ip V_p = ∫ ∇N_i dx, at every node (zero inside), with and
+    /// without B̄ (the cell centre's gradient integrates a full cell's divergence alike).
+    #[test]
+    fn mapped_forces_of_a_uniform_stress_in_a_full_block_are_the_exact_integral() {
+        let grid = Grid { origin: [0.0, 0.0], h: [0.5, 0.8], cells: [8, 8] };
+        let lp = [0.125, 0.2];
+        for bbar in [false, true] {
+            let cell = CellGeometry { bbar, ..CellGeometry::plane(grid.h) };
+            let mut mapped: HashMap<(u32, u32), [f64; 4]> = HashMap::new();
+            let mut gimp: HashMap<(u32, u32), [f64; 2]> = HashMap::new();
+            for j in 0..8 {
+                for i in 0..6 {
+                    let x = [0.5 + lp[0] + 2.0 * lp[0] * i as f64, 0.8 + lp[1] + 2.0 * lp[1] * j as f64];
+                    for (node, op) in mapped_operators(&grid, cell, x, lp) {
+                        let e = mapped.entry(node).or_default();
+                        e[0] += op.g[0];
+                        e[1] += op.g[1];
+                        e[2] += op.gv[0];
+                        e[3] += op.gv[1];
+                    }
+                    for (node, _, g) in shape::stencil(Basis::Gimp, &grid, x, lp).iter() {
+                        let e = gimp.entry((node[0], node[1])).or_default();
+                        e[0] += g[0] * 4.0 * lp[0] * lp[1];
+                        e[1] += g[1] * 4.0 * lp[0] * lp[1];
+                    }
+                }
+            }
+            let scale = grid.h[0].max(grid.h[1]);
+            for (node, f) in &mapped {
+                let exact = gimp.get(node).copied().unwrap_or_default();
+                for d in 0..2 {
+                    assert!(
+                        (f[d] - exact[d]).abs() < 1e-13 * scale,
+                        "node {node:?} (B̄ {bbar}): {f:?} against {exact:?}"
+                    );
+                    assert!(
+                        (f[2 + d] - exact[d]).abs() < 1e-13 * scale,
+                        "node {node:?} (B̄ {bbar}): {f:?} against {exact:?}"
+                    );
+                }
+            }
+            assert!(mapped[&(2, 2)][0].abs() < 1e-14 && gimp[&(1, 1)][0] < -0.1, "interior / corner: {mapped:?}");
+        }
+    }
+
+    /// One point anywhere (across cell edges, partly outside the grid's first cells): its operators
+    /// carry its volume inside the grid (Σ_i s_i), reproduce linear fields (Σ_i x_i ⊗ G_i = Σ_i s_i I,
+    /// so that ∫σ dV is the first moment of the nodal forces) and, in axial symmetry, the hoop strain
+    /// of u_r = c r (Σ_i r_i T_i = Σ_i s_i), with and without B̄.
+    #[test]
+    fn mapped_force_operators_carry_the_volume_and_reproduce_linear_fields() {
+        let grid = Grid { origin: [0.0, 0.0], h: [0.4, 0.3], cells: [10, 10] };
+        let inside = ([0.9, 0.4], [0.05, 0.05]);
+        for (x, lp) in [([1.03, 0.71], [0.13, 0.11]), ([0.45, 1.2], [0.2, 0.15]), ([0.81, 0.6], [0.05, 0.07]), inside] {
+            for (axisymmetric, bbar) in [(false, false), (false, true), (true, false), (true, true)] {
+                let cell = CellGeometry { h: grid.h, lo: [0.0; 2], bbar, axisymmetric };
+                let ops = mapped_operators(&grid, cell, x, lp);
+                let pos = |(i, j): (u32, u32)| [i as f64 * grid.h[0], j as f64 * grid.h[1]];
+                let volume: f64 = ops.values().map(|o| o.s).sum();
+                // The point's volume: its area, times 2πr over it in axial symmetry (linear in r:
+                // its centre's).
+                let area = 4.0 * lp[0] * lp[1];
+                let expected = if axisymmetric { area * std::f64::consts::TAU * x[0] } else { area };
+                let mut first = [[0.0; 2]; 2];
+                let mut first_v = [[0.0; 2]; 2];
+                let (mut hoop, mut hoop_v) = (0.0, 0.0);
+                for (&node, o) in &ops {
+                    let p = pos(node);
+                    for a in 0..2 {
+                        for b in 0..2 {
+                            first[a][b] += p[a] * o.g[b];
+                            first_v[a][b] += p[a] * o.gv[b];
+                        }
+                    }
+                    hoop += p[0] * o.t;
+                    hoop_v += p[0] * o.tv;
+                }
+                let what = format!("point {x:?} ({axisymmetric}, B̄ {bbar})");
+                if bbar && (x, lp) == inside {
+                    // Within one cell, B̄'s volumetric part is the cell centre's gradient times
+                    // the point's volume.
+                    let (_, gc) = q4([0.0, 0.0], grid.h);
+                    for (k, node) in [(2, 1), (3, 1), (2, 2), (3, 2)].into_iter().enumerate() {
+                        let gv = ops[&node].gv;
+                        if axisymmetric {
+                            // And its hoop part N_k(x_c)/r_c = 1/(4 r_c).
+                            let tv = ops[&node].tv;
+                            assert!((tv - volume * 0.25 / 1.0).abs() < 1e-13 * volume, "{what}: T̄ {tv}");
+                        }
+                        for d in 0..2 {
+                            assert!((gv[d] - volume * gc[k][d]).abs() < 1e-13 * volume / grid.h[d], "{what}: {gv:?}");
+                        }
+                    }
+                }
+                if !axisymmetric {
+                    assert!((volume / expected - 1.0).abs() < 1e-13, "{what}: volume {volume} against {expected}");
+                } else {
+                    // 2πr at the Gauss points weighs the point's area as the double mapping
+                    // smears it over the cell, not at its own radius: 7.4 % more for the small
+                    // point at r = 0.9 m in the cell [0.8, 1.2] m (1/0.9 at most).
+                    assert!((volume / expected - 1.0).abs() < 0.1, "{what}: volume {volume} against {expected}");
+                    assert!((hoop / volume - 1.0).abs() < 1e-13, "{what}: hoop {hoop} against {volume}");
+                    assert!((hoop_v / volume - 1.0).abs() < 1e-13, "{what}: B̄ hoop {hoop_v} against {volume}");
+                }
+                for a in 0..2 {
+                    for b in 0..2 {
+                        let e = if a == b { volume } else { 0.0 };
+                        assert!((first[a][b] - e).abs() < 1e-13 * volume, "{what}: first moment {first:?}");
+                        assert!((first_v[a][b] - e).abs() < 1e-13 * volume, "{what}: B̄ first moment {first_v:?}");
+                    }
+                }
+            }
+        }
     }
 
     /// Part E item 3: on the full, unrotated block, DM, GM and DM-G give the finite-element K_mag

@@ -720,17 +720,18 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     pub rotated: Stress,
     /// The soil model's update from `rotated` by the strain increment.
     pub upd: StressUpdate,
-    /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}.
+    /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}, the operators the forces are
+    /// integrated with: the basis's own, or [001]'s double-mapped ones ([`Point::with_forces`]).
     pub spatial: [([f64; D], [f64; D]); M],
     /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain and in three
-    /// dimensions).
+    /// dimensions), the forces' like [`Point::spatial`].
     pub hoop: [(f64, f64); M],
     /// The operators the strain is recovered with (see [`Point::with_recovery`]): the basis
     /// itself, or [001]'s CMPM patch functions; the kinematics and every derivative of them use
     /// these, the forces use `basis`.
     pub strain: &'a [NodeBasis<D>],
-    /// `spatial` and `hoop` of the strain operators where they are not the basis (see
-    /// [`Point::strain_operators`]; `None`: the basis's own, not copied).
+    /// `spatial` and `hoop` of the strain operators where they are not the force operators (see
+    /// [`Point::strain_operators`]; `None`: the same, not copied).
     recovered: Option<OnNew<D, M>>,
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
@@ -910,6 +911,27 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             *dp = face.basis.iter().zip(states.iter().take(self.basis.len())).map(|((s, _), st)| s * st.d[p]).sum();
         }
         self.faces = faces;
+        self
+    }
+
+    /// The point with its forces integrated by the operators `forces` (one per node of its basis,
+    /// in its order; their `g`, `gv`, `t`, `tv` per unit volume of the point on x_n; empty: the
+    /// basis's own, unchanged): [001]'s double-mapped internal force
+    /// (`stabilisation.internal_force = "mapped"`, [`super::cell::mapped_force_operators`]). They
+    /// take the step's kinematics as the basis does (pushed forward by F⁻ᵀ, the volume by J), so the
+    /// residual's terms and their tangent need no change; the strain keeps its own operators.
+    /// One-phase only (validation): every term that integrates with [`Point::spatial`] takes them.
+    #[inline]
+    pub fn with_forces(mut self, forces: &[NodeBasis<D>]) -> Point<'a, D, M> {
+        if forces.is_empty() {
+            return self;
+        }
+        debug_assert_eq!(forces.len(), self.basis.len(), "force operators for another stencil");
+        if self.recovered.is_none() {
+            // The strain's operators were the basis's, held in `spatial` and `hoop`.
+            self.recovered = Some((self.spatial, self.hoop));
+        }
+        (self.spatial, self.hoop) = on_new_configuration(&self.kin, forces);
         self
     }
 

@@ -271,16 +271,45 @@ fn sample_strain(nn: usize, hoop: bool) -> Vec<NodeBasis> {
         .collect()
 }
 
+/// Force operators that differ from [`sample_in`]'s basis and from [`sample_strain`] (standing
+/// for [001]'s double-mapped internal force, see [`Point::with_forces`]), with a volumetric part
+/// of their own and, if `hoop`, hoop operators.
+fn sample_forces(nn: usize, hoop: bool) -> Vec<NodeBasis> {
+    (0..nn)
+        .map(|k| {
+            let x = k as f64 + 0.25;
+            let g = [(x * 1.7).sin() * 2.2, (x * 0.6).cos() * 2.9];
+            let gv = [(x * 0.5).cos() * 1.9, (x * 1.2).sin() * 2.4];
+            let (t, tv) = if hoop { (0.4 + 0.3 * (x * 0.9).cos(), 0.2 + 0.1 * x.sin()) } else { (0.0, 0.0) };
+            NodeBasis { s: 0.0, g, gv, t, tv }
+        })
+        .collect()
+}
+
+/// The operators of a point for [`check_term`]: axisymmetric (`.0`), its strain recovered by
+/// other operators than the basis (`.1`), its forces integrated by others again (`.2`).
+type Mode = (bool, bool, bool);
+
+/// The modes [`check_term`] runs through: each switch alone, none, and all together.
+const MODES: [Mode; 6] = [
+    (false, false, false),
+    (true, false, false),
+    (false, true, false),
+    (true, true, false),
+    (false, false, true),
+    (true, true, true),
+];
+
 /// Runs the finite-difference check of one term (with the hoop operators of an axisymmetric
-/// point if `hoop`, and with the strain recovered by other operators than the basis if
-/// `recovery`); returns the blocks.
+/// point, the strain recovered by other operators than the basis and the forces integrated by
+/// others again, as `mode` says); returns the blocks.
 fn check_term(
     term: &Term,
     model: &Constitutive,
     stress: Stress,
     layout: Layout,
     nm: &Scheme,
-    (hoop, recovery): (bool, bool),
+    (hoop, recovery, forces): Mode,
     linear: bool,
 ) -> Vec<BlockError> {
     let mut basis = sample_in(6, hoop);
@@ -292,38 +321,52 @@ fn check_term(
         p.jbar = 1.03;
         p.fbar_rows = 2.0e8;
     }
-    let strain = if recovery { sample_strain(6, hoop) } else { basis.clone() };
+    let recovered = if recovery { sample_strain(6, hoop) } else { Vec::new() };
     p.stress = stress;
     p.linear = linear;
-    check_term_in::<2, MAX_NODES, MAX_DOF>(term, model, layout, nm, &basis, &strain, &p, &sample_faces(basis.len()))
+    let forces = if forces { sample_forces(6, hoop) } else { Vec::new() };
+    // Without recovery the strain operators are the basis itself (the same slice, as the
+    // assembly passes it: the point then keeps one set of operators on x_{n+1}).
+    let ops = Operators { basis: &basis, strain: if recovery { &recovered } else { &basis }, forces: &forces };
+    check_term_in::<2, MAX_NODES, MAX_DOF>(term, model, layout, nm, ops, &p, &sample_faces(basis.len()))
 }
 
-/// The finite-difference check of one term at the point of `basis`, `strain`, particle `p` and
+/// A point's basis, strain operators and force operators (empty: the basis's) for
+/// [`check_term_in`].
+#[derive(Clone, Copy)]
+struct Operators<'a, const D: usize> {
+    basis: &'a [NodeBasis<D>],
+    strain: &'a [NodeBasis<D>],
+    forces: &'a [NodeBasis<D>],
+}
+
+/// The finite-difference check of one term at the point of operators `ops`, particle `p` and
 /// drained `faces`, in any dimension; returns the blocks.
-#[allow(clippy::too_many_arguments)]
 fn check_term_in<const D: usize, const M: usize, const N: usize>(
     term: &Term<D, M>,
     model: &Constitutive,
     layout: Layout,
     nm: &Scheme,
-    basis: &[NodeBasis<D>],
-    strain: &[NodeBasis<D>],
+    ops: Operators<D>,
     p: &ParticleInput<D>,
     faces: &[DrainedFace<D, M>],
 ) -> Vec<BlockError> {
+    let Operators { basis, strain, forces } = ops;
     let nd = layout.nd;
     let m = basis.len() * nd;
     let nm = *nm;
     let d0 = increments(m, layout);
     let point = |st: &[NodeState<N>]| -> Vec<f64> {
-        let pt = Point::<D, M>::with_recovery(basis, strain, st, p, model, layout).with_faces(faces, st);
+        let pt =
+            Point::<D, M>::with_recovery(basis, strain, st, p, model, layout).with_forces(forces).with_faces(faces, st);
         let mut r = vec![0.0; m];
         (term.1)(&pt, &nm, &mut r);
         r
     };
     let res = |d: &[f64]| point(&states_of::<N>(d, nd, &nm));
     let st = states_of::<N>(&d0, nd, &nm);
-    let pt = Point::<D, M>::with_recovery(basis, strain, &st, p, model, layout).with_faces(faces, &st);
+    let pt =
+        Point::<D, M>::with_recovery(basis, strain, &st, p, model, layout).with_forces(forces).with_faces(faces, &st);
     let mut t = vec![0.0; m * m];
     (term.2)(&pt, &nm, &mut t);
     fd_blocks(nd, &d0, &steps(layout), &res, &t)
@@ -348,11 +391,10 @@ fn every_term_matches_central_differences_block_by_block() {
     let names = ["ux", "uy", "p", "Ux", "Uy"];
     for (layout, sname, nm) in layouts_and_schemes() {
         for (mname, model, stress) in models() {
-            let modes = [(false, false), (true, false), (false, true), (true, true)];
-            for (term, mode) in terms().into_iter().flat_map(|t| modes.map(|m| (t, m))) {
+            for (term, mode) in terms().into_iter().flat_map(|t| MODES.map(|m| (t, m))) {
                 for b in check_term(&term, &model, stress, layout, &nm, mode, false) {
                     let what = format!(
-                        "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain) {mode:?})",
+                        "{} ({mname}, nd = {}, {sname}, (axisymmetric, recovered strain, mapped forces) {mode:?})",
                         term.0, layout.nd
                     );
                     assert_block(&b, &names, &what);
@@ -379,7 +421,7 @@ fn fbar_terms_match_central_differences_block_by_block() {
         let names = layout.field_names();
         for (mname, model, stress) in models() {
             for term in &terms {
-                let blocks = check_term(term, &model, stress, layout, &nm, (false, false), false);
+                let blocks = check_term(term, &model, stress, layout, &nm, (false, false, false), false);
                 for b in &blocks {
                     assert_block(b, names, &format!("{} ({mname}, {sname})", term.0));
                 }
@@ -403,7 +445,7 @@ fn linear_increments_have_an_affine_residual_and_a_matching_tangent() {
     let names = ["ux", "uy"];
     for (layout, sname, nm) in layouts_and_schemes().into_iter().filter(|l| l.0.nd == 2) {
         for (mname, model, stress) in models() {
-            for mode in [(false, false), (true, false), (false, true), (true, true)] {
+            for mode in MODES {
                 for term in terms() {
                     for b in check_term(&term, &model, stress, layout, &nm, mode, true) {
                         assert!(
@@ -807,8 +849,9 @@ mod three {
             p.jbar = 1.03;
             p.fbar_rows = 2.0e8;
         }
-        let strain = if recovery { strain(8) } else { basis.clone() };
-        check_term_in::<3, M3, MAX_DOF_3D>(term, model, layout, nm, &basis, &strain, &p, &faces(basis.len()))
+        let recovered = if recovery { strain(8) } else { Vec::new() };
+        let ops = super::Operators { basis: &basis, strain: if recovery { &recovered } else { &basis }, forces: &[] };
+        check_term_in::<3, M3, MAX_DOF_3D>(term, model, layout, nm, ops, &p, &faces(basis.len()))
     }
 }
 

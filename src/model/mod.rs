@@ -68,6 +68,8 @@ pub struct Model<const D: usize = 2> {
     pub stiffness: crate::case::Stiffness,
     /// How a point's strain increment is recovered ([001] §5.5).
     pub stress_recovery: crate::case::StressRecovery,
+    /// How the skeleton's internal force is integrated (at the points, or double-mapped).
+    pub internal_force: crate::case::InternalForce,
     /// Geometrically linear steps (`analysis.kinematics = "linear_increments"`).
     pub linear_increments: bool,
     /// Whether the mapped `stiffness` is Newton's matrix (else it serves the K_mag diagnostic only).
@@ -459,6 +461,7 @@ impl<const D: usize> Model<D> {
             geometry: geometry_of(case),
             stiffness: case.stabilisation.stiffness,
             stress_recovery: case.stabilisation.stress_recovery,
+            internal_force: case.stabilisation.internal_force,
             linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
             stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,
             patch_recovery: case.analysis.formulation == Formulation::TwoPhase
@@ -811,6 +814,7 @@ mod tests {
             geometry: shape::Geometry::Solid,
             stiffness: m.stiffness,
             stress_recovery: m.stress_recovery,
+            internal_force: m.internal_force,
             linear_increments: m.linear_increments,
             stiffness_in_jacobian: m.stiffness_in_jacobian,
         }
