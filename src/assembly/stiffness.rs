@@ -211,14 +211,7 @@ pub(super) fn mapped_forces(model: &Model, ghost: &GhostedRange, st: &mut Stenci
         for (cell, weights) in cells {
             let slots = mapping.slots(k, nodes, cell)?;
             for (&slot, op) in slots.iter().zip(mapped_force_operators(&mapping.geometry(cell), weights)) {
-                let f = &mut forces[first + slot as usize];
-                f.s += op.s / v;
-                f.t += op.t / v;
-                f.tv += op.tv / v;
-                for d in 0..2 {
-                    f.g[d] += op.g[d] / v;
-                    f.gv[d] += op.gv[d] / v;
-                }
+                forces[first + slot as usize].add_scaled(&op, 1.0 / v);
             }
         }
     }

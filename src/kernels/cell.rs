@@ -285,14 +285,7 @@ mod tests {
             let geometry = CellGeometry { lo: [ci as f64 * grid.h[0], cj as f64 * grid.h[1]], ..cell };
             let ops = mapped_force_operators(&geometry, w.map(|v| v * w_p));
             for (node, op) in [(ci, cj), (ci + 1, cj), (ci, cj + 1), (ci + 1, cj + 1)].into_iter().zip(ops) {
-                let e = out.entry(node).or_default();
-                e.s += op.s;
-                e.t += op.t;
-                e.tv += op.tv;
-                for d in 0..2 {
-                    e.g[d] += op.g[d];
-                    e.gv[d] += op.gv[d];
-                }
+                out.entry(node).or_default().add_scaled(&op, 1.0);
             }
         }
         out

@@ -242,6 +242,19 @@ impl<const D: usize> Default for NodeBasis<D> {
     }
 }
 
+impl<const D: usize> NodeBasis<D> {
+    /// Adds `factor` times every operator of `other` (value, gradients, hoop operators).
+    pub fn add_scaled(&mut self, other: &NodeBasis<D>, factor: f64) {
+        self.s += factor * other.s;
+        self.t += factor * other.t;
+        self.tv += factor * other.tv;
+        for d in 0..D {
+            self.g[d] += factor * other.g[d];
+            self.gv[d] += factor * other.gv[d];
+        }
+    }
+}
+
 /// The basis of a whole stencil without B̄, with the hoop operators `hoop` (zero in plane
 /// strain), appended to `out`.
 pub fn plain_basis<const D: usize, const M: usize>(st: &Stencil<D, M>, hoop: &[f64], out: &mut Vec<NodeBasis<D>>) {
