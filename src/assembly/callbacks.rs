@@ -236,6 +236,47 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
         f(&pt.with_forces(step.stencils.forces_of(k)))
     }
 
+    /// Calls `f` with the point of particle `k` whose basis also holds its slots beyond the grid
+    /// ([`super::stencils::WallSlot`], after the raw slots), at the ghosted increments `xl` or at an
+    /// explicit step's start: the held slots move nothing (zero increments), so the point's state
+    /// is the one of [`Self::with_point`] and the extra entries of its blocks are the wall's share.
+    /// Without drained faces (they act on the pressure rows only).
+    fn with_point_beyond<R>(
+        &self,
+        k: usize,
+        xl: &[f64],
+        at_start: bool,
+        f: impl FnOnce(&kernels::Point<D, M>) -> R,
+    ) -> R {
+        let step = self.step;
+        let (nodes, basis) = step.stencils.get(k);
+        let beyond = step.stencils.beyond_of(k);
+        let grown = |ops: &[kernels::NodeBasis<D>], held: bool| -> Vec<kernels::NodeBasis<D>> {
+            let extra = beyond.iter().map(|w| if held { w.basis } else { kernels::NodeBasis::default() });
+            ops.iter().copied().chain(extra).collect()
+        };
+        let all = grown(basis, true);
+        // Recovered strain and double-mapped force operators have nothing beyond the grid: zero
+        // operators there (the held slots' increments are zero anyway).
+        let recovered = !std::ptr::eq(step.stencils.strain_of(k), basis);
+        let strain_ops = recovered.then(|| grown(step.stencils.strain_of(k), false));
+        let strain = strain_ops.as_deref().unwrap_or(&all);
+        let force_ops = grown(step.stencils.forces_of(k), false);
+        let forces: &[kernels::NodeBasis<D>] = if step.stencils.forces_of(k).is_empty() { &[] } else { &force_ops };
+        let input = particle_input(self.model, step, k);
+        let layout = step.layout.expect("prepared");
+        if at_start {
+            return f(&kernels::Point::<D, M>::at_start(&all, strain, &input, layout).with_forces(forces));
+        }
+        let mut states = node_states::<D, M, N>(step, k, xl);
+        for s in &mut states[nodes.len()..all.len()] {
+            *s = NodeState::default();
+        }
+        let mat = &self.model.materials[self.model.particles.material[k] as usize];
+        let pt = kernels::Point::<D, M>::with_recovery(&all, strain, &states[..all.len()], &input, &mat.model, layout);
+        f(&pt.with_forces(forces))
+    }
+
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
     fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
         let nm = self.step.nm.expect("prepared");
@@ -568,6 +609,37 @@ impl<'a, const D: usize, const M: usize, const N: usize> Assembler<'a, D, M, N> 
             }
             *i = *a - f;
         }
+    }
+
+    /// The shares of the held slots beyond the grid ([`Stencils::beyond`], in their order) at the
+    /// increments `xl` (or an explicit step's start): per slot its unweighted residual (every term,
+    /// as on a held node) and its internal forces ([`kernels::Terms::Forces`]), `nd` values each,
+    /// flat.
+    pub(super) fn wall_shares(&self, xl: &[f64], at_start: bool) -> Vec<f64> {
+        let step = self.step;
+        let nd = step.dofs.nd;
+        let plain = step.nm.expect("prepared").unweighted();
+        let beyond = &step.stencils.beyond;
+        let mut out = Vec::with_capacity(2 * nd * beyond.len());
+        let (mut buf, mut fbuf) = (vec![0.0; M * N], vec![0.0; M * N]);
+        let ps = self.particles();
+        let mut j = 0;
+        while j < beyond.len() {
+            let k = beyond[j].k as usize;
+            let raw = step.stencils.get(k).0.len();
+            let count = step.stencils.beyond_of(k).len();
+            ps.with_point_beyond(k, xl, at_start, |pt| {
+                let m = pt.size();
+                kernels::residual(pt, &plain, &mut buf[..m]);
+                kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
+            });
+            for slot in raw..raw + count {
+                out.extend_from_slice(&buf[slot * nd..(slot + 1) * nd]);
+                out.extend_from_slice(&fbuf[slot * nd..(slot + 1) * nd]);
+            }
+            j += count;
+        }
+        out
     }
 
     /// The nodal diagnostics of [001] Eqs. 25–26 per ghosted dof of the solid's motion: the diagonal

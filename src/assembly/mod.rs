@@ -1591,6 +1591,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             let start = self.step.start_terms.take().expect("an explicit step's start terms");
             (all, inertia, magnitude) = (start.all, start.inertia, start.magnitude);
         }
+        let mut walls = Vec::new();
         self.with_assembler(model, |asm| {
             if !at_start {
                 asm.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
@@ -1598,6 +1599,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             if diagnostics {
                 asm.nodal_stiffness_and_force(&xl, &mut stiffness, &mut internal);
             }
+            walls = asm.wall_shares(&xl, at_start);
         });
         if diagnostics {
             for v in [&mut stiffness, &mut internal] {
@@ -1660,6 +1662,25 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             }
         }
         self.last_reactions = reactions;
+        // The held nodes beyond the grid that GIMP supports reach past a wall (this rank's
+        // particles'): they do not move, and their share of the particles' forces is the wall's
+        // reaction, booked on the boundary that holds the wall node next to them.
+        for (w, share) in self.step.stencils.beyond.iter().zip(walls.chunks_exact(2 * nd)) {
+            let b = self.step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
+            let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
+            for &(c, dir) in &motion {
+                let (reaction, inertia) = (share[c], share[c] - share[nd + c]);
+                if b < nb {
+                    local[4 * dd + 1 + D * b + dir] += reaction;
+                }
+                for (row, x) in xr.iter().enumerate() {
+                    let k = row * D + dir;
+                    local[k] += x * (reaction - inertia);
+                    local[2 * dd + k] += x * reaction;
+                    local[3 * dd + k] += x * inertia;
+                }
+            }
+        }
         let s = coll.sum(&local)?;
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         Ok(StepForces {

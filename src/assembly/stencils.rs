@@ -72,6 +72,31 @@ pub struct Stencils<const D: usize = 2> {
     /// The force operators of each raw slot (`kernels::Point::with_forces`, [001]'s double-mapped
     /// internal force), flat like `basis`; empty when the forces are integrated with the basis.
     pub forces: Vec<NodeBasis<D>>,
+    /// The slots beyond the grid of the GIMP supports that reach past a held wall, by particle
+    /// (see [`WallSlot`]).
+    pub beyond: Vec<WallSlot<D>>,
+}
+
+/// A node beyond the grid's edge that a GIMP particle's support reaches past a wall ([`check_edges`]).
+/// The stencil drops it, so the particle's basis there is lost; the node is the rigid wall's
+/// material, held in every direction (a dropped node has no unknowns), and its share of the
+/// particle's forces is the wall's reaction. The equilibrium identity counts it
+/// (`GridSystem::step_forces`): without it the first moment of the nodal forces misses
+/// Σ_p V_p σ_p ⊗ Σ_beyond x ∇S, which grows with the stretch of the domains at a fixed base.
+#[derive(Debug, Clone, Copy)]
+pub struct WallSlot<const D: usize = 2> {
+    /// The particle.
+    pub k: u32,
+    /// Its basis at the node (on x_n). With B̄ the volumetric gradients are zero: the particle's
+    /// cell-centre gradients ∇̄S, from the cells inside the grid only, already reproduce a linear
+    /// field on their own.
+    pub basis: NodeBasis<D>,
+    /// The node's position (it does not move).
+    pub at: [f64; D],
+    /// The grid node on the wall next to it (ghosted numbering), whose boundary takes the share.
+    pub wall: u32,
+    /// The direction normal to the wall it lies beyond.
+    pub normal: u8,
 }
 
 impl<const D: usize> Stencils<D> {
@@ -121,6 +146,13 @@ impl<const D: usize> Stencils<D> {
     pub fn extensions(&self, k: usize) -> &[Extension] {
         let r = self.ext_offsets.get(k).copied().unwrap_or(0)..self.ext_offsets.get(k + 1).copied().unwrap_or(0);
         &self.ext[r]
+    }
+
+    /// The slots beyond the grid of particle `k` ([`WallSlot`]; most particles have none).
+    pub fn beyond_of(&self, k: usize) -> &[WallSlot<D>] {
+        let first = self.beyond.partition_point(|w| (w.k as usize) < k);
+        let last = first + self.beyond[first..].partition_point(|w| w.k as usize == k);
+        &self.beyond[first..last]
     }
 }
 
@@ -286,14 +318,13 @@ pub fn build_in<const D: usize, const M: usize>(
     let hi = g.extent_max();
     let tol = 1e-9 * (1..D).fold(g.h[0], |m, d| m.min(g.h[d]));
     let axisymmetric = model.geometry.axisymmetric();
-    let plane_grid =
-        crate::model::grid::Grid::new([g.origin[0], g.origin[1]], [g.h[0], g.h[1]], [g.cells[0], g.cells[1]]);
     for k in 0..ps.len() {
         let (x, lp) = (ps.x[k], ps.lp[k]);
         if !x.iter().all(|v| v.is_finite()) {
             return Err(format!("material point {}: its position is not finite (NaN or Inf)", ps.id[k]));
         }
         let reach = if model.basis == Basis::Gimp { lp } else { [0.0; D] };
+        let crossed_before = crossings.len();
         for d in 0..D {
             if x[d] - reach[d] < g.origin[d] - tol {
                 crossings.push(Crossing { k, side: 2 * d });
@@ -302,19 +333,7 @@ pub fn build_in<const D: usize, const M: usize>(
                 crossings.push(Crossing { k, side: 2 * d + 1 });
             }
         }
-        let (mut st, hoop): (shape::Stencil<D, M>, [f64; M]) = if axisymmetric {
-            // The axisymmetric stencil with its hoop operators (two dimensions only).
-            let (s2, h2) = model.geometry.stencil(model.basis, &plane_grid, [x[0], x[1]], [lp[0], lp[1]]);
-            let mut st = shape::Stencil::<D, M> { len: s2.len, ..Default::default() };
-            for n in 0..s2.len {
-                st.nodes[n] = std::array::from_fn(|d| s2.nodes[n][d]);
-                st.w[n] = s2.w[n];
-                st.dw[n] = std::array::from_fn(|d| s2.dw[n][d]);
-            }
-            (st, std::array::from_fn(|n| if n < s2.len { h2[n] } else { 0.0 }))
-        } else {
-            (shape::stencil_in(model.basis, g, x, lp), [0.0; M])
-        };
+        let (mut st, hoop) = stencil_with_hoop::<D, M>(model, g, x, lp);
         let gv = model.bbar.then(|| {
             shape::volumetric_operators_in(model.basis, g, x, lp, &mut st, &|c| roots.root_of(c), axisymmetric)
         });
@@ -347,15 +366,89 @@ pub fn build_in<const D: usize, const M: usize>(
             }
         }
         out.offsets.push(out.nodes.len());
+        if crossings.len() > crossed_before && model.basis == Basis::Gimp {
+            beyond_the_grid::<D, M>(model, ghost, k, &mut out.beyond)?;
+        }
     }
     Ok((out, crossings))
+}
+
+/// The stencil of a particle at `x` with half-widths `lp` on `grid` with the hoop operator of each
+/// node: zero in plane strain and in three dimensions, the axisymmetric stencil's otherwise (two
+/// dimensions only).
+fn stencil_with_hoop<const D: usize, const M: usize>(
+    model: &Model<D>,
+    grid: &crate::model::grid::Grid<D>,
+    x: [f64; D],
+    lp: [f64; D],
+) -> (shape::Stencil<D, M>, [f64; M]) {
+    if !model.geometry.axisymmetric() {
+        return (shape::stencil_in(model.basis, grid, x, lp), [0.0; M]);
+    }
+    let plane = crate::model::grid::Grid::new(
+        [grid.origin[0], grid.origin[1]],
+        [grid.h[0], grid.h[1]],
+        [grid.cells[0], grid.cells[1]],
+    );
+    let (s2, h2) = model.geometry.stencil(model.basis, &plane, [x[0], x[1]], [lp[0], lp[1]]);
+    let mut st = shape::Stencil::<D, M> { len: s2.len, ..Default::default() };
+    for n in 0..s2.len {
+        st.nodes[n] = std::array::from_fn(|d| s2.nodes[n][d]);
+        st.w[n] = s2.w[n];
+        st.dw[n] = std::array::from_fn(|d| s2.dw[n][d]);
+    }
+    (st, std::array::from_fn(|n| if n < s2.len { h2[n] } else { 0.0 }))
+}
+
+/// Appends the slots of particle `k`'s GIMP support beyond the grid ([`WallSlot`]): its stencil on
+/// the grid grown by one cell on every side, the nodes outside the original grid. Inside the grid
+/// the weights are those of the particle's stencil (GIMP's are local to each node).
+fn beyond_the_grid<const D: usize, const M: usize>(
+    model: &Model<D>,
+    ghost: &GhostedRange<D>,
+    k: usize,
+    out: &mut Vec<WallSlot<D>>,
+) -> Result<(), String> {
+    let g = &model.grid;
+    let (x, lp) = (model.particles.x[k], model.particles.lp[k]);
+    let grown = crate::model::grid::Grid::<D>::new(
+        std::array::from_fn(|d| g.origin[d] - g.h[d]),
+        g.h,
+        std::array::from_fn(|d| g.cells[d] + 2),
+    );
+    let (st, hoop) = stencil_with_hoop::<D, M>(model, &grown, x, lp);
+    for (n, &t) in hoop.iter().enumerate().take(st.len) {
+        let at = st.nodes[n].map(|v| v as usize);
+        let Some(normal) = (0..D).find(|&d| at[d] == 0 || at[d] == grown.cells[d]) else { continue };
+        let on_wall: [usize; D] = std::array::from_fn(|d| at[d].clamp(1, g.cells[d] + 1) - 1);
+        let position = grown.position(at);
+        let wall = ghost.local(on_wall).ok_or_else(|| {
+            format!(
+                "material point {} at {} m reaches past the grid to {} m, next to node {} outside this \
+                 rank's ghost region",
+                model.particles.id[k],
+                crate::model::position_text(&x),
+                crate::model::position_text(&position),
+                crate::model::index_text(&on_wall)
+            )
+        })?;
+        let (gv, tv) = if model.bbar { ([0.0; D], 0.0) } else { (st.dw[n], t) };
+        out.push(WallSlot {
+            k: k as u32,
+            basis: NodeBasis { s: st.w[n], g: st.dw[n], gv, t, tv },
+            at: position,
+            wall: wall as u32,
+            normal: normal as u8,
+        });
+    }
+    Ok(())
 }
 
 /// The grid's edge. A support that reaches past a side of the grid loses the part of its basis
 /// beyond it (the partition of unity, and with it part of the particle's internal force and load).
 /// Where the particle's nodes on that side are held in the side's normal direction by a boundary
 /// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
-/// as its reaction; on any other side the run must stop, naming the particle, its body, the time
+/// as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must stop, naming the particle, its body, the time
 /// and the side. (Linear MPM and B-splines: a centre outside the grid always stops the run.)
 pub fn check_edges<const D: usize>(
     model: &Model<D>,
@@ -758,8 +851,42 @@ mod tests {
         moved.particles.x[0][0] -= 0.02;
         let last = moved.particles.len() - 1;
         moved.particles.x[last][2] = 0.29;
-        let (_, crossings) = build_in::<3, { shape::MAX_STENCIL_3D }>(&moved, &ghost, &roots).unwrap();
+        let (st, crossings) = build_in::<3, { shape::MAX_STENCIL_3D }>(&moved, &ghost, &roots).unwrap();
         let sides: Vec<(usize, &str)> = crossings.iter().map(|c| (c.k, SIDES[c.side])).collect();
         assert_eq!(sides, [(0, "x_min"), (last, "z_max")]);
+        // Their slots beyond the grid complete the partition of unity and the reproduction of
+        // linear fields (Σ x_i ⊗ ∇S_i = I over the raw and the held slots); the cell-centre
+        // gradients ∇̄S need none (the slots' are zero); each slot's wall node is the nearest
+        // node on the grid's edge.
+        assert!(st.beyond.iter().all(|w| w.k == 0 || w.k as usize == last));
+        for (k, side) in [(0, 0), (last, 5)] {
+            let (nodes, basis) = st.get(k);
+            let beyond = st.beyond_of(k);
+            assert!(beyond.iter().any(|w| w.basis.s > 0.0), "point {k}: no weight beyond the grid");
+            let mut ops: Vec<([f64; 3], NodeBasis<3>)> =
+                nodes.iter().map(|&l| g.position(ghost.indices(l as usize))).zip(basis.iter().copied()).collect();
+            let sum_in: f64 = ops.iter().map(|(_, b)| b.s).sum();
+            assert!(sum_in < 1.0 - 1e-3, "point {k}: the grid keeps Σ S = {sum_in}");
+            ops.extend(beyond.iter().map(|w| (w.at, w.basis)));
+            let sum: f64 = ops.iter().map(|(_, b)| b.s).sum();
+            assert!((sum - 1.0).abs() < 1e-13, "point {k}: Σ S = {sum} with the slots beyond");
+            for a in 0..3 {
+                for b in 0..3 {
+                    let want = if a == b { 1.0 } else { 0.0 };
+                    let xg: f64 = ops.iter().map(|(x, n)| x[a] * n.g[b]).sum();
+                    let xgv: f64 = ops.iter().map(|(x, n)| x[a] * n.gv[b]).sum();
+                    assert!((xg - want).abs() < 1e-10 && (xgv - want).abs() < 1e-10, "point {k}: {xg} {xgv} ({a}{b})");
+                }
+            }
+            let hi = g.extent_max();
+            let outside = |w: &WallSlot<3>, d: usize| w.at[d] < g.origin[d] || w.at[d] > hi[d];
+            assert!(beyond.iter().any(|w| w.basis.s > 0.0 && w.normal as usize == side / 2));
+            for w in beyond {
+                let wall = g.position(ghost.indices(w.wall as usize));
+                assert!(outside(w, w.normal as usize), "{:?} is not beyond the grid in {}", w.at, w.normal);
+                let clamped: [f64; 3] = std::array::from_fn(|d| w.at[d].clamp(g.origin[d], hi[d]));
+                assert!((0..3).all(|d| (wall[d] - clamped[d]).abs() < 1e-12), "{wall:?} next to {:?}", w.at);
+            }
+        }
     }
 }
