@@ -3,15 +3,14 @@
 //! block-by-block finite-difference check of the assembled tangent. Every test runs the real
 //! binary in its own process (PETSc and MPI can be initialised once per process).
 
+mod common;
+
+use common::{assert_tangent_agrees, root};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_porompm")
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn out_dir(name: &str) -> PathBuf {
@@ -346,26 +345,24 @@ fn terzaghi_on_two_ranks_matches_one_rank() {
 #[test]
 fn the_assembled_tangent_matches_finite_differences_block_by_block() {
     // A small two-dimensional two-phase case: every block (ux, uy, p, Ux, Uy)² is exercised.
-    let o = porompm(&[
-        "test-jacobian",
-        "cases/terzaghi.toml",
-        "--steps",
-        "3",
-        "--set",
-        "grid.cells=[2,4]",
-        "--set",
-        "grid.size=[0.2,0.4]",
-        "--set",
-        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.2,0.4]}}",
-        "--set",
-        "loads[0].region={min=[0.0,0.2],max=[0.2,0.4]}",
-        "--set",
-        "probes=[]",
-    ]);
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{text}\n{}", stderr(&o));
-    assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 25, "{text}");
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+    assert_tangent_agrees(
+        &[
+            "cases/terzaghi.toml",
+            "--steps",
+            "3",
+            "--set",
+            "grid.cells=[2,4]",
+            "--set",
+            "grid.size=[0.2,0.4]",
+            "--set",
+            "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.2,0.4]}}",
+            "--set",
+            "loads[0].region={min=[0.0,0.2],max=[0.2,0.4]}",
+            "--set",
+            "probes=[]",
+        ],
+        25,
+    );
 }
 
 /// The small slumping block of the tangent checks: 6 × 5 cells, a 0.5 m block, no probes.
@@ -389,12 +386,8 @@ const PLASTIC_SOIL: &str = "materials[0].model={type=\"mohr_coulomb\",young_modu
 fn the_tangent_with_bbar_matches_finite_differences_on_a_two_dimensional_block() {
     // A small slumping block after five steps under gravity: a genuinely two-dimensional
     // deformation, B̄ on ([000] §3), moving drained surfaces and GIMP domains that follow the stretch.
-    let head = ["test-jacobian", "cases/slumping_block.toml", "--steps", "5", "--set", "stabilisation.bbar=true"];
-    let o = porompm(&[&head[..], &SMALL_BLOCK, &["--set", "time.dt=0.01"]].concat());
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{text}\n{}", stderr(&o));
-    assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 25, "{text}");
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+    let head = ["cases/slumping_block.toml", "--steps", "5", "--set", "stabilisation.bbar=true"];
+    assert_tangent_agrees(&[&head[..], &SMALL_BLOCK, &["--set", "time.dt=0.01"]].concat(), 25);
 }
 
 /// At rest (the vertical cut's held gravity stage, elastic: the increments are near zero) the
@@ -402,8 +395,7 @@ fn the_tangent_with_bbar_matches_finite_differences_on_a_two_dimensional_block()
 /// (measured 8.7e-9; a step of 1e-12 of a cell left the residual's round-off at 7.3e-6).
 #[test]
 fn the_tangent_check_holds_at_rest() {
-    let o = porompm(&[
-        "test-jacobian",
+    let args = [
         "cases/vertical_cut.toml",
         "--steps",
         "60",
@@ -411,36 +403,32 @@ fn the_tangent_check_holds_at_rest() {
         "parameters.h=0.25",
         "--set",
         "materials.clay.model.cohesion=1e5",
-    ]);
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{text}\n{}", stderr(&o));
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+    ];
+    assert_tangent_agrees(&args, 4);
 }
 
 #[test]
 fn the_one_phase_tangent_matches_finite_differences_too() {
-    let o = porompm(&[
-        "test-jacobian",
-        "cases/elastic_column.toml",
-        "--steps",
-        "5",
-        "--set",
-        "grid.cells=[2,6]",
-        "--set",
-        "grid.size=[0.1,0.3]",
-        "--set",
-        "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.1,0.3]}}",
-        "--set",
-        "loads.surcharge.region={min=[0.0,0.3],max=[0.1,0.3]}",
-        "--set",
-        "probes=[]",
-        "--set",
-        "time.dt=0.05",
-    ]);
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{text}\n{}", stderr(&o));
-    assert_eq!(text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count(), 4, "{text}");
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
+    assert_tangent_agrees(
+        &[
+            "cases/elastic_column.toml",
+            "--steps",
+            "5",
+            "--set",
+            "grid.cells=[2,6]",
+            "--set",
+            "grid.size=[0.1,0.3]",
+            "--set",
+            "bodies[0].shape={rectangle={min=[0.0,0.0],max=[0.1,0.3]}}",
+            "--set",
+            "loads.surcharge.region={min=[0.0,0.3],max=[0.1,0.3]}",
+            "--set",
+            "probes=[]",
+            "--set",
+            "time.dt=0.05",
+        ],
+        4,
+    );
 }
 
 /// The element test drives loose sand through plane-strain compression at constant lateral stress:
@@ -503,18 +491,15 @@ fn an_expression_with_an_unknown_parameter_is_named() {
 /// most points have yielded and every block still matches central differences.
 #[test]
 fn the_plastic_tangent_with_pressure_projection_matches_finite_differences() {
-    let head = ["test-jacobian", "cases/slumping_block.toml", "--steps", "10", "--set", "stabilisation.bbar=true"];
+    let head = ["cases/slumping_block.toml", "--steps", "10", "--set", "stabilisation.bbar=true"];
     let projection = ["--set", "stabilisation.pressure_projection=1.0", "--set", "time.dt=0.02", "--set", PLASTIC_SOIL];
-    let o = porompm(&[&head[..], &SMALL_BLOCK, &projection].concat());
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{text}\n{}", stderr(&o));
+    let text = assert_tangent_agrees(&[&head[..], &SMALL_BLOCK, &projection].concat(), 25);
     let yielded: usize = text
         .lines()
         .find_map(|l| l.strip_prefix("material points that have yielded: "))
         .and_then(|v| v.trim().parse().ok())
         .unwrap_or_else(|| panic!("no yield count in:\n{text}"));
     assert!(yielded >= 10, "only {yielded} points have yielded:\n{text}");
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
 }
 
 /// The tangent of the implicit F̄ (`kernels::fbar`: the projected volume ratio J̄ as a nodal
@@ -527,24 +512,19 @@ fn the_fbar_tangent_matches_finite_differences_for_u_and_u_p() {
     let small = [&SMALL_BLOCK[..], &["--set", "stabilisation={fbar=true}", "--set", "time.dt=0.02"]].concat();
     let plastic = ["--set", "analysis.formulation=one_phase", "--set", PLASTIC_SOIL];
     let quasi_static = ["--set", "stages.0.analysis=quasi_static"];
-    let check = |extra: &[&str], flip: Option<&str>| {
-        let mut args = vec!["test-jacobian", "cases/slumping_block.toml", "--steps", "10"];
+    let check = |extra: &[&'static str], flip: Option<&'static str>| -> Vec<&'static str> {
+        let mut args = vec!["cases/slumping_block.toml", "--steps", "10"];
         args.extend_from_slice(&small);
         args.extend_from_slice(extra);
         if let Some(f) = flip {
             args.extend_from_slice(&["--flip-block", f]);
         }
-        porompm(&args)
+        args
     };
     let mut texts = Vec::new();
     for (extra, blocks) in [(&plastic[..], 9), (&quasi_static[..], 16)] {
-        let o = check(extra, None);
-        let text = String::from_utf8_lossy(&o.stdout).to_string();
-        assert!(o.status.success(), "{extra:?}: {text}\n{}", stderr(&o));
-        let rows = text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count();
-        assert_eq!(rows, blocks, "{text}");
+        let text = assert_tangent_agrees(&check(extra, None), blocks);
         assert!(text.lines().any(|l| l.trim_start().starts_with("Jbar   ux")), "{text}");
-        assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
         texts.push(text);
     }
     let yielded: usize = texts[0]
@@ -552,13 +532,8 @@ fn the_fbar_tangent_matches_finite_differences_for_u_and_u_p() {
         .find_map(|l| l.strip_prefix("material points that have yielded: ").and_then(|v| v.trim().parse().ok()))
         .expect("a yield count");
     assert!(yielded >= 5, "only {yielded} points have yielded");
-    let o = check(&plastic, Some("ux,Jbar"));
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "a negated ux–Jbar block must be seen: {}",
-        String::from_utf8_lossy(&o.stdout)
-    );
+    let (code, text, _) = common::test_jacobian(&check(&plastic, Some("ux,Jbar")));
+    assert_eq!(code, Some(1), "a negated ux–Jbar block must be seen: {text}");
 }
 
 /// A load that overflows the Newton update (NaN in the solve) ends the run `failed` on every rank

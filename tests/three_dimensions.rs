@@ -445,23 +445,6 @@ fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
     );
 }
 
-/// `porompm test-jacobian` with `args`: its status and standard output.
-fn test_jacobian(args: &[&str]) -> (Option<i32>, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_porompm"))
-        .arg("test-jacobian")
-        .args(args)
-        .current_dir(common::root())
-        .output()
-        .expect("porompm runs");
-    let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-    (o.status.code(), text)
-}
-
-/// The number of block rows of a test-jacobian table.
-fn blocks(text: &str) -> usize {
-    text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count()
-}
-
 /// The assembled three-dimensional tangents against central differences of the assembled residual,
 /// block by block (`porompm test-jacobian`, one rank): a consolidating block's u–p–U system after
 /// three steps (7 × 7 blocks, every one of them exercised), the square footing's plastic Tresca soil
@@ -512,12 +495,9 @@ fn the_three_dimensional_tangents_match_finite_differences_block_by_block() {
 /// Checks that `porompm test-jacobian ARGS` passes with `n_blocks` blocks within 1e-6 and fails with
 /// the block `flip` (ROW,COL) negated; returns the passing run's output.
 fn assert_tangent_checked(args: &[&str], n_blocks: usize, flip: &str) -> String {
-    let (code, text) = test_jacobian(args);
-    assert_eq!(code, Some(0), "{text}");
-    assert_eq!(blocks(&text), n_blocks, "{text}");
-    assert!(text.contains("all blocks agree within 1.0e-6"), "{text}");
-    let (code, flipped) = test_jacobian(&[args, &["--flip-block", flip]].concat());
-    assert_eq!(code, Some(1), "the flipped {flip} block: {flipped}");
+    let text = common::assert_tangent_agrees(args, n_blocks);
+    let (code, flipped, err) = common::test_jacobian(&[args, &["--flip-block", flip]].concat());
+    assert_eq!(code, Some(1), "the flipped {flip} block: {flipped}\n{err}");
     text
 }
 

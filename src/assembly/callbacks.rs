@@ -261,12 +261,13 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
         let recovered = !std::ptr::eq(step.stencils.strain_of(k), basis);
         let strain_ops = recovered.then(|| grown(step.stencils.strain_of(k), false));
         let strain = strain_ops.as_deref().unwrap_or(&all);
-        let force_ops = grown(step.stencils.forces_of(k), false);
-        let forces: &[kernels::NodeBasis<D>] = if step.stencils.forces_of(k).is_empty() { &[] } else { &force_ops };
+        // An empty slice: the forces take the basis (`kernels::Point::with_forces`).
+        let forces = step.stencils.forces_of(k);
+        let forces = if forces.is_empty() { Vec::new() } else { grown(forces, false) };
         let input = particle_input(self.model, step, k);
         let layout = step.layout.expect("prepared");
         if at_start {
-            return f(&kernels::Point::<D, M>::at_start(&all, strain, &input, layout).with_forces(forces));
+            return f(&kernels::Point::<D, M>::at_start(&all, strain, &input, layout).with_forces(&forces));
         }
         let mut states = node_states::<D, M, N>(step, k, xl);
         for s in &mut states[nodes.len()..all.len()] {
@@ -274,7 +275,7 @@ impl<const D: usize, const M: usize, const N: usize> Particles<'_, D, M, N> {
         }
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         let pt = kernels::Point::<D, M>::with_recovery(&all, strain, &states[..all.len()], &input, &mat.model, layout);
-        f(&pt.with_forces(forces))
+        f(&pt.with_forces(&forces))
     }
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
@@ -623,21 +624,18 @@ impl<'a, const D: usize, const M: usize, const N: usize> Assembler<'a, D, M, N> 
         let mut out = Vec::with_capacity(2 * nd * beyond.len());
         let (mut buf, mut fbuf) = (vec![0.0; M * N], vec![0.0; M * N]);
         let ps = self.particles();
-        let mut j = 0;
-        while j < beyond.len() {
-            let k = beyond[j].k as usize;
+        for slots in beyond.chunk_by(|a, b| a.k == b.k) {
+            let k = slots[0].k as usize;
             let raw = step.stencils.get(k).0.len();
-            let count = step.stencils.beyond_of(k).len();
             ps.with_point_beyond(k, xl, at_start, |pt| {
                 let m = pt.size();
                 kernels::residual(pt, &plain, &mut buf[..m]);
                 kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
             });
-            for slot in raw..raw + count {
+            for slot in raw..raw + slots.len() {
                 out.extend_from_slice(&buf[slot * nd..(slot + 1) * nd]);
                 out.extend_from_slice(&fbuf[slot * nd..(slot + 1) * nd]);
             }
-            j += count;
         }
         out
     }

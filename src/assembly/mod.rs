@@ -1646,19 +1646,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
                 let q = l * nd + c;
                 let b = self.step.dofs.boundary[q];
                 let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
-                if (b as usize) < nb {
-                    local[4 * dd + 1 + D * b as usize + dir] += reaction;
-                }
                 reactions[q] = reaction;
                 let reaction_old = last.get(q).copied().unwrap_or(reaction);
                 local[4 * dd] += 0.5 * (fext_old[q] + fext[q] + reaction_old + reaction) * self.step.solution[q];
-                for (row, x) in xr.iter().enumerate() {
-                    let k = row * D + dir;
-                    local[k] += x * (fext[q] + reaction - inertia[q]);
-                    local[dd + k] += x * fext[q];
-                    local[2 * dd + k] += x * reaction;
-                    local[3 * dd + k] += x * inertia[q];
-                }
+                book_node_forces(&mut local, nb, b as usize, &xr, dir, [fext[q], reaction, inertia[q]]);
             }
         }
         self.last_reactions = reactions;
@@ -1669,16 +1660,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             let b = self.step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
             let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
             for &(c, dir) in &motion {
-                let (reaction, inertia) = (share[c], share[c] - share[nd + c]);
-                if b < nb {
-                    local[4 * dd + 1 + D * b + dir] += reaction;
-                }
-                for (row, x) in xr.iter().enumerate() {
-                    let k = row * D + dir;
-                    local[k] += x * (reaction - inertia);
-                    local[2 * dd + k] += x * reaction;
-                    local[3 * dd + k] += x * inertia;
-                }
+                book_node_forces(&mut local, nb, b, &xr, dir, [0.0, share[c], share[c] - share[nd + c]]);
             }
         }
         let s = coll.sum(&local)?;
@@ -2013,4 +1995,29 @@ pub fn describe_solver<const D: usize, const M: usize, const N: usize>(
     };
     let newton = if lag > 1 || lag == -1 || lag == -2 { "modified Newton (lagged Jacobian)" } else { "Newton" };
     Ok(format!("{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"))
+}
+
+/// Books one node's forces in direction `dir`, `[external, reaction, inertia]`, at `xr` (its position
+/// about the moments' origin) into `step_forces`'s local sums: the first moments of the total
+/// (external + reaction − inertia), external, reaction and inertia forces (D² each, in that order)
+/// and, for a node held by boundary `boundary` < `nb`, that boundary's reaction (after the work).
+fn book_node_forces<const D: usize>(
+    local: &mut [f64],
+    nb: usize,
+    boundary: usize,
+    xr: &[f64; D],
+    dir: usize,
+    [fext, reaction, inertia]: [f64; 3],
+) {
+    let dd = D * D;
+    if boundary < nb {
+        local[4 * dd + 1 + D * boundary + dir] += reaction;
+    }
+    for (row, x) in xr.iter().enumerate() {
+        let k = row * D + dir;
+        local[k] += x * (fext + reaction - inertia);
+        local[dd + k] += x * fext;
+        local[2 * dd + k] += x * reaction;
+        local[3 * dd + k] += x * inertia;
+    }
 }

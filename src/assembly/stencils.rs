@@ -448,8 +448,9 @@ fn beyond_the_grid<const D: usize, const M: usize>(
 /// beyond it (the partition of unity, and with it part of the particle's internal force and load).
 /// Where the particle's nodes on that side are held in the side's normal direction by a boundary
 /// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
-/// as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must stop, naming the particle, its body, the time
-/// and the side. (Linear MPM and B-splines: a centre outside the grid always stops the run.)
+/// as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must
+/// stop, naming the particle, its body, the time and the side. (Linear MPM and B-splines: a centre
+/// outside the grid always stops the run.)
 pub fn check_edges<const D: usize>(
     model: &Model<D>,
     st: &Stencils<D>,

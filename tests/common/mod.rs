@@ -207,3 +207,25 @@ pub fn gold_run(case: &str) -> GoldRun {
     }
     GoldRun { metrics, results }
 }
+
+/// `porompm test-jacobian ARGS` (one rank): its exit code, standard output and standard error.
+pub fn test_jacobian(args: &[&str]) -> (Option<i32>, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_porompm"))
+        .arg("test-jacobian")
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("porompm runs");
+    (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// Checks that `porompm test-jacobian ARGS` passes with a table of `n_blocks` field-pair blocks,
+/// every one within 1e-6 of central differences; returns its standard output.
+pub fn assert_tangent_agrees(args: &[&str], n_blocks: usize) -> String {
+    let (code, text, err) = test_jacobian(args);
+    assert_eq!(code, Some(0), "{args:?}: {text}\n{err}");
+    let blocks = text.lines().filter(|l| l.split_whitespace().count() == 5 && !l.contains("row")).count();
+    assert_eq!(blocks, n_blocks, "{args:?}: {text}");
+    assert!(text.contains("all blocks agree within 1.0e-6"), "{args:?}: {text}");
+    text
+}
