@@ -933,7 +933,12 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Assemb
         j.set_values_coo(&values, false).map_err(fatal)?;
         self.values = values;
         if let Some(schur) = self.schur.as_deref_mut() {
-            schur.update(j, &step.fixed_stress).map_err(fatal)?;
+            if schur.has_blocks() {
+                let mut invert = |block: &mut [f64], n: usize| crate::kernels::dense::invert_in_place(block, n);
+                schur.update_with_blocks(j, &step.schur_groups, &mut invert, &step.fixed_stress).map_err(fatal)?;
+            } else {
+                schur.update(j, &step.fixed_stress).map_err(fatal)?;
+            }
         }
         *self.seconds += t0.elapsed().as_secs_f64();
         Ok(())

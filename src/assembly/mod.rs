@@ -26,6 +26,7 @@
 //! one COO value array. Every decision that leads to a collective is agreed across ranks first
 //! ([`Collective::agree`]).
 
+mod aggregates;
 mod bench;
 mod callbacks;
 mod check;
@@ -113,6 +114,9 @@ struct StepData<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// The diagonal the fixed-stress Schur preconditioner adds to A_pp, per owned pressure row
     /// (see [`GridSystem::fixed_stress_diagonal`]; empty without that preconditioner).
     fixed_stress: Vec<f64>,
+    /// The free-surface aggregates of the u–p–U system's Schur preconditioner, as positions in
+    /// this rank's rows of the `u` split (see [`aggregates`]; empty without it).
+    schur_groups: Vec<Vec<usize>>,
     /// The drained faces imposed weakly (see [`GridSystem::drained_faces`]) and the particle of
     /// each, in increasing order.
     faces: Vec<kernels::DrainedFace<D, M>>,
@@ -219,6 +223,29 @@ pub fn pressure_scale<const D: usize>(model: &Model<D>) -> f64 {
         1.0
     }
 }
+
+/// The share c of the solid's fixed-stress term in the Schur preconditioner of the u–p–U system
+/// (see `GridSystem::fixed_stress_diagonal`) for a step of `dt`: c = min(1, Cr / 108), Cr =
+/// c_p Δt / h the Courant number of the fastest drained compression wave, c_p = √(M / ρ) with the
+/// drained constrained modulus M and the mixture's density ρ = (1 − n) ρ_s + n ρ_w, h the smallest
+/// cell size. Fitted on the spectra of the slumping block's tangents (docs/solvers.md): the best
+/// shares 0.0625 at Δt = 4 ms and 0.25 at 16 ms on 64 × 48 cells (Cr = 6.7 and 27) lie on it, and
+/// at 1 ms (Cr = 1.7; best share 0) it adds 0.016.
+pub fn fixed_stress_share<const D: usize>(model: &Model<D>, dt: f64) -> f64 {
+    let cp = model
+        .materials
+        .iter()
+        .map(|m| {
+            let rho = (1.0 - m.porosity) * m.solid_density + m.porosity * m.water_density;
+            (m.model.elastic().constrained_modulus() / rho).sqrt()
+        })
+        .fold(0.0, f64::max);
+    let h = (1..D).fold(model.grid.h[0], |h, d| h.min(model.grid.h[d]));
+    (cp * dt / h / FIXED_STRESS_COURANT).min(1.0)
+}
+
+/// The Courant number at which [`fixed_stress_share`] reaches 1.
+const FIXED_STRESS_COURANT: f64 = 108.0;
 
 /// The PETSc option that turns the field-wise Krylov convergence test off (`false`): by default
 /// a Krylov solve converges only when the residual of every field (u, p, U), relative to its own
@@ -384,8 +411,10 @@ pub struct GridSystem<
     near_null: Vec<Vector>,
     /// The mean filled fraction of each moving boundary's nodes at the current step's start.
     boundary_fill: Vec<Option<f64>>,
-    /// The fixed-stress Schur preconditioner, when the options ask for one (see [`splits`]).
+    /// porompm's Schur preconditioner, when the options ask for one (see [`splits`]).
     schur: Option<petsc::SchurUser>,
+    /// Its tuning from the options (the u–p–U system's aggregates and fixed-stress share).
+    schur_tuning: splits::SchurTuning,
     /// The reactions per ghosted dof of the last converged step (for the work of the next).
     last_reactions: Vec<f64>,
     /// K_mag and F^int_mag ([001] Eqs. 25–26) per owned node of the last step whose forces were
@@ -521,6 +550,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         let positions: Vec<[f64; D]> = owned.iter().map(|&n| grid.position(n)).collect();
         let first_dof = x.ownership_range()?.0;
         let schur = splits::define(&mut snes, comm, coll, layout, first_dof, &positions)?;
+        let schur_tuning = splits::SchurTuning::from_options()?;
         let near_null = splits::displacement_near_null_space(comm, coll, layout, &positions)?;
         // Every linear solve measured field by field (not under Eisenstat–Walker, whose own
         // post-solve hook it would replace).
@@ -556,6 +586,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             snes,
             jac: None,
             schur,
+            schur_tuning,
             near_null,
             boundary_fill: Vec::new(),
             user_atol,
@@ -671,7 +702,18 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
         }
         stencils::extend(&mut st, model, &self.ghost, &dofs, &self.motion());
         self.step_data(model, active, (t_new - dt, t_new), st, dofs, &nodal, coll)?;
-        self.step.fixed_stress = self.fixed_stress_diagonal(model).map_err(|e| e.to_string())?;
+        self.step.fixed_stress = self.fixed_stress_diagonal(model, dt).map_err(|e| e.to_string())?;
+        if self.schur.as_ref().is_some_and(|s| s.has_blocks()) {
+            let (nodes, p) = (std::array::from_fn(|d| model.grid.cells[d] + 1), self.layout.p.expect("a Schur split"));
+            self.step.schur_groups = aggregates::surface_groups(
+                &self.ghost,
+                nodes,
+                &self.owned_nodes,
+                &self.step.dofs,
+                p,
+                self.schur_tuning.strip,
+            );
+        }
         if weak {
             (self.step.face_owner, self.step.faces) = self.drained_faces(model, active).into_iter().unzip();
         }
@@ -727,24 +769,34 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             .collect())
     }
 
-    /// Step 4: the diagonal of the fixed-stress Schur preconditioner Sp = A_pp + diag(d) of the
-    /// u–p system (see [`splits`]), per owned pressure row in the `p` split's order:
-    /// d_i = −s² Σ_k N_i(x_k) V_k / K_dr,k, the lumped pressure mass of the points over their
-    /// skeleton's drained (plane-strain) bulk modulus, in PETSc's scaling (s the pressure scale);
-    /// 0 on fixed pressures, whose rows stay the unit diagonal. It is the volume change of the
-    /// fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible grains, as the
-    /// continuity equation assumes), with the sign of A_pp's storage term. Empty without that
-    /// preconditioner.
-    fn fixed_stress_diagonal(&mut self, model: &Model<D>) -> Result<Vec<f64>, Error> {
+    /// Step 4: the diagonal d of porompm's Schur preconditioners (see [`splits`]), per owned
+    /// pressure row in the `p` split's order, in PETSc's scaling (s the pressure scale); 0 on fixed
+    /// pressures, whose rows stay the unit diagonal. Empty without such a preconditioner.
+    ///
+    /// * u–p: Sp = A_pp + diag(d), d_i = −s² Σ_k N_i(x_k) V_k / K_dr,k, the lumped pressure mass of
+    ///   the points over their skeleton's drained bulk modulus (plane strain: λ + μ). It is the
+    ///   volume change of the fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible
+    ///   grains, as the continuity equation assumes), with the sign of A_pp's storage term.
+    /// * u–p–U: Sp = A_pp − A_pu B⁻¹ A_up + diag(d), d_i = −c s² Σ_k (1 − n_k)² N_i(x_k) V_k /
+    ///   K_dr,k: the share c ([`Self::fixed_stress_share`]) of the solid's part of that term.
+    ///   B⁻¹'s diagonal captures the inertia, which dominates the long waves; the skeleton's
+    ///   compressibility dominates the waves shorter than the distance a compression wave crosses
+    ///   in a step, a share that grows with the step's Courant number.
+    fn fixed_stress_diagonal(&mut self, model: &Model<D>, dt: f64) -> Result<Vec<f64>, Error> {
         let (Some(p), true) = (self.layout.p, self.schur.is_some()) else { return Ok(Vec::new()) };
+        let dynamic = self.layout.w.is_some();
+        let share =
+            if dynamic { self.schur_tuning.share.unwrap_or_else(|| fixed_stress_share(model, dt)) } else { 1.0 };
         let nd = self.layout.nd;
         let mut mass = vec![0.0; self.ghost.len() * nd];
         let (st, ps) = (&self.step.stencils, &model.particles);
         for k in 0..st.len() {
-            let drained = model.materials[ps.material[k] as usize].model.elastic().plane_bulk_modulus();
+            let elastic = model.materials[ps.material[k] as usize].model.elastic();
+            let drained = if D == 3 { elastic.bulk_modulus() } else { elastic.plane_bulk_modulus() };
+            let solid = if dynamic { (1.0 - ps.porosity[k]).powi(2) } else { 1.0 };
             let (nodes, basis) = st.get(k);
             for (&node, nb) in nodes.iter().zip(basis) {
-                mass[node as usize * nd + p] += nb.s * ps.volume[k] / drained;
+                mass[node as usize * nd + p] += nb.s * ps.volume[k] * solid / drained;
             }
         }
         self.sum_over_ranks(&mut mass)?;
@@ -754,7 +806,7 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
             .owned_nodes
             .iter()
             .map(|&a| a as usize * nd + p)
-            .map(|q| if fixed[q] { 0.0 } else { -s2 * mass[q] })
+            .map(|q| if fixed[q] { 0.0 } else { -share * s2 * mass[q] })
             .collect())
     }
 

@@ -14,6 +14,15 @@
 //! One options file (`-fieldsplit_u_*`, `-fieldsplit_p_*`) thus serves the u–p and the u–p–U
 //! systems alike. PETSc 3.18's own DM splits lose the block size (see docs/solvers.md).
 //!
+//! A Schur-complement split of the dynamic u–p–U system whose options ask for a user-built Schur
+//! preconditioner gets porompm's free-surface approximation, Sp = A_pp − A_pu B⁻¹ A_up −
+//! c s² Σ (1 − n)² N V / K_dr: selfp with the exact inverse of A_uu over the aggregates of the
+//! free-surface strip ([`super::aggregates`]) in place of its diagonal there, plus a share c of the
+//! solid's fixed-stress term that grows with the step's Courant number (see
+//! `GridSystem::fixed_stress_diagonal`). `-porompm_schur_strip_depth` (live pressure layers, 3;
+//! 0 leaves selfp's diagonal everywhere), `-porompm_schur_strip_width` (nodes along the surface, 2)
+//! and `-porompm_schur_fixed_stress_share` (c, in place of the rule) tune it.
+//!
 //! A Schur-complement split of the u–p system whose options ask for a user-built Schur
 //! preconditioner (`-pc_fieldsplit_schur_precondition user`) gets porompm's fixed-stress
 //! approximation, Sp = A_pp − s² M_L / K_dr (see `GridSystem::fixed_stress_diagonal`): the
@@ -46,15 +55,10 @@ pub(super) fn define<const D: usize>(
     let user_schur = SchurUser::requested(&pc)?;
     let Some(p) = layout.p else { return Ok(None) };
     let own_splits = !user_defines_splits()?;
-    if user_schur && (layout.w.is_some() || !own_splits) {
+    if user_schur && !own_splits {
         return Err(petsc::Error::new(format!(
-            "-{SCHUR_USER_OPTION} user (porompm's fixed-stress Schur preconditioner) applies to the u–p system of \
-             quasi-static stages with porompm's own splits; this run {}: use selfp",
-            if layout.w.is_some() {
-                "solves the dynamic u–p–U system"
-            } else {
-                "defines its own -pc_fieldsplit_<n>_fields"
-            }
+            "-{SCHUR_USER_OPTION} user (porompm's own Schur preconditioner) needs porompm's splits `u` and `p`; \
+             this run defines its own -pc_fieldsplit_<n>_fields: use selfp"
         )));
     }
     if pc.type_name()? != "fieldsplit" || !own_splits {
@@ -72,10 +76,52 @@ pub(super) fn define<const D: usize>(
     let pressure = IndexSet::new_general(comm, &index(&[p]))?;
     pc.field_split_set_is("u", &u)?;
     pc.field_split_set_is("p", &pressure)?;
-    if user_schur {
-        return Ok(Some(SchurUser::new(&pc, pressure)?));
+    if !user_schur {
+        return Ok(None);
     }
-    Ok(None)
+    Ok(Some(if layout.w.is_some() {
+        SchurUser::with_blocks(&pc, u, pressure)?
+    } else {
+        SchurUser::new(&pc, pressure)?
+    }))
+}
+
+/// The tuning of porompm's Schur preconditioner of the u–p–U system (see the module documentation),
+/// from the options database.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct SchurTuning {
+    /// The free-surface aggregates' shape.
+    pub strip: super::aggregates::StripShape,
+    /// The share c of the solid's fixed-stress term, when the options set it (else the rule of
+    /// `GridSystem::fixed_stress_share`).
+    pub share: Option<f64>,
+}
+
+impl SchurTuning {
+    /// Reads `-porompm_schur_strip_depth`, `-porompm_schur_strip_width` and
+    /// `-porompm_schur_fixed_stress_share`; a value that does not parse, or a negative share, is
+    /// an error naming the option.
+    pub fn from_options() -> Result<SchurTuning, petsc::Error> {
+        let options = Options::global();
+        let read = |name: &str| -> Result<Option<f64>, petsc::Error> {
+            match options.get_string(name)? {
+                None => Ok(None),
+                Some(v) => match v.trim().parse::<f64>() {
+                    Ok(x) if x.is_finite() && x >= 0.0 => Ok(Some(x)),
+                    _ => Err(petsc::Error::new(format!("{name} {v}: expected a number ≥ 0"))),
+                },
+            }
+        };
+        let mut t = SchurTuning::default();
+        if let Some(d) = read("-porompm_schur_strip_depth")? {
+            t.strip.depth = d as usize;
+        }
+        if let Some(w) = read("-porompm_schur_strip_width")? {
+            t.strip.width = (w as usize).max(1);
+        }
+        t.share = read("-porompm_schur_fixed_stress_share")?;
+        Ok(t)
+    }
 }
 
 /// The rigid-body modes of the grid as the near-null space of a system whose unknowns are all

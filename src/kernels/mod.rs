@@ -51,6 +51,7 @@
 //! ([`fbar`], [`kinematics::Kinematics::with_projected_volume`]).
 
 pub mod cell;
+pub mod dense;
 pub mod fbar;
 pub mod flow;
 pub mod inertia;

@@ -36,6 +36,13 @@ impl IndexSet {
         Ok(n as usize)
     }
 
+    /// Number of indices over all ranks.
+    pub fn global_len(&self) -> Result<usize> {
+        let mut n: Int = 0;
+        call!(ISGetSize(self.raw, &mut n))?;
+        Ok(n as usize)
+    }
+
     /// The indices on this rank.
     pub fn indices(&self) -> Result<Vec<Int>> {
         let n = self.local_len()?;
