@@ -231,7 +231,7 @@ pub fn pressure_scale<const D: usize>(model: &Model<D>) -> f64 {
 /// cell size. Fitted on the spectra of the slumping block's tangents (docs/solvers.md): the best
 /// shares 0.0625 at Δt = 4 ms and 0.25 at 16 ms on 64 × 48 cells (Cr = 6.7 and 27) lie on it, and
 /// at 1 ms (Cr = 1.7; best share 0) it adds 0.016.
-pub fn fixed_stress_share<const D: usize>(model: &Model<D>, dt: f64) -> f64 {
+fn fixed_stress_share<const D: usize>(model: &Model<D>, dt: f64) -> f64 {
     let cp = model
         .materials
         .iter()
@@ -774,11 +774,11 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// pressures, whose rows stay the unit diagonal. Empty without such a preconditioner.
     ///
     /// * u–p: Sp = A_pp + diag(d), d_i = −s² Σ_k N_i(x_k) V_k / K_dr,k, the lumped pressure mass of
-    ///   the points over their skeleton's drained bulk modulus (plane strain: λ + μ). It is the
+    ///   the points over their skeleton's drained bulk modulus (λ + μ in plane strain, λ + 2μ/3 in three dimensions). It is the
     ///   volume change of the fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible
     ///   grains, as the continuity equation assumes), with the sign of A_pp's storage term.
     /// * u–p–U: Sp = A_pp − A_pu B⁻¹ A_up + diag(d), d_i = −c s² Σ_k (1 − n_k)² N_i(x_k) V_k /
-    ///   K_dr,k: the share c ([`Self::fixed_stress_share`]) of the solid's part of that term.
+    ///   K_dr,k: the share c ([`fixed_stress_share`]) of the solid's part of that term.
     ///   B⁻¹'s diagonal captures the inertia, which dominates the long waves; the skeleton's
     ///   compressibility dominates the waves shorter than the distance a compression wave crosses
     ///   in a step, a share that grows with the step's Courant number.
