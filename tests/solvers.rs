@@ -201,6 +201,18 @@ fn the_free_surface_schur_preconditioner_of_the_dynamic_system_is_selfp_without_
 }
 
 #[test]
+fn a_user_schur_preconditioner_with_splits_of_the_options_own_is_refused_by_name() {
+    let (case, mut args) = up();
+    args.extend(["--options-file".into(), "petsc_options/fieldsplit-fixed-stress.opts".into(), "--".into()]);
+    args.extend(["-pc_fieldsplit_0_fields", "0,1", "-pc_fieldsplit_1_fields", "2"].map(String::from));
+    let run = run_case(case, &dir("user-own-splits"), &args);
+    assert!(!run.output.status.success(), "a user Schur preconditioner ran on splits of the options' own");
+    let err = run.stderr();
+    assert!(err.contains("pc_fieldsplit_schur_precondition") && err.contains("_fields"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
 fn an_iterative_strategy_on_an_unstabilised_case_warns_and_only_then() {
     let short = "stages.consolidation.duration=0.0002";
     let opts = |file: &str| vec!["--options-file".to_string(), format!("petsc_options/{file}.opts")];
