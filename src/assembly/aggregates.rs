@@ -20,6 +20,7 @@
 //! boundary cuts becomes two. A node sees the surface only within its rank's ghosted block.
 
 use crate::assembly::dofs::DofMap;
+use crate::model::grid::indices_of;
 use petsc::GhostedRange;
 use std::collections::BTreeMap;
 
@@ -100,10 +101,10 @@ pub fn surface_groups<const D: usize>(
         near.then_some(key)
     };
     // The offsets within `BEYOND` nodes, nearest first.
-    let reach = BEYOND as i64;
-    let mut offsets: Vec<[i64; D]> = (0..(2 * reach + 1).pow(D as u32))
-        .map(|k| std::array::from_fn(|d| (k / (2 * reach + 1).pow(d as u32)) % (2 * reach + 1) - reach))
-        .filter(|o: &[i64; D]| o.iter().any(|&v| v != 0))
+    let side = 2 * BEYOND + 1;
+    let mut offsets: Vec<[i64; D]> = (0..side.pow(D as u32))
+        .map(|k| indices_of([side; D], k).map(|i| i as i64 - BEYOND as i64))
+        .filter(|o| o.iter().any(|&v| v != 0))
         .collect();
     offsets.sort_by_key(|o| (o.iter().map(|v| v * v).sum::<i64>(), *o));
     let key_of = |l: usize| -> Option<Vec<i64>> {

@@ -216,7 +216,7 @@ pub struct NodeBlock {
 /// drifted by 0.1 % of the load per step (Terzaghi, Δt = 0.1 s).
 pub fn pressure_scale<const D: usize>(model: &Model<D>) -> f64 {
     let m = model.materials.iter().map(|m| m.model.elastic().constrained_modulus()).fold(0.0, f64::max);
-    let h = (1..D).fold(model.grid.h[0], |h, d| h.min(model.grid.h[d]));
+    let h = model.grid.h_min();
     if m > 0.0 && h > 0.0 {
         m / h
     } else {
@@ -240,8 +240,7 @@ fn fixed_stress_share<const D: usize>(model: &Model<D>, dt: f64) -> f64 {
             (m.model.elastic().constrained_modulus() / rho).sqrt()
         })
         .fold(0.0, f64::max);
-    let h = (1..D).fold(model.grid.h[0], |h, d| h.min(model.grid.h[d]));
-    (cp * dt / h / FIXED_STRESS_COURANT).min(1.0)
+    (cp * dt / model.grid.h_min() / FIXED_STRESS_COURANT).min(1.0)
 }
 
 /// The Courant number at which [`fixed_stress_share`] reaches 1.
@@ -774,9 +773,10 @@ impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
     /// pressures, whose rows stay the unit diagonal. Empty without such a preconditioner.
     ///
     /// * u–p: Sp = A_pp + diag(d), d_i = −s² Σ_k N_i(x_k) V_k / K_dr,k, the lumped pressure mass of
-    ///   the points over their skeleton's drained bulk modulus (λ + μ in plane strain, λ + 2μ/3 in three dimensions). It is the
-    ///   volume change of the fixed-stress split, β = α²/K_dr with Biot's α = 1 (incompressible
-    ///   grains, as the continuity equation assumes), with the sign of A_pp's storage term.
+    ///   the points over their skeleton's drained bulk modulus (λ + μ in plane strain, λ + 2μ/3 in
+    ///   three dimensions). It is the volume change of the fixed-stress split, β = α²/K_dr with
+    ///   Biot's α = 1 (incompressible grains, as the continuity equation assumes), with the sign of
+    ///   A_pp's storage term.
     /// * u–p–U: Sp = A_pp − A_pu B⁻¹ A_up + diag(d), d_i = −c s² Σ_k (1 − n_k)² N_i(x_k) V_k /
     ///   K_dr,k: the share c ([`fixed_stress_share`]) of the solid's part of that term.
     ///   B⁻¹'s diagonal captures the inertia, which dominates the long waves; the skeleton's

@@ -99,13 +99,10 @@ impl SchurUser {
     pub fn update(&mut self, a: &dyn MatOps, add: &[Real]) -> Result<()> {
         let old = self.built.take();
         let fresh = old.is_none();
-        let reuse = if fresh { sys::MatReuse::MAT_INITIAL_MATRIX } else { sys::MatReuse::MAT_REUSE_MATRIX };
-        let mut raw = old.as_ref().map_or(std::ptr::null_mut(), |(sp, _)| sp.raw);
-        call!(MatCreateSubMatrix(a.raw(), self.rows.raw(), self.rows.raw(), reuse, &mut raw))?;
         let (sp, mut d) = match old {
-            Some(kept) => kept,
+            Some((sp, d)) => (sub_matrix(a, &self.rows, &self.rows, Some(sp))?, d),
             None => {
-                let sp = Mat { raw };
+                let sp = sub_matrix(a, &self.rows, &self.rows, None)?;
                 let d = sp.create_vecs()?.1;
                 (sp, d)
             }
@@ -132,22 +129,11 @@ impl SchurUser {
     ) -> Result<()> {
         let first = self.first.as_ref().ok_or_else(|| Error::new("SchurUser: no first split for a block inverse"))?;
         let binv = block_inverse(a, first, groups, invert)?;
-        if self.coupling.is_none() {
-            let initial = sys::MatReuse::MAT_INITIAL_MATRIX;
-            let sub = |r: &IndexSet, c: &IndexSet| -> Result<Mat> {
-                let mut raw = std::ptr::null_mut();
-                call!(MatCreateSubMatrix(a.raw(), r.raw(), c.raw(), initial, &mut raw))?;
-                Ok(Mat { raw })
-            };
-            self.coupling = Some([sub(&self.rows, first)?, sub(first, &self.rows)?, sub(&self.rows, &self.rows)?]);
-        } else if let Some(kept) = &mut self.coupling {
-            let reuse = sys::MatReuse::MAT_REUSE_MATRIX;
-            for (m, (r, c)) in kept.iter_mut().zip([(&self.rows, first), (first, &self.rows), (&self.rows, &self.rows)])
-            {
-                call!(MatCreateSubMatrix(a.raw(), r.raw(), c.raw(), reuse, &mut m.raw))?;
-            }
-        }
-        let [a10, a01, a11] = self.coupling.as_ref().expect("extracted above");
+        let [k10, k01, k11] = self.coupling.take().map_or([None, None, None], |k| k.map(Some));
+        let (rows, first) = (&self.rows, first);
+        let coupling =
+            [sub_matrix(a, rows, first, k10)?, sub_matrix(a, first, rows, k01)?, sub_matrix(a, rows, rows, k11)?];
+        let [a10, a01, a11] = self.coupling.insert(coupling);
         let mut raw = std::ptr::null_mut();
         call!(MatMatMatMult(
             a10.raw,
@@ -172,6 +158,15 @@ impl SchurUser {
     fn hand_over(&self, sp: &Mat) -> Result<()> {
         call!(PCFieldSplitSetSchurPre(self.pc, sys::PCFieldSplitSchurPreType::PC_FIELDSPLIT_SCHUR_PRE_USER, sp.raw))
     }
+}
+
+/// The sub-matrix `a[rows, cols]`, refilled in `kept` (extracted before from an operator of the
+/// same pattern) or extracted anew.
+fn sub_matrix(a: &dyn MatOps, rows: &IndexSet, cols: &IndexSet, kept: Option<Mat>) -> Result<Mat> {
+    let reuse = if kept.is_some() { sys::MatReuse::MAT_REUSE_MATRIX } else { sys::MatReuse::MAT_INITIAL_MATRIX };
+    let mut m = kept.unwrap_or(Mat { raw: std::ptr::null_mut() });
+    call!(MatCreateSubMatrix(a.raw(), rows.raw(), cols.raw(), reuse, &mut m.raw))?;
+    Ok(m)
 }
 
 /// Adds `add` (this rank's rows) to the diagonal of `sp`, through the vector `d` laid out like its
