@@ -51,7 +51,7 @@ pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, ou
         let row = (i * nd + j) * m;
         out[row + i * nd + j] += w * b.s;
         for l in 0..pt.basis.len() {
-            let g = pt.strain_operators().0[l].0;
+            let g = pt.motion_operators().0[l].0;
             for d in 0..D {
                 out[row + l * nd + d] -= w * b.s * j_new * g[d];
             }

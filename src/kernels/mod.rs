@@ -728,9 +728,14 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     pub layout: Layout,
     /// Interpolated increments, velocities and accelerations.
     pub interp: Interp<D>,
-    /// Finite-strain kinematics of the step.
+    /// Finite-strain kinematics of the step's motion, from the basis: F, J, the volume ratio, the
+    /// gradients on x_{n+1} and the deformation the particle keeps.
     pub kin: Kinematics<D>,
-    /// The effective stress at t_n rotated with the material (Hughes–Winget).
+    /// The kinematics of the recovered strain (see [`Point::with_recovery`]) where the strain
+    /// operators are not the basis (`None`: `kin`'s; [`Point::strain_kin`]).
+    recovered_kin: Option<Kinematics<D>>,
+    /// The effective stress at t_n rotated with the material (Hughes–Winget), by the strain's
+    /// rotation.
     pub rotated: Stress,
     /// The soil model's update from `rotated` by the strain increment.
     pub upd: StressUpdate,
@@ -741,12 +746,13 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     /// dimensions), the forces' like [`Point::spatial`].
     pub hoop: [(f64, f64); M],
     /// The operators the strain is recovered with (see [`Point::with_recovery`]): the basis
-    /// itself, or [001]'s CMPM patch functions; the kinematics and every derivative of them use
-    /// these, the forces use `basis`.
+    /// itself, or [001]'s CMPM patch functions; the strain increment, the rotation and the soil
+    /// model's update use these (through [`Point::strain_kin`]), the motion and the forces the
+    /// basis.
     pub strain: &'a [NodeBasis<D>],
-    /// `spatial` and `hoop` of the strain operators where they are not the force operators (see
-    /// [`Point::strain_operators`]; `None`: the same, not copied).
-    recovered: Option<OnNew<D, M>>,
+    /// `spatial` and `hoop` of the basis where they are not the force operators (see
+    /// [`Point::motion_operators`]; `None`: the same, not copied).
+    motion: Option<OnNew<D, M>>,
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
@@ -812,11 +818,15 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     }
 
     /// [`Point::new`] with the strain recovered by the operators `strain` (one per node of
-    /// `basis`, in its order; its `g`, `gv`, `t`, `tv` are used, its `s` is not): the step's
-    /// deformation gradient is F = I + Σ Δu_i ⊗ e_i, e_i = `strain[i].g`, and so the strain
-    /// increment the soil model sees, the rotation and the volume change; the forces keep the
-    /// basis, f_i = B̄'_iᵀσ V. [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
-    /// passes its patch functions; `strain = basis` is the usual point.
+    /// `basis`, in its order; its `g`, `gv`, `t`, `tv` are used, its `s` is not): the stress sees
+    /// the deformation gradient F̃ = I + Σ Δu_i ⊗ e_i, e_i = `strain[i].g`, so the strain
+    /// increment the soil model takes and the rotation of the stress are the recovered ones; the
+    /// motion keeps the basis: the step's F, its volume ratio, the gradients on x_{n+1}, the
+    /// deformation and volume the particle keeps, and the forces f_i = B̄'_iᵀσ V. This is [001]'s
+    /// reading (`../shared/seeds-001-002.md` Part A8: the strain is recovered for the stress only;
+    /// positions, F and volume as without it). [001]'s CMPM recovery
+    /// (`stabilisation.stress_recovery = "cmpm"`) passes its patch functions; `strain = basis` is
+    /// the usual point.
     #[inline]
     pub fn with_recovery<const N: usize>(
         basis: &'a [NodeBasis<D>],
@@ -828,8 +838,12 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     ) -> Point<'a, D, M> {
         debug_assert_eq!(layout.dim, D, "a layout of {} dimensions at a point of {D}", layout.dim);
         let interp = interpolate(basis, states, &part.pred, layout);
-        let mut kin = Kinematics::new(strain, states.iter().map(|s| std::array::from_fn(|c| s.d[c])), part.linear)
-            .with_volume_scale(part.fbar);
+        let increments = || states.iter().map(|s| std::array::from_fn(|c| s.d[c]));
+        let mut kin = Kinematics::new(basis, increments(), part.linear).with_volume_scale(part.fbar);
+        // (Cases combine neither F̄ nor B̄ with a recovered strain, validation; its kinematics take
+        // F̄'s scale and projection all the same, so that every term is defined for any operators.)
+        let mut recovered_kin = (!std::ptr::eq(strain, basis))
+            .then(|| Kinematics::new(strain, increments(), part.linear).with_volume_scale(part.fbar));
         // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
         let mut jbar_nodes = [0.0; M];
         if let Some(j) = layout.jbar {
@@ -837,31 +851,34 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
                 *t = st.d[j];
             }
             // r − 1 = (1 + Σ S ϑ − J̄_n)/J̄_n, without the cancellation of forming r first.
-            kin = kin.with_projected_volume((interp.jbar - (part.jbar - 1.0)) / part.jbar);
+            let r_minus_one = (interp.jbar - (part.jbar - 1.0)) / part.jbar;
+            kin = kin.with_projected_volume(r_minus_one);
+            recovered_kin = recovered_kin.map(|k| k.with_projected_volume(r_minus_one));
         }
-        let rotated = kin.rotate(&part.stress);
+        let sk = recovered_kin.as_ref().unwrap_or(&kin);
+        let rotated = sk.rotate(&part.stress);
         // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
-        let f_bar = kin.f_bar();
+        let f_bar = sk.f_bar();
         let df = f_bar.map(|r| r.map(|v| v * part.fbar));
         let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
             .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
-            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &kin.deps));
+            .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));
         let (spatial, hoop) = on_new_configuration(&kin, basis);
-        let recovered = (!std::ptr::eq(strain, basis)).then(|| on_new_configuration(&kin, strain));
         Point {
             basis,
             part,
             layout,
             interp,
             kin,
+            recovered_kin,
             rotated,
             upd,
             spatial,
             hoop,
             strain,
-            recovered,
+            motion: None,
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
@@ -884,7 +901,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let interp = interpolate(basis, &AT_REST[..basis.len()], &part.pred, layout);
         let kin = Kinematics::rest();
         let (spatial, hoop) = on_new_configuration(&kin, basis);
-        let recovered = (!std::ptr::eq(strain, basis)).then(|| on_new_configuration(&kin, strain));
         let zero = [[0.0; soil::NS]; soil::NS];
         Point {
             basis,
@@ -892,6 +908,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             layout,
             interp,
             kin,
+            recovered_kin: None,
             rotated: part.stress,
             upd: StressUpdate {
                 stress: part.stress,
@@ -903,7 +920,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             spatial,
             hoop,
             strain,
-            recovered,
+            motion: None,
             p: part.p,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
@@ -933,31 +950,42 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// basis's own, unchanged): [001]'s double-mapped internal force
     /// (`stabilisation.internal_force = "mapped"`, [`super::cell::mapped_force_operators`]). They
     /// take the step's kinematics as the basis does (pushed forward by F⁻ᵀ, the volume by J), so the
-    /// residual's terms and their tangent need no change; the strain keeps its own operators.
-    /// One-phase only (validation): every term that integrates with [`Point::spatial`] takes them.
+    /// residual's terms and their tangent need no change; the strain and the motion keep their
+    /// own operators. One-phase only (validation): every term that integrates with
+    /// [`Point::spatial`] takes them.
     #[inline]
     pub fn with_forces(mut self, forces: &[NodeBasis<D>]) -> Point<'a, D, M> {
         if forces.is_empty() {
             return self;
         }
         debug_assert_eq!(forces.len(), self.basis.len(), "force operators for another stencil");
-        if self.recovered.is_none() {
-            // The strain's operators were the basis's, held in `spatial` and `hoop`.
-            self.recovered = Some((self.spatial, self.hoop));
+        if self.motion.is_none() {
+            // The basis's operators on x_{n+1}, held in `spatial` and `hoop` until now.
+            self.motion = Some((self.spatial, self.hoop));
         }
         (self.spatial, self.hoop) = on_new_configuration(&self.kin, forces);
         self
     }
 
-    /// The gradients ∇'S, ∇̄'S and hoop operators T', T̄' on x_{n+1} of the strain operators (see
-    /// [`Point::with_recovery`]), per node: the basis's own ([`Point::spatial`], [`Point::hoop`])
-    /// or the recovered ones.
+    /// The gradients ∇'S, ∇̄'S and hoop operators T', T̄' on x_{n+1} of the basis, per node: the
+    /// operators the step's F and volume ratio are built with, so every derivative of the motion
+    /// (of J_v, of the gradients on x_{n+1}) with respect to Δu_l goes through node l's. They are
+    /// [`Point::spatial`] and [`Point::hoop`] unless the forces take other operators
+    /// ([`Point::with_forces`]).
     #[inline]
-    pub fn strain_operators(&self) -> (&[Gradients<D>], &[(f64, f64)]) {
-        match &self.recovered {
+    pub fn motion_operators(&self) -> (&[Gradients<D>], &[(f64, f64)]) {
+        match &self.motion {
             Some((s, h)) => (s, h),
             None => (&self.spatial, &self.hoop),
         }
+    }
+
+    /// The kinematics the stress sees: the recovered strain's ([`Point::with_recovery`]) or the
+    /// motion's ([`Point::kin`]). Its strain increment, rotation and their derivatives (taken
+    /// with the operators [`Point::strain`]) are the soil model's.
+    #[inline]
+    pub fn strain_kin(&self) -> &Kinematics<D> {
+        self.recovered_kin.as_ref().unwrap_or(&self.kin)
     }
 
     /// Number of local dofs (stencil nodes × dofs per node).
@@ -1086,7 +1114,7 @@ impl<const D: usize> StepResult<D> {
             eps_pd: pt.upd.eps_pd,
             f_inc: pt.kin.f_bar(),
             jacobian: pt.kin.jv,
-            deps: pt.kin.deps,
+            deps: pt.strain_kin().deps,
             grad_n: pt.part.grad_n,
             jbar: pt.layout.jbar.map(|_| 1.0 + pt.interp.jbar),
             velocity: None,

@@ -16,9 +16,10 @@
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
 //!
-//! Every derivative with respect to Δu_l goes through node l's strain operators
-//! ([`super::Point::strain`], [`super::Point::strain_operators`]): the basis itself, or [001]'s CMPM
-//! patch functions, which recover the strain while the forces keep the basis.
+//! The material part's derivatives with respect to Δu_l go through node l's strain operators
+//! ([`super::Point::strain`] with [`super::Point::strain_kin`]): the basis itself, or [001]'s CMPM
+//! patch functions, which recover the strain the stress sees; the volume and geometric parts go
+//! through the basis ([`super::Point::motion_operators`]), which moves the point and its volume.
 //!
 //! Axial symmetry adds the hoop stress to the radial force, f_i,r += V_{n+1}(dev σ'_θθ T'_i +
 //! σ'_m T̄'_i) (B̄'ᵀσ' with the hoop row of [`super::bbar`]), ∂J_v/∂Δu_l,r gains J_v T̄'_l, and
@@ -106,20 +107,21 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
     let drot = kinematics::rotate_derivative(&pt.rotated);
     let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node.
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics.
+    let sk = pt.strain_kin();
     let mut a = [[[0.0; D]; R]; M];
     for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
-        let de = pt.kin.deps_derivative(bl);
+        let de = sk.deps_derivative(bl);
         let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
         if D == 2 {
-            let dt = pt.kin.theta_derivative(bl);
+            let dt = sk.theta_derivative(bl);
             for r in 0..nr {
                 for d in 0..D {
                     a[l][r][d] = t_drot[r] * dt[d] + material_part(r, d);
                 }
             }
         } else {
-            let dr = pt.kin.rotated_derivative(bl, &pt.rotated);
+            let dr = sk.rotated_derivative(bl, &pt.rotated);
             for r in 0..nr {
                 for d in 0..D {
                     a[l][r][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
@@ -130,7 +132,7 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     let dev_tt = s[3] - pm;
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
-    let (strain_spatial, strain_hoop) = pt.strain_operators();
+    let (motion_spatial, motion_hoop) = pt.motion_operators();
     for k in 0..pt.basis.len() {
         let (gk, gvk) = pt.spatial[k];
         let hk = pt.hoop[k];
@@ -138,9 +140,9 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
         let mut tk = traction(&dev, pm, gk, gvk);
         tk[0] += hoop_force(s, pm, hk);
         for l in 0..pt.basis.len() {
-            // Derivatives with respect to Δu_l go through the strain operators of node l.
-            let (gl, gvl) = strain_spatial[l];
-            let hl = strain_hoop[l];
+            // The motion's derivatives with respect to Δu_l go through node l's basis.
+            let (gl, gvl) = motion_spatial[l];
+            let hl = motion_hoop[l];
             let dev_gl = dev_times(&dev, gl);
             // ∂J_v/∂Δu_l / J_v: the divergence and, radially, the hoop term.
             let mut djv = gvl;
@@ -162,7 +164,7 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // An implicit F̄ step ([`super::fbar`]): the stress sees r = (1 + Σ_i S_ip ϑ_i)/J̄_p^n, so
     // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
     if let Some(j) = pt.layout.jbar {
-        let de = pt.kin.deps_volume_derivative();
+        let de = pt.strain_kin().deps_volume_derivative();
         let dsig: [f64; NS] = std::array::from_fn(|r| (0..nr).map(|q| d_alg[r][q] * de[q]).sum::<f64>());
         let vj = v * material / pt.part.jbar;
         for k in 0..pt.basis.len() {
@@ -224,7 +226,7 @@ pub mod pore_pressure {
             return;
         }
         let (nd, m) = (pt.layout.nd, pt.size());
-        let (strain_spatial, strain_hoop) = pt.strain_operators();
+        let (motion_spatial, motion_hoop) = pt.motion_operators();
         let (fs, fw) = shares(pt);
         let v = pt.volume_new() * nm.w_force;
         for k in 0..pt.basis.len() {
@@ -232,7 +234,7 @@ pub mod pore_pressure {
             let mut divk = gvk;
             divk[0] += tk;
             for (l, bl) in pt.basis.iter().enumerate() {
-                let (gvl, tl) = (strain_spatial[l].1, strain_hoop[l].1);
+                let (gvl, tl) = (motion_spatial[l].1, motion_hoop[l].1);
                 for c in 0..D {
                     let ru = (k * nd + c) * m;
                     if let Some(p) = pt.layout.p {

@@ -508,6 +508,33 @@ fn the_plastic_sample_really_returns() {
     assert!(pt.kin.theta.abs() > 1e-4, "the sample must rotate: θ = {}", pt.kin.theta);
 }
 
+/// A recovered strain is the stress's only ([001] read as `../shared/seeds-001-002.md` Part A8):
+/// the soil model's increment, the rotated stress and the update are those of a point whose basis
+/// were the strain operators, while the motion (F, the volume ratio, the gradients on x_{n+1}, what
+/// the particle keeps) is the basis's, as without recovery; in axial symmetry and in plane strain.
+#[test]
+fn a_recovered_strain_moves_the_stress_and_leaves_the_motion_to_the_basis() {
+    for hoop in [false, true] {
+        let (_, model, stress) = models()[1];
+        let (basis, strain) = (sample_in(6, hoop), sample_strain(6, hoop));
+        let nm = Scheme::newmark(0.25, 0.5, 1e-3);
+        let p = ParticleInput { stress, ..part() };
+        let st = states(&increments(basis.len() * 2, Layout::U), 2, &nm);
+        let recovered = Point::<2>::with_recovery(&basis, &strain, &st, &p, &model, Layout::U);
+        let own = Point::<2>::new(&basis, &st, &p, &model, Layout::U);
+        let of_strain = Point::<2>::new(&strain, &st, &p, &model, Layout::U);
+        let (r, b, s) = (StepResult::of(&recovered), StepResult::of(&own), StepResult::of(&of_strain));
+        // The sample's two sets of operators give different motions and strains.
+        assert!((b.jacobian - s.jacobian).abs() > 1e-3 && (b.deps[0] - s.deps[0]).abs() > 1e-3, "{hoop}");
+        assert_eq!((r.jacobian, r.f_inc), (b.jacobian, b.f_inc), "the motion is the basis's ({hoop})");
+        assert_eq!(recovered.spatial, own.spatial, "the gradients on x_{{n+1}} are the basis's ({hoop})");
+        assert_eq!(recovered.volume_new(), own.volume_new());
+        assert_eq!((r.deps, r.stress, r.eps_pd), (s.deps, s.stress, s.eps_pd), "the stress is the strain's ({hoop})");
+        assert_eq!(recovered.rotated, of_strain.rotated);
+        assert!(r.eps_pd > 0.0, "the sample returns plastically ({hoop})");
+    }
+}
+
 /// Flips the sign of each non-zero (row field, column field) block of the tangent `t` (nodes of
 /// `nd` dofs) in turn and asserts that the central differences of `res` at `d0` catch it, naming
 /// the term by `what`; returns the number of blocks flipped.
