@@ -198,6 +198,8 @@ enum Mode {
     Fatal,
     Panic,
     Domain,
+    /// The tangent's entries are all zero (the same nonzero pattern): a singular matrix.
+    Singular,
 }
 
 impl Cubic {
@@ -239,7 +241,7 @@ impl NonlinearProblem for Cubic {
             Mode::Fatal => return Err(CallbackError::Fatal("the residual refuses".into())),
             Mode::Panic => panic!("deliberate panic in a residual callback"),
             Mode::Domain => return Err(CallbackError::Domain("volume became negative".into())),
-            Mode::Normal => {}
+            Mode::Normal | Mode::Singular => {}
         }
         let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
         let r = self.eval(&xv);
@@ -249,7 +251,10 @@ impl NonlinearProblem for Cubic {
 
     fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
         let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
-        let t = self.tangent(&xv);
+        let mut t = self.tangent(&xv);
+        if self.mode == Mode::Singular {
+            t.fill(0.0);
+        }
         let idx: Vec<i32> = (0..self.n as i32).collect();
         j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
         j.set_values(&idx, &idx, &t, false).map_err(|e| CallbackError::Fatal(e.to_string()))?;
@@ -275,6 +280,39 @@ fn snes_self(problem: &mut Cubic) -> Result<petsc::SolveOutcome, petsc::Error> {
     let mut x = Vector::from_slice(&vec![0.5; problem.n])?;
     let mut j = dense_matrix(problem.n)?;
     snes.solve(&mut x, &mut j, problem)
+}
+
+/// A Newton solve whose MUMPS factorisation fails (a singular Jacobian) ends as diverged, and the
+/// next solve with the same SNES and the same nonzero pattern converges: PETSc 3.18's MUMPS
+/// interface would otherwise skip that factorisation and fail hard in the solve (INFOG(1) = −3),
+/// which `Snes::solve` prevents by dropping the failed factors (`forget_failed_factorisation`).
+fn a_failed_mumps_factorisation_leaves_the_next_solve_free() -> TestResult {
+    let n = 6;
+    let mut snes = Snes::new(Comm::self_()).map_err(e)?;
+    {
+        let mut ksp = snes.ksp().map_err(e)?;
+        ksp.set_type("preonly").map_err(e)?;
+        let mut pc = ksp.pc().map_err(e)?;
+        pc.set_type("lu").map_err(e)?;
+        pc.set_factor_solver_type("mumps").map_err(e)?;
+    }
+    snes.set_tolerances(Some(1e-12), Some(1e-10), Some(0.0), Some(30)).map_err(e)?;
+    let mut j = dense_matrix(n).map_err(e)?;
+    let mut solve = |mode| {
+        let mut p = Cubic { n, b: vec![1.0; n], calls: 0, mode };
+        let mut x = Vector::from_slice(&vec![0.5; n])?;
+        snes.solve(&mut x, &mut j, &mut p)
+    };
+    let first = solve(Mode::Singular).map_err(e)?;
+    if first.converged || first.reason_text != "DIVERGED_LINEAR_SOLVE" {
+        return Err(format!("a singular Jacobian gave {}", first.reason_text));
+    }
+    let second = solve(Mode::Normal).map_err(|err| format!("the solve after the failed factorisation: {err}"))?;
+    if !second.converged {
+        return Err(format!("the regular solve after the singular one: {}", second.reason_text));
+    }
+    println!("    singular: {}; then {} in {} iterations", first.reason_text, second.reason_text, second.iterations);
+    Ok(())
 }
 
 fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResult {
@@ -470,6 +508,10 @@ fn main() {
             callback_errors_panics_and_domain_errors_are_reported,
         ),
         ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
+        (
+            "a_failed_mumps_factorisation_leaves_the_next_solve_free",
+            a_failed_mumps_factorisation_leaves_the_next_solve_free,
+        ),
         ("unused_options_are_reported", unused_options_are_reported),
         (
             "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",

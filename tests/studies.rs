@@ -334,8 +334,9 @@ fn slope_sand_dilatancy() {
 /// roughness is at most a fifth of MPM's and its σ_m chequerboard index below MPM's at 0.1 and
 /// 1.0 m. F^int_mag's roughness and σ_m's total variation at B and C are reported, not asserted:
 /// [001]'s ratios (≤ 1/3) are not reached by any variant (docs/stiffness.md). DM-GC itself (CMPM
-/// strain) does not reach 1.0 m: a point inverts at 0.73 m with the basis's forces and at 0.05 m
-/// with the mapped ones. About 2 minutes.
+/// strain, recovered for the stress only) does not reach 1.0 m: with the basis's forces Newton fails
+/// at 0.84 m after a point near the crest is inverted by its basis's motion, with the mapped ones a
+/// point inverts at 0.06 m. About 2 minutes.
 #[test]
 #[ignore]
 fn vertical_cut_items_10_and_11() {

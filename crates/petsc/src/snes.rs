@@ -328,6 +328,39 @@ impl Snes {
         call!(SNESView(self.raw, viewer.raw()))
     }
 
+    /// Drops the factors of a factorisation preconditioner (`lu`, `cholesky`) whose last
+    /// factorisation failed, so that the next solve analyses and factorises the matrix anew.
+    ///
+    /// PETSc 3.18's MUMPS interface, after a numerical factorisation that failed (INFOG(1) = −10,
+    /// a numerically singular matrix), clears the error at the next setup with the same nonzero
+    /// pattern, takes the stored negative INFOG(1) for a failed analysis, skips the factorisation
+    /// without flagging it, and then fails hard in the solve (INFOG(1) = −3: no factors): a Δt cut
+    /// after a singular Jacobian would end the run with that error instead of trying the smaller
+    /// step. Called after a solve that ended in `SNES_DIVERGED_LINEAR_SOLVE`; acts only when the
+    /// linear solve failed in the preconditioner (`KSP_DIVERGED_PC_FAILED`, a reason every rank
+    /// shares, since the reset is collective). Costs a new symbolic factorisation at the next
+    /// solve.
+    fn forget_failed_factorisation(&mut self) -> Result<()> {
+        let mut ksp = std::ptr::null_mut();
+        call!(SNESGetKSP(self.raw, &mut ksp))?;
+        let mut reason = sys::KSPConvergedReason(0);
+        call!(KSPGetConvergedReason(ksp, &mut reason))?;
+        if reason != sys::KSPConvergedReason::KSP_DIVERGED_PC_FAILED {
+            return Ok(());
+        }
+        let mut pc = std::ptr::null_mut();
+        call!(KSPGetPC(ksp, &mut pc))?;
+        let mut t: sys::PCType = std::ptr::null();
+        call!(PCGetType(pc, &mut t))?;
+        // SAFETY: PETSc returns a NUL-terminated static string (or null before a type is set).
+        let name =
+            if t.is_null() { String::new() } else { unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned() };
+        if name == "lu" || name == "cholesky" {
+            call!(PCReset(pc))?;
+        }
+        Ok(())
+    }
+
     /// The 2-norm of each component of the SNES's residual vector (empty if it has none yet or
     /// its block size is one).
     fn residual_components(&self) -> Result<Vec<Real>> {
@@ -385,6 +418,9 @@ impl Snes {
         call!(SNESGetConvergenceHistory(self.raw, &mut hist, &mut hist_its, &mut nhist))?;
         let n = (nhist.max(0) as usize).min(self.history.len());
         let final_residual_components = self.residual_components()?;
+        if reason == sys::SNESConvergedReason::SNES_DIVERGED_LINEAR_SOLVE {
+            self.forget_failed_factorisation()?;
+        }
         Ok(SolveOutcome {
             converged: reason.0 > 0,
             reason: reason.0,
