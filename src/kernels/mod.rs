@@ -838,12 +838,14 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     ) -> Point<'a, D, M> {
         debug_assert_eq!(layout.dim, D, "a layout of {} dimensions at a point of {D}", layout.dim);
         let interp = interpolate(basis, states, &part.pred, layout);
-        let increments = || states.iter().map(|s| std::array::from_fn(|c| s.d[c]));
-        let mut kin = Kinematics::new(basis, increments(), part.linear).with_volume_scale(part.fbar);
+        let kinematics_of = |ops: &[NodeBasis<D>]| {
+            Kinematics::new(ops, states.iter().map(|s| std::array::from_fn(|c| s.d[c])), part.linear)
+                .with_volume_scale(part.fbar)
+        };
+        let mut kin = kinematics_of(basis);
         // (Cases combine neither F̄ nor B̄ with a recovered strain, validation; its kinematics take
         // F̄'s scale and projection all the same, so that every term is defined for any operators.)
-        let mut recovered_kin = (!std::ptr::eq(strain, basis))
-            .then(|| Kinematics::new(strain, increments(), part.linear).with_volume_scale(part.fbar));
+        let mut recovered_kin = (!std::ptr::eq(strain, basis)).then(|| kinematics_of(strain));
         // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
         let mut jbar_nodes = [0.0; M];
         if let Some(j) = layout.jbar {

@@ -164,7 +164,7 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // An implicit F̄ step ([`super::fbar`]): the stress sees r = (1 + Σ_i S_ip ϑ_i)/J̄_p^n, so
     // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
     if let Some(j) = pt.layout.jbar {
-        let de = pt.strain_kin().deps_volume_derivative();
+        let de = sk.deps_volume_derivative();
         let dsig: [f64; NS] = std::array::from_fn(|r| (0..nr).map(|q| d_alg[r][q] * de[q]).sum::<f64>());
         let vj = v * material / pt.part.jbar;
         for k in 0..pt.basis.len() {

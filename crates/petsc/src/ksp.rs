@@ -175,6 +175,13 @@ impl PcRef<'_> {
         call!(PCFieldSplitSetIS(self.raw, c.as_ptr(), is.raw()))
     }
 
+    /// Frees what the preconditioner built (a factorisation's factors, a multigrid's levels) and
+    /// the operators it holds, so that its next setup builds everything anew (`PCReset`;
+    /// collective).
+    pub fn reset(&mut self) -> Result<()> {
+        call!(PCReset(self.raw))
+    }
+
     /// For factorisation preconditioners: the package doing it (`"mumps"`, `"petsc"`, ...).
     pub fn factor_solver_type(&self) -> Result<Option<String>> {
         let mut t: sys::MatSolverType = std::ptr::null();

@@ -7,7 +7,7 @@
 //! instead of failing, so the caller can cut the step.
 
 use crate::fields::{FieldMonitor, FieldTest, Fields};
-use crate::ksp::KspRef;
+use crate::ksp::{KspOps, KspRef};
 use crate::mat::{Mat, MatRef};
 use crate::vector::{VecOps, VecRef, Vector};
 use crate::{cstring, error, Comm, Int, Real, Result};
@@ -341,22 +341,13 @@ impl Snes {
     /// shares, since the reset is collective). Costs a new symbolic factorisation at the next
     /// solve.
     fn forget_failed_factorisation(&mut self) -> Result<()> {
-        let mut ksp = std::ptr::null_mut();
-        call!(SNESGetKSP(self.raw, &mut ksp))?;
-        let mut reason = sys::KSPConvergedReason(0);
-        call!(KSPGetConvergedReason(ksp, &mut reason))?;
-        if reason != sys::KSPConvergedReason::KSP_DIVERGED_PC_FAILED {
+        let mut ksp = self.ksp()?;
+        if ksp.last_solve()?.reason != sys::KSPConvergedReason::KSP_DIVERGED_PC_FAILED.0 {
             return Ok(());
         }
-        let mut pc = std::ptr::null_mut();
-        call!(KSPGetPC(ksp, &mut pc))?;
-        let mut t: sys::PCType = std::ptr::null();
-        call!(PCGetType(pc, &mut t))?;
-        // SAFETY: PETSc returns a NUL-terminated static string (or null before a type is set).
-        let name =
-            if t.is_null() { String::new() } else { unsafe { CStr::from_ptr(t) }.to_string_lossy().into_owned() };
-        if name == "lu" || name == "cholesky" {
-            call!(PCReset(pc))?;
+        let mut pc = ksp.pc()?;
+        if matches!(pc.type_name()?.as_str(), "lu" | "cholesky") {
+            pc.reset()?;
         }
         Ok(())
     }
