@@ -86,7 +86,7 @@ fn particle_kernels(c: &mut Criterion) {
     g.finish();
 
     let basis = bases(&model);
-    let nm = kernels::Scheme::of(&model.integration, 1e-3, false);
+    let nm = porompm::scheme::Scheme::of(&model.integration, 1e-3, false);
     let states: Vec<Vec<NodeState>> = basis
         .iter()
         .enumerate()
@@ -108,7 +108,7 @@ fn particle_kernels(c: &mut Criterion) {
     let body_acc = vec![[0.0, -9.81]; model.n_bodies];
     let inputs: Vec<kernels::ParticleInput> = (0..n)
         .map(|k| {
-            let mut input = model.particle_input(k, &body_acc);
+            let mut input = kernels::ParticleInput::of(&model, k, &body_acc);
             input.pred = Predictors::new(&nm, [0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
             input
         })
@@ -121,7 +121,8 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt = kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                let pt =
+                    kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, porompm::layout::Layout::UPU);
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -134,7 +135,8 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt = kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, kernels::Layout::UPU);
+                let pt =
+                    kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, porompm::layout::Layout::UPU);
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }
@@ -267,9 +269,9 @@ fn particle_kernels_3d(c: &mut Criterion) {
         })
     });
     let basis: Vec<Vec<NodeBasis<3>>> = (0..n).map(stencil).collect();
-    let layout = kernels::Layout::UPU.in_dim(3);
-    let nm = kernels::Scheme::of(&model.integration, 1e-3, false);
-    let states: Vec<Vec<NodeState<{ kernels::MAX_DOF_3D }>>> = basis
+    let layout = porompm::layout::Layout::UPU.in_dim(3);
+    let nm = porompm::scheme::Scheme::of(&model.integration, 1e-3, false);
+    let states: Vec<Vec<NodeState<{ porompm::layout::MAX_DOF_3D }>>> = basis
         .iter()
         .enumerate()
         .map(|(k, b)| {
@@ -284,7 +286,8 @@ fn particle_kernels_3d(c: &mut Criterion) {
         })
         .collect();
     let body_acc = vec![[0.0, -9.81, 0.0]; model.n_bodies];
-    let inputs: Vec<kernels::ParticleInput<3>> = (0..n).map(|k| model.particle_input(k, &body_acc)).collect();
+    let inputs: Vec<kernels::ParticleInput<3>> =
+        (0..n).map(|k| kernels::ParticleInput::of(&model, k, &body_acc)).collect();
     let soil = &model.materials[0].model;
     let largest = basis.iter().map(|b| b.len() * layout.nd).max().unwrap_or(0);
     g.bench_function("residual", |b| {
@@ -324,8 +327,8 @@ fn particle_kernels_3d(c: &mut Criterion) {
 fn global_assembly(c: &mut Criterion) {
     let case = load("cases/slumping_block.toml", &[]);
     let coll = porompm::parallel::Collective::world();
-    let layout = kernels::Layout::UPU;
-    let system = porompm::assembly::GridSystem::new(
+    let layout = porompm::layout::Layout::UPU;
+    let system = porompm::assembly::System::<2>::new(
         &coll,
         &porompm::model::grid_of(&case),
         layout,
@@ -333,20 +336,21 @@ fn global_assembly(c: &mut Criterion) {
         case.stabilisation.stiffness,
     );
     let mut system = system.expect("the grid system is created");
-    let model = Model::build(&case, |i, j| system.owns_cell(i, j));
+    let model = Model::build(&case, |i, j| system.space().owns_cell_in([i, j]));
     let stage = &case.stages[0];
     let active = model.active(stage);
-    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
-    system.prepare_step(&model, &active, stage.dt(), stage.dt(), &coll, &names).expect("the first step is prepared");
-    system.assemble_once(&model).expect("the system assembles");
+    let step = system.prepare(&model, &active, stage.dt(), stage.dt(), &coll).expect("the first step is prepared");
+    system.assemble_once(&step, &model, &coll).expect("the system assembles");
     let mut g = group(c, "assembly", model.particles.len());
-    g.bench_function("residual_and_jacobian", |b| b.iter(|| black_box(system.assemble_once(&model).unwrap())));
+    g.bench_function("residual_and_jacobian", |b| {
+        b.iter(|| black_box(system.assemble_once(&step, &model, &coll).unwrap()))
+    });
     g.finish();
     eprintln!(
         "assembly: {} material points, {} grid dofs ({} unknowns)",
         model.particles.len(),
-        system.total_dofs(),
-        system.free_dofs()
+        system.space().total_dofs(),
+        step.free_dofs()
     );
 }
 

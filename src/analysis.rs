@@ -1,6 +1,6 @@
 //! Analysis types: what a stage solves. Each type is a choice of unknowns per node (a
 //! [`Layout`]) and of a time treatment (an [`Integration`], which the kernels turn into the weights
-//! of their terms, [`crate::kernels::Scheme`]); the driver, the assembly and the particle update are
+//! of their terms, [`crate::scheme::Scheme`]); the driver, the assembly and the particle update are
 //! the same for all of them.
 //!
 //! | stage `analysis` | formulation | unknowns per node | time |
@@ -22,7 +22,8 @@
 //! quasi-static consolidation and a dynamic failure in one case.
 
 use crate::case::{AnalysisType, Case, Drainage, Formulation, Stage};
-use crate::kernels::{Integration, Layout};
+use crate::layout::Layout;
+use crate::scheme::Integration;
 
 /// What one stage solves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,10 +40,10 @@ impl StageAnalysis {
     /// The analysis of `stage` in `case` (validated: a quasi-static stage is two-phase, a static
     /// stage of a two-phase case says its drainage).
     pub fn of(case: &Case, stage: &Stage) -> StageAnalysis {
-        let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+        let pore_water = case.analysis.formulation == Formulation::TwoPhase;
         let mut analysis = match stage.analysis {
             AnalysisType::Dynamic => StageAnalysis {
-                layout: if two_phase { Layout::UPU } else { Layout::U },
+                layout: if pore_water { Layout::UPU } else { Layout::U },
                 integration: stage.time_integration.as_ref().unwrap_or(&case.time_integration).integration(),
                 dt_limit: None,
             },
@@ -52,7 +53,7 @@ impl StageAnalysis {
                 dt_limit: None,
             },
             AnalysisType::Static => StageAnalysis {
-                layout: match (two_phase, stage.drainage) {
+                layout: match (pore_water, stage.drainage) {
                     (true, Some(Drainage::Undrained)) => Layout::UP,
                     _ => Layout::U,
                 },
@@ -62,7 +63,7 @@ impl StageAnalysis {
             AnalysisType::DynamicExplicit => {
                 let e = stage.explicit.unwrap_or_default();
                 StageAnalysis {
-                    layout: if two_phase { Layout::UW } else { Layout::U },
+                    layout: if pore_water { Layout::UW } else { Layout::U },
                     integration: Integration::Explicit {
                         flip: e.flip_blend,
                         damping: e.local_damping,
@@ -124,19 +125,19 @@ impl StageAnalysis {
 /// The time a P-wave takes to cross the smallest cell, h_min / max c_p, with c_p of each material
 /// at rest: the CFL limit of an explicit step (the explicit stage takes C times it) [s]. One-phase,
 /// c_p = sqrt(E_c/ρ) (E_c the constrained modulus, ρ the mixture density); two-phase, the faster
-/// of the two P-waves of the u–U system without drag ([`two_phase_wave_speed`]), which bounds the
+/// of the two P-waves of the u–U system without drag ([`coupled_wave_speed`]), which bounds the
 /// undrained wave (the phases locked by a large drag) too.
 pub fn wave_step(case: &Case) -> f64 {
     let h = case.cell_size();
-    let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+    let pore_water = case.analysis.formulation == Formulation::TwoPhase;
     let c = case
         .materials
         .iter()
         .map(|m| {
             let mat = crate::model::material::Material::from_case(m, case.analysis.formulation);
             let e_c = mat.model.elastic().constrained_modulus();
-            if two_phase {
-                two_phase_wave_speed(e_c, mat.inv_q_at(m.porosity), m.porosity, mat.solid_density, mat.water_density)
+            if pore_water {
+                coupled_wave_speed(e_c, mat.inv_q_at(m.porosity), m.porosity, mat.solid_density, mat.water_density)
             } else {
                 (e_c / mat.mixture_density(m.porosity)).sqrt()
             }
@@ -151,7 +152,7 @@ pub fn wave_step(case: &Case) -> f64 {
 /// [003] Eqs. 23a–c) against the mass M = diag((1 − n)ρ_s, nρ_w); c² is the larger eigenvalue of
 /// M⁻¹K. Any drag couples the phases towards the undrained wave, whose c² = (E_c + Q)/ρ is a
 /// Rayleigh quotient of the same pair and so no larger.
-pub fn two_phase_wave_speed(e_c: f64, inv_q: f64, n: f64, rho_s: f64, rho_w: f64) -> f64 {
+pub fn coupled_wave_speed(e_c: f64, inv_q: f64, n: f64, rho_s: f64, rho_w: f64) -> f64 {
     let q = 1.0 / inv_q;
     let (ms, mw) = ((1.0 - n) * rho_s, n * rho_w);
     let (a, b, d) = ((e_c + (1.0 - n).powi(2) * q) / ms, n * (1.0 - n) * q / (ms * mw).sqrt(), n * n * q / mw);
@@ -165,22 +166,22 @@ pub const DEFAULT_THETA: f64 = 1.0;
 
 #[cfg(test)]
 mod tests {
-    use super::two_phase_wave_speed;
+    use super::coupled_wave_speed;
 
     /// The fast wave of the u–U pair: without a water stiffness it is the skeleton's own wave in
     /// the grains' mass; without a skeleton, K = Q v vᵀ (v = (1 − n, n)) has the one eigenvalue
     /// Q vᵀM⁻¹v = Q ((1 − n)/ρ_s + n/ρ_w); and it is never slower than the undrained wave of the
     /// locked mixture, sqrt((E_c + Q)/ρ).
     #[test]
-    fn the_two_phase_wave_speed_has_its_limits() {
+    fn the_coupled_wave_speed_has_its_limits() {
         let (n, rs, rw) = (0.3, 2650.0, 1000.0);
-        let c = two_phase_wave_speed(1e7, 1e6, n, rs, rw);
+        let c = coupled_wave_speed(1e7, 1e6, n, rs, rw);
         assert!((c / (1e7 / ((1.0 - n) * rs)).sqrt() - 1.0).abs() < 1e-9, "{c}");
         let q = 2.2e9 / n;
-        let c = two_phase_wave_speed(0.0, 1.0 / q, n, rs, rw);
+        let c = coupled_wave_speed(0.0, 1.0 / q, n, rs, rw);
         assert!((c / (q * ((1.0 - n) / rs + n / rw)).sqrt() - 1.0).abs() < 1e-12, "{c}");
         for e_c in [1e5, 1e7, 1e9, 1e11] {
-            let fast = two_phase_wave_speed(e_c, 1.0 / q, n, rs, rw);
+            let fast = coupled_wave_speed(e_c, 1.0 / q, n, rs, rw);
             let undrained = ((e_c + q) / ((1.0 - n) * rs + n * rw)).sqrt();
             assert!(fast >= undrained * (1.0 - 1e-12), "E_c = {e_c}: {fast} < {undrained}");
         }

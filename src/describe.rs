@@ -20,7 +20,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     let _ = writeln!(
         s,
         "formulation: {} (the first stage: {} dofs per node: {})",
-        if model.two_phase { "two_phase" } else { "one_phase" },
+        if model.pore_water { "two_phase" } else { "one_phase" },
         layout.nd,
         layout.field_names().join(", ")
     );
@@ -271,7 +271,7 @@ fn describe_solid(case: &Case, label: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "case: {label}");
     let _ = writeln!(s, "dimension: 3 (y vertical; volumes in m³)");
-    let _ = writeln!(s, "formulation: {}", if model.two_phase { "two_phase" } else { "one_phase" });
+    let _ = writeln!(s, "formulation: {}", if model.pore_water { "two_phase" } else { "one_phase" });
     let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
     let _ = writeln!(
         s,

@@ -112,6 +112,14 @@ pub fn imbalance(counts: &[f64]) -> f64 {
     counts.iter().copied().fold(0.0, f64::max) / (total / counts.len() as f64)
 }
 
+/// The load imbalance of the run's ranks holding `local` points each (collective; 1 on one rank).
+pub fn imbalance_of(local: usize, coll: &Collective) -> Result<f64, String> {
+    if coll.size() == 1 {
+        return Ok(1.0);
+    }
+    Ok(imbalance(&coll.gather(&[local as f64])?))
+}
+
 /// A distribution of the cells over `ranks` ranks that balances the points, in any dimension:
 /// `hist` holds the number of points per cell (x fastest: i + j nx [+ k nx ny], summed over
 /// ranks). Every tensor grid of slabs m × n [× l] = ranks is tried (m, then n, ascending), its cuts

@@ -89,7 +89,7 @@ pub fn run(model: &Constitutive, path: &LoadPath) -> Result<Vec<Row>, String> {
                         a[i][j] = upd.tangent[ci][cj];
                     }
                 }
-                let dx = crate::model::linalg::solve_regularised(a, rhs, m).ok_or_else(|| {
+                let dx = crate::algebra::linalg::solve_regularised(a, rhs, m).ok_or_else(|| {
                     format!("segment {si}, increment {n}: the stress-controlled rows of the tangent are singular")
                 })?;
                 for (j, &cj) in free.iter().enumerate() {

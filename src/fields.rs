@@ -104,7 +104,7 @@ pub fn particle_fields<const D: usize>(model: &Model<D>, coll: &Collective) -> (
         // [002]'s projected volume ratio J̄ the stress sees (its volume is det F V⁰).
         pf.push(scalar("jbar", real(&|r| r[scalars + 5])));
     }
-    if model.two_phase {
+    if model.pore_water {
         pf.push(scalar("p", real(&|r| r[scalars])));
         pf.push(scalar("p_excess", real(&|r| r[scalars] - r[scalars + 1])));
     }
@@ -123,7 +123,7 @@ pub fn frame<const D: usize>(model: &Model<D>, nodes: &NodeBlock, coll: &Collect
         Field { name: "active", components: 1, values: Values::Int(active) },
         Field { name: "du", components: 3, values: Values::Real(d.iter().flat_map(|v| vec3::<D>(v, 1)).collect()) },
     ];
-    if model.two_phase {
+    if model.pore_water {
         gf.push(Field { name: "dp", components: 1, values: Values::Real(d.iter().map(|v| v[p]).collect()) });
         gf.push(Field {
             name: "dU",

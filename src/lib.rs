@@ -5,6 +5,7 @@
 //! small dense block at a time); [`assembly`] is the only module that talks to PETSc; [`io`] is the
 //! only module that touches files; [`driver`] is the algorithm on one page.
 
+pub mod algebra;
 pub mod analysis;
 pub mod assembly;
 pub mod case;
@@ -16,13 +17,18 @@ pub mod element_test;
 pub mod fields;
 pub mod io;
 pub mod kernels;
+pub mod layout;
 pub mod model;
 pub mod parallel;
 pub mod plot;
 pub mod progress;
+pub mod recorders;
 pub mod report;
+pub mod scheme;
 pub mod state;
+pub mod summary;
 pub mod sweep;
+pub mod update;
 pub mod verification;
 
 /// porompm's version and git revision.

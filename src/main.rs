@@ -432,7 +432,7 @@ fn abort_all_ranks_on_panic() {
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         previous(info);
-        if !petsc::snes::in_callback() {
+        if !petsc::callback::in_callback() {
             eprintln!("porompm: a rank panicked (a bug, please report it); ending every rank of the run");
             use mpi::traits::Communicator;
             mpi::topology::SimpleCommunicator::world().abort(70);

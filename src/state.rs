@@ -4,10 +4,11 @@
 //! The state is: every particle array (including the soil model's internal variables, which are
 //! the stress and ε_p^d, and the Newmark velocities and accelerations of both phases), the time,
 //! the step count, the index of the stage, the step control's Δt and its count of accepted steps
-//! since Δt last changed, the run's counters, the probes' excess-pressure extremes, the largest
-//! diagnostics so far, and what the verification check has gathered (if the check can keep
-//! it; see [`crate::verification::Check::checkpoint_state`]). Everything else (grid, loads,
-//! boundaries, matrices) is rebuilt from the case.
+//! since Δt last changed, the run's counters, each load's sum of increments, and what each of the
+//! run's recorders has gathered (the probes' excess-pressure extremes, the largest diagnostics so
+//! far, the verification check's state if it can keep one; see
+//! `crate::recorders::Recorder::state`). Everything else (grid, loads, boundaries, matrices) is
+//! rebuilt from the case.
 //!
 //! A checkpoint names its case by a fingerprint of the validated case without its `[output]` table
 //! (output intervals may differ between the runs), and carries a checksum of its content. Reading
@@ -17,7 +18,7 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 8;
+pub const FORMAT_VERSION: u64 = 9;
 
 /// The particle arrays of a checkpoint of points in `dim` dimensions: (name, components), in the
 /// order of [`write_record`]: `dim` components per vector, dim² for F (row by row), six stresses.
@@ -83,15 +84,12 @@ pub struct Checkpoint {
     pub successes: u64,
     /// Step cuts, Newton iterations, Krylov iterations and matrix-structure reuses so far.
     pub counters: [u64; 5],
-    /// The stability diagnostics' state ([`crate::diagnostics::Monitor::state`]).
-    pub diagnostics: Vec<f64>,
-    /// The probes' signed excess-pressure extremes, in case order.
-    pub probe_extremes: Vec<f64>,
+    /// The recorders' states, each under its name (`crate::recorders::Recorder::state`; a
+    /// recorder that keeps none is absent).
+    pub recorders: Vec<(String, Vec<f64>)>,
     /// Each load's factor reached so far, in case order (what a load with an `increment_factor`
     /// has summed; see [`crate::model::loads::Increments`]).
     pub load_totals: Vec<f64>,
-    /// The verification check's own state (`None`: the check keeps none).
-    pub check_state: Option<Vec<f64>>,
     /// The dimension of the run's points (2 or 3): a record holds [`record_len`]`(dim)` values.
     pub dim: usize,
     /// This rank's slab of the particle records ([`write_record`]) of all ranks sorted by id, laid
@@ -144,11 +142,8 @@ pub fn check_case(cp: &Checkpoint, case: &Case) -> Result<(), String> {
             cp.case_fingerprint
         ));
     }
-    if cp.stage as usize >= case.stages.len()
-        || cp.probe_extremes.len() != case.probes.len()
-        || cp.load_totals.len() != case.loads.len()
-    {
-        return Err("its stage, probes or loads do not match the case".into());
+    if cp.stage as usize >= case.stages.len() || cp.load_totals.len() != case.loads.len() {
+        return Err("its stage or loads do not match the case".into());
     }
     if cp.dim != case.dimension() {
         return Err(format!("its points are {}-dimensional, this case's {}-dimensional", cp.dim, case.dimension()));
@@ -306,26 +301,17 @@ impl Checkpoint {
         for c in self.counters {
             h.u64(c);
         }
-        h.u64(self.diagnostics.len() as u64);
-        for &v in &self.diagnostics {
-            h.f64(v);
-        }
-        h.u64(self.probe_extremes.len() as u64);
-        for &v in &self.probe_extremes {
-            h.f64(v);
+        h.u64(self.recorders.len() as u64);
+        for (name, state) in &self.recorders {
+            h.bytes(name.as_bytes());
+            h.u64(state.len() as u64);
+            for &v in state {
+                h.f64(v);
+            }
         }
         h.u64(self.load_totals.len() as u64);
         for &v in &self.load_totals {
             h.f64(v);
-        }
-        match &self.check_state {
-            None => h.u64(u64::MAX),
-            Some(s) => {
-                h.u64(s.len() as u64);
-                for &v in s {
-                    h.f64(v);
-                }
-            }
         }
         h.u64(self.total);
         h.u64(records_hash);
@@ -438,10 +424,8 @@ mod tests {
             dt: 1e-3,
             successes: 2,
             counters: [1, 2, 3, 4, 5],
-            diagnostics: vec![0.1],
-            probe_extremes: vec![1.0],
+            recorders: vec![("diagnostics".into(), vec![0.1]), ("check".into(), vec![2.0])],
             load_totals: vec![0.5],
-            check_state: Some(vec![2.0]),
             dim: 2,
             particles: records_of(&ps),
             first: 0,
@@ -456,8 +440,11 @@ mod tests {
         third[3 * RECORD..].swap_with_slice(&mut fourth[..RECORD]);
         assert_ne!(sum(&cp), sum(&other), "records in another order");
         let mut other = cp.clone();
-        other.check_state = None;
-        assert_ne!(sum(&cp), sum(&other));
+        other.recorders.pop();
+        assert_ne!(sum(&cp), sum(&other), "a recorder's state dropped");
+        let mut other = cp.clone();
+        other.recorders[1].0 = "checks".into();
+        assert_ne!(sum(&cp), sum(&other), "a recorder's state under another name");
         // Split into two slabs (two ranks), the shares add up to the whole's.
         let (mut a, mut b) = (cp.clone(), cp.clone());
         a.particles.truncate(15 * RECORD);

@@ -337,3 +337,36 @@ fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
         }
     }
 }
+
+/// The `plastic_dissipation` column of history.csv: a von Mises block in homogeneous isochoric
+/// pure shear past its elastic limit dissipates √3 c ε̄ V (every point at q = √3 c, ε̄ the probe's
+/// equivalent plastic strain, V the block's area), to round-off, at every row; nothing while it is
+/// elastic; and a restart from the middle ends with the same total.
+#[test]
+fn the_plastic_dissipation_of_a_sheared_von_mises_block_is_its_closed_form() {
+    let dir = out_dir("plastic_shear");
+    let args = common::set_args(&["stages.shear.duration=1.0"]);
+    let run = common::run_case("tests/cases/plastic_shear.toml", &dir, &args);
+    assert!(run.completed(), "{}", run.stderr());
+    let (w, eps) = (run.column("plastic_dissipation"), run.column("centre.eps_pd"));
+    let (c, area) = (1.0e3, 16.0);
+    assert!(eps.first() == Some(&0.0) && w.first() == Some(&0.0));
+    assert!(eps[eps.len() - 1] > 0.01, "the block yields: ε̄ = {}", eps[eps.len() - 1]);
+    for (k, (w, e)) in w.iter().zip(&eps).enumerate() {
+        let exact = 3f64.sqrt() * c * e * area;
+        assert!((w - exact).abs() <= 1e-9 * exact.max(1.0), "row {k}: W_p = {w}, √3 c ε̄ V = {exact}");
+    }
+    // The column restarts with the run (a checkpoint at step 13 of 20).
+    let half = out_dir("plastic_shear_checkpoint");
+    let mut args = common::set_args(&["stages.shear.duration=1.0"]);
+    args.extend(["--checkpoint-every".into(), "13".into()]);
+    let first = common::run_case("tests/cases/plastic_shear.toml", &half, &args);
+    assert!(first.completed(), "{}", first.stderr());
+    let restarted = out_dir("plastic_shear_restarted");
+    let mut args = common::set_args(&["stages.shear.duration=1.0"]);
+    args.extend(["--restart".into(), half.join("checkpoint.h5").display().to_string()]);
+    let again = common::run_case("tests/cases/plastic_shear.toml", &restarted, &args);
+    assert!(again.completed(), "{}", again.stderr());
+    let (a, b) = (w[w.len() - 1], again.column("plastic_dissipation"));
+    assert!((b[b.len() - 1] - a).abs() <= 1e-12 * a, "restarted {} against {a}", b[b.len() - 1]);
+}

@@ -813,7 +813,7 @@ fn implicit_against_explicit_footing() {
 }
 
 /// [002]'s landslide (§4.4, Part E item 16; `cases/landslide_3d.toml`, the reconstructed slope of
-/// docs/cases_3d_plan.md §1, on a prism one cell wide between its roller walls, W = h = 0.5 m: the
+/// docs/cases_3d.md §1, on a prism one cell wide between its roller walls, W = h = 0.5 m: the
 /// walls make it a plane-strain slice whatever its width) with F̄-uGIMP, F̄-B-spline and standard
 /// uGIMP and B-splines, each
 /// settled for 1 s at peak strength and run for 5.5 s after the peak strength is divided by 1.65
@@ -823,8 +823,7 @@ fn implicit_against_explicit_footing() {
 /// B-splines' below 0.75 of each F̄ run-out; and the guards without which the ratios mean
 /// nothing: every slope stood before the trigger (front advance and largest speed within the
 /// check's tolerances), every body kept its mass, and both F̄ slopes failed (R ≥ H = 5 m: the mass
-/// ran out farther than the slope is high; docs/cases_3d_plan.md had proposed 2H before any run,
-/// and the plane section's F̄ run-outs came out at 9.0 and 8.7 m). The
+/// ran out farther than the slope is high; the plane section's F̄ run-outs are 9.0 and 8.7 m). The
 /// paper's run-outs (29.96, 29.29, 0.0055 and 19.07 m) belong to its lost geometry and are
 /// printed beside ours, not asserted. On two ranks; about an hour (F̄-uGIMP: 834 s).
 #[test]

@@ -23,11 +23,13 @@
 //! Run: `cargo test --release --test three_dimensional_system` (harness-free: PETSc is
 //! initialised once for all tests).
 
+use porompm::algebra::det;
 use porompm::analysis::StageAnalysis;
-use porompm::assembly::{GridSystem, StepForces};
+use porompm::assembly::{StepDim, StepForces, System};
 use porompm::case::{parse, Case};
-use porompm::kernels::kinematics::det;
-use porompm::kernels::{MAX_DOF, MAX_DOF_3D, MAX_NODES, MAX_NODES_3D};
+use porompm::kernels::{MAX_NODES, MAX_NODES_3D};
+use porompm::layout::Dim;
+use porompm::layout::{MAX_DOF, MAX_DOF_3D};
 use porompm::model::Model;
 use porompm::parallel::Collective;
 
@@ -195,38 +197,39 @@ struct Run {
     id: Vec<u64>,
 }
 
-/// Runs every step of the first stage of a case of dimension D through `GridSystem<D, M, N>`
+/// Runs every step of the first stage of a case of dimension D through `System<D, M, N>`
 /// (positions kept with three components, z = 0 in the plane); returns the run, the model at its
 /// end and the last step's forces.
 fn run_in<const D: usize, const M: usize, const N: usize>(
     case: &Case,
     coll: &Collective,
-) -> Result<(Run, Model<D>, StepForces<D>), String> {
+) -> Result<(Run, Model<D>, StepForces<D>), String>
+where
+    Dim<D>: StepDim<D>,
+{
     let stage = &case.stages[0];
     let analysis = StageAnalysis::of(case, stage);
     let grid = porompm::model::grid_of(case);
-    let mut system =
-        GridSystem::<D, M, N>::new(coll, &grid, analysis.layout.in_dim(D), None, case.jacobian_stiffness())
-            .map_err(|e| e.to_string())?;
-    let mut model = Model::<D>::of_case(case, |c| system.owns_cell_in(c));
+    let mut system = System::<D, M, N>::new(coll, &grid, analysis.layout.in_dim(D), None, case.jacobian_stiffness())
+        .map_err(|e| e.to_string())?;
+    let mut model = Model::<D>::of_case(case, |c| system.space().owns_cell_in(c));
     model.integration = analysis.integration;
     let active = model.active(stage);
-    let names: Vec<String> = case.bodies.iter().map(|b| b.name.clone()).collect();
     let (dt, steps) = (stage.dt(), (stage.duration / stage.dt()).round() as usize);
     let mut run = Run { id: model.particles.id.clone(), ..Run::default() };
     let mut forces = StepForces::default();
     for n in 1..=steps {
-        system.prepare_step(&model, &active, n as f64 * dt, dt, coll, &names)?;
-        let out = system.solve(&model).map_err(|e| e.to_string())?;
+        let step = system.prepare(&model, &active, n as f64 * dt, dt, coll)?;
+        let (out, solution) = system.solve(&step, &model, coll).map_err(|e| e.to_string())?;
         if !out.converged {
             return Err(format!("step {n} in {D} dimensions did not converge: {}", out.reason));
         }
         system.accept_increment(dt).map_err(|e| e.to_string())?;
-        forces = system.step_forces(&model, coll, false)?;
-        let results: Vec<_> = (0..model.particles.len()).map(|k| system.step_result(&model, k)).collect();
+        forces = system.forces(&step, &solution, &model, coll, false, &forces.reactions_by_dof)?;
+        let results: Vec<_> = (0..model.particles.len()).map(|k| step.result::<N>(&model, &solution, k)).collect();
         let start_volume = model.particles.volume.clone();
         for (k, r) in results.iter().enumerate() {
-            model.update_particle(k, r, r.interp.dp, dt).map_err(|e| e.0)?;
+            porompm::update::update_particle(&mut model, k, r, r.interp.dp, dt).map_err(|e| e.0)?;
         }
         let ps = &model.particles;
         let weighted = |f: &dyn Fn(usize) -> f64| (0..ps.len()).map(|k| start_volume[k] * f(k)).sum::<f64>();

@@ -1,8 +1,9 @@
 //! One assembly of the global system without a solve, for benchmarks (`benches/kernels.rs`).
 
-use super::{Assembler, GridSystem};
-use crate::kernels;
+use super::step::Step;
+use super::System;
 use crate::model::Model;
+use crate::parallel::Collective;
 use petsc::snes::NonlinearProblem;
 use petsc::{CallbackError, Error, VecOps};
 
@@ -12,26 +13,16 @@ fn error(e: CallbackError) -> Error {
     }
 }
 
-impl GridSystem {
-    /// Assembles the residual and the Jacobian of the prepared step once at Δd = 0: the assembly
+impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
+    /// Assembles the residual and the Jacobian of the prepared `step` once at Δd = 0: the assembly
     /// work of one Newton iteration (every particle's kernels, scattered into PETSc's vector and
     /// matrix) without the linear solve. Returns the 2-norm of the residual.
-    pub fn assemble_once(&mut self, model: &Model) -> Result<f64, Error> {
-        self.x.set_all(0.0)?;
-        let mut seconds = 0.0;
-        let GridSystem { dm, x, x_local, f_local, work_global, jac, step, stages, .. } = self;
-        let jac = jac.as_mut().ok_or_else(|| Error::new("the step was not prepared"))?;
-        let mut asm = Assembler::<2, { kernels::MAX_NODES }, { kernels::MAX_DOF }>::new(
-            dm,
-            model,
-            step,
-            x_local,
-            f_local,
-            &mut seconds,
-            &stages.assembly,
-        );
-        asm.residual(&x.as_ref(), &mut work_global.as_ref()).map_err(error)?;
-        asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(error)?;
-        work_global.norm2()
+    pub fn assemble_once(&mut self, step: &Step<D, M>, model: &Model<D>, coll: &Collective) -> Result<f64, Error> {
+        let (x, jac, mut callbacks) = self.parts(step, model, coll)?;
+        x.set_all(0.0)?;
+        let mut f = x.duplicate()?;
+        callbacks.residual(&x.as_ref(), &mut f.as_ref()).map_err(error)?;
+        callbacks.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(error)?;
+        f.norm2()
     }
 }

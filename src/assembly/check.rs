@@ -12,8 +12,10 @@
 /// Scaled size below which a block's error is measured against this floor instead of its own scale.
 pub const WEAK_BLOCK: f64 = 1e-3;
 
-use super::GridSystem;
+use super::step::Step;
+use super::System;
 use crate::model::Model;
+use crate::parallel::Collective;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
 use petsc::VecOps;
@@ -33,41 +35,42 @@ pub struct BlockCheck {
     pub relative_error: f64,
 }
 
-impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
-    /// Compares the assembled tangent of the prepared step with central finite differences of the
-    /// assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
+impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
+    /// Compares the assembled tangent of the prepared `step` with central finite differences of
+    /// the assembled residual, block by block over the free dofs, at the iterate `fraction` × (the
     /// converged increment of this step). `flip` negates one (row field, column field) block of
     /// the assembled tangent first, to show that the check sees it. One rank only (it builds the
     /// dense FD Jacobian: small cases only); any dimension.
     pub fn jacobian_check(
         &mut self,
+        step: &Step<D, M>,
         model: &Model<D>,
+        coll: &Collective,
         fraction: f64,
         flip: Option<(usize, usize)>,
     ) -> Result<Vec<BlockCheck>, super::Error> {
-        if self.comm.size() != 1 {
+        if coll.size() != 1 {
             return Err(petsc::Error::new("the finite-difference Jacobian check runs on one rank"));
         }
-        let nd = self.layout.nd;
-        let p = self.layout.p;
+        let nd = step.layout.nd;
+        let p = step.layout.p;
         let h_cell = model.grid.h_min();
-        let names = self.layout.field_names();
+        let names = step.layout.field_names();
         // A realistic iterate: part of this step's converged increment.
-        self.solve(model)?;
-        let mut x = self.x.duplicate()?;
-        self.x.copy_to(&mut x)?;
+        self.solve(step, model, coll)?;
+        let (x_now, jac, mut asm) = self.parts(step, model, coll)?;
+        let mut x = x_now.duplicate()?;
+        x_now.copy_to(&mut x)?;
         x.scale(fraction)?;
         let n = x.local_size()?;
         let fixed: Vec<bool> = {
             let mut f = vec![false; n];
-            for &(o, _) in &self.step.dofs.owned_fixed {
+            for &(o, _) in &step.dofs.owned_fixed {
                 f[o] = true;
             }
             f
         };
         let free: Vec<usize> = (0..n).filter(|&o| !fixed[o]).collect();
-        let mut seconds = 0.0;
-        let (_, _, jac, mut asm) = self.split(model, &mut seconds)?;
         asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
         let (_, mut dense) = jac.local_rows_dense()?;
         if let Some((rf, cf)) = flip {

@@ -8,7 +8,7 @@
 //! free wherever a point reaches the node, `kernels::fbar`). Fixed dofs keep their rows in the global vector (residual
 //! x − value, unit diagonal, no column entries), so the layout never changes.
 
-use crate::kernels::Layout;
+use crate::layout::Layout;
 use crate::model::{Active, Model};
 use petsc::GhostedRange;
 

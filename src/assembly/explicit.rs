@@ -52,7 +52,7 @@
 //!    unchecked). The field w − v^n (zero at fixed dofs) is kept for the particle update
 //!    (`StepResult::velocity`). Each order above 1 costs one more pass over the points.
 //!
-//! 8. two-phase (the u–U system, `kernels::Layout::UW`; docs/analysis.md "Two-phase explicit"):
+//! 8. two-phase (the u–U system, `crate::layout::Layout::UW`; docs/analysis.md "Two-phase explicit"):
 //!    step 1 maps the water's mass nρ_w V and momentum too, and the drag C_i = Σ S_ip c_p
 //!    (c = n²γ_w V/k, [003] Eqs. 16c–e); step 2's forces are the u–p–U kernels' at Δd = 0 (the
 //!    effective stress, (1 − n)p on the skeleton and np on the water, [003] Eqs. 23a, c) without
@@ -62,213 +62,231 @@
 //!    each point (`kernels::flow::continuity::pointwise_increment`), or, with
 //!    `explicit.pore_pressure = "nodal"`, from its lumped form per node,
 //!    Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p, zero at drained nodes
-//!    (`GridSystem::drained_nodes`), each point taking Σ_i S_ip Δp_i
-//!    (`GridSystem::nodal_pressure_increments`). The lumped inertia the balance counts includes
+//!    (`pressure::drained_nodes`), each point taking Σ_i S_ip Δp_i
+//!    (`nodal_pressure_increments`). The lumped inertia the balance counts includes
 //!    each phase's drag.
 //!
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
-use super::{callbacks, Error, GridSystem, StepSolve};
-use crate::kernels::kinematics::{det, Kinematics};
-use crate::kernels::{self, Integration};
+use super::points::{node_states, particle_input, Points};
+use super::prepare::start_value;
+use super::space::NodeSpace;
+use super::stencils::Stencils;
+use super::step::{Solution, Step};
+use super::{Error, StepSolve};
+use crate::algebra::det;
+use crate::kernels::{self, Kinematics};
 use crate::model::{fbar, Model};
+use crate::scheme::Integration;
 
-impl<const D: usize, const M: usize, const N: usize> GridSystem<D, M, N> {
-    /// The explicit step's nodal update (see the module documentation), in any dimension; always
-    /// "converged".
-    pub(super) fn explicit_update(&mut self, model: &Model<D>) -> Result<StepSolve, Error> {
-        let t0 = std::time::Instant::now();
-        let Integration::Explicit { damping, xpic, .. } = model.integration else {
-            unreachable!("explicit_update is only called for explicit stages")
+/// The explicit step's nodal update (see the module documentation), in any dimension; always
+/// "converged".
+pub(super) fn update<const D: usize, const M: usize, const N: usize>(
+    space: &mut NodeSpace<D>,
+    step: &Step<D, M>,
+    model: &Model<D>,
+) -> Result<(StepSolve, Solution), Error> {
+    let t0 = std::time::Instant::now();
+    let Integration::Explicit { damping, xpic, .. } = model.integration else {
+        return Err(Error::new("an explicit update of a step that is not explicit"));
+    };
+    let nd = space.layout.nd;
+    let ng = space.ghost.len() * nd;
+    let ps = &model.particles;
+    let points = Points::<D, M, N>::new(model, step);
+    let water = space.layout.w.map(|_| ps.vel_w.as_slice());
+    let mut lumped = points.lumped_mass_and_momentum(&ps.vel, water);
+    let start = &step.start_terms;
+    let mut residual: Vec<f64> = start.all.iter().zip(&step.fext).map(|(a, e)| a - e).collect();
+    for v in [&mut lumped.mass, &mut lumped.momentum, &mut lumped.drag, &mut residual] {
+        if !v.is_empty() {
+            space.sum_over_ranks(v)?;
+        }
+    }
+    let dt = step.dt;
+    let dofs = &step.dofs;
+    let (mass, momentum) = (&lumped.mass, &lumped.momentum);
+    let mut solution = Solution { increments: vec![0.0; ng], explicit_inertia: vec![0.0; ng], ..Solution::default() };
+    // (solid dof, water dof) of each node and direction: the phases' updates are coupled by
+    // the drag; one-phase nodes have no water dof.
+    let water_offset = space.layout.w;
+    let pairs =
+        (0..space.ghost.len()).flat_map(|l| (0..D).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
+    for (qs, qw) in pairs {
+        let phase = |q: usize| {
+            let v0 = if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 };
+            NodalPhase {
+                fixed: dofs.fixed[q].then(|| dofs.value[q] / dt),
+                mass: mass[q],
+                v0,
+                force: damped(-residual[q], damping, v0),
+            }
         };
-        let nd = self.layout.nd;
-        let ng = self.ghost.len() * nd;
-        let ps = &model.particles;
-        let water = self.layout.w.map(|_| ps.vel_w.as_slice());
-        let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&ps.vel, water));
-        let start = self.step.start_terms.as_ref().expect("an explicit step's start terms");
-        let mut residual: Vec<f64> = start.all.iter().zip(&self.step.fext).map(|(a, e)| a - e).collect();
-        for v in [&mut lumped.mass, &mut lumped.momentum, &mut lumped.drag, &mut residual] {
-            if !v.is_empty() {
-                self.sum_over_ranks(v)?;
+        let solid = phase(qs);
+        let fluid = qw.map(phase);
+        let drag = qw.map_or(0.0, |_| lumped.drag[qs]);
+        let (vs, vw) = nodal_velocities(&solid, fluid.as_ref(), drag, dt);
+        // The inertia with the damping force and the drag (forces the balance must count).
+        for (q, ph, v, sign) in [(Some(qs), Some(&solid), vs, 1.0), (qw, fluid.as_ref(), vw, -1.0)] {
+            let (Some(q), Some(ph)) = (q, ph) else { continue };
+            solution.increments[q] = dt * v;
+            if ph.fixed.is_none() && ph.mass > 0.0 {
+                solution.explicit_inertia[q] = ph.mass * (v - ph.v0) / dt + ph.force.1 + sign * drag * (vs - vw);
             }
         }
-        let dt = self.step.dt;
-        let dofs = &self.step.dofs;
-        let (mass, momentum) = (&lumped.mass, &lumped.momentum);
-        let mut solution = vec![0.0; ng];
-        let mut inertia = vec![0.0; ng];
-        // (solid dof, water dof) of each node and direction: the phases' updates are coupled by
-        // the drag; one-phase nodes have no water dof.
-        let water_offset = self.layout.w;
-        let pairs =
-            (0..self.ghost.len()).flat_map(|l| (0..D).map(move |c| (l * nd + c, water_offset.map(|w| l * nd + w + c))));
-        for (qs, qw) in pairs {
-            let phase = |q: usize| {
-                let v0 = if mass[q] > 0.0 { momentum[q] / mass[q] } else { 0.0 };
-                NodalPhase {
-                    fixed: dofs.fixed[q].then(|| dofs.value[q] / dt),
-                    mass: mass[q],
-                    v0,
-                    force: damped(-residual[q], damping, v0),
-                }
-            };
-            let solid = phase(qs);
-            let fluid = qw.map(phase);
-            let drag = qw.map_or(0.0, |_| lumped.drag[qs]);
-            let (vs, vw) = nodal_velocities(&solid, fluid.as_ref(), drag, dt);
-            // The inertia with the damping force and the drag (forces the balance must count).
-            for (q, ph, v, sign) in [(Some(qs), Some(&solid), vs, 1.0), (qw, fluid.as_ref(), vw, -1.0)] {
-                let (Some(q), Some(ph)) = (q, ph) else { continue };
-                solution[q] = dt * v;
-                if ph.fixed.is_none() && ph.mass > 0.0 {
-                    inertia[q] = ph.mass * (v - ph.v0) / dt + ph.force.1 + sign * drag * (vs - vw);
-                }
-            }
-        }
-        // The velocities of the step's start the FLIP update subtracts: the lumped ones, zero
-        // where a boundary holds the component still.
-        self.step.start_velocity = (0..ng).map(|q| super::start_value(model, dofs, q, mass, momentum)).collect();
-        self.step.solution = solution;
-        self.step.explicit_inertia = inertia;
-        self.step.xpic_correction =
-            if xpic > 0 { self.xpic_correction(model, xpic, &lumped.mass, &lumped.momentum)? } else { Vec::new() };
-        if model.fbar {
-            self.step.fbar_scale = self.fbar_scales(model)?;
-        }
-        if !self.step.drained.is_empty() {
-            self.step.pressure_increment = self.nodal_pressure_increments(model)?;
-        }
-        let seconds = t0.elapsed().as_secs_f64();
-        Ok(StepSolve {
-            converged: true,
-            reason: "EXPLICIT".into(),
-            newton_iterations: 0,
-            linear_iterations: 0,
-            residual_history: Vec::new(),
-            domain_error: None,
-            nonfinite: None,
-            assembly_seconds: seconds,
-            solve_seconds: seconds,
-            field_residuals: Vec::new(),
-            field_scales: self.step.field_scales.clone(),
-            linear_field_residuals: Vec::new(),
-            solver_used: false,
-            line_search_retry: false,
+    }
+    // The velocities of the step's start the FLIP update subtracts: the lumped ones, zero
+    // where a boundary holds the component still.
+    solution.start_velocity = (0..ng).map(|q| start_value(model, dofs, q, mass, momentum)).collect();
+    if xpic > 0 {
+        solution.xpic_correction = xpic_correction(space, step, &points, xpic, &lumped.mass, &lumped.momentum)?;
+    }
+    if model.fbar {
+        solution.fbar_scale = fbar_scales::<D, M, N>(space, step, model, &solution)?;
+    }
+    if !step.drained.is_empty() {
+        solution.pressure_increment = nodal_pressure_increments::<D, M, N>(space, step, model, &solution)?;
+    }
+    let seconds = t0.elapsed().as_secs_f64();
+    let solve = StepSolve {
+        converged: true,
+        reason: "EXPLICIT".into(),
+        newton_iterations: 0,
+        linear_iterations: 0,
+        residual_history: Vec::new(),
+        domain_error: None,
+        nonfinite: None,
+        assembly_seconds: seconds,
+        solve_seconds: seconds,
+        field_residuals: Vec::new(),
+        field_scales: step.field_scales.clone(),
+        linear_field_residuals: Vec::new(),
+        solver_used: false,
+        line_search_retry: false,
+    };
+    Ok((solve, solution))
+}
+
+/// The nodal pore pressure's increment at each point of a two-phase step (see the module
+/// documentation): the points' own increments Δp_p of the step's solution, their lumped
+/// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
+/// drained nodes), and Σ_i S_ip Δp_i at each point.
+fn nodal_pressure_increments<const D: usize, const M: usize, const N: usize>(
+    space: &mut NodeSpace<D>,
+    step: &Step<D, M>,
+    model: &Model<D>,
+    solution: &Solution,
+) -> Result<Vec<f64>, Error> {
+    let st = &step.stencils;
+    let mut storage = Vec::with_capacity(st.len());
+    let own: Vec<f64> = (0..st.len())
+        .map(|k| {
+            let (nodes, basis) = st.get(k);
+            let states = node_states::<D, M, N>(step, k, &solution.increments);
+            let input = particle_input(model, step, k);
+            storage.push(input.volume * input.inv_q);
+            let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), step.layout);
+            kernels::flow::continuity::pointwise_increment(&it, &input)
         })
-    }
+        .collect();
+    project_weighted(space, st, &storage, &own, &step.drained)
+}
 
-    /// The nodal pore pressure's increment at each point of a two-phase step (see the module
-    /// documentation): the points' own increments Δp_p of the step's solution, their lumped
-    /// continuity equation per node, Δp_i = Σ_p S_ip (V/Q)_p Δp_p / Σ_p S_ip (V/Q)_p (zero at
-    /// drained nodes), and Σ_i S_ip Δp_i at each point.
-    fn nodal_pressure_increments(&mut self, model: &Model<D>) -> Result<Vec<f64>, Error> {
-        let st = &self.step.stencils;
-        let mut storage = Vec::with_capacity(st.len());
-        let own: Vec<f64> = (0..st.len())
-            .map(|k| {
-                let (nodes, basis) = st.get(k);
-                let states = callbacks::node_states::<D, M, N>(&self.step, k, &self.step.solution);
-                let input = callbacks::particle_input(model, &self.step, k);
-                storage.push(input.volume * input.inv_q);
-                let it = kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout);
-                kernels::flow::continuity::pointwise_increment(&it, &input)
-            })
-            .collect();
-        let drained = std::mem::take(&mut self.step.drained);
-        let out = self.project_weighted(&storage, &own, &drained);
-        self.step.drained = drained;
-        out
-    }
-
-    /// XPIC(m)'s nodal field w − v^n (see the module documentation) from the step's lumped mass and
-    /// momentum (summed over the ranks), per ghosted dof; zero at fixed dofs and where there is no
-    /// mass.
-    fn xpic_correction(&mut self, model: &Model<D>, m: u8, mass: &[f64], momentum: &[f64]) -> Result<Vec<f64>, Error> {
-        let velocity = |mass: &[f64], momentum: &[f64]| -> Vec<f64> {
-            mass.iter().zip(momentum).map(|(m, p)| if *m > 0.0 { p / m } else { 0.0 }).collect()
-        };
-        let v0 = velocity(mass, momentum);
-        let (mut u, mut w) = (v0.clone(), vec![0.0; v0.len()]);
-        let mut binomial = 1.0;
-        for k in 1..=m {
-            binomial *= f64::from(m - k + 1) / f64::from(k);
-            if k > 1 {
-                // S⁺S u: u at the points, their momenta back to the nodes.
-                let at_points: Vec<[f64; D]> =
-                    (0..self.step.stencils.len()).map(|p| self.interpolated(p, &u).du).collect();
-                let mut lumped = self.with_assembler(model, |asm| asm.lumped_mass_and_momentum(&at_points, None));
-                for v in [&mut lumped.mass, &mut lumped.momentum] {
-                    self.sum_over_ranks(v)?;
-                }
-                u = velocity(&lumped.mass, &lumped.momentum);
+/// XPIC(m)'s nodal field w − v^n (see the module documentation) from the step's lumped mass and
+/// momentum (summed over the ranks), per ghosted dof; zero at fixed dofs and where there is no
+/// mass.
+fn xpic_correction<const D: usize, const M: usize, const N: usize>(
+    space: &mut NodeSpace<D>,
+    step: &Step<D, M>,
+    points: &Points<D, M, N>,
+    m: u8,
+    mass: &[f64],
+    momentum: &[f64],
+) -> Result<Vec<f64>, Error> {
+    let velocity = |mass: &[f64], momentum: &[f64]| -> Vec<f64> {
+        mass.iter().zip(momentum).map(|(m, p)| if *m > 0.0 { p / m } else { 0.0 }).collect()
+    };
+    let v0 = velocity(mass, momentum);
+    let (mut u, mut w) = (v0.clone(), vec![0.0; v0.len()]);
+    let mut binomial = 1.0;
+    for k in 1..=m {
+        binomial *= f64::from(m - k + 1) / f64::from(k);
+        if k > 1 {
+            // S⁺S u: u at the points, their momenta back to the nodes.
+            let at_points: Vec<[f64; D]> = (0..step.stencils.len()).map(|p| step.interpolated::<N>(p, &u).du).collect();
+            let mut lumped = points.lumped_mass_and_momentum(&at_points, None);
+            for v in [&mut lumped.mass, &mut lumped.momentum] {
+                space.sum_over_ranks(v)?;
             }
-            let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
-            for (wi, ui) in w.iter_mut().zip(&u) {
-                *wi += sign * binomial * ui;
-            }
+            u = velocity(&lumped.mass, &lumped.momentum);
         }
-        let fixed = &self.step.dofs.fixed;
-        Ok((0..w.len()).map(|q| if fixed[q] || mass[q] <= 0.0 { 0.0 } else { w[q] - v0[q] }).collect())
-    }
-
-    /// [002]'s projection for the step's nodal increments (see the module documentation): the
-    /// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
-    /// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/D} of the increment (Eq. 27, the in-plane block in
-    /// plane strain; J̄_p^n the point's stored value) and s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/D} of the
-    /// total deformation (Eq. 18).
-    fn fbar_scales(&mut self, model: &Model<D>) -> Result<Vec<[f64; 3]>, Error> {
-        let (st, ps) = (&self.step.stencils, &model.particles);
-        // Per point: ΔJ.
-        let dj: Vec<f64> = (0..st.len())
-            .map(|k| {
-                let (nodes, _) = st.get(k);
-                let states = callbacks::node_states::<D, M, N>(&self.step, k, &self.step.solution);
-                let d = states[..nodes.len()].iter().map(|s| std::array::from_fn(|c| s.d[c]));
-                Kinematics::new(st.strain_of(k), d, false).j
-            })
-            .collect();
-        let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();
-        let projected = self.project_per_point(model, &own)?;
-        Ok((0..own.len())
-            .map(|k| {
-                let p = projected[k];
-                [fbar::scale(p, ps.jbar[k] * dj[k], D), fbar::scale(p, own[k], D), p]
-            })
-            .collect())
-    }
-
-    /// The volume-weighted projection Π(q) of a per-point quantity `q` (this rank's points) on the
-    /// nodes and back to each point with the step's weights ([002] Eqs. 19–21; nodal sums over
-    /// the ranks).
-    fn project_per_point(&mut self, model: &Model<D>, q: &[f64]) -> Result<Vec<f64>, Error> {
-        self.project_weighted(&model.particles.volume[..q.len()], q, &[])
-    }
-
-    /// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
-    /// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
-    /// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
-    fn project_weighted(&mut self, weight: &[f64], q: &[f64], zero: &[bool]) -> Result<Vec<f64>, Error> {
-        let (nd, nn) = (self.layout.nd, self.ghost.len());
-        let st = &self.step.stencils;
-        // Each point's (node, S) pairs, flat like the stencils (`offsets[k]..offsets[k + 1]`).
-        let flat: Vec<(usize, f64)> = st.nodes.iter().zip(&st.basis).map(|(&n, b)| (n as usize, b.s)).collect();
-        let shares = |st: &super::stencils::Stencils<D>, k: usize| &flat[st.offsets[k]..st.offsets[k + 1]];
-        let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares(st, k), weight[k], q[k])));
-        // The nodal sums over ranks (the first component's slot of each node).
-        let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
-        for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
-            for (l, v) in local.iter().enumerate() {
-                sum[l * nd] = *v;
-            }
-            self.sum_over_ranks(sum)?;
+        let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
+        for (wi, ui) in w.iter_mut().zip(&u) {
+            *wi += sign * binomial * ui;
         }
-        let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
-        let weighted: Vec<f64> =
-            (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
-        let st = &self.step.stencils;
-        Ok((0..st.len()).map(|k| fbar::gather(shares(st, k), &volume, &weighted)).collect())
     }
+    let fixed = &step.dofs.fixed;
+    Ok((0..w.len()).map(|q| if fixed[q] || mass[q] <= 0.0 { 0.0 } else { w[q] - v0[q] }).collect())
+}
+
+/// [002]'s projection for the step's nodal increments (see the module documentation): the
+/// projection J̄_p^{n+1} = Π(J^n ΔJ)_p of the points' own volume ratios, the scale
+/// c_p = (J̄_p^{n+1}/(J̄_p^n ΔJ_p))^{1/D} of the increment (Eq. 27, the in-plane block in
+/// plane strain; J̄_p^n the point's stored value) and s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/D} of the
+/// total deformation (Eq. 18).
+fn fbar_scales<const D: usize, const M: usize, const N: usize>(
+    space: &mut NodeSpace<D>,
+    step: &Step<D, M>,
+    model: &Model<D>,
+    solution: &Solution,
+) -> Result<Vec<[f64; 3]>, Error> {
+    let (st, ps) = (&step.stencils, &model.particles);
+    // Per point: ΔJ.
+    let dj: Vec<f64> = (0..st.len())
+        .map(|k| {
+            let (nodes, _) = st.get(k);
+            let states = node_states::<D, M, N>(step, k, &solution.increments);
+            let d = states[..nodes.len()].iter().map(|s| std::array::from_fn(|c| s.d[c]));
+            Kinematics::new(st.strain_of(k), d, false).j
+        })
+        .collect();
+    let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();
+    // The volume-weighted projection ([002] Eqs. 19–21).
+    let projected = project_weighted(space, st, &ps.volume[..own.len()], &own, &[])?;
+    Ok((0..own.len())
+        .map(|k| {
+            let p = projected[k];
+            [fbar::scale(p, ps.jbar[k] * dj[k], D), fbar::scale(p, own[k], D), p]
+        })
+        .collect())
+}
+
+/// The projection of a per-point quantity `q` with the per-point weights `weight` (a volume):
+/// q_i = Σ_p S_ip w_p q_p / Σ_p S_ip w_p on the nodes (sums over the ranks), zero at the
+/// ghosted nodes `zero` marks (none if it is empty), and Σ_i S_ip q_i back at each point.
+fn project_weighted<const D: usize>(
+    space: &mut NodeSpace<D>,
+    st: &Stencils<D>,
+    weight: &[f64],
+    q: &[f64],
+    zero: &[bool],
+) -> Result<Vec<f64>, Error> {
+    let (nd, nn) = (space.layout.nd, space.ghost.len());
+    // Each point's (node, S) pairs, flat like the stencils (`offsets[k]..offsets[k + 1]`).
+    let flat: Vec<(usize, f64)> = st.nodes.iter().zip(&st.basis).map(|(&n, b)| (n as usize, b.s)).collect();
+    let shares = |k: usize| &flat[st.offsets[k]..st.offsets[k + 1]];
+    let (volume, weighted) = fbar::scatter(nn, (0..q.len()).map(|k| (shares(k), weight[k], q[k])));
+    // The nodal sums over ranks (the first component's slot of each node).
+    let mut sums = [vec![0.0; nn * nd], vec![0.0; nn * nd]];
+    for (sum, local) in sums.iter_mut().zip([&volume, &weighted]) {
+        for (l, v) in local.iter().enumerate() {
+            sum[l * nd] = *v;
+        }
+        space.sum_over_ranks(sum)?;
+    }
+    let volume: Vec<f64> = (0..nn).map(|l| sums[0][l * nd]).collect();
+    let weighted: Vec<f64> = (0..nn).map(|l| if zero.get(l) == Some(&true) { 0.0 } else { sums[1][l * nd] }).collect();
+    Ok((0..st.len()).map(|k| fbar::gather(shares(k), &volume, &weighted)).collect())
 }
 
 /// One phase of one nodal direction in an explicit step (summed over the ranks).

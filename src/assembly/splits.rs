@@ -32,7 +32,7 @@
 //! the diagonal of the stiffness, which shrinks as h² under refinement, and its spectrum spreads
 //! with the grid; the fixed-stress one does not (docs/solvers.md).
 
-use crate::kernels::Layout;
+use crate::layout::Layout;
 use crate::parallel::Collective;
 use petsc::ksp::KspOps;
 use petsc::{Comm, IndexSet, Options, SchurUser, Snes, VecOps, Vector};
@@ -86,6 +86,19 @@ pub(super) fn define<const D: usize>(
     }))
 }
 
+/// What a step's preparation computes for porompm's Schur preconditioner: its diagonal when there
+/// is one, and the free-surface aggregates when it inverts blocks of A_uu (see
+/// `assembly::pressure::fixed_stress_diagonal` and [`super::aggregates`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SchurNeeds {
+    /// The options ask for porompm's Schur preconditioner.
+    pub schur: bool,
+    /// It inverts A_uu's blocks over the free-surface aggregates (the u–p–U system's).
+    pub blocks: bool,
+    /// Its tuning.
+    pub tuning: SchurTuning,
+}
+
 /// The tuning of porompm's Schur preconditioner of the u–p–U system (see the module documentation),
 /// from the options database.
 #[derive(Debug, Clone, Copy, Default)]
@@ -93,7 +106,7 @@ pub(super) struct SchurTuning {
     /// The free-surface aggregates' shape.
     pub strip: super::aggregates::StripShape,
     /// The share c of the solid's fixed-stress term, when the options set it (else the rule of
-    /// `GridSystem::fixed_stress_share`).
+    /// `assembly::pressure::fixed_stress_share`).
     pub share: Option<f64>,
 }
 

@@ -51,7 +51,7 @@ struct Share {
 
 /// The mapped-stiffness shares of a step's points.
 #[derive(Debug, Default)]
-pub(super) struct MappedStiffness {
+pub struct MappedStiffness {
     /// The factor of each point's own material tangent (1, omp/cmp or 0).
     material: Vec<f64>,
     shares: Vec<Share>,

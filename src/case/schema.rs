@@ -1189,12 +1189,12 @@ impl TimeIntegration {
     }
 
     /// The kernels' form of these parameters.
-    pub fn integration(&self) -> crate::kernels::Integration {
+    pub fn integration(&self) -> crate::scheme::Integration {
         if self.is_newmark() {
             let (b, g) = self.newmark();
-            crate::kernels::Integration::newmark(b, g)
+            crate::scheme::Integration::newmark(b, g)
         } else {
-            crate::kernels::Integration::generalized_alpha(self.rho_inf.unwrap_or(DEFAULT_RHO_INF))
+            crate::scheme::Integration::generalized_alpha(self.rho_inf.unwrap_or(DEFAULT_RHO_INF))
         }
     }
 }

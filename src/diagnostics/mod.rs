@@ -71,7 +71,7 @@ pub struct Row {
 /// The running diagnostics of a run.
 #[derive(Debug, Clone, Default)]
 pub struct Monitor {
-    two_phase: bool,
+    pore_water: bool,
     dynamic: bool,
     /// The energy ledger of the dynamic steps.
     pub ledger: energy::Ledger,
@@ -118,14 +118,14 @@ fn worse(a: f64, b: f64) -> f64 {
 
 impl Monitor {
     /// The diagnostics of a run; `dynamic`: whether any stage is dynamic.
-    pub fn new(two_phase: bool, dynamic: bool) -> Monitor {
-        Monitor { two_phase, dynamic, last: [f64::NAN; 2], ..Monitor::default() }
+    pub fn new(pore_water: bool, dynamic: bool) -> Monitor {
+        Monitor { pore_water, dynamic, last: [f64::NAN; 2], ..Monitor::default() }
     }
 
     /// The history columns of the diagnostics.
     pub fn columns(&self) -> Vec<String> {
         let mut c = Vec::new();
-        if self.two_phase {
+        if self.pore_water {
             c.extend(["checkerboard_index", "pressure_oscillation_index", "p_min", "p_max"].map(String::from));
         }
         if self.dynamic {
@@ -151,7 +151,7 @@ impl Monitor {
     ) -> Result<(Vec<f64>, Vec<Warning>), String> {
         let mut values = Vec::new();
         let mut warnings = Vec::new();
-        if self.two_phase {
+        if self.pore_water {
             let fit = crate::verification::checkerboard::pressure_fit(model, owners, coll)?;
             let ps = &model.particles;
             let (mut lo, mut hi, mut scale) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);

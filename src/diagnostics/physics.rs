@@ -38,8 +38,8 @@
 use super::Warning;
 use crate::analysis::StageAnalysis;
 use crate::case::{AnalysisType, Case, Drainage};
-use crate::kernels::Integration;
 use crate::model::Model;
+use crate::scheme::Integration;
 
 /// Poisson's ratio from which a skeleton without B̄ locks.
 pub const LOCKING_NU: f64 = 0.49;
@@ -76,7 +76,7 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
             }
         }
     }
-    if model.two_phase && model.pressure_projection.is_none() && !model.patch_recovery {
+    if model.pore_water && model.pressure_projection.is_none() && !model.patch_recovery {
         'stages: for (s, stage) in case.stages.iter().enumerate() {
             let flow = match (stage.analysis, stage.drainage) {
                 (AnalysisType::Static, Some(Drainage::Undrained)) => false,
@@ -150,7 +150,7 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
         }
     }
     let dynamic = case.stages.iter().any(|s| s.analysis == AnalysisType::Dynamic);
-    if model.two_phase && dynamic {
+    if model.pore_water && dynamic {
         for (i, b) in case.bodies.iter().enumerate().filter(|(_, b)| b.particles_per_cell == 1) {
             warn(
                 &mut out,
@@ -163,7 +163,7 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
             );
         }
     }
-    if model.two_phase {
+    if model.pore_water {
         let extent = (0..D).map(|d| model.grid.h[d] * model.grid.cells[d] as f64).fold(0.0, f64::max);
         for (s, stage) in case.stages.iter().enumerate().filter(|(_, s)| s.analysis == AnalysisType::Dynamic) {
             // The fastest consolidation of the materials.
@@ -204,7 +204,7 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
             .materials
             .iter()
             .map(|m| {
-                let stiff = m.model.elastic().constrained_modulus() + if model.two_phase { 1.0 / m.inv_q } else { 0.0 };
+                let stiff = m.model.elastic().constrained_modulus() + if model.pore_water { 1.0 / m.inv_q } else { 0.0 };
                 (stiff / m.mixture_density(m.porosity)).sqrt() * stage.dt() / h
             })
             .fold(0.0, f64::max);

@@ -1,10 +1,10 @@
 //! `checkpoint.h5`: reading and writing a [`Checkpoint`] (see [`crate::state`] for what it holds).
 //!
 //! Layout: root attributes `format` ("porompm-checkpoint"), `version`, `case_fingerprint`, `time`
-//! [s], `step`, `stage`, `dt` [s], `successes`, `has_check_state`, then
+//! [s], `step`, `stage`, `dt` [s], `successes`, then
 //! `checksum` and, written last, `complete` = 1; datasets `counters` (step cuts, Newton and Krylov
-//! iterations, matrix-structure reuses, line-search retries), `diagnostics` (see `Monitor::state`), `probe_extremes` [Pa],
-//! `load_totals`, `check_state`, and one dataset per
+//! iterations, matrix-structure reuses, line-search retries), `load_totals`, the group `recorders`
+//! with one dataset per recorder's state (named as the recorder), and one dataset per
 //! particle array under `/particles` (n × components, SI units, sorted by id; the points' dimension
 //! is the number of components of `x`, 2 or 3, and sets every vector's and F's, `state::particle_fields`).
 //!
@@ -95,16 +95,17 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         attr_u64(loc, "stage", cp.stage)?;
         attr_f64(loc, "dt", cp.dt)?;
         attr_u64(loc, "successes", cp.successes)?;
-        attr_u64(loc, "has_check_state", cp.check_state.is_some() as u64)?;
         f.new_dataset::<u64>()
             .shape(cp.counters.len())
             .create("counters")
             .and_then(|d| d.write_raw(&cp.counters[..]))?;
-        dataset_f64(&f, "diagnostics", &[cp.diagnostics.len()], &cp.diagnostics)?;
-        dataset_f64(&f, "probe_extremes", &[cp.probe_extremes.len()], &cp.probe_extremes)?;
         dataset_f64(&f, "load_totals", &[cp.load_totals.len()], &cp.load_totals)?;
-        let state = cp.check_state.clone().unwrap_or_default();
-        dataset_f64(&f, "check_state", &[state.len()], &state)?;
+        {
+            let g = f.create_group("recorders")?;
+            for (name, state) in &cp.recorders {
+                dataset_f64(&g, name, &[state.len()], state)?;
+            }
+        }
         {
             let g = f.create_group("particles")?;
             let (n, rows, first) = (cp.total as usize, cp.records().len(), cp.first as usize);
@@ -190,8 +191,16 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
     let corrupt = |e: h5::Error| format!("checkpoint {name} cannot be read: {e}");
     let counters: Vec<u64> = f.dataset("counters").and_then(|d| d.read_raw()).map_err(corrupt)?;
     let vec_f64 = |n: &str| f.dataset(n).and_then(|d| d.read_raw::<f64>());
-    let has_state = u("has_check_state").map_err(corrupt)? == 1;
-    let state = vec_f64("check_state").map_err(corrupt)?;
+    let recorders = {
+        let g = f.group("recorders").map_err(corrupt)?;
+        let mut names = g.member_names().map_err(corrupt)?;
+        names.sort();
+        let mut states = Vec::with_capacity(names.len());
+        for n in names {
+            states.push((n.clone(), g.dataset(&n).and_then(|d| d.read_raw::<f64>()).map_err(corrupt)?));
+        }
+        states
+    };
     let g = f.group("particles").map_err(corrupt)?;
     // The points' dimension: the components of their positions.
     let dim = g.dataset("x").map_err(corrupt)?.shape().get(1).copied().unwrap_or(0);
@@ -237,10 +246,8 @@ fn read_share(path: &Path, comm: &SimpleCommunicator) -> Result<(Checkpoint, u64
         dt: x("dt").map_err(corrupt)?,
         successes: u("successes").map_err(corrupt)?,
         counters: counters.try_into().map_err(|_| format!("checkpoint {name}: `counters` must hold 5 values"))?,
-        diagnostics: vec_f64("diagnostics").map_err(corrupt)?,
-        probe_extremes: vec_f64("probe_extremes").map_err(corrupt)?,
+        recorders,
         load_totals: vec_f64("load_totals").map_err(corrupt)?,
-        check_state: has_state.then_some(state),
         dim,
         particles,
         first: a as u64,
@@ -267,10 +274,8 @@ mod tests {
             dt: 1e-3 / 3.0,
             successes: 2,
             counters: [1, 301, 302, 7, 2],
-            diagnostics: vec![f64::NAN, 0.5],
-            probe_extremes: vec![-12.5, 3.0],
+            recorders: vec![("check".into(), vec![1.0, 2.0]), ("diagnostics".into(), vec![f64::NAN, 0.5])],
             load_totals: vec![0.25, 1.0 / 3.0],
-            check_state: Some(vec![1.0, 2.0]),
             dim,
             particles,
             first: 0,
@@ -299,7 +304,10 @@ mod tests {
         assert_eq!((back.first, back.total, back.dim), (0, 2, 2));
         assert_eq!(back.particles, cp.particles);
         assert_eq!(back.time.to_bits(), cp.time.to_bits());
-        assert!(back.diagnostics[0].is_nan() && back.diagnostics[1] == 0.5 && back.check_state == cp.check_state);
+        assert_eq!(back.recorders.len(), 2);
+        assert!(
+            back.recorders[1].1[0].is_nan() && back.recorders[1].1[1] == 0.5 && back.recorders[0] == cp.recorders[0]
+        );
 
         // Change one particle value behind the checksum's back.
         {

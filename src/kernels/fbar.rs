@@ -62,12 +62,12 @@ pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, ou
 #[cfg(test)]
 mod tests {
     use super::super::{plain_basis, Layout, NodeBasis, NodeState, ParticleInput, Point, Scheme};
-    use crate::kernels::Integration;
     use crate::model::fbar::tests::Lcg;
     use crate::model::fbar::{gather, scatter};
     use crate::model::grid::Grid;
     use crate::model::shape::{self, Basis};
     use crate::model::soil::{Constitutive, LinearElastic};
+    use crate::scheme::Integration;
 
     /// The kernels' sample particle with the volume, deformation gradient and J̄ of a point of
     /// the cloud, and the projection rows' scale.

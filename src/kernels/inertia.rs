@@ -49,7 +49,7 @@ pub mod drag {
     /// Adds the drag residual (two-phase layouts only).
     pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
-        if nm.explicit {
+        if nm.is_explicit() {
             return;
         }
         let (nd, it) = (pt.layout.nd, &pt.interp);
@@ -65,7 +65,7 @@ pub mod drag {
     /// Adds w_f a₁ C in the u–u, u–U, U–u and U–U blocks.
     pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
         let Some(w) = pt.layout.w else { return };
-        if nm.explicit {
+        if nm.is_explicit() {
             return;
         }
         let (nd, m) = (pt.layout.nd, pt.size());

@@ -51,16 +51,19 @@
 //! ([`fbar`], [`kinematics::Kinematics::with_projected_volume`]).
 
 pub mod cell;
-pub mod dense;
 pub mod fbar;
 pub mod flow;
 pub mod inertia;
+pub mod input;
 pub mod kinematics;
 pub mod stress;
 
+use crate::layout::{Layout, MAX_DOF, MAX_DOF_3D};
 use crate::model::finite_strain;
 use crate::model::shape::Stencil;
 use crate::model::soil::{self, Constitutive, Stress, StressUpdate};
+use crate::scheme::Scheme;
+pub use input::ParticleInput;
 pub use kinematics::Kinematics;
 
 /// Largest number of stencil nodes of a particle in two dimensions (see
@@ -69,11 +72,6 @@ pub const MAX_NODES: usize = crate::model::shape::MAX_STENCIL;
 /// Largest number of stencil nodes of a particle in three dimensions (see
 /// [`crate::model::shape::MAX_STENCIL_3D`]).
 pub const MAX_NODES_3D: usize = crate::model::shape::MAX_STENCIL_3D;
-/// Largest number of dofs per node in two dimensions (u–p–U: 2D + 1), the size of a plane
-/// [`NodeState`].
-pub const MAX_DOF: usize = 5;
-/// Largest number of dofs per node in three dimensions (u–p–U: 2D + 1).
-pub const MAX_DOF_3D: usize = 7;
 /// Largest local block dimension of a plane point.
 pub const MAX_LOCAL: usize = MAX_NODES * MAX_DOF;
 
@@ -86,138 +84,6 @@ pub const fn strain_rows<const D: usize>() -> usize {
         soil::NS_PLANE
     } else {
         soil::NS
-    }
-}
-
-/// Component indices within a node of the two-phase layout.
-pub mod dof {
-    /// Solid displacement x.
-    pub const UX: usize = 0;
-    /// Solid displacement y.
-    pub const UY: usize = 1;
-    /// Pore pressure.
-    pub const P: usize = 2;
-    /// Water displacement x.
-    pub const WX: usize = 3;
-    /// Water displacement y.
-    pub const WY: usize = 4;
-}
-
-/// Which unknowns a node carries and where: the solid displacement always at 0 and 1, then the
-/// pore pressure and the water displacement if the system has them, and last the projected volume
-/// ratio of an implicit F̄ step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Layout {
-    /// The spatial dimension: the solid (and the water) displacement has this many components.
-    pub dim: usize,
-    /// Dofs per node.
-    pub nd: usize,
-    /// Offset of the pore pressure.
-    pub p: Option<usize>,
-    /// Offset of the water displacement's x component.
-    pub w: Option<usize>,
-    /// Offset of ϑ = J̄ − 1, the nodal value of [002]'s projected volume ratio in an implicit
-    /// step with F̄ ([`fbar`]; `stabilisation.fbar`).
-    pub jbar: Option<usize>,
-}
-
-impl Layout {
-    /// u (one-phase: total stress or dry).
-    pub const U: Layout = Layout { dim: 2, nd: 2, p: None, w: None, jbar: None };
-    /// u–p (the quasi-static Biot system, or undrained static): solid displacement and pore
-    /// pressure; the water follows the solid plus its Darcy flux.
-    pub const UP: Layout = Layout { dim: 2, nd: 3, p: Some(dof::P), w: None, jbar: None };
-    /// u–p–U.
-    pub const UPU: Layout = Layout { dim: 2, nd: 5, p: Some(dof::P), w: Some(dof::WX), jbar: None };
-    /// u–U (the explicit two-phase system, the "v–w form"): the motion of both phases at the
-    /// nodes, the pore pressure at the points (its continuity equation held point by point,
-    /// [`flow::continuity::pointwise_increment`]).
-    pub const UW: Layout = Layout { dim: 2, nd: 4, p: None, w: Some(2), jbar: None };
-    /// u with [002]'s F̄ in an implicit step: the solid displacement and the projected volume
-    /// ratio ϑ = J̄ − 1 at the nodes ([`fbar`]).
-    pub const U_FBAR: Layout = Layout { dim: 2, nd: 3, p: None, w: None, jbar: Some(2) };
-    /// u–p with F̄ (the quasi-static Biot system or an undrained static stage).
-    pub const UP_FBAR: Layout = Layout { dim: 2, nd: 4, p: Some(dof::P), w: None, jbar: Some(3) };
-
-    /// The layout of the same fields in `dim` dimensions: the solid displacement's `dim`
-    /// components first, then the pore pressure, the water displacement's `dim` components and
-    /// the projected volume ratio, each where the layout has it (the two-dimensional constants
-    /// are `Layout::U.in_dim(2)` and so on).
-    pub const fn in_dim(&self, dim: usize) -> Layout {
-        let mut nd = dim;
-        let p = if self.p.is_some() {
-            nd += 1;
-            Some(nd - 1)
-        } else {
-            None
-        };
-        let w = if self.w.is_some() {
-            nd += dim;
-            Some(nd - dim)
-        } else {
-            None
-        };
-        let jbar = if self.jbar.is_some() {
-            nd += 1;
-            Some(nd - 1)
-        } else {
-            None
-        };
-        Layout { dim, nd, p, w, jbar }
-    }
-
-    /// The layout with the projected volume ratio of an implicit F̄ step added (u and u–p only:
-    /// `None` for the others).
-    pub fn with_fbar(&self) -> Option<Layout> {
-        match *self {
-            Layout::U => Some(Layout::U_FBAR),
-            Layout::UP => Some(Layout::UP_FBAR),
-            _ => None,
-        }
-    }
-
-    /// The names of the layout's nodal fields, in dof order.
-    pub fn field_names(&self) -> &'static [&'static str] {
-        match (self.dim, self.p, self.w, self.jbar) {
-            (2, None, Some(_), _) => &["ux", "uy", "Ux", "Uy"],
-            (2, None, None, Some(_)) => &["ux", "uy", "Jbar"],
-            (2, Some(_), None, Some(_)) => &["ux", "uy", "p", "Jbar"],
-            (2, ..) => &["ux", "uy", "p", "Ux", "Uy"][..self.nd],
-            (_, None, Some(_), _) => &["ux", "uy", "uz", "Ux", "Uy", "Uz"],
-            (_, None, None, Some(_)) => &["ux", "uy", "uz", "Jbar"],
-            (_, Some(_), None, Some(_)) => &["ux", "uy", "uz", "p", "Jbar"],
-            _ => &["ux", "uy", "uz", "p", "Ux", "Uy", "Uz"][..self.nd],
-        }
-    }
-
-    /// The position in the full two-phase order (ux, uy, p, Ux, Uy; [`dof`]) of this layout's
-    /// dof component `c`, the order in which boundaries name what they fix; `None` for the
-    /// projected volume ratio, which no boundary fixes.
-    pub fn canonical(&self, c: usize) -> Option<usize> {
-        // The full two-phase layout of the same dimension: ux, uy, [uz,] p, Ux, Uy[, Uz].
-        let full = Layout::UPU.in_dim(self.dim);
-        match (self.p, self.w, self.jbar) {
-            (_, _, Some(j)) if c == j => None,
-            (_, Some(w), _) if c >= w => full.w.map(|fw| fw + c - w),
-            (Some(p), _, _) if c == p => full.p,
-            _ => Some(c),
-        }
-    }
-
-    /// The physical fields and their dof offsets: the solid displacement u, then the pore
-    /// pressure p and the water displacement U where the system has them.
-    pub fn fields(&self) -> Vec<(&'static str, Vec<usize>)> {
-        let mut out = vec![("u", (0..self.dim).collect())];
-        if let Some(p) = self.p {
-            out.push(("p", vec![p]));
-        }
-        if let Some(w) = self.w {
-            out.push(("U", (w..w + self.dim).collect()));
-        }
-        if let Some(j) = self.jbar {
-            out.push(("Jbar", vec![j]));
-        }
-        out
     }
 }
 
@@ -303,258 +169,6 @@ impl<const N: usize> NodeState<N> {
     #[inline]
     pub fn set(&mut self, c: usize, x: f64, nm: &Scheme) {
         (self.d[c], self.a[c], self.v[c]) = (x, nm.a0 * x, nm.a1 * x);
-    }
-}
-
-/// The particle quantities the kernels need (at t_n), in `D` dimensions (two unless it says
-/// otherwise).
-#[derive(Debug, Clone, Copy)]
-pub struct ParticleInput<const D: usize = 2> {
-    /// Volume V [m³ per m in two dimensions, m³ in three].
-    pub volume: f64,
-    /// Porosity n.
-    pub porosity: f64,
-    /// Mass of the u equation (grains, or mixture in one-phase) [kg].
-    pub mass: f64,
-    /// Water mass n ρ_w V [kg] (two-phase).
-    pub water_mass: f64,
-    /// Drag coefficient n² γ_w V / k [N s/m] (two-phase).
-    pub drag: f64,
-    /// 1/Q [1/Pa] (two-phase).
-    pub inv_q: f64,
-    /// Mobility k/γ_w of Darcy's law [m²/(Pa s)] (two-phase).
-    pub mobility: f64,
-    /// Water density ρ_w [kg/m³] (two-phase).
-    pub water_density: f64,
-    /// Pore-pressure gradient at t_n [Pa/m] (two-phase), carried by the particle.
-    pub grad_p: [f64; D],
-    /// Effective stress at t_n [Pa].
-    pub stress: Stress,
-    /// Deformation gradient at t_n (in-plane in two dimensions; what a hyperelastic model's
-    /// stress follows).
-    pub def_grad: [[f64; D]; D],
-    /// Accumulated deviatoric plastic strain ε̄ at t_n (the soil model's internal variable).
-    pub eps_pd: f64,
-    /// Pore pressure at t_n [Pa].
-    pub p: f64,
-    /// Body acceleration at t_{n+1} [m/s²].
-    pub body_acc: [f64; D],
-    /// Porosity gradient ∇n at t_n [1/m] (two-phase).
-    pub grad_n: [f64; D],
-    /// Newmark predictors of the point.
-    pub pred: Predictors<D>,
-    /// A geometrically linear step (`analysis.kinematics = "linear_increments"`, [001] Eqs. 5, 7,
-    /// 11): see [`kinematics`].
-    pub linear: bool,
-    /// The F̄ projection's scale c of the step's in-plane deformation, ΔF̄ = c ΔF ([002] Eq. 27;
-    /// 1 without it), which the rate-form stress updates see: see
-    /// [`kinematics::Kinematics::with_volume_scale`].
-    pub fbar: f64,
-    /// The F̄ projection's scale of the point's total deformation, F̄ = s F with s = (J̄/J)^{1/D}
-    /// ([002] Eq. 18; 1 without it), which a hyperelastic model sees: at the step's start that
-    /// of the point's stored J̄ (its stress σ_n), at its end that of the projected J̄_{n+1}.
-    pub fbar_total: f64,
-    /// The step's Δt [s], which a rate-dependent model (the Newtonian fluid's viscosity) divides
-    /// the step's deformation by; 0 where no step is being taken.
-    pub dt: f64,
-    /// [002]'s projected volume ratio J̄_p^n the point carries (1 without F̄): an implicit F̄
-    /// step's stress sees the volume ratio J̄_{n+1}/J̄_n ([`fbar`]).
-    pub jbar: f64,
-    /// The scale κ [Pa/m] of an implicit F̄ step's projection rows ([`fbar`]; 0 otherwise).
-    pub fbar_rows: f64,
-}
-
-/// How a stage treats time ([`Scheme`] is its form for one step of length Δt).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Integration {
-    /// Dynamics with the generalized-α method of Chung & Hulbert (1993): inertia at
-    /// t_{n+1−α_m}, every other force of the momentum balances at t_{n+1−α_f}, with the Newmark
-    /// updates of parameters β and γ. Newmark is α_m = α_f = 0.
-    Dynamic {
-        /// Newmark β.
-        beta: f64,
-        /// Newmark γ.
-        gamma: f64,
-        /// α_m.
-        alpha_m: f64,
-        /// α_f.
-        alpha_f: f64,
-    },
-    /// No inertia; the water's mass balance with Darcy's law, its flux at t_{n+θ} (θ-method;
-    /// θ = 1 is backward Euler).
-    QuasiStatic {
-        /// θ ∈ [1/2, 1].
-        theta: f64,
-    },
-    /// No inertia, no flow (drained with the pore pressure held, total stress, or undrained).
-    Static,
-    /// Explicit dynamics, update-stress-last ([002] §2.2, Eqs. 7–17): the nodal velocities follow
-    /// from the lumped mass and the forces of the step's start (`assembly::explicit`); the
-    /// kernels see the step as a static one (no inertia terms: the step's out-of-balance force is
-    /// the inertia).
-    Explicit {
-        /// FLIP share η of the particle velocity update ([002] Eq. 13).
-        flip: f64,
-        /// Local damping α (Al-Kafaji 2013).
-        damping: f64,
-        /// The order m of the XPIC transfer (Hammerquist & Nairn 2017) that replaces the FLIP/PIC
-        /// blend; 0 for the blend.
-        xpic: u8,
-        /// A two-phase stage's pore pressure held point by point (the "v–w" form) rather than by
-        /// the lumped nodal continuity equation (`assembly::explicit`).
-        pointwise_pressure: bool,
-    },
-}
-
-impl Integration {
-    /// Whether a step starts from the last increment scaled to its Δt (a constant-rate predictor,
-    /// as static and consolidation codes do) rather than from Δd = 0. Without inertia the path is
-    /// smooth in the load, and the extrapolated increment leaves only the change of the rate to
-    /// Newton: an elastic load step then converges in one iteration instead of two. The dynamic
-    /// schemes start from Δd = 0, which is their own (Newmark) predictor of the motion.
-    pub fn extrapolates(&self) -> bool {
-        !matches!(self, Integration::Dynamic { .. } | Integration::Explicit { .. })
-    }
-
-    /// Whether the step is explicit (no equations are solved).
-    pub fn is_explicit(&self) -> bool {
-        matches!(self, Integration::Explicit { .. })
-    }
-
-    /// Newmark's method with β and γ.
-    pub fn newmark(beta: f64, gamma: f64) -> Integration {
-        Integration::Dynamic { beta, gamma, alpha_m: 0.0, alpha_f: 0.0 }
-    }
-
-    /// The generalized-α method with the spectral radius ρ∞ ∈ [0, 1] at infinite frequency
-    /// (Chung & Hulbert 1993, Eqs. 25 and 17): α_m = (2ρ∞ − 1)/(ρ∞ + 1), α_f = ρ∞/(ρ∞ + 1),
-    /// γ = 1/2 − α_m + α_f, β = (1 − α_m + α_f)²/4; second-order accurate, unconditionally stable,
-    /// with the least low-frequency damping for the high-frequency damping ρ∞ asks for.
-    pub fn generalized_alpha(rho_inf: f64) -> Integration {
-        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
-        let alpha_f = rho_inf / (rho_inf + 1.0);
-        let gamma = 0.5 - alpha_m + alpha_f;
-        Integration::Dynamic { beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2), gamma, alpha_m, alpha_f }
-    }
-}
-
-/// One step of length Δt under an [`Integration`]: the factors a₀ = ∂a/∂Δd = 1/(βΔt²) and
-/// a₁ = ∂v/∂Δd = γ/(βΔt) (zero without inertia), and the weights of the terms at t_{n+1}.
-#[derive(Debug, Clone, Copy)]
-pub struct Scheme {
-    /// ∂a_{n+1}/∂Δd.
-    pub a0: f64,
-    /// ∂v_{n+1}/∂Δd.
-    pub a1: f64,
-    /// Weight of the inertia terms m a_{n+1}: 1 − α_m.
-    pub w_inertia: f64,
-    /// Weight of the other momentum terms at t_{n+1} (stress, pressure, drag, body force,
-    /// external loads): 1 − α_f.
-    pub w_force: f64,
-    /// Weight of the mass balance of the water (continuity and Darcy flux): 1 (0 in the
-    /// generalized-α history, which has none).
-    pub w_mass: f64,
-    /// Δt of the Darcy flux in the continuity rows (u–p), 0 where the water's motion is an unknown
-    /// or there is no flow.
-    pub flow_dt: f64,
-    /// θ of the Darcy flux.
-    pub theta: f64,
-    beta: f64,
-    gamma: f64,
-    dt: f64,
-    /// An explicit step: its "predictors" are the velocity and acceleration of the step's start
-    /// interpolated from the nodes (what the FLIP update needs); no term of the residual uses them.
-    explicit: bool,
-}
-
-impl Scheme {
-    /// The step's Δt [s].
-    pub fn dt(&self) -> f64 {
-        self.dt
-    }
-
-    /// Whether the step is explicit (its forces are those of its start).
-    pub fn is_explicit(&self) -> bool {
-        self.explicit
-    }
-
-    /// Newmark factors for step `dt`.
-    pub fn newmark(beta: f64, gamma: f64, dt: f64) -> Scheme {
-        Scheme::of(&Integration::newmark(beta, gamma), dt, false)
-    }
-
-    /// The scheme of `integration` for a step `dt`; `flow` says whether the layout carries Darcy's
-    /// flux (u–p: a pressure and no water motion).
-    pub fn of(integration: &Integration, dt: f64, flow: bool) -> Scheme {
-        let mut s = Scheme {
-            a0: 0.0,
-            a1: 0.0,
-            w_inertia: 0.0,
-            w_force: 1.0,
-            w_mass: 1.0,
-            flow_dt: 0.0,
-            theta: 1.0,
-            beta: 0.25,
-            gamma: 0.5,
-            dt,
-            explicit: integration.is_explicit(),
-        };
-        match *integration {
-            Integration::Dynamic { beta, gamma, alpha_m, alpha_f } => {
-                s.a0 = 1.0 / (beta * dt * dt);
-                s.a1 = gamma / (beta * dt);
-                s.w_inertia = 1.0 - alpha_m;
-                s.w_force = 1.0 - alpha_f;
-                (s.beta, s.gamma) = (beta, gamma);
-                if flow {
-                    s.flow_dt = dt;
-                }
-            }
-            Integration::QuasiStatic { theta } => {
-                s.theta = theta;
-                if flow {
-                    s.flow_dt = dt;
-                }
-            }
-            Integration::Static | Integration::Explicit { .. } => {}
-        }
-        s
-    }
-
-    /// The weights of the generalized-α history: α_m on the inertia at t_n, α_f on the forces at
-    /// t_n, nothing on the mass balance; `None` for a scheme without one (Newmark, static).
-    pub fn history(&self) -> Option<Scheme> {
-        let (am, af) = (1.0 - self.w_inertia, 1.0 - self.w_force);
-        if self.a0 == 0.0 || (am == 0.0 && af == 0.0) {
-            return None;
-        }
-        Some(Scheme { a0: 0.0, a1: 0.0, w_inertia: am, w_force: af, w_mass: 0.0, flow_dt: 0.0, ..*self })
-    }
-
-    /// The same scheme with the terms at t_{n+1} unweighted (w_m = w_f = 1): the balance at t_{n+1}
-    /// for the equilibrium identity.
-    pub fn unweighted(&self) -> Scheme {
-        // An explicit step has no inertia terms (its inertia is the lumped nodal update's).
-        Scheme { w_inertia: if self.explicit { 0.0 } else { 1.0 }, w_force: 1.0, ..*self }
-    }
-
-    /// Predictors (ã_n, ṽ_n) of a point with velocity `v` and acceleration `a` at t_n ([003] Eq. 21
-    /// at Δd = 0); zero without inertia.
-    pub fn predict<const D: usize>(&self, v: [f64; D], a: [f64; D]) -> ([f64; D], [f64; D]) {
-        if self.explicit {
-            return (a, v);
-        }
-        if self.a0 == 0.0 {
-            return ([0.0; D], [0.0; D]);
-        }
-        let (b, g, dt) = (self.beta, self.gamma, self.dt);
-        let pa = |c: usize| -v[c] / (b * dt) - (0.5 / b - 1.0) * a[c];
-        let pv = |c: usize| -(g / b - 1.0) * v[c] - (0.5 * g / b - 1.0) * dt * a[c];
-        let (mut oa, mut ov) = ([0.0; D], [0.0; D]);
-        for c in 0..D {
-            (oa[c], ov[c]) = (pa(c), pv(c));
-        }
-        (oa, ov)
     }
 }
 
@@ -863,7 +477,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
         let f_bar = sk.f_bar();
         let df = f_bar.map(|r| r.map(|v| v * part.fbar));
-        let f_new = kinematics::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
+        let f_new = crate::algebra::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
         let upd = model
             .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));

@@ -26,8 +26,8 @@
 //! ∂T'_i/∂Δu_l,r = −T'_i T'_l (T' = T/F_θθ) gives the geometric part
 //! −V_{n+1} (dev σ'_θθ T'_i T'_l + σ'_m T̄'_i T̄'_l) in the r–r entry.
 
-use super::kinematics::Mat;
 use super::{bbar, kinematics, strain_rows, Point, Scheme};
+use crate::algebra::Mat;
 use crate::model::soil::{principal, Stress, NS};
 
 /// The deviatoric stress (its in-plane part in two dimensions) and the mean stress (σ_zz
@@ -41,7 +41,7 @@ fn split<const D: usize>(s: &Stress) -> (Mat<D>, f64) {
 /// dev σ v (dev σ is symmetric: its transpose's product).
 #[inline]
 fn dev_times<const D: usize>(dev: &Mat<D>, v: [f64; D]) -> [f64; D] {
-    kinematics::mul_t(dev, v)
+    crate::algebra::mul_t(dev, v)
 }
 
 /// The force of stress `s` on a node with gradients (g, gv) on x_{n+1}, per unit volume.

@@ -11,7 +11,7 @@
 //! the stress into R σ Rᵀ.
 
 use super::soil::principal::{self, Principal};
-use super::soil::{Stress, NS};
+use super::soil::stress::{Stress, NS};
 
 /// An in-plane 2 × 2 matrix.
 pub type M2 = [[f64; 2]; 2];
@@ -359,7 +359,7 @@ mod tests {
     }
 
     fn q_of(s: Stress) -> f64 {
-        crate::verification::invariants(&s).1
+        crate::model::soil::invariants(&s).1
     }
 
     #[test]

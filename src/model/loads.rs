@@ -147,27 +147,13 @@ pub enum LoadTarget<const D: usize = 2> {
     BodyForce { acceleration: [f64; D], bodies: Option<Vec<u16>> },
     /// A pressure on a fixed polyline: its Gauss points with the force per unit pressure there
     /// (weight × length × the unit normal to the left) [m].
-    LinePressure { points: Vec<([f64; 2], [f64; 2])>, pressure: f64 },
-}
-
-impl LoadDef {
-    /// Resolves a case load on this rank's particles and the grid.
-    pub fn from_case(l: &case::Load, c: &case::Case, grid: &Grid, particles: &Particles) -> LoadDef {
-        match l {
-            case::Load::LinePressure { points, pressure, .. } => LoadDef::with_target(
-                l,
-                c,
-                LoadTarget::LinePressure { points: line_gauss_points(points), pressure: *pressure },
-            ),
-            _ => LoadDef::from_case_in(l, c, grid, particles).expect("a load of any dimension"),
-        }
-    }
+    LinePressure { points: Vec<([f64; D], [f64; D])>, pressure: f64 },
 }
 
 impl<const D: usize> LoadDef<D> {
     /// Resolves a case load of any dimension on this rank's particles and the grid: a face
-    /// traction, a nodal traction or a body force (`None` for the plane's line pressures, which
-    /// validation keeps out of three-dimensional cases).
+    /// traction, a nodal traction, a body force or, in the plane, a line pressure (`None` for a
+    /// line pressure in three dimensions, which validation refuses).
     pub fn from_case_in(
         l: &case::Load,
         c: &case::Case,
@@ -196,6 +182,11 @@ impl<const D: usize> LoadDef<D> {
                 bodies: bodies
                     .as_ref()
                     .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
+            },
+            // A pressure on a polyline of the plane (validation keeps it out of three dimensions).
+            case::Load::LinePressure { points, pressure, .. } if D == 2 => LoadTarget::LinePressure {
+                points: line_gauss_points(points).into_iter().map(|(x, f)| (vector(&x), vector(&f))).collect(),
+                pressure: *pressure,
             },
             case::Load::LinePressure { .. } => return None,
         };
@@ -376,7 +367,7 @@ impl<const D: usize> Motion<D> {
     /// exp(L s): the deformation gradient of the motion's homogeneous flow at flow parameter `s`
     /// (None without a velocity gradient).
     pub fn flow(&self, s: f64) -> Option<[[f64; D]; D]> {
-        self.gradient.as_ref().map(|(l, _)| crate::model::linalg::expm(l.map(|row| row.map(|v| v * s))))
+        self.gradient.as_ref().map(|(l, _)| crate::algebra::linalg::expm(l.map(|row| row.map(|v| v * s))))
     }
 
     /// ∫₀ᵗ f dτ: the argument of the flow's exponential at `t`.
@@ -434,9 +425,17 @@ pub struct BoundaryDef<const D: usize = 2> {
 }
 
 impl BoundaryDef {
+    /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
+    /// particles, see [`crate::model::Model::surface_fixes`]).
+    pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
+        self.holds_node(grid, [i, j])
+    }
+}
+
+impl<const D: usize> BoundaryDef<D> {
     /// The axis of an axisymmetric model: u_r = 0 and U_r = 0 on the grid side r = 0 (named
     /// [`super::AXIS`]; it is not a case boundary and holds in every stage).
-    pub fn axis() -> BoundaryDef {
+    pub fn axis() -> BoundaryDef<D> {
         BoundaryDef {
             name: super::AXIS.to_string(),
             side: Some(Side::XMin),
@@ -448,14 +447,6 @@ impl BoundaryDef {
         }
     }
 
-    /// Whether node (i, j) belongs to it (sides and regions; surfaces are resolved per step from the
-    /// particles, see [`crate::model::Model::surface_fixes`]).
-    pub fn contains(&self, grid: &Grid, i: usize, j: usize) -> bool {
-        self.holds_node(grid, [i, j])
-    }
-}
-
-impl<const D: usize> BoundaryDef<D> {
     /// Whether this is the axis of an axisymmetric model.
     pub fn is_axis(&self) -> bool {
         self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()

@@ -138,7 +138,7 @@ impl<const D: usize> Particles<D> {
     /// body that contains it. Cells and their sub-cells are visited x fastest.
     pub fn generate(case: &Case, grid: &Grid<D>, owned: impl Fn([usize; D]) -> bool) -> Particles<D> {
         let mut ps = Particles::default();
-        let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+        let pore_water = case.analysis.formulation == Formulation::TwoPhase;
         let geometry = super::geometry_of(case);
         for (b, body) in case.bodies.iter().enumerate() {
             let mat_index = case.material_index(&body.material).expect("validated");
@@ -172,7 +172,7 @@ impl<const D: usize> Particles<D> {
                     let earlier = case.bodies[..b].iter().any(|o| case.body_holds(o, x));
                     if case.body_holds(body, x) && !earlier && owned(cell) {
                         let vol = volume * geometry.measure(x[0]);
-                        ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), two_phase);
+                        ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), pore_water);
                     }
                     if !super::shape::next_combination(&mut sub, [n; D]) {
                         break;
@@ -194,10 +194,10 @@ impl<const D: usize> Particles<D> {
         grid: &Grid<D>,
         (id, b, mat_index): (u64, usize, usize),
         (x, lp, vol): ([f64; D], [f64; D], f64),
-        two_phase: bool,
+        pore_water: bool,
     ) {
         let (body, mat) = (&case.bodies[b], &case.materials[mat_index]);
-        let mass = if two_phase {
+        let mass = if pore_water {
             (1.0 - mat.porosity) * mat.solid_density * vol
         } else {
             ((1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density) * vol
@@ -221,7 +221,7 @@ impl<const D: usize> Particles<D> {
         ps.acc_w.push([0.0; D]);
         let (stress, p, grad_p) = match (&body.initial_stress, body.uniform_stress_vector()) {
             (Some(init), _) => {
-                let (s, p, grad_p) = geostatic(case, grid, init, x, two_phase);
+                let (s, p, grad_p) = geostatic(case, grid, init, x, pore_water);
                 (crate::model::soil::plane(s), p, grad_p)
             }
             (None, Some(s)) => (s, 0.0, [0.0; D]),
@@ -253,12 +253,12 @@ fn geostatic<const D: usize>(
     grid: &Grid<D>,
     init: &crate::case::InitialStress,
     x: [f64; D],
-    two_phase: bool,
+    pore_water: bool,
 ) -> ([f64; 4], f64, [f64; D]) {
     let g = case.analysis.g;
     let (surface, mass) = case.column_above(x, grid.h[1] / 50.0);
     let sigma_v = -g * mass;
-    let (p, grad_p) = if two_phase {
+    let (p, grad_p) = if pore_water {
         let rho_w = case
             .body_at(x)
             .map_or(1000.0, |b| case.materials[case.material_index(&b.material).expect("validated")].water_density);
@@ -519,7 +519,7 @@ mod tests {
         assert_eq!(m.fixing_boundaries(&active, [2, 10, 1]), [None; 7]);
         let motion = m.boundaries[2].motion.as_ref().unwrap();
         assert_eq!(motion.displacement_at(0.05), [0.001, -0.01, 0.002]);
-        assert_eq!(crate::kernels::Layout::UPU.in_dim(3).canonical(6), Some(6));
-        assert_eq!(crate::kernels::Layout::UP.in_dim(3).canonical(3), Some(3));
+        assert_eq!(crate::layout::Layout::UPU.in_dim(3).canonical(6), Some(6));
+        assert_eq!(crate::layout::Layout::UP.in_dim(3).canonical(3), Some(3));
     }
 }

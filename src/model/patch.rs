@@ -145,7 +145,7 @@ fn fit<const D: usize>(pts: &[PatchPoint<D>], at: [f64; D]) -> f64 {
         }
     }
     // Symmetric positive definite when the slopes are kept only where the points spread.
-    let coef = crate::model::linalg::solve(a, b, m).unwrap_or([b[0] / a[0][0], 0.0, 0.0, 0.0]);
+    let coef = crate::algebra::linalg::solve(a, b, m).unwrap_or([b[0] / a[0][0], 0.0, 0.0, 0.0]);
     basis(at).iter().zip(coef).map(|(q, c)| q * c).sum()
 }
 

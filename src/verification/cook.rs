@@ -16,8 +16,9 @@
 //!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which item 13 compares
 //!   between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
 
-use super::{invariants, Check, Findings, Metric};
+use super::{Check, Findings, Metric};
 use crate::case::{Case, Verification};
+use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;
@@ -121,7 +122,7 @@ fn fit_sums(points: impl Iterator<Item = ([f64; 2], f64)>, radius: f64) -> ([f64
 /// do not determine a plane.
 fn fitted(sums: &[f64]) -> f64 {
     let a = [[sums[0], sums[1], sums[2]], [sums[1], sums[3], sums[4]], [sums[2], sums[4], sums[5]]];
-    crate::model::linalg::solve(a, [sums[6], sums[7], sums[8]], 3).map_or(f64::NAN, |c| c[0])
+    crate::algebra::linalg::solve(a, [sums[6], sums[7], sums[8]], 3).map_or(f64::NAN, |c| c[0])
 }
 
 impl Check for CookCheck {

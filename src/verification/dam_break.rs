@@ -28,8 +28,9 @@
 //! The comparison of two runs (F̄ with uGIMP against F̄ with B-splines, [002] Fig. 13; F̄ against
 //! standard MPM) reads the history columns and the results of both.
 
-use super::{invariants, Check, Findings, Metric};
+use super::{Check, Findings, Metric};
 use crate::case::{Case, Load, Shape, Verification};
+use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::{Axis, ColourMap, Figure, MapPoints, Series, Style};

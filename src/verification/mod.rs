@@ -38,6 +38,7 @@ pub mod waves;
 pub mod xie_leo;
 
 use crate::case::{self, Case, ConductivityLaw, Load, TimeFunction, Verification};
+use crate::layout::Dim;
 use crate::model::Model;
 use crate::parallel::Collective;
 use serde::Serialize;
@@ -149,14 +150,6 @@ pub(crate) fn elastic_body(c: &Case, body: &str) -> Result<(usize, f64, f64), St
     }
 }
 
-/// σ_m and q = √(3J₂) of a stress [xx, yy, xy, zz, yz, zx].
-pub(crate) fn invariants(s: &crate::model::soil::Stress) -> (f64, f64) {
-    let m = (s[0] + s[1] + s[3]) / 3.0;
-    let d = [s[0] - m, s[1] - m, s[3] - m];
-    let shear = s[2] * s[2] + s[4] * s[4] + s[5] * s[5];
-    (m, (1.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * shear)).sqrt())
-}
-
 /// The time function a load names (a constant 1 if none).
 pub(crate) fn load_time_fn(c: &Case, name: &Option<String>) -> crate::model::loads::TimeFn {
     name.as_ref()
@@ -230,27 +223,43 @@ impl Column {
     }
 }
 
-/// The check the case asks for in dimension D: [`for_case`] in the plane; in three dimensions the
-/// checks validation lets a three-dimensional case ask for (the consolidating column against
-/// Terzaghi, the bearing capacity, the run-out and the patch test).
+/// The checks a case of dimension D may ask for: every check in the plane ([`for_case`]); in
+/// three dimensions those validation lets a three-dimensional case ask for (the consolidating
+/// column against Terzaghi, the bearing capacity, the run-out and the patch test).
+pub trait CaseChecks<const D: usize> {
+    /// The check the case asks for, if any (collective).
+    fn for_case(c: &Case, model: &Model<D>, coll: &Collective) -> Result<Option<Box<dyn Check<D>>>, String>;
+}
+
+impl CaseChecks<2> for Dim<2> {
+    fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box<dyn Check>>, String> {
+        for_case(c, model, coll)
+    }
+}
+
+impl CaseChecks<3> for Dim<3> {
+    fn for_case(c: &Case, model: &Model<3>, coll: &Collective) -> Result<Option<Box<dyn Check<3>>>, String> {
+        match &c.verification {
+            None => Ok(None),
+            Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
+            Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
+            Some(Verification::Runout { .. }) => Ok(Some(Box::new(runout::RunoutCheck::new(c, model, coll)?))),
+            Some(Verification::Patch { .. }) => Ok(Some(Box::new(patch::PatchCheck::new(c, model)?))),
+            Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
+        }
+    }
+}
+
+/// The check the case asks for in dimension D ([`CaseChecks`]).
 pub fn for_case_in<const D: usize>(
     c: &Case,
     model: &Model<D>,
     coll: &Collective,
-) -> Result<Option<Box<dyn Check<D>>>, String> {
-    if let Some(plane) = model.as_plane() {
-        // The same boxed checks, seen as those of dimension D = 2.
-        let checks: Box<dyn std::any::Any> = Box::new(for_case(c, plane, coll)?);
-        return Ok(*checks.downcast::<Option<Box<dyn Check<D>>>>().expect("the checks of a plane model"));
-    }
-    match &c.verification {
-        None => Ok(None),
-        Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
-        Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
-        Some(Verification::Runout { .. }) => Ok(Some(Box::new(runout::RunoutCheck::new(c, model, coll)?))),
-        Some(Verification::Patch { .. }) => Ok(Some(Box::new(patch::PatchCheck::new(c, model)?))),
-        Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
-    }
+) -> Result<Option<Box<dyn Check<D>>>, String>
+where
+    Dim<D>: CaseChecks<D>,
+{
+    <Dim<D> as CaseChecks<D>>::for_case(c, model, coll)
 }
 
 /// The footing of the case's `bearing_capacity` verification, in any dimension.

@@ -258,7 +258,7 @@ mod tests {
         assert!(close(&s2, &s3, 1e-9), "{s2:?} against {s3:?}");
 
         let l = [[0.02, -0.3, 0.1], [0.25, -0.01, 0.05], [-0.08, 0.15, 0.03]];
-        let f = embed(&crate::model::linalg::expm(l));
+        let f = embed(&crate::algebra::linalg::expm(l));
         let (ln_v, r) = log_stretch_and_rotation(&f);
         let rt: M3 = std::array::from_fn(|i| std::array::from_fn(|k| r[k][i]));
         let rrt = mul(r, rt);

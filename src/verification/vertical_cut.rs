@@ -16,9 +16,10 @@
 //! * the total variation Σ|Δσ_m| over the run of the mean stress at the points nearest `b` (in
 //!   the shear band) and `c` (in the sliding block), [001]'s p–q paths of Figs. 30–31 in one number.
 
-use super::{invariants, Check, Findings, Metric};
+use super::{Check, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::case::{Case, SoilModel, Verification};
+use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;

@@ -208,7 +208,7 @@ unsafe extern "C" fn field_converged(
     if n == 0 {
         test.next_check = None;
     }
-    code(crate::snes::guarded(|| test.converged(ksp, n, rnorm, reason)), "field-wise convergence test")
+    code(crate::callback::guarded(|| test.converged(ksp, n, rnorm, reason)), "field-wise convergence test")
 }
 
 /// The PETSc error code of a callback's outcome, its message recorded for the caller.
@@ -243,7 +243,7 @@ pub(crate) unsafe extern "C" fn post_solve(
     }
     // SAFETY: `ctx` is the address of the Box<FieldMonitor> owned by the Snes, which outlives its KSP.
     let monitor = unsafe { &mut *(ctx as *mut FieldMonitor) };
-    code(crate::snes::guarded(|| monitor.record(ksp, b, x)), "per-field residuals of the linear solve")
+    code(crate::callback::guarded(|| monitor.record(ksp, b, x)), "per-field residuals of the linear solve")
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@ macro_rules! call {
     };
 }
 
+pub mod callback;
 pub mod comm;
 pub mod dm;
 pub mod error;

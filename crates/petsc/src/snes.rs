@@ -6,6 +6,7 @@
 //! trial state as inadmissible (`SNESSetFunctionDomainError`), which makes the solve end as diverged
 //! instead of failing, so the caller can cut the step.
 
+use crate::callback::guarded;
 use crate::fields::{FieldMonitor, FieldTest, Fields};
 use crate::ksp::{KspOps, KspRef};
 use crate::mat::{Mat, MatRef};
@@ -13,26 +14,6 @@ use crate::vector::{VecOps, VecRef, Vector};
 use crate::{cstring, error, Comm, Int, Real, Result};
 use petsc_sys as sys;
 use std::ffi::{c_char, c_void, CStr};
-use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-/// Callbacks running now in this process (their panics are caught and become SNES errors).
-static IN_CALLBACK: AtomicUsize = AtomicUsize::new(0);
-
-/// Whether a residual or Jacobian callback is running in this process (on any thread, so also
-/// on the worker threads a callback starts): a panic then is caught and becomes an error that
-/// every rank agrees on, and a panic hook must not end the process for it.
-pub fn in_callback() -> bool {
-    IN_CALLBACK.load(Ordering::SeqCst) > 0
-}
-
-/// Runs `f` counted as a callback (see [`in_callback`]), catching its panic.
-pub(crate) fn guarded<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
-    IN_CALLBACK.fetch_add(1, Ordering::SeqCst);
-    let r = catch_unwind(AssertUnwindSafe(f));
-    IN_CALLBACK.fetch_sub(1, Ordering::SeqCst);
-    r
-}
 
 /// Why a callback could not produce its result.
 #[derive(Debug, Clone)]

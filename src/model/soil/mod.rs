@@ -16,47 +16,15 @@
 
 pub mod mohr_coulomb;
 pub mod principal;
+pub mod stress;
 pub mod von_mises;
 
 pub use mohr_coulomb::MohrCoulomb;
+pub use stress::{invariants, plane, plane_block, Mat6, Stress, IDENTITY6, NS, NS_PLANE};
 pub use von_mises::VonMises;
 
 use crate::model::finite_strain::M3;
 use principal::Principal;
-
-/// Components of the stress and strain vectors.
-pub const NS: usize = 6;
-
-/// Components of the stress and strain vectors a plane-strain or axisymmetric point uses
-/// ([xx, yy, xy, zz]; its yz and zx are zero).
-pub const NS_PLANE: usize = 4;
-
-/// A stress [xx, yy, xy, zz, yz, zx] (tensor shears) or strain (engineering shears) vector.
-pub type Stress = [f64; NS];
-
-/// A 6×6 matrix in the stress-vector basis.
-pub type Mat6 = [[f64; NS]; NS];
-
-/// The 6×6 identity.
-pub const IDENTITY6: Mat6 = {
-    let mut m = [[0.0; NS]; NS];
-    let mut k = 0;
-    while k < NS {
-        m[k][k] = 1.0;
-        k += 1;
-    }
-    m
-};
-
-/// The block of a 6×6 matrix a plane-strain or axisymmetric point uses ([xx, yy, xy, zz]).
-pub fn plane_block(m: &Mat6) -> [[f64; NS_PLANE]; NS_PLANE] {
-    std::array::from_fn(|r| std::array::from_fn(|c| m[r][c]))
-}
-
-/// The stress vector of a plane state [xx, yy, xy, zz] (yz = zx = 0).
-pub fn plane(s: [f64; NS_PLANE]) -> Stress {
-    [s[0], s[1], s[2], s[3], 0.0, 0.0]
-}
 
 /// Where a return mapping ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -25,7 +25,7 @@
 //! yield and flow normals of the active planes and J the local Jacobian.
 
 use super::{Region, ReturnResult};
-use crate::model::linalg::solve;
+use crate::algebra::linalg::solve;
 
 /// Mohr–Coulomb parameters (angles in radians, stresses in Pa).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -14,7 +14,7 @@
 //! and λ_Z = σ_zz with e_Z = (0, 0, 1). A general one is diagonalised by cyclic Jacobi rotations,
 //! which keep every eigenvalue to relative round-off.
 
-use super::{Mat6, Stress, NS};
+use super::stress::{Mat6, Stress, NS};
 
 /// The (row, column) of each stress-vector component in the symmetric tensor.
 pub const TENSOR_INDEX: [(usize, usize); NS] = [(0, 0), (1, 1), (0, 1), (2, 2), (1, 2), (2, 0)];

@@ -264,7 +264,7 @@ fn tresca_limits_the_largest_shear_stress_to_the_cohesion() {
 fn von_mises_returns_radially_and_softens_to_the_residual_strength() {
     let model = vm(12.0 * KPA, 3.0 * KPA, -30.0 * KPA);
     let Constitutive::VonMises(_, p) = model else { unreachable!() };
-    let q = |s: &Stress| crate::verification::invariants(s).1;
+    let q = |s: &Stress| crate::model::soil::invariants(s).1;
     for (eps0, l) in [
         (0.0, [0.0, -40.0, -10.0]),
         (0.1, [5.0, -60.0, -20.0]),
