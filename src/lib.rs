@@ -23,6 +23,7 @@ pub mod progress;
 pub mod report;
 pub mod state;
 pub mod sweep;
+pub mod validation;
 pub mod verification;
 
 /// porompm's version and git revision.

@@ -171,9 +171,9 @@ impl Model {
     pub fn build(case: &Case, owned: impl Fn(usize, usize) -> bool) -> Model {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, |c| owned(c[0], c[1]));
-        let loads = case.loads.iter().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
+        let loads = case.load_ids().map(|l| LoadDef::from_case(l, case, &grid, &particles)).collect();
         let mut boundaries: Vec<BoundaryDef> =
-            case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
+            case.boundary_ids().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
         let geometry = geometry_of(case);
         if geometry.axisymmetric() && grid.origin[0].abs() <= 1e-12 * grid.h[0] {
             boundaries.push(BoundaryDef::axis());
@@ -202,8 +202,8 @@ impl Model<3> {
     pub fn build_solid(case: &Case, owned: impl Fn([usize; 3]) -> bool) -> Model<3> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
-        let boundaries = case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
-        let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
+        let boundaries = case.boundary_ids().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
+        let loads = case.load_ids().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
         Model { loads, boundaries, ..Model::bare(case, grid, particles) }
     }
 }
@@ -233,7 +233,7 @@ impl<const D: usize> Model<D> {
     /// Resolves the case's moving surfaces again on this rank's points (see
     /// [`Model::resolve_targets`]).
     fn resolve_surfaces(&mut self, case: &Case) {
-        for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
+        for (b, c) in self.boundaries.iter_mut().zip(case.boundary_ids()) {
             if b.surface.is_some() {
                 *b = BoundaryDef::from_case(c, case, &self.particles);
             }
@@ -374,7 +374,7 @@ impl<const D: usize> Model<D> {
     /// this rank's points, after points moved between ranks. Both depend only on what travels with
     /// a point (its body, and its position and domain at t = 0), so every point keeps its loads.
     pub fn resolve_targets(&mut self, case: &Case) {
-        for (l, c) in self.loads.iter_mut().zip(&case.loads) {
+        for (l, c) in self.loads.iter_mut().zip(case.load_ids()) {
             if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
                 // The state of a load with increments is global (the same on every rank): kept.
                 let increments = l.increments.take();
@@ -731,7 +731,7 @@ mod tests {
 
     /// The two-phase column of the case tests, with gravity's pore-pressure gradient on its points.
     fn column() -> Model {
-        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
         let mut m = Model::build(&c, |_, _| true);
         m.integration = crate::kernels::Integration::QuasiStatic { theta: 1.0 };
         for g in m.particles.grad_p.iter_mut() {
@@ -752,7 +752,7 @@ mod tests {
         .iter()
         .map(|s| crate::case::Override::parse(s).unwrap())
         .collect();
-        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
         let mut m = Model::build(&c, |_, _| true);
         let strength = |m: &Model| match &m.materials[0].model {
             crate::model::soil::Constitutive::MohrCoulomb(_, mc) => (mc.cohesion, mc.phi.tan()),
