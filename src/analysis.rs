@@ -43,7 +43,7 @@ impl StageAnalysis {
         let mut analysis = match stage.analysis {
             AnalysisType::Dynamic => StageAnalysis {
                 layout: if two_phase { Layout::UPU } else { Layout::U },
-                integration: stage.time_integration.as_ref().unwrap_or(&case.time_integration).integration(),
+                integration: Integration::of(stage.time_integration.as_ref().unwrap_or(&case.time_integration)),
                 dt_limit: None,
             },
             AnalysisType::QuasiStatic => StageAnalysis {

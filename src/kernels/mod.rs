@@ -436,6 +436,17 @@ impl Integration {
         let gamma = 0.5 - alpha_m + alpha_f;
         Integration::Dynamic { beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2), gamma, alpha_m, alpha_f }
     }
+
+    /// The dynamic scheme a case's time integration asks for: Newmark's when it names it or gives
+    /// β or γ, else the generalized-α method.
+    pub fn of(t: &crate::case::TimeIntegration) -> Integration {
+        if t.is_newmark() {
+            let (beta, gamma) = t.newmark();
+            Integration::newmark(beta, gamma)
+        } else {
+            Integration::generalized_alpha(t.spectral_radius())
+        }
+    }
 }
 
 /// One step of length Δt under an [`Integration`]: the factors a₀ = ∂a/∂Δd = 1/(βΔt²) and

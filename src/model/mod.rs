@@ -448,7 +448,7 @@ impl<const D: usize> Model<D> {
             loads: Vec::new(),
             boundaries: Vec::new(),
             g: case.analysis.g,
-            integration: case.time_integration.integration(),
+            integration: crate::kernels::Integration::of(&case.time_integration),
             bbar: case.stabilisation.bbar,
             fbar: case.stabilisation.fbar,
             n_bodies: case.bodies.len(),

@@ -239,14 +239,9 @@ impl TimeIntegration {
         (self.beta.unwrap_or(0.25), self.gamma.unwrap_or(0.5))
     }
 
-    /// The kernels' form of these parameters.
-    pub fn integration(&self) -> crate::kernels::Integration {
-        if self.is_newmark() {
-            let (b, g) = self.newmark();
-            crate::kernels::Integration::newmark(b, g)
-        } else {
-            crate::kernels::Integration::generalized_alpha(self.rho_inf.unwrap_or(DEFAULT_RHO_INF))
-        }
+    /// The generalized-α method's ρ∞ (default [`DEFAULT_RHO_INF`]).
+    pub fn spectral_radius(&self) -> f64 {
+        self.rho_inf.unwrap_or(DEFAULT_RHO_INF)
     }
 
     /// Checks that the scheme is one and unconditionally stable (Newmark's average-acceleration
