@@ -21,15 +21,12 @@ pub struct Body {
     pub shape: Shape,
     /// The body's extent [z_min, z_max] along z [m], inside the grid (three-dimensional cases
     /// only; default: the grid's).
-    #[serde(default)]
     pub z: Option<[f64; 2]>,
     /// A geostatic initial stress (default: stress-free).
-    #[serde(default)]
     pub initial_stress: Option<InitialStress>,
     /// A uniform initial effective stress [xx, yy, xy, zz] [Pa] (tension positive), instead of a
     /// geostatic one (e.g. for patch tests and rigid-rotation checks); a three-dimensional case may
     /// give the two other shears too, [xx, yy, xy, zz, yz, zx].
-    #[serde(default)]
     pub uniform_stress: Option<Vec<f64>>,
     /// Displacement of every material point from the centre of its sub-cell, as a fraction of the
     /// point spacing in each direction, drawn from a fixed pseudo-random sequence keyed by the
@@ -125,7 +122,6 @@ pub struct Region {
     /// Upper-right corner [m].
     pub max: [f64; 2],
     /// Its extent [z_min, z_max] along z in a three-dimensional case [m] (default: all of it).
-    #[serde(default)]
     pub z: Option<[f64; 2]>,
 }
 

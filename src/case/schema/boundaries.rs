@@ -15,16 +15,13 @@ pub struct Boundary {
     /// The name stages and the verification give to use it.
     pub name: String,
     /// A side of the grid (give exactly one of `side`, `region` and `surface`).
-    #[serde(default)]
     pub side: Option<Side>,
     /// The nodes inside this box, at least one (give exactly one of `side`, `region` and
     /// `surface`).
-    #[serde(default)]
     pub region: Option<Region>,
     /// The moving surface of a body: the nodes on or beyond the exposed faces of its boundary
     /// particles, found again every step (a drained free surface: `fix = ["p"]`; in the
     /// quasi-static u–p system p = 0 is imposed on the faces themselves, by Nitsche's method).
-    #[serde(default)]
     pub surface: Option<Surface>,
     /// Components fixed, at least one: `ux`, `uy`, `uz`, `Ux`, `Uy`, `Uz` and `p` (drained). In a
     /// one_phase analysis the water-phase components have no dofs and are ignored. Fixed to zero
@@ -34,12 +31,10 @@ pub struct Boundary {
     /// moved by `displacement` × f(t) (f the time function; constant 1 without one). Fixed water
     /// components move with the solid (the boundary is impermeable to flow across it).
     /// Two components in a plane case, three in a three-dimensional one.
-    #[serde(default)]
     pub displacement: Option<Vec<f64>>,
     /// Prescribed velocity [m/s] of the fixed displacement components, scaled by the time function:
     /// the nodes move by ∫ `velocity` f(t) dt. One component per dimension; not with
     /// `displacement`.
-    #[serde(default)]
     pub velocity: Option<Vec<f64>>,
     /// A velocity gradient L [1/s] of a homogeneous flow about `center`, scaled by the time
     /// function with `velocity` (its translation part, default zero): over a step the node at x moves
@@ -47,15 +42,12 @@ pub struct Boundary {
     /// (e.g. a rigid rotation ω: L = [[0, −ω], [ω, 0]]). Rows L_ij = ∂v_i/∂x_j: two rows of two in a
     /// plane case, three rows of three in a three-dimensional one. `fix` must list every
     /// displacement component.
-    #[serde(default)]
     pub velocity_gradient: Option<Vec<Vec<f64>>>,
     /// Centre c of the `velocity_gradient`'s flow [m] (default: the origin); one coordinate per
     /// dimension.
-    #[serde(default)]
     pub center: Option<Vec<f64>>,
     /// The name of the time function scaling `displacement`, `velocity` or `velocity_gradient`
     /// (default: a constant 1).
-    #[serde(default)]
     pub time_function: Option<String>,
 }
 
@@ -73,7 +65,6 @@ pub struct Surface {
     /// face (x for a y face, y for an x face; the box stays where it is at t = 0), so that a
     /// footing's edge stays at the box's edge; put that edge on a grid line (a boundary fixes whole
     /// nodes).
-    #[serde(default)]
     pub region: Option<Region>,
 }
 

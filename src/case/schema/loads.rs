@@ -43,14 +43,12 @@ pub struct ParticleTraction {
     /// The particles carrying it: those whose centres lie inside at t = 0.
     pub region: Region,
     /// The name of the only body whose particles carry it (default: any).
-    #[serde(default)]
     pub body: Option<String>,
     /// Which face of each particle domain carries it.
     pub face: Side,
     /// Traction vector [Pa]: two components in a plane case, three in a three-dimensional one.
     pub traction: Vec<f64>,
     /// The name of the time function scaling it (default: a constant 1).
-    #[serde(default)]
     pub time_function: Option<String>,
     /// An expression in `x` and `y` [m] (and `z` in a three-dimensional case, and the case's
     /// parameters) that scales each step's increment of the load by where the loaded faces are
@@ -61,7 +59,6 @@ pub struct ParticleTraction {
     /// [001]'s internal pressure re-evaluated at the current inner radius,
     /// `"A / x^2 + 2 * C"`). Written without the leading `=` (it is evaluated during the run,
     /// not when the case is read). Without it the traction is `traction` × f(t).
-    #[serde(default)]
     pub increment_factor: Option<String>,
 }
 
@@ -77,7 +74,6 @@ pub struct NodalTraction {
     /// Traction vector [Pa]: two components in a plane case, three in a three-dimensional one.
     pub traction: Vec<f64>,
     /// The name of the time function scaling it (default: a constant 1).
-    #[serde(default)]
     pub time_function: Option<String>,
 }
 
@@ -92,7 +88,6 @@ pub struct LinePressure {
     /// The pressure p [Pa].
     pub pressure: f64,
     /// The name of the time function scaling it (default: a constant 1).
-    #[serde(default)]
     pub time_function: Option<String>,
 }
 
@@ -107,10 +102,8 @@ pub struct BodyForce {
     pub acceleration: Vec<f64>,
     /// The names of the bodies it acts on (default: all), e.g. a footing whose unit weight is
     /// ramped up.
-    #[serde(default)]
     pub bodies: Option<Vec<String>>,
     /// The name of the time function scaling it (default: a constant 1).
-    #[serde(default)]
     pub time_function: Option<String>,
 }
 

@@ -22,15 +22,12 @@ pub struct Material {
     #[serde(default = "default_rho_w")]
     pub water_density: f64,
     /// Bulk modulus of the pore water K_w [Pa], in (0, 1e13]; required in a two-phase analysis.
-    #[serde(default)]
     pub water_bulk_modulus: Option<f64>,
     /// Bulk modulus of the solid grains K_s [Pa], in (0, 1e13], or `inf` for incompressible
     /// grains; required in a two-phase analysis.
-    #[serde(default)]
     pub solid_bulk_modulus: Option<f64>,
     /// Hydraulic conductivity k [m/s] at the initial porosity, in (0, 1]; required in a two-phase
     /// analysis.
-    #[serde(default)]
     pub hydraulic_conductivity: Option<f64>,
     /// How the conductivity changes with the void ratio: `constant` (the default) or `xie_leo`.
     #[serde(default)]
@@ -125,24 +122,20 @@ pub struct MohrCoulomb {
     /// Peak cohesion c_p [Pa], ≥ 0 (> 0 when φ = 0).
     pub cohesion: f64,
     /// Residual cohesion c_r [Pa], ≥ 0 (default: c_p, no softening).
-    #[serde(default)]
     pub residual_cohesion: Option<f64>,
     /// Accumulated deviatoric plastic strain ε_p^r at which c_r is reached [-], > 0; required when
     /// c_r differs from c_p.
-    #[serde(default)]
     pub softening_strain: Option<f64>,
     /// Initial dilation angle ψ_ini [degrees], in (−90, φ] (default 0).
     #[serde(default)]
     pub dilation_angle: f64,
     /// Critical-state dilation angle ψ_crit [degrees], in (−90, φ] (default: ψ_ini, a constant
     /// dilation angle).
-    #[serde(default)]
     pub critical_dilation_angle: Option<f64>,
     /// Decay rate η of ψ = ψ_crit + (ψ_ini − ψ_crit) exp(−η ε̄) [-], ≥ 0 (default 0).
     #[serde(default)]
     pub dilation_decay: f64,
     /// Tensile strength t of a cut-off σ_i ≤ t [Pa], ≥ 0 (default: no cut-off).
-    #[serde(default)]
     pub tension_cutoff: Option<f64>,
 }
 
@@ -157,7 +150,6 @@ pub struct VonMises {
     /// Peak shear strength c_p [Pa], > 0.
     pub cohesion: f64,
     /// Residual shear strength c_r [Pa], ≥ 0 (default: c_p).
-    #[serde(default)]
     pub residual_cohesion: Option<f64>,
     /// Softening modulus H_s = dc/dε̄ [Pa], in (−√3 G, 0] with G the shear modulus (default 0).
     #[serde(default)]
@@ -175,7 +167,6 @@ pub struct HenckyJ2 {
     /// Peak shear strength c_p [Pa], > 0.
     pub cohesion: f64,
     /// Residual shear strength c_r [Pa], in [0, c_p] (default: c_p, no softening).
-    #[serde(default)]
     pub residual_cohesion: Option<f64>,
     /// Softening rate η of c(ε̄) [-], ≥ 0 and below 3μ / (√3 (c_p − c_r)), where the return stops
     /// being unique (default 0).

@@ -75,7 +75,6 @@ pub struct CaseFile {
     #[serde(default)]
     pub probes: Vec<Probe>,
     /// The analytical reference the run is checked against, if any.
-    #[serde(default)]
     pub verification: Option<Verification>,
 }
 

@@ -9,7 +9,6 @@ use serde::{Deserialize, Serialize};
 pub struct Solver {
     /// A PETSc options file applied before the command line's, relative to the case file (default:
     /// the built-in strategy).
-    #[serde(default)]
     pub options_file: Option<String>,
 }
 

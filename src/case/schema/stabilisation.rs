@@ -6,35 +6,30 @@ use serde::{Deserialize, Serialize};
 
 /// Stabilisation switches.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Stabilisation {
     /// MLSA patch recovery of the pore-pressure increments ([003] §3.3, Eqs. 26–30). Default: off
     /// (`DEFAULT_PATCH_RECOVERY` in the model says what was measured for that choice); cases with
     /// large deformations need it.
-    #[serde(default)]
     pub patch_recovery: Option<bool>,
     /// B̄ for GIMP ([000] §3, Eqs. 12–16): the volumetric part of B from cell-centre gradients weighted
     /// by the share of the particle domain in each cell. Default: off.
-    #[serde(default)]
     pub bbar: bool,
     /// [002]'s F̄ by volume-averaged projection ([002] §3, Algorithm 1): each point's step scales
     /// its in-plane deformation increment so that its volume ratio is the volume-weighted average
     /// of the points sharing its nodes, which relieves volumetric locking for any non-negative
     /// basis. In plane strain, without B̄, with the particle stiffness and the basis's strain, in
     /// one-phase explicit stages and in implicit stages that solve u or u–p. Default: off.
-    #[serde(default)]
     pub fbar: bool,
     /// Pressure-projection stabilisation of the equal-order pressure (Bochev & Dohrmann 2006): the
     /// factor α of τ = α/G (G the skeleton's shear modulus) in the cell-wise penalty on the
     /// non-constant part of the pressure increment [-], in (0, 1e3]. Default: none.
-    #[serde(default)]
     pub pressure_projection: Option<f64>,
     /// How a particle's pore pressure follows a converged step (two-phase): `increments` (the
     /// default: p += the interpolated, or patch-recovered, increment) or `projected_total` (p is
     /// the interpolation of the total nodal field P + Δp, P the consistent L² projection of the
     /// particles' pressures onto the nodal functions, so that whatever the nodes cannot represent
     /// does not accumulate on the particles). Not with `patch_recovery`.
-    #[serde(default)]
     pub pressure_update: PressureUpdate,
     /// How the skeleton's material stiffness enters the Newton matrix ([001] §5,
     /// docs/axisymmetry.md): `particle` (the default: the exact tangent, integrated at the points),
@@ -45,13 +40,11 @@ pub struct Stabilisation {
     /// option but `particle` is an approximate Jacobian: Newton converges to the same answer, at a
     /// linear rate; with `-snes_type ksponly` a step is [001]'s single linear solve. Plane cases
     /// with the linear or GIMP bases only.
-    #[serde(default)]
     pub stiffness: Stiffness,
     /// Where a mapped `stiffness` serves: `jacobian` (the default: it is Newton's matrix, [001]'s
     /// scheme, converging linearly) or `diagnostics` (only the nodal K_mag diagnostic is computed
     /// with it; Newton keeps the exact tangent and converges quadratically to the same answer,
     /// since the residual is the same).
-    #[serde(default)]
     pub mapped_stiffness: MappedStiffnessUse,
     /// How a point's strain increment is recovered from the nodal displacements ([001] §5.5):
     /// `basis` (the default: with the gradients of the point's basis functions, as its forces are
@@ -63,7 +56,6 @@ pub struct Stabilisation {
     /// the point's weights there, the transpose of its forces, so that the point's force and strain
     /// are one Galerkin pair and its tangent is symmetric). The residual keeps the basis for the
     /// forces unless `internal_force` says otherwise, and its tangent stays exact.
-    #[serde(default)]
     pub stress_recovery: StressRecovery,
     /// How the skeleton's internal force is integrated: `particle` (the default: at the points with
     /// the basis's gradients, F_i = Σ_p B_i(x_p)ᵀ σ_p V_p) or `mapped` (double-mapped like the
@@ -72,7 +64,6 @@ pub struct Stabilisation {
     /// points, σ_g = Σ_i N_i(x_g) σ_i^e, and F_e = Σ_g B_gᵀ σ_g |J|, as [001] Eqs. 16–20 map D_p).
     /// Needs a mapped `stiffness` (`gauss_mapping`, `double_mapping` or `double_mapping_gimp`), a
     /// one-phase plane case without B-splines; the residual and its exact tangent change together.
-    #[serde(default)]
     pub internal_force: InternalForce,
 }
 

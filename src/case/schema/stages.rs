@@ -10,7 +10,6 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct Time {
     /// Time step of the stages that do not give their own `dt` [s], > 0.
-    #[serde(default)]
     pub dt: Option<f64>,
 }
 
@@ -24,15 +23,12 @@ pub struct Stage {
     pub duration: f64,
     /// Time step Δt [s], in (0, duration], at most 1e8 steps in the stage (default: `time.dt`;
     /// one of them is required).
-    #[serde(default)]
     pub dt: Option<f64>,
     /// The names of the boundaries active in this stage (default: all).
-    #[serde(default)]
     pub boundaries: Option<Vec<String>>,
     /// The names of the loads active in this stage (default: all).
-    #[serde(default)]
     pub loads: Option<Vec<String>>,
-    /// How many times in a row a step may be cut before the run fails, at most 30 (default 4).
+    /// How many times in a row a step may be cut before the run fails [-], at most 30 (default 4).
     #[serde(default = "default_cuts")]
     pub max_step_cuts: usize,
     /// The factor applied to Δt at each cut [-], in (0, 1) (default 0.5).
@@ -48,26 +44,21 @@ pub struct Stage {
     /// θ of a quasi-static stage's Darcy flux [-], in [1/2, 1] (default 1, backward Euler: no
     /// oscillation at large Δt; 1/2 is second order but rings when c_v Δt/h² ≫ 1). Only
     /// `quasi_static` stages take it.
-    #[serde(default)]
     pub theta: Option<f64>,
     /// The water in a static stage of a two-phase case (required there, and taken nowhere else):
     /// `drained` (the pore pressure is held; the u system) or `undrained` (no flow: the u–p
     /// system without Darcy's law).
-    #[serde(default)]
     pub drainage: Option<Drainage>,
     /// The largest step the stage may grow to after easy steps (at most 3 Newton iterations, a
     /// few in a row) [s], finite and at least `dt` (default: `dt`, no growth beyond it).
-    #[serde(default)]
     pub dt_max: Option<f64>,
     /// The time integration of this stage (default: the case's `time_integration`); only
     /// `dynamic` stages take it. A settling stage can damp the transient of an unbalanced initial
     /// state numerically, e.g. `{ beta = 0.49, gamma = 0.9 }` with a Δt near the lowest period of
     /// the soil.
-    #[serde(default)]
     pub time_integration: Option<TimeIntegration>,
     /// The explicit integrator's settings of a `dynamic_explicit` stage (defaults if absent); only
     /// such stages take it.
-    #[serde(default)]
     pub explicit: Option<Explicit>,
     /// The strength reduction factor F of this stage [-], in (0, 100] (default 1: the case's
     /// strengths): from the stage's start every material's peak strength is the case's divided by
@@ -77,7 +68,6 @@ pub struct Stage {
     /// take it. Each stage reduces the case's strengths afresh (factors do not compound); the
     /// points keep their stress and accumulated plastic strain, so a point beyond the reduced
     /// strength returns to it in its next update.
-    #[serde(default)]
     pub strength_reduction: Option<f64>,
 }
 
@@ -106,7 +96,6 @@ pub struct Explicit {
     /// space that lets pure FLIP ring), at m − 1 extra passes over the points per step. In
     /// [1, 8], one-phase stages only; default: none (the blend). Hammerquist & Nairn suggest 2
     /// to 5.
-    #[serde(default)]
     pub xpic_order: Option<u8>,
     /// Where a two-phase stage's pore pressure lives (the u–U system: both phases' motion at
     /// the nodes). `pointwise` (default): each point keeps its own increment Δp_p from its
@@ -122,7 +111,6 @@ pub struct Explicit {
     /// but, like it without stabilisation, not inf–sup stable: near undrained conditions the
     /// pressure alternates (Terzaghi at k = 1e-12 m/s: 0.61 and 1.41 times the undrained
     /// pressure at two points). One-phase stages take neither.
-    #[serde(default)]
     pub pore_pressure: Option<ExplicitPressure>,
 }
 
@@ -189,23 +177,19 @@ fn default_cut_factor() -> f64 {
 }
 
 /// The time integration of dynamic stages: the generalized-α method of Chung & Hulbert (1993) with
-/// spectral radius `rho_inf` (default [`DEFAULT_RHO_INF`]), or Newmark ([003] Eqs. 20–22) when
-/// `scheme = "newmark"` or `beta`/`gamma` are given.
+/// spectral radius `rho_inf` (default 0.2, [`DEFAULT_RHO_INF`]), or Newmark ([003] Eqs. 20–22)
+/// when `scheme = "newmark"` or `beta`/`gamma` are given.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeIntegration {
     /// `generalized_alpha` (the default) or `newmark`.
-    #[serde(default)]
     pub scheme: Option<TimeScheme>,
     /// Newmark's β [-], with 2β ≥ γ and β ≤ 1 (default 1/4: average acceleration); Newmark only.
-    #[serde(default)]
     pub beta: Option<f64>,
     /// Newmark's γ [-], ≥ 1/2 (default 1/2: no numerical damping); Newmark only.
-    #[serde(default)]
     pub gamma: Option<f64>,
     /// Spectral radius at infinite frequency ρ∞ of the generalized-α method [-], in [0, 1]: 1
     /// damps nothing, 0 annihilates the highest frequencies in one step (default 0.2).
-    #[serde(default)]
     pub rho_inf: Option<f64>,
 }
 

@@ -104,7 +104,7 @@ pub struct HarmonicColumn {
     /// The name of the harmonic surface load, a particle or nodal traction with a `harmonic` time
     /// function.
     pub load: String,
-    /// Number of final load periods over which the amplitude is measured, ≥ 1 (default 3).
+    /// Number of final load periods over which the amplitude is measured [-], ≥ 1 (default 3).
     #[serde(default = "default_periods")]
     pub measure_periods: usize,
     /// Pass threshold for the maximum amplitude error relative to the peak amplitude [-], > 0.
@@ -120,7 +120,6 @@ pub struct ElasticColumn {
     /// The name of the body-force load carrying gravity.
     pub gravity: String,
     /// The name of the surface load (a particle or nodal traction), if any.
-    #[serde(default)]
     pub surcharge: Option<String>,
     /// Pass threshold for max |σ_yy − σ*| / max |σ*| over the column [-], > 0 (default 0.01).
     #[serde(default = "default_column_tol")]
@@ -138,12 +137,10 @@ pub struct BearingCapacity {
     pub soil: String,
     /// The name of the load: a traction (its pressure), or a body force on the footing body (its
     /// weight over `loaded_width`; the body force must name its bodies). Give `load` or `footing`.
-    #[serde(default)]
     pub load: Option<String>,
     /// The name of a rigid footing pushed into the soil under displacement control: a boundary
     /// that fixes `uy` and moves it vertically (`velocity` or `displacement`); the pressure is its
     /// vertical reaction on the soil over `loaded_width` ([002] §4.2). Give `load` or `footing`.
-    #[serde(default)]
     pub footing: Option<String>,
     /// Width carrying the load in the model [m], > 0 (the half-width in a half model).
     pub loaded_width: f64,
@@ -151,7 +148,6 @@ pub struct BearingCapacity {
     /// half-length of a footing in a quarter model): the pressure is the force over
     /// `loaded_width` × `loaded_depth`. Required in three dimensions; two-dimensional cases do not
     /// take it.
-    #[serde(default)]
     pub loaded_depth: Option<f64>,
     /// Footing breadth B [m], > 0 (normalises the settlement).
     pub breadth: f64,
@@ -160,12 +156,10 @@ pub struct BearingCapacity {
     pub settlement_point: Vec<f64>,
     /// d/B [-], > 0, at which q_ult is read for the metric `bearing_capacity_ratio` (a
     /// load-controlled footing; give this or `plateau`, or neither for no metric).
-    #[serde(default)]
     pub failure_settlement: Option<f64>,
     /// The range [d/B_from, d/B_to] [-], 0 ≤ d/B_from < d/B_to, over which the mean of q is q_ult
     /// for the metric `bearing_capacity_ratio` (a displacement-controlled footing, whose load
     /// levels off at the limit load).
-    #[serde(default)]
     pub plateau: Option<[f64; 2]>,
     /// Reference q_ult/c [-], > 0 (default 2 + π, Prandtl).
     #[serde(default = "default_prandtl")]
@@ -182,7 +176,6 @@ pub struct BearingCapacity {
     pub report_loads: Vec<f64>,
     /// d/B [-], > 0, at which the run ends, completed (a load-controlled footing beyond its limit
     /// load runs away; default: run to the end).
-    #[serde(default)]
     pub stop_settlement: Option<f64>,
 }
 
@@ -276,7 +269,6 @@ pub struct HollowCylinder {
     /// small-strain increment of the wall whose inner face has moved to r_i when the load applied
     /// there is the original Δσ_rr(r_i) (an `increment_factor` `A / x^2 + 2 * C`). Without it only
     /// the first step is checked.
-    #[serde(default)]
     pub increments: Option<IncrementTolerances>,
 }
 
@@ -367,11 +359,9 @@ pub struct DamBreak {
     pub hydrostatic_tolerance: f64,
     /// x of the wall the front runs into [m]; the front's speed bound applies while the front is
     /// more than a cell from it (default: no wall, the whole run).
-    #[serde(default)]
     pub far_wall: Option<f64>,
     /// A measured front position to compare with: `"martin_moyce_1952"` (Martin & Moyce 1952,
     /// the column of height 2a on width a, n² = 2; the body must have that aspect ratio).
-    #[serde(default)]
     pub experiment: Option<String>,
     /// Largest accepted mean |Z/Z_exp − 1| of the front against `experiment` [-], > 0 (default
     /// 0.1).
