@@ -31,7 +31,7 @@ fn load(case_file: &str, sets: &[&str]) -> case::Case {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(case_file);
     let text = porompm::io::read_text(&path).expect("the case file is readable");
     let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).expect("valid override")).collect();
-    case::parse(&text, case_file, &overrides).expect("the case parses")
+    porompm::validation::load(&text, case_file, &overrides).expect("the case parses")
 }
 
 /// A small deterministic pseudo-random sequence in [-1, 1].
@@ -248,7 +248,7 @@ const BOX_3D: &str = r#"
 
 fn particle_kernels_3d(c: &mut Criterion) {
     const M: usize = kernels::MAX_NODES_3D;
-    let case = case::parse(BOX_3D, "box_3d", &[]).expect("the 3D box parses");
+    let case = porompm::validation::load(BOX_3D, "box_3d", &[]).expect("the 3D box parses");
     let model = porompm::model::Model::build_solid(&case, |_| true);
     let ps = &model.particles;
     let n = ps.len();

@@ -1,7 +1,7 @@
 //! `porompm check`: what a case will build, computed without PETSc (one process).
 
 use crate::assembly::{dofs, WELL_FILLED_FRACTION};
-use crate::case::{Case, Load, SoilModel};
+use crate::case::{Case, Load};
 use crate::model::{shape, Model};
 use std::fmt::Write;
 
@@ -11,8 +11,6 @@ pub fn describe(case: &Case, label: &str) -> String {
         return describe_solid(case, label);
     }
     let model = Model::build(case, |_, _| true);
-    let g = &model.grid;
-    let nd = model.ndof();
     // The first stage's own unknowns per node (its analysis type's layout).
     let layout = crate::analysis::StageAnalysis::of(case, &case.stages[0]).layout;
     let mut s = String::new();
@@ -25,22 +23,8 @@ pub fn describe(case: &Case, label: &str) -> String {
         layout.field_names().join(", ")
     );
     let _ = writeln!(s, "basis: {:?}", case.analysis.shape_functions);
-    let _ = writeln!(
-        s,
-        "geometry: {}",
-        match model.geometry {
-            shape::Geometry::PlaneStrain => "plane strain (volumes per metre of thickness)".to_string(),
-            shape::Geometry::Solid => "three dimensions (volumes in m³)".to_string(),
-            shape::Geometry::Axisymmetric(w) => format!(
-                "axisymmetric about the y axis (x ≡ r; ring volumes 2πrA; hoop strain u_r/r; GIMP weights in r: {w:?}){}",
-                if model.boundaries.iter().any(|b| b.is_axis()) {
-                    "; u_r = 0 on the axis (boundary `axis`)"
-                } else {
-                    ""
-                }
-            ),
-        }
-    );
+    let _ = writeln!(s, "geometry: {}", geometry_line(&model));
+    let g = &model.grid;
     let _ = writeln!(
         s,
         "grid: {} × {} cells of {:.4} × {:.4} m from ({}, {}); {} nodes, {} grid dofs",
@@ -51,61 +35,17 @@ pub fn describe(case: &Case, label: &str) -> String {
         g.origin[0],
         g.origin[1],
         g.node_count(),
-        g.node_count() * nd
+        g.node_count() * model.ndof()
     );
     for m in &case.materials {
-        let model_txt = match &m.model {
-            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-                format!("linear elastic, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
-            }
-            SoilModel::NeoHookean { young_modulus, poisson_ratio } => {
-                format!("neo-Hookean, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}")
-            }
-            SoilModel::NewtonianFluid { bulk_modulus, viscosity, bulk_viscosity } => format!(
-                "Newtonian fluid (finite strain), K = {bulk_modulus:.4e} Pa, μ_v = {viscosity:.4e} Pa s, ζ = \
-                 {bulk_viscosity:.4e} Pa s"
-            ),
-            SoilModel::MohrCoulomb {
-                young_modulus,
-                poisson_ratio,
-                friction_angle,
-                cohesion,
-                residual_cohesion,
-                softening_strain,
-                dilation_angle,
-                critical_dilation_angle,
-                dilation_decay,
-                tension_cutoff,
-            } => {
-                let mut t = format!(
-                    "{}, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, φ = {friction_angle}°, c = {cohesion:.4e} Pa, ψ = {dilation_angle}°",
-                    if *friction_angle == 0.0 { "Tresca (Mohr–Coulomb with φ = 0)" } else { "Mohr–Coulomb" }
-                );
-                if let (Some(r), Some(e)) = (residual_cohesion, softening_strain) {
-                    t += &format!(", softening to c_r = {r:.4e} Pa at ε̄ = {e}");
-                }
-                if let Some(pc) = critical_dilation_angle {
-                    t += &format!(", ψ → {pc}° with η = {dilation_decay}");
-                }
-                if let Some(tc) = tension_cutoff {
-                    t += &format!(", tension cut-off {tc:.4e} Pa");
-                }
-                t
-            }
-            SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
-                format!(
-                    "von Mises, E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, c = {cohesion:.4e} Pa → c_r = {:.4e} Pa, H_s = {softening_modulus:.4e} Pa",
-                    residual_cohesion.unwrap_or(*cohesion)
-                )
-            }
-            SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
-                format!(
-                    "Hencky–J2 (finite strain), E = {young_modulus:.4e} Pa, ν = {poisson_ratio}, c = {cohesion:.4e} Pa → c_r = {:.4e} Pa, η = {softening_rate}",
-                    residual_cohesion.unwrap_or(*cohesion)
-                )
-            }
-        };
-        let _ = writeln!(s, "material `{}`: {model_txt}, n = {}, ρ_s = {} kg/m³", m.name, m.porosity, m.solid_density);
+        let _ = writeln!(
+            s,
+            "material `{}`: {}, n = {}, ρ_s = {} kg/m³",
+            m.name,
+            m.model.describe(),
+            m.porosity,
+            m.solid_density
+        );
     }
     for (b, body) in case.bodies.iter().enumerate() {
         let count = model.particles.body.iter().filter(|&&x| x as usize == b).count();
@@ -117,9 +57,39 @@ pub fn describe(case: &Case, label: &str) -> String {
         );
     }
     let _ = writeln!(s, "material points: {}", model.particles.len());
+    let _ = writeln!(s, "{}", unknowns_line(case, &model, layout));
+    for (l, id) in model.loads.iter().zip(case.load_ids()) {
+        let _ = writeln!(s, "load `{}`: {}", l.name, load_text(case.load(id), l.size()));
+    }
+    boundary_lines(&mut s, &model);
+    for st in &case.stages {
+        let _ = writeln!(s, "{}", stage_line(case, &model, st));
+    }
+    numerics_lines(&mut s, case, &model);
+    for w in crate::diagnostics::physics::warnings(case, &model) {
+        let _ = writeln!(s, "warning [{}]: {}", w.kind, w.message);
+    }
+    let verification = case.verification.as_ref().map_or("none".to_string(), |v| v.describe());
+    let _ = writeln!(s, "verification: {verification}");
+    s
+}
 
-    // Active nodes (filled fraction of their support, as in crate::assembly) and unknowns of the
-    // first step.
+/// The plane's geometry in words, with the axis of an axisymmetric model.
+fn geometry_line(model: &Model) -> String {
+    match model.geometry {
+        shape::Geometry::PlaneStrain => "plane strain (volumes per metre of thickness)".to_string(),
+        shape::Geometry::Solid => "three dimensions (volumes in m³)".to_string(),
+        shape::Geometry::Axisymmetric(w) => format!(
+            "axisymmetric about the y axis (x ≡ r; ring volumes 2πrA; hoop strain u_r/r; GIMP weights in r: {w:?}){}",
+            if model.boundaries.iter().any(|b| b.is_axis()) { "; u_r = 0 on the axis (boundary `axis`)" } else { "" }
+        ),
+    }
+}
+
+/// The active nodes at t = 0 (filled fraction of their support, as in crate::assembly) and the
+/// unknowns of the first step.
+fn unknowns_line(case: &Case, model: &Model, layout: crate::layout::Layout) -> String {
+    let g = &model.grid;
     let mut filled = vec![0.0; g.node_count()];
     for k in 0..model.particles.len() {
         let st = shape::stencil(model.basis, g, model.particles.x[k], model.particles.lp[k]);
@@ -142,30 +112,30 @@ pub fn describe(case: &Case, label: &str) -> String {
                 .count();
         }
     }
-    let _ = writeln!(s, "active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}");
+    format!("active nodes at t = 0: {active_nodes}; unknowns of the first step: {unknowns}")
+}
 
-    for l in &model.loads {
-        let kind = match case.load(&l.name) {
-            Some(Load::ParticleTraction { increment_factor, .. }) => {
-                let follows = increment_factor.as_deref().map_or(String::new(), |e| {
-                    format!(", each increment scaled by `{e}` at the loaded faces' mean centre at the step's start")
-                });
-                format!("particle traction on {} material points{follows}", l.size())
-            }
-            Some(Load::NodalTraction { .. }) => format!("nodal traction on {} nodes", l.size()),
-            Some(Load::LinePressure { pressure, .. }) => {
-                format!("pressure {pressure} Pa on a line ({} Gauss points)", l.size())
-            }
-            Some(Load::BodyForce { acceleration, .. }) => {
-                format!("body force {acceleration:?} m/s²")
-            }
-            None => String::new(),
-        };
-        let _ = writeln!(s, "load `{}`: {kind}", l.name);
+/// A plane case's load in words; `size` is the number of points, nodes or Gauss points it acts on.
+fn load_text(load: &Load, size: usize) -> String {
+    match load {
+        Load::ParticleTraction(t) => {
+            let follows = t.increment_factor.as_deref().map_or(String::new(), |e| {
+                format!(", each increment scaled by `{e}` at the loaded faces' mean centre at the step's start")
+            });
+            format!("particle traction on {size} material points{follows}")
+        }
+        Load::NodalTraction(_) => format!("nodal traction on {size} nodes"),
+        Load::LinePressure(p) => format!("pressure {} Pa on a line ({size} Gauss points)", p.pressure),
+        Load::BodyForce(f) => format!("body force {:?} m/s²", f.acceleration),
     }
+}
+
+/// Each boundary of a plane model with the nodes it fixes.
+fn boundary_lines(s: &mut String, model: &Model) {
+    let g = &model.grid;
     for (bi, b) in model.boundaries.iter().enumerate() {
         let fix: Vec<String> = b.fix.iter().map(|d| d.to_string()).collect();
-        if let Some(line) = surface_line(&model, bi, &fix) {
+        if let Some(line) = surface_line(model, bi, &fix) {
             let _ = writeln!(s, "{line}");
             continue;
         }
@@ -173,17 +143,20 @@ pub fn describe(case: &Case, label: &str) -> String {
             .flat_map(|j| (0..g.nodes()[0]).map(move |i| (i, j)))
             .filter(|&(i, j)| b.contains(g, i, j))
             .count();
-        let ignored = if nd == 2 && b.fix.iter().all(|d| !matches!(d, crate::case::Dof::Ux | crate::case::Dof::Uy)) {
+        let water_only = b.fix.iter().all(|d| !matches!(d, crate::case::Dof::Ux | crate::case::Dof::Uy));
+        let ignored = if model.ndof() == 2 && water_only {
             " (water-phase components: ignored in a one_phase analysis)"
         } else {
             ""
         };
         let _ = writeln!(s, "boundary `{}`: {} fixed on {count} nodes{ignored}", b.name, fix.join(", "));
     }
-    for st in &case.stages {
-        let _ = writeln!(s, "{}", stage_line(case, &model, st));
-    }
-    let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce { .. }));
+}
+
+/// The features, kinematics, stiffness and strain recovery, internal force and solver of a plane
+/// model.
+fn numerics_lines(s: &mut String, case: &Case, model: &Model) {
+    let gravity = case.loads.iter().any(|l| matches!(l, Load::BodyForce(_)));
     let _ = writeln!(
         s,
         "features: gravity {}; return mapping {}; B-bar {}; F-bar {}; patch recovery {}; GIMP domains {}",
@@ -215,23 +188,8 @@ pub fn describe(case: &Case, label: &str) -> String {
     let _ = writeln!(
         s,
         "stiffness in the Newton matrix: {}; strain recovery: {}",
-        match (model.stiffness, model.stiffness_in_jacobian) {
-            (crate::case::Stiffness::Particle, _) => "the exact tangent".to_string(),
-            (other, false) => {
-                format!("the exact tangent ({} serves the K_mag diagnostic only)", other.name())
-            }
-            (other, true) => format!(
-                "{} ([001]'s mapped stiffness: an approximate Jacobian, Newton converges linearly; up to {} \
-                 iterations a step)",
-                other.name(),
-                crate::assembly::newton_iterations(other)
-            ),
-        },
-        match model.stress_recovery {
-            crate::case::StressRecovery::Basis => "the basis functions' gradients",
-            crate::case::StressRecovery::Cmpm => "CMPM patch functions ([001] Eqs. 22–23, corrected)",
-            crate::case::StressRecovery::Mapped => "the double-mapped operators (the forces' transpose)",
-        }
+        stiffness_text(model),
+        recovery_text(model)
     );
     if model.internal_force == crate::case::InternalForce::Mapped {
         let _ = writeln!(
@@ -248,18 +206,29 @@ pub fn describe(case: &Case, label: &str) -> String {
             |f| format!("options file {f}")
         )
     );
-    for w in crate::diagnostics::physics::warnings(case, &model) {
-        let _ = writeln!(s, "warning [{}]: {}", w.kind, w.message);
+}
+
+/// The material stiffness of the Newton matrix in words.
+fn stiffness_text(model: &Model) -> String {
+    match (model.stiffness, model.stiffness_in_jacobian) {
+        (crate::case::Stiffness::Particle, _) => "the exact tangent".to_string(),
+        (other, false) => format!("the exact tangent ({} serves the K_mag diagnostic only)", other.name()),
+        (other, true) => format!(
+            "{} ([001]'s mapped stiffness: an approximate Jacobian, Newton converges linearly; up to {} iterations a \
+             step)",
+            other.name(),
+            crate::assembly::newton_iterations(other)
+        ),
     }
-    match &case.verification {
-        Some(v) => {
-            let _ = writeln!(s, "verification: {}", crate::verification::describe(v));
-        }
-        None => {
-            let _ = writeln!(s, "verification: none");
-        }
+}
+
+/// The strain recovery in words.
+fn recovery_text(model: &Model) -> &'static str {
+    match model.stress_recovery {
+        crate::case::StressRecovery::Basis => "the basis functions' gradients",
+        crate::case::StressRecovery::Cmpm => "CMPM patch functions ([001] Eqs. 22–23, corrected)",
+        crate::case::StressRecovery::Mapped => "the double-mapped operators (the forces' transpose)",
     }
-    s
 }
 
 /// The description of a three-dimensional case: its grid, bodies and material points, loads,
@@ -300,16 +269,14 @@ fn describe_solid(case: &Case, label: &str) -> String {
         );
     }
     let _ = writeln!(s, "material points: {}", ps.len());
-    for l in &model.loads {
-        let kind = match case.load(&l.name) {
-            Some(Load::ParticleTraction { traction, .. }) => {
-                format!("particle traction {traction:?} Pa on {} material points", l.size())
+    for (l, id) in model.loads.iter().zip(case.load_ids()) {
+        let kind = match case.load(id) {
+            Load::ParticleTraction(t) => {
+                format!("particle traction {:?} Pa on {} material points", t.traction, l.size())
             }
-            Some(Load::NodalTraction { traction, .. }) => {
-                format!("nodal traction {traction:?} Pa on {} nodes", l.size())
-            }
-            Some(Load::BodyForce { acceleration, .. }) => format!("body force {acceleration:?} m/s²"),
-            _ => String::new(),
+            Load::NodalTraction(t) => format!("nodal traction {:?} Pa on {} nodes", t.traction, l.size()),
+            Load::BodyForce(f) => format!("body force {:?} m/s²", f.acceleration),
+            Load::LinePressure(_) => String::new(),
         };
         let _ = writeln!(s, "load `{}`: {kind}", l.name);
     }
@@ -379,7 +346,7 @@ mod tests {
     #[test]
     fn a_three_dimensional_case_is_described() {
         let text = crate::case::tests_support::with_grid("[0.1, 1.0, 0.2]", "[1, 10, 2]");
-        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let d = super::describe(&c, "column_3d.toml");
         for want in [
             "dimension: 3",

@@ -153,7 +153,7 @@ mod tests {
     fn a_three_dimensional_model_writes_its_third_components() {
         let (_lock, _world) = crate::io::test_world();
         let text = crate::case::tests_support::with_grid("[0.1, 1.0, 0.2]", "[1, 10, 2]");
-        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let mut m = Model::build_solid(&c, |_| true);
         let s = [-1.0e3, -2.0e3, 150.0, -1.2e3, 80.0, -120.0];
         m.particles.stress.iter_mut().for_each(|x| *x = s);

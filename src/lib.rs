@@ -29,6 +29,7 @@ pub mod state;
 pub mod summary;
 pub mod sweep;
 pub mod update;
+pub mod validation;
 pub mod verification;
 
 /// porompm's version and git revision.

@@ -168,7 +168,7 @@ fn load_case(path: &Path, sets: &[String]) -> Result<case::Case, Failure> {
     let overrides: Vec<Override> =
         sets.iter().map(|s| Override::parse(s)).collect::<Result<_, _>>().map_err(|e| input(e.to_string()))?;
     let text = io::read_text(path).map_err(input)?;
-    case::parse(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
+    porompm::validation::load(&text, &path.display().to_string(), &overrides).map_err(|e| input(e.to_string()))
 }
 
 /// Checkpointing, restart and distribution settings of `porompm run`.
@@ -442,9 +442,11 @@ fn abort_all_ranks_on_panic() {
 
 fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure> {
     let mtext = io::read_text(material).map_err(input)?;
-    let m = case::element::parse_material(&mtext, &material.display().to_string()).map_err(|e| input(e.to_string()))?;
+    let m = porompm::element_test::input::parse_material(&mtext, &material.display().to_string())
+        .map_err(|e| input(e.to_string()))?;
     let ptext = io::read_text(path).map_err(input)?;
-    let p = case::element::parse_path(&ptext, &path.display().to_string()).map_err(|e| input(e.to_string()))?;
+    let p = porompm::element_test::input::parse_path(&ptext, &path.display().to_string())
+        .map_err(|e| input(e.to_string()))?;
     let model = porompm::model::material::soil_model(&m.model);
     let rows = porompm::element_test::run(&model, &p).map_err(failed)?;
     let file =

@@ -43,36 +43,56 @@ fn num(v: &Value) -> String {
 /// The table of a summary.
 pub fn format(v: &Value, dir: &str) -> String {
     let mut s = String::new();
+    run_lines(&mut s, v, dir);
+    let get = |k: &str| v.get(k).filter(|x| !x.is_null());
+    if let Some(t) = get("timings").and_then(Value::as_object) {
+        timings(&mut s, t);
+    }
+    if let Some(m) = get("verification").and_then(Value::as_object).filter(|m| !m.is_empty()) {
+        verification(&mut s, m, get("verification_passed").and_then(Value::as_bool));
+    }
+    if let Some(r) = get("results").and_then(Value::as_object).filter(|r| !r.is_empty()) {
+        s.push_str("\nresults\n");
+        let w = r.keys().map(String::len).max().unwrap_or(0);
+        for (name, x) in r {
+            let _ = writeln!(s, "  {name:<w$} {:>12}", num(x));
+        }
+    }
+    s
+}
+
+/// The run's lines: what ran, how long, how many steps and unknowns, where it restarted from.
+fn run_lines(s: &mut String, v: &Value, dir: &str) {
     let get = |k: &str| v.get(k).filter(|x| !x.is_null());
     let line = |s: &mut String, label: &str, value: String| {
         let _ = writeln!(s, "{label:<22} {value}");
     };
-    line(&mut s, "run", dir.to_string());
+    line(s, "run", dir.to_string());
     for (label, key) in [("case", "case"), ("status", "status"), ("error", "error"), ("porompm", "porompm_version")] {
         if let Some(x) = get(key) {
-            line(&mut s, label, num(x));
+            line(s, label, num(x));
         }
     }
     if let Some(o) = get("overrides").and_then(Value::as_array).filter(|o| !o.is_empty()) {
-        line(&mut s, "overrides", o.iter().map(num).collect::<Vec<_>>().join(" "));
+        line(s, "overrides", o.iter().map(num).collect::<Vec<_>>().join(" "));
     }
     if let Some(x) = get("wall_time_s").and_then(Value::as_f64) {
-        line(&mut s, "wall time", format!("{x:.3} s"));
+        line(s, "wall time", format!("{x:.3} s"));
     }
     if let (Some(t), Some(e)) = (get("time_s"), get("end_time_s")) {
-        line(&mut s, "simulated time", format!("{} s of {} s", num(t), num(e)));
+        line(s, "simulated time", format!("{} s of {} s", num(t), num(e)));
     }
     if let Some(x) = get("steps") {
         let cuts = get("step_cuts").map(num).unwrap_or_else(|| "0".into());
-        line(&mut s, "steps", format!("{} ({cuts} cuts)", num(x)));
+        line(s, "steps", format!("{} ({cuts} cuts)", num(x)));
     }
     if let Some(x) = get("snes_iterations") {
         let k = get("ksp_iterations").map(num).unwrap_or_else(|| "-".into());
-        line(&mut s, "iterations", format!("{} Newton, {k} Krylov", num(x)));
+        line(s, "iterations", format!("{} Newton, {k} Krylov", num(x)));
     }
     if let Some(x) = get("dofs") {
         let g = get("grid_dofs").map(num).unwrap_or_else(|| "-".into());
-        line(&mut s, "unknowns", format!("{} (grid dofs {g})", num(x)));
+        line(s, "unknowns", format!("{} (grid dofs {g})", num(x)));
     }
     for (label, key) in [
         ("material points", "particles"),
@@ -83,7 +103,7 @@ pub fn format(v: &Value, dir: &str) -> String {
         ("stopped", "stopped"),
     ] {
         if let Some(x) = get(key).filter(|x| x.as_str() != Some("")) {
-            line(&mut s, label, num(x));
+            line(s, label, num(x));
         }
     }
     if let Some(r) = get("restarted_from") {
@@ -96,56 +116,52 @@ pub fn format(v: &Value, dir: &str) -> String {
         if let Some(n) = r.get("note").and_then(Value::as_str) {
             let _ = write!(text, " ({n})");
         }
-        line(&mut s, "restarted from", text);
+        line(s, "restarted from", text);
     }
-    if let Some(t) = get("timings").and_then(Value::as_object) {
-        s.push_str("\ntimings [s]\n");
-        let total: f64 = t.values().filter_map(Value::as_f64).sum();
-        for (k, x) in t {
-            let name = k.strip_suffix("_s").unwrap_or(k);
-            let x = x.as_f64().unwrap_or(f64::NAN);
-            let share = if total > 0.0 { 100.0 * x / total } else { 0.0 };
-            let _ = writeln!(s, "  {name:<20} {x:>10.4} {share:>5.1} %");
-        }
+}
+
+/// The timings in seconds with their shares of the total.
+fn timings(s: &mut String, t: &serde_json::Map<String, Value>) {
+    s.push_str("\ntimings [s]\n");
+    let total: f64 = t.values().filter_map(Value::as_f64).sum();
+    for (k, x) in t {
+        let name = k.strip_suffix("_s").unwrap_or(k);
+        let x = x.as_f64().unwrap_or(f64::NAN);
+        let share = if total > 0.0 { 100.0 * x / total } else { 0.0 };
+        let _ = writeln!(s, "  {name:<20} {x:>10.4} {share:>5.1} %");
     }
-    if let Some(m) = get("verification").and_then(Value::as_object).filter(|m| !m.is_empty()) {
-        let verdict = match get("verification_passed").and_then(Value::as_bool) {
-            Some(true) => " (all pass)",
-            Some(false) => " (some FAIL)",
-            None => "",
+}
+
+/// The verification metrics, one a line, with the verdict `passed` of them all.
+fn verification(s: &mut String, m: &serde_json::Map<String, Value>, passed: Option<bool>) {
+    let verdict = match passed {
+        Some(true) => " (all pass)",
+        Some(false) => " (some FAIL)",
+        None => "",
+    };
+    let _ = writeln!(s, "\nverification{verdict}");
+    let w = m.keys().map(String::len).max().unwrap_or(6).max(6);
+    let _ = writeln!(
+        s,
+        "  {:<w$} {:>12} {:>12} {:>12}  {:<4}  detail",
+        "metric", "value", "reference", "tolerance", "pass"
+    );
+    for (name, x) in m {
+        let f = |k: &str| x.get(k).map(num).unwrap_or_else(|| "-".into());
+        let pass = match x.get("pass").and_then(Value::as_bool) {
+            Some(true) => "pass",
+            Some(false) => "FAIL",
+            None => "-",
         };
-        let _ = writeln!(s, "\nverification{verdict}");
-        let w = m.keys().map(String::len).max().unwrap_or(6).max(6);
+        let detail = x.get("detail").and_then(Value::as_str).unwrap_or("");
         let _ = writeln!(
             s,
-            "  {:<w$} {:>12} {:>12} {:>12}  {:<4}  detail",
-            "metric", "value", "reference", "tolerance", "pass"
+            "  {name:<w$} {:>12} {:>12} {:>12}  {pass:<4}  {detail}",
+            f("value"),
+            f("reference"),
+            f("tolerance")
         );
-        for (name, x) in m {
-            let f = |k: &str| x.get(k).map(num).unwrap_or_else(|| "-".into());
-            let pass = match x.get("pass").and_then(Value::as_bool) {
-                Some(true) => "pass",
-                Some(false) => "FAIL",
-                None => "-",
-            };
-            let detail = x.get("detail").and_then(Value::as_str).unwrap_or("");
-            let _ = writeln!(
-                s,
-                "  {name:<w$} {:>12} {:>12} {:>12}  {pass:<4}  {detail}",
-                f("value"),
-                f("reference"),
-                f("tolerance")
-            );
-        }
     }
-    if let Some(r) = get("results").and_then(Value::as_object).filter(|r| !r.is_empty()) {
-        s.push_str("\nresults\n");
-        let w = r.keys().map(String::len).max().unwrap_or(0);
-        for (name, x) in r {
-            let _ = writeln!(s, "  {name:<w$} {:>12}", num(x));
-        }
-    }
-    s
 }
 
 #[cfg(test)]

@@ -125,7 +125,7 @@ impl Fnv {
 
 /// A fingerprint of the case as validated (after `--set` overrides), without its `[output]` table.
 pub fn case_fingerprint(case: &Case) -> u64 {
-    let mut c = case.clone();
+    let mut c = case.file().clone();
     c.output = Default::default();
     let text = serde_json::to_string(&c).unwrap_or_default();
     let mut h = Fnv::new();
@@ -322,10 +322,9 @@ impl Checkpoint {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case;
 
     fn particles() -> (Case, Particles) {
-        let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
         let g = crate::model::grid_of(&c);
         let ps = Particles::generate(&c, &g, |_| true);
         (c, ps)
@@ -381,7 +380,9 @@ mod tests {
     /// components and the 3 × 3 F.
     #[test]
     fn three_dimensional_records_round_trip_every_particle_array() {
-        let c = case::parse(&crate::case::tests_support::with_grid("[0.2, 1.0, 0.3]", "[2, 10, 3]"), "t", &[]).unwrap();
+        let c =
+            crate::validation::load(&crate::case::tests_support::with_grid("[0.2, 1.0, 0.3]", "[2, 10, 3]"), "t", &[])
+                .unwrap();
         let mut ps = Particles::<3>::generate(&c, &crate::model::grid_of(&c), |_| true);
         let mut v = 0.5;
         let mut next = || {
@@ -452,10 +453,12 @@ mod tests {
         b.first = 15;
         assert_eq!(a.records_hash().wrapping_add(b.records_hash()), cp.records_hash());
         // The output table does not change the fingerprint; the physics does.
-        let mut c2 = c.clone();
-        c2.output.history_every = 5;
-        assert_eq!(case_fingerprint(&c2), cp.case_fingerprint);
-        c2.time.dt = Some(2e-3);
-        assert_ne!(case_fingerprint(&c2), cp.case_fingerprint);
+        let set = |s: &str| {
+            let sets = [crate::case::Override::parse(s).unwrap()];
+            crate::validation::load(crate::case::tests_support::MINIMAL, "t", &sets).unwrap()
+        };
+        assert_eq!(case_fingerprint(&c), cp.case_fingerprint);
+        assert_eq!(case_fingerprint(&set("output.history_every=5")), cp.case_fingerprint);
+        assert_ne!(case_fingerprint(&set("time.dt=2e-3")), cp.case_fingerprint);
     }
 }

@@ -272,7 +272,7 @@ pub fn run(req: &SweepRequest) -> Result<SweepOutcome, SweepError> {
         .collect::<Result<_, _>>()
         .map_err(|e| input(e.to_string()))?;
     let text = io::read_text(&req.case).map_err(input)?;
-    crate::case::parse(&text, &req.case.display().to_string(), &overrides).map_err(|e| input(e.to_string()))?;
+    crate::validation::load(&text, &req.case.display().to_string(), &overrides).map_err(|e| input(e.to_string()))?;
     for f in &req.options_files {
         if !f.is_file() {
             return Err(input(format!("PETSc options file {} does not exist", f.display())));
@@ -296,7 +296,7 @@ pub fn run(req: &SweepRequest) -> Result<SweepOutcome, SweepError> {
                     .map_err(|e| input(format!("--variant {}: {e}", v.name)))?,
             );
         }
-        crate::case::parse(&text, &req.case.display().to_string(), &sets)
+        crate::validation::load(&text, &req.case.display().to_string(), &sets)
             .map_err(|e| input(format!("--variant {}: {e}", v.name)))?;
     }
     let strategies = Strategy::from_files(&req.options_files);

@@ -191,7 +191,7 @@ mod tests {
 
     /// The two-phase column of the case tests, with gravity's pore-pressure gradient on its points.
     fn column() -> Model {
-        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
         let mut m = Model::build(&c, |_, _| true);
         m.integration = crate::scheme::Integration::QuasiStatic { theta: 1.0 };
         for g in m.particles.grad_p.iter_mut() {

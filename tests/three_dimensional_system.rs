@@ -26,12 +26,13 @@
 use porompm::algebra::det;
 use porompm::analysis::StageAnalysis;
 use porompm::assembly::{StepDim, StepForces, System};
-use porompm::case::{parse, Case};
+use porompm::case::Case;
 use porompm::kernels::{MAX_NODES, MAX_NODES_3D};
 use porompm::layout::Dim;
 use porompm::layout::{MAX_DOF, MAX_DOF_3D};
 use porompm::model::Model;
 use porompm::parallel::Collective;
+use porompm::validation::load as parse;
 
 /// The plane section: a 0.2 m × 0.6 m column of Mohr–Coulomb soil on a fixed base between
 /// smooth walls, drained at its top, pressed down by 3 mm over its left half (a strip footing

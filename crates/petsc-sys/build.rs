@@ -71,8 +71,21 @@ fn main() {
     {
         println!("cargo:rustc-check-cfg=cfg({flag})");
     }
+    let found = find();
+    check_configuration(&include_dirs(&found.petsc_cflags));
+    link(&found.petsc_libs);
+    bindings(&found);
+}
 
-    // ---- 1. find everything, report everything that is missing at once ----
+/// The compiler and linker flags of PETSc and MPI.
+struct Found {
+    petsc_cflags: String,
+    petsc_libs: String,
+    mpi_cflags: String,
+}
+
+/// Step 1: finds everything, and reports everything that is missing at once.
+fn find() -> Found {
     let mut missing = Vec::new();
     let has_pc = have_pkg_config();
     if !has_pc {
@@ -91,24 +104,31 @@ fn main() {
     if !have_libclang() {
         missing.push(Missing { what: "libclang (bindgen parses the PETSc headers with it)", package: "libclang-dev" });
     }
-    if !missing.is_empty() {
-        let mut msg = String::from("\n\npetsc-sys cannot be built; missing:\n");
-        for m in &missing {
-            msg.push_str(&format!("  - {}  -> Debian package `{}`\n", m.what, m.package));
+    match (petsc_cflags, petsc_libs, mpi_cflags) {
+        (Some(petsc_cflags), Some(petsc_libs), Some(mpi_cflags)) if missing.is_empty() => {
+            Found { petsc_cflags, petsc_libs, mpi_cflags }
         }
-        let pkgs: Vec<&str> = missing.iter().map(|m| m.package).collect();
-        msg.push_str(&format!("Install them with:  apt-get install -y {}\n", pkgs.join(" ")));
-        msg.push_str("(or run `make setup`, which installs every system dependency of porompm)\n\n");
-        eprintln!("{msg}");
-        println!("cargo:warning={}", msg.replace('\n', " "));
-        std::process::exit(1);
+        _ => report_missing(&missing),
     }
-    let petsc_cflags = petsc_cflags.unwrap();
-    let petsc_libs = petsc_libs.unwrap();
-    let mpi_cflags = mpi_cflags.unwrap();
+}
 
-    // ---- 2. check the PETSc configuration ----
-    let incs = include_dirs(&petsc_cflags);
+/// Names every missing piece and its Debian package, then stops the build.
+fn report_missing(missing: &[Missing]) -> ! {
+    let mut msg = String::from("\n\npetsc-sys cannot be built; missing:\n");
+    for m in missing {
+        msg.push_str(&format!("  - {}  -> Debian package `{}`\n", m.what, m.package));
+    }
+    let pkgs: Vec<&str> = missing.iter().map(|m| m.package).collect();
+    msg.push_str(&format!("Install them with:  apt-get install -y {}\n", pkgs.join(" ")));
+    msg.push_str("(or run `make setup`, which installs every system dependency of porompm)\n\n");
+    eprintln!("{msg}");
+    println!("cargo:warning={}", msg.replace('\n', " "));
+    std::process::exit(1);
+}
+
+/// Steps 2 and 3: checks the PETSc configuration in `petscconf.h` (in the include directories
+/// `incs`), and records the version and the external packages.
+fn check_configuration(incs: &[PathBuf]) {
     let conf = incs
         .iter()
         .map(|d| d.join("petscconf.h"))
@@ -126,23 +146,7 @@ fn main() {
     if defined("PETSC_USE_COMPLEX") {
         fail("this PETSc uses complex PetscScalar; porompm needs the real build (-lpetsc_real)");
     }
-    let version_h = incs.iter().map(|d| d.join("petscversion.h")).find(|p| p.exists());
-    let version = version_h
-        .and_then(|p| std::fs::read_to_string(p).ok())
-        .map(|t| {
-            let get = |key: &str| {
-                t.lines()
-                    .find_map(|l| {
-                        let mut w = l.split_whitespace();
-                        (w.next() == Some("#define") && w.next() == Some(key))
-                            .then(|| w.next().unwrap_or("?").to_string())
-                    })
-                    .unwrap_or_else(|| "?".into())
-            };
-            format!("{}.{}.{}", get("PETSC_VERSION_MAJOR"), get("PETSC_VERSION_MINOR"), get("PETSC_VERSION_SUBMINOR"))
-        })
-        .unwrap_or_else(|| "unknown".into());
-    println!("cargo:version={version}");
+    println!("cargo:version={}", version(incs));
     println!("cargo:include={}", incs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(":"));
     for (macro_name, key, cfg) in [
         ("PETSC_HAVE_MUMPS", "mumps", "petsc_have_mumps"),
@@ -157,8 +161,30 @@ fn main() {
             println!("cargo:rustc-cfg={cfg}");
         }
     }
+}
 
-    // ---- 3. link ----
+/// PETSc's version from `petscversion.h` (`unknown` without it).
+fn version(incs: &[PathBuf]) -> String {
+    let version_h = incs.iter().map(|d| d.join("petscversion.h")).find(|p| p.exists());
+    version_h
+        .and_then(|p| std::fs::read_to_string(p).ok())
+        .map(|t| {
+            let get = |key: &str| {
+                t.lines()
+                    .find_map(|l| {
+                        let mut w = l.split_whitespace();
+                        (w.next() == Some("#define") && w.next() == Some(key))
+                            .then(|| w.next().unwrap_or("?").to_string())
+                    })
+                    .unwrap_or_else(|| "?".into())
+            };
+            format!("{}.{}.{}", get("PETSC_VERSION_MAJOR"), get("PETSC_VERSION_MINOR"), get("PETSC_VERSION_SUBMINOR"))
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// Links PETSc with the flags `petsc_libs`.
+fn link(petsc_libs: &str) {
     for flag in petsc_libs.split_whitespace() {
         if let Some(dir) = flag.strip_prefix("-L") {
             println!("cargo:rustc-link-search=native={dir}");
@@ -166,8 +192,10 @@ fn main() {
             println!("cargo:rustc-link-lib={lib}");
         }
     }
+}
 
-    // ---- 4. bindings ----
+/// Step 4: the raw bindings, generated by bindgen.
+fn bindings(found: &Found) {
     let mut builder = bindgen::Builder::default()
         .header("wrapper.h")
         .allowlist_function("(Petsc|Vec|Mat|KSP|PC|SNES|DM|DMDA|IS|ISLocalToGlobalMapping)[A-Za-z0-9_]*")
@@ -185,10 +213,10 @@ fn main() {
         .layout_tests(false)
         .generate_comments(false)
         .parse_callbacks(Box::new(bindgen::CargoCallbacks::new()));
-    for d in include_dirs(&petsc_cflags).iter().chain(include_dirs(&mpi_cflags).iter()) {
+    for d in include_dirs(&found.petsc_cflags).iter().chain(include_dirs(&found.mpi_cflags).iter()) {
         builder = builder.clang_arg(format!("-I{}", d.display()));
     }
-    for f in petsc_cflags.split_whitespace().filter(|f| f.starts_with("-D")) {
+    for f in found.petsc_cflags.split_whitespace().filter(|f| f.starts_with("-D")) {
         builder = builder.clang_arg(f);
     }
     let bindings = builder.generate().unwrap_or_else(|e| fail(&format!("bindgen failed on the PETSc headers: {e}")));

@@ -133,7 +133,7 @@ mod tests {
     #[test]
     fn a_three_dimensional_dof_map_fixes_and_moves_its_boundaries() {
         let text = crate::case::tests_support::solid_with_boundaries(r#"["uz"]"#, "velocity = [0.0, -0.01, 0.002]");
-        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let m = Model::build_solid(&c, |_| true);
         let active = m.active(&c.stages[0]);
         let nodes = m.grid.nodes();

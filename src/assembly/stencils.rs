@@ -813,7 +813,7 @@ mod tests {
                 "shape = { polygon = { vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.75], [0.0, 1.0]] } }\n        z = [0.0, 0.2]",
             )
             .replace("[analysis]", "[stabilisation]\n        bbar = true\n        [analysis]");
-        let c = crate::case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let model = Model::build_solid(&c, |_| true);
         let g = &model.grid;
         let ghost = GhostedRange { start: [0; 3], count: g.nodes(), dof: 1 };

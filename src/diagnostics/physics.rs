@@ -38,6 +38,7 @@
 use super::Warning;
 use crate::analysis::StageAnalysis;
 use crate::case::{AnalysisType, Case, Drainage};
+use crate::model::material::Material;
 use crate::model::Model;
 use crate::scheme::Integration;
 
@@ -57,142 +58,177 @@ pub const COURANT_LIMIT: f64 = 1.0;
 /// The warnings of a case (its model built).
 pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
     let mut out = Vec::new();
-    let warn = |out: &mut Vec<Warning>, kind: &str, message: String| {
-        out.push(Warning { kind: kind.into(), message, time_s: None, value: None, threshold: None })
-    };
-    let h = model.grid.h_min();
     if !model.bbar && !model.fbar {
-        for (i, m) in model.materials.iter().enumerate() {
-            let nu = m.model.elastic().poisson;
-            if nu >= LOCKING_NU {
-                warn(
-                    &mut out,
-                    "locking",
-                    format!(
-                        "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ or F̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true (implicit stages) or stabilisation.fbar = true",
-                        m.name
-                    ),
-                );
-            }
-        }
+        locking(model, &mut out);
     }
     if model.pore_water && model.pressure_projection.is_none() && !model.patch_recovery {
-        'stages: for (s, stage) in case.stages.iter().enumerate() {
-            let flow = match (stage.analysis, stage.drainage) {
-                (AnalysisType::Static, Some(Drainage::Undrained)) => false,
-                (AnalysisType::Static, _) => continue,
-                _ => true,
-            };
-            let explicit = stage.analysis == AnalysisType::DynamicExplicit;
-            let e = stage.explicit.unwrap_or_default();
-            if explicit && e.pore_pressure != Some(crate::case::ExplicitPressure::Nodal) {
+        near_undrained(case, model, &mut out);
+    }
+    if model.patch_recovery {
+        patch_recovery_quasi_static(case, &mut out);
+    }
+    if model.pore_water && case.stages.iter().any(|s| s.analysis == AnalysisType::Dynamic) {
+        single_point_cells(case, &mut out);
+    }
+    if model.pore_water {
+        unresolved_consolidation(case, model, &mut out);
+    }
+    undamped_large_steps(case, model, &mut out);
+    out
+}
+
+/// A warning of `kind` with its message.
+fn warn(out: &mut Vec<Warning>, kind: &str, message: String) {
+    out.push(Warning { kind: kind.into(), message, time_s: None, value: None, threshold: None })
+}
+
+/// The consolidation coefficient c_v [m²/s] of material `m`.
+fn consolidation_coefficient<const D: usize>(model: &Model<D>, m: &Material) -> f64 {
+    m.conductivity
+        / (m.water_density * model.g.abs().max(f64::MIN_POSITIVE))
+        / (1.0 / m.model.elastic().constrained_modulus() + m.inv_q)
+}
+
+/// `locking`: a material with ν ≥ [`LOCKING_NU`] without B̄ or F̄.
+fn locking<const D: usize>(model: &Model<D>, out: &mut Vec<Warning>) {
+    for (i, m) in model.materials.iter().enumerate() {
+        let nu = m.model.elastic().poisson;
+        if nu >= LOCKING_NU {
+            warn(
+                out,
+                "locking",
+                format!(
+                    "materials[{i}] (`{}`): ν = {nu} ≥ {LOCKING_NU} locks without B̄ or F̄ (the volumetric strain is constrained at every material point); set stabilisation.bbar = true (implicit stages) or stabilisation.fbar = true",
+                    m.name
+                ),
+            );
+        }
+    }
+}
+
+/// `equal_order_near_undrained`: the first stage and material whose water is much stiffer than
+/// the skeleton and drains too little for the equal-order pressure.
+fn near_undrained<const D: usize>(case: &Case, model: &Model<D>, out: &mut Vec<Warning>) {
+    let h = model.grid.h_min();
+    for (s, stage) in case.stages.iter().enumerate() {
+        let flow = match (stage.analysis, stage.drainage) {
+            (AnalysisType::Static, Some(Drainage::Undrained)) => false,
+            (AnalysisType::Static, _) => continue,
+            _ => true,
+        };
+        let explicit = stage.analysis == AnalysisType::DynamicExplicit;
+        if explicit && stage.explicit.unwrap_or_default().pore_pressure != Some(crate::case::ExplicitPressure::Nodal) {
+            continue;
+        }
+        for (i, m) in model.materials.iter().enumerate() {
+            let big_m = m.model.elastic().constrained_modulus();
+            let q = 1.0 / m.inv_q;
+            if q < STIFF_WATER * big_m {
                 continue;
             }
-            for (i, m) in model.materials.iter().enumerate() {
-                let big_m = m.model.elastic().constrained_modulus();
-                let q = 1.0 / m.inv_q;
-                if q < STIFF_WATER * big_m {
-                    continue;
-                }
-                let cv =
-                    m.conductivity / (m.water_density * model.g.abs().max(f64::MIN_POSITIVE)) / (1.0 / big_m + m.inv_q);
-                if explicit {
-                    let ratio = cv * stage.duration / (h * h);
-                    if ratio < 1.0 {
-                        warn(
-                            &mut out,
-                            "equal_order_near_undrained",
-                            format!(
-                                "stage `{}` (stages[{s}]) with materials[{i}] (`{}`): the water is {:.0} times stiffer than the skeleton and drains less than a cell over the \
-                                 whole explicit stage (c_v T / h² = {ratio:.1e} < 1); the nodal pore pressure (`explicit.pore_pressure = \"nodal\"`) then alternates from node to \
-                                 node: use the point-wise pressure (leave `pore_pressure` out)",
-                                stage.name,
-                                m.name,
-                                q / big_m,
-                            ),
-                        );
-                        break 'stages;
-                    }
-                    continue;
-                }
-                let ratio = if flow { cv * stage.dt() / (h * h) } else { 0.0 };
-                if ratio < UNDRAINED_RATIO {
+            let cv = consolidation_coefficient(model, m);
+            if explicit {
+                let ratio = cv * stage.duration / (h * h);
+                if ratio < 1.0 {
                     warn(
-                        &mut out,
+                        out,
                         "equal_order_near_undrained",
                         format!(
-                            "stage `{}` (stages[{s}]) with materials[{i}] (`{}`): the water is {:.0} times stiffer than the skeleton and drains {} (c_v Δt / h² = {ratio:.1e} < {UNDRAINED_RATIO}); \
-                             equal-order pressures then alternate from node to node: set stabilisation.pressure_projection = 2.0",
+                            "stage `{}` (stages[{s}]) with materials[{i}] (`{}`): the water is {:.0} times stiffer than the skeleton and drains less than a cell over the \
+                             whole explicit stage (c_v T / h² = {ratio:.1e} < 1); the nodal pore pressure (`explicit.pore_pressure = \"nodal\"`) then alternates from node to \
+                             node: use the point-wise pressure (leave `pore_pressure` out)",
                             stage.name,
                             m.name,
                             q / big_m,
-                            if flow { "less than a tenth of a cell per step" } else { "not at all (undrained stage)" }
                         ),
                     );
-                    break 'stages;
+                    return;
                 }
+                continue;
             }
-        }
-    }
-    if model.patch_recovery {
-        if let Some((s, stage)) = case.stages.iter().enumerate().find(|(_, s)| s.analysis == AnalysisType::QuasiStatic)
-        {
-            warn(
-                &mut out,
-                "patch_recovery_quasi_static",
-                format!(
-                    "stage `{}` (stages[{s}]) is quasi-static with stabilisation.patch_recovery = true: the MLSA recovery (made for the dynamic u–p–U system) replaces each point's \
-                     pressure increment by a patch fit while the Darcy flux keeps the interpolated gradient, which makes the quasi-static answers worse (Terzaghi's settlement error \
-                     three times larger); set stabilisation.patch_recovery = false, with stabilisation.pressure_projection near undrained conditions",
-                    stage.name
-                ),
-            );
-        }
-    }
-    let dynamic = case.stages.iter().any(|s| s.analysis == AnalysisType::Dynamic);
-    if model.pore_water && dynamic {
-        for (i, b) in case.bodies.iter().enumerate().filter(|(_, b)| b.particles_per_cell == 1) {
-            warn(
-                &mut out,
-                "single_point_cells",
-                format!(
-                    "bodies[{i}] (`{}`): one material point per cell integrates each cell at a single point, which leaves the u–p–U system of a dynamic stage modes its stiffness does not see \
-                     (the Terzaghi column diverges within ten steps); use particles_per_cell ≥ 2, or quasi_static stages",
-                    b.name
-                ),
-            );
-        }
-    }
-    if model.pore_water {
-        let extent = (0..D).map(|d| model.grid.h[d] * model.grid.cells[d] as f64).fold(0.0, f64::max);
-        for (s, stage) in case.stages.iter().enumerate().filter(|(_, s)| s.analysis == AnalysisType::Dynamic) {
-            // The fastest consolidation of the materials.
-            let t_c = model
-                .materials
-                .iter()
-                .map(|m| {
-                    let cv = m.conductivity
-                        / (m.water_density * model.g.abs().max(f64::MIN_POSITIVE))
-                        / (1.0 / m.model.elastic().constrained_modulus() + m.inv_q);
-                    extent * extent / cv
-                })
-                .fold(f64::INFINITY, f64::min);
-            let share = stage.dt() / t_c;
-            if share > CONSOLIDATION_SHARE {
+            let ratio = if flow { cv * stage.dt() / (h * h) } else { 0.0 };
+            if ratio < UNDRAINED_RATIO {
                 warn(
-                    &mut out,
-                    "unresolved_consolidation",
+                    out,
+                    "equal_order_near_undrained",
                     format!(
-                        "stage `{}` (stages[{s}]): Δt = {:.3e} s is {share:.2} of the consolidation time H²/c_v = {t_c:.3e} s (H = {extent} m, the grid's larger side): \
-                         the dynamic step does not resolve the flow and the pore pressure can undershoot (below zero under a compressive load); \
-                         take Δt ≤ {CONSOLIDATION_SHARE} H²/c_v, or for a slow process analysis = \"quasi_static\" (backward Euler, stable at any step)",
+                        "stage `{}` (stages[{s}]) with materials[{i}] (`{}`): the water is {:.0} times stiffer than the skeleton and drains {} (c_v Δt / h² = {ratio:.1e} < {UNDRAINED_RATIO}); \
+                         equal-order pressures then alternate from node to node: set stabilisation.pressure_projection = 2.0",
                         stage.name,
-                        stage.dt()
+                        m.name,
+                        q / big_m,
+                        if flow { "less than a tenth of a cell per step" } else { "not at all (undrained stage)" }
                     ),
                 );
+                return;
             }
         }
     }
+}
+
+/// `patch_recovery_quasi_static`: the first quasi-static stage with the MLSA patch recovery.
+fn patch_recovery_quasi_static(case: &Case, out: &mut Vec<Warning>) {
+    if let Some((s, stage)) = case.stages.iter().enumerate().find(|(_, s)| s.analysis == AnalysisType::QuasiStatic) {
+        warn(
+            out,
+            "patch_recovery_quasi_static",
+            format!(
+                "stage `{}` (stages[{s}]) is quasi-static with stabilisation.patch_recovery = true: the MLSA recovery (made for the dynamic u–p–U system) replaces each point's \
+                 pressure increment by a patch fit while the Darcy flux keeps the interpolated gradient, which makes the quasi-static answers worse (Terzaghi's settlement error \
+                 three times larger); set stabilisation.patch_recovery = false, with stabilisation.pressure_projection near undrained conditions",
+                stage.name
+            ),
+        );
+    }
+}
+
+/// `single_point_cells`: every body with one material point per cell (in a two-phase case with a
+/// dynamic stage).
+fn single_point_cells(case: &Case, out: &mut Vec<Warning>) {
+    for (i, b) in case.bodies.iter().enumerate().filter(|(_, b)| b.particles_per_cell == 1) {
+        warn(
+            out,
+            "single_point_cells",
+            format!(
+                "bodies[{i}] (`{}`): one material point per cell integrates each cell at a single point, which leaves the u–p–U system of a dynamic stage modes its stiffness does not see \
+                 (the Terzaghi column diverges within ten steps); use particles_per_cell ≥ 2, or quasi_static stages",
+                b.name
+            ),
+        );
+    }
+}
+
+/// `unresolved_consolidation`: every dynamic stage whose step is too long a share of the fastest
+/// consolidation time H²/c_v of the materials (H the grid's larger side).
+fn unresolved_consolidation<const D: usize>(case: &Case, model: &Model<D>, out: &mut Vec<Warning>) {
+    let extent = (0..D).map(|d| model.grid.h[d] * model.grid.cells[d] as f64).fold(0.0, f64::max);
+    let t_c = model
+        .materials
+        .iter()
+        .map(|m| extent * extent / consolidation_coefficient(model, m))
+        .fold(f64::INFINITY, f64::min);
+    for (s, stage) in case.stages.iter().enumerate().filter(|(_, s)| s.analysis == AnalysisType::Dynamic) {
+        let share = stage.dt() / t_c;
+        if share > CONSOLIDATION_SHARE {
+            warn(
+                out,
+                "unresolved_consolidation",
+                format!(
+                    "stage `{}` (stages[{s}]): Δt = {:.3e} s is {share:.2} of the consolidation time H²/c_v = {t_c:.3e} s (H = {extent} m, the grid's larger side): \
+                     the dynamic step does not resolve the flow and the pore pressure can undershoot (below zero under a compressive load); \
+                     take Δt ≤ {CONSOLIDATION_SHARE} H²/c_v, or for a slow process analysis = \"quasi_static\" (backward Euler, stable at any step)",
+                    stage.name,
+                    stage.dt()
+                ),
+            );
+        }
+    }
+}
+
+/// `undamped_large_step`: every dynamic stage whose time integration damps nothing and whose step
+/// is longer than a compression wave takes to cross a cell.
+fn undamped_large_steps<const D: usize>(case: &Case, model: &Model<D>, out: &mut Vec<Warning>) {
+    let h = model.grid.h_min();
     for (s, stage) in case.stages.iter().enumerate() {
         let Integration::Dynamic { gamma, alpha_m, alpha_f, .. } = StageAnalysis::of(case, stage).integration else {
             continue;
@@ -204,13 +240,14 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
             .materials
             .iter()
             .map(|m| {
-                let stiff = m.model.elastic().constrained_modulus() + if model.pore_water { 1.0 / m.inv_q } else { 0.0 };
+                let stiff =
+                    m.model.elastic().constrained_modulus() + if model.pore_water { 1.0 / m.inv_q } else { 0.0 };
                 (stiff / m.mixture_density(m.porosity)).sqrt() * stage.dt() / h
             })
             .fold(0.0, f64::max);
         if courant > COURANT_LIMIT {
             warn(
-                &mut out,
+                out,
                 "undamped_large_step",
                 format!(
                     "stage `{}` (stages[{s}]): Δt = {:.3e} s is {courant:.1} times the time a compression wave takes to cross a cell, and its time integration damps nothing: \
@@ -221,5 +258,4 @@ pub fn warnings<const D: usize>(case: &Case, model: &Model<D>) -> Vec<Warning> {
             );
         }
     }
-    out
 }

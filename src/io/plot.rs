@@ -7,7 +7,7 @@
 //! non-positive values. A figure with a [`crate::plot::ColourMap`] draws it under its series on axes
 //! of equal scale, with a colour bar on the right (the viridis colour scale).
 
-use crate::plot::{Axis, ColourMap, Figure, Style};
+use crate::plot::{Axis, ColourMap, Figure, Series, Style};
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
@@ -302,71 +302,16 @@ where
         .draw()
         .map_err(err)?;
     if let Some(m) = &f.map {
-        let (lo, hi) = m.limits();
-        let (hx, hy) = m.half_size;
-        let cells = m.points.iter().filter(|p| p.0.is_finite() && p.1.is_finite()).map(|&(x, y, v)| {
-            let corner = |dx: f64, dy: f64| (to_axis(&f.x, x + dx), to_axis(&f.y, y + dy));
-            Rectangle::new([corner(-hx, -hy), corner(hx, hy)], viridis((v - lo) / (hi - lo)).filled())
-        });
-        chart.draw_series(cells).map_err(err)?;
+        draw_map(&mut chart, f, m)?;
     }
     for s in &f.series {
-        let c = colour(s.colour);
-        let pts: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .filter(|p| drawable(&f.x, p.0) && drawable(&f.y, p.1))
-            .map(|p| (to_axis(&f.x, p.0), to_axis(&f.y, p.1)))
-            .collect();
-        if pts.is_empty() {
-            continue;
-        }
-        let line = ShapeStyle::from(&c).stroke_width(2);
-        let anno = match s.style {
-            Style::Line => chart.draw_series(LineSeries::new(pts.clone(), line)).map_err(err)?,
-            Style::Dashed => chart.draw_series(DashedLineSeries::new(pts.clone(), 10, 6, line)).map_err(err)?,
-            Style::Markers => chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, ShapeStyle::from(&c).stroke_width(1))))
-                .map_err(err)?,
-            Style::LineMarkers => {
-                chart.draw_series(LineSeries::new(pts.clone(), line)).map_err(err)?;
-                chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?
-            }
-        };
-        match s.style {
-            Style::Markers => anno.label(&s.label).legend(move |(x, y)| Circle::new((x + 10, y), 4, c)),
-            Style::Dashed => anno.label(&s.label).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (7, 0)], c.stroke_width(2))
-                    + PathElement::new(vec![(13, 0), (20, 0)], c.stroke_width(2))
-            }),
-            _ => anno
-                .label(&s.label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))),
-        };
-        if !s.point_labels.is_empty() {
-            let labelled = s
-                .points
-                .iter()
-                .zip(&s.point_labels)
-                .filter(|(p, _)| drawable(&f.x, p.0) && drawable(&f.y, p.1))
-                .map(|(p, l)| (to_axis(&f.x, p.0), to_axis(&f.y, p.1), l.clone()));
-            chart
-                .draw_series(labelled.map(|(x, y, l)| {
-                    EmptyElement::at((x, y)) + Text::new(l, (7, 5), ("sans-serif", 15).into_font().color(&c))
-                }))
-                .map_err(err)?;
-        }
+        draw_series(&mut chart, f, s)?;
     }
-    let ylo = yr.0;
-    for v in &f.vertical_lines {
-        if !drawable(&f.x, v.x) {
-            continue;
-        }
+    for v in f.vertical_lines.iter().filter(|v| drawable(&f.x, v.x)) {
         let c = colour(v.colour);
         let x = to_axis(&f.x, v.x);
         chart
-            .draw_series(DashedLineSeries::new(vec![(x, ylo), (x, yr.1)], 8, 5, c.stroke_width(2)))
+            .draw_series(DashedLineSeries::new(vec![(x, yr.0), (x, yr.1)], 8, 5, c.stroke_width(2)))
             .map_err(err)?
             .label(&v.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y - 6), (x + 20, y + 6)], c.stroke_width(2)));
@@ -381,6 +326,79 @@ where
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A chart of the bitmap backend on coordinates `X` × `Y`.
+type Chart<'a, X, Y> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<X, Y>>;
+
+/// The colour map `m` of figure `f`: a filled rectangle per point.
+fn draw_map<X, Y>(chart: &mut Chart<'_, X, Y>, f: &Figure, m: &ColourMap) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let (lo, hi) = m.limits();
+    let (hx, hy) = m.half_size;
+    let cells = m.points.iter().filter(|p| p.0.is_finite() && p.1.is_finite()).map(|&(x, y, v)| {
+        let corner = |dx: f64, dy: f64| (to_axis(&f.x, x + dx), to_axis(&f.y, y + dy));
+        Rectangle::new([corner(-hx, -hy), corner(hx, hy)], viridis((v - lo) / (hi - lo)).filled())
+    });
+    chart.draw_series(cells).map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// One series of figure `f` in its style, with its legend entry and its points' labels.
+fn draw_series<X, Y>(chart: &mut Chart<'_, X, Y>, f: &Figure, s: &Series) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+    let c = colour(s.colour);
+    let on_axes = |p: &(f64, f64)| drawable(&f.x, p.0) && drawable(&f.y, p.1);
+    let pts: Vec<(f64, f64)> =
+        s.points.iter().filter(|p| on_axes(p)).map(|p| (to_axis(&f.x, p.0), to_axis(&f.y, p.1))).collect();
+    if pts.is_empty() {
+        return Ok(());
+    }
+    let line = ShapeStyle::from(&c).stroke_width(2);
+    let anno = match s.style {
+        Style::Line => chart.draw_series(LineSeries::new(pts.clone(), line)).map_err(err)?,
+        Style::Dashed => chart.draw_series(DashedLineSeries::new(pts.clone(), 10, 6, line)).map_err(err)?,
+        Style::Markers => chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, ShapeStyle::from(&c).stroke_width(1))))
+            .map_err(err)?,
+        Style::LineMarkers => {
+            chart.draw_series(LineSeries::new(pts.clone(), line)).map_err(err)?;
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(err)?
+        }
+    };
+    match s.style {
+        Style::Markers => anno.label(&s.label).legend(move |(x, y)| Circle::new((x + 10, y), 4, c)),
+        Style::Dashed => anno.label(&s.label).legend(move |(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (7, 0)], c.stroke_width(2))
+                + PathElement::new(vec![(13, 0), (20, 0)], c.stroke_width(2))
+        }),
+        _ => anno.label(&s.label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))),
+    };
+    if s.point_labels.is_empty() {
+        return Ok(());
+    }
+    let labelled = s
+        .points
+        .iter()
+        .zip(&s.point_labels)
+        .filter(|(p, _)| on_axes(p))
+        .map(|(p, l)| (to_axis(&f.x, p.0), to_axis(&f.y, p.1), l.clone()));
+    chart
+        .draw_series(
+            labelled.map(|(x, y, l)| {
+                EmptyElement::at((x, y)) + Text::new(l, (7, 5), ("sans-serif", 15).into_font().color(&c))
+            }),
+        )
         .map_err(err)?;
     Ok(())
 }

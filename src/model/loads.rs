@@ -2,7 +2,7 @@
 
 use super::grid::Grid;
 use super::particles::Particles;
-use crate::case::{self, Dof, Region, Side, TimeFunction};
+use crate::case::{self, BoundaryId, Dof, LoadId, Region, Side, TimeFunction};
 
 /// A scalar function of time.
 #[derive(Debug, Clone)]
@@ -29,16 +29,19 @@ impl TimeFn {
     /// From the case's definition.
     pub fn from_case(f: &TimeFunction) -> TimeFn {
         match f {
-            TimeFunction::Constant { value, .. } => TimeFn::Constant(*value),
-            TimeFunction::Ramp { start, duration, .. } => TimeFn::Ramp { start: *start, duration: *duration },
-            TimeFunction::SmoothRamp { start, duration, .. } => {
-                TimeFn::SmoothRamp { start: *start, duration: *duration }
+            TimeFunction::Constant(c) => TimeFn::Constant(c.value),
+            TimeFunction::Ramp(r) => TimeFn::Ramp { start: r.start, duration: r.duration },
+            TimeFunction::SmoothRamp(r) => TimeFn::SmoothRamp { start: r.start, duration: r.duration },
+            TimeFunction::Harmonic(h) => {
+                TimeFn::Harmonic { omega: h.angular_frequency, phase: h.phase, ramp: h.ramp_duration }
             }
-            TimeFunction::Harmonic { angular_frequency, phase, ramp_duration, .. } => {
-                TimeFn::Harmonic { omega: *angular_frequency, phase: *phase, ramp: *ramp_duration }
-            }
-            TimeFunction::Table { times, values, .. } => TimeFn::Table { t: times.clone(), v: values.clone() },
+            TimeFunction::Table(t) => TimeFn::Table { t: t.times.clone(), v: t.values.clone() },
         }
+    }
+
+    /// The function scaling a load or a motion: the case's `f`, or a constant 1 without one.
+    pub fn scaling(f: Option<&TimeFunction>) -> TimeFn {
+        f.map_or(TimeFn::Constant(1.0), TimeFn::from_case)
     }
 
     /// f(t).
@@ -151,46 +154,41 @@ pub enum LoadTarget<const D: usize = 2> {
 }
 
 impl<const D: usize> LoadDef<D> {
-    /// Resolves a case load of any dimension on this rank's particles and the grid: a face
-    /// traction, a nodal traction, a body force or, in the plane, a line pressure (`None` for a
-    /// line pressure in three dimensions, which validation refuses).
-    pub fn from_case_in(
-        l: &case::Load,
-        c: &case::Case,
-        grid: &Grid<D>,
-        particles: &Particles<D>,
-    ) -> Option<LoadDef<D>> {
+    /// Resolves the case's load `id` of any dimension on this rank's particles and the grid: a
+    /// face traction, a nodal traction, a body force or, in the plane, a line pressure (`None`
+    /// for a line pressure in three dimensions, which validation refuses).
+    pub fn from_case_in(id: LoadId, c: &case::Case, grid: &Grid<D>, particles: &Particles<D>) -> Option<LoadDef<D>> {
         let vector = |v: &[f64]| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
-        let target = match l {
-            case::Load::ParticleTraction { region, body, face, traction, .. } => LoadTarget::ParticleTraction {
+        let bodies = c.load_bodies(id);
+        let target = match c.load(id) {
+            case::Load::ParticleTraction(t) => LoadTarget::ParticleTraction {
                 particles: (0..particles.len())
                     .filter(|&k| {
-                        let in_body = body.as_ref().is_none_or(|b| c.bodies[particles.body[k] as usize].name == *b);
+                        let in_body =
+                            bodies.is_none_or(|bs| bs.iter().any(|b| b.index() == particles.body[k] as usize));
                         in_body
-                            && region.contains_in(particles.x0[k])
-                            && face_is_exposed(c, particles.x0[k], particles.lp0[k], *face)
+                            && t.region.contains_in(particles.x0[k])
+                            && face_is_exposed(c, particles.x0[k], particles.lp0[k], t.face)
                     })
                     .collect(),
-                face: *face,
-                traction: vector(traction),
+                face: t.face,
+                traction: vector(&t.traction),
             },
-            case::Load::NodalTraction { region, traction, .. } => {
-                LoadTarget::NodalTraction { nodes: tributary_nodes(grid, region), traction: vector(traction) }
+            case::Load::NodalTraction(t) => {
+                LoadTarget::NodalTraction { nodes: tributary_nodes(grid, &t.region), traction: vector(&t.traction) }
             }
-            case::Load::BodyForce { acceleration, bodies, .. } => LoadTarget::BodyForce {
-                acceleration: vector(acceleration),
-                bodies: bodies
-                    .as_ref()
-                    .map(|names| names.iter().filter_map(|n| c.body_index(n)).map(|i| i as u16).collect()),
+            case::Load::BodyForce(f) => LoadTarget::BodyForce {
+                acceleration: vector(&f.acceleration),
+                bodies: bodies.map(|bs| bs.iter().map(|b| b.index() as u16).collect()),
             },
             // A pressure on a polyline of the plane (validation keeps it out of three dimensions).
-            case::Load::LinePressure { points, pressure, .. } if D == 2 => LoadTarget::LinePressure {
-                points: line_gauss_points(points).into_iter().map(|(x, f)| (vector(&x), vector(&f))).collect(),
-                pressure: *pressure,
+            case::Load::LinePressure(l) if D == 2 => LoadTarget::LinePressure {
+                points: line_gauss_points(&l.points).into_iter().map(|(x, f)| (vector(&x), vector(&f))).collect(),
+                pressure: l.pressure,
             },
-            case::Load::LinePressure { .. } => return None,
+            case::Load::LinePressure(_) => return None,
         };
-        Some(LoadDef::with_target(l, c, target))
+        Some(LoadDef::with_target(id, c, target))
     }
 
     /// Number of particles or nodes it acts on (for `check`).
@@ -203,10 +201,10 @@ impl<const D: usize> LoadDef<D> {
         }
     }
 
-    /// The load `l` of case `c` acting on `target`, with its time function and increments.
-    fn with_target(l: &case::Load, c: &case::Case, target: LoadTarget<D>) -> LoadDef<D> {
-        let time_fn =
-            l.time_function().and_then(|n| c.time_function(n)).map(TimeFn::from_case).unwrap_or(TimeFn::Constant(1.0));
+    /// The load `id` of case `c` acting on `target`, with its time function and increments.
+    fn with_target(id: LoadId, c: &case::Case, target: LoadTarget<D>) -> LoadDef<D> {
+        let l = c.load(id);
+        let time_fn = TimeFn::scaling(c.load_time_function(id));
         let increments = l.increment_factor().map(|e| Increments {
             expr: e.to_string(),
             params: c.parameters.clone(),
@@ -452,11 +450,12 @@ impl<const D: usize> BoundaryDef<D> {
         self.name == super::AXIS && self.side == Some(Side::XMin) && self.surface.is_none()
     }
 
-    /// From the case; a surface is resolved on this rank's particles (those of the body, inside the
-    /// surface's region if it has one, whose face in a listed direction is exposed at t = 0).
-    pub fn from_case(b: &case::Boundary, c: &case::Case, particles: &Particles<D>) -> BoundaryDef<D> {
-        let surface = b.surface.as_ref().map(|sf| {
-            let body = c.body_index(&sf.body).expect("validated") as u16;
+    /// From the case's boundary `id`; a surface is resolved on this rank's particles (those of the
+    /// body, inside the surface's region if it has one, whose face in a listed direction is exposed
+    /// at t = 0).
+    pub fn from_case(id: BoundaryId, c: &case::Case, particles: &Particles<D>) -> BoundaryDef<D> {
+        let surface = c.boundary(id).surface.as_ref().zip(c.surface_body(id)).map(|(sf, body)| {
+            let body = body.index() as u16;
             let mut v = Vec::new();
             for k in (0..particles.len()).filter(|&k| particles.body[k] == body) {
                 if sf.region.is_some_and(|r| !r.contains_in(particles.x0[k])) {
@@ -470,18 +469,13 @@ impl<const D: usize> BoundaryDef<D> {
             }
             v
         });
-        BoundaryDef::from_case_in(b, c, surface)
+        BoundaryDef::from_case_in(id, c, surface)
     }
 
-    /// From the case, with its moving `surface` resolved on this rank's particles.
-    pub fn from_case_in(b: &case::Boundary, c: &case::Case, surface: Option<Vec<(usize, Side)>>) -> BoundaryDef<D> {
-        let time_fn = || {
-            b.time_function
-                .as_ref()
-                .and_then(|n| c.time_function(n))
-                .map(TimeFn::from_case)
-                .unwrap_or(TimeFn::Constant(1.0))
-        };
+    /// From the case's boundary `id`, with its moving `surface` resolved on this rank's particles.
+    pub fn from_case_in(id: BoundaryId, c: &case::Case, surface: Option<Vec<(usize, Side)>>) -> BoundaryDef<D> {
+        let b = c.boundary(id);
+        let time_fn = || TimeFn::scaling(c.boundary_time_function(id));
         let vector = |v: &Vec<f64>| -> [f64; D] { std::array::from_fn(|d| v.get(d).copied().unwrap_or(0.0)) };
         // A velocity gradient (D × D, validated) about its centre (default the origin).
         let gradient = b.velocity_gradient.as_ref().map(|l| {

@@ -1,6 +1,7 @@
 //! Materials: phase properties of the mixture, permeability laws and the skeleton's soil model
 //! ([`super::soil`]).
 
+use super::finite_strain;
 use super::soil::{Constitutive, LinearElastic, MohrCoulomb, VonMises};
 use crate::case::{self, Formulation, SoilModel};
 
@@ -72,73 +73,58 @@ impl Material {
 
 /// The solver's soil model for the case's (angles from degrees to radians).
 pub fn soil_model(m: &SoilModel) -> Constitutive {
-    match *m {
-        SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-            Constitutive::LinearElastic(LinearElastic::new(young_modulus, poisson_ratio))
+    let elastic = |e: f64, nu: f64| LinearElastic::new(e, nu);
+    match m {
+        SoilModel::LinearElastic(p) => Constitutive::LinearElastic(elastic(p.young_modulus, p.poisson_ratio)),
+        SoilModel::MohrCoulomb(p) => mohr_coulomb(p),
+        SoilModel::VonMises(p) => {
+            let el = elastic(p.young_modulus, p.poisson_ratio);
+            let strength = VonMises {
+                shear: el.shear_modulus(),
+                cohesion: p.cohesion,
+                residual_cohesion: p.residual_cohesion.unwrap_or(p.cohesion),
+                softening_modulus: p.softening_modulus,
+            };
+            Constitutive::VonMises(el, strength)
         }
-        SoilModel::MohrCoulomb {
-            young_modulus,
-            poisson_ratio,
-            friction_angle,
-            cohesion,
-            residual_cohesion,
-            softening_strain,
-            dilation_angle,
-            critical_dilation_angle,
-            dilation_decay,
-            tension_cutoff,
-        } => {
-            let el = LinearElastic::new(young_modulus, poisson_ratio);
-            let psi = dilation_angle.to_radians();
-            Constitutive::MohrCoulomb(
-                el,
-                MohrCoulomb {
-                    shear: el.shear_modulus(),
-                    lame: el.lame(),
-                    phi: friction_angle.to_radians(),
-                    cohesion,
-                    residual_cohesion: residual_cohesion.unwrap_or(cohesion),
-                    softening_strain: softening_strain.unwrap_or(f64::INFINITY),
-                    psi_ini: psi,
-                    psi_crit: critical_dilation_angle.map_or(psi, f64::to_radians),
-                    eta: dilation_decay,
-                    tension: tension_cutoff,
-                },
-            )
-        }
-        SoilModel::HenckyJ2 { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_rate } => {
-            Constitutive::HenckyJ2(
-                LinearElastic::new(young_modulus, poisson_ratio),
-                crate::model::finite_strain::HenckyJ2::new(
-                    young_modulus,
-                    poisson_ratio,
-                    cohesion,
-                    residual_cohesion.unwrap_or(cohesion),
-                    softening_rate,
-                ),
-            )
-        }
-        SoilModel::NewtonianFluid { bulk_modulus, viscosity, bulk_viscosity } => Constitutive::NewtonianFluid(
-            LinearElastic::from_bulk_shear(bulk_modulus, 0.0),
-            crate::model::finite_strain::NewtonianFluid { bulk: bulk_modulus, viscosity, bulk_viscosity },
+        SoilModel::HenckyJ2(p) => Constitutive::HenckyJ2(
+            elastic(p.young_modulus, p.poisson_ratio),
+            finite_strain::HenckyJ2::new(p.young_modulus, p.poisson_ratio, p.cohesion, p.residual(), p.softening_rate),
         ),
-        SoilModel::NeoHookean { young_modulus, poisson_ratio } => Constitutive::NeoHookean(
-            LinearElastic::new(young_modulus, poisson_ratio),
-            crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio),
+        SoilModel::NewtonianFluid(p) => Constitutive::NewtonianFluid(
+            LinearElastic::from_bulk_shear(p.bulk_modulus, 0.0),
+            finite_strain::NewtonianFluid {
+                bulk: p.bulk_modulus,
+                viscosity: p.viscosity,
+                bulk_viscosity: p.bulk_viscosity,
+            },
         ),
-        SoilModel::VonMises { young_modulus, poisson_ratio, cohesion, residual_cohesion, softening_modulus } => {
-            let el = LinearElastic::new(young_modulus, poisson_ratio);
-            Constitutive::VonMises(
-                el,
-                VonMises {
-                    shear: el.shear_modulus(),
-                    cohesion,
-                    residual_cohesion: residual_cohesion.unwrap_or(cohesion),
-                    softening_modulus,
-                },
-            )
-        }
+        SoilModel::NeoHookean(p) => Constitutive::NeoHookean(
+            elastic(p.young_modulus, p.poisson_ratio),
+            finite_strain::NeoHookean::new(p.young_modulus, p.poisson_ratio),
+        ),
     }
+}
+
+/// The solver's Mohr–Coulomb model for the case's parameters.
+fn mohr_coulomb(p: &case::MohrCoulomb) -> Constitutive {
+    let el = LinearElastic::new(p.young_modulus, p.poisson_ratio);
+    let psi = p.dilation_angle.to_radians();
+    Constitutive::MohrCoulomb(
+        el,
+        MohrCoulomb {
+            shear: el.shear_modulus(),
+            lame: el.lame(),
+            phi: p.friction_angle.to_radians(),
+            cohesion: p.cohesion,
+            residual_cohesion: p.residual_cohesion.unwrap_or(p.cohesion),
+            softening_strain: p.softening_strain.unwrap_or(f64::INFINITY),
+            psi_ini: psi,
+            psi_crit: p.critical_dilation_angle.map_or(psi, f64::to_radians),
+            eta: p.dilation_decay,
+            tension: p.tension_cutoff,
+        },
+    )
 }
 
 /// 1/Q = n/K_w + (1 − n)/K_s ([003] Eq. 5); infinite moduli contribute nothing.

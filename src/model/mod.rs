@@ -216,7 +216,7 @@ impl<const D: usize> Model<D> {
     /// Resolves the case's moving surfaces again on this rank's points (see
     /// [`Model::resolve_targets`]).
     fn resolve_surfaces(&mut self, case: &Case) {
-        for (b, c) in self.boundaries.iter_mut().zip(&case.boundaries) {
+        for (b, c) in self.boundaries.iter_mut().zip(case.boundary_ids()) {
             if b.surface.is_some() {
                 *b = BoundaryDef::from_case(c, case, &self.particles);
             }
@@ -315,9 +315,9 @@ impl<const D: usize> Model<D> {
     pub fn of_case(case: &Case, owned: impl Fn([usize; D]) -> bool) -> Model<D> {
         let grid = grid_of(case);
         let particles = Particles::generate(case, &grid, owned);
-        let loads = case.loads.iter().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
+        let loads = case.load_ids().filter_map(|l| LoadDef::from_case_in(l, case, &grid, &particles)).collect();
         let mut boundaries: Vec<BoundaryDef<D>> =
-            case.boundaries.iter().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
+            case.boundary_ids().map(|b| BoundaryDef::from_case(b, case, &particles)).collect();
         if geometry_of(case).axisymmetric() && grid.origin[0].abs() <= 1e-12 * grid.h[0] {
             boundaries.push(BoundaryDef::axis());
         }
@@ -348,7 +348,7 @@ impl<const D: usize> Model<D> {
     /// this rank's points, after points moved between ranks. Both depend only on what travels with
     /// a point (its body, and its position and domain at t = 0), so every point keeps its loads.
     pub fn resolve_targets(&mut self, case: &Case) {
-        for (l, c) in self.loads.iter_mut().zip(&case.loads) {
+        for (l, c) in self.loads.iter_mut().zip(case.load_ids()) {
             if matches!(l.target, LoadTarget::ParticleTraction { .. }) {
                 // The state of a load with increments is global (the same on every rank): kept.
                 let increments = l.increments.take();
@@ -540,7 +540,7 @@ mod tests {
         .iter()
         .map(|s| crate::case::Override::parse(s).unwrap())
         .collect();
-        let c = crate::case::parse(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
         let mut m = Model::build(&c, |_, _| true);
         let strength = |m: &Model| match &m.materials[0].model {
             crate::model::soil::Constitutive::MohrCoulomb(_, mc) => (mc.cohesion, mc.phi.tan()),

@@ -140,8 +140,9 @@ impl<const D: usize> Particles<D> {
         let mut ps = Particles::default();
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
         let geometry = super::geometry_of(case);
-        for (b, body) in case.bodies.iter().enumerate() {
-            let mat_index = case.material_index(&body.material).expect("validated");
+        for id in case.body_ids() {
+            let (b, body) = (id.index(), case.body(id));
+            let mat_index = case.material_id_of(id).index();
             let n = body.particles_per_cell;
             let (lo2, hi2) = body.shape.bounds();
             let depth = case.body_depth(body);
@@ -259,9 +260,7 @@ fn geostatic<const D: usize>(
     let (surface, mass) = case.column_above(x, grid.h[1] / 50.0);
     let sigma_v = -g * mass;
     let (p, grad_p) = if pore_water {
-        let rho_w = case
-            .body_at(x)
-            .map_or(1000.0, |b| case.materials[case.material_index(&b.material).expect("validated")].water_density);
+        let rho_w = case.body_at(x).map_or(1000.0, |b| case.material_of(b).water_density);
         let level = match init.water_table {
             crate::case::WaterTable::Surface => surface,
             crate::case::WaterTable::Level(y) => y,
@@ -280,11 +279,10 @@ fn geostatic<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case;
 
     #[test]
     fn a_column_is_filled_with_two_by_two_points_per_cell_of_the_right_volume() {
-        let c = case::parse(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
         let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
         let ps = Particles::generate(&c, &g, |_| true);
         assert_eq!(ps.len(), 40);
@@ -309,7 +307,7 @@ mod tests {
                 "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
                 "shape = { polygon = { vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] } }\n        [[bodies]]\n        name = \"block\"\n        material = \"soil\"\n        particles_per_cell = 1\n        shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }",
             );
-        let c = case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
         let ps = Particles::generate(&c, &g, |_| true);
         let tri: f64 = (0..ps.len()).filter(|&k| ps.body[k] == 0).map(|k| ps.volume[k]).sum();
@@ -341,7 +339,7 @@ mod tests {
                      shape = {{ polygon = {{ vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.5], [0.0, 1.0]] }} }}"
                 ),
             );
-        case::parse(&text, "t", &[]).unwrap()
+        crate::validation::load(&text, "t", &[]).unwrap()
     }
 
     /// A three-dimensional case's bodies are their sections extruded along z: 2 × 2 × 2 points per
@@ -482,19 +480,23 @@ mod tests {
             ),
         ];
         for (text, want) in cases {
-            let e = case::parse(&text, "t", &[]).unwrap_err().to_string();
+            let e = crate::validation::load(&text, "t", &[]).unwrap_err().to_string();
             assert!(e.contains(want), "{e}\n  does not say: {want}");
         }
-        assert!(case::parse(&solid, "t", &[]).is_ok());
+        assert!(crate::validation::load(&solid, "t", &[]).is_ok());
         // A nodal traction on the top face, and a face traction whose increments follow the
         // loaded faces with an expression in z, are three-dimensional loads.
         let loaded = solid.clone()
             + "[[loads]]\nname = \"q\"\nkind = \"nodal_traction\"\nregion = { min = [0.0, 1.0], max = [0.1, 1.0] }\ntraction = [0.0, -1.0, 0.0]\n"
             + "[[loads]]\nname = \"t\"\nkind = \"particle_traction\"\nregion = { min = [0.0, 0.9], max = [0.1, 1.0] }\nface = \"y_max\"\ntraction = [0.0, -1.0, 0.0]\nincrement_factor = \"1 + z\"\n";
-        assert!(case::parse(&loaded, "t", &[]).is_ok(), "{:?}", case::parse(&loaded, "t", &[]).err());
+        assert!(
+            crate::validation::load(&loaded, "t", &[]).is_ok(),
+            "{:?}",
+            crate::validation::load(&loaded, "t", &[]).err()
+        );
         let plane_z = base.to_string()
             + "[[loads]]\nname = \"t\"\nkind = \"particle_traction\"\nregion = { min = [0.0, 0.9], max = [0.1, 1.0] }\nface = \"y_max\"\ntraction = [0.0, -1.0]\nincrement_factor = \"1 + z\"\n";
-        let e = case::parse(&plane_z, "t", &[]).unwrap_err().to_string();
+        let e = crate::validation::load(&plane_z, "t", &[]).unwrap_err().to_string();
         assert!(e.contains("key `loads[0].increment_factor`: `1 + z`"), "{e}");
     }
 
@@ -507,7 +509,7 @@ mod tests {
             r#"["uz", "Uz"]"#,
             "displacement = [0.001, -0.01, 0.002]",
         );
-        let c = case::parse(&text, "t", &[]).unwrap();
+        let c = crate::validation::load(&text, "t", &[]).unwrap();
         let m = crate::model::Model::build_solid(&c, |_| true);
         let active = m.active(&c.stages[0]);
         // The full order of three dimensions: ux, uy, uz, p, Ux, Uy, Uz.

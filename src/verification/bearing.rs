@@ -22,14 +22,15 @@
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
 use super::{Check, Findings, Metric, Table};
-use crate::case::{Case, Load, SoilModel};
+use crate::case::{BearingCapacity, Case, FootingIds, Load, LoadId, Loading};
+use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
 
 /// The load–settlement check, of a footing in D dimensions.
 pub struct BearingCheck<const D: usize = 2> {
     load: LoadKind,
-    time_fn: crate::model::loads::TimeFn,
+    time_fn: TimeFn,
     cohesion: f64,
     breadth: f64,
     point_id: u64,
@@ -57,97 +58,43 @@ enum LoadKind {
     Reaction(usize, f64),
 }
 
-/// What loads the footing.
-pub enum Loading<'a> {
-    /// A load of the case (a traction or a body force on the footing body).
-    Load(&'a str),
-    /// A boundary of the case moving the nodes under the footing (displacement control).
-    Footing(&'a str),
-}
-
-/// Parameters of [`BearingCheck::new`], as in the case's `[verification]`.
-pub struct BearingSpec<'a> {
-    /// The soil body.
-    pub soil: &'a str,
-    /// The load.
-    pub load: Loading<'a>,
-    /// Loaded width in the model [m].
-    pub loaded_width: f64,
-    /// Loaded extent along z in the model [m] (three dimensions).
-    pub loaded_depth: Option<f64>,
-    /// Footing breadth B [m].
-    pub breadth: f64,
-    /// Where the settlement is measured at t = 0.
-    pub settlement_point: &'a [f64],
-    /// d/B at which q_ult is read.
-    pub failure_settlement: Option<f64>,
-    /// d/B range over which q is averaged for q_ult.
-    pub plateau: Option<[f64; 2]>,
-    /// Reference q_ult/c.
-    pub reference: f64,
-    /// Tolerance of the ratio.
-    pub tolerance: f64,
-    /// d/B values at which q/c is reported.
-    pub report_settlements: &'a [f64],
-    /// q/c values at which the settlement is reported.
-    pub report_loads: &'a [f64],
-    /// d/B at which the run stops.
-    pub stop_settlement: Option<f64>,
-}
-
 impl<const D: usize> BearingCheck<D> {
-    /// Builds the check from the case. The pressure is the force over the loaded width (per unit
-    /// length in the plane) or over the loaded width × depth (three dimensions).
-    pub fn new(c: &Case, model: &Model<D>, coll: &Collective, spec: &BearingSpec) -> Result<BearingCheck<D>, String> {
-        let soil = c.body(spec.soil).ok_or(format!("no body `{}`", spec.soil))?;
-        let mat = c.material(&soil.material).expect("validated");
-        let cohesion = match &mat.model {
-            SoilModel::MohrCoulomb { cohesion, .. }
-            | SoilModel::VonMises { cohesion, .. }
-            | SoilModel::HenckyJ2 { cohesion, .. } => *cohesion,
-            SoilModel::LinearElastic { .. } | SoilModel::NeoHookean { .. } | SoilModel::NewtonianFluid { .. } => {
-                return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil))
-            }
+    /// Builds the check of the case's `bearing_capacity` verification `spec`, whose names resolve
+    /// to `ids`. The pressure is the force over the loaded width (per unit length in the plane) or
+    /// over the loaded width × depth (three dimensions).
+    pub fn new(
+        c: &Case,
+        model: &Model<D>,
+        coll: &Collective,
+        spec: &BearingCapacity,
+        ids: &FootingIds,
+    ) -> Result<BearingCheck<D>, String> {
+        let Some(cohesion) = c.material_of(ids.soil).model.cohesion() else {
+            return Err(format!("the soil `{}` has no cohesion: give it a plastic model", spec.soil));
         };
         if cohesion <= 0.0 {
             return Err("the bearing capacity check normalises by the cohesion, which must be positive".into());
         }
         let loaded = spec.loaded_width * spec.loaded_depth.unwrap_or(1.0);
-        let (load, time_fn) = match spec.load {
-            Loading::Footing(name) => {
-                let b = model.boundaries.iter().position(|b| b.name == name).ok_or(format!("no boundary `{name}`"))?;
-                (LoadKind::Reaction(b, loaded), crate::model::loads::TimeFn::Constant(1.0))
-            }
-            Loading::Load(name) => load_of(c, name, loaded)?,
+        let (load, time_fn) = match ids.loading {
+            Loading::Footing(b) => (LoadKind::Reaction(b.index(), loaded), TimeFn::Constant(1.0)),
+            Loading::Load(l) => (load_of(c, l, loaded)?, super::load_time_fn(c, l)),
         };
         if spec.settlement_point.len() != D {
             return Err(format!("the settlement point needs {D} coordinates, got {}", spec.settlement_point.len()));
         }
-        // The material point nearest to the settlement point (over all ranks).
-        let ps = &model.particles;
-        let local: Vec<f64> = (0..ps.len())
-            .flat_map(|k| {
-                let d = (0..D).map(|c| (ps.x0[k][c] - spec.settlement_point[c]).powi(2)).sum::<f64>().sqrt();
-                [d, ps.id[k] as f64]
-            })
-            .collect();
-        let all = coll.gather(&local)?;
-        let best = all
-            .chunks(2)
-            .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
-            .ok_or("there are no material points")?;
         Ok(BearingCheck {
             load,
             time_fn,
             cohesion,
             breadth: spec.breadth,
-            point_id: best[1] as u64,
+            point_id: nearest_point(model, coll, &spec.settlement_point)?,
             failure: spec.failure_settlement,
             plateau: spec.plateau,
             reference: spec.reference,
             tolerance: spec.tolerance,
-            report: spec.report_settlements.to_vec(),
-            report_loads: spec.report_loads.to_vec(),
+            report: spec.report_settlements.clone(),
+            report_loads: spec.report_loads.clone(),
             stop_at: spec.stop_settlement,
             baseline: 0.0,
             reaction: [0.0; D],
@@ -188,36 +135,35 @@ impl<const D: usize> BearingCheck<D> {
     }
 }
 
-/// The pressure of a case load on the footing and its time function.
-fn load_of(c: &Case, name: &str, width: f64) -> Result<(LoadKind, crate::model::loads::TimeFn), String> {
-    let case_load = c.load(name);
-    let load = match case_load {
-        Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }) => {
-            LoadKind::Traction(traction[1].abs())
+/// The id of the material point nearest to `point` at t = 0, over all ranks (collective).
+fn nearest_point<const D: usize>(model: &Model<D>, coll: &Collective, point: &[f64]) -> Result<u64, String> {
+    let ps = &model.particles;
+    let local: Vec<f64> = (0..ps.len())
+        .flat_map(|k| {
+            let d = (0..D).map(|c| (ps.x0[k][c] - point[c]).powi(2)).sum::<f64>().sqrt();
+            [d, ps.id[k] as f64]
+        })
+        .collect();
+    let all = coll.gather(&local)?;
+    let best = all
+        .chunks(2)
+        .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
+        .ok_or("there are no material points")?;
+    Ok(best[1] as u64)
+}
+
+/// The pressure of the case's load `id` on the footing, over the loaded `width`.
+fn load_of(c: &Case, id: LoadId, width: f64) -> Result<LoadKind, String> {
+    if let Some(traction) = c.load(id).traction() {
+        return Ok(LoadKind::Traction(traction[1].abs()));
+    }
+    match (c.load(id), c.load_bodies(id)) {
+        (Load::BodyForce(f), Some(bodies)) if !bodies.is_empty() => {
+            Ok(LoadKind::Weight(f.acceleration[1].abs(), bodies.iter().map(|b| b.index() as u16).collect(), width))
         }
-        Some(Load::BodyForce { acceleration, bodies, .. }) => {
-            let names = bodies.clone().unwrap_or_default();
-            if names.is_empty() {
-                return Err(format!("the body force `{name}` must name the footing body in `bodies`"));
-            }
-            let idx = names
-                .iter()
-                .map(|n| c.body_index(n).map(|i| i as u16))
-                .collect::<Option<Vec<_>>>()
-                .ok_or("unknown body")?;
-            LoadKind::Weight(acceleration[1].abs(), idx, width)
-        }
-        Some(Load::LinePressure { .. }) => {
-            return Err(format!("the load `{name}` of a bearing check must be a traction or a weight"))
-        }
-        None => return Err(format!("no load `{name}`")),
-    };
-    let time_fn = case_load
-        .and_then(|l| l.time_function())
-        .and_then(|n| c.time_function(n))
-        .map(crate::model::loads::TimeFn::from_case)
-        .unwrap_or(crate::model::loads::TimeFn::Constant(1.0));
-    Ok((load, time_fn))
+        (Load::BodyForce(f), _) => Err(format!("the body force `{}` must name the footing body in `bodies`", f.name)),
+        (l, _) => Err(format!("the load `{}` of a bearing check must be a traction or a weight", l.name())),
+    }
 }
 
 impl<const D: usize> Check<D> for BearingCheck<D> {

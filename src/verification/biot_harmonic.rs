@@ -247,75 +247,47 @@ impl BiotSolution {
     }
 }
 
-/// Converts the Zienkiewicz, Chang & Bettess (1980) numbers `Π₁` and `Π₂` into the angular frequency `ω` [rad/s] and
-/// the hydraulic conductivity `k` [m/s], returned as `(ω, k)`.
-///
-/// With `ρ = (1 − n) ρ_s + n ρ_w`, `V_c² = (E_c + K_w/n)/ρ` and `β = ρ_w/ρ`, the definitions `Π₂ = ω² H² / V_c²` and
-/// `Π₁ = k V_c² / (g β ω H²)` give `ω = √Π₂ V_c / H` and `k = Π₁ g β ω H² / V_c²`.
-#[allow(clippy::too_many_arguments)]
-pub fn zienkiewicz_parameters(
-    constrained_modulus: f64,
-    water_bulk_modulus: f64,
-    porosity: f64,
-    solid_density: f64,
-    water_density: f64,
-    gravity: f64,
-    height: f64,
-    pi1: f64,
-    pi2: f64,
-) -> (f64, f64) {
-    let (vc2, beta) = compression_speed_squared_and_beta(
-        constrained_modulus,
-        water_bulk_modulus,
-        porosity,
-        solid_density,
-        water_density,
-    );
-    let omega = pi2.sqrt() * vc2.sqrt() / height;
-    let conductivity = pi1 * gravity * beta * omega * height * height / vc2;
-    (omega, conductivity)
+/// The saturated mixture of a column as the Zienkiewicz, Chang & Bettess (1980) numbers see it:
+/// with `ρ = (1 − n) ρ_s + n ρ_w`, the compression speed `V_c² = (E_c + K_w/n)/ρ` and `β = ρ_w/ρ`,
+/// `Π₁ = k V_c² / (g β ω H²)` and `Π₂ = ω² H² / V_c²`.
+#[derive(Debug, Clone, Copy)]
+pub struct Mixture {
+    /// E_c [Pa].
+    pub constrained_modulus: f64,
+    /// K_w [Pa].
+    pub water_bulk_modulus: f64,
+    /// n [-].
+    pub porosity: f64,
+    /// ρ_s [kg/m³].
+    pub solid_density: f64,
+    /// ρ_w [kg/m³].
+    pub water_density: f64,
 }
 
-/// Converts the angular frequency `ω` [rad/s] and the hydraulic conductivity `k` [m/s] into the Zienkiewicz, Chang &
-/// Bettess (1980) numbers, returned as `(Π₁, Π₂)`; this is the inverse of [`zienkiewicz_parameters`].
-///
-/// The definitions are `Π₁ = k V_c² / (g β ω H²)` and `Π₂ = ω² H² / V_c²` with `V_c² = (E_c + K_w/n)/ρ` and
-/// `β = ρ_w/ρ`.
-#[allow(clippy::too_many_arguments)]
-pub fn zienkiewicz_numbers(
-    constrained_modulus: f64,
-    water_bulk_modulus: f64,
-    porosity: f64,
-    solid_density: f64,
-    water_density: f64,
-    gravity: f64,
-    height: f64,
-    omega: f64,
-    conductivity: f64,
-) -> (f64, f64) {
-    let (vc2, beta) = compression_speed_squared_and_beta(
-        constrained_modulus,
-        water_bulk_modulus,
-        porosity,
-        solid_density,
-        water_density,
-    );
-    let pi1 = conductivity * vc2 / (gravity * beta * omega * height * height);
-    let pi2 = omega * omega * height * height / vc2;
-    (pi1, pi2)
-}
+impl Mixture {
+    /// `(V_c², β)`.
+    fn speed_squared_and_beta(&self) -> (f64, f64) {
+        let n = self.porosity;
+        let rho = (1.0 - n) * self.solid_density + n * self.water_density;
+        ((self.constrained_modulus + self.water_bulk_modulus / n) / rho, self.water_density / rho)
+    }
 
-/// Returns `(V_c², β)` with `V_c² = (E_c + K_w/n)/ρ` and `β = ρ_w/ρ`.
-fn compression_speed_squared_and_beta(
-    constrained_modulus: f64,
-    water_bulk_modulus: f64,
-    porosity: f64,
-    solid_density: f64,
-    water_density: f64,
-) -> (f64, f64) {
-    let rho = (1.0 - porosity) * solid_density + porosity * water_density;
-    let vc2 = (constrained_modulus + water_bulk_modulus / porosity) / rho;
-    (vc2, water_density / rho)
+    /// The angular frequency `ω` [rad/s] and the hydraulic conductivity `k` [m/s] of the numbers
+    /// `Π₁` and `Π₂` on a column of height `H` under gravity `g`: `ω = √Π₂ V_c / H` and
+    /// `k = Π₁ g β ω H² / V_c²`.
+    pub fn zienkiewicz_parameters(&self, gravity: f64, height: f64, pi1: f64, pi2: f64) -> (f64, f64) {
+        let (vc2, beta) = self.speed_squared_and_beta();
+        let omega = pi2.sqrt() * vc2.sqrt() / height;
+        (omega, pi1 * gravity * beta * omega * height * height / vc2)
+    }
+
+    /// The numbers `(Π₁, Π₂)` of the angular frequency `ω` [rad/s] and the hydraulic conductivity
+    /// `k` [m/s]: the inverse of [`Mixture::zienkiewicz_parameters`].
+    pub fn zienkiewicz_numbers(&self, gravity: f64, height: f64, omega: f64, conductivity: f64) -> (f64, f64) {
+        let (vc2, beta) = self.speed_squared_and_beta();
+        let pi1 = conductivity * vc2 / (gravity * beta * omega * height * height);
+        (pi1, omega * omega * height * height / vc2)
+    }
 }
 
 /// Returns the two roots of the monic quadratic `s² + b s + c = 0`, computed without cancellation.
@@ -403,13 +375,20 @@ mod tests {
     const N: f64 = 0.3;
     const RHO_S: f64 = 2650.0;
     const RHO_W: f64 = 1000.0;
+    const SOIL: Mixture = Mixture {
+        constrained_modulus: EC,
+        water_bulk_modulus: KW,
+        porosity: N,
+        solid_density: RHO_S,
+        water_density: RHO_W,
+    };
     const G: f64 = 9.81;
     const H: f64 = 10.0;
     const LOAD: f64 = 1000.0;
 
     /// The reference soil of the brief with incompressible grains, Q = K_w / n, for given Π₁ and Π₂.
     fn column(pi1: f64, pi2: f64) -> BiotColumn {
-        let (omega, conductivity) = zienkiewicz_parameters(EC, KW, N, RHO_S, RHO_W, G, H, pi1, pi2);
+        let (omega, conductivity) = SOIL.zienkiewicz_parameters(G, H, pi1, pi2);
         BiotColumn {
             height: H,
             constrained_modulus: EC,
@@ -503,13 +482,13 @@ mod tests {
 
     #[test]
     fn zienkiewicz_numbers_round_trip() {
-        let (omega, k) = zienkiewicz_parameters(EC, KW, N, RHO_S, RHO_W, G, H, 0.7, 3.0);
-        let (pi1, pi2) = zienkiewicz_numbers(EC, KW, N, RHO_S, RHO_W, G, H, omega, k);
+        let (omega, k) = SOIL.zienkiewicz_parameters(G, H, 0.7, 3.0);
+        let (pi1, pi2) = SOIL.zienkiewicz_numbers(G, H, omega, k);
         assert!((pi1 - 0.7).abs() < 1e-12 && (pi2 - 3.0).abs() < 1e-12);
         // V_c² = (E_c + K_w/n)/ρ, so Π₂ = 1 means ω H = V_c.
         let rho = (1.0 - N) * RHO_S + N * RHO_W;
         let vc = ((EC + KW / N) / rho).sqrt();
-        let (omega, _) = zienkiewicz_parameters(EC, KW, N, RHO_S, RHO_W, G, H, 1.0, 1.0);
+        let (omega, _) = SOIL.zienkiewicz_parameters(G, H, 1.0, 1.0);
         assert!((omega * H - vc).abs() < 1e-9 * vc);
     }
 
@@ -648,7 +627,14 @@ mod zone_parameters_for_cases {
             (10.0, 5.0, 499.9975, 0.4904975),
         ];
         for (pi1, pi2, w_case, k_case) in zones {
-            let (w, k) = super::zienkiewicz_parameters(5e9, 2e9, 0.4, 2666.7, 1000.0, 9.81, 10.0, pi1, pi2);
+            let soil = super::Mixture {
+                constrained_modulus: 5e9,
+                water_bulk_modulus: 2e9,
+                porosity: 0.4,
+                solid_density: 2666.7,
+                water_density: 1000.0,
+            };
+            let (w, k) = soil.zienkiewicz_parameters(9.81, 10.0, pi1, pi2);
             println!(
                 "Π1 = {pi1}, Π2 = {pi2}: ω = {w:.6} rad/s, k = {k:.6e} m/s, period {:.6} s",
                 2.0 * std::f64::consts::PI / w

@@ -17,7 +17,7 @@
 //!   between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Verification};
+use crate::case::{BodyId, Case, CookMembrane};
 use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -40,24 +40,20 @@ pub struct CookCheck {
 }
 
 impl CookCheck {
-    /// The check of a `cook_membrane` verification.
-    pub fn new(c: &Case) -> Result<CookCheck, String> {
-        let Some(Verification::CookMembrane { body, tip, reference, tolerance, fit_radius }) = &c.verification else {
-            return Err("not a Cook's-membrane verification".into());
-        };
-        let bi = c.body_index(body).ok_or(format!("verification: no body `{body}`"))?;
-        Ok(CookCheck {
-            body: bi as u16,
-            tip: *tip,
-            reference: *reference,
-            tolerance: *tolerance,
-            fit_radius: *fit_radius,
+    /// The check of a `cook_membrane` verification `spec` of `body`.
+    pub fn new(c: &Case, spec: &CookMembrane, body: BodyId) -> CookCheck {
+        CookCheck {
+            body: body.index() as u16,
+            tip: spec.tip,
+            reference: spec.reference,
+            tolerance: spec.tolerance,
+            fit_radius: spec.fit_radius,
             end: c.end_time(),
             history: Vec::new(),
             map: (Vec::new(), (0.0, 0.0)),
             checkerboard: f64::NAN,
             points: 0,
-        })
+        }
     }
 
     /// The fitted vertical displacement of the tip and the nearest point's (collective).

@@ -29,7 +29,7 @@
 //! standard MPM) reads the history columns and the results of both.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Load, Shape, Verification};
+use crate::case::{Case, DamBreak, DamBreakIds, Load, Rectangle, Shape};
 use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -136,45 +136,37 @@ pub struct DamBreakCheck {
 }
 
 impl DamBreakCheck {
-    /// The check of a `dam_break` verification (its case validated); collective.
-    pub fn new(c: &Case, model: &Model, coll: &Collective) -> Result<DamBreakCheck, String> {
-        let Some(Verification::DamBreak {
-            body,
-            gravity,
-            settle_stage,
-            hydrostatic_tolerance,
-            far_wall,
-            experiment,
-            front_tolerance,
-            spray_fraction,
-        }) = &c.verification
-        else {
-            return Err("not a dam-break verification".into());
-        };
-        let bi = c.body_index(body).ok_or(format!("verification: no body `{body}`"))?;
-        let b = &c.bodies[bi];
-        let Shape::Rectangle { min, max } = b.shape else {
+    /// The check of a `dam_break` verification `spec`, whose names resolve to `ids`; collective.
+    pub fn new(
+        c: &Case,
+        model: &Model,
+        coll: &Collective,
+        spec: &DamBreak,
+        ids: &DamBreakIds,
+    ) -> Result<DamBreakCheck, String> {
+        let body = &spec.body;
+        let Shape::Rectangle(Rectangle { min, max }) = c.body(ids.body).shape else {
             return Err(format!("verification: the column `{body}` must be a rectangle"));
         };
-        let Some(Load::BodyForce { acceleration, .. }) = c.load(gravity) else {
-            return Err(format!("verification: `{gravity}` must be a body_force load"));
+        let Load::BodyForce(gravity) = c.load(ids.gravity) else {
+            return Err(format!("verification: `{}` must be a body_force load", spec.gravity));
         };
-        let g = acceleration[0].hypot(acceleration[1]);
+        let g = gravity.acceleration[0].hypot(gravity.acceleration[1]);
         if g.is_nan() || g <= 0.0 {
-            return Err(format!("verification: the gravity load `{gravity}` has no acceleration"));
+            return Err(format!("verification: the gravity load `{}` has no acceleration", spec.gravity));
         }
-        let mat = c.material(&b.material).expect("validated");
+        let mat = c.material_of(ids.body);
         let density = (1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density;
-        let s = c.stages.iter().position(|s| &s.name == settle_stage).ok_or(format!("no stage `{settle_stage}`"))?;
-        let release = c.stages[..=s].iter().map(|s| s.duration).sum();
+        let release = c.stages[..=ids.settle_stage.index()].iter().map(|s| s.duration).sum();
         let (width, height) = (max[0] - min[0], max[1] - min[1]);
-        if experiment.is_some() && (height / width / MARTIN_MOYCE_ASPECT - 1.0).abs() > 0.01 {
+        if spec.experiment.is_some() && (height / width / MARTIN_MOYCE_ASPECT - 1.0).abs() > 0.01 {
             return Err(format!(
                 "verification: Martin & Moyce's series is for a column twice as high as wide (n² = 2); `{body}` is \
                  {height} m high on {width} m (n² = {:.3})",
                 height / width
             ));
         }
+        let bi = ids.body.index();
         let ps = &model.particles;
         let mine = (0..ps.len()).filter(|&k| ps.body[k] as usize == bi).map(|k| ps.mass[k]).sum::<f64>();
         let mass0 = coll.sum(&[mine])?[0];
@@ -188,10 +180,10 @@ impl DamBreakCheck {
             height,
             h: model.grid.h[0].max(model.grid.h[1]),
             release,
-            far_wall: *far_wall,
-            tolerance: *hydrostatic_tolerance,
-            experiment: experiment.clone(),
-            front_tolerance: *front_tolerance,
+            far_wall: spec.far_wall,
+            tolerance: spec.hydrostatic_tolerance,
+            experiment: spec.experiment.clone(),
+            front_tolerance: spec.front_tolerance,
             mass0,
             mass_change: 0.0,
             settled: None,
@@ -200,7 +192,7 @@ impl DamBreakCheck {
             history: Vec::new(),
             speed_ratio: 0.0,
             checkerboard_end: f64::NAN,
-            spray: *spray_fraction,
+            spray: spec.spray_fraction,
             tip: f64::NAN,
         })
     }

@@ -18,7 +18,7 @@
 //! increment.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, IncrementTolerances, Load, Verification};
+use crate::case::{BodyAndLoad, Case, HollowCylinder, IncrementTolerances};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -118,41 +118,27 @@ pub struct HollowCylinderCheck {
 }
 
 impl HollowCylinderCheck {
-    /// The check of a `hollow_cylinder` verification.
-    pub fn new(c: &Case) -> Result<HollowCylinderCheck, String> {
-        let Some(Verification::HollowCylinder {
-            body,
-            load,
-            inner_radius,
-            outer_radius,
-            displacement_tolerance,
-            stress_tolerance,
-            increments,
-        }) = &c.verification
-        else {
-            return Err("not a hollow-cylinder verification".into());
+    /// The check of a `hollow_cylinder` verification `spec`, whose names resolve to `ids`.
+    pub fn new(c: &Case, spec: &HollowCylinder, ids: &BodyAndLoad) -> Result<HollowCylinderCheck, String> {
+        let (young_modulus, poisson_ratio) = super::elastic_body(c, ids.body)?;
+        let load = c.load(ids.load);
+        let Some(traction) = load.traction() else {
+            return Err(format!("`{}` is not a nodal_traction or particle_traction load", spec.load));
         };
-        let (bi, young_modulus, poisson_ratio) = super::elastic_body(c, body)?;
-        let (traction, time_function) = match c.load(load) {
-            Some(Load::NodalTraction { traction, time_function, .. })
-            | Some(Load::ParticleTraction { traction, time_function, .. }) => (traction[0], time_function),
-            _ => return Err(format!("`{load}` is not a nodal_traction or particle_traction load")),
-        };
-        let time_fn = super::load_time_fn(c, time_function);
         Ok(HollowCylinderCheck {
-            body: bi as u16,
+            body: ids.body.index() as u16,
             theory: FixedWallLame {
-                a: *inner_radius,
-                b: *outer_radius,
-                p: traction.abs(),
+                a: spec.inner_radius,
+                b: spec.outer_radius,
+                p: traction[0].abs(),
                 e: young_modulus,
                 nu: poisson_ratio,
             },
-            time_fn,
-            factor: c.load(load).and_then(|l| l.increment_factor()).map(|e| (e.to_string(), c.parameters.clone())),
-            tolerances: (*displacement_tolerance, *stress_tolerance),
+            time_fn: super::load_time_fn(c, ids.load),
+            factor: load.increment_factor().map(|e| (e.to_string(), c.parameters.clone())),
+            tolerances: (spec.displacement_tolerance, spec.stress_tolerance),
             first: None,
-            steps: increments.map(|tolerances| Steps {
+            steps: spec.increments.map(|tolerances| Steps {
                 tolerances,
                 last: None,
                 worst_q: (0.0, 0.0),

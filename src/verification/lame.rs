@@ -11,7 +11,7 @@
 //! there), at the end of the run.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Load, Verification};
+use crate::case::{self, BodyAndLoad, Case, Load};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -53,31 +53,18 @@ pub struct LameCheck {
 }
 
 impl LameCheck {
-    /// The check of a `lame` verification.
-    pub fn new(c: &Case) -> Result<LameCheck, String> {
-        let Some(Verification::Lame {
-            body,
-            load,
-            center,
-            inner_radius,
-            outer_radius,
-            displacement_tolerance,
-            stress_tolerance,
-        }) = &c.verification
-        else {
-            return Err("not a Lamé verification".into());
+    /// The check of a `lame` verification `spec`, whose names resolve to `ids`.
+    pub fn new(c: &Case, spec: &case::Lame, ids: &BodyAndLoad) -> Result<LameCheck, String> {
+        let (e, nu) = super::elastic_body(c, ids.body)?;
+        let Load::LinePressure(load) = c.load(ids.load) else {
+            return Err(format!("`{}` is not a line_pressure load", spec.load));
         };
-        let (bi, e, nu) = super::elastic_body(c, body)?;
-        let Some(Load::LinePressure { pressure, time_function, .. }) = c.load(load) else {
-            return Err(format!("`{load}` is not a line_pressure load"));
-        };
-        let time_fn = super::load_time_fn(c, time_function);
         Ok(LameCheck {
-            body: bi as u16,
-            center: *center,
-            theory: Lame { a: *inner_radius, b: *outer_radius, p: *pressure, e, nu },
-            time_fn,
-            tolerances: (*displacement_tolerance, *stress_tolerance),
+            body: ids.body.index() as u16,
+            center: spec.center,
+            theory: Lame { a: spec.inner_radius, b: spec.outer_radius, p: load.pressure, e, nu },
+            time_fn: super::load_time_fn(c, ids.load),
+            tolerances: (spec.displacement_tolerance, spec.stress_tolerance),
             last: [f64::NAN; 4],
         })
     }

@@ -25,6 +25,7 @@ pub mod biot_harmonic;
 pub mod checkerboard;
 pub mod cook;
 pub mod dam_break;
+pub mod elastic_column;
 pub mod figures;
 pub mod hollow_cylinder;
 pub mod lame;
@@ -37,8 +38,11 @@ pub mod vertical_cut;
 pub mod waves;
 pub mod xie_leo;
 
-use crate::case::{self, Case, ConductivityLaw, Load, TimeFunction, Verification};
+use crate::case::{
+    self, BodyAndLoad, BodyId, Case, ConductivityLaw, LinkedVerification, LoadId, SoilModel, TimeFunction,
+};
 use crate::layout::Dim;
+use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
 use serde::Serialize;
@@ -137,25 +141,23 @@ pub trait Check<const D: usize = 2> {
     }
 }
 
-/// The index of a linear elastic `body` of the case with its Young's modulus [Pa] and Poisson's
-/// ratio, for the elastic closed forms.
-pub(crate) fn elastic_body(c: &Case, body: &str) -> Result<(usize, f64, f64), String> {
-    let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-    let mat = &c.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
-    match mat.model {
-        crate::case::SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-            Ok((bi, young_modulus, poisson_ratio))
-        }
-        _ => Err(format!("body `{body}` is not linear elastic")),
+/// The Young's modulus [Pa] and Poisson's ratio of a linear elastic `body`, for the elastic
+/// closed forms.
+pub(crate) fn elastic_body(c: &Case, body: BodyId) -> Result<(f64, f64), String> {
+    match &c.material_of(body).model {
+        SoilModel::LinearElastic(e) => Ok((e.young_modulus, e.poisson_ratio)),
+        _ => Err(format!("body `{}` is not linear elastic", c.body(body).name)),
     }
 }
 
-/// The time function a load names (a constant 1 if none).
-pub(crate) fn load_time_fn(c: &Case, name: &Option<String>) -> crate::model::loads::TimeFn {
-    name.as_ref()
-        .and_then(|n| c.time_function(n))
-        .map(crate::model::loads::TimeFn::from_case)
-        .unwrap_or(crate::model::loads::TimeFn::Constant(1.0))
+/// The time function of a load (a constant 1 if it names none).
+pub(crate) fn load_time_fn(c: &Case, load: LoadId) -> TimeFn {
+    TimeFn::scaling(c.load_time_function(load))
+}
+
+/// The value of a load's time function at time `t` (1 without one).
+fn load_factor(c: &Case, load: LoadId, t: f64) -> f64 {
+    load_time_fn(c, load).eval(t)
 }
 
 /// Geometry and soil of a loaded one-dimensional column, taken from the case.
@@ -178,23 +180,19 @@ pub(crate) struct Column {
 }
 
 impl Column {
-    /// The column of `body` loaded by `load`; its cross-section is its width in the plane (per metre
-    /// of thickness; a ring's area in axial symmetry) and its width times its depth along z in
-    /// three dimensions.
-    fn from_case<const D: usize>(c: &Case, model: &Model<D>, body: &str, load: &str) -> Result<Column, String> {
-        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-        let b = &c.bodies[bi];
+    /// The column of the body loaded by the load of `ids`; its cross-section is its width in the
+    /// plane (per metre of thickness; a ring's area in axial symmetry) and its width times its
+    /// depth along z in three dimensions.
+    fn from_case<const D: usize>(c: &Case, model: &Model<D>, ids: &BodyAndLoad) -> Result<Column, String> {
+        let b = c.body(ids.body);
         let (lo, hi) = b.shape.bounds();
-        let traction = match c.load(load) {
-            Some(Load::ParticleTraction { traction, .. }) | Some(Load::NodalTraction { traction, .. }) => {
-                [traction[0], traction[1]]
-            }
-            _ => return Err(format!("verification load `{load}` must be a particle_traction or nodal_traction")),
+        let load = c.load(ids.load);
+        let Some(traction) = load.traction() else {
+            return Err(format!("verification load `{}` must be a particle_traction or nodal_traction", load.name()));
         };
-        let mi = c.material_index(&b.material).expect("validated");
-        let mat = &model.materials[mi];
+        let mat = &model.materials[c.material_id_of(ids.body).index()];
         Ok(Column {
-            body: bi as u16,
+            body: ids.body.index() as u16,
             top: hi[1],
             height: hi[1] - lo[1],
             width: model.geometry.plan_area(lo[0], hi[0])
@@ -239,14 +237,18 @@ impl CaseChecks<2> for Dim<2> {
 
 impl CaseChecks<3> for Dim<3> {
     fn for_case(c: &Case, model: &Model<3>, coll: &Collective) -> Result<Option<Box<dyn Check<3>>>, String> {
-        match &c.verification {
-            None => Ok(None),
-            Some(Verification::Terzaghi { .. }) => Ok(Some(Box::new(terzaghi_check(c, model, coll)?))),
-            Some(Verification::BearingCapacity { .. }) => Ok(Some(Box::new(bearing_check(c, model, coll)?))),
-            Some(Verification::Runout { .. }) => Ok(Some(Box::new(runout::RunoutCheck::new(c, model, coll)?))),
-            Some(Verification::Patch { .. }) => Ok(Some(Box::new(patch::PatchCheck::new(c, model)?))),
-            Some(v) => Err(format!("the `{}` check is two-dimensional", v.kind())),
-        }
+        use LinkedVerification as V;
+        Ok(Some(match c.linked_verification() {
+            None => return Ok(None),
+            Some(V::Terzaghi(t, ids)) => Box::new(terzaghi_check(c, model, coll, t, ids)?),
+            Some(V::BearingCapacity(b, ids)) => Box::new(bearing::BearingCheck::new(c, model, coll, b, ids)?),
+            Some(V::Runout(r, ids)) => Box::new(runout::RunoutCheck::new(c, model, coll, r, ids)?),
+            Some(V::Patch(p, ids)) => Box::new(patch::PatchCheck::new(c, model, p, ids)?),
+            Some(_) => {
+                let kind = c.verification.as_ref().map_or("", |v| v.kind());
+                return Err(format!("the `{kind}` check is two-dimensional"));
+            }
+        }))
     }
 }
 
@@ -262,67 +264,17 @@ where
     <Dim<D> as CaseChecks<D>>::for_case(c, model, coll)
 }
 
-/// The footing of the case's `bearing_capacity` verification, in any dimension.
-fn bearing_check<const D: usize>(
+/// The consolidating column of the case's `terzaghi` verification, in any dimension.
+fn terzaghi_check<const D: usize>(
     c: &Case,
     model: &Model<D>,
     coll: &Collective,
-) -> Result<bearing::BearingCheck<D>, String> {
-    let Some(Verification::BearingCapacity {
-        soil,
-        load,
-        loaded_width,
-        loaded_depth,
-        breadth,
-        settlement_point,
-        failure_settlement,
-        plateau,
-        reference,
-        tolerance,
-        report_settlements,
-        report_loads,
-        stop_settlement,
-        footing,
-    }) = &c.verification
-    else {
-        return Err("the case asks for no bearing capacity check".into());
-    };
-    bearing::BearingCheck::new(
-        c,
-        model,
-        coll,
-        &bearing::BearingSpec {
-            soil,
-            load: match (load, footing) {
-                (_, Some(f)) => bearing::Loading::Footing(f),
-                (Some(l), None) => bearing::Loading::Load(l),
-                (None, None) => return Err("give the bearing check a `load` or a `footing`".into()),
-            },
-            loaded_width: *loaded_width,
-            loaded_depth: *loaded_depth,
-            breadth: *breadth,
-            settlement_point,
-            failure_settlement: *failure_settlement,
-            plateau: *plateau,
-            reference: *reference,
-            tolerance: *tolerance,
-            report_settlements,
-            report_loads,
-            stop_settlement: *stop_settlement,
-        },
-    )
-}
-
-/// The consolidating column of the case's `terzaghi` verification, in any dimension.
-fn terzaghi_check<const D: usize>(c: &Case, model: &Model<D>, coll: &Collective) -> Result<ConsolidationCheck, String> {
-    let Some(Verification::Terzaghi { body, load, time_factors, e_p_tolerance, p_rms_tolerance, settlement_tolerance }) =
-        &c.verification
-    else {
-        return Err("the case asks for no Terzaghi check".into());
-    };
-    let col = Column::from_case(c, model, body, load)?;
+    spec: &case::Terzaghi,
+    ids: &BodyAndLoad,
+) -> Result<ConsolidationCheck, String> {
+    let col = Column::from_case(c, model, ids)?;
     let theory = terzaghi::Terzaghi::new(
-        col.load * load_factor(c, load, c.end_time()).abs(),
+        col.load * load_factor(c, ids.load, c.end_time()).abs(),
         col.height,
         col.constrained_modulus,
         col.inv_q,
@@ -330,99 +282,90 @@ fn terzaghi_check<const D: usize>(c: &Case, model: &Model<D>, coll: &Collective)
         col.water_density * col.g,
     );
     theory.validate()?;
-    let targets = time_factors
+    let targets = spec
+        .time_factors
         .iter()
         .enumerate()
         .map(|(i, &tv)| Target {
             label: format!("Tv{}", tv_name(tv)),
             t: theory.time_for(tv),
-            full: i + 1 == time_factors.len(),
+            full: i + 1 == spec.time_factors.len(),
             result: None,
             profile: Vec::new(),
         })
         .collect();
-    let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
+    let tol = (spec.e_p_tolerance, spec.p_rms_tolerance, spec.settlement_tolerance);
     ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)
+}
+
+/// The large-strain column of the case's `large_strain_consolidation` verification.
+fn large_strain_check(
+    c: &Case,
+    model: &Model,
+    coll: &Collective,
+    spec: &case::LargeStrainConsolidation,
+    ids: &BodyAndLoad,
+) -> Result<ConsolidationCheck, String> {
+    let col = Column::from_case(c, model, ids)?;
+    if c.material_of(ids.body).hydraulic_conductivity_law != ConductivityLaw::XieLeo {
+        return Err(format!(
+            "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{}`",
+            c.body(ids.body).name
+        ));
+    }
+    let theory = xie_leo::XieLeo {
+        load: col.load * load_factor(c, ids.load, c.end_time()).abs(),
+        height: col.height,
+        m_v: 1.0 / col.constrained_modulus,
+        conductivity: col.conductivity,
+        water_unit_weight: col.water_density * col.g,
+    };
+    theory.validate()?;
+    let targets = spec
+        .degrees
+        .iter()
+        .map(|&u| Target {
+            label: format!("Us{}", tv_name(u)),
+            t: theory.time_for_degree(u),
+            full: true,
+            result: None,
+            profile: Vec::new(),
+        })
+        .collect();
+    let tol = (spec.e_p_tolerance, spec.p_rms_tolerance, spec.settlement_tolerance);
+    ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)
 }
 
 /// The check the case asks for, if any.
 pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box<dyn Check>>, String> {
-    let Some(v) = &c.verification else {
+    use LinkedVerification as V;
+    let Some(v) = c.linked_verification() else {
         return Ok(None);
     };
-    let end = c.end_time();
     Ok(Some(match v {
-        Verification::Patch { .. } => Box::new(patch::PatchCheck::new(c, model)?),
-        Verification::Lame { .. } => Box::new(lame::LameCheck::new(c)?),
-        Verification::HollowCylinder { .. } => Box::new(hollow_cylinder::HollowCylinderCheck::new(c)?),
-        Verification::StiffnessMap { .. } => Box::new(stiffness_map::StiffnessMapCheck::new(c)?),
-        Verification::VerticalCut { .. } => Box::new(vertical_cut::VerticalCutCheck::new(c)?),
-        Verification::CookMembrane { .. } => Box::new(cook::CookCheck::new(c)?),
-        Verification::DamBreak { .. } => Box::new(dam_break::DamBreakCheck::new(c, model, coll)?),
-        Verification::Runout { .. } => Box::new(runout::RunoutCheck::new(c, model, coll)?),
-        Verification::Terzaghi { .. } => Box::new(terzaghi_check(c, model, coll)?),
-        Verification::LargeStrainConsolidation {
-            body,
-            load,
-            degrees,
-            e_p_tolerance,
-            p_rms_tolerance,
-            settlement_tolerance,
-        } => {
-            let col = Column::from_case(c, model, body, load)?;
-            let bi = col.body as usize;
-            let law =
-                c.materials[c.material_index(&c.bodies[bi].material).expect("validated")].hydraulic_conductivity_law;
-            if law != ConductivityLaw::XieLeo {
-                return Err(format!(
-                    "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{body}`"
-                ));
-            }
-            let theory = xie_leo::XieLeo {
-                load: col.load * load_factor(c, load, end).abs(),
-                height: col.height,
-                m_v: 1.0 / col.constrained_modulus,
-                conductivity: col.conductivity,
-                water_unit_weight: col.water_density * col.g,
+        V::Patch(p, ids) => Box::new(patch::PatchCheck::new(c, model, p, ids)?),
+        V::Lame(l, ids) => Box::new(lame::LameCheck::new(c, l, ids)?),
+        V::HollowCylinder(h, ids) => Box::new(hollow_cylinder::HollowCylinderCheck::new(c, h, ids)?),
+        V::StiffnessMap(s, body) => Box::new(stiffness_map::StiffnessMapCheck::new(c, s, *body)?),
+        V::VerticalCut(v, body) => Box::new(vertical_cut::VerticalCutCheck::new(c, v, *body)?),
+        V::CookMembrane(m, body) => Box::new(cook::CookCheck::new(c, m, *body)),
+        V::DamBreak(d, ids) => Box::new(dam_break::DamBreakCheck::new(c, model, coll, d, ids)?),
+        V::Runout(r, ids) => Box::new(runout::RunoutCheck::new(c, model, coll, r, ids)?),
+        V::Terzaghi(t, ids) => Box::new(terzaghi_check(c, model, coll, t, ids)?),
+        V::LargeStrainConsolidation(x, ids) => Box::new(large_strain_check(c, model, coll, x, ids)?),
+        V::HarmonicColumn(h, ids) => {
+            let col = Column::from_case(c, model, ids)?;
+            let Some(TimeFunction::Harmonic(f)) = c.load_time_function(ids.load) else {
+                let name = c.load(ids.load).name();
+                return Err(format!("verification load `{name}` must have a harmonic time function"));
             };
-            theory.validate()?;
-            let targets = degrees
-                .iter()
-                .map(|&u| Target {
-                    label: format!("Us{}", tv_name(u)),
-                    t: theory.time_for_degree(u),
-                    full: true,
-                    result: None,
-                    profile: Vec::new(),
-                })
-                .collect();
-            let tol = (*e_p_tolerance, *p_rms_tolerance, *settlement_tolerance);
-            Box::new(ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)?)
+            Box::new(HarmonicCheck::new(col, f.angular_frequency, c.end_time(), h.measure_periods, h.tolerance)?)
         }
-        Verification::HarmonicColumn { body, load, measure_periods, tolerance } => {
-            let col = Column::from_case(c, model, body, load)?;
-            let omega = match c.load(load).and_then(|l| l.time_function()).and_then(|n| c.time_function(n)) {
-                Some(TimeFunction::Harmonic { angular_frequency, .. }) => *angular_frequency,
-                _ => return Err(format!("verification load `{load}` must have a harmonic time function")),
-            };
-            Box::new(HarmonicCheck::new(col, omega, end, *measure_periods, *tolerance)?)
-        }
-        Verification::ElasticColumn { body, gravity, surcharge, stress_tolerance, settlement_tolerance } => {
-            Box::new(ElasticColumnCheck::new(
-                c,
-                model,
-                coll,
-                body,
-                gravity,
-                surcharge.as_deref(),
-                *stress_tolerance,
-                *settlement_tolerance,
-            )?)
-        }
-        Verification::BearingCapacity { .. } => Box::new(bearing_check(c, model, coll)?),
-        Verification::ShockWave { body, load, probe_depth, fast_tolerance, slow_tolerance } => {
-            let col = Column::from_case(c, model, body, load)?;
-            Box::new(shock::ShockCheck::new(col, *probe_depth, *fast_tolerance, *slow_tolerance, model, coll)?)
+        V::ElasticColumn(e, ids) => Box::new(elastic_column::ElasticColumnCheck::new(c, model, coll, e, ids)?),
+        V::BearingCapacity(b, ids) => Box::new(bearing::BearingCheck::new(c, model, coll, b, ids)?),
+        V::ShockWave(s, ids) => {
+            let col = Column::from_case(c, model, ids)?;
+            Box::new(shock::ShockCheck::new(col, s.probe_depth, s.fast_tolerance, s.slow_tolerance, model, coll)?)
         }
     }))
 }
@@ -848,238 +791,5 @@ impl Check for HarmonicCheck {
             "Biot, steady state",
             &reference,
         )]
-    }
-}
-
-/// The value of a load's time function at time `t` (1 without one).
-fn load_factor(c: &Case, load: &str, t: f64) -> f64 {
-    c.load(load)
-        .and_then(|l| l.time_function())
-        .and_then(|n| c.time_function(n))
-        .map_or(1.0, |f| crate::model::loads::TimeFn::from_case(f).eval(t))
-}
-
-/// Elastic column under self-weight and surcharge (one-phase), checked against the static solution
-/// at the end of the run: σ_yy = −(ρ g d + q) at initial depth d, settlement ρ g H²/(2E_c) + q H/E_c
-/// (small strain), the settlement measured as (Σ V₀ − Σ V)/width like Terzaghi's.
-pub struct ElasticColumnCheck {
-    body: u16,
-    top: f64,
-    width: f64,
-    density: f64,
-    gravity: f64,
-    surcharge: f64,
-    settlement: f64,
-    tolerances: (f64, f64),
-    volume0: f64,
-    last_settlement: f64,
-    /// (t, settlement) after every step.
-    history: Vec<(f64, f64)>,
-    /// (initial depth, σ_yy) of the column's particles after [`Check::finish`].
-    stress_profile: Vec<(f64, f64)>,
-    height: f64,
-}
-
-impl ElasticColumnCheck {
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        c: &Case,
-        model: &Model,
-        coll: &Collective,
-        body: &str,
-        gravity: &str,
-        surcharge: Option<&str>,
-        stress_tol: f64,
-        settle_tol: f64,
-    ) -> Result<ElasticColumnCheck, String> {
-        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-        let (lo, hi) = c.bodies[bi].shape.bounds();
-        let mat = &model.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
-        let end = c.end_time();
-        let g = match c.load(gravity) {
-            Some(Load::BodyForce { acceleration, .. }) => acceleration[1].abs() * load_factor(c, gravity, end),
-            _ => return Err(format!("`{gravity}` is not a body force")),
-        };
-        let q = match surcharge.map(|s| (s, c.load(s))) {
-            Some((s, Some(Load::ParticleTraction { traction, .. } | Load::NodalTraction { traction, .. }))) => {
-                traction[1].abs() * load_factor(c, s, end)
-            }
-            Some((s, _)) => return Err(format!("`{s}` is not a traction")),
-            None => 0.0,
-        };
-        let density = mat.mixture_density(mat.porosity);
-        let ec = mat.model.elastic().constrained_modulus();
-        let height = hi[1] - lo[1];
-        let v0: f64 = (0..model.particles.len())
-            .filter(|&k| model.particles.body[k] as usize == bi)
-            .map(|k| model.particles.volume[k])
-            .sum();
-        Ok(ElasticColumnCheck {
-            body: bi as u16,
-            top: hi[1],
-            width: model.geometry.plan_area(lo[0], hi[0]),
-            density,
-            gravity: g,
-            surcharge: q,
-            settlement: density * g * height * height / (2.0 * ec) + q * height / ec,
-            tolerances: (stress_tol, settle_tol),
-            volume0: coll.sum(&[v0])?[0],
-            last_settlement: 0.0,
-            history: Vec::new(),
-            stress_profile: Vec::new(),
-            height,
-        })
-    }
-}
-
-impl Check for ElasticColumnCheck {
-    fn columns(&self) -> Vec<String> {
-        vec!["column.settlement".into()]
-    }
-
-    /// Its metrics come from the final state alone.
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        Ok(Some(Vec::new()))
-    }
-
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
-        let v: f64 = (0..model.particles.len())
-            .filter(|&k| model.particles.body[k] == self.body)
-            .map(|k| model.particles.volume[k])
-            .sum();
-        self.last_settlement = (self.volume0 - coll.sum(&[v])?[0]) / self.width;
-        self.history.push((t, self.last_settlement));
-        Ok(vec![self.last_settlement])
-    }
-
-    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
-        let ps = &model.particles;
-        let local: Vec<f64> = (0..ps.len())
-            .filter(|&k| ps.body[k] == self.body)
-            .flat_map(|k| [self.top - ps.x0[k][1], ps.stress[k][1]])
-            .collect();
-        let all = coll.gather(&local)?;
-        let exact = |d: f64| -(self.density * self.gravity * d + self.surcharge);
-        let peak = all.chunks(2).map(|d| exact(d[0]).abs()).fold(0.0, f64::max);
-        let worst = all.chunks(2).map(|d| (d[1] - exact(d[0])).abs()).fold(0.0, f64::max);
-        self.stress_profile = all.chunks(2).map(|d| (d[0], d[1])).collect();
-        let s = self.last_settlement;
-        Ok((
-            vec![
-                (
-                    "stress_max_rel_error".into(),
-                    Metric::error(
-                        worst / peak,
-                        self.tolerances.0,
-                        format!("max |σ_yy − σ*| = {worst:.4e} Pa; max |σ*| = {peak:.4e} Pa"),
-                    ),
-                ),
-                (
-                    "settlement_rel_error".into(),
-                    Metric::error(
-                        (s - self.settlement).abs() / self.settlement,
-                        self.tolerances.1,
-                        format!("settlement {s:.6e} m vs static {:.6e} m", self.settlement),
-                    ),
-                ),
-            ],
-            Vec::new(),
-        ))
-    }
-
-    fn figures(&self) -> Vec<crate::plot::Figure> {
-        let kpa = |v: &[(f64, f64)]| v.iter().map(|&(d, s)| (d, 1e-3 * s)).collect::<Vec<_>>();
-        let exact: Vec<(f64, f64)> =
-            [0.0, self.height].iter().map(|&d| (d, -(self.density * self.gravity * d + self.surcharge))).collect();
-        let t_end = self.history.last().map_or(0.0, |r| r.0);
-        let t_start = self.history.first().map_or(0.0, |r| r.0);
-        let mut settle = figures::settlement_history(
-            "elastic_column_settlement.png",
-            "Elastic column: settlement under self-weight, then the surcharge",
-            &self.history,
-            Some(("static solution, final load", &[(t_start, self.settlement), (t_end, self.settlement)])),
-        );
-        settle.series[1].label = "static solution under the final load".into();
-        vec![
-            figures::depth_profile(
-                "elastic_column_stress.png",
-                "Elastic column: vertical stress at the end of the run",
-                "vertical stress σ_yy [kPa]",
-                "initial depth below the top [m]",
-                "MPM",
-                &kpa(&self.stress_profile),
-                "static solution −(ρ g d + q)",
-                &kpa(&exact),
-            ),
-            settle,
-        ]
-    }
-}
-
-/// The case's verification kind, for `check`.
-pub fn describe(v: &case::Verification) -> String {
-    match v {
-        Verification::Terzaghi { time_factors, .. } => {
-            format!("Terzaghi consolidation at T_v = {time_factors:?}")
-        }
-        Verification::HarmonicColumn { measure_periods, .. } => {
-            format!("harmonic column (Zienkiewicz et al. 1980), last {measure_periods} periods")
-        }
-        Verification::ShockWave { probe_depth, .. } => {
-            format!("shock-wave arrival at {probe_depth} m depth")
-        }
-        Verification::ElasticColumn { .. } => "static elastic column under self-weight and surcharge".into(),
-        Verification::LargeStrainConsolidation { degrees, .. } => {
-            format!("large-strain consolidation (Xie & Leo 2004) at U_s = {degrees:?}")
-        }
-        Verification::Lame { inner_radius, outer_radius, .. } => {
-            format!("Lamé cylinder, a = {inner_radius} m, b = {outer_radius} m: u_r, σ_rr, σ_θθ")
-        }
-        Verification::HollowCylinder { inner_radius, outer_radius, increments, .. } => format!(
-            "axisymmetric hollow cylinder with a fixed outer wall ([001] §3.1), a = {inner_radius} m, \
-             b = {outer_radius} m: u_r(a) and Δσ_rr after the first load step{}",
-            if increments.is_some() {
-                "; every step's Δq and Δσ_m at mp1 and mp1's radius against the closed form of the remaining cylinder"
-            } else {
-                ""
-            }
-        ),
-        Verification::CookMembrane { tip, reference, .. } => format!(
-            "Cook's membrane ([002] §4.1): the tip ({}, {})'s vertical displacement at rest against {reference} m, \
-             the mean stress's chequerboard index",
-            tip[0], tip[1]
-        ),
-        Verification::DamBreak { settle_stage, experiment, .. } => format!(
-            "dam break ([002] §4.3): the hydrostatic pressure at the end of stage `{settle_stage}`, the mass, the \
-             front's advance against the shallow-water speed 2√(gH){}",
-            experiment.as_ref().map_or(String::new(), |e| format!(", the front against `{e}`"))
-        ),
-        Verification::Runout { trigger_stage, .. } => format!(
-            "run-out of a slope failing from stage `{trigger_stage}` on ([002] §4.4): the slope standing before it, \
-             the mass, the front's advance (no reference solution)"
-        ),
-        Verification::StiffnessMap { center, radius, .. } => format!(
-            "nodal stiffness K_mag ([001] Eq. 25) within {radius} m of ({}, {}) against the finite-element value",
-            center[0], center[1]
-        ),
-        Verification::VerticalCut { stop_displacement, .. } => format!(
-            "vertical cut ([001] §7.2) to a toe displacement of {stop_displacement} m: yield check, smoothness of K_mag and F^int_mag"
-        ),
-        Verification::Patch { boundary, .. } => {
-            format!("patch test: uniform stress under the homogeneous flow of boundary `{boundary}`")
-        }
-        Verification::BearingCapacity { failure_settlement, plateau, reference, .. } => {
-            match (failure_settlement, plateau) {
-                (Some(f), _) => format!("bearing capacity: q_ult/c at d/B = {f} against {reference:.4}"),
-                (None, Some([a, b])) => {
-                    format!("bearing capacity: q_ult/c, the mean q/c over d/B in [{a}, {b}], against {reference:.4}")
-                }
-                (None, None) => "load–settlement curve of a footing".into(),
-            }
-        }
     }
 }

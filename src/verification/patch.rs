@@ -12,7 +12,7 @@
 //!   stress of F itself, exact to round-off.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, SoilModel, Verification};
+use crate::case::{Case, Patch, PatchIds, SoilModel};
 use crate::model::finite_strain::{embed, mul, M3};
 use crate::model::loads::Motion;
 use crate::model::soil::principal::{self, Principal};
@@ -50,38 +50,28 @@ fn log_stretch_and_rotation(f: &M3) -> (Stress, M3) {
 }
 
 impl<const D: usize> PatchCheck<D> {
-    /// The check of a `patch` verification.
-    pub fn new(c: &Case, model: &Model<D>) -> Result<PatchCheck<D>, String> {
-        let Some(Verification::Patch { body, boundary, spread_tolerance, tolerance }) = &c.verification else {
-            return Err("not a patch verification".into());
-        };
-        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-        let b = &c.bodies[bi];
-        let mat = &c.materials[c.material_index(&b.material).expect("validated")];
-        let (elastic, hyperelastic) = match mat.model {
-            SoilModel::LinearElastic { young_modulus, poisson_ratio } => {
-                (LinearElastic::new(young_modulus, poisson_ratio), None)
-            }
-            SoilModel::NeoHookean { young_modulus, poisson_ratio } => (
-                LinearElastic::new(young_modulus, poisson_ratio),
-                Some(crate::model::finite_strain::NeoHookean::new(young_modulus, poisson_ratio)),
+    /// The check of a `patch` verification `spec`, whose names resolve to `ids`.
+    pub fn new(c: &Case, model: &Model<D>, spec: &Patch, ids: &PatchIds) -> Result<PatchCheck<D>, String> {
+        let (elastic, hyperelastic) = match &c.material_of(ids.body).model {
+            SoilModel::LinearElastic(e) => (LinearElastic::new(e.young_modulus, e.poisson_ratio), None),
+            SoilModel::NeoHookean(e) => (
+                LinearElastic::new(e.young_modulus, e.poisson_ratio),
+                Some(crate::model::finite_strain::NeoHookean::new(e.young_modulus, e.poisson_ratio)),
             ),
-            _ => return Err(format!("body `{body}` is not elastic (linear or neo-Hookean)")),
+            _ => return Err(format!("body `{}` is not elastic (linear or neo-Hookean)", spec.body)),
         };
-        let motion = model
-            .boundaries
-            .iter()
-            .find(|x| &x.name == boundary)
-            .and_then(|x| x.motion.clone())
-            .ok_or(format!("boundary `{boundary}` has no motion"))?;
+        let motion = model.boundaries[ids.boundary.index()]
+            .motion
+            .clone()
+            .ok_or(format!("boundary `{}` has no motion", spec.boundary))?;
         Ok(PatchCheck {
-            body: bi as u16,
+            body: ids.body.index() as u16,
             motion,
             elastic,
             hyperelastic,
-            initial: b.uniform_stress_vector().unwrap_or([0.0; NS]),
-            spread_tolerance: *spread_tolerance,
-            tolerance: *tolerance,
+            initial: c.body(ids.body).uniform_stress_vector().unwrap_or([0.0; NS]),
+            spread_tolerance: spec.spread_tolerance,
+            tolerance: spec.tolerance,
             last: (f64::NAN, f64::NAN, 0.0),
         })
     }

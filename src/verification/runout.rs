@@ -22,7 +22,7 @@
 //! MPM (item 16's geometry-independent assertions).
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Verification};
+use crate::case::{Case, Runout, RunoutIds};
 use crate::model::Model;
 use crate::parallel::Collective;
 
@@ -111,26 +111,20 @@ pub struct RunoutCheck {
 }
 
 impl RunoutCheck {
-    /// The check of the case's `runout` verification (its case validated); collective.
-    pub fn new<const D: usize>(c: &Case, model: &Model<D>, coll: &Collective) -> Result<RunoutCheck, String> {
-        let Some(Verification::Runout {
-            body,
-            trigger_stage,
-            standing_advance,
-            standing_speed,
-            snapshot_times,
-            failed_strain,
-            spray_fraction,
-        }) = &c.verification
-        else {
-            return Err("not a run-out verification".into());
-        };
-        let bi = c.body_index(body).ok_or(format!("verification: no body `{body}`"))? as u16;
-        let s = c.stages.iter().position(|s| &s.name == trigger_stage).ok_or(format!("no stage `{trigger_stage}`"))?;
-        let trigger = c.stages[..s].iter().map(|s| s.duration).sum();
-        let start = Front::of(model, bi, *spray_fraction, coll)?;
+    /// The check of the case's `runout` verification `spec`, whose names resolve to `ids`;
+    /// collective.
+    pub fn new<const D: usize>(
+        c: &Case,
+        model: &Model<D>,
+        coll: &Collective,
+        spec: &Runout,
+        ids: &RunoutIds,
+    ) -> Result<RunoutCheck, String> {
+        let bi = ids.body.index() as u16;
+        let trigger = c.stages[..ids.trigger_stage.index()].iter().map(|s| s.duration).sum();
+        let start = Front::of(model, bi, spec.spray_fraction, coll)?;
         if start.mass.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return Err(format!("verification: the body `{body}` holds no material points"));
+            return Err(format!("verification: the body `{}` holds no material points", spec.body));
         }
         Ok(RunoutCheck {
             body: bi,
@@ -142,11 +136,11 @@ impl RunoutCheck {
             mass_change: 0.0,
             last: start,
             snapshots: Vec::new(),
-            snapshot_times: snapshot_times.clone(),
-            standing_advance: *standing_advance,
-            standing_speed: *standing_speed,
-            failed_strain: *failed_strain,
-            spray: *spray_fraction,
+            snapshot_times: spec.snapshot_times.clone(),
+            standing_advance: spec.standing_advance,
+            standing_speed: spec.standing_speed,
+            failed_strain: spec.failed_strain,
+            spray: spec.spray_fraction,
         })
     }
 

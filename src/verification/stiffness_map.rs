@@ -10,7 +10,7 @@
 
 use super::{Check, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
-use crate::case::{Case, Verification};
+use crate::case::{BodyId, Case, StiffnessMap};
 use crate::model::Model;
 use crate::parallel::Collective;
 
@@ -30,17 +30,14 @@ pub struct StiffnessMapCheck {
 }
 
 impl StiffnessMapCheck {
-    /// The check of a `stiffness_map` verification.
-    pub fn new(c: &Case) -> Result<StiffnessMapCheck, String> {
-        let Some(Verification::StiffnessMap { body, center, radius, tolerance }) = &c.verification else {
-            return Err("not a stiffness-map verification".into());
-        };
-        let (_, e, nu) = super::elastic_body(c, body)?;
+    /// The check of a `stiffness_map` verification `spec` of `body`.
+    pub fn new(c: &Case, spec: &StiffnessMap, body: BodyId) -> Result<StiffnessMapCheck, String> {
+        let (e, nu) = super::elastic_body(c, body)?;
         Ok(StiffnessMapCheck {
-            center: *center,
-            radius: *radius,
+            center: spec.center,
+            radius: spec.radius,
             reference: fem_k_mag(e, nu),
-            tolerance: *tolerance,
+            tolerance: spec.tolerance,
             last: None,
             local_map: Vec::new(),
             map: (Vec::new(), (0.0, 0.0)),

@@ -18,7 +18,7 @@
 
 use super::{Check, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
-use crate::case::{Case, SoilModel, Verification};
+use crate::case::{BodyId, Case, SoilModel, VerticalCut};
 use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -59,25 +59,19 @@ pub struct VerticalCutCheck {
 }
 
 impl VerticalCutCheck {
-    /// The check of a `vertical_cut` verification.
-    pub fn new(c: &Case) -> Result<VerticalCutCheck, String> {
-        let Some(Verification::VerticalCut { body, toe, b, c: cpoint, stop_displacement, snapshots }) = &c.verification
-        else {
-            return Err("not a vertical-cut verification".into());
+    /// The check of a `vertical_cut` verification `spec` of `body`.
+    pub fn new(c: &Case, spec: &VerticalCut, body: BodyId) -> Result<VerticalCutCheck, String> {
+        let SoilModel::VonMises(m) = &c.material_of(body).model else {
+            return Err(format!("body `{}` is not von Mises", spec.body));
         };
-        let bi = c.body_index(body).ok_or(format!("no body `{body}`"))?;
-        let mat = &c.materials[c.material_index(&c.bodies[bi].material).expect("validated")];
-        let SoilModel::VonMises { cohesion, residual_cohesion, softening_modulus, .. } = mat.model else {
-            return Err(format!("body `{body}` is not von Mises"));
-        };
-        let mut snapshots = snapshots.clone();
+        let mut snapshots = spec.snapshots.clone();
         snapshots.sort_by(f64::total_cmp);
         Ok(VerticalCutCheck {
-            body: bi as u16,
-            points: [*toe, *b, *cpoint],
-            stop_at: *stop_displacement,
+            body: body.index() as u16,
+            points: [spec.toe, spec.b, spec.c],
+            stop_at: spec.stop_displacement,
             snapshots,
-            strength: (cohesion, residual_cohesion.unwrap_or(cohesion), softening_modulus),
+            strength: (m.cohesion, m.residual_cohesion.unwrap_or(m.cohesion), m.softening_modulus),
             toe: 0.0,
             yield_ratio: 0.0,
             eps_max: 0.0,

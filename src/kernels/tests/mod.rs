@@ -4,7 +4,7 @@
 //! whole point (rest, rigid rotation, Newmark).
 
 use super::*;
-use crate::case::SoilModel;
+use crate::case::{self, SoilModel};
 use crate::layout::MAX_DOF_3D;
 use crate::model::material::soil_model;
 use crate::model::soil::LinearElastic;
@@ -12,7 +12,7 @@ use crate::scheme::Integration;
 
 /// A non-associated Mohr–Coulomb soil with softening.
 fn mohr_coulomb(cohesion: f64) -> Constitutive {
-    soil_model(&SoilModel::MohrCoulomb {
+    soil_model(&SoilModel::MohrCoulomb(case::MohrCoulomb {
         young_modulus: 1e7,
         poisson_ratio: 0.3,
         friction_angle: 30.0,
@@ -23,7 +23,7 @@ fn mohr_coulomb(cohesion: f64) -> Constitutive {
         critical_dilation_angle: Some(0.0),
         dilation_decay: 10.0,
         tension_cutoff: None,
-    })
+    }))
 }
 
 /// The agreement of one (row field, column field) block of a tangent with finite differences.

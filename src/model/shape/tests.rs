@@ -18,8 +18,7 @@ fn uniform_bsplines_are_partitions_of_unity_with_their_moments_and_derivatives()
                 m2 += (i * i) as f64 * w;
                 d0 += g;
                 let e = 1e-6;
-                let fd = (uniform_bspline(degree, s - i as f64 + e).0
-                    - uniform_bspline(degree, s - i as f64 - e).0)
+                let fd = (uniform_bspline(degree, s - i as f64 + e).0 - uniform_bspline(degree, s - i as f64 - e).0)
                     / (2.0 * e);
                 // Central differences across a knot see the jump of the second derivative: O(e).
                 assert!((fd - g).abs() < 1e-5, "degree {degree} s {s} node {i}: {g} vs {fd}");
@@ -183,8 +182,7 @@ fn face_weights_are_the_hat_functions_and_move_continuously() {
         assert!((edge - 1.0).abs() < 1e-12, "y = {y:e}: {edge}");
     }
     // Crossing the grid line y = 0.75 changes no weight by more than the motion.
-    let (a, b) =
-        (face_weights(Basis::Gimp, &g, [1.1, 0.75 - 1e-9]), face_weights(Basis::Gimp, &g, [1.1, 0.75 + 1e-9]));
+    let (a, b) = (face_weights(Basis::Gimp, &g, [1.1, 0.75 - 1e-9]), face_weights(Basis::Gimp, &g, [1.1, 0.75 + 1e-9]));
     for j in 2..=4u32 {
         let on = |w: &Stencil| -> f64 { w.iter().filter(|([_, jj], _, _)| *jj == j).map(|(_, s, _)| s).sum() };
         assert!((on(&a) - on(&b)).abs() < 1e-7, "row {j}: {} vs {}", on(&a), on(&b));
@@ -199,10 +197,8 @@ fn face_weights_balance_the_gimp_internal_force_of_a_uniform_stress() {
     let g = grid();
     for (x, lp) in [([1.2, 0.74], [0.1, 0.05]), ([1.2, 0.78], [0.2, 0.03]), ([1.2, 0.9], [0.2, 0.1])] {
         let st = stencil(Basis::Gimp, &g, x, lp);
-        let (top, bottom) = (
-            face_weights(Basis::Gimp, &g, [x[0], x[1] + lp[1]]),
-            face_weights(Basis::Gimp, &g, [x[0], x[1] - lp[1]]),
-        );
+        let (top, bottom) =
+            (face_weights(Basis::Gimp, &g, [x[0], x[1] + lp[1]]), face_weights(Basis::Gimp, &g, [x[0], x[1] - lp[1]]));
         let v = 4.0 * lp[0] * lp[1];
         for (node, _, dw) in st.iter() {
             let at = |w: &Stencil| w.iter().filter(|(n, _, _)| *n == node).map(|(_, s, _)| s).sum::<f64>();
@@ -437,8 +433,7 @@ fn every_basis_reproduces_linear_fields_in_three_dimensions() {
     let lp = [0.125, 0.0625, 0.1];
     // Domains inside the grid, some touching its faces or crossing grid lines; and, for the bases
     // whose support does not depend on a domain, points on the grid's faces and edges.
-    let inner =
-        [[0.3, -0.4, 1.3], [0.125, -0.0625, 2.5], [1.375, -0.25, 1.1], [0.74, -0.26, 2.21], [1.2, -0.07, 1.79]];
+    let inner = [[0.3, -0.4, 1.3], [0.125, -0.0625, 2.5], [1.375, -0.25, 1.1], [0.74, -0.26, 2.21], [1.2, -0.07, 1.79]];
     let faces = [[0.0, 0.0, 2.6], [1.5, -0.5, 1.0], [1.5, 0.0, 2.6]];
     for basis in [Basis::Gimp, Basis::Linear, Basis::BSpline2, Basis::BSpline3] {
         let on_faces: &[[f64; 3]] = if basis == Basis::Gimp { &[] } else { &faces };
@@ -473,9 +468,8 @@ fn every_basis_reproduces_linear_fields_in_three_dimensions() {
                     xm[d] -= e;
                     let (sp, sm): (Stencil<3, MAX_STENCIL_3D>, Stencil<3, MAX_STENCIL_3D>) =
                         (stencil_in(basis, &g, xp, lp), stencil_in(basis, &g, xm, lp));
-                    let at = |s: &Stencil<3, MAX_STENCIL_3D>, n: [u32; 3]| {
-                        s.iter().find(|o| o.0 == n).map_or(0.0, |o| o.1)
-                    };
+                    let at =
+                        |s: &Stencil<3, MAX_STENCIL_3D>, n: [u32; 3]| s.iter().find(|o| o.0 == n).map_or(0.0, |o| o.1);
                     for (n, _, dw) in st.iter() {
                         let fd = (at(&sp, n) - at(&sm, n)) / (2.0 * e);
                         assert!((fd - dw[d]).abs() < 1e-5, "{basis:?} {x:?} node {n:?} d{d}: {} vs {fd}", dw[d]);

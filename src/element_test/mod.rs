@@ -6,8 +6,10 @@
 //! with the model's consistent tangent (the stress-controlled rows of dσ/dΔε), so a plastic increment
 //! converges quadratically, as the residual history of each row shows.
 
-use crate::case::element::{Control, LoadPath};
+pub mod input;
+
 use crate::model::soil::{Constitutive, Region, Stress, NS};
+use input::{Control, LoadPath};
 
 /// The state after one increment.
 #[derive(Debug, Clone)]
@@ -166,8 +168,8 @@ pub fn table(rows: &[Row]) -> Vec<Vec<String>> {
 
 #[cfg(test)]
 mod tests {
+    use super::input::{parse_material, parse_path};
     use super::*;
-    use crate::case::element::{parse_material, parse_path};
     use crate::model::material::soil_model;
 
     fn model(text: &str) -> Constitutive {

@@ -9,8 +9,7 @@
 //! `{ strain = 0.0 }`, which with `zz = { strain = 0.0 }` is plane strain. Examples live in
 //! `element_tests/`.
 
-use super::schema::SoilModel;
-use super::{validate, CaseError};
+use crate::case::{CaseError, SoilModel};
 use crate::model::soil::{Stress, NS};
 use serde::{Deserialize, Serialize};
 
@@ -114,8 +113,8 @@ fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Resul
 /// Parses and validates MATERIAL.toml.
 pub fn parse_material(text: &str, origin: &str) -> Result<MaterialFile, CaseError> {
     let m: MaterialFile = parse_toml(text, origin)?;
-    validate::soil_model("model", &m.model).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
-    if matches!(m.model, SoilModel::NeoHookean { .. } | SoilModel::HenckyJ2 { .. } | SoilModel::NewtonianFluid { .. }) {
+    crate::validation::soil_model("model", &m.model).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
+    if m.model.is_finite_strain() {
         return Err(CaseError::new(format!(
             "{origin}: key `model.type`: the element test drives incremental models along strain increments; \
              the finite-strain models (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) follow the deformation gradient and are not \

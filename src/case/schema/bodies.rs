@@ -1,0 +1,316 @@
+//! `[[bodies]]`: the regions filled with material points at t = 0, their initial stress, and the
+//! planar shapes and boxes the case uses to select points and nodes.
+
+use crate::case::check::{at, finite, finite2, positive, Checked};
+use serde::{Deserialize, Serialize};
+
+/// A body filled with material points.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// The name probes, loads, boundaries and the verification give to use it.
+    pub name: String,
+    /// The name of its material.
+    pub material: String,
+    /// Material points per cell and direction, in [1, 8] (2 gives 2 × 2 per cell in the plane,
+    /// 2 × 2 × 2 in three dimensions).
+    #[serde(default = "default_ppc")]
+    pub particles_per_cell: usize,
+    /// The region it occupies at t = 0: in three dimensions its section in the x–y plane,
+    /// extruded along z over `z`.
+    pub shape: Shape,
+    /// The body's extent [z_min, z_max] along z [m], inside the grid (three-dimensional cases
+    /// only; default: the grid's).
+    pub z: Option<[f64; 2]>,
+    /// A geostatic initial stress (default: stress-free).
+    pub initial_stress: Option<InitialStress>,
+    /// A uniform initial effective stress [xx, yy, xy, zz] [Pa] (tension positive), instead of a
+    /// geostatic one (e.g. for patch tests and rigid-rotation checks); a three-dimensional case may
+    /// give the two other shears too, [xx, yy, xy, zz, yz, zx].
+    pub uniform_stress: Option<Vec<f64>>,
+    /// Displacement of every material point from the centre of its sub-cell, as a fraction of the
+    /// point spacing in each direction, drawn from a fixed pseudo-random sequence keyed by the
+    /// point's id (the same on any number of ranks) [-], in [0, 0.5) (default 0: a regular
+    /// arrangement).
+    #[serde(default)]
+    pub perturbation: f64,
+}
+
+fn default_ppc() -> usize {
+    2
+}
+
+/// A geostatic initial state in equilibrium with gravity g = `analysis.g` acting from t = 0 (the
+/// case must apply that gravity in full from the start): at a point at height y under a column of
+/// material reaching y_top at its x, the total vertical stress is σ_v = −g ∫_y^{y_top} ρ dy (the
+/// densities of the bodies met along the column), the pore pressure p = ρ_w g (y_w − y) below the
+/// water table y_w (two-phase), the effective stresses σ'_yy = σ_v + p, σ'_xx = σ'_zz = K₀ σ'_yy,
+/// σ'_xy = 0. Near a slope this is not in equilibrium; the first steps redistribute it.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InitialStress {
+    /// Coefficient of earth pressure at rest K₀ = σ'_h/σ'_v [-], > 0.
+    pub k0: f64,
+    /// The water table (two-phase): `"surface"` (the top of the material in each column, the
+    /// default) or a height y_w [m].
+    #[serde(default)]
+    pub water_table: WaterTable,
+}
+
+/// Where the pore pressure of a geostatic state is zero.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(untagged)]
+pub enum WaterTable {
+    /// `"surface"`: the top of the material in each column.
+    #[default]
+    #[serde(with = "surface_word")]
+    #[schemars(with = "String")]
+    Surface,
+    /// A height [m].
+    Level(f64),
+}
+
+mod surface_word {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str("surface")
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+        let w = String::deserialize(d)?;
+        if w == "surface" {
+            Ok(())
+        } else {
+            Err(serde::de::Error::custom(format!("expected \"surface\" or a height, got \"{w}\"")))
+        }
+    }
+}
+
+/// A planar region, written `{ rectangle = { ... } }` or `{ polygon = { ... } }`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Shape {
+    /// An axis-aligned rectangle.
+    Rectangle(Rectangle),
+    /// A simple polygon.
+    Polygon(Polygon),
+}
+
+/// An axis-aligned rectangle of the plane.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Rectangle {
+    /// Lower-left corner [m].
+    pub min: [f64; 2],
+    /// Upper-right corner [m], above and right of `min`.
+    pub max: [f64; 2],
+}
+
+/// A simple polygon of the plane.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Polygon {
+    /// Its vertices in order [m], at least three.
+    pub vertices: Vec<[f64; 2]>,
+}
+
+/// An axis-aligned box [m] used to select nodes or particles.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    /// Lower-left corner [m].
+    pub min: [f64; 2],
+    /// Upper-right corner [m].
+    pub max: [f64; 2],
+    /// Its extent [z_min, z_max] along z in a three-dimensional case [m] (default: all of it).
+    pub z: Option<[f64; 2]>,
+}
+
+impl Body {
+    /// The `uniform_stress` as a stress vector [xx, yy, xy, zz, yz, zx] [Pa] (the shears it does
+    /// not give are zero).
+    pub fn uniform_stress_vector(&self) -> Option<[f64; 6]> {
+        self.uniform_stress.as_ref().map(|s| std::array::from_fn(|c| s.get(c).copied().unwrap_or(0.0)))
+    }
+
+    /// Checks the body's own values; `key` is its table (`bodies[0]`). Its material, its extent
+    /// along z and the number of stress components depend on the rest of the case: validation
+    /// checks them.
+    pub fn check(&self, key: &str) -> Checked {
+        if self.particles_per_cell == 0 || self.particles_per_cell > 8 {
+            return Err(format!(
+                "key `{}`: must be between 1 and 8, got {}",
+                at(key, "particles_per_cell"),
+                self.particles_per_cell
+            ));
+        }
+        self.shape.check(&at(key, "shape"))?;
+        if !(0.0..0.5).contains(&self.perturbation) {
+            return Err(format!("key `{}`: must be in [0, 0.5), got {}", at(key, "perturbation"), self.perturbation));
+        }
+        if self.uniform_stress.is_some() && self.initial_stress.is_some() {
+            return Err(format!("key `{key}`: give `initial_stress` or `uniform_stress`, not both"));
+        }
+        match &self.initial_stress {
+            Some(init) => init.check(&at(key, "initial_stress")),
+            None => Ok(()),
+        }
+    }
+}
+
+impl InitialStress {
+    /// Checks K₀ and the water table; `key` is its table.
+    pub fn check(&self, key: &str) -> Checked {
+        positive(&at(key, "k0"), self.k0)?;
+        match self.water_table {
+            WaterTable::Level(y) => finite(&at(key, "water_table"), y),
+            WaterTable::Surface => Ok(()),
+        }
+    }
+}
+
+impl Shape {
+    /// Checks the corners or vertices; `key` is the shape's table (`bodies[0].shape`).
+    pub fn check(&self, key: &str) -> Checked {
+        match self {
+            Shape::Rectangle(r) => r.check(&at(key, "rectangle")),
+            Shape::Polygon(p) => p.check(&at(key, "polygon")),
+        }
+    }
+
+    /// Bounding box (min, max) [m].
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        match self {
+            Shape::Rectangle(r) => (r.min, r.max),
+            Shape::Polygon(p) => {
+                let mut lo = [f64::INFINITY; 2];
+                let mut hi = [f64::NEG_INFINITY; 2];
+                for v in &p.vertices {
+                    for d in 0..2 {
+                        lo[d] = lo[d].min(v[d]);
+                        hi[d] = hi[d].max(v[d]);
+                    }
+                }
+                (lo, hi)
+            }
+        }
+    }
+
+    /// Whether point `p` lies inside (boundary points of a rectangle count as inside; polygons use
+    /// the even–odd rule).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        match self {
+            Shape::Rectangle(Rectangle { min, max }) => {
+                p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1]
+            }
+            Shape::Polygon(Polygon { vertices }) => {
+                let mut inside = false;
+                let n = vertices.len();
+                let mut j = n - 1;
+                for i in 0..n {
+                    let (a, b) = (vertices[i], vertices[j]);
+                    if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0] {
+                        inside = !inside;
+                    }
+                    j = i;
+                }
+                inside
+            }
+        }
+    }
+}
+
+impl Rectangle {
+    /// Checks that the corners are finite and ordered; `key` is the rectangle's table.
+    pub fn check(&self, key: &str) -> Checked {
+        finite2(&at(key, "min"), self.min)?;
+        finite2(&at(key, "max"), self.max)?;
+        if !(self.max[0] > self.min[0] && self.max[1] > self.min[1]) {
+            return Err(format!("key `{key}`: max must exceed min in x and y, got {:?} .. {:?}", self.min, self.max));
+        }
+        Ok(())
+    }
+}
+
+impl Polygon {
+    /// Checks the number of vertices and that they are finite; `key` is the polygon's table.
+    pub fn check(&self, key: &str) -> Checked {
+        if self.vertices.len() < 3 {
+            return Err(format!("key `{}`: a polygon needs at least 3 vertices", at(key, "vertices")));
+        }
+        for (j, v) in self.vertices.iter().enumerate() {
+            finite2(&format!("{key}.vertices[{j}]"), *v)?;
+        }
+        Ok(())
+    }
+}
+
+impl Region {
+    /// Checks that the corners are finite and ordered (a box may be flat: a line of nodes); `key`
+    /// is the region's table.
+    pub fn check(&self, key: &str) -> Checked {
+        finite2(&at(key, "min"), self.min)?;
+        finite2(&at(key, "max"), self.max)?;
+        if self.max[0] < self.min[0] || self.max[1] < self.min[1] {
+            return Err(format!("key `{key}`: max must not be below min"));
+        }
+        Ok(())
+    }
+
+    /// Whether point `p` lies in the box (boundary included, with a tolerance of 1e-9 of the box's
+    /// size and coordinates, so that points on a grid line are not lost to round-off, also when the
+    /// box is a line).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        (0..2).all(|d| self.spans(d, p[d], 0.0))
+    }
+
+    /// Whether point `p` of a case of dimension `D` lies in the box: [`Region::contains`] in x and
+    /// y and, in three dimensions, its `z` range (all of z without one) with the same tolerance.
+    pub fn contains_in<const D: usize>(&self, p: [f64; D]) -> bool {
+        if !self.contains([p[0], p[1]]) {
+            return false;
+        }
+        D < 3 || self.spans_z(p[2])
+    }
+
+    /// Whether `z` lies in the box's `z` range (all of z without one), with the tolerance of
+    /// [`Region::contains`].
+    pub fn spans_z(&self, z: f64) -> bool {
+        match self.z {
+            Some([lo, hi]) => {
+                let tol = 1e-9 * ((hi - lo).abs() + lo.abs() + hi.abs()) + 1e-15;
+                z >= lo - tol && z <= hi + tol
+            }
+            None => true,
+        }
+    }
+
+    /// Whether the grid node at `p` lies in the box: as [`Region::contains`], with a further
+    /// 1e-9 of the cell size `h`, the round-off of origin + i h (a line at x = 0 holds the node
+    /// computed at −2e-15).
+    pub fn holds_node(&self, p: [f64; 2], h: [f64; 2]) -> bool {
+        (0..2).all(|d| self.spans(d, p[d], 1e-9 * h[d]))
+    }
+
+    /// Whether the grid node at `p` of a case of dimension `D` lies in the box: [`Region::holds_node`]
+    /// in x and y and, in three dimensions, its `z` range (all of z without one) with the same
+    /// tolerance.
+    pub fn holds_node_in<const D: usize>(&self, p: [f64; D], h: [f64; D]) -> bool {
+        if !self.holds_node([p[0], p[1]], [h[0], h[1]]) {
+            return false;
+        }
+        match (D, self.z) {
+            (3, Some([lo, hi])) => {
+                let tol = 1e-9 * ((hi - lo).abs() + lo.abs() + hi.abs()) + 1e-15 + 1e-9 * h[2];
+                p[2] >= lo - tol && p[2] <= hi + tol
+            }
+            _ => true,
+        }
+    }
+
+    /// Whether coordinate `x` of direction `d` lies in the box's range, with `slack` beyond the
+    /// tolerance of [`Region::contains`].
+    pub fn spans(&self, d: usize, x: f64, slack: f64) -> bool {
+        let tol = 1e-9 * ((self.max[d] - self.min[d]).abs() + self.min[d].abs() + self.max[d].abs()) + 1e-15 + slack;
+        x >= self.min[d] - tol && x <= self.max[d] + tol
+    }
+}

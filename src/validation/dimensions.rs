@@ -1,0 +1,83 @@
+//! What a case's dimension and geometry allow: what a three-dimensional case may not ask for
+//! (line pressures, which are plane by nature) or not yet (the plane benchmarks' checks, [001]'s
+//! CMPM and mapped stiffnesses), and the conditions of an axisymmetric one.
+
+use crate::case::check::Checked;
+use crate::case::{Case, Geometry, Load, Stiffness, StressRecovery, Verification};
+
+/// What a three-dimensional case may not ask for, and the space of its points' identifiers.
+pub(super) fn three_dimensional(c: &Case) -> Checked {
+    let not_yet =
+        |key: &str| Err(format!("key `{key}`: not available in a three-dimensional case yet (docs/dimensions.md)"));
+    if c.analysis.geometry == Geometry::Axisymmetric {
+        return Err("key `analysis.geometry`: a three-dimensional case has no axial symmetry (give two entries \
+                    per grid key for an axisymmetric one)"
+            .into());
+    }
+    if let Some(i) = c.loads.iter().position(|l| matches!(l, Load::LinePressure(_))) {
+        return Err(format!(
+            "key `loads[{i}].kind = \"line_pressure\"`: a line pressure acts on a plane polyline; a \
+             three-dimensional case loads a surface with a `particle_traction` or a `nodal_traction`"
+        ));
+    }
+    match &c.verification {
+        None
+        | Some(
+            Verification::Terzaghi(_)
+            | Verification::BearingCapacity(_)
+            | Verification::Runout(_)
+            | Verification::Patch(_),
+        ) => {}
+        Some(v) => return not_yet(&format!("verification.kind = \"{}\"", v.kind())),
+    }
+    if c.stabilisation.stress_recovery == StressRecovery::Cmpm {
+        return Err("key `stabilisation.stress_recovery`: [001]'s CMPM recovery is two-dimensional".into());
+    }
+    if c.stabilisation.stiffness != Stiffness::Particle {
+        return not_yet("stabilisation.stiffness");
+    }
+    // A point's identifier numbers its sub-cell below bit 48 (at most 8 points per cell and
+    // direction, `Particles::generate`).
+    let sub_cells: f64 = c.grid.cells.iter().map(|&n| 8.0 * n as f64).product();
+    if sub_cells >= (1u64 << 48) as f64 {
+        return Err(format!(
+            "key `grid.cells`: {:?} cells are too many to number the material points of (at most 2^48 / 512 cells)",
+            c.grid.cells
+        ));
+    }
+    Ok(())
+}
+
+/// The conditions of an axisymmetric case: x is the radius, so the grid starts at r ≥ 0 (the
+/// material then lies at r > 0, and nodes on the axis get u_r = 0 from the model's own `axis`
+/// boundary, a name no case boundary may take); the verification references that assume plane
+/// strain are refused. `tol` [m] is the round-off allowed below r = 0.
+pub(super) fn axisymmetry(c: &Case, tol: f64) -> Checked {
+    if c.analysis.geometry != Geometry::Axisymmetric {
+        return Ok(());
+    }
+    if c.origin()[0] < -tol {
+        return Err(format!(
+            "key `grid.origin`: an axisymmetric analysis has x ≡ r ≥ 0, so the grid must start at x ≥ 0 (got {})",
+            c.origin()[0]
+        ));
+    }
+    if let Some(b) = c.boundaries.iter().find(|b| b.name == crate::model::AXIS) {
+        return Err(format!(
+            "key `boundaries`: the name `{}` is taken by the axis of an axisymmetric analysis (u_r = 0 at r = 0, \
+             added by the program); rename the boundary",
+            b.name
+        ));
+    }
+    match &c.verification {
+        None
+        | Some(Verification::Terzaghi(_))
+        | Some(Verification::ElasticColumn(_))
+        | Some(Verification::HollowCylinder(_)) => Ok(()),
+        Some(v) => Err(format!(
+            "key `verification`: the `{}` reference is a plane-strain solution and cannot check an axisymmetric \
+             analysis (the one-dimensional columns `terzaghi` and `elastic_column` and the `hollow_cylinder` can)",
+            v.kind()
+        )),
+    }
+}

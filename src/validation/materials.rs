@@ -1,0 +1,104 @@
+//! Materials: the porosity and the water's keys as the formulation needs them, each model's own
+//! ranges, whether a softening model has a unique return, and where the finite-strain models may
+//! be used.
+
+use crate::case::check::{at, in_closed_open, in_open, magnitude, modulus, positive_or_inf, Checked, MAX_CONDUCTIVITY};
+use crate::case::{AnalysisType, Case, Formulation, Geometry, Material, SoilModel};
+use crate::model::finite_strain;
+
+/// Every material, then where its model may be used.
+pub(super) fn check(c: &Case) -> Checked {
+    let two_phase = c.analysis.formulation == Formulation::TwoPhase;
+    for (i, m) in c.materials.iter().enumerate() {
+        material(&format!("materials[{i}]"), m, two_phase)?;
+    }
+    finite_strain_materials(c)
+}
+
+/// One material: its porosity's range (a one-phase material may have no pores: a fluid, a solid;
+/// its density is the mixture's), its own values and model, and the two-phase keys.
+fn material(key: &str, m: &Material, two_phase: bool) -> Checked {
+    let k = |f: &str| at(key, f);
+    if two_phase {
+        in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+    } else {
+        in_closed_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
+    }
+    m.check(key)?;
+    soil_model(&k("model"), &m.model)?;
+    if !two_phase {
+        return Ok(());
+    }
+    let required = |f: &str, v: Option<f64>, hint: &str| {
+        v.ok_or_else(|| format!("key `{}`: required in a two_phase analysis{hint}", k(f)))
+    };
+    modulus(&k("water_bulk_modulus"), required("water_bulk_modulus", m.water_bulk_modulus, "")?)?;
+    let why = "more permeable than open gravel";
+    let conductivity = required("hydraulic_conductivity", m.hydraulic_conductivity, "")?;
+    magnitude(&k("hydraulic_conductivity"), conductivity, MAX_CONDUCTIVITY, "m/s", why)?;
+    match required("solid_bulk_modulus", m.solid_bulk_modulus, " (inf for incompressible grains)")? {
+        ks if ks.is_infinite() => positive_or_inf(&k("solid_bulk_modulus"), ks),
+        ks => modulus(&k("solid_bulk_modulus"), ks),
+    }
+}
+
+/// Checks a soil model's parameters; `key` is the key of its table (e.g. `materials[0].model`):
+/// its own ranges, and for Hencky–J2 whether the softening keeps the return unique, which the
+/// model says.
+pub fn soil_model(key: &str, model: &SoilModel) -> Checked {
+    model.check(key)?;
+    let SoilModel::HenckyJ2(p) = model else {
+        return Ok(());
+    };
+    let residual = p.residual();
+    let m = finite_strain::HenckyJ2::new(p.young_modulus, p.poisson_ratio, p.cohesion, residual, p.softening_rate);
+    if !m.well_posed() {
+        return Err(format!(
+            "key `{}`: the softening outpaces the elastic unloading (3μ ≤ √3 η (c_p − c_r)), so the return is not \
+             unique; it must be below {:.4e}",
+            at(key, "softening_rate"),
+            3.0 * m.shear / (3f64.sqrt() * (p.cohesion - residual))
+        ));
+    }
+    Ok(())
+}
+
+/// Where a finite-strain material (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) may be used: in
+/// explicit stages only (the implicit stages need its consistent tangent, not built), in plane
+/// strain (its kinematics have F_zz = 1), and, for the hyperelastic neo-Hookean and the fluid,
+/// without an initial stress (their stress is a function of the deformation and rate alone; a
+/// Hencky–J2 point's initial stress is its initial elastic strain).
+fn finite_strain_materials(c: &Case) -> Checked {
+    for (i, m) in c.materials.iter().enumerate().filter(|(_, m)| m.model.is_finite_strain()) {
+        let name = m.model.kind();
+        if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
+            return Err(format!(
+                "key `materials[{i}].model`: `{name}` runs in dynamic_explicit stages only (its consistent \
+                 tangent for the implicit stages is not built), and stage `{}` is not one",
+                s.name
+            ));
+        }
+        if c.analysis.geometry == Geometry::Axisymmetric {
+            return Err(format!(
+                "key `materials[{i}].model`: `{name}` is written for plane strain (F_zz = 1) and the analysis is \
+                 axisymmetric"
+            ));
+        }
+        if matches!(m.model, SoilModel::HenckyJ2(_)) {
+            continue;
+        }
+        let stressed = c.body_ids().find(|&b| {
+            let body = c.body(b);
+            c.material_id_of(b).index() == i && (body.initial_stress.is_some() || body.uniform_stress.is_some())
+        });
+        if let Some(b) = stressed {
+            return Err(format!(
+                "key `bodies.{}`: a {name} body takes no initial stress (its stress is a function of its \
+                 deformation{}; reach a stressed state with a settling stage)",
+                c.body(b).name,
+                if matches!(m.model, SoilModel::NewtonianFluid(_)) { " and its rate" } else { "" }
+            ));
+        }
+    }
+    Ok(())
+}
