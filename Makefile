@@ -26,27 +26,30 @@ study: build
 	cargo test --release --locked --test studies --test gold --test extreme -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13 --skip footing_fbar_item_14 --skip dam_break_item_15 --skip footing_square_3d_finest --skip landslide_item_16
 	python3 scripts/terzaghi_family.py
 
-# Cook's membrane ([002] §4.1, Part E item 13; eight runs on two ranks, about 7 hours; COOK_H=1
-# for the 1 m grid only, about 30 minutes).
+# [002] §4.1 Cook's membrane: the tip's displacement and the stress chequerboard of F̄ and standard
+# MPM with uGIMP and B-splines (eight runs on two ranks, about 7 hours; COOK_H=1 for the 1 m grid
+# only, about 30 minutes).
 study-cook: build
 	cargo test --release --locked --test studies cook_membrane_item_13 -- --ignored --nocapture
 
-# [002]'s strip footing (Part E item 14; nine runs on two ranks, about 80 minutes).
+# [002] §4.2 strip footing on Hencky–J2 clay: the bearing capacity of F̄ and standard MPM against
+# Prandtl's 2 + π (nine runs on two ranks, about 80 minutes).
 study-footing: build
 	cargo test --release --locked --test studies footing_fbar_item_14 -- --ignored --nocapture
 
-# [002]'s dam break at the water's stiffness (Part E item 15; four runs on two ranks, about 7
-# minutes; it reports the unmet assertions and fails).
+# [002] §4.3 dam break at the water's stiffness: hydrostatic pressure, front and pressure chequerboard
+# of F̄ and standard MPM (four runs on two ranks, about 7 minutes; it reports the unmet assertions
+# and fails).
 study-dam: build
 	cargo test --release --locked --test studies dam_break_item_15 -- --ignored --nocapture
 
 # The square footing at the finest mesh that runs here (k = 10, ≈ 10⁵ unknowns, GAMG on two ranks,
-# about 25 minutes) against the issue's 5 %, and one against two ranks at k = 3.
+# about 25 minutes) within 5 % of N_c = 5.91, and one against two ranks at k = 3.
 study-footing-3d: build
 	cargo test --release --locked --test studies footing_square_3d_finest -- --ignored --nocapture
 
-# [002]'s landslide, reconstructed (Part E item 16; four runs on two ranks, about an hour): the
-# run-outs of F̄ and standard MPM with uGIMP and B-splines against item 16's assertions.
+# [002] §4.4 landslide, reconstructed (four runs on two ranks, about an hour): the run-outs of F̄ and
+# standard MPM with uGIMP and B-splines, compared by their ratios (the geometry is not the paper's).
 study-landslide: build
 	cargo test --release --locked --test studies landslide_item_16 -- --ignored --nocapture
 

@@ -13,7 +13,7 @@
 //!   3 × 3 × 3-node GIMP stencils with B̄; u–p–U with seven dofs per node), per particle as above,
 //!   the cost per point the estimate of a large three-dimensional run starts from.
 //! * `assembly/residual_and_jacobian`: the residual and Jacobian of one Newton iteration assembled into
-//!   PETSc (`GridSystem::assemble_once`) on the slumping block at its first step.
+//!   PETSc (`System::assemble_once`) on the slumping block at its first step.
 //!
 //! PETSc is initialised once for the whole run in `main`.
 

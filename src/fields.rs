@@ -112,7 +112,7 @@ pub fn particle_fields<const D: usize>(model: &Model<D>, coll: &Collective) -> (
 }
 
 /// This rank's share of the fields at time `t` (collective). `nodes` is this rank's
-/// [`crate::assembly::GridSystem::owned_node_block`].
+/// [`crate::assembly::System::node_block`].
 pub fn frame<const D: usize>(model: &Model<D>, nodes: &NodeBlock, coll: &Collective, t: f64) -> Frame {
     let (pf, particles, first_particle) = particle_fields(model, coll);
     let d: Vec<&[f64]> = nodes.values.chunks_exact(node_values(D)).collect();

@@ -98,7 +98,7 @@ pub fn update_particle<const D: usize>(
         Integration::Explicit { flip, .. } => {
             // [002] Eqs. 11–13: FLIP v_p + Σ S (v_i^{n+1} − v_i^n) blended with PIC Σ S v_i^{n+1};
             // Σ S v_i^{n+1} = Δu_p/Δt, and Σ S v_i^n is the interpolated nodal velocity of the
-            // grid update's start (`interp.v_u`, set by `GridSystem::step_result` from the
+            // grid update's start (`interp.v_u`, set by `Points::result` from the
             // lumped velocities, `assembly::explicit`); the water's likewise
             // (Δw_p/Δt and `interp.v_w`). XPIC sets the solid's velocity itself
             // (`StepResult::velocity`; one-phase only).

@@ -1,6 +1,6 @@
 //! The global system in three dimensions (issue «Three dimensions»), without the driver: steps of
 //! a three-dimensional model prepared, solved by PETSc and taken back to its points through
-//! `porompm::assembly::SolidSystem`, the same code as the plane `GridSystem`.
+//! `porompm::assembly::SolidSystem`, the same code as the plane `System`.
 //!
 //! * `a_slab_steps_as_its_plane_twin`: a slab one cell thick held between two smooth walls
 //!   (u_z = 0 on both z faces) is a plane-strain body: a consolidating, yielding soil (the u–p
@@ -323,7 +323,7 @@ fn a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin(coll: &Collective)
 
 /// The slab with the pressure projection (`stabilisation.pressure_projection = 2`, B̄ off, three
 /// steps) steps as its plane section with it: a cell's block S over its eight trilinear functions
-/// (`GridSystem::projection_cells`) sees in the slab's pressure, constant along z, what the four
+/// (`pressure::projection_cells`) sees in the slab's pressure, constant along z, what the four
 /// bilinear ones see in the section's. The projection moves the section's pore pressures (by more
 /// than 1e-3 of their largest), so the comparison sees it.
 fn a_slab_with_the_pressure_projection_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {
@@ -363,7 +363,7 @@ fn with_moving_surfaces() -> String {
 /// section drained and pressed through the same surfaces (B̄ off, three steps): the surfaces'
 /// fixed nodes (`Model::surface_fixes`: the faces' normals turned with the material, the nodes on
 /// the face's side, the region's extent along x and, in the slab, along z) and Nitsche's drained
-/// faces (`GridSystem::drained_faces`: the trilinear functions at the face points, the faces'
+/// faces (`pressure::drained_faces`: the trilinear functions at the face points, the faces'
 /// areas) in three dimensions; and so does the slab lying in the (x, z) plane, whose surfaces are
 /// its z_max faces (normals along z, the strip's region with a z range).
 fn a_slab_with_moving_surfaces_steps_as_its_plane_twin(coll: &Collective) -> Result<(), String> {

@@ -113,39 +113,47 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
                 fd[r * n + c] = (a[r] - b[r]) / (2.0 * h);
             }
         }
-        // D: |diagonal|, or the row's largest entry where the diagonal is zero.
-        let d: Vec<f64> = (0..n)
-            .map(|r| {
-                let diag = dense[r * n + r].abs();
-                if diag > 0.0 {
-                    diag
-                } else {
-                    free.iter().fold(0.0f64, |m, &c| m.max(dense[r * n + c].abs())).max(f64::MIN_POSITIVE)
-                }
-            })
-            .collect();
-        let mut out = Vec::new();
-        for rf in 0..nd {
-            for cf in 0..nd {
-                let (mut err, mut big, mut big_fd) = (0.0f64, 0.0f64, 0.0f64);
-                for &r in free.iter().filter(|&&r| r % nd == rf) {
-                    for &c in free.iter().filter(|&&c| c % nd == cf) {
-                        let s = 1.0 / (d[r] * d[c]).sqrt();
-                        err = err.max((dense[r * n + c] - fd[r * n + c]).abs() * s);
-                        big = big.max(dense[r * n + c].abs() * s);
-                        big_fd = big_fd.max(fd[r * n + c].abs() * s);
-                    }
-                }
-                let scale = big.max(big_fd).max(WEAK_BLOCK);
-                out.push(BlockCheck {
-                    row: names[rf],
-                    col: names[cf],
-                    max_abs_error: err,
-                    max_abs_entry: big,
-                    relative_error: err / scale,
-                });
-            }
-        }
-        Ok(out)
+        Ok(compare_blocks(&dense, &fd, &free, nd, names))
     }
+}
+
+/// Compares the tangent `dense` with its finite differences `fd` (both n × n, row-major), both
+/// scaled by D^{-1/2} on either side, over the `free` dofs, block by block for each (row field,
+/// column field) pair of the `nd` fields named `names`.
+fn compare_blocks(dense: &[f64], fd: &[f64], free: &[usize], nd: usize, names: &[&'static str]) -> Vec<BlockCheck> {
+    let n = fd.len().isqrt();
+    // D: |diagonal|, or the row's largest entry where the diagonal is zero.
+    let d: Vec<f64> = (0..n)
+        .map(|r| {
+            let diag = dense[r * n + r].abs();
+            if diag > 0.0 {
+                diag
+            } else {
+                free.iter().fold(0.0f64, |m, &c| m.max(dense[r * n + c].abs())).max(f64::MIN_POSITIVE)
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    for rf in 0..nd {
+        for cf in 0..nd {
+            let (mut err, mut big, mut big_fd) = (0.0f64, 0.0f64, 0.0f64);
+            for &r in free.iter().filter(|&&r| r % nd == rf) {
+                for &c in free.iter().filter(|&&c| c % nd == cf) {
+                    let s = 1.0 / (d[r] * d[c]).sqrt();
+                    err = err.max((dense[r * n + c] - fd[r * n + c]).abs() * s);
+                    big = big.max(dense[r * n + c].abs() * s);
+                    big_fd = big_fd.max(fd[r * n + c].abs() * s);
+                }
+            }
+            let scale = big.max(big_fd).max(WEAK_BLOCK);
+            out.push(BlockCheck {
+                row: names[rf],
+                col: names[cf],
+                max_abs_error: err,
+                max_abs_entry: big,
+                relative_error: err / scale,
+            });
+        }
+    }
+    out
 }

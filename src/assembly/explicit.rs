@@ -1,4 +1,4 @@
-//! The explicit step ([002] §2.2, Eqs. 7–17; `../shared/seeds-001-002.md` Part C1):
+//! The explicit step ([002] §2.2, Eqs. 7–17):
 //! update-stress-last with symplectic Euler on the lumped mass, over the same stencils, dof map,
 //! loads and kernels as the implicit steps. It is the `solve` of a `dynamic_explicit` stage:
 //!
@@ -9,7 +9,7 @@
 //! 2. forces (Eq. 10): f_i = −r_i with r the residual at the step's start, f_int(σ_n) on x_n
 //!    minus the body force and the loads of the step (those of t_{n+1}); its terms are prepared
 //!    with the step (`StartTerms`, by the same pass as the implicit step's balance,
-//!    `Assembler::nodal_terms` at Δd = 0), and serve the step's equilibrium identity too;
+//!    `Points::nodal_terms` at Δd = 0), and serve the step's equilibrium identity too;
 //! 3. local damping (Al-Kafaji 2013): f_i ← f_i − α |f_i| sign(v_i^n) per component;
 //! 4. grid update (Eq. 9): v_i^{n+1} = v_i^n + Δt f_i/m_i at free dofs; a fixed dof moves by its
 //!    prescribed increment (zero, or a boundary's motion);
@@ -18,7 +18,7 @@
 //!    14–17) and the FLIP/PIC velocity update of `Model::update_particle` ([002] Eqs. 11–13)
 //!    follow. The FLIP increment Σ S_ip (v_i^{n+1} − v_i^n) takes the v_i^n of this update (the
 //!    lumped momentum over the lumped mass, zero where a boundary holds the component still,
-//!    `StepData::start_velocity`), not the predictors' nodal velocities of the raw projection:
+//!    `Solution::start_velocity`), not the predictors' nodal velocities of the raw projection:
 //!    the two differ at the nodes to which barely filled nodes hand their shares, and a FLIP
 //!    increment formed with the raw ones added that difference to the points' velocities at every
 //!    step, an instability that grew faster the smaller the step (the landslide's inclined face

@@ -19,13 +19,13 @@
 //! c s² Σ (1 − n)² N V / K_dr: selfp with the exact inverse of A_uu over the aggregates of the
 //! free-surface strip ([`super::aggregates`]) in place of its diagonal there, plus a share c of the
 //! solid's fixed-stress term that grows with the step's Courant number (see
-//! `GridSystem::fixed_stress_diagonal`). `-porompm_schur_strip_depth` (live pressure layers, 3;
+//! `pressure::fixed_stress_diagonal`). `-porompm_schur_strip_depth` (live pressure layers, 3;
 //! 0 leaves selfp's diagonal everywhere), `-porompm_schur_strip_width` (nodes along the surface, 2)
 //! and `-porompm_schur_fixed_stress_share` (c, in place of the rule) tune it.
 //!
 //! A Schur-complement split of the u–p system whose options ask for a user-built Schur
 //! preconditioner (`-pc_fieldsplit_schur_precondition user`) gets porompm's fixed-stress
-//! approximation, Sp = A_pp − s² M_L / K_dr (see `GridSystem::fixed_stress_diagonal`): the
+//! approximation, Sp = A_pp − s² M_L / K_dr (see `pressure::fixed_stress_diagonal`): the
 //! pressure block of the tangent plus the lumped pressure mass over the skeleton's drained bulk
 //! modulus, the volume change a pressure increment causes when the mean total stress is held
 //! fixed. PETSc's `selfp` (A_pp − A_pu diag(A_uu)⁻¹ A_up) approximates that volume change through

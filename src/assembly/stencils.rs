@@ -81,7 +81,7 @@ pub struct Stencils<const D: usize = 2> {
 /// The stencil drops it, so the particle's basis there is lost; the node is the rigid wall's
 /// material, held in every direction (a dropped node has no unknowns), and its share of the
 /// particle's forces is the wall's reaction. The equilibrium identity counts it
-/// (`GridSystem::step_forces`): without it the first moment of the nodal forces misses
+/// (`System::forces`): without it the first moment of the nodal forces misses
 /// Σ_p V_p σ_p ⊗ Σ_beyond x ∇S, which grows with the stretch of the domains at a fixed base.
 #[derive(Debug, Clone, Copy)]
 pub struct WallSlot<const D: usize = 2> {
@@ -542,8 +542,8 @@ pub fn extension_in<const D: usize>(
     None
 }
 
-/// [001]'s CMPM strain recovery (`stabilisation.stress_recovery = "cmpm"`, [001] Eqs. 21–24,
-/// `../shared/seeds-001-002.md` Part A7; step 4 of a step, before the extensions): for each point,
+/// [001]'s CMPM strain recovery (`stabilisation.stress_recovery = "cmpm"`, [001] Eqs. 21–24;
+/// step 4 of a step, before the extensions): for each point,
 /// the patch of its centre's cell in each direction is cubic when the node columns (rows) on both
 /// sides of the cell are well filled, quadratic when one side is, linear otherwise (a neighbour
 /// that is outside the grid or barely filled would pull the strain towards its extended or absent

@@ -1,5 +1,5 @@
 //! The skeleton's material stiffness in the Newton matrix, as `stabilisation.stiffness` asks
-//! ([001] §5; `../shared/seeds-001-002.md` Parts A4–A6, A8): each material point's share of the
+//! ([001] §5, docs/stiffness.md): each material point's share of the
 //! cells it maps to, prepared once per step on x_n.
 //!
 //! * `particle`: the exact tangent (share: none, material factor 1).

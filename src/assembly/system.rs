@@ -126,7 +126,7 @@ pub struct System<
     /// Steps that reused the previous matrix structure (and hence its symbolic factorisation).
     pub reused_patterns: usize,
     /// The owned part of the last accepted step's Δd and its Δt, the predictor of the next step
-    /// when the analysis extrapolates (see [`kernels::Integration::extrapolates`]).
+    /// when the analysis extrapolates (see [`crate::scheme::Integration::extrapolates`]).
     last_increment: Option<(Vec<f64>, f64)>,
     stages: Stages,
 }

@@ -188,7 +188,11 @@ where
         let mut notes = Vec::new();
         for r in self.recorders.iter_mut() {
             let state = cp.recorders.iter().find(|(name, _)| name == r.name()).map(|(_, s)| &s[..]);
-            notes.extend(r.restore(state, &at, self.journal.summary)?);
+            notes.extend(r.restore(crate::recorders::FromCheckpoint {
+                state,
+                at: &at,
+                summary: self.journal.summary,
+            })?);
         }
         Ok((!notes.is_empty()).then(|| notes.join("; ")))
     }

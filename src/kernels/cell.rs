@@ -1,16 +1,17 @@
-//! Cell kernels of the double-mapping stiffness of [001] §5.3–5.4 (`../shared/seeds-001-002.md`
-//! Parts A5, A6): the particles' moduli mapped to the cell's nodes (D_i^e, [001] Eqs. 16 and 20),
-//! from there to the cell's 2 × 2 Gauss points (D_g, Eq. 17), and the cell's stiffness integrated at
-//! those points as in the finite element method (K_e, Eqs. 19 and 20). Pure functions on one cell of
+//! Cell kernels of the double-mapping stiffness of [001] §5.3–5.4 (docs/stiffness.md): the
+//! particles' moduli mapped to the cell's nodes (D_i^e, [001] Eqs. 16 and 20), from there to the
+//! cell's 2 × 2 Gauss points (D_g, Eq. 17), and the cell's stiffness integrated at those points as
+//! in the finite element method (K_e, Eqs. 19 and 20). Pure functions on one cell of
 //! size h_x × h_y, nodes in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1); moduli as
 //! 4 × 4 matrices on porompm's strain vector (ε_xx, ε_yy, γ_xy, ε_zz), ε_zz the hoop strain in axial
 //! symmetry (zero in plane strain). With B̄ the Gauss points' B takes its volumetric part from the
-//! cell centre (selective integration, `../shared/seeds-001-002.md` Part A8); in axial symmetry each
+//! cell centre (selective integration, Hughes 1980); in axial symmetry each
 //! Gauss point is weighted by 2πr_g and the hoop row of B is N_i(x_g)/r_g.
 //!
 //! The assembly uses them one material point at a time (`stabilisation.stiffness`): the mapped
 //! stiffness is linear in the nodal moduli, so a cell's K_e is the sum of its points' shares.
-//! `tests` below hold the checks of Part E items 3 and 4.
+//! `tests` below check K_mag on [001] §6's block of particles, whole and unrotated, and turned
+//! by 20°.
 
 use super::bbar;
 
@@ -128,11 +129,12 @@ pub fn mapped_stiffness(cell: &CellGeometry, d_nodes: &[Moduli; 4]) -> [[f64; 8]
 }
 
 /// The double-mapped internal force's operators of one material point on one cell
-/// (`stabilisation.internal_force = "mapped"`, `../shared/seeds-001-002.md` Part A8 step 2): the
-/// point's stress goes to the cell's nodes with its `weights` w_i W_p (σ_i^e = Σ_p w_ip W_p σ_p, as
-/// [001] Eqs. 16 and 20 map D_p), to the Gauss points (σ_g = Σ_i N_i(x_g) σ_i^e, Eq. 17) and the
-/// force is integrated there, F_k = Σ_g B_k(x_g)ᵀ σ_g |J| m(r_g). Linear in σ_p, so with the
-/// point's share ω_g = Σ_i N_i(x_g) w_i W_p |J| m(r_g) of Gauss point g it is F_k = Ĝ_kᵀ σ_p with,
+/// (`stabilisation.internal_force = "mapped"`, the double-mapped reading of [001]'s internal force
+/// that docs/stiffness.md describes): the point's stress goes to the cell's nodes with its
+/// `weights` w_i W_p (σ_i^e = Σ_p w_ip W_p σ_p, as [001] Eqs. 16 and 20 map D_p), to the Gauss
+/// points (σ_g = Σ_i N_i(x_g) σ_i^e, Eq. 17) and the force is integrated there,
+/// F_k = Σ_g B_k(x_g)ᵀ σ_g |J| m(r_g). Linear in σ_p, so with the point's share
+/// ω_g = Σ_i N_i(x_g) w_i W_p |J| m(r_g) of Gauss point g it is F_k = Ĝ_kᵀ σ_p with,
 /// for each node k of the cell, `g` = Σ_g ω_g ∇N_k(x_g), `gv` its volumetric part (from the cell
 /// centre with B̄), `t` = Σ_g ω_g N_k(x_g)/r_g and `tv` (0.25/r_c with B̄) the hoop operators (zero
 /// in plane strain), and `s` = Σ_g ω_g N_k(x_g): integrated operators, a volume times those of
@@ -193,7 +195,7 @@ mod tests {
         DmG,
     }
 
-    /// The lattice of [001] §6 (`seeds-001-002.md` B2): cells of h = 1, four particles per cell at
+    /// The lattice of [001] §6: cells of h = 1, four particles per cell at
     /// the quarter points, rotated by `theta` about the node C = (20, 20), kept within 14 h of C;
     /// returns the particles' positions.
     fn lattice(theta: f64) -> Vec<[f64; 2]> {
@@ -407,7 +409,7 @@ mod tests {
         }
     }
 
-    /// Part E item 3: on the full, unrotated block, DM, GM and DM-G give the finite-element K_mag
+    /// The full, unrotated block: DM, GM and DM-G give the finite-element K_mag
     /// at every interior node (1e-10 relative after rounding the reference to its 6 digits); regular
     /// MPM and GIMP with 2 × 2 quarter-point particles give 3059.60 (−6.25 %).
     #[test]
@@ -426,9 +428,9 @@ mod tests {
         }
     }
 
-    /// Part E item 4: the block rotated by 20°: DM-G within 1 % of the finite-element K_mag at every
+    /// The block rotated by 20°: DM-G within 1 % of the finite-element K_mag at every
     /// node, GIMP below it at every node, and the rms deviations ordered DM-G < DM < GM < MPM < W*
-    /// (measured: 0.17 %, 2.4 %, 4.0 %, 4.7 %, 7.2 %; `seeds-001-002.md` B2).
+    /// (measured: 0.17 %, 2.4 %, 4.0 %, 4.7 %, 7.2 %; docs/stiffness.md).
     #[test]
     fn on_a_rotated_block_dm_g_stays_within_one_percent_and_the_methods_keep_their_order() {
         let theta = 20f64.to_radians();

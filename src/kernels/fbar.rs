@@ -79,8 +79,8 @@ mod tests {
     /// scattered over a grid (GIMP and B-splines, J_p^n ≠ 1, J̄_p^n ≠ J_p^n), solving R_i = 0 for ϑ
     /// (one Newton step: the rows are linear in ϑ with a diagonal block) gives each point the
     /// J̄_p^{n+1} = 1 + Σ_i S_ip ϑ_i of `model::fbar::{scatter, gather}` applied to its own
-    /// J_p^n ΔJ_p, and Σ_p V_p J̄_p^{n+1} = Σ_p V_p J_p^n ΔJ_p (`../shared/seeds-001-002.md` Part E
-    /// item 6, the conservation identity, here of the implicit form).
+    /// J_p^n ΔJ_p, and Σ_p V_p J̄_p^{n+1} = Σ_p V_p J_p^n ΔJ_p (the projection's conservation
+    /// identity, here of the implicit form).
     #[test]
     fn the_converged_rows_are_algorithm_1_and_conserve_the_volume() {
         let grid = Grid::new([0.0, 0.0], [0.5, 0.4], [6, 5]);

@@ -32,7 +32,7 @@
 //! material part alone. J, J_v and F̄ are still those of the motion: the particle's volume, domain
 //! and position follow it between steps.
 //!
-//! **Axial symmetry** (x ≡ r, `../shared/seeds-001-002.md` Part A2): F is block diagonal with the
+//! **Axial symmetry** (x ≡ r, docs/axisymmetry.md): F is block diagonal with the
 //! hoop stretch F_θθ = 1 + H_θθ, H_θθ = Σ T_i Δu_r,i (T_i the node's hoop operator, S_i/r_p for the
 //! planar weights: F_θθ = r_{n+1}/r_n), and F_v,θθ likewise with B̄'s T̄_i. Then J = det F_rz F_θθ,
 //! J_v = det F_v,rz F_v,θθ, the mid-step hoop rate L_θθ = H_θθ/(1 + H_θθ/2) is the fourth strain

@@ -207,7 +207,7 @@ impl<const D: usize> Predictors<D> {
 /// the strain rows [xx, yy, γxy, zz, γyz, γzx] × D displacement components ([000] Eq. 16):
 /// B̄ = B − ⅓ m mᵀB + ⅓ m mᵀB̄_v with m = [1, 1, 0, 1, 0, 0]. In two dimensions the rows are
 /// [rr, yy, ry, θθ] (the last two zero), the hoop row of B being [T, 0]
-/// (`../shared/seeds-001-002.md` Part A2); in three the zz row of B is [0, 0, ∂_z S] and the shear
+/// (docs/axisymmetry.md); in three the zz row of B is [0, 0, ∂_z S] and the shear
 /// rows [0, ∂_z S, ∂_y S] and [∂_z S, 0, ∂_x S].
 #[inline]
 pub fn bbar<const D: usize>(g: [f64; D], gv: [f64; D], hoop: (f64, f64)) -> [[f64; D]; soil::NS] {
@@ -437,8 +437,8 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// increment the soil model takes and the rotation of the stress are the recovered ones; the
     /// motion keeps the basis: the step's F, its volume ratio, the gradients on x_{n+1}, the
     /// deformation and volume the particle keeps, and the forces f_i = B̄'_iᵀσ V. This is [001]'s
-    /// reading (`../shared/seeds-001-002.md` Part A8: the strain is recovered for the stress only;
-    /// positions, F and volume as without it). [001]'s CMPM recovery
+    /// reading (docs/stiffness.md: the strain is recovered for the stress only; positions, F and
+    /// volume as without it). [001]'s CMPM recovery
     /// (`stabilisation.stress_recovery = "cmpm"`) passes its patch functions; `strain = basis` is
     /// the usual point.
     #[inline]

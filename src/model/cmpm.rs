@@ -1,13 +1,14 @@
 //! The composite-MPM (CMPM) patch functions of [001] §5.5 for stress recovery: the strain at a
 //! particle from a higher-order Lagrange interpolation over the particle's cell and its neighbours
-//! ([001] Eqs. 21–24; `../shared/seeds-001-002.md` Part A7). In each direction the patch is cubic
+//! ([001] Eqs. 21–24). In each direction the patch is cubic
 //! (a neighbour cell on both sides: nodes at ξ = −3, −1, 1, 3 in the local coordinate of the
 //! particle's cell, [001] Eq. 22), quadratic (one neighbour: nodes −1, 1, 3 or −3, −1, 1, the
 //! corrected [001] Eq. 23) or linear (none). The functions are negative in places: they recover
 //! strains, they never map mass or momentum.
 //!
 //! `assembly::stencils::cmpm_patches` builds each point's patch from them
-//! (`stabilisation.stress_recovery = "cmpm"`); the tests below are Part E item 1.
+//! (`stabilisation.stress_recovery = "cmpm"`); the tests below check that the functions are a
+//! partition of unity and reproduce polynomials of their degree.
 
 /// Which 1D patch a direction uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,9 +83,9 @@ mod tests {
         (0..=10).map(|k| -1.0 + 0.2 * k as f64)
     }
 
-    /// Part E item 1: at 11 points of [−1, 1] the functions of every patch sum to 1 and their
-    /// derivatives to 0 (1e-14), each is the Lagrange polynomial of its node, and they reproduce
-    /// ξ³ (cubic), ξ² (quadratic) and ξ (linear) with their derivatives exactly.
+    /// The partition of unity: at 11 points of [−1, 1] the functions of every patch sum to 1 and
+    /// their derivatives to 0 (1e-14), each is the Lagrange polynomial of its node, and they
+    /// reproduce ξ³ (cubic), ξ² (quadratic) and ξ (linear) with their derivatives exactly.
     #[test]
     fn patch_functions_are_a_partition_of_unity_and_reproduce_their_degree() {
         for patch in PATCHES {

@@ -1,7 +1,7 @@
-//! F̄ by volume-averaged projection ([002] §3, Eqs. 18–27, Algorithm 1;
-//! `../shared/seeds-001-002.md` Part C2): the volumetric part of each point's deformation is
-//! replaced by a volume-weighted average over the supports of the basis functions it shares with
-//! its neighbours, which relieves volumetric locking for any non-negative basis (GIMP, B-splines).
+//! F̄ by volume-averaged projection ([002] §3, Eqs. 18–27, Algorithm 1): the volumetric part of
+//! each point's deformation is replaced by a volume-weighted average over the supports of the basis
+//! functions it shares with its neighbours, which relieves volumetric locking for any non-negative
+//! basis (GIMP, B-splines).
 //!
 //! Per step, with ΔF_p the point's increment of the deformation gradient, ΔJ_p = det ΔF_p and
 //! J̄_p^n = det F̄_p^n (Algorithm 1):
@@ -130,7 +130,7 @@ pub(crate) mod tests {
     #[test]
     fn the_projection_conserves_the_volume_weighted_sum() {
         // Σ_p V_p^n J̄_p^{n+1} = Σ_p V_p^n J̄_p^n ΔJ_p (partition of unity, the same weights both
-        // ways; seeds-001-002.md Part E item 6).
+        // ways: the projection's conservation identity).
         let mut rng = Lcg(7);
         for basis in BASES {
             let (_, c) = cloud(basis, &mut rng);

@@ -1,12 +1,12 @@
-//! Finite-strain materials of [002] (`../shared/seeds-001-002.md` Part C4; the paper omits their
-//! forms, so these are the standard ones it names): compressible neo-Hookean, Hencky elasticity
+//! Finite-strain materials of [002]'s examples (§4.1–4.4; the paper names them but omits their
+//! forms, so these are the standard ones): compressible neo-Hookean, Hencky elasticity
 //! with J2 plasticity and exponential softening, and a Newtonian fluid. The deformation gradient is
 //! 3 × 3 ([`M3`]; a plane-strain point's is [`plane`], F_zz = 1); stresses are the 6-vectors
 //! [xx, yy, xy, zz, yz, zx] of [`super::soil`] (Cauchy, tension positive).
 //!
 //! They are total (hyperelastic) or multiplicative forms driven by the deformation gradient (with
-//! [002]'s F̄, by F̄; [`super::fbar`]); they are used by the explicit integrator (issue «Seed
-//! [002]»), which needs no tangent. Each is objective by construction: the neo-Hookean and Hencky
+//! [002]'s F̄, by F̄; [`super::fbar`]); they are used by the explicit integrator, which needs
+//! no tangent. Each is objective by construction: the neo-Hookean and Hencky
 //! stresses are isotropic functions of b = F Fᵀ (or b^e), so a rotation R of the deformation turns
 //! the stress into R σ Rᵀ.
 
@@ -243,10 +243,11 @@ impl HenckyJ2 {
     }
 }
 
-/// A weakly compressible Newtonian fluid (the dam break, [002] §4.3): σ = −p 1 + 2μ_v dev d + ζ tr d 1
-/// with the pressure of the equation of state p = K max(1 − J, 0) (water takes no tension: a
-/// stretched point is separating, not pulling) and the rate of deformation d = sym L
-/// (seeds-001-002.md Part C4; for the |J − 1| ~ 1e-5 of water any equation of state is the same).
+/// A weakly compressible Newtonian fluid (the dam break, [002] §4.3):
+/// σ = −p 1 + 2μ_v dev d + ζ tr d 1 with the pressure of the equation of state
+/// p = K max(1 − J, 0) (water takes no tension: a stretched point is separating, not pulling) and
+/// the rate of deformation d = sym L ([002] does not state its equation of state; for the
+/// |J − 1| ~ 1e-5 of water any one is the same).
 /// The bulk viscosity ζ is the explicit codes' damping of volumetric ringing (Abaqus/Explicit's
 /// linear bulk viscosity ζ = b₁ ρ c h, b₁ = 0.06 by default; Stokes' hypothesis gives water none).
 /// With F̄, the pressure sees J̄ and the bulk viscosity the rate of J̄.

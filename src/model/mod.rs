@@ -22,8 +22,8 @@ use shape::Basis;
 
 /// Everything that describes the continuum and its discretisation on this rank, in `D` dimensions
 /// (two unless it says otherwise). A three-dimensional model has face and nodal tractions and body
-/// forces, side, region and moving-surface boundaries; the line pressures are plane (issue «Three
-/// dimensions», docs/dimensions.md).
+/// forces, side, region and moving-surface boundaries; the line pressures are plane
+/// (docs/dimensions.md).
 #[derive(Debug, Clone)]
 pub struct Model<const D: usize = 2> {
     /// Whether the points carry pore water (the two-phase formulation; its stages solve u–p–U,

@@ -1,5 +1,5 @@
 //! Basis functions of the material point method: uGIMP ([003] Eqs. 13–15), standard linear MPM, and
-//! quadratic and cubic B-splines ([002] §2.2.1; `../shared/seeds-001-002.md` Part C3).
+//! quadratic and cubic B-splines ([002] §2.2.1).
 //!
 //! In 1D the GIMP function of node i for a particle at x_p with half-width l_p is the average of the
 //! linear hat N_i over the particle domain [x_p − l_p, x_p + l_p]:
@@ -32,7 +32,7 @@ impl Basis {
 }
 
 /// The uniform B-spline of degree 2 or 3 centred on a node, N(ξ) and dN/dξ at ξ = (x − x_i)/h
-/// ([002] §2.2.1; seeds-001-002.md Part C3):
+/// ([002] §2.2.1):
 ///   quadratic: 3/4 − ξ² for |ξ| < 1/2, ½(3/2 − |ξ|)² for 1/2 ≤ |ξ| < 3/2;
 ///   cubic: ½|ξ|³ − ξ² + 2/3 for |ξ| < 1, (2 − |ξ|)³/6 for 1 ≤ |ξ| < 2; 0 beyond.
 #[inline]
@@ -379,7 +379,7 @@ impl Geometry {
 }
 
 /// How an axisymmetric analysis (x ≡ r ≥ 0, y the axis) weights a GIMP particle in r
-/// (`../shared/seeds-001-002.md` Part A2).
+/// (`analysis.axisymmetric_weights`, docs/axisymmetry.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AxisymmetricWeights {
     /// Option A: the planar GIMP functions S_i, ∇S_i, and the hoop operator T_i = S_i / r_p.
@@ -458,11 +458,11 @@ pub type LocalGimp = [((u32, u32), [f64; 4]); 4];
 /// The local GIMP weights of [001] §5.4 (double mapping with local GIMP functions, DM-G): for
 /// each cell e the particle's domain overlaps, S*^e_ip = (1/V_p) ∫_{Ω_p ∩ Ω_e} N^e_i dx for the
 /// cell's four nodes, in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1) of the cell's
-/// lower-left node (i, j). Separable closed form (`../shared/seeds-001-002.md` Part A6): per
+/// lower-left node (i, j). Separable closed form of the integral: per
 /// direction the overlap [s, t] of the domain with the cell [a, a + h] gives the right node
 /// I_R = ((t − a)² − (s − a)²)/2h and the left node I_L = (t − s) − I_R, over 2l. Summed over the
 /// cells, the weights of a node are its planar GIMP weight. At most 2 × 2 cells (l ≤ h/2); cells
-/// outside the grid are dropped. Not yet used by the kernels (issue «Seed [001]»).
+/// outside the grid are dropped. `assembly::stiffness` maps DM-G's stiffness with them.
 pub fn local_gimp(grid: &Grid, x: [f64; 2], lp: [f64; 2]) -> (LocalGimp, usize) {
     let mut per_dir = [[(0u32, 0.0, 0.0); 2]; 2];
     let mut count = [0usize; 2];

@@ -2,12 +2,11 @@
 //! metrics against the analytical reference in `summary.json`, its tables and figures, the event
 //! times the stepping lands on and its reason to stop a run.
 
-use super::{Converged, Moment, Recorder, Sink};
+use super::{Converged, FromCheckpoint, Moment, Recorder, Restored, Sink};
 use crate::case::Case;
 use crate::layout::Dim;
 use crate::model::Model;
 use crate::parallel::Collective;
-use crate::summary::Summary;
 use crate::verification::{self, CaseChecks, Check};
 
 /// The check the case asks for.
@@ -65,12 +64,7 @@ impl<const D: usize> Recorder<D> for Verification<D> {
         self.check.checkpoint_state(at.model, at.coll)
     }
 
-    fn restore(
-        &mut self,
-        state: Option<&[f64]>,
-        at: &Moment<D>,
-        _summary: &mut Summary,
-    ) -> Result<Option<String>, String> {
+    fn restore(&mut self, FromCheckpoint { state, at, .. }: FromCheckpoint<D>) -> Restored {
         match state {
             Some(s) => {
                 self.check.restore_state(s, at.model).map_err(|e| format!("verification state: {e}"))?;

@@ -2,11 +2,10 @@
 //! checkerboard and pressure oscillation indices and the pore-pressure range, in runs with dynamic
 //! stages the energy balance; the warnings they raise and their worst values in `summary.json`.
 
-use super::{Moment, Recorder, Sink};
+use super::{FromCheckpoint, Moment, Recorder, Restored, Sink};
 use crate::case::{AnalysisType, Case};
 use crate::diagnostics::Monitor;
 use crate::model::Model;
-use crate::summary::Summary;
 
 /// The run's diagnostics.
 pub struct Diagnostics {
@@ -55,12 +54,7 @@ impl<const D: usize> Recorder<D> for Diagnostics {
         self.monitor.state(at.coll).map(Some)
     }
 
-    fn restore(
-        &mut self,
-        state: Option<&[f64]>,
-        at: &Moment<D>,
-        summary: &mut Summary,
-    ) -> Result<Option<String>, String> {
+    fn restore(&mut self, FromCheckpoint { state, at, summary }: FromCheckpoint<D>) -> Restored {
         self.monitor
             .restore_state(state.unwrap_or_default(), at.coll.rank() == 0)
             .map_err(|e| format!("diagnostics: {e}"))?;

@@ -8,9 +8,8 @@
 //! finite-strain model (neo-Hookean, Hencky–J2, the Newtonian fluid), whose elasticity is not C,
 //! are not counted.
 
-use super::{Converged, Moment, Recorder, Sink};
+use super::{Converged, FromCheckpoint, Moment, Recorder, Restored, Sink};
 use crate::model::soil::{Constitutive, Stress};
-use crate::summary::Summary;
 
 /// Whether a model has points whose plastic work this recorder counts (a Mohr–Coulomb or von
 /// Mises material).
@@ -83,12 +82,7 @@ impl<const D: usize> Recorder<D> for Dissipation {
         Ok(Some(vec![self.total]))
     }
 
-    fn restore(
-        &mut self,
-        state: Option<&[f64]>,
-        _at: &Moment<D>,
-        _summary: &mut Summary,
-    ) -> Result<Option<String>, String> {
+    fn restore(&mut self, FromCheckpoint { state, .. }: FromCheckpoint<D>) -> Restored {
         self.total = state.and_then(|s| s.first().copied()).unwrap_or(0.0);
         Ok(None)
     }

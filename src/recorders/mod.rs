@@ -89,6 +89,19 @@ pub struct Sink<'a> {
     pub figures: Vec<Figure>,
 }
 
+/// What a recorder continues from at a restart.
+pub struct FromCheckpoint<'a, 'b, const D: usize> {
+    /// Its state in the checkpoint (`None`: the checkpoint holds none for it).
+    pub state: Option<&'b [f64]>,
+    /// The run as restored: its points, time and step.
+    pub at: &'b Moment<'a, D>,
+    /// The summary, which a recorder may fill again from its state.
+    pub summary: &'b mut Summary,
+}
+
+/// What a recorder could not restore, if anything.
+pub type Restored = Result<Option<String>, String>;
+
 /// One thing that records a run (see the module documentation). Every method but
 /// [`Recorder::record`] has a default that does nothing.
 pub trait Recorder<const D: usize> {
@@ -126,14 +139,9 @@ pub trait Recorder<const D: usize> {
         Ok(None)
     }
 
-    /// Continues from its checkpoint state (`None`: the checkpoint holds none for it), the points
-    /// already restored; returns what it could not restore, if anything.
-    fn restore(
-        &mut self,
-        _state: Option<&[f64]>,
-        _at: &Moment<D>,
-        _summary: &mut Summary,
-    ) -> Result<Option<String>, String> {
+    /// Continues from its checkpoint state, the points already restored; returns what it could
+    /// not restore, if anything.
+    fn restore(&mut self, _from: FromCheckpoint<D>) -> Restored {
         Ok(None)
     }
 

@@ -3,11 +3,10 @@
 //! two-phase runs, pore pressure and excess pore pressure; `summary.json` its final displacement and
 //! the extremes of its excess pore pressure.
 
-use super::{Moment, Recorder, Sink};
+use super::{FromCheckpoint, Moment, Recorder, Restored, Sink};
 use crate::case::Case;
 use crate::model::Model;
 use crate::parallel::Collective;
-use crate::summary::Summary;
 
 /// A probe: the particle it follows and what it has seen.
 struct Probe {
@@ -127,12 +126,7 @@ impl<const D: usize> Recorder<D> for Probes {
         Ok(Some(self.probes.iter().map(|p| p.excess_extreme).collect()))
     }
 
-    fn restore(
-        &mut self,
-        state: Option<&[f64]>,
-        _at: &Moment<D>,
-        _summary: &mut Summary,
-    ) -> Result<Option<String>, String> {
+    fn restore(&mut self, FromCheckpoint { state, .. }: FromCheckpoint<D>) -> Restored {
         let extremes = state.unwrap_or_default();
         if extremes.len() != self.probes.len() {
             return Err(format!(

@@ -12,12 +12,12 @@ use crate::case::{
 pub(super) fn check(c: &Case) -> Checked {
     c.analysis.check("analysis")?;
     c.stabilisation.check("stabilisation")?;
-    let two_phase = c.analysis.formulation == Formulation::TwoPhase;
+    let pore_water = c.analysis.formulation == Formulation::TwoPhase;
     if c.analysis.kinematics == KinematicsKind::LinearIncrements {
-        linear_increments(c, two_phase)?;
+        linear_increments(c, pore_water)?;
     }
     let st = &c.stabilisation;
-    if st.pressure_update == PressureUpdate::ProjectedTotal && !two_phase {
+    if st.pressure_update == PressureUpdate::ProjectedTotal && !pore_water {
         return Err("key `stabilisation.pressure_update`: `projected_total` needs a two-phase case".into());
     }
     if st.stiffness == Stiffness::DoubleMappingGimp && c.analysis.shape_functions == ShapeFunctions::Linear {
@@ -34,13 +34,13 @@ pub(super) fn check(c: &Case) -> Checked {
     if st.fbar {
         fbar(c)?;
     }
-    if st.stress_recovery == StressRecovery::Cmpm && two_phase {
+    if st.stress_recovery == StressRecovery::Cmpm && pore_water {
         return Err("key `stabilisation.stress_recovery`: `cmpm` is for one_phase analyses ([001] is one-phase; in \
                     the coupled systems the continuity equation's divergence would no longer be the transpose of \
                     the pressure's force)"
             .into());
     }
-    if st.internal_force == InternalForce::Mapped && two_phase {
+    if st.internal_force == InternalForce::Mapped && pore_water {
         return Err("key `stabilisation.internal_force`: `mapped` is for one_phase analyses ([001] is one-phase; \
                     the pore pressure's forces and the continuity equation keep the basis)"
             .into());
@@ -49,8 +49,8 @@ pub(super) fn check(c: &Case) -> Checked {
 }
 
 /// `linear_increments` is for one-phase cases whose stages are static.
-fn linear_increments(c: &Case, two_phase: bool) -> Checked {
-    if two_phase {
+fn linear_increments(c: &Case, pore_water: bool) -> Checked {
+    if pore_water {
         return Err("key `analysis.kinematics`: `linear_increments` is for a one_phase analysis (the two-phase \
                     pressure and flow terms are written on the configuration at the step's end)"
             .into());

@@ -8,29 +8,29 @@ use crate::model::finite_strain;
 
 /// Every material, then where its model may be used.
 pub(super) fn check(c: &Case) -> Checked {
-    let two_phase = c.analysis.formulation == Formulation::TwoPhase;
+    let pore_water = c.analysis.formulation == Formulation::TwoPhase;
     for (i, m) in c.materials.iter().enumerate() {
-        material(&format!("materials[{i}]"), m, two_phase)?;
+        material(&format!("materials[{i}]"), m, pore_water)?;
     }
     finite_strain_materials(c)
 }
 
 /// One material: its porosity's range (a one-phase material may have no pores: a fluid, a solid;
 /// its density is the mixture's), its own values and model, and the two-phase keys.
-fn material(key: &str, m: &Material, two_phase: bool) -> Checked {
+fn material(key: &str, m: &Material, pore_water: bool) -> Checked {
     let k = |f: &str| at(key, f);
-    if two_phase {
+    if pore_water {
         in_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
     } else {
         in_closed_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
     }
     m.check(key)?;
     soil_model(&k("model"), &m.model)?;
-    if !two_phase {
+    if !pore_water {
         return Ok(());
     }
     let required = |f: &str, v: Option<f64>, hint: &str| {
-        v.ok_or_else(|| format!("key `{}`: required in a two_phase analysis{hint}", k(f)))
+        v.ok_or_else(|| format!("key `{}`: required with `formulation = \"two_phase\"`{hint}", k(f)))
     };
     modulus(&k("water_bulk_modulus"), required("water_bulk_modulus", m.water_bulk_modulus, "")?)?;
     let why = "more permeable than open gravel";

@@ -10,22 +10,22 @@ pub(super) fn check(c: &Case) -> Checked {
         s.check(&format!("stages[{i}]"))?;
     }
     c.time_integration.check("time_integration")?;
-    let two_phase = c.analysis.formulation == Formulation::TwoPhase;
-    c.stages.iter().try_for_each(|s| analysis_type(c, s, two_phase))
+    let pore_water = c.analysis.formulation == Formulation::TwoPhase;
+    c.stages.iter().try_for_each(|s| analysis_type(c, s, pore_water))
 }
 
 /// What a stage's analysis type needs of the formulation.
-fn analysis_type(c: &Case, s: &Stage, two_phase: bool) -> Checked {
+fn analysis_type(c: &Case, s: &Stage, pore_water: bool) -> Checked {
     let key = |k: &str| format!("stages.{}.{k}", s.name);
     match s.analysis {
-        AnalysisType::QuasiStatic if !two_phase => {
+        AnalysisType::QuasiStatic if !pore_water => {
             return Err(format!(
                 "key `{}`: a quasi_static stage solves the water's flow and needs `analysis.formulation = \
                  \"two_phase\"`; use `static` for a one-phase case",
                 key("analysis")
             ))
         }
-        AnalysisType::Static if two_phase && s.drainage.is_none() => {
+        AnalysisType::Static if pore_water && s.drainage.is_none() => {
             return Err(format!(
                 "key `{}`: a static stage of a two-phase case needs `drainage = \"drained\"` (the pore pressure is \
                  held) or `\"undrained\"` (no flow)",
@@ -34,15 +34,15 @@ fn analysis_type(c: &Case, s: &Stage, two_phase: bool) -> Checked {
         }
         _ => {}
     }
-    if s.drainage.is_some() && !(s.analysis == AnalysisType::Static && two_phase) {
+    if s.drainage.is_some() && !(s.analysis == AnalysisType::Static && pore_water) {
         return Err(format!("key `{}`: only a static stage of a two-phase case takes `drainage`", key("drainage")));
     }
     if s.analysis != AnalysisType::DynamicExplicit {
         return Ok(());
     }
     let e = s.explicit.unwrap_or_default();
-    if two_phase {
-        explicit_two_phase(c, s, &e)
+    if pore_water {
+        explicit_with_pore_water(c, s, &e)
     } else if e.pore_pressure.is_some() {
         Err(format!(
             "key `{}`: a one-phase stage has no pore pressure; leave `pore_pressure` out",
@@ -57,7 +57,7 @@ fn analysis_type(c: &Case, s: &Stage, two_phase: bool) -> Checked {
 /// pressure lives at the points, so no boundary can fix it (a surface where the water may leave is
 /// drained by itself, one where its normal motion is fixed is impermeable), and the transfers and
 /// projections built for the one-phase system (XPIC, F̄) are not built for the water.
-fn explicit_two_phase(c: &Case, s: &Stage, e: &Explicit) -> Checked {
+fn explicit_with_pore_water(c: &Case, s: &Stage, e: &Explicit) -> Checked {
     if e.xpic_order.is_some() {
         return Err(format!(
             "key `stages.{}.explicit.xpic_order`: XPIC is built for one-phase explicit stages only (the water's \

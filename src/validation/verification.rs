@@ -71,8 +71,8 @@ pub(super) fn check(c: &Case) -> Checked {
     let Some(v) = c.linked_verification() else {
         return Ok(());
     };
-    if let Some((two_phase, message)) = formulation_needed(v) {
-        if two_phase != (c.analysis.formulation == Formulation::TwoPhase) {
+    if let Some((pore_water, message)) = formulation_needed(v) {
+        if pore_water != (c.analysis.formulation == Formulation::TwoPhase) {
             return Err(format!("key `verification`: {message}"));
         }
     }

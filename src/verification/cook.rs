@@ -1,4 +1,4 @@
-//! Cook's membrane of [002] §4.1 (`../shared/seeds-001-002.md` Parts D1 and E item 13): a tapered
+//! Cook's membrane of [002] §4.1: a tapered
 //! plate clamped on its left edge and sheared on its right, run until it is at rest. What the run
 //! says about itself:
 //!
@@ -13,8 +13,8 @@
 //!   tenth of the run, relative to the displacement (a metric with a tolerance of a tenth of the
 //!   accuracy asked of the tip, so that a run stopped while still moving cannot pass);
 //! * the chequerboard index of the mean stress σ_m over the body's points at the end
-//!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which item 13 compares
-//!   between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
+//!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which `make study-cook`
+//!   compares between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
 
 use super::{Check, Findings, Metric};
 use crate::case::{BodyId, Case, CookMembrane};

@@ -1,15 +1,14 @@
-//! The dam break of [002] §4.3 (`../shared/seeds-001-002.md` Parts D3 and E item 15): a column of
-//! water at rest behind a gate collapses when the gate is removed. The case has a settling stage
-//! (the water, under gravity behind the gate, comes to rest with local damping) and flow stages
-//! (the gate, a boundary, left out). What the run says about itself:
+//! The dam break of [002] §4.3: a column of water at rest behind a gate collapses when the gate is
+//! removed. The case has a settling stage (the water, under gravity behind the gate, comes to rest
+//! with local damping) and flow stages (the gate, a boundary, left out). What the run says about
+//! itself:
 //!
 //! * at the end of the settling stage, the pressure p = −σ_m of every point more than one cell
 //!   above the base against the hydrostatic ρ g d, d the depth below the water's current surface
-//!   (the top of the highest point's domain): the largest |p − ρ g d| / (ρ g H) (item 15: 2 %),
-//!   with the points of the bottom cell row left out (item 15 "excluding the bottom row": the
-//!   basis's boundary layer at the base), and the pressure's chequerboard index
-//!   (`checkerboard::fit_of` over the gathered points), which item 15 compares between F̄ and
-//!   standard MPM;
+//!   (the top of the highest point's domain): the largest |p − ρ g d| / (ρ g H) (`make study-dam`
+//!   asks for 2 %), with the points of the bottom cell row left out (the basis's boundary layer at
+//!   the base), and the pressure's chequerboard index (`checkerboard::fit_of` over the gathered
+//!   points), which `make study-dam` compares between F̄ and standard MPM;
 //! * the mass of the water (the sum over the points and ranks) against its initial value: a point
 //!   lost or counted twice (a migration fault) shows here;
 //! * after the gate opens, the front z and the centre of mass x_c (both from the back wall) after

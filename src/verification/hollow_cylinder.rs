@@ -1,7 +1,7 @@
 //! The hollow cylinder of [001] §3.1 in axial symmetry: a thick-walled cylinder under internal
-//! pressure with its outer wall held radially and plane strain along the axis
-//! (`../shared/seeds-001-002.md` Part B1, which reconstructs these boundary conditions from [001]'s
-//! constants A = 19.56 kN and C = 10.87 kPa).
+//! pressure with its outer wall held radially and plane strain along the axis (boundary
+//! conditions that [001] does not state; they are the ones that reproduce its constants
+//! A = 19.56 kN and C = 10.87 kPa).
 //!
 //! With inner radius a, outer radius b, pressure p, shear modulus μ, Poisson's ratio ν and
 //! κ = 1/(1 − 2ν), compression positive:
@@ -86,7 +86,7 @@ struct Mp1 {
     x: [f64; 2],
 }
 
-/// The step-by-step comparison ([001]'s increments, Part E item 9).
+/// The step-by-step comparison with [001]'s load increments.
 #[derive(Debug, Clone, Copy)]
 struct Steps {
     tolerances: IncrementTolerances,
@@ -473,8 +473,9 @@ fn von_mises(rr: f64, tt: f64, yy: f64, ry: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// [001]'s constants and `../shared/seeds-001-002.md` Part B1's values follow, and the solution
-    /// meets its boundary conditions and Hooke's law in axial symmetry with ε_yy = 0.
+    /// [001]'s constants A and C follow, with the closed form's values at r = a and its mean
+    /// stress, and the solution meets its boundary conditions and Hooke's law in axial symmetry
+    /// with ε_yy = 0.
     #[test]
     fn the_closed_form_has_the_paper_s_constants_and_meets_its_conditions() {
         let l = FixedWallLame { a: 0.5, b: 1.5, p: 100.0, e: 1000.0, nu: 0.3 };

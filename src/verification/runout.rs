@@ -1,8 +1,7 @@
-//! The run-out of a failing slope ([002] §4.4, the landslide; `../shared/seeds-001-002.md` Part D4
-//! and Part E item 16), in any dimension. The case has stages in which the slope stands (e.g. a
-//! settling stage at peak strength) and, from the `trigger_stage` on, stages in which it fails
-//! (e.g. with the peak strength divided by a strength reduction factor). What the run says about
-//! itself:
+//! The run-out of a failing slope ([002] §4.4, the landslide), in any dimension. The case has
+//! stages in which the slope stands (e.g. a settling stage at peak strength) and, from the
+//! `trigger_stage` on, stages in which it fails (e.g. with the peak strength divided by a strength
+//! reduction factor). What the run says about itself:
 //!
 //! * before the trigger, the slope stands: the front's advance since t = 0 and, at the trigger,
 //!   the largest speed of the body's points (metrics `standing_advance` and `standing_speed`);
@@ -19,7 +18,7 @@
 //! ahead of it (the points' leading edges x_p + l_p binned at h/20, as the dam break's front,
 //! [`Front::of`]): a few points shed ahead of the mass do not carry it. There is no reference
 //! solution; `make study-landslide` compares the run-outs of the bases and of F̄ against standard
-//! MPM (item 16's geometry-independent assertions).
+//! MPM (assertions on their ratios, which do not depend on the slope's geometry).
 
 use super::{Check, Findings, Metric};
 use crate::case::{Case, Runout, RunoutIds};

@@ -1,4 +1,4 @@
-//! [001] §6's stiffness test (`../shared/seeds-001-002.md` Part B2): the nodal diagnostic
+//! [001] §6's stiffness test (docs/stiffness.md): the nodal diagnostic
 //! K_mag = √(K_x² + K_y²) ([001] Eq. 25; `K_x`, `K_y` the diagonal entries of the assembled
 //! material stiffness, field `K_mag`) of a block of material points, against the value of an
 //! interior node of a uniform finite-element mesh of square Q4 cells with 2 × 2 Gauss points,

@@ -1,18 +1,18 @@
-//! The vertical cut of [001] §3.2 and §7.2 (`../shared/seeds-001-002.md` Part B3, Part E items
-//! 10–12). There is no closed form; what the run can say about itself:
+//! The vertical cut of [001] §3.2 and §7.2. There is no closed form; what the run can say about
+//! itself:
 //!
 //! * the toe's horizontal displacement (the material point nearest `toe` at t = 0), which ends the
 //!   run at `stop_displacement` ([001] shows the fields up to 1.0 m);
-//! * the constitutive check of item 12: q ≤ √3 c(ε̄) at every point of the body and every step
+//! * the constitutive check: q ≤ √3 c(ε̄) at every point of the body and every step
 //!   (q = √(3J₂) of the effective stress, c(ε̄) the softened strength of the von Mises model), as
 //!   the excess max(q/√3c − 1, 0) with a tolerance of 1e-8, and the largest ε̄ (the residual
 //!   strength is reached at ε̄ = (c_p − c_r)/|H_s|);
-//! * the smoothness of item 11 when the toe passes each of `snapshots`: the roughness of the nodal
-//!   diagnostics K_mag and F^int_mag ([001] Eqs. 25–26), rms of the discrete Laplacian
-//!   K_{i+1,j} + K_{i−1,j} + K_{i,j+1} + K_{i,j−1} − 4K_{i,j} over the mean, over the nodes
-//!   whose stencil has whole supports in the material ([`INSIDE_DEPTH`]), the chequerboard
-//!   index of σ_m over the body's points (`checkerboard::fit_of`), and the maps of σ_m and K_mag
-//!   (`figures`; every rank gathers the body's points at a snapshot);
+//! * the smoothness of the fields when the toe passes each of `snapshots`: the roughness of the
+//!   nodal diagnostics K_mag and F^int_mag ([001] Eqs. 25–26), rms of the discrete Laplacian
+//!   K_{i+1,j} + K_{i−1,j} + K_{i,j+1} + K_{i,j−1} − 4K_{i,j} over the mean, over the nodes whose
+//!   stencil has whole supports in the material ([`INSIDE_DEPTH`]), the chequerboard index of σ_m
+//!   over the body's points (`checkerboard::fit_of`), and the maps of σ_m and K_mag (`figures`;
+//!   every rank gathers the body's points at a snapshot);
 //! * the total variation Σ|Δσ_m| over the run of the mean stress at the points nearest `b` (in
 //!   the shear band) and `c` (in the sliding block), [001]'s p–q paths of Figs. 30–31 in one number.
 

@@ -510,7 +510,7 @@ fn the_plastic_sample_really_returns() {
     assert!(pt.kin.theta.abs() > 1e-4, "the sample must rotate: θ = {}", pt.kin.theta);
 }
 
-/// A recovered strain is the stress's only ([001] read as `../shared/seeds-001-002.md` Part A8):
+/// A recovered strain is the stress's only ([001] §5.5 as docs/stiffness.md reads it):
 /// the soil model's increment, the rotated stress and the update are those of a point whose basis
 /// were the strain operators, while the motion (F, the volume ratio, the gradients on x_{n+1}, what
 /// the particle keeps) is the basis's, as without recovery; in axial symmetry and in plane strain.

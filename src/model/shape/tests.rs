@@ -340,7 +340,7 @@ fn axisymmetric_samples() -> Vec<(Basis, AxisymmetricWeights, [f64; 2], [f64; 2]
     out
 }
 
-/// Part E item 5 of `../shared/seeds-001-002.md`: for u_r = α + βr, u_y = γy the particle's
+/// Axisymmetric strains of a linear field: for u_r = α + βr, u_y = γy the particle's
 /// strains are exact, ε_rr = β, ε_yy = γ, ε_θθ = α/r_p + β, and Σ S_i = 1, for both GIMP options
 /// and the linear basis.
 #[test]
@@ -367,9 +367,9 @@ fn axisymmetric_strains_of_a_linear_field_are_exact() {
     }
 }
 
-/// Option B's r-functions against the closed forms of Part A2: Σ G^r = 0, the same hoop operator
-/// as Option A, and S^r = N_i(r_p) + n₁ l²/(3 r_p) for a domain inside one cell (n₁ = ±1/h the hat's
-/// slope there).
+/// Option B's r-functions against their closed forms (docs/axisymmetry.md, "GIMP in r"): Σ G^r = 0,
+/// the same hoop operator as Option A, and S^r = N_i(r_p) + n₁ l²/(3 r_p) for a domain inside one
+/// cell (n₁ = ±1/h the hat's slope there).
 #[test]
 fn r_weighted_gimp_matches_its_closed_forms() {
     let h = 0.1;
@@ -389,7 +389,7 @@ fn r_weighted_gimp_matches_its_closed_forms() {
     assert!(gsum.abs() < 1e-13 && (ssum - 1.0).abs() < 1e-14, "Σ G^r = {gsum}, Σ S^r = {ssum}");
 }
 
-/// Part E item 2 of `../shared/seeds-001-002.md`: the local GIMP weights of all cells sum to 1
+/// The partition of unity of the local GIMP weights: the weights of all cells sum to 1
 /// for a domain inside the grid, and a node's weights summed over the cells are its planar GIMP
 /// weight (so a domain inside one cell has the planar weights there), to 1e-14.
 #[test]
