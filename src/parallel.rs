@@ -12,11 +12,20 @@ use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 
+/// Points a thread must get for a thread of its own to pay when the threads are not set: starting
+/// and joining a thread at each of a step's assemblies costs about what the kernels of a few
+/// hundred points do, and a small problem run on threads spends its steps waiting for them
+/// (Terzaghi's column of 40 points took three times longer on two threads than on one while the
+/// machine's other core was busy).
+pub const POINTS_PER_THREAD: usize = 2000;
+
 /// The run's communicator (MPI_COMM_WORLD) and its reductions, and the threads each rank runs its
 /// particle loops on.
 pub struct Collective {
     world: SimpleCommunicator,
     threads: usize,
+    /// Whether `--threads` set the threads (then every one is used, however few the points).
+    threads_set: bool,
     /// The collective operations this rank took part in, and the bytes they brought it.
     traffic: std::cell::Cell<Traffic>,
 }
@@ -44,12 +53,14 @@ impl Collective {
         let world = SimpleCommunicator::world();
         let on_node = world.split_shared(world.rank()).size().max(1) as usize;
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        Collective { world, threads: (cores / on_node).max(1), traffic: Default::default() }
+        Collective { world, threads: (cores / on_node).max(1), threads_set: false, traffic: Default::default() }
     }
 
-    /// Sets the threads of this rank's particle loops (`--threads`; at least one).
+    /// Sets the threads of this rank's particle loops (`--threads`; at least one), used whatever
+    /// the number of points.
     pub fn set_threads(&mut self, n: usize) {
         self.threads = n.max(1);
+        self.threads_set = true;
     }
 
     /// This rank's collective traffic so far.
@@ -62,9 +73,15 @@ impl Collective {
         self.traffic.set(Traffic { calls: t.calls + 1, bytes: t.bytes + bytes as u64 });
     }
 
-    /// The threads of this rank's particle loops.
-    pub fn threads(&self) -> usize {
-        self.threads
+    /// The threads of this rank's particle loops over `points` points: those `--threads` set, or
+    /// else this rank's share of the cores, as long as each thread gets at least
+    /// [`POINTS_PER_THREAD`] points.
+    pub fn threads_for(&self, points: usize) -> usize {
+        if self.threads_set {
+            self.threads
+        } else {
+            self.threads.min(points / POINTS_PER_THREAD).max(1)
+        }
     }
 
     /// The communicator (for PETSc and for point-to-point exchanges).

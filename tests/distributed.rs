@@ -278,6 +278,9 @@ fn a_panic_on_one_rank_ends_every_rank() {
         .arg("--quiet")
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        // One machine: the shared-memory transports, without probing the network ones (UCX).
+        .env("OMPI_MCA_pml", "ob1")
+        .env("OMPI_MCA_osc", "^ucx")
         .env("PORO_FAULT_PANIC_RANK", "1")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()

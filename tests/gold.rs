@@ -355,13 +355,13 @@ const RANKS_RTOL: f64 = 1e-5;
 /// another size on several.
 const RANKS_FLOOR: f64 = 1e-9;
 
-/// The cases the default suite also runs on three ranks: those whose three-rank run takes a few
+/// The cases the default suite runs on three ranks rather than two: those whose three-rank run takes a few
 /// seconds (the plane and 3D patch tests, rotations and cylinders, Terzaghi's column in the plane
 /// and in 3D, the static elastic column, the peer footing) and the explicit F̄ footing (7 s; the
 /// explicit path with points crossing rank boundaries). Every other case's three-rank run took 7 to
 /// 60 s, 650 s together, where three processes share the two cores of the CI machine: the default
-/// suite runs those on two ranks, `make study` on three as well
-/// ([`the_other_cases_give_their_gold_values_on_three_ranks`]).
+/// suite runs those on two ranks, `make study` on three as well, and these on two
+/// ([`every_case_gives_its_gold_values_on_the_other_rank_count`]).
 const THREE_RANKS_BY_DEFAULT: &[&str] = &[
     "elastic_column",
     "footing_fbar",
@@ -404,6 +404,9 @@ fn gold_values_on_ranks(runs: &[(&str, usize)], table_name: &str) {
         let o = cmd
             .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
             .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            // One machine: the shared-memory transports, without probing the network ones (UCX).
+            .env("OMPI_MCA_pml", "ob1")
+            .env("OMPI_MCA_osc", "^ucx")
             .current_dir(root())
             .output()
             .expect("mpirun runs");
@@ -436,26 +439,24 @@ fn gold_values_on_ranks(runs: &[(&str, usize)], table_name: &str) {
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
-/// Every case gives its gold values on two ranks, and the [`THREE_RANKS_BY_DEFAULT`] on three
-/// ([`gold_values_on_ranks`]; table `target/distributed/ranks.md`).
+/// Every case gives its gold values on several ranks: the [`THREE_RANKS_BY_DEFAULT`] on three,
+/// every other case on two ([`gold_values_on_ranks`]; table `target/distributed/ranks.md`).
 #[test]
-fn every_case_gives_its_gold_values_on_two_ranks_and_the_quick_ones_on_three() {
+fn every_case_gives_its_gold_values_on_two_ranks_or_on_three() {
     assert!(THREE_RANKS_BY_DEFAULT.iter().all(|c| CASES.contains(c)), "{THREE_RANKS_BY_DEFAULT:?} are cases");
-    let runs: Vec<(&str, usize)> = CASES
-        .iter()
-        .flat_map(|&case| [(case, 2), (case, 3)])
-        .filter(|&(case, ranks)| ranks == 2 || THREE_RANKS_BY_DEFAULT.contains(&case))
-        .collect();
+    let runs: Vec<(&str, usize)> =
+        CASES.iter().map(|&case| (case, if THREE_RANKS_BY_DEFAULT.contains(&case) { 3 } else { 2 })).collect();
     gold_values_on_ranks(&runs, "ranks.md");
 }
 
-/// Every case but the [`THREE_RANKS_BY_DEFAULT`] gives its gold values on three ranks (`make
-/// study`; table `target/distributed/ranks_study.md`).
+/// The rank counts the default suite leaves out (`make study`; table
+/// `target/distributed/ranks_study.md`): every case but the [`THREE_RANKS_BY_DEFAULT`] on three
+/// ranks, and those on two.
 #[test]
-#[ignore = "the longer three-rank runs (make study)"]
-fn the_other_cases_give_their_gold_values_on_three_ranks() {
+#[ignore = "the other rank counts (make study)"]
+fn every_case_gives_its_gold_values_on_the_other_rank_count() {
     let runs: Vec<(&str, usize)> =
-        CASES.iter().filter(|c| !THREE_RANKS_BY_DEFAULT.contains(c)).map(|&case| (case, 3)).collect();
+        CASES.iter().map(|&case| (case, if THREE_RANKS_BY_DEFAULT.contains(&case) { 2 } else { 3 })).collect();
     gold_values_on_ranks(&runs, "ranks_study.md");
 }
 

@@ -129,7 +129,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
         coll: &Collective,
     ) -> Result<Step<D, M>, String> {
         let layout = space.layout;
-        let bands = bands(&st, space.ghost.count, coll.threads());
+        let bands = bands(&st, space.ghost.count, coll.threads_for(st.len()));
         let (smooth, grad_n) = predictors(layout, model, &st, &dofs, nodal);
         let projection = pressure::projection_cells(space, model);
         let (fext, applied) = coll.agree(loads::external_forces::<D, M>(space, model, active, t_new, &dofs))?;

@@ -117,6 +117,9 @@ pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run
         .args(&all)
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        // One machine: the shared-memory transports, without probing the network ones (UCX).
+        .env("OMPI_MCA_pml", "ob1")
+        .env("OMPI_MCA_osc", "^ucx")
         .current_dir(root())
         .output()
         .expect("mpirun runs");
