@@ -425,18 +425,19 @@ fn start_mpi_and_petsc(args: &[String]) -> Result<(mpi::environment::Universe, C
 }
 
 /// Open MPI settings for a process started without `mpirun` (a singleton: one rank, which talks to
-/// no other process), unless the environment already sets them: no supporting daemon
-/// (`ess_singleton_isolated`) and the shared-memory and self transports instead of probing the
-/// network ones (UCX's `pml` and `osc`). They take the start of every one-rank run from 0.55 s to
-/// 0.15 s (`porompm info`, Open MPI 4.1). Runs started by `mpirun` are left alone: there the
-/// launcher and the user choose the transports of the machine. Called before MPI starts, while the
-/// process has one thread.
+/// no other process), unless the environment already sets them: the shared-memory and self
+/// transports instead of probing the network ones (UCX's `pml` and `osc`), which takes the start
+/// of every one-rank run from 0.55 s to 0.34 s (`porompm info`, Open MPI 4.1). The singleton's
+/// supporting daemon stays: without it (`ess_singleton_isolated`) every isolated singleton shares
+/// one session directory, and MPI-I/O's shared file pointers of two runs at once clash there.
+/// Runs started by `mpirun` are left alone: there the launcher and the user choose the transports
+/// of the machine. Called before MPI starts, while the process has one thread.
 fn quick_singleton_start() {
     let launched = ["OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"].iter().any(|v| std::env::var_os(v).is_some());
     if launched {
         return;
     }
-    for (key, value) in [("OMPI_MCA_ess_singleton_isolated", "1"), ("OMPI_MCA_pml", "ob1"), ("OMPI_MCA_osc", "^ucx")] {
+    for (key, value) in [("OMPI_MCA_pml", "ob1"), ("OMPI_MCA_osc", "^ucx")] {
         if std::env::var_os(key).is_none() {
             std::env::set_var(key, value);
         }

@@ -450,7 +450,7 @@ fn bad_explicit_settings_are_named() {
         &[
             "stabilisation.fbar=true",
             "stabilisation.stiffness=particle",
-            "stabilisation.stress_recovery=none",
+            "stabilisation.stress_recovery=basis",
             "analysis.geometry=\"plane_strain\"",
         ],
         "`analysis.kinematics = \"linear_increments\"` has none",
@@ -534,6 +534,7 @@ fn bad_explicit_settings_are_named() {
 /// settling stage a tenth as long leaves the pressure off the hydrostatic one, and XPIC(1) (PIC)
 /// holds the front back.
 #[test]
+#[ignore = "make study: the whole collapse against the experiment; the default suite runs the case's first 0.15 s against its gold values on one and two ranks"]
 fn the_collapsing_column_follows_martin_and_moyce() {
     let case = "cases/dam_break_martin_moyce.toml";
     let weak = [

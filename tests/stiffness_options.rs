@@ -193,6 +193,7 @@ fn the_rotated_lattice_keeps_the_papers_order_of_stiffness_errors() {
 /// to 1e-6 with the case's Newton tolerance (measured 5.1e-8; 6.3e-2 before the held nodes beyond
 /// the base took their share: tests/equilibrium.rs).
 #[test]
+#[ignore = "make study: the cut run to 1 m; the default suite runs it to 0.1 m against its gold values, yield excess and equilibrium among them, on one and two ranks"]
 fn the_vertical_cut_runs_to_a_metre_of_toe_displacement() {
     let r = run_case("cases/vertical_cut.toml", &out_dir("cut"), &[]);
     assert!(r.completed(), "{}", r.stderr());
@@ -217,6 +218,7 @@ fn the_vertical_cut_runs_to_a_metre_of_toe_displacement() {
 /// and reported in docs/stress_maps.md: F^int_mag's roughness (the forces are integrated at the
 /// points with the basis in both) and σ_m's total variation at B and C.
 #[test]
+#[ignore = "make study: [001]'s comparison of DM-GC with MPM on the cut; DM-GC stays in the default suite through the cylinder's increments and the full block's K_mag"]
 fn dm_gc_smooths_k_mag_and_sigma_m_on_the_vertical_cut() {
     let short = ["--set", "verification.stop_displacement=0.1", "--set", "verification.snapshots=[0.1]"];
     let run = |name: &str, sets: &[&str]| {

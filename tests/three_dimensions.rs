@@ -508,6 +508,7 @@ fn assert_tangent_checked(args: &[&str], n_blocks: usize, flip: &str) -> String 
 /// the grid update's own (the barely filled nodes' shares moved to their masters), the face blew up
 /// (15 m/s at 0.1 s, 91 m/s at 0.15 s).
 #[test]
+#[ignore = "make study: the default suite runs the same prism's settling and failure stages against their gold values on one and two ranks, which a blow-up changes"]
 fn the_landslide_face_settles_without_blowing_up() {
     let dir = std::env::temp_dir().join("porompm-landslide-settle");
     let mut sets: Vec<String> =
