@@ -1,5 +1,6 @@
-//! The plastic work dissipated by the skeleton (`plastic_dissipation` in `history.csv`): W_p = Σ_steps Σ_p V_p σ'_{n+1} : Δε^p with the plastic strain
-//! increment of the step's return mapping, Δε^p = Δε − C⁻¹(σ'_{n+1} − σ'_n), C the point's linear
+//! The plastic work dissipated by the skeleton (`plastic_dissipation` in `history.csv`):
+//! W_p = Σ_steps Σ_p V_p σ'_{n+1} : Δε^p with the plastic strain increment of the step's return
+//! mapping, Δε^p = Δε − C⁻¹(σ'_{n+1} − σ'_n), C the point's linear
 //! isotropic elasticity (Δε^e = Δs/2G + Δσ_m/3K per normal component, Δτ/G per engineering
 //! shear), σ' the effective stress after the step and V_p the point's volume after it [J per m in
 //! plane strain, J in axial symmetry and in three dimensions]. It is the dissipation of the
