@@ -413,7 +413,7 @@ fn three_dimensional_runs_refuse_what_they_cannot_do_yet() {
     common::assert_refused(
         "cases/terzaghi_3d.toml",
         &dir,
-        &["loads=[{name=\"q\", kind=\"line_pressure\", points=[[0.0, 1.0], [0.1, 1.0]], pressure=1.0}]"],
+        &["loads=[{name=\"surface\", kind=\"line_pressure\", points=[[0.0, 1.0], [0.1, 1.0]], pressure=1.0}]"],
         "a line pressure acts on a plane polyline",
     );
     // The footing's bearing check: a 3D loaded area needs its extent along z; a plane one has none.
