@@ -274,18 +274,7 @@ fn mpirun(n: usize, args: &[&str]) -> Option<Output> {
     let np = n.to_string();
     let mut all = vec!["--oversubscribe", "-n", np.as_str(), bin()];
     all.extend_from_slice(args);
-    Some(
-        Command::new("mpirun")
-            .args(&all)
-            .current_dir(root())
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            // One machine: the shared-memory transports, without probing the network ones (UCX).
-            .env("OMPI_MCA_pml", "ob1")
-            .env("OMPI_MCA_osc", "^ucx")
-            .output()
-            .expect("mpirun runs"),
-    )
+    Some(common::mpi_env(&mut Command::new("mpirun")).args(&all).current_dir(root()).output().expect("mpirun runs"))
 }
 
 #[test]

@@ -272,15 +272,10 @@ fn a_panic_on_one_rank_ends_every_rank() {
     let dir = out_dir("panic");
     let _ = std::fs::remove_dir_all(&dir);
     let started = std::time::Instant::now();
-    let output = std::process::Command::new("timeout")
+    let output = mpi_env(&mut std::process::Command::new("timeout"))
         .args(["120", "mpirun", "--oversubscribe", "-n", "2", env!("CARGO_BIN_EXE_porompm"), "run", SLIDING, "--out"])
         .arg(&dir)
         .arg("--quiet")
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        // One machine: the shared-memory transports, without probing the network ones (UCX).
-        .env("OMPI_MCA_pml", "ob1")
-        .env("OMPI_MCA_osc", "^ucx")
         .env("PORO_FAULT_PANIC_RANK", "1")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()

@@ -401,15 +401,7 @@ fn gold_values_on_ranks(runs: &[(&str, usize)], table_name: &str) {
         for s in &gold.sets {
             cmd.args(["--set", s]);
         }
-        let o = cmd
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            // One machine: the shared-memory transports, without probing the network ones (UCX).
-            .env("OMPI_MCA_pml", "ob1")
-            .env("OMPI_MCA_osc", "^ucx")
-            .current_dir(root())
-            .output()
-            .expect("mpirun runs");
+        let o = common::mpi_env(&mut cmd).current_dir(root()).output().expect("mpirun runs");
         assert_ne!(o.status.code(), Some(124), "{case}: no end within 600 s on {ranks} ranks (a hang)");
         let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap_or_default())
             .unwrap_or_else(|_| panic!("{case}: no summary.json on {ranks} ranks"));

@@ -34,11 +34,7 @@ fn run_file_on(ranks: usize, path: &str, label: &str, args: &[String]) -> Value 
     let mut cmd = if ranks > 1 {
         let mut c = Command::new("mpirun");
         c.args(["--oversubscribe", "-n", &ranks.to_string(), env!("CARGO_BIN_EXE_porompm")]);
-        c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            // One machine: the shared-memory transports, without probing the network ones (UCX).
-            .env("OMPI_MCA_pml", "ob1")
-            .env("OMPI_MCA_osc", "^ucx");
+        common::mpi_env(&mut c);
         c
     } else {
         Command::new(env!("CARGO_BIN_EXE_porompm"))

@@ -98,6 +98,15 @@ pub fn metric(s: &Value, name: &str) -> f64 {
     s["verification"][name]["value"].as_f64().unwrap_or(f64::NAN)
 }
 
+/// The environment of an `mpirun` on this machine: as root, and on the shared-memory transports
+/// without probing the network ones (UCX).
+pub fn mpi_env(cmd: &mut Command) -> &mut Command {
+    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_pml", "ob1")
+        .env("OMPI_MCA_osc", "^ucx")
+}
+
 /// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`, alone on
 /// the [`CORES`]; one rank runs the binary directly), with a 600 s limit so that a hang fails the
 /// test instead of holding it.
@@ -113,16 +122,7 @@ pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run
         .to_vec();
     all.extend(["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()]);
     all.extend(args.iter().cloned());
-    let output = Command::new("timeout")
-        .args(&all)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        // One machine: the shared-memory transports, without probing the network ones (UCX).
-        .env("OMPI_MCA_pml", "ob1")
-        .env("OMPI_MCA_osc", "^ucx")
-        .current_dir(root())
-        .output()
-        .expect("mpirun runs");
+    let output = mpi_env(&mut Command::new("timeout")).args(&all).current_dir(root()).output().expect("mpirun runs");
     assert_ne!(output.status.code(), Some(124), "{case} on {ranks} ranks: no end within 600 s (a hang)");
     let summary = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap_or_default())
         .unwrap_or(Value::Null);
