@@ -191,9 +191,11 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         let strain = step.stencils.strain_of(k);
         let layout = step.layout;
-        let pt =
+        let mut pt =
             kernels::Point::<D, M>::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
-        f(&pt.with_forces(step.stencils.forces_of(k)).with_faces(step.faces_of(k), &states[..nodes.len()]))
+        pt.set_forces(step.stencils.forces_of(k));
+        pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
+        f(&pt)
     }
 
     /// Particle `k` at an explicit step's start with the stress it carries
@@ -202,8 +204,9 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let step = self.step;
         let (_, basis) = step.stencils.get(k);
         let input = particle_input(self.model, step, k);
-        let pt = kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout);
-        f(&pt.with_forces(step.stencils.forces_of(k)))
+        let mut pt = kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout);
+        pt.set_forces(step.stencils.forces_of(k));
+        f(&pt)
     }
 
     /// Calls `f` with the point of particle `k` whose basis also holds its slots beyond the grid
@@ -237,15 +240,19 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let input = particle_input(self.model, step, k);
         let layout = step.layout;
         if at_start {
-            return f(&kernels::Point::<D, M>::at_start(&all, strain, &input, layout).with_forces(&forces));
+            let mut pt = kernels::Point::<D, M>::at_start(&all, strain, &input, layout);
+            pt.set_forces(&forces);
+            return f(&pt);
         }
         let mut states = node_states::<D, M, N>(step, k, xl);
         for s in &mut states[nodes.len()..all.len()] {
             *s = NodeState::default();
         }
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
-        let pt = kernels::Point::<D, M>::with_recovery(&all, strain, &states[..all.len()], &input, &mat.model, layout);
-        f(&pt.with_forces(&forces))
+        let mut pt =
+            kernels::Point::<D, M>::with_recovery(&all, strain, &states[..all.len()], &input, &mat.model, layout);
+        pt.set_forces(&forces);
+        f(&pt)
     }
 
     /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
@@ -336,16 +343,16 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
             let mat = &self.model.materials[self.model.particles.material[k] as usize];
             let states = node_states::<D, M, N>(step, k, xl);
             let strain = step.stencils.strain_of(k);
-            let pt = kernels::Point::<D, M>::with_recovery(
+            let mut pt = kernels::Point::<D, M>::with_recovery(
                 basis,
                 strain,
                 &states[..nodes.len()],
                 &input,
                 &mat.model,
                 layout,
-            )
-            .with_forces(step.stencils.forces_of(k))
-            .with_faces(step.faces_of(k), &states[..nodes.len()]);
+            );
+            pt.set_forces(step.stencils.forces_of(k));
+            pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
             if self.model.stiffness_in_jacobian {
                 kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
@@ -769,9 +776,10 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         let mat = &model.materials[model.particles.material[k] as usize];
         let strain = self.stencils.strain_of(k);
-        let pt = kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout)
-            .with_forces(self.stencils.forces_of(k))
-            .with_faces(self.faces_of(k), &states[..nodes.len()]);
+        let mut pt =
+            kernels::Point::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, self.layout);
+        pt.set_forces(self.stencils.forces_of(k));
+        pt.set_faces(self.faces_of(k), &states[..nodes.len()]);
         let mut result = StepResult::of(&pt);
         if let Some(f) = fbar {
             result.jbar = Some(f[2]);

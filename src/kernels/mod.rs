@@ -547,18 +547,21 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// The point with its drained `faces` (at most [`MAX_FACES`]), their pressure increments
     /// interpolated from the same nodal `states`.
     #[inline]
-    pub fn with_faces<const N: usize>(
-        mut self,
-        faces: &'a [DrainedFace<D, M>],
-        states: &[NodeState<N>],
-    ) -> Point<'a, D, M> {
-        let Some(p) = self.layout.p else { return self };
+    pub fn with_faces<const N: usize>(mut self, faces: &'a [DrainedFace<D, M>], states: &[NodeState<N>]) -> Self {
+        self.set_faces(faces, states);
+        self
+    }
+
+    /// [`Point::with_faces`] in place (a point is a few kilobytes: the assembly loops build it
+    /// once and set what it needs, rather than move it through each builder call).
+    #[inline]
+    pub fn set_faces<const N: usize>(&mut self, faces: &'a [DrainedFace<D, M>], states: &[NodeState<N>]) {
+        let Some(p) = self.layout.p else { return };
         let faces = &faces[..faces.len().min(MAX_FACES)];
         for (dp, face) in self.face_dp.iter_mut().zip(faces) {
             *dp = face.basis.iter().zip(states.iter().take(self.basis.len())).map(|((s, _), st)| s * st.d[p]).sum();
         }
         self.faces = faces;
-        self
     }
 
     /// The point with its forces integrated by the operators `forces` (one per node of its basis,
@@ -570,9 +573,16 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// own operators. One-phase only (validation): every term that integrates with
     /// [`Point::spatial`] takes them.
     #[inline]
-    pub fn with_forces(mut self, forces: &[NodeBasis<D>]) -> Point<'a, D, M> {
+    pub fn with_forces(mut self, forces: &[NodeBasis<D>]) -> Self {
+        self.set_forces(forces);
+        self
+    }
+
+    /// [`Point::with_forces`] in place (see [`Point::set_faces`]).
+    #[inline]
+    pub fn set_forces(&mut self, forces: &[NodeBasis<D>]) {
         if forces.is_empty() {
-            return self;
+            return;
         }
         debug_assert_eq!(forces.len(), self.basis.len(), "force operators for another stencil");
         if self.motion.is_none() {
@@ -580,7 +590,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             self.motion = Some((self.spatial, self.hoop));
         }
         (self.spatial, self.hoop) = on_new_configuration(&self.kin, forces);
-        self
     }
 
     /// The gradients ∇'S, ∇̄'S and hoop operators T', T̄' on x_{n+1} of the basis, per node: the
