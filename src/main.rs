@@ -404,9 +404,27 @@ fn finish(
     result
 }
 
+/// PETSc's command line is `-name [value]` pairs: a word where a name belongs (a name without its
+/// dash, or a second value) PETSc would ignore without a word; it is refused, named.
+fn check_petsc_words(args: &[String]) -> Result<(), String> {
+    let mut after_name = false;
+    for a in args {
+        let name = a.strip_prefix('-').is_some_and(|n| n.starts_with(|c: char| c.is_ascii_alphabetic()));
+        if !name && !after_name {
+            return Err(format!(
+                "PETSc option `{a}` (after `--`): an option's name begins with `-` (`-{a}`?) and at most one value \
+                 follows it"
+            ));
+        }
+        after_name = name;
+    }
+    Ok(())
+}
+
 /// Initialises MPI (rsmpi) and then PETSc on its world communicator; the caller drops them in
 /// reverse order.
 fn start_mpi_and_petsc(args: &[String]) -> Result<(mpi::environment::Universe, Collective, petsc::Petsc), Failure> {
+    check_petsc_words(args).map_err(input)?;
     quick_singleton_start();
     let universe = mpi::initialize().ok_or_else(|| input("MPI could not be initialised (already initialised?)"))?;
     let coll = Collective::world();

@@ -757,3 +757,80 @@ fn strength_reduction_and_runout_input_is_refused_with_a_clear_message() {
         ],
     );
 }
+
+/// Input that used to run silently to a wrong answer, each now one error naming the key: a body
+/// that holds no material point, two bodies that overlap, a polygon that crosses itself, a plane
+/// load region with a z extent, a `--set` of a parameter the case does not declare, two stages of
+/// one name, a PETSc option without its dash.
+#[test]
+fn geometry_and_names_that_would_be_ignored_are_named() {
+    assert_sets_refused(
+        "cases/terzaghi.toml",
+        &[
+            (
+                "bodies.0.shape={rectangle={min=[0.0,0.0],max=[0.1,0.01]}}",
+                "key `bodies[0].shape`: body `column` holds no material point",
+            ),
+            (
+                "bodies.0.shape={polygon={vertices=[[0.0,0.0],[0.1,1.0],[0.1,0.0],[0.0,1.0]]}}",
+                "the polygon crosses itself: its edges 0–1 and 2–3 meet",
+            ),
+            (
+                "bodies.0.shape={polygon={vertices=[[0.0,0.0],[0.1,0.0],[0.05,0.0],[0.05,1.0]]}}",
+                "the polygon crosses itself",
+            ),
+            (
+                "loads.0.region={min=[0.0,0.5],max=[0.1,1.0],z=[0.0,1.0]}",
+                "key `loads[0].region.z`: only a three-dimensional case",
+            ),
+            ("parameters.h=0.5", "--set parameters.h: the case declares no parameters, so none named `h`"),
+        ],
+    );
+    assert_sets_refused(
+        "cases/footing_ld.toml",
+        &[(
+            "bodies.1.shape={rectangle={min=[0.0,0.0],max=[5.0,5.25]}}",
+            "key `bodies[1].shape`: body `soil` overlaps body `footing` (bodies[0]): 8 of its",
+        )],
+    );
+    assert_sets_refused(
+        "cases/footing_sd.toml",
+        &[("parameters.H=0.5", "--set parameters.H: the case declares no parameter `H` (it declares: ")],
+    );
+    assert_sets_refused(
+        "cases/elastic_column.toml",
+        &[("stages.1.name=self_weight", "stages: the name `self_weight` is used twice")],
+    );
+    for (words, needle) in [
+        (&["snes_type", "newtonls"][..], "PETSc option `snes_type` (after `--`): an option's name begins with `-`"),
+        (&["-snes_type", "newtonls", "basic"][..], "PETSc option `basic` (after `--`)"),
+    ] {
+        let out = out_dir("petsc-words");
+        let mut args = vec!["run", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--"];
+        args.extend(words);
+        assert_one_line_error(&porompm(&args), needle);
+    }
+}
+
+/// A face traction whose region holds no loaded face (here the column's top is at y = 1 m, the
+/// region below it) ends the run at its set-up, naming the load's key, and leaves an earlier
+/// run's results in the directory as they were.
+#[test]
+fn a_load_that_acts_on_nothing_is_named_and_a_run_that_fails_to_start_changes_nothing() {
+    let out = out_dir("load-on-nothing");
+    let o = porompm(&["run", "cases/terzaghi.toml", "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = std::fs::read(out.join("summary.json")).unwrap();
+    let o = porompm(&[
+        "run",
+        "cases/terzaghi.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "loads.0.region={min=[0.0,0.0],max=[0.1,0.4]}",
+    ]);
+    assert_one_line_error(&o, "key `loads[0].region`: load `surface` acts on no material point");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before, "the finished run's summary is kept");
+    assert!(out.join("history.csv").exists());
+}

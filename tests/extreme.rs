@@ -352,3 +352,87 @@ fn the_energy_balance_closes_on_the_shipped_dynamic_cases() {
         assert!(e <= bound, "{name}: energy imbalance {e}");
     }
 }
+
+/// A full disk while a checkpoint is written (a disk of 300 kB, emulated by PORO_FAULT_DISK_BYTES:
+/// the output directory alone on it): on one and on two ranks the run ends at once with one error
+/// line naming the full disk, exit code 1, `status: failed`; the last checkpoint written stays
+/// whole (a run restarts from it to the end) and no partial file is left.
+#[test]
+fn a_full_disk_ends_the_run_cleanly_and_keeps_the_last_checkpoint() {
+    for ranks in [1, 2] {
+        let dir = std::env::temp_dir().join(format!("porompm-extreme-full-disk-{ranks}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let bin = env!("CARGO_BIN_EXE_porompm");
+        let np = ranks.to_string();
+        let mut cmd = if ranks == 1 {
+            std::process::Command::new("timeout")
+        } else {
+            let mut c = std::process::Command::new("timeout");
+            common::mpi_env(&mut c);
+            c
+        };
+        let launcher: Vec<&str> = if ranks == 1 { vec!["120"] } else { vec!["120", "mpirun", "-n", &np] };
+        let out = cmd
+            .args(launcher)
+            .args([bin, "run", "cases/terzaghi.toml", "--out"])
+            .arg(&dir)
+            .args(["--quiet", "--threads", "1", "--checkpoint-every", "50"])
+            .env("PORO_FAULT_DISK_BYTES", "300000")
+            .current_dir(root())
+            .output()
+            .expect("porompm runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(124), "{ranks} ranks: hung\n{err}");
+        assert!(!out.status.success(), "{ranks} ranks: {err}");
+        let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
+        assert_eq!(errors.len(), 1, "{ranks} ranks: one error line\n{err}");
+        assert!(errors[0].contains("cannot write a checkpoint, the last one is kept: the disk is full"), "{err}");
+        assert!(!err.contains("PETSC ERROR") && !err.contains("Segmentation") && !err.contains("signal"), "{err}");
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(s["status"], "failed", "{s}");
+        assert!(s["steps"].as_u64().unwrap() >= 100, "{s}");
+        assert!(!dir.join("checkpoint.h5.tmp").exists() && !dir.join("summary.tmp").exists());
+        let restart = dir.join("restarted");
+        let r = run_case(
+            "cases/terzaghi.toml",
+            &restart,
+            &["--restart".into(), dir.join("checkpoint.h5").display().to_string()],
+        );
+        assert!(r.completed(), "{ranks} ranks: the kept checkpoint restarts: {}", r.stderr());
+        assert_eq!(r.summary["steps"], 601);
+    }
+}
+
+/// MUMPS out of workspace (the slumping block at k = 1e-12 m/s with the default ICNTL(14)):
+/// the step is factorised again with 20 times the workspace, said in an event line, and the run
+/// goes on; a MUMPS failure that more workspace does not cure (a memory cap, ICNTL(23) = 1 MB)
+/// ends the run with its cause named.
+#[test]
+fn a_direct_solver_out_of_workspace_retries_with_more() {
+    let sets = ["materials.soil.hydraulic_conductivity=1e-12", "stages.slump.duration=0.003"];
+    let dir = std::env::temp_dir().join(format!("porompm-extreme-mumps-{}", std::process::id()));
+    // Not quiet: the event lines are the record of the retry.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_porompm"))
+        .args(["run", "cases/slumping_block.toml", "--out"])
+        .arg(&dir)
+        .args(set_args(&sets))
+        .current_dir(root())
+        .output()
+        .expect("porompm runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("MUMPS: its real workspace was too small (INFOG(1) = -9") && err.contains("ICNTL(14) = 400"),
+        "{err}"
+    );
+    let capped = std::env::temp_dir().join(format!("porompm-extreme-mumps-capped-{}", std::process::id()));
+    let mut args = set_args(&["stages.slump.duration=0.003"]);
+    args.extend(["--".into(), "-mat_mumps_icntl_23".into(), "1".into()]);
+    let r = run_case("cases/slumping_block.toml", &capped, &args);
+    assert_eq!(r.summary["status"], "failed");
+    assert!(
+        r.stderr().contains("MUMPS: the memory allowed by ICNTL(23) was too small (INFOG(1) = -19"),
+        "{}",
+        r.stderr()
+    );
+}

@@ -163,6 +163,7 @@ pub(super) fn update<const D: usize, const M: usize, const N: usize>(
         linear_field_residuals: Vec::new(),
         solver_used: false,
         line_search_retry: false,
+        workspace_retry: None,
     };
     Ok((solve, solution))
 }

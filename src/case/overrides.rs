@@ -75,6 +75,17 @@ fn segments(key: &str) -> Result<Vec<Segment>, String> {
 pub fn apply(doc: &mut Value, ov: &Override) -> Result<String, CaseError> {
     let err = |m: String| CaseError::new(format!("--set {}: {m}", ov.key));
     let segs = segments(&ov.key).map_err(err)?;
+    if let [Segment::Key(table), Segment::Key(name)] = &segs[..] {
+        // `[parameters]` is free-form: a name it does not declare would be set and never read.
+        let declared = doc.get("parameters").and_then(Value::as_table);
+        if table == "parameters" && !declared.is_some_and(|t| t.contains_key(name)) {
+            let names: Vec<&str> = declared.map(|t| t.keys().map(String::as_str).collect()).unwrap_or_default();
+            return Err(err(match names.is_empty() {
+                true => format!("the case declares no parameters, so none named `{name}`"),
+                false => format!("the case declares no parameter `{name}` (it declares: {})", names.join(", ")),
+            }));
+        }
+    }
     let mut path = String::new();
     let mut cur = doc;
     for (k, seg) in segs.iter().enumerate() {
@@ -185,5 +196,16 @@ mod tests {
         assert!(e.to_string().contains("out of range"), "{e}");
         let e = apply(&mut d, &Override::parse("grid.cells.x=3").unwrap()).unwrap_err();
         assert!(e.to_string().starts_with("--set grid.cells.x"), "{e}");
+    }
+
+    #[test]
+    fn only_declared_parameters_can_be_set() {
+        let mut d = doc();
+        let e = apply(&mut d, &Override::parse("parameters.h=0.5").unwrap()).unwrap_err();
+        assert!(e.to_string().contains("declares no parameters, so none named `h`"), "{e}");
+        d.as_table_mut().unwrap().insert("parameters".into(), toml::from_str::<Value>("h = 1.0\nb = 2.0").unwrap());
+        assert_eq!(apply(&mut d, &Override::parse("parameters.h=0.5").unwrap()).unwrap(), "parameters.h");
+        let e = apply(&mut d, &Override::parse("parameters.H=0.5").unwrap()).unwrap_err();
+        assert!(e.to_string().contains("no parameter `H` (it declares: b, h)"), "{e}");
     }
 }

@@ -83,6 +83,27 @@ impl RunError {
             RunError::Input(m) | RunError::Failed(m) | RunError::Interrupted(m) => m,
         }
     }
+
+    /// The same error with `note` added to its message.
+    fn noting(self, note: &str) -> RunError {
+        match self {
+            RunError::Input(m) => RunError::Input(format!("{m}; {note}")),
+            RunError::Failed(m) => RunError::Failed(format!("{m}; {note}")),
+            RunError::Interrupted(m) => RunError::Interrupted(format!("{m}; {note}")),
+        }
+    }
+}
+
+/// `result` made the same on every rank: what rank 0 alone writes (history rows, the running
+/// summary, the fields' index) can fail there alone, and the other ranks would then wait for it
+/// in their next collective call. Collective.
+fn on_every_rank<T>(coll: &Collective, result: Result<T, RunError>) -> Result<T, RunError> {
+    let agreed = coll.agree(result.as_ref().map(|_| ()).map_err(|e| e.message().to_string()));
+    match (result, agreed) {
+        (Err(e), _) => Err(e),
+        (Ok(_), Err(m)) => Err(RunError::Failed(m)),
+        (Ok(v), Ok(())) => Ok(v),
+    }
 }
 
 /// A failure of the run's machinery (PETSc, MPI, files) while it runs.
@@ -100,19 +121,21 @@ impl<const D: usize> Dimension<D> for Dim<D> where Dim<D>: StepDim<D> + CaseChec
 pub fn run(req: &RunRequest, out: &mut RunOutput) -> (Summary, Option<RunError>) {
     let start = Instant::now();
     let mut summary = setup::summary_of(req);
-    let result = out.write_summary(&summary).map_err(RunError::Input).and_then(|_| match req.case.dimension() {
+    let result = match req.case.dimension() {
         3 => run_in::<3, { MAX_NODES_3D }, { MAX_DOF_3D }>(req, out, &mut summary),
         _ => run_in::<2, { MAX_NODES }, { MAX_DOF }>(req, out, &mut summary),
-    });
+    };
     // The field files' index lists every output time, also of a failed run.
     let indexed = out.finish_fields();
     let result = result.and_then(|_| indexed.map_err(RunError::Failed));
     journal::settle(&mut summary, req.coll, start);
     let err = result.err();
     summary.settle(err.as_ref().map(|e| (e.message(), matches!(e, RunError::Interrupted(_)))));
-    let written = out.write_summary(&summary);
+    // A run that failed before it began leaves the directory as it was (the error is its record).
+    let written = if out.has_begun() { out.write_summary(&summary) } else { Ok(()) };
     match (err, written) {
-        (Some(e), _) => (summary, Some(e)),
+        (Some(e), Ok(())) => (summary, Some(e)),
+        (Some(e), Err(w)) => (summary, Some(e.noting(&format!("summary.json was not updated: {w}")))),
         (None, Err(w)) => (summary, Some(RunError::Failed(w))),
         (None, Ok(())) => (summary, None),
     }
@@ -345,16 +368,18 @@ where
             energy,
             nodes: &self.nodes,
         };
-        let (values, warnings) = self.journal.with_sink(|sink: &mut Sink| {
+        let recorded = self.journal.with_sink(|sink: &mut Sink| {
             let mut values = Vec::new();
             for r in self.recorders.iter_mut() {
                 values.extend(r.record(&at, row, sink)?);
             }
             Ok(values)
-        })?;
-        if row {
-            self.journal.history_row(&values)?;
-        }
+        });
+        let recorded = recorded.and_then(|(values, warnings)| match row {
+            true => self.journal.history_row(&values).map(|_| warnings),
+            false => Ok(warnings),
+        });
+        let warnings = on_every_rank(self.coll, recorded)?;
         self.journal.warn(warnings);
         self.journal.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())
@@ -364,12 +389,13 @@ where
     fn milestone(&mut self) -> Result<(), RunError> {
         let at =
             Moment::between(&self.model, self.coll, self.system.space().owners(), (self.t, self.step), &self.nodes);
-        let (_, warnings) = self.journal.with_sink(|sink: &mut Sink| {
+        let recorded = self.journal.with_sink(|sink: &mut Sink| {
             for r in self.recorders.iter_mut() {
                 r.milestone(&at, sink)?;
             }
             Ok(())
-        })?;
+        });
+        let (_, warnings) = on_every_rank(self.coll, recorded)?;
         self.journal.warn(warnings);
         Ok(())
     }
@@ -384,7 +410,7 @@ where
         let at =
             Moment::between(&self.model, self.coll, self.system.space().owners(), (self.t, self.step), &self.nodes);
         let mut figures = Vec::new();
-        let (_, warnings) = self.journal.with_sink(|sink: &mut Sink| {
+        let recorded = self.journal.with_sink(|sink: &mut Sink| {
             let mut first_error = Ok(());
             for r in self.recorders.iter_mut() {
                 let done = r.finish(&at, sink);
@@ -392,7 +418,8 @@ where
             }
             figures = std::mem::take(&mut sink.figures);
             first_error
-        })?;
+        });
+        let (_, warnings) = on_every_rank(self.coll, recorded)?;
         self.journal.warn(warnings);
         self.journal.figures(figures);
         self.journal.summary.timings.output_s += t0.elapsed().as_secs_f64();

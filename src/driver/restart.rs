@@ -73,7 +73,8 @@ where
             self.write_checkpoint(stage_index, control)?;
         }
         if !interrupted {
-            return self.journal.keep_summary(self.step.is_multiple_of(self.case.output.history_every));
+            let kept = self.journal.keep_summary(self.step.is_multiple_of(self.case.output.history_every));
+            return super::on_every_rank(self.coll, kept);
         }
         self.write_checkpoint(stage_index, control)?;
         Err(RunError::Interrupted(format!(

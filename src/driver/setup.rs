@@ -10,6 +10,7 @@ use crate::case::{Case, Stage, Stiffness};
 use crate::io::RunOutput;
 use crate::layout::Dim;
 use crate::model::{grid_of, Active, Model};
+use crate::parallel::Collective;
 use crate::progress::Progress;
 use crate::summary::Summary;
 use std::time::Instant;
@@ -23,6 +24,25 @@ pub(super) fn summary_of(req: &RunRequest) -> Summary {
         req.coll.size(),
         crate::assembly::petsc_options().unwrap_or_default(),
     )
+}
+
+/// Every face traction acts on some material point: a region that holds no point of its bodies
+/// with the loaded face on the material's surface would load nothing, silently. Collective.
+fn loads_that_act<const D: usize>(case: &Case, model: &Model<D>, coll: &Collective) -> Result<(), String> {
+    for (i, l) in case.loads.iter().enumerate() {
+        let crate::case::Load::ParticleTraction(t) = l else { continue };
+        let here = model.loads.iter().find(|d| d.name == l.name()).map_or(0, |d| d.size());
+        if coll.sum(&[here as f64])?[0] == 0.0 {
+            return Err(format!(
+                "key `loads[{i}].region`: load `{}` acts on no material point: no point of {} lies in its region \
+                 with its {} face on the surface of the material",
+                l.name(),
+                t.body.as_ref().map_or("any body".to_string(), |b| format!("body `{b}`")),
+                serde_json::to_string(&t.face).unwrap_or_default()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `test-jacobian` checks the exact tangent: a case whose Newton matrix is one of [001]'s mapped
@@ -61,11 +81,13 @@ where
             .map_err(|e| input(e.to_string()))?;
         let setup_stage = system.phase(Phase::Setup).map_err(|e| input(e.to_string()))?;
         let model = Model::<D>::of_case(case, |c| system.space().owns_cell_in(c));
+        loads_that_act(case, &model, coll).map_err(input)?;
         let recorders = crate::recorders::registered(case, &model, coll).map_err(input)?;
         summary.particles = coll.sum(&[model.particles.len() as f64]).map_err(input)?[0] as usize;
         summary.grid_dofs = system.space().total_dofs();
         let columns: Vec<String> = recorders.iter().flat_map(|r| r.columns()).collect();
-        out.start_history(&columns).map_err(input)?;
+        coll.agree(out.begin(&*summary)).map_err(input)?;
+        coll.agree(out.start_history(&columns)).map_err(input)?;
         if case.output.fields_every > 0 {
             out.start_fields(crate::fields::grid_geometry(&model), coll.communicator()).map_err(input)?;
         }

@@ -65,6 +65,9 @@ where
         if solved.solver_used && summary.solver.is_empty() {
             self.first_solve()?;
         }
+        if let Some(why) = &solved.workspace_retry {
+            self.journal.progress(&format!("  step from t = {:.6e} s: {why}", self.t));
+        }
         if solved.converged && solved.line_search_retry {
             self.journal.progress(&format!(
                 "  step from t = {:.6e} s: full Newton steps failed, solved with a line search ({})",

@@ -42,16 +42,18 @@ fn dataset_f64(g: &h5::Group, name: &str, shape: &[usize], data: &[f64]) -> h5::
     g.new_dataset::<f64>().shape(shape.to_vec()).create(name)?.write_raw(data)
 }
 
-/// The same outcome on every rank of `comm`: `Ok` if every rank's is, else this rank's error or,
-/// on the ranks that succeeded, a note that another failed.
+/// The same outcome on every rank of `comm` ([`super::agree`]).
 fn agree<T>(comm: &SimpleCommunicator, local: Result<T, String>) -> Result<T, String> {
-    let mine = local.is_err() as i32;
-    let mut any = 0i32;
-    comm.all_reduce_into(&mine, &mut any, SystemOperation::max());
-    match local {
-        Ok(_) if any > 0 => Err("another rank could not read or write the checkpoint".into()),
-        other => other,
-    }
+    super::agree(comm, local, "another rank could not read or write the checkpoint")
+}
+
+/// The size of `cp`'s file [B], about: its numbers and the metadata of its datasets.
+fn size_of(cp: &Checkpoint) -> u64 {
+    let numbers = cp.total as usize * record_len(cp.dim)
+        + cp.recorders.iter().map(|(_, s)| s.len()).sum::<usize>()
+        + cp.counters.len()
+        + cp.load_totals.len();
+    8 * numbers as u64 + 16 * 1024
 }
 
 /// The particles' checksum share of every rank, added (wrapping).
@@ -82,6 +84,15 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         false => Ok(()),
     };
     agree(comm, removed)?;
+    // A full disk is refused before HDF5 starts: a write that fails inside its collective calls
+    // can leave the ranks in different ones and the file open at exit.
+    let room = match (writer, path.parent()) {
+        (true, Some(dir)) => {
+            super::check_room(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }, &tmp, size_of(cp))
+        }
+        _ => Ok(()),
+    };
+    agree(comm, room.map_err(|e| format!("cannot write a checkpoint, the last one is kept: {e}")))?;
     let hash = hash_over_ranks(comm, cp.records_hash());
     let written = (|| -> h5::Result<()> {
         let f = open_mpio(&tmp, comm, true)?;
@@ -124,7 +135,13 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
         f.flush()?;
         f.close()
     })();
-    agree(comm, written.map_err(fail))?;
+    if let Err(e) = agree(comm, written.map_err(fail)) {
+        // The partial file is removed to give its room back to the summary.
+        if writer {
+            let _ = fs::remove_file(&tmp);
+        }
+        return Err(e);
+    }
     let renamed = if writer {
         let sync = |p: &Path| fs::File::open(p).and_then(|f| f.sync_all());
         sync(&tmp)

@@ -263,8 +263,25 @@ impl FieldFiles {
         }
     }
 
-    /// Appends one output time (collective) and, on the writing rank, rewrites the XDMF file.
-    pub fn write(&mut self, frame: &Frame) -> Result<(), String> {
+    /// The size of `frame` in the HDF5 file [B], about: its numbers over all ranks and the
+    /// metadata of its datasets.
+    fn size_of(&self, frame: &Frame) -> u64 {
+        let nodes: usize = self.grid.nodes.iter().product();
+        let per_point: usize = frame.particle_fields.iter().map(|f| f.components).sum();
+        let per_node: usize = frame.grid_fields.iter().map(|f| f.components).sum();
+        let datasets = frame.particle_fields.len() + frame.grid_fields.len();
+        8 * (frame.particles * per_point + nodes * per_node) as u64 + 2048 * datasets as u64
+    }
+
+    /// Appends one output time (collective over `comm`, the ranks the files were created on) and,
+    /// on the writing rank, rewrites the XDMF file. A disk without room for the output time is
+    /// refused on every rank before HDF5 writes anything.
+    pub fn write(&mut self, frame: &Frame, comm: &SimpleCommunicator) -> Result<(), String> {
+        let room = match (self.writer, self.h5.parent()) {
+            (true, Some(dir)) => super::check_room(dir, &self.h5, self.size_of(frame)),
+            _ => Ok(()),
+        };
+        super::agree(comm, room, "another rank could not write the fields")?;
         let i = self.frames;
         let fail = |e: h5::Error| format!("cannot write {}: {e}", self.h5.display());
         let [nx, ny, nz] = self.grid.nodes;
@@ -416,7 +433,7 @@ mod tests {
                 node_block: ([0, 0, 0], [3, 5, 1]),
                 grid_fields: vec![Field { name: "active", components: 1, values: Values::Int(vec![1; 15]) }],
             };
-            files.write(&frame).unwrap();
+            files.write(&frame, &world).unwrap();
         }
         files.finish().unwrap();
         let text = fs::read_to_string(dir.join("fields.xdmf")).unwrap();
@@ -436,7 +453,7 @@ mod tests {
             node_block: ([0, 0, 0], [3, 5, 1]),
             grid_fields: vec![],
         };
-        assert!(files.write(&bad).unwrap_err().contains("`position`"));
+        assert!(files.write(&bad, &world).unwrap_err().contains("`position`"));
         let bad = Frame {
             time: 1.0,
             particles: 3,
@@ -448,9 +465,9 @@ mod tests {
             node_block: ([0, 0, 0], [3, 5, 1]),
             grid_fields: vec![],
         };
-        assert!(files.write(&bad).unwrap_err().contains("`p` has 1 values"));
+        assert!(files.write(&bad, &world).unwrap_err().contains("`p` has 1 values"));
         let bad = Frame { first_particle: 2, particle_fields: bad.particle_fields[..1].to_vec(), ..bad.clone() };
-        assert!(files.write(&bad).unwrap_err().contains("outside"), "rows 2..5 of 3 particles");
+        assert!(files.write(&bad, &world).unwrap_err().contains("outside"), "rows 2..5 of 3 particles");
         files.finish().unwrap();
         assert_eq!(fs::read_to_string(dir.join("fields.xdmf")).unwrap(), text, "the XDMF file lists complete frames");
         fs::remove_dir_all(&dir).unwrap();
@@ -480,7 +497,7 @@ mod tests {
                 Field { name: "du", components: 3, values: Values::Real((0..30).map(f64::from).collect()) },
             ],
         };
-        files.write(&frame).unwrap();
+        files.write(&frame, &world).unwrap();
         files.finish().unwrap();
         let text = fs::read_to_string(dir.join("fields.xdmf")).unwrap();
         assert!(text.contains("TopologyType=\"3DCoRectMesh\" Dimensions=\"2 5 3\""), "{text}");
@@ -499,7 +516,7 @@ mod tests {
         assert_eq!(du.shape(), vec![2, 5, 3, 3]);
         // A block outside the grid along z is refused.
         let bad = Frame { node_block: ([0, 0, 1], [3, 5, 2]), ..frame.clone() };
-        assert!(files.write(&bad).unwrap_err().contains("outside"));
+        assert!(files.write(&bad, &world).unwrap_err().contains("outside"));
         fs::remove_dir_all(&dir).unwrap();
     }
 }

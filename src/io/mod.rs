@@ -70,42 +70,180 @@ pub struct RunOutput {
     shared: Option<PathBuf>,
     history: Option<BufWriter<File>>,
     fields: Option<fields::FieldFiles>,
+    /// The writing rank's lock on the directory ([`LOCK_FILE`]), held while this output lives.
+    _lock: Option<File>,
+    /// Whether the run has begun writing ([`RunOutput::begin`]).
+    begun: bool,
 }
 
-/// Writes `content` to `path` atomically (write a temporary file, then rename).
+/// The file in an output directory that the run writing into it holds locked (`flock`, released
+/// by the kernel when the process ends, however it ends); it holds the process id.
+pub const LOCK_FILE: &str = ".porompm.lock";
+
+/// Takes the lock on `dir` ([`LOCK_FILE`]), or says which process holds it.
+fn lock(dir: &Path) -> Result<File, String> {
+    let path = dir.join(LOCK_FILE);
+    let mut f = fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+    match f.try_lock() {
+        Ok(()) => {}
+        Err(fs::TryLockError::WouldBlock) => {
+            let holder = fs::read_to_string(&path).unwrap_or_default();
+            let holder = holder.trim();
+            let holder = if holder.is_empty() { String::new() } else { format!(" ({holder})") };
+            return Err(format!(
+                "output directory {} is in use by another run{holder}: give this run another --out, or wait for that one to end",
+                dir.display()
+            ));
+        }
+        Err(fs::TryLockError::Error(e)) => return Err(format!("cannot lock {}: {e}", path.display())),
+    }
+    let stamp = format!("process {} on {}", std::process::id(), hostname());
+    f.set_len(0)
+        .and_then(|_| f.write_all(stamp.as_bytes()))
+        .and_then(|_| f.flush())
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(f)
+}
+
+/// This machine's name, for the lock's holder (empty if unknown).
+fn hostname() -> String {
+    fs::read_to_string("/proc/sys/kernel/hostname").map(|h| h.trim().to_string()).unwrap_or_default()
+}
+
+/// Writes `content` to `path` atomically (write a temporary file, then rename). A failed write
+/// leaves `path` as it was and removes its temporary file.
 pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
     let tmp = path.with_extension("tmp");
-    let mut f = File::create(&tmp).map_err(|e| format!("cannot create {}: {e}", tmp.display()))?;
-    f.write_all(content).and_then(|_| f.sync_all()).map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
-    fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
+    let written = File::create(&tmp)
+        .map_err(|e| format!("cannot create {}: {e}", tmp.display()))
+        .and_then(|mut f| {
+            f.write_all(content).and_then(|_| f.sync_all()).map_err(|e| format!("cannot write {}: {e}", tmp.display()))
+        })
+        .and_then(|_| {
+            fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} to {}: {e}", tmp.display(), path.display()))
+        });
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// Room a file about to be written must leave free on its disk: the summary, the history rows
+/// and the event lines that follow it must still fit, also when the run then ends.
+pub const SPARE_BYTES: u64 = 64 * 1024;
+
+/// Whether the disk of `dir` has room for `file`, about `bytes` long, and [`SPARE_BYTES`] more
+/// (one eighth of `bytes` added for the file's metadata); the error names the file, what it needs
+/// and what is free. A disk whose free space cannot be read passes.
+pub fn check_room(dir: &Path, file: &Path, bytes: u64) -> Result<(), String> {
+    let Some(free) = free_space(dir) else { return Ok(()) };
+    let need = bytes + bytes / 8 + SPARE_BYTES;
+    if free >= need {
+        return Ok(());
+    }
+    let kib = |b: u64| match b < 1 << 20 {
+        true => format!("{} KiB", b.div_ceil(1024)),
+        false => format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0)),
+    };
+    Err(format!(
+        "the disk is full: {} needs about {} and the disk of {} has {} free",
+        file.display(),
+        kib(need),
+        dir.display(),
+        kib(free)
+    ))
+}
+
+/// The free space of the disk of `dir` [B]: the file system's or, for the tests of a full disk
+/// (fault injection), that of a disk of `PORO_FAULT_DISK_BYTES` bytes holding `dir` alone.
+fn free_space(dir: &Path) -> Option<u64> {
+    match std::env::var("PORO_FAULT_DISK_BYTES").ok().and_then(|v| v.parse::<u64>().ok()) {
+        Some(disk) => Some(disk.saturating_sub(bytes_under(dir))),
+        None => fs4::available_space(dir).ok(),
+    }
+}
+
+/// The bytes of the files under `dir`.
+fn bytes_under(dir: &Path) -> u64 {
+    let Ok(entries) = fs::read_dir(dir) else { return 0 };
+    entries
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => bytes_under(&e.path()),
+            _ => e.metadata().map_or(0, |m| m.len()),
+        })
+        .sum()
+}
+
+/// The same outcome on every rank of `comm`: `Ok` if every rank's is, else this rank's error or,
+/// on the ranks that succeeded, the note `other` that another failed.
+pub(crate) fn agree<T>(comm: &SimpleCommunicator, local: Result<T, String>, other: &str) -> Result<T, String> {
+    use mpi::collective::SystemOperation;
+    use mpi::traits::CommunicatorCollectives;
+    let mine = local.is_err() as i32;
+    let mut any = 0i32;
+    comm.all_reduce_into(&mine, &mut any, SystemOperation::max());
+    match local {
+        Ok(_) if any > 0 => Err(other.into()),
+        other => other,
+    }
 }
 
 impl RunOutput {
-    /// Prepares `dir` (created if needed) on the writing rank; the others only keep its name, for
-    /// the field files all ranks write. Results of
-    /// an earlier run in the same directory are removed first so that they cannot be mistaken
-    /// for this run's.
+    /// Prepares `dir` (created if needed) on the writing rank and locks it for this run (a second
+    /// run into it is refused while this one lives); the others only keep its name, for the field
+    /// files all ranks write. Nothing in it changes until [`RunOutput::begin`].
     pub fn create(dir: &Path, writer: bool) -> Result<RunOutput, String> {
-        if !writer {
-            return Ok(RunOutput { dir: None, shared: Some(dir.to_path_buf()), history: None, fields: None });
+        let mut out = RunOutput {
+            dir: None,
+            shared: Some(dir.to_path_buf()),
+            history: None,
+            fields: None,
+            _lock: None,
+            begun: false,
+        };
+        if writer {
+            fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+            out._lock = Some(lock(dir)?);
+            out.dir = Some(dir.to_path_buf());
         }
-        fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
-        for old in ["summary.json", "history.csv", "amplitude_profile.csv", "fields.h5", "fields.xdmf"] {
-            let p = dir.join(old);
-            if p.exists() {
-                fs::remove_file(&p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
+        Ok(out)
+    }
+
+    /// Begins the run's output once it has been set up: the results of an earlier run in the
+    /// directory are removed (so that they cannot be mistaken for this run's, and a run that
+    /// fails to start leaves them as they were), then `summary` is written.
+    pub fn begin<T: Serialize>(&mut self, summary: &T) -> Result<(), String> {
+        if let Some(dir) = &self.dir {
+            for old in ["summary.json", "history.csv", "amplitude_profile.csv", "fields.h5", "fields.xdmf"] {
+                let p = dir.join(old);
+                if p.exists() {
+                    fs::remove_file(&p).map_err(|e| format!("cannot remove old {}: {e}", p.display()))?;
+                }
+            }
+            let plots = dir.join(PLOTS_DIR);
+            if plots.is_dir() {
+                fs::remove_dir_all(&plots).map_err(|e| format!("cannot remove old {}: {e}", plots.display()))?;
             }
         }
-        let plots = dir.join(PLOTS_DIR);
-        if plots.is_dir() {
-            fs::remove_dir_all(&plots).map_err(|e| format!("cannot remove old {}: {e}", plots.display()))?;
-        }
-        Ok(RunOutput { dir: Some(dir.to_path_buf()), shared: Some(dir.to_path_buf()), history: None, fields: None })
+        self.begun = true;
+        self.write_summary(summary)
+    }
+
+    /// Whether [`RunOutput::begin`] has been called.
+    pub fn has_begun(&self) -> bool {
+        self.begun
     }
 
     /// An output that writes nothing on any rank (the tangent check).
     pub fn silent() -> RunOutput {
-        RunOutput { dir: None, shared: None, history: None, fields: None }
+        RunOutput { dir: None, shared: None, history: None, fields: None, _lock: None, begun: false }
     }
 
     /// Draws the figures as PNG files into `plots/` (created if needed) and returns the paths.
@@ -161,10 +299,10 @@ impl RunOutput {
         Ok(())
     }
 
-    /// Appends one output time to the field files (if started; collective).
-    pub fn write_fields(&mut self, frame: &fields::Frame) -> Result<(), String> {
+    /// Appends one output time to the field files (if started; collective over `comm`).
+    pub fn write_fields(&mut self, frame: &fields::Frame, comm: &SimpleCommunicator) -> Result<(), String> {
         match self.fields.as_mut() {
-            Some(f) => f.write(frame),
+            Some(f) => f.write(frame, comm),
             None => Ok(()),
         }
     }
@@ -280,8 +418,14 @@ mod tests {
         fs::create_dir_all(&dir).unwrap();
         fs::write(dir.join("summary.json"), "{\"status\": \"completed\"}").unwrap();
         let mut out = RunOutput::create(&dir, true).unwrap();
-        assert!(!dir.join("summary.json").exists(), "a stale summary must not survive");
-        out.write_summary(&serde_json::json!({"status": "running"})).unwrap();
+        assert!(dir.join("summary.json").exists(), "nothing is removed before the run begins");
+        let second = RunOutput::create(&dir, true).err().unwrap_or_default();
+        assert!(second.contains("in use by another run (process "), "{second}");
+        out.begin(&serde_json::json!({"status": "running"})).unwrap();
+        assert!(
+            fs::read_to_string(dir.join("summary.json")).unwrap().contains("running"),
+            "a stale summary is replaced"
+        );
         out.start_history(&["time".into(), "p".into()]).unwrap();
         out.history_row(&[0.5, 1.25]).unwrap();
         out.write_table("t.csv", &["a", "b"], &[vec![1.0, 2.0]]).unwrap();
@@ -291,7 +435,8 @@ mod tests {
         assert!(fs::read_to_string(dir.join("t.csv")).unwrap().starts_with("a,b\n"));
         fs::create_dir_all(dir.join(PLOTS_DIR)).unwrap();
         fs::write(dir.join(PLOTS_DIR).join("old.png"), "stale").unwrap();
-        RunOutput::create(&dir, true).unwrap();
+        drop(out);
+        RunOutput::create(&dir, true).unwrap().begin(&serde_json::json!({})).unwrap();
         assert!(!dir.join(PLOTS_DIR).exists(), "stale plots must not survive");
         let peak = peak_memory_mib().unwrap();
         assert!(peak > 1.0 && peak < 1e6, "{peak} MiB");

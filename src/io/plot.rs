@@ -35,14 +35,21 @@ fn colour(i: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
+/// The size of a figure's PNG file at most [B], about.
+const FIGURE_BYTES: u64 = 256 * 1024;
+
 /// Writes every figure that has data as `<dir>/<figure.file>` (the directory is created if needed)
-/// and returns the paths written.
+/// and returns the paths written. A figure the disk has no room for is not started.
 pub fn write_figures(dir: &Path, figures: &[Figure]) -> Result<Vec<PathBuf>, String> {
     let mut written = Vec::new();
     for f in figures.iter().filter(|f| f.has_data()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         let path = dir.join(&f.file);
-        render(&path, f).map_err(|e| format!("cannot draw {}: {e}", path.display()))?;
+        super::check_room(dir, &path, FIGURE_BYTES)?;
+        if let Err(e) = render(&path, f) {
+            let _ = std::fs::remove_file(&path);
+            return Err(format!("cannot draw {}: {e}", path.display()));
+        }
         written.push(path);
     }
     Ok(written)

@@ -135,7 +135,8 @@ impl<const D: usize> Particles<D> {
     /// Fills the bodies of the case with n^D points per cell (n = `particles_per_cell`), keeping
     /// those whose cell satisfies `owned(cell)` (the cells of this rank). Points are placed at the
     /// centres of the sub-cells (moved by the body's `perturbation`); a point belongs to the first
-    /// body that contains it. Cells and their sub-cells are visited x fastest.
+    /// body that contains it (validation refuses overlaps unless the later body says
+    /// `overlap = "yield"`). Cells and their sub-cells are visited x fastest.
     pub fn generate(case: &Case, grid: &Grid<D>, owned: impl Fn([usize; D]) -> bool) -> Particles<D> {
         let mut ps = Particles::default();
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
@@ -144,45 +145,15 @@ impl<const D: usize> Particles<D> {
             let (b, body) = (id.index(), case.body(id));
             let mat_index = case.material_id_of(id).index();
             let n = body.particles_per_cell;
-            let (lo2, hi2) = body.shape.bounds();
-            let depth = case.body_depth(body);
-            let (lo, hi): ([f64; D], [f64; D]) = (
-                std::array::from_fn(|d| if d < 2 { lo2[d] } else { depth[0] }),
-                std::array::from_fn(|d| if d < 2 { hi2[d] } else { depth[1] }),
-            );
-            let c0 = grid.cell_containing(lo).unwrap_or([0; D]);
-            let c1 = grid.cell_containing(hi).unwrap_or(grid.cells.map(|c| c - 1));
             let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
             let volume = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
-            let counts = std::array::from_fn(|d| c1[d] - c0[d] + 1);
-            let mut offset = [0; D];
-            loop {
-                let cell: [usize; D] = std::array::from_fn(|d| c0[d] + offset[d]);
-                let mut sub = [0usize; D];
-                loop {
-                    // Global id from the body and the sub-cell position: unique and independent of
-                    // how cells are distributed over ranks.
-                    let number = (0..D)
-                        .rev()
-                        .fold(0u64, |acc, d| acc * (grid.cells[d] * 8) as u64 + (cell[d] * n + sub[d]) as u64);
-                    let id = ((b as u64) << 48) | number;
-                    let x: [f64; D] = std::array::from_fn(|d| {
-                        let shake = body.perturbation * (2.0 * jitter(id, d as u64) - 1.0);
-                        grid.origin[d] + (cell[d] as f64 + (sub[d] as f64 + 0.5 + shake) / n as f64) * grid.h[d]
-                    });
-                    let earlier = case.bodies[..b].iter().any(|o| case.body_holds(o, x));
-                    if case.body_holds(body, x) && !earlier && owned(cell) {
-                        let vol = volume * geometry.measure(x[0]);
-                        ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), pore_water);
-                    }
-                    if !super::shape::next_combination(&mut sub, [n; D]) {
-                        break;
-                    }
+            for_each_candidate(case, grid, b, |cell, id, x| {
+                let earlier = case.bodies[..b].iter().any(|o| case.body_holds(o, x));
+                if case.body_holds(body, x) && !earlier && owned(cell) {
+                    let vol = volume * geometry.measure(x[0]);
+                    ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), pore_water);
                 }
-                if !super::shape::next_combination(&mut offset, counts) {
-                    break;
-                }
-            }
+            });
         }
         ps
     }
@@ -239,6 +210,51 @@ impl<const D: usize> Particles<D> {
 
 /// A pseudo-random number in [0, 1) from a point's id and a stream (SplitMix64): the same point
 /// gets the same number on any rank.
+/// Calls `f(cell, id, x)` for every place body `b` of `case` may put a material point: the
+/// centres of the n^D sub-cells (n its `particles_per_cell`) of the cells its bounding box
+/// touches, moved by its `perturbation`, with the point's global id (from the body and the
+/// sub-cell, the same on any number of ranks). Cells and their sub-cells are visited x fastest;
+/// whether the body holds the place is the caller's question.
+pub fn for_each_candidate<const D: usize>(
+    case: &Case,
+    grid: &Grid<D>,
+    b: usize,
+    mut f: impl FnMut([usize; D], u64, [f64; D]),
+) {
+    let body = &case.bodies[b];
+    let n = body.particles_per_cell;
+    let (lo2, hi2) = body.shape.bounds();
+    let depth = case.body_depth(body);
+    let (lo, hi): ([f64; D], [f64; D]) = (
+        std::array::from_fn(|d| if d < 2 { lo2[d] } else { depth[0] }),
+        std::array::from_fn(|d| if d < 2 { hi2[d] } else { depth[1] }),
+    );
+    let c0 = grid.cell_containing(lo).unwrap_or([0; D]);
+    let c1 = grid.cell_containing(hi).unwrap_or(grid.cells.map(|c| c - 1));
+    let counts = std::array::from_fn(|d| c1[d] - c0[d] + 1);
+    let mut offset = [0; D];
+    loop {
+        let cell: [usize; D] = std::array::from_fn(|d| c0[d] + offset[d]);
+        let mut sub = [0usize; D];
+        loop {
+            let number =
+                (0..D).rev().fold(0u64, |acc, d| acc * (grid.cells[d] * 8) as u64 + (cell[d] * n + sub[d]) as u64);
+            let id = ((b as u64) << 48) | number;
+            let x: [f64; D] = std::array::from_fn(|d| {
+                let shake = body.perturbation * (2.0 * jitter(id, d as u64) - 1.0);
+                grid.origin[d] + (cell[d] as f64 + (sub[d] as f64 + 0.5 + shake) / n as f64) * grid.h[d]
+            });
+            f(cell, id, x);
+            if !super::shape::next_combination(&mut sub, [n; D]) {
+                break;
+            }
+        }
+        if !super::shape::next_combination(&mut offset, counts) {
+            break;
+        }
+    }
+}
+
 fn jitter(id: u64, stream: u64) -> f64 {
     let mut z = id.wrapping_mul(2).wrapping_add(stream).wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -305,7 +321,7 @@ mod tests {
             .replace("size = [0.1, 1.0]\n        cells = [1, 10]", "size = [1.0, 1.0]\n        cells = [10, 10]")
             .replace(
                 "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
-                "shape = { polygon = { vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] } }\n        [[bodies]]\n        name = \"block\"\n        material = \"soil\"\n        particles_per_cell = 1\n        shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }",
+                "shape = { polygon = { vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] } }\n        [[bodies]]\n        name = \"block\"\n        material = \"soil\"\n        particles_per_cell = 1\n        overlap = \"yield\"\n        shape = { rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }",
             );
         let c = crate::validation::load(&text, "t", &[]).unwrap();
         let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
@@ -335,7 +351,7 @@ mod tests {
                 &format!(
                     "shape = {{ rectangle = {{ min = [0.0, 0.0], max = [0.4, 1.0] }} }}\n        z = [0.0, 0.2]\n        \
                      initial_stress = {{ k0 = 0.5 }}\n        {extra}\n        [[bodies]]\n        name = \"rest\"\n        \
-                     material = \"soil\"\n        particles_per_cell = 1\n        \
+                     material = \"soil\"\n        particles_per_cell = 1\n        overlap = \"yield\"\n        \
                      shape = {{ polygon = {{ vertices = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.5], [0.0, 1.0]] }} }}"
                 ),
             );

@@ -24,7 +24,7 @@ impl Fields {
         }
         let t0 = std::time::Instant::now();
         let frame = crate::fields::frame(at.model, at.nodes, at.coll, at.t);
-        sink.out.write_fields(&frame)?;
+        sink.out.write_fields(&frame, at.coll.communicator())?;
         self.written = Some(at.step);
         sink.summary.timings.output_s += t0.elapsed().as_secs_f64();
         Ok(())

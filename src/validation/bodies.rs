@@ -24,6 +24,52 @@ pub(super) fn check(c: &Case) -> Checked {
             ));
         }
     }
+    match c.dimension() {
+        3 => occupancy::<3>(c),
+        _ => occupancy::<2>(c),
+    }
+}
+
+/// Every body holds material points of its own: at least one of the places its
+/// `particles_per_cell` gives it lies inside it, and none lies inside an earlier body too (a
+/// point belongs to one body; two bodies that overlap would leave the later one without its
+/// points there, silently).
+fn occupancy<const D: usize>(c: &Case) -> Checked {
+    let grid = crate::model::grid_of::<D>(c);
+    for (i, b) in c.bodies.iter().enumerate() {
+        let (mut held, mut overlaps) = (0usize, vec![0usize; i]);
+        crate::model::particles::for_each_candidate(c, &grid, i, |_, _, x| {
+            if c.body_holds(b, x) {
+                held += 1;
+                if let Some(e) = c.bodies[..i].iter().position(|o| c.body_holds(o, x)) {
+                    overlaps[e] += 1;
+                }
+            }
+        });
+        let key = format!("bodies[{i}].shape");
+        let own = held - overlaps.iter().sum::<usize>();
+        if held == 0 || own == 0 {
+            let (n, per) = (b.particles_per_cell, if D == 3 { "³" } else { "²" });
+            let spacing = grid.h[0].min(grid.h[1]) / n as f64;
+            let why = match held {
+                0 => format!(
+                    "none of its {n}{per} points per cell lies inside it (it is thinner than the point spacing, \
+                     {spacing:e} m); make it larger or give it more `particles_per_cell`"
+                ),
+                _ => "every point it would hold lies inside an earlier body".into(),
+            };
+            return Err(format!("key `{key}`: body `{}` holds no material point: {why}", b.name));
+        }
+        let refuses = b.overlap == crate::case::Overlap::Refuse;
+        if let Some((e, &n)) = overlaps.iter().enumerate().find(|(_, &n)| n > 0 && refuses) {
+            return Err(format!(
+                "key `{key}`: body `{}` overlaps body `{}` (bodies[{e}]): {n} of its {held} material points lie \
+                 inside both; a material point belongs to one body: make them meet without overlapping, or \
+                 give this body `overlap = \"yield\"` to leave those points to the earlier one",
+                b.name, c.bodies[e].name
+            ));
+        }
+    }
     Ok(())
 }
 

@@ -5,6 +5,23 @@
 use crate::case::check::Checked;
 use crate::case::{Case, Geometry, Load, Stiffness, StressRecovery, Verification};
 
+/// A plane (or axisymmetric) case's load regions have no extent along z: one given would be
+/// ignored (the boundaries' regions are checked with their other z keys).
+pub(super) fn plane_regions(c: &Case) -> Checked {
+    let with_z = c.loads.iter().position(|l| match l {
+        Load::ParticleTraction(t) => t.region.z.is_some(),
+        Load::NodalTraction(t) => t.region.z.is_some(),
+        _ => false,
+    });
+    match with_z {
+        Some(i) => Err(format!(
+            "key `loads[{i}].region.z`: only a three-dimensional case (three entries in `grid.size`) takes a \
+             region's extent along z"
+        )),
+        None => Ok(()),
+    }
+}
+
 /// What a three-dimensional case may not ask for, and the space of its points' identifiers.
 pub(super) fn three_dimensional(c: &Case) -> Checked {
     let not_yet =

@@ -10,6 +10,8 @@ pub(super) fn check(c: &Case) -> Checked {
     c.grid.check("grid")?;
     if c.dimension() == 3 {
         dimensions::three_dimensional(c)?;
+    } else {
+        dimensions::plane_regions(c)?;
     }
     dimensions::axisymmetry(c, Bounds::of(c).tol[0])
 }

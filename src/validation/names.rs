@@ -28,6 +28,7 @@ impl<'a> Names<'a> {
         if file.stages.is_empty() {
             return Err("at least one [[stages]] table is needed".into());
         }
+        unique("stages", file.stages.iter().map(|s| s.name.as_str()))?;
         unique("probes", file.probes.iter().map(|p| p.name.as_str()))?;
         Ok(Names { file })
     }

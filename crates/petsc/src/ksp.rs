@@ -188,4 +188,65 @@ impl PcRef<'_> {
         call!(PCFactorGetMatSolverType(self.raw, &mut t))?;
         Ok((!t.is_null()).then(|| c_str(t)))
     }
+
+    /// The state of this preconditioner's MUMPS factorisation, once it has been set up (`None`
+    /// for another preconditioner or package).
+    pub fn mumps_status(&self) -> Result<Option<MumpsStatus>> {
+        if !matches!(self.type_name()?.as_str(), "lu" | "cholesky")
+            || self.factor_solver_type()?.as_deref() != Some("mumps")
+        {
+            return Ok(None);
+        }
+        let mut f: sys::Mat = std::ptr::null_mut();
+        call!(PCFactorGetMatrix(self.raw, &mut f))?;
+        if f.is_null() {
+            return Ok(None);
+        }
+        let (mut infog1, mut infog2, mut icntl14): (Int, Int, Int) = (0, 0, 0);
+        call!(MatMumpsGetInfog(f, 1, &mut infog1))?;
+        call!(MatMumpsGetInfog(f, 2, &mut infog2))?;
+        call!(MatMumpsGetIcntl(f, 14, &mut icntl14))?;
+        Ok(Some(MumpsStatus { infog1, infog2, icntl14 }))
+    }
+
+    /// The options prefix of the preconditioner (empty without one).
+    pub fn prefix(&self) -> Result<String> {
+        let mut p: *const c_char = std::ptr::null();
+        call!(PCGetOptionsPrefix(self.raw, &mut p))?;
+        Ok(if p.is_null() { String::new() } else { c_str(p) })
+    }
+}
+
+/// What MUMPS reports of its last factorisation ([`PcRef::mumps_status`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MumpsStatus {
+    /// INFOG(1): 0 on success, negative on an error (MUMPS users' guide, §8).
+    pub infog1: Int,
+    /// INFOG(2): the error's detail.
+    pub infog2: Int,
+    /// ICNTL(14): the percentage by which the workspace exceeds the analysis' estimate.
+    pub icntl14: Int,
+}
+
+impl MumpsStatus {
+    /// Whether the factorisation failed for a workspace or buffer that ICNTL(14) sizes (INFOG(1)
+    /// = −8, −9, −11, −12, −14, −15, −17 or −20).
+    pub fn workspace_too_small(&self) -> bool {
+        matches!(self.infog1, -8 | -9 | -11 | -12 | -14 | -15 | -17 | -20)
+    }
+
+    /// What an error INFOG(1) means, in a few words (empty on success).
+    pub fn cause(&self) -> String {
+        let what = match self.infog1 {
+            0.. => return String::new(),
+            -8 | -14 | -15 => "its integer workspace was too small",
+            -9 | -11 | -12 => "its real workspace was too small",
+            -17 | -20 => "its communication buffers were too small",
+            -10 => "the matrix is numerically singular",
+            -13 => "it could not allocate memory",
+            -19 => "the memory allowed by ICNTL(23) was too small",
+            _ => "it failed",
+        };
+        format!("MUMPS: {what} (INFOG(1) = {}, INFOG(2) = {})", self.infog1, self.infog2)
+    }
 }

@@ -39,7 +39,7 @@ pub use error::{Error, Result};
 pub use fields::{FieldMonitor, Fields};
 pub use init::{Petsc, PetscBuild};
 pub use is::IndexSet;
-pub use ksp::{Ksp, KspRef, PcRef};
+pub use ksp::{Ksp, KspRef, MumpsStatus, PcRef};
 pub use log::{LogStage, StageGuard};
 pub use mat::{Mat, MatRef};
 pub use options::{OptionEntry, Options};

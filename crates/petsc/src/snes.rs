@@ -56,6 +56,8 @@ pub struct SolveOutcome {
     /// The largest relative residual of each field over the linear solves (see
     /// [`crate::fields::relative_field_residuals`]; empty without [`Snes::monitor_fields`]).
     pub linear_field_residuals: Vec<Real>,
+    /// After a linear solve that failed in a MUMPS factorisation, what MUMPS reported.
+    pub factorisation: Option<crate::MumpsStatus>,
 }
 
 /// An owned SNES, destroyed on drop.
@@ -309,6 +311,21 @@ impl Snes {
         call!(SNESView(self.raw, viewer.raw()))
     }
 
+    /// What MUMPS reported of a factorisation that failed in the last linear solve (`None`
+    /// unless the solve failed in its preconditioner and that was a MUMPS factorisation).
+    fn failed_factorisation(&mut self) -> Result<Option<crate::MumpsStatus>> {
+        let mut ksp = self.ksp()?;
+        if ksp.last_solve()?.reason != sys::KSPConvergedReason::KSP_DIVERGED_PC_FAILED.0 {
+            return Ok(None);
+        }
+        Ok(ksp.pc()?.mumps_status()?.filter(|m| m.infog1 < 0))
+    }
+
+    /// The options prefix of the SNES's preconditioner (empty without one).
+    pub fn pc_prefix(&mut self) -> Result<String> {
+        self.ksp()?.pc()?.prefix()
+    }
+
     /// Drops the factors of a factorisation preconditioner (`lu`, `cholesky`) whose last
     /// factorisation failed, so that the next solve analyses and factorises the matrix anew.
     ///
@@ -390,7 +407,9 @@ impl Snes {
         call!(SNESGetConvergenceHistory(self.raw, &mut hist, &mut hist_its, &mut nhist))?;
         let n = (nhist.max(0) as usize).min(self.history.len());
         let final_residual_components = self.residual_components()?;
+        let mut factorisation = None;
         if reason == sys::SNESConvergedReason::SNES_DIVERGED_LINEAR_SOLVE {
+            factorisation = self.failed_factorisation()?;
             self.forget_failed_factorisation()?;
         }
         Ok(SolveOutcome {
@@ -403,6 +422,7 @@ impl Snes {
             domain_error: ctx.domain_error,
             final_residual_components,
             linear_field_residuals: self.fields.as_ref().map(|m| m.worst.clone()).unwrap_or_default(),
+            factorisation,
         })
     }
 }

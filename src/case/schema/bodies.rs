@@ -34,6 +34,22 @@ pub struct Body {
     /// arrangement).
     #[serde(default)]
     pub perturbation: f64,
+    /// Where it overlaps a body listed before it: `"refuse"` (the default: an error, since a
+    /// material point belongs to one body) or `"yield"` (the earlier bodies keep their points
+    /// there and this one fills the rest, e.g. a block around a wedge listed first).
+    #[serde(default)]
+    pub overlap: Overlap,
+}
+
+/// What a body does where it overlaps a body listed before it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Overlap {
+    /// An error: bodies must not overlap.
+    #[default]
+    Refuse,
+    /// The earlier bodies keep their points there.
+    Yield,
 }
 
 fn default_ppc() -> usize {
@@ -240,8 +256,57 @@ impl Polygon {
         for (j, v) in self.vertices.iter().enumerate() {
             finite2(&format!("{key}.vertices[{j}]"), *v)?;
         }
+        // A simple polygon: no two edges meet but neighbours at their shared vertex (even-odd
+        // filling would otherwise give a crossed outline holes and double layers, silently).
+        let n = self.vertices.len();
+        let edge = |i: usize| (self.vertices[i], self.vertices[(i + 1) % n]);
+        for i in 0..n {
+            for j in i + 1..n {
+                let neighbours = j == i + 1 || (i == 0 && j == n - 1);
+                if segments_meet(edge(i), edge(j), neighbours) {
+                    return Err(format!(
+                        "key `{}`: the polygon crosses itself: its edges {i}–{} and {j}–{} meet; give the vertices \
+                         of a simple polygon in order",
+                        at(key, "vertices"),
+                        (i + 1) % n,
+                        (j + 1) % n
+                    ));
+                }
+            }
+        }
         Ok(())
     }
+}
+
+/// Whether the segments `a` and `b` share a point; for `neighbours` (edges with a common
+/// vertex) whether they share more than that vertex (they overlap, folding back).
+fn segments_meet(a: ([f64; 2], [f64; 2]), b: ([f64; 2], [f64; 2]), neighbours: bool) -> bool {
+    let cross = |o: [f64; 2], p: [f64; 2], q: [f64; 2]| (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+    let within = |o: [f64; 2], p: [f64; 2], q: [f64; 2]| {
+        q[0] >= o[0].min(p[0]) && q[0] <= o[0].max(p[0]) && q[1] >= o[1].min(p[1]) && q[1] <= o[1].max(p[1])
+    };
+    let (d1, d2) = (cross(b.0, b.1, a.0), cross(b.0, b.1, a.1));
+    let (d3, d4) = (cross(a.0, a.1, b.0), cross(a.0, a.1, b.1));
+    if neighbours {
+        // Collinear neighbours that fold back over each other.
+        let folds =
+            |o: [f64; 2], p: [f64; 2], q: [f64; 2]| (p[0] - o[0]) * (q[0] - o[0]) + (p[1] - o[1]) * (q[1] - o[1]) > 0.0;
+        let shared = if a.1 == b.0 {
+            Some((a.1, a.0, b.1))
+        } else if b.1 == a.0 {
+            Some((a.0, a.1, b.0))
+        } else {
+            None
+        };
+        return shared.is_some_and(|(v, p, q)| cross(v, p, q) == 0.0 && folds(v, p, q));
+    }
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    (d1 == 0.0 && within(b.0, b.1, a.0))
+        || (d2 == 0.0 && within(b.0, b.1, a.1))
+        || (d3 == 0.0 && within(a.0, a.1, b.0))
+        || (d4 == 0.0 && within(a.0, a.1, b.1))
 }
 
 impl Region {
