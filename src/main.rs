@@ -270,8 +270,10 @@ fn run_started(
         interrupt: Some(interrupt),
     };
     let (summary, err) = driver::run(&req, &mut output);
+    // A run refused before it began has only its error to say.
+    let begun = output.has_begun();
     drop(output);
-    if coll.rank() == 0 && !quiet {
+    if coll.rank() == 0 && !quiet && begun {
         for (name, m) in &summary.verification {
             eprintln!(
                 "{name} = {:.4e} (tolerance {:.1e}) {}  [{}]",
@@ -601,9 +603,18 @@ fn main() -> ExitCode {
             sweep(case, out, options_file, vary, variant, set, metric, *quiet, petsc)
         }
         Command::Report { dir } => porompm::report::report(dir).map(|t| print!("{t}")).map_err(input),
-        Command::Check { case, set } => {
-            load_case(case, set).map(|c| print!("{}", porompm::describe::describe(&c, &case.display().to_string())))
-        }
+        Command::Check { case, set } => load_case(case, set).and_then(|c| {
+            // The estimate first: a case too large for this machine is not built to be described.
+            let e = porompm::model::memory::Estimate::of(&c);
+            match io::available_memory() {
+                Some(free) if e.needed > free => Err(input(e.refusal(e.needed, free))),
+                _ => {
+                    print!("{}", porompm::describe::describe(&c, &case.display().to_string()));
+                    println!("{}", e.line());
+                    Ok(())
+                }
+            }
+        }),
         Command::TestJacobian { case, steps, tolerance, flip_block, set, petsc } => {
             test_jacobian(case, *steps, *tolerance, flip_block.as_deref(), set, petsc)
         }

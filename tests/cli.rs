@@ -834,3 +834,22 @@ fn a_load_that_acts_on_nothing_is_named_and_a_run_that_fails_to_start_changes_no
     assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before, "the finished run's summary is kept");
     assert!(out.join("history.csv").exists());
 }
+
+/// A case too large for this machine (a 6000 × 6000 grid: about 10¹² B) is refused before
+/// anything is allocated, with one line giving what it needs and what the machine has, by `run`
+/// and by `check`; `check` prints the estimate of a case that fits.
+#[test]
+fn a_case_too_large_for_the_machine_is_refused_at_once() {
+    let out = out_dir("too-large");
+    let out = out.to_str().unwrap();
+    let big = "grid.cells=[6000,6000]";
+    for args in [
+        vec!["check", "cases/terzaghi.toml", "--set", big],
+        vec!["run", "cases/terzaghi.toml", "--out", out, "--set", big],
+    ] {
+        assert_one_line_error(&porompm(&args), "of memory on this machine (");
+    }
+    let o = porompm(&["check", "cases/terzaghi.toml"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && text.contains("\nmemory: about "), "{text}");
+}

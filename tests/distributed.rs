@@ -287,3 +287,30 @@ fn a_panic_on_one_rank_ends_every_rank() {
     assert!(stderr.contains("ending every rank of the run"), "{stderr}");
     println!("ended after {:.1} s with {:?}", started.elapsed().as_secs_f64(), output.status.code());
 }
+
+/// The energies of the 3D and the 2D patch tests are the same on 1, 2 and 3 ranks to 1e-10
+/// relative, also on 2 ranks, where the grid is repartitioned after the first step (the last
+/// step's reactions, which the next step's work averages with its own, are carried over to the
+/// new distribution node by node).
+#[test]
+fn the_energies_are_the_same_on_one_two_and_three_ranks_with_repartitioning() {
+    for case in ["patch_test_3d", "patch_test"] {
+        let runs: Vec<Run> = (1..=3)
+            .map(|n| {
+                let r = run_case_on(n, &format!("cases/{case}.toml"), &out_dir(&format!("energies-{case}-{n}")), &[]);
+                assert!(r.completed(), "{case} on {n} ranks: {}", r.stderr());
+                r
+            })
+            .collect();
+        assert_eq!(runs[1].summary["repartitions"], 1, "{case}: the two-rank run repartitions");
+        for name in ["energy_external", "energy_internal", "energy_kinetic", "energy_balance_error"] {
+            let one = runs[0].column(name);
+            for (n, r) in runs.iter().enumerate().skip(1) {
+                for (a, b) in one.iter().zip(r.column(name)) {
+                    let scale = one.iter().fold(1e-30f64, |m, v| m.max(v.abs()));
+                    assert!((a - b).abs() <= 1e-10 * scale, "{case}, {name} on {} ranks: {b} against {a}", n + 1);
+                }
+            }
+        }
+    }
+}

@@ -141,6 +141,38 @@ impl<const D: usize> NodeSpace<D> {
         coll.sum(&all)
     }
 
+    /// A per-dof array of this rank's ghosted layout (its owned nodes' entries; a step's
+    /// reactions) over the whole grid (x fastest, [`Layout::nd`] per node), summed over ranks: what
+    /// a node space that replaces this one on another distribution takes over
+    /// ([`NodeSpace::owned_dofs_of`]; collective).
+    pub fn global_dofs(&self, local: &[f64], coll: &Collective) -> Result<Vec<f64>, String> {
+        let nodes = self.dm.info().nodes;
+        let nd = self.layout.nd;
+        let mut all = vec![0.0; nodes.iter().product::<usize>() * nd];
+        for &a in &self.owned_nodes {
+            let (l, g) = (a as usize * nd, flat_number(nodes, self.ghost.indices(a as usize)) * nd);
+            if let Some(v) = local.get(l..l + nd) {
+                all[g..g + nd].copy_from_slice(v);
+            }
+        }
+        coll.sum(&all)
+    }
+
+    /// This rank's ghosted per-dof array of the whole grid's `all` ([`NodeSpace::global_dofs`]):
+    /// its owned nodes' entries, zero at the ghosts.
+    pub fn owned_dofs_of(&self, all: &[f64]) -> Vec<f64> {
+        let nodes = self.dm.info().nodes;
+        let nd = self.layout.nd;
+        let mut local = vec![0.0; self.ghost.len() * nd];
+        for &a in &self.owned_nodes {
+            let (l, g) = (a as usize * nd, flat_number(nodes, self.ghost.indices(a as usize)) * nd);
+            if let Some(v) = all.get(g..g + nd) {
+                local[l..l + nd].copy_from_slice(v);
+            }
+        }
+        local
+    }
+
     /// This rank's block of the nodal values `all` of the whole grid (x fastest; from
     /// [`NodeSpace::global_values`]), or zeros where `all` does not reach.
     pub fn block_of(&self, all: &[f64]) -> NodeBlock {

@@ -70,8 +70,14 @@ where
         };
         // The last step's nodal values, for the field output on the new distribution.
         let carried = self.system.space().global_values(&self.nodes, self.coll).map_err(failed)?;
+        // The last step's reactions, by node: the next step's work takes their mean with its own.
+        let reactions = self.system.space().global_dofs(&self.last_reactions, self.coll).map_err(failed)?;
+        let had_reactions = !self.last_reactions.is_empty();
         self.replace_system(self.system.layout(), &owners)?;
         self.nodes = self.system.space().block_of(&carried);
+        if had_reactions {
+            self.last_reactions = self.system.space().owned_dofs_of(&reactions);
+        }
         self.journal.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
         self.migrate_particles()?;
         self.journal.summary.repartitions += 1;

@@ -94,6 +94,22 @@ impl RunError {
     }
 }
 
+/// Refuses a case whose memory ([`crate::model::memory::Estimate`], without a direct solver's
+/// factors) does not fit in what the machines running it have available, before anything is
+/// allocated: each machine needs its ranks' share. Collective.
+fn memory_fits(case: &Case, coll: &Collective) -> Result<(), RunError> {
+    use crate::model::memory::{Estimate, BASE_BYTES};
+    let e = Estimate::of(case);
+    let machine = crate::io::machine_id();
+    let here = coll.gather_of(&[machine]).iter().filter(|&&m| m == machine).count() as f64;
+    let need = (e.needed - BASE_BYTES) * here / coll.size() as f64 + BASE_BYTES * here;
+    let fits = match crate::io::available_memory() {
+        Some(free) if need > free => Err(e.refusal(need, free)),
+        _ => Ok(()),
+    };
+    coll.agree(fits).map_err(RunError::Input)
+}
+
 /// `result` made the same on every rank: what rank 0 alone writes (history rows, the running
 /// summary, the fields' index) can fail there alone, and the other ranks would then wait for it
 /// in their next collective call. Collective.
@@ -152,6 +168,7 @@ fn run_in<const D: usize, const M: usize, const N: usize>(
 where
     Dim<D>: Dimension<D>,
 {
+    memory_fits(req.case, req.coll)?;
     let mut sim = Simulation::<D, M, N>::set_up(req, out, summary)?;
     let stages = sim.run_stages();
     let finished = sim.finish();

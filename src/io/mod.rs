@@ -48,6 +48,23 @@ pub fn peak_memory_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
+/// The memory this machine has available for a new run [B] (`MemAvailable` of `/proc/meminfo`),
+/// if the system reports it.
+pub fn available_memory() -> Option<f64> {
+    let info = fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// A number naming this machine (a hash of its host name), to tell which ranks share it.
+pub fn machine_id() -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    hostname().hash(&mut h);
+    h.finish()
+}
+
 /// Creates a directory and its parents if needed.
 pub fn create_dir(dir: &Path) -> Result<(), String> {
     fs::create_dir_all(dir).map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))

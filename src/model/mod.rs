@@ -8,6 +8,7 @@ pub mod finite_strain;
 pub mod grid;
 pub mod loads;
 pub mod material;
+pub mod memory;
 pub mod particles;
 pub mod patch;
 pub mod shape;

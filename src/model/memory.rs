@@ -1,0 +1,170 @@
+//! The memory a run of a case takes, estimated from the case alone before anything is allocated:
+//! its material points, the grid's vectors, the matrix of an implicit stage and, for a direct
+//! solver, the factors. A run refuses to start when the part it cannot do without (everything but
+//! the factors) does not fit in the memory the machine has available; `porompm check` prints the
+//! whole estimate.
+
+use crate::case::{AnalysisType, Case, Formulation, ShapeFunctions};
+
+/// What every rank takes before the case's own data: PETSc, MPI, HDF5 and the program (measured:
+/// 50–60 MiB for the smallest cases on one rank) [B].
+pub const BASE_BYTES: f64 = 60.0 * 1024.0 * 1024.0;
+
+/// A material point's state, stencil and the step's per-point data in two dimensions, measured
+/// (peak memory of the shipped plane cases against their points: 6–9 kB) [B].
+pub const POINT_BYTES_2D: f64 = 6.0e3;
+
+/// The same in three dimensions (the square footing at 21 952 points: 21 kB) [B].
+pub const POINT_BYTES_3D: f64 = 21.0e3;
+
+/// Vectors of the grid's dofs a step keeps (solution, residual, local copies, predictors,
+/// projections, forces and reactions), 8 B each.
+const GRID_VECTORS: f64 = 30.0;
+
+/// Bytes per matrix entry: its value and column index, and the COO arrays it is built from.
+const MATRIX_ENTRY_BYTES: f64 = 20.0;
+
+/// The memory of a run of a case, estimated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// Material points (exact, or for a very large case the sub-cell count of the bodies' boxes).
+    pub points: f64,
+    /// Grid dofs of the largest layout the case's stages take.
+    pub grid_dofs: f64,
+    /// Entries of the matrix (zero when every stage is explicit).
+    pub matrix_entries: f64,
+    /// The points, grid vectors and matrix, with one rank's [`BASE_BYTES`] [B].
+    pub needed: f64,
+    /// A direct solver's factors on top of `needed` (fill measured on the shipped cases: about 10
+    /// times the matrix in two dimensions, 50 in three) [B].
+    pub factors: f64,
+}
+
+impl Estimate {
+    /// The estimate of `case`.
+    pub fn of(case: &Case) -> Estimate {
+        let dim = case.dimension();
+        let cells: Vec<f64> = (0..dim).map(|d| case.grid.cells[d] as f64).collect();
+        let nodes: f64 = cells.iter().map(|c| c + 1.0).product();
+        let two_phase = case.analysis.formulation == Formulation::TwoPhase;
+        let nd = if two_phase { 2 * dim + 1 } else { dim } as f64;
+        let grid_dofs = nodes * nd;
+        let reach = match case.analysis.shape_functions {
+            ShapeFunctions::Linear => 1.0,
+            ShapeFunctions::Bspline3 => 3.0,
+            _ => 2.0,
+        };
+        let implicit = case.stages.iter().any(|s| s.analysis != AnalysisType::DynamicExplicit);
+        let per_row = (2.0f64 * reach + 1.0).powi(dim as i32) * nd;
+        let matrix_entries = if implicit { grid_dofs * per_row } else { 0.0 };
+        let points = points_of(case);
+        let point_bytes = if dim == 3 { POINT_BYTES_3D } else { POINT_BYTES_2D };
+        let needed =
+            BASE_BYTES + points * point_bytes + grid_dofs * GRID_VECTORS * 8.0 + matrix_entries * MATRIX_ENTRY_BYTES;
+        let fill = if dim == 3 { 50.0 } else { 10.0 };
+        Estimate { points, grid_dofs, matrix_entries, needed, factors: matrix_entries * 12.0 * fill }
+    }
+}
+
+/// The material points of `case`: counted where the bodies' boxes hold at most 5e7 candidate
+/// places, otherwise the count of those places (an upper bound; such a case is refused on its
+/// grid alone).
+fn points_of(case: &Case) -> f64 {
+    let dim = case.dimension();
+    let h = case.cell_size_in::<3>();
+    let boxes: f64 = case
+        .bodies
+        .iter()
+        .map(|b| {
+            let (lo, hi) = b.shape.bounds();
+            let depth = case.body_depth(b);
+            let extent = [hi[0] - lo[0], hi[1] - lo[1], depth[1] - depth[0]];
+            (0..dim).map(|d| (extent[d] / h[d]).ceil().max(1.0) * b.particles_per_cell as f64).product::<f64>()
+        })
+        .sum();
+    if boxes > 5.0e7 {
+        return boxes;
+    }
+    match dim {
+        3 => counted::<3>(case),
+        _ => counted::<2>(case),
+    }
+}
+
+/// The material points of `case`, counted as [`super::particles::Particles::generate`] places them.
+fn counted<const D: usize>(case: &Case) -> f64 {
+    let grid = super::grid_of::<D>(case);
+    let mut n = 0usize;
+    for (b, body) in case.bodies.iter().enumerate() {
+        super::particles::for_each_candidate(case, &grid, b, |_, _, x| {
+            if case.body_holds(body, x) && !case.bodies[..b].iter().any(|o| case.body_holds(o, x)) {
+                n += 1;
+            }
+        });
+    }
+    n as f64
+}
+
+impl Estimate {
+    /// The line `porompm check` prints.
+    pub fn line(&self) -> String {
+        format!(
+            "memory: about {} on one rank ({:.3e} material points, {:.3e} grid dofs, {:.3e} matrix entries); a \
+             direct solver's factors about {} more",
+            human(self.needed),
+            self.points,
+            self.grid_dofs,
+            self.matrix_entries,
+            human(self.factors)
+        )
+    }
+
+    /// The refusal of a run that needs `need` [B] on a machine with `free` [B] available.
+    pub fn refusal(&self, need: f64, free: f64) -> String {
+        format!(
+            "the case needs about {} of memory on this machine ({:.3e} material points, {:.3e} grid dofs, {:.3e} \
+             matrix entries; `porompm check` shows the estimate) and it has {} available: coarsen the grid or run \
+             on more machines",
+            human(need),
+            self.points,
+            self.grid_dofs,
+            self.matrix_entries,
+            human(free)
+        )
+    }
+}
+
+/// `bytes` for a person: KiB, MiB or GiB with three figures.
+pub fn human(bytes: f64) -> String {
+    let units = [("GiB", 1u64 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
+    for (name, size) in units {
+        if bytes >= size as f64 {
+            return format!("{:.3} {name}", bytes / size as f64);
+        }
+    }
+    format!("{bytes:.0} B")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_estimate_counts_points_and_grows_with_the_grid() {
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let e = Estimate::of(&c);
+        assert_eq!(e.points, 40.0);
+        // Two-phase u–p–U in the plane: 5 dofs on each of 2 × 11 nodes.
+        assert_eq!(e.grid_dofs, 110.0);
+        assert!(e.needed > BASE_BYTES + 40.0 * POINT_BYTES_2D && e.needed < 2.0 * BASE_BYTES, "{}", human(e.needed));
+        let big = crate::validation::load(
+            crate::case::tests_support::MINIMAL,
+            "t",
+            &[crate::case::Override::parse("grid.cells=[4000,4000]").unwrap()],
+        )
+        .unwrap();
+        let b = Estimate::of(&big);
+        assert!(b.needed > 1e11, "a 4000 × 4000 grid needs over 100 GB: {}", human(b.needed));
+        assert_eq!(human(1536.0), "1.500 KiB");
+    }
+}
