@@ -15,6 +15,17 @@ pub(super) fn check(c: &Case) -> Checked {
         match l {
             Load::ParticleTraction(t) => {
                 components(&format!("{key}.traction"), &t.traction, dim)?;
+                let held = match dim {
+                    3 => points_in::<3>(c, i, &t.region),
+                    _ => points_in::<2>(c, i, &t.region),
+                };
+                if !held {
+                    return Err(format!(
+                        "key `{key}.region`: load `{}` acts on no material point: no point of {} lies in its region",
+                        t.name,
+                        t.body.as_ref().map_or("any body".to_string(), |b| format!("body `{b}`"))
+                    ));
+                }
                 if let Some(e) = &t.increment_factor {
                     increment_factor(c, &key, &t.region, e)?;
                 }
@@ -33,6 +44,26 @@ pub(super) fn check(c: &Case) -> Checked {
         }
     }
     Ok(())
+}
+
+/// Whether `region` holds a material point of the bodies load `load` acts on (whether the point's
+/// loaded face is on the material's surface is the run's question: it depends on the others).
+fn points_in<const D: usize>(c: &Case, load: usize, region: &Region) -> bool {
+    let grid = crate::model::grid_of::<D>(c);
+    let bodies = c.load_bodies(crate::case::LoadId::new(load));
+    let mut found = false;
+    for (b, body) in c.bodies.iter().enumerate() {
+        if found || bodies.is_some_and(|bs| !bs.iter().any(|id| id.index() == b)) {
+            continue;
+        }
+        crate::model::particles::for_each_candidate(c, &grid, b, |_, _, x| {
+            found = found
+                || (region.contains_in(x)
+                    && c.body_holds(body, x)
+                    && !c.bodies[..b].iter().any(|o| c.body_holds(o, x)));
+        });
+    }
+    found
 }
 
 /// Whether an increment factor `e` evaluates where the loaded faces start: the region's centre

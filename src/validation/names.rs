@@ -105,6 +105,9 @@ impl<'a> Names<'a> {
             for n in s.loads.iter().flatten() {
                 self.load(&format!("stages[{i}].loads"), n)?;
             }
+            // A name listed twice would act once (or twice): either way not what the list says.
+            unique(&format!("key `stages[{i}].boundaries`"), s.boundaries.iter().flatten().map(String::as_str))?;
+            unique(&format!("key `stages[{i}].loads`"), s.loads.iter().flatten().map(String::as_str))?;
         }
         Ok(())
     }

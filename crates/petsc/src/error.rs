@@ -1,7 +1,7 @@
 //! Every PETSc error code becomes a [`Result`] here, and only here.
 //!
-//! At initialisation an error handler is pushed that records PETSc's own message (function, text,
-//! file and line) instead of printing a traceback. [`check`] turns a non-zero code into an [`Error`]
+//! At initialisation an error handler is pushed that records PETSc's own message (function and
+//! text) instead of printing a traceback. [`check`] turns a non-zero code into an [`Error`]
 //! carrying that message. Callbacks written in Rust (SNES residual and Jacobian) report their own
 //! errors through [`set_pending`] so that the message that reaches the caller is the Rust one.
 
@@ -102,7 +102,10 @@ pub(crate) unsafe extern "C" fn record_error(
             msg = generic_message(code);
         }
         let f = text(func);
-        let full = if f.is_empty() { msg } else { format!("{f}(): {msg} [{}:{line}]", text(file)) };
+        // PETSc's source file and line are internals a user cannot act on: left out of the message
+        // (a debugger, `-on_error_attach_debugger`, finds them).
+        let _ = (line, file);
+        let full = if f.is_empty() { msg } else { format!("{f}(): {msg}") };
         set_pending(full);
     } else {
         PENDING.with(|p| {
