@@ -46,8 +46,8 @@ impl Estimate {
         let dim = case.dimension();
         let cells: Vec<f64> = (0..dim).map(|d| case.grid.cells[d] as f64).collect();
         let nodes: f64 = cells.iter().map(|c| c + 1.0).product();
-        let two_phase = case.analysis.formulation == Formulation::TwoPhase;
-        let nd = if two_phase { 2 * dim + 1 } else { dim } as f64;
+        let pore_water = case.analysis.formulation == Formulation::TwoPhase;
+        let nd = if pore_water { 2 * dim + 1 } else { dim } as f64;
         let grid_dofs = nodes * nd;
         let reach = match case.analysis.shape_functions {
             ShapeFunctions::Linear => 1.0,
