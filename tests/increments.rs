@@ -131,7 +131,11 @@ fn bad_increment_input_is_refused_with_a_clear_message() {
         (CASE, &["loads.0.increment_factor=1 / (x - x)"], "is not finite"),
         // Valid at the region's centre, infinite where the faces are (x = 0.5 m) at the start.
         (CASE, &["loads.0.increment_factor=1 / (x - 0.5)"], "at [0.5, 0.1]: the value inf is not finite"),
-        (CASE, &["loads.0.region.min=[1.0,0.0]", "loads.0.region.max=[1.1,0.2]"], "no loaded face is left"),
+        (
+            CASE,
+            &["loads.0.region.min=[1.0,0.0]", "loads.0.region.max=[1.1,0.2]"],
+            "key `loads[0].region`: load `inner_pressure` acts on no material point",
+        ),
         ("cases/terzaghi.toml", &["analysis.kinematics=linear_increments"], "is for a one_phase analysis"),
         ("cases/vertical_cut.toml", &["analysis.kinematics=linear_increments"], "steps are static"),
         ("cases/terzaghi.toml", &["loads.0.increment_factor=x"], "only the hollow_cylinder check follows one"),
