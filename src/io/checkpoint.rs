@@ -86,12 +86,7 @@ pub fn write(path: &Path, cp: &Checkpoint, comm: &SimpleCommunicator, writer: bo
     agree(comm, removed)?;
     // A full disk is refused before HDF5 starts: a write that fails inside its collective calls
     // can leave the ranks in different ones and the file open at exit.
-    let room = match (writer, path.parent()) {
-        (true, Some(dir)) => {
-            super::check_room(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }, &tmp, size_of(cp))
-        }
-        _ => Ok(()),
-    };
+    let room = if writer { super::check_room(&tmp, size_of(cp)) } else { Ok(()) };
     agree(comm, room.map_err(|e| format!("cannot write a checkpoint, the last one is kept: {e}")))?;
     let hash = hash_over_ranks(comm, cp.records_hash());
     let written = (|| -> h5::Result<()> {

@@ -155,10 +155,11 @@ pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<(), String> {
 /// and the event lines that follow it must still fit, also when the run then ends.
 pub const SPARE_BYTES: u64 = 64 * 1024;
 
-/// Whether the disk of `dir` has room for `file`, about `bytes` long, and [`SPARE_BYTES`] more
-/// (one eighth of `bytes` added for the file's metadata); the error names the file, what it needs
-/// and what is free. A disk whose free space cannot be read passes.
-pub fn check_room(dir: &Path, file: &Path, bytes: u64) -> Result<(), String> {
+/// Whether the disk of `file`'s directory has room for it, about `bytes` long, and
+/// [`SPARE_BYTES`] more (one eighth of `bytes` added for the file's metadata); the error names the
+/// file, what it needs and what is free. A disk whose free space cannot be read passes.
+pub fn check_room(file: &Path, bytes: u64) -> Result<(), String> {
+    let dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let Some(free) = free_space(dir) else { return Ok(()) };
     let need = bytes + bytes / 8 + SPARE_BYTES;
     if free >= need {

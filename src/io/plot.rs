@@ -45,7 +45,7 @@ pub fn write_figures(dir: &Path, figures: &[Figure]) -> Result<Vec<PathBuf>, Str
     for f in figures.iter().filter(|f| f.has_data()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         let path = dir.join(&f.file);
-        super::check_room(dir, &path, FIGURE_BYTES)?;
+        super::check_room(&path, FIGURE_BYTES)?;
         if let Err(e) = render(&path, f) {
             let _ = std::fs::remove_file(&path);
             return Err(format!("cannot draw {}: {e}", path.display()));

@@ -147,9 +147,8 @@ impl<const D: usize> Particles<D> {
             let n = body.particles_per_cell;
             let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
             let volume = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
-            for_each_candidate(case, grid, b, |cell, id, x| {
-                let earlier = case.bodies[..b].iter().any(|o| case.body_holds(o, x));
-                if case.body_holds(body, x) && !earlier && owned(cell) {
+            for_each_point(case, grid, b, |cell, id, x| {
+                if owned(cell) {
                     let vol = volume * geometry.measure(x[0]);
                     ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), pore_water);
                 }
@@ -253,6 +252,21 @@ pub fn for_each_candidate<const D: usize>(
             break;
         }
     }
+}
+
+/// [`for_each_candidate`] for the places where body `b` puts its material points: those it holds
+/// and no body listed before it holds ([`Case::body_at`]), on any rank.
+pub fn for_each_point<const D: usize>(
+    case: &Case,
+    grid: &Grid<D>,
+    b: usize,
+    mut f: impl FnMut([usize; D], u64, [f64; D]),
+) {
+    for_each_candidate(case, grid, b, |cell, id, x| {
+        if case.body_at(x).is_some_and(|at| at.index() == b) {
+            f(cell, id, x);
+        }
+    });
 }
 
 fn jitter(id: u64, stream: u64) -> f64 {

@@ -52,16 +52,11 @@ fn points_in<const D: usize>(c: &Case, load: usize, region: &Region) -> bool {
     let grid = crate::model::grid_of::<D>(c);
     let bodies = c.load_bodies(crate::case::LoadId::new(load));
     let mut found = false;
-    for (b, body) in c.bodies.iter().enumerate() {
+    for b in 0..c.bodies.len() {
         if found || bodies.is_some_and(|bs| !bs.iter().any(|id| id.index() == b)) {
             continue;
         }
-        crate::model::particles::for_each_candidate(c, &grid, b, |_, _, x| {
-            found = found
-                || (region.contains_in(x)
-                    && c.body_holds(body, x)
-                    && !c.bodies[..b].iter().any(|o| c.body_holds(o, x)));
-        });
+        crate::model::particles::for_each_point(c, &grid, b, |_, _, x| found = found || region.contains_in(x));
     }
     found
 }
