@@ -339,7 +339,8 @@ fn global_assembly(c: &mut Criterion) {
     let model = Model::build(&case, |i, j| system.space().owns_cell_in([i, j]));
     let stage = &case.stages[0];
     let active = model.active(stage);
-    let step = system.prepare(&model, &active, stage.dt(), stage.dt(), &coll).expect("the first step is prepared");
+    let step =
+        system.prepare(&model, &active, (stage.dt(), stage.dt()), false, &coll).expect("the first step is prepared");
     system.assemble_once(&step, &model, &coll).expect("the system assembles");
     let mut g = group(c, "assembly", model.particles.len());
     g.bench_function("residual_and_jacobian", |b| {

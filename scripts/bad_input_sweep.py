@@ -63,6 +63,7 @@ runtime = [
  ("terzaghi", [], ["--", "-ksp_rtol", "abc"]),
  ("terzaghi", [], ["--", "-snes_max_it", "-5"]),
  ("terzaghi", [], ["--checkpoint-every", "-1"]),
+ ("terzaghi", [], ["--checkpoint-every", "0"]),
  ("terzaghi", [], ["--threads", "0"]),
  ("terzaghi", [], ["--restart", "/nonexistent.h5"]),
  ("terzaghi", [], ["--restart", "cases/terzaghi.toml"]),

@@ -40,9 +40,10 @@ enum Command {
         /// a terminal).
         #[arg(long)]
         quiet: bool,
-        /// Write the full state to DIR/checkpoint.h5 every N steps (atomically; 0: never).
-        #[arg(long = "checkpoint-every", value_name = "N", default_value_t = 0)]
-        checkpoint_every: usize,
+        /// Write the full state to DIR/checkpoint.h5 every N steps, N ≥ 1 (atomically; without
+        /// it, no checkpoint).
+        #[arg(long = "checkpoint-every", value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+        checkpoint_every: Option<u32>,
         /// Continue from a checkpoint.h5 written by a run of the same case.
         #[arg(long, value_name = "CHECKPOINT")]
         restart: Option<PathBuf>,
@@ -611,7 +612,7 @@ fn main() -> ExitCode {
             petsc,
         } => {
             let cont = Continuation {
-                checkpoint_every: *checkpoint_every,
+                checkpoint_every: checkpoint_every.map_or(0, |n| n as usize),
                 restart: restart.as_deref(),
                 threads: *threads,
                 balance_threshold: *balance_threshold,

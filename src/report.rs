@@ -20,7 +20,128 @@ pub fn report(dir: &Path) -> Result<String, String> {
     if !v.is_object() || v.get("status").is_none() {
         return Err(format!("{} is not a porompm summary (no `status`)", path.display()));
     }
+    check_shape(&v).map_err(|e| format!("{} is not a porompm summary: {e}", path.display()))?;
     Ok(format(&v, &dir.display().to_string()))
+}
+
+/// The JSON kinds a summary's value may have where the report reads it.
+#[derive(Clone, Copy)]
+enum Kind {
+    Text,
+    Number,
+    Count,
+    Flag,
+}
+
+impl Kind {
+    fn holds(self, x: &Value) -> bool {
+        match self {
+            Kind::Text => x.is_string(),
+            Kind::Number => x.is_number(),
+            Kind::Count => x.is_u64(),
+            Kind::Flag => x.is_boolean(),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Text => "a string",
+            Kind::Number => "a number",
+            Kind::Count => "a whole number ≥ 0",
+            Kind::Flag => "true or false",
+        }
+    }
+}
+
+/// Every value the report reads has its summary's kind (null stands for "none" or a non-finite
+/// number anywhere); an error names the first key that does not, so that a file of another shape
+/// is refused rather than shown in part.
+fn check_shape(v: &Value) -> Result<(), String> {
+    use Kind::*;
+    let wrong = |key: &str, kind: Kind| format!("`{key}` is {}, expected {}", describe(&v[key]), kind.name());
+    let top = [
+        ("status", Text),
+        ("case", Text),
+        ("error", Text),
+        ("porompm_version", Text),
+        ("wall_time_s", Number),
+        ("time_s", Number),
+        ("end_time_s", Number),
+        ("steps", Count),
+        ("step_cuts", Count),
+        ("snes_iterations", Count),
+        ("ksp_iterations", Count),
+        ("dofs", Count),
+        ("grid_dofs", Count),
+        ("particles", Count),
+        ("ranks", Count),
+        ("solver", Text),
+        ("matrix_structure_reuses", Count),
+        ("checkerboard_index_max", Number),
+        ("stopped", Text),
+        ("verification_passed", Flag),
+    ];
+    for (key, kind) in top {
+        if v.get(key).is_some_and(|x| !x.is_null() && !kind.holds(x)) {
+            return Err(wrong(key, kind));
+        }
+    }
+    let object = |key: &str| -> Result<Option<&serde_json::Map<String, Value>>, String> {
+        match v.get(key) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::Object(m)) => Ok(Some(m)),
+            Some(x) => Err(format!("`{key}` is {}, expected an object", describe(x))),
+        }
+    };
+    let entries = |key: &str, kind: Kind| -> Result<(), String> {
+        for (name, x) in object(key)?.into_iter().flatten() {
+            if !x.is_null() && !kind.holds(x) {
+                return Err(format!("`{key}.{name}` is {}, expected {}", describe(x), kind.name()));
+            }
+        }
+        Ok(())
+    };
+    entries("timings", Number)?;
+    if let Some(m) = object("memory")? {
+        for (name, x) in m.iter().filter(|(k, _)| *k != "peak_rise") {
+            if !x.is_null() && !Number.holds(x) {
+                return Err(format!("`memory.{name}` is {}, expected {}", describe(x), Number.name()));
+            }
+        }
+    }
+    entries("results", Number)?;
+    for (name, m) in object("verification")?.into_iter().flatten() {
+        let Value::Object(m) = m else {
+            return Err(format!("`verification.{name}` is {}, expected an object", describe(m)));
+        };
+        for (key, kind) in
+            [("value", Number), ("reference", Number), ("tolerance", Number), ("pass", Flag), ("detail", Text)]
+        {
+            if let Some(x) = m.get(key).filter(|x| !x.is_null() && !kind.holds(x)) {
+                return Err(format!("`verification.{name}.{key}` is {}, expected {}", describe(x), kind.name()));
+            }
+        }
+    }
+    if let Some(o) = v.get("overrides").filter(|o| !o.is_null()) {
+        if !o.as_array().is_some_and(|a| a.iter().all(Value::is_string)) {
+            return Err(format!("`overrides` is {}, expected a list of strings", describe(o)));
+        }
+    }
+    object("restarted_from")?;
+    Ok(())
+}
+
+/// A JSON value's kind, for a message.
+fn describe(x: &Value) -> String {
+    match x {
+        Value::Null => "null".into(),
+        Value::Bool(b) => format!("{b}"),
+        Value::Number(n) => format!("the number {n}"),
+        Value::String(s) if s.chars().count() <= 40 => format!("the string \"{s}\""),
+        Value::String(_) => "a string".into(),
+        Value::Array(_) => "a list".into(),
+        Value::Object(_) => "an object".into(),
+    }
 }
 
 fn num(v: &Value) -> String {
@@ -47,6 +168,14 @@ pub fn format(v: &Value, dir: &str) -> String {
     let get = |k: &str| v.get(k).filter(|x| !x.is_null());
     if let Some(t) = get("timings").and_then(Value::as_object) {
         timings(&mut s, t);
+    }
+    if let Some(m) = get("memory").and_then(Value::as_object).filter(|m| !m.is_empty()) {
+        memory(
+            &mut s,
+            m,
+            get("peak_memory_total_mib").and_then(Value::as_f64),
+            get("particles").and_then(Value::as_u64),
+        );
     }
     if let Some(m) = get("verification").and_then(Value::as_object).filter(|m| !m.is_empty()) {
         verification(&mut s, m, get("verification_passed").and_then(Value::as_bool));
@@ -132,6 +261,32 @@ fn timings(s: &mut String, t: &serde_json::Map<String, Value>) {
     }
 }
 
+/// Memory by structure [MiB] and per material point [B], beside the resident peak (summed over
+/// ranks) and what the structures listed leave of it (PETSc's solver, MPI, HDF5, the program's
+/// code and the allocator).
+fn memory(s: &mut String, m: &serde_json::Map<String, Value>, resident: Option<f64>, points: Option<u64>) {
+    let per_point =
+        |mib: f64| points.filter(|&n| n > 0).map_or("-".into(), |n| format!("{:.0}", mib * 1048576.0 / n as f64));
+    s.push_str("\nmemory [MiB, B per point]\n");
+    let mut listed = 0.0;
+    for (k, x) in m.iter().filter_map(|(k, x)| Some((k, x.as_f64()?))) {
+        let name = k.strip_suffix("_mib").unwrap_or(k);
+        listed += x;
+        let _ = writeln!(s, "  {name:<20} {x:>10.1} {:>8}", per_point(x));
+    }
+    if let Some(r) = resident {
+        let _ = writeln!(s, "  {:<20} {:>10.1} {:>8}", "other", r - listed, per_point(r - listed));
+        let _ = writeln!(s, "  {:<20} {:>10.1} {:>8}", "resident peak", r, per_point(r));
+    }
+    if let Some(rise) = m.get("peak_rise").and_then(Value::as_object) {
+        s.push_str("  resident peak (rank 0) rose by, in\n");
+        for (k, x) in rise.iter().filter_map(|(k, x)| Some((k, x.as_f64()?))) {
+            let name = k.strip_suffix("_mib").unwrap_or(k);
+            let _ = writeln!(s, "    {name:<18} {x:>10.1}");
+        }
+    }
+}
+
 /// The verification metrics, one a line, with the verdict `passed` of them all.
 fn verification(s: &mut String, m: &serde_json::Map<String, Value>, passed: Option<bool>) {
     let verdict = match passed {
@@ -167,6 +322,27 @@ fn verification(s: &mut String, m: &serde_json::Map<String, Value>, passed: Opti
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_summary_of_another_shape_is_refused_naming_its_key() {
+        let ok = serde_json::json!({"status": "completed", "steps": 3, "timings": {"setup_s": 0.5},
+                                     "verification": {"e": {"value": null, "pass": true}}, "overrides": ["a=1"]});
+        assert_eq!(check_shape(&ok), Ok(()));
+        for (bad, key) in [
+            (serde_json::json!({"status": 3}), "`status` is the number 3, expected a string"),
+            (serde_json::json!({"status": "x", "steps": "many"}), "`steps` is the string \"many\""),
+            (serde_json::json!({"status": "x", "steps": -1}), "`steps` is the number -1, expected a whole number"),
+            (serde_json::json!({"status": "x", "timings": 5}), "`timings` is the number 5, expected an object"),
+            (serde_json::json!({"status": "x", "timings": {"a_s": "1"}}), "`timings.a_s` is the string"),
+            (serde_json::json!({"status": "x", "verification": {"e": 1}}), "`verification.e` is the number 1"),
+            (serde_json::json!({"status": "x", "verification": {"e": {"pass": 1}}}), "`verification.e.pass`"),
+            (serde_json::json!({"status": "x", "results": {"r": [1]}}), "`results.r` is a list"),
+            (serde_json::json!({"status": "x", "overrides": "a=1"}), "`overrides` is the string"),
+        ] {
+            let e = check_shape(&bad).unwrap_err();
+            assert!(e.contains(key), "{e} lacks {key}");
+        }
+    }
 
     #[test]
     fn a_failed_summary_shows_its_error_and_every_metric() {

@@ -168,6 +168,13 @@ impl Scheme {
         Some(Scheme { a0: 0.0, a1: 0.0, w_inertia: am, w_force: af, w_mass: 0.0, flow_dt: 0.0, ..*self })
     }
 
+    /// The momentum balance of the step's start, unweighted (w_m = w_f = 1, no mass balance, no
+    /// dependence on Δd): with the velocities and accelerations of t_n in place of the predictors,
+    /// its residual M a_n + f_int,n − f_n is what the start is out of balance by.
+    pub fn start_balance(&self) -> Scheme {
+        Scheme { a0: 0.0, a1: 0.0, w_inertia: 1.0, w_force: 1.0, w_mass: 0.0, flow_dt: 0.0, ..*self }
+    }
+
     /// The same scheme with the terms at t_{n+1} unweighted (w_m = w_f = 1): the balance at t_{n+1}
     /// for the equilibrium identity.
     pub fn unweighted(&self) -> Scheme {

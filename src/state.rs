@@ -244,6 +244,7 @@ pub fn particles_from_flat<const D: usize>(flat: &[f64]) -> Particles<D> {
         let k = ps.len() - 1;
         unpack(&mut ps, k, r);
     }
+    ps.shrink_to_fit();
     ps
 }
 

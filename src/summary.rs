@@ -44,6 +44,69 @@ pub struct Timings {
     pub tangent_matvec_s: Option<f64>,
 }
 
+/// Where the memory goes [MiB]: what the program's structures hold on the heap, summed over ranks,
+/// each the largest over the steps (not all at the same step), beside the resident peak.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct MemoryUse {
+    /// The material points' state.
+    pub particles_mib: f64,
+    /// A step's stencils (nodes, weights and gradients of every point's support).
+    pub stencils_mib: f64,
+    /// The rest of a step's data: dof map, loads, predictors, bands, pressure projection, drained
+    /// faces, mapped stiffness.
+    pub step_data_mib: f64,
+    /// The matrix as PETSc stores it (values, column indices, row bookkeeping; `MatGetInfo`).
+    pub matrix_mib: f64,
+    /// The program's side of the matrix: its block pattern and the assembly's buffer of values.
+    pub matrix_assembly_mib: f64,
+    /// The converged step's per-point results and the points' state at the step's start, held
+    /// during the particle update.
+    pub step_results_mib: f64,
+    /// How far rank 0's resident peak rose [MiB] by the end of the set-up (the program, MPI,
+    /// PETSc, the model), and then while steps were set up, solved (matrix creation, assembly and
+    /// the linear solver's set-up and work) and their points updated; the rest of the peak rose
+    /// while writing results.
+    pub peak_rise: PeakRise,
+}
+
+/// Rises of the resident peak by phase [MiB] (see [`MemoryUse::peak_rise`]).
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct PeakRise {
+    pub setup_mib: f64,
+    pub step_setup_mib: f64,
+    pub solve_mib: f64,
+    pub particle_update_mib: f64,
+}
+
+impl MemoryUse {
+    /// The six amounts, in this order, from bytes.
+    pub fn of_bytes(b: [f64; 6]) -> MemoryUse {
+        let m = |x: f64| x / (1024.0 * 1024.0);
+        MemoryUse {
+            particles_mib: m(b[0]),
+            stencils_mib: m(b[1]),
+            step_data_mib: m(b[2]),
+            matrix_mib: m(b[3]),
+            matrix_assembly_mib: m(b[4]),
+            step_results_mib: m(b[5]),
+            peak_rise: PeakRise::default(),
+        }
+    }
+
+    /// Each amount the larger of the two.
+    pub fn max(self, o: MemoryUse) -> MemoryUse {
+        MemoryUse {
+            particles_mib: self.particles_mib.max(o.particles_mib),
+            stencils_mib: self.stencils_mib.max(o.stencils_mib),
+            step_data_mib: self.step_data_mib.max(o.step_data_mib),
+            matrix_mib: self.matrix_mib.max(o.matrix_mib),
+            matrix_assembly_mib: self.matrix_assembly_mib.max(o.matrix_assembly_mib),
+            step_results_mib: self.step_results_mib.max(o.step_results_mib),
+            peak_rise: self.peak_rise,
+        }
+    }
+}
+
 /// `summary.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
@@ -111,6 +174,8 @@ pub struct Summary {
     /// The sum of every rank's peak resident memory [MiB] (equal to `peak_memory_mib` on one rank).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_total_mib: Option<f64>,
+    /// Where the memory goes, by structure (see [`MemoryUse`]).
+    pub memory: MemoryUse,
     /// Largest checkerboard index of the pore pressures over the output steps (two-phase runs; see
     /// `verification::checkerboard`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -191,6 +256,7 @@ impl Summary {
             timings: Timings::default(),
             peak_memory_mib: None,
             peak_memory_total_mib: None,
+            memory: MemoryUse::default(),
             checkerboard_index_max: None,
             pressure_oscillation_index_max: None,
             pore_pressure_range: None,

@@ -265,13 +265,31 @@ fn report_prints_the_summary_and_names_a_bad_directory() {
         "settlement_rel_error_Tv0.5".into(),
         "linear_solve".into(),
         "middle.excess_p_final".into(),
+        "memory [MiB, B per point]".into(),
+        "resident peak (rank 0) rose by, in".into(),
     ] {
         assert!(text.contains(&want), "`{want}` missing in:\n{text}");
     }
+    // The points' state: 308 bytes a point in two dimensions (the types' sizes, no slack).
+    let points = text.lines().find(|l| l.trim_start().starts_with("particles ")).expect("a particles line");
+    assert!(points.trim_end().ends_with(" 308"), "{points}");
+    assert!(
+        s["memory"]["stencils_mib"].as_f64().unwrap() > 0.0 && s["memory"]["matrix_mib"].as_f64().unwrap() > 0.0,
+        "{s}"
+    );
     let o = porompm(&["report", "no/such/dir"]);
     assert_one_line_error(&o, "no/such/dir is not a directory");
     let o = porompm(&["report", "cases"]);
     assert_one_line_error(&o, "has no summary.json");
+    // A summary.json of another shape is refused, naming its key, rather than shown in part.
+    let other = out_dir("report-other-shape");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("summary.json"), r#"{"status": "completed", "steps": "many", "timings": {}}"#).unwrap();
+    let o = porompm(&["report", other.to_str().unwrap()]);
+    assert_one_line_error(&o, "is not a porompm summary: `steps` is the string \"many\", expected a whole number");
+    // Checkpoints every 0 steps is no count: refused at once, naming the option.
+    let o = porompm(&["run", "cases/terzaghi.toml", "--out", other.to_str().unwrap(), "--checkpoint-every", "0"]);
+    assert_one_line_error(&o, "--checkpoint-every");
 }
 
 #[test]

@@ -220,7 +220,7 @@ where
     let mut run = Run { id: model.particles.id.clone(), ..Run::default() };
     let mut forces = StepForces::default();
     for n in 1..=steps {
-        let step = system.prepare(&model, &active, n as f64 * dt, dt, coll)?;
+        let step = system.prepare(&model, &active, (n as f64 * dt, dt), false, coll)?;
         let (out, solution) = system.solve(&step, &model, coll).map_err(|e| e.to_string())?;
         if !out.converged {
             return Err(format!("step {n} in {D} dimensions did not converge: {}", out.reason));

@@ -1,8 +1,10 @@
 //! Small dense algebra shared by the model and the kernels: D × D matrices (D = 2 or 3) and
 //! their determinant, cofactors, inverse and products; small linear solves and the matrix
-//! exponential ([`linalg`]); the inverse of a dense block ([`dense`]).
+//! exponential ([`linalg`]); the inverse of a dense block ([`dense`]); the heap bytes of a
+//! container ([`heap`]).
 
 pub mod dense;
+pub mod heap;
 pub mod linalg;
 
 /// A 2 × 2 matrix, rows first.

@@ -35,6 +35,12 @@ pub struct DofMap {
 }
 
 impl DofMap {
+    /// The bytes the map holds on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        use crate::algebra::heap::capacity as c;
+        c(&self.well) + c(&self.fixed) + c(&self.value) + c(&self.boundary) + c(&self.owned_fixed)
+    }
+
     /// Whether a node's motion component `c` is fixed by a boundary (not merely by being barely
     /// filled).
     pub fn boundary_fixed(&self, node: usize, c: usize) -> bool {

@@ -27,8 +27,9 @@ pub struct StepForces<const D: usize = 2> {
     pub reactions_by_dof: Vec<f64>,
     /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
-    /// (trapezoidal; the reactions at t_n are the last step's, none after a new node space)
-    /// [J per m].
+    /// (trapezoidal; the reactions at t_n are the last step's, none after a new node space; at
+    /// the first step of a Newmark stage the free dofs' force at t_n is the one its start is in
+    /// balance with, f_n + r_n) [J per m].
     pub work: f64,
     /// The norm of each field's equation magnitudes at the converged state (Σ over particles of
     /// their absolute residual blocks plus the absolute loads, over the free dofs, in PETSc's
@@ -132,7 +133,10 @@ pub(super) fn of_step<const D: usize, const M: usize, const N: usize>(
             let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
             reactions[q] = reaction;
             let reaction_old = last_reactions.get(q).copied().unwrap_or(reaction);
-            local[4 * dd] += 0.5 * (fext_old[q] + fext[q] + reaction_old + reaction) * solution.increments[q];
+            // The first step of a Newmark stage: the force its start is in balance with is
+            // f_n + r_n (r_n = `start_imbalance`, zero where a boundary holds the dof).
+            let start = if (b as usize) < nb { 0.0 } else { step.start_imbalance.get(q).copied().unwrap_or(0.0) };
+            local[4 * dd] += 0.5 * (fext_old[q] + start + fext[q] + reaction_old + reaction) * solution.increments[q];
             book_node_forces(&mut local, nb, b as usize, &xr, dir, [fext[q], reaction, inertia[q]]);
         }
     }

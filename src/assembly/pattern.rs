@@ -73,6 +73,14 @@ impl Pattern {
 }
 
 impl<const D: usize> Pattern<D> {
+    /// The bytes the pattern holds on the heap (the hash map's entries at its capacity, with one
+    /// control byte each).
+    pub fn heap_bytes(&self) -> usize {
+        use crate::algebra::heap::capacity as c;
+        let far = self.far.capacity() * (std::mem::size_of::<((u32, u32), u32)>() + 1);
+        c(&self.pairs) + c(&self.near) + c(&self.row_start) + far
+    }
+
     /// The place in the dense table of the pair of nodes a (indices `ia`) and b (indices `ib`),
     /// if their offset is within REACH in every direction.
     #[inline]

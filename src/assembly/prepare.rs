@@ -55,6 +55,9 @@ pub(super) struct StepRequest<'a, const D: usize, const M: usize> {
     /// The pattern of the solver's matrix, if it has one.
     pub kept: Option<Arc<Pattern<D>>>,
     pub schur: SchurNeeds,
+    /// Whether the step is the first of its stage (the energy ledger's start, see
+    /// [`Step::imbalance_at_start`]).
+    pub stage_start: bool,
 }
 
 impl<const D: usize, const M: usize> Step<D, M> {
@@ -69,7 +72,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
     where
         Dim<D>: StepDim<D>,
     {
-        let StepRequest { active, times, kept, schur } = request;
+        let StepRequest { active, times, kept, schur, stage_start } = request;
         let (t_old, t_new) = times;
         let dt = t_new - t_old;
         let (mut st, crossings) = stencils_on_xn::<D, M>(space, model, coll)?;
@@ -82,6 +85,14 @@ impl<const D: usize, const M: usize> Step<D, M> {
         stencils::extend(&mut st, model, &space.ghost, &dofs, &space.motion());
         let mut step = Step::data::<N>(space, model, active, times, st, dofs, &nodal, coll)?;
         step.boundary_fill = boundary_fill;
+        // Newmark's step takes the forces of t_n only through the balance of a_n; a generalized-α
+        // step carries them in its history, f_n itself (`Scheme::history`).
+        let newmark =
+            matches!(model.integration, crate::scheme::Integration::Dynamic { .. }) && step.scheme.history().is_none();
+        if stage_start && newmark {
+            step.start_imbalance =
+                step.imbalance_at_start::<N>(space, model, active, t_old).map_err(|e| e.to_string())?;
+        }
         step.stiffness = <Dim<D> as StepDim<D>>::mapped_stiffness(model, &space.ghost, &step.stencils, coll)?;
         step.fixed_stress = pressure::fixed_stress_diagonal(space, &step, model, &schur).map_err(|e| e.to_string())?;
         if schur.blocks {
@@ -111,6 +122,32 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         step.matrix_pattern(space, kept, coll)?;
         Ok(step)
+    }
+
+    /// What the step's start is out of balance by, r_n per ghosted dof summed over ranks
+    /// ([`Step::start_imbalance`]): the residual M a_n + f_int,n − f_n at Δd = 0 with the
+    /// velocities and accelerations of t_n the points carry (projected as the predictors are) and
+    /// the body forces and loads of t_n. The first step of a Newmark stage starts from
+    /// accelerations that need not balance the stage's loads (a body at rest under a load on from
+    /// t_n); Newmark's step sees the forces of t_n only through the balance of a_n, so it acts as
+    /// if the force at t_n were f_n + r_n, and the energy ledger books that step's work with it
+    /// ([`super::forces`]): the trapezoidal identity Δu·M(a_n + a_{n+1})/2 = ΔK then holds.
+    /// Collective.
+    fn imbalance_at_start<const N: usize>(
+        &self,
+        space: &mut NodeSpace<D>,
+        model: &Model<D>,
+        active: &Active,
+        t_old: f64,
+    ) -> Result<Vec<f64>, Error>
+    where
+        Dim<D>: StepDim<D>,
+    {
+        let body_acc_old = model.body_accelerations(active, t_old);
+        let scheme = self.scheme.start_balance();
+        let mut r = Points::<D, M, N>::new(model, self).terms_at_start(&scheme, &body_acc_old, &self.fext_old, true);
+        space.sum_over_ranks(&mut r)?;
+        Ok(r)
     }
 
     /// Step 4: the data the callbacks use, from the effective stencils `st` and the dof map: the
@@ -162,6 +199,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
             face_owner: Vec::new(),
             stiffness: MappedStiffness::default(),
             start_terms: StartTerms::default(),
+            start_imbalance: Vec::new(),
             drained: Vec::new(),
             boundary_fill: Vec::new(),
         };

@@ -100,6 +100,15 @@ pub struct WallSlot<const D: usize = 2> {
 }
 
 impl<const D: usize> Stencils<D> {
+    /// The bytes the stencils hold on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        use crate::algebra::heap::capacity as c;
+        let offsets = [&self.offsets, &self.eff_offsets, &self.ext_offsets].map(c).iter().sum::<usize>();
+        let nodes = c(&self.nodes) + c(&self.eff_nodes);
+        let bases = [&self.basis, &self.strain, &self.forces].map(c).iter().sum::<usize>();
+        offsets + nodes + bases + c(&self.ext) + c(&self.beyond)
+    }
+
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.offsets.len().saturating_sub(1)

@@ -68,6 +68,10 @@ pub struct Step<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// An explicit step: the terms of its start (σ_n on x_n and the body force of t_{n+1}, without
     /// the loads), this rank's shares per ghosted dof; empty vectors otherwise.
     pub(super) start_terms: StartTerms,
+    /// The first step of a Newmark stage: what its start is out of balance by per
+    /// ghosted dof, summed over ranks (M a_n + f_int,n − f_n, [`Step::imbalance_at_start`]);
+    /// empty otherwise.
+    pub(super) start_imbalance: Vec<f64>,
     /// A two-phase explicit step with the nodal pore pressure: whether each ghosted node is
     /// drained; empty otherwise.
     pub(super) drained: Vec<bool>,
@@ -135,6 +139,33 @@ impl Band {
 }
 
 impl<const D: usize, const M: usize> Step<D, M> {
+    /// The bytes the step's data hold on the heap, `(stencils, the rest)`: the stencils, and the
+    /// dof map, loads, predictors, bands, projection, faces, mapped stiffness and start terms
+    /// (the matrix pattern, shared with the system's matrix, is the matrix's).
+    pub fn heap_bytes(&self) -> (usize, usize) {
+        use crate::algebra::heap::{capacity as c, nested};
+        let projection = c(&self.projection) + self.projection.iter().map(|p| c(&p.nodes) + c(&p.s)).sum::<usize>();
+        let t = &self.start_terms;
+        let per_dof = [&self.fext, &self.fext_old, &self.history, &self.field_scales, &self.fixed_stress]
+            .into_iter()
+            .chain([&t.all, &t.inertia, &t.magnitude, &self.start_imbalance])
+            .map(c)
+            .sum::<usize>();
+        let per_point = c(&self.grad_n) + c(&self.smooth) + c(&self.body_acc);
+        let groups = nested(&self.projection_blocks) + nested(&self.schur_groups);
+        let faces = c(&self.faces) + c(&self.face_owner) + c(&self.drained) + c(&self.boundary_fill);
+        let rest = per_dof
+            + per_point
+            + projection
+            + groups
+            + faces
+            + self.dofs.heap_bytes()
+            + c(&self.bands)
+            + c(&self.fixed_diagonals)
+            + self.stiffness.heap_bytes();
+        (self.stencils.heap_bytes(), rest)
+    }
+
     /// Unknowns of the step (free dofs over all ranks).
     pub fn free_dofs(&self) -> usize {
         self.dofs.free_dofs

@@ -145,6 +145,12 @@ impl<'a> Mapping<'a> {
 }
 
 impl MappedStiffness {
+    /// The bytes the mapped stiffness holds on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        use crate::algebra::heap::capacity as c;
+        c(&self.material) + c(&self.shares) + c(&self.offsets)
+    }
+
     /// The shares of this rank's points for the model's option (empty for `particle`).
     pub(super) fn prepare(model: &Model, ghost: &GhostedRange, st: &Stencils) -> Result<MappedStiffness, String> {
         let mut out = MappedStiffness::default();

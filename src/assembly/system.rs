@@ -226,6 +226,16 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.space.layout
     }
 
+    /// The matrix's memory: PETSc's (values, indices and its own bookkeeping, summed over ranks,
+    /// `MatGetInfo`) and this rank's in the program (the block pattern and the assembly's buffer
+    /// of block values, one value per stored entry), in bytes; zeros without a matrix.
+    pub fn matrix_memory(&self) -> Result<(f64, usize), Error> {
+        let Some(m) = &self.matrix else { return Ok((0.0, 0)) };
+        let nd = self.space.layout.nd;
+        let values = m.pattern.len() * nd * nd * std::mem::size_of::<f64>();
+        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + values))
+    }
+
     /// Enters a log stage until the guard is dropped.
     pub fn phase(&self, p: Phase) -> Result<StageGuard, Error> {
         match p {
@@ -238,13 +248,15 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     }
 
     /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
-    /// boundaries ([`Step::prepare`]). Collective; every rank returns the same outcome.
+    /// boundaries ([`Step::prepare`]); `stage_start` says it is the first of its stage.
+    /// Collective; every rank returns the same outcome.
+    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
         &mut self,
         model: &Model<D>,
         active: &Active,
-        t_new: f64,
-        dt: f64,
+        (t_new, dt): (f64, f64),
+        stage_start: bool,
         coll: &Collective,
     ) -> Result<Step<D, M>, String>
     where
@@ -256,7 +268,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             tuning: self.schur_tuning,
         };
         let kept = self.matrix.as_ref().map(|m| m.pattern.clone());
-        let request = StepRequest { active, times: (t_new - dt, t_new), kept, schur };
+        let request = StepRequest { active, times: (t_new - dt, t_new), kept, schur, stage_start };
         Step::prepare::<N>(&mut self.space, model, request, coll)
     }
 

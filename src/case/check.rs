@@ -47,6 +47,38 @@ pub fn modulus(key: &str, v: f64) -> Checked {
     magnitude(key, v, MAX_MODULUS, "Pa", "stiffer than any geomaterial: the tangent would hold no digits of the load")
 }
 
+/// A strength in [0, [`MAX_MODULUS`]] Pa (above zero unless `zero` allows it): a strength above the
+/// stiffest modulus a case may give is never reached.
+pub fn strength(key: &str, v: f64, zero: bool) -> Checked {
+    if zero {
+        non_negative(key, v)?;
+    } else {
+        positive(key, v)?;
+    }
+    if v > MAX_MODULUS {
+        return Err(format!(
+            "key `{key}`: must be at most {MAX_MODULUS:e} Pa (a strength above the stiffest modulus a case may give: \
+             the material would never yield), got {v:e}"
+        ));
+    }
+    Ok(())
+}
+
+/// The largest dynamic viscosity a case may give [Pa s]: about glacier ice's.
+pub const MAX_VISCOSITY: f64 = 1e13;
+
+/// A dynamic viscosity in [0, [`MAX_VISCOSITY`]] Pa s.
+pub fn viscosity(key: &str, v: f64) -> Checked {
+    non_negative(key, v)?;
+    if v > MAX_VISCOSITY {
+        return Err(format!(
+            "key `{key}`: must be at most {MAX_VISCOSITY:e} Pa s (about glacier ice's: a fluid more viscous is a \
+             solid over any duration a run resolves), got {v:e}"
+        ));
+    }
+    Ok(())
+}
+
 /// A number above zero, or `inf`.
 pub fn positive_or_inf(key: &str, v: f64) -> Checked {
     if v > 0.0 && !v.is_nan() {

@@ -13,7 +13,11 @@
 //! Darcy dissipation Δt d |w|² with w the relative velocity at t_{n+1} interpolated from the grid
 //! (as the drag term of the residual sees it; the particles' own velocities carry the noise of
 //! the grid-to-particle update, which at the slope's failure counted 14 times the work done), the drag
-//! coefficient d = n²γ_w V/k, its body-force work b·(m Δu + m_w ΔU). The loads' and reactions'
+//! coefficient d = n²γ_w V/k, its body-force work b̄·(m Δu + m_w ΔU) with b̄ the mean of the body
+//! accelerations of t_n and t_{n+1} (the trapezoidal product the integrator's energy identity
+//! holds with: for Newmark's average acceleration Δu = Δt (v_n + v_{n+1})/2, so Δu·M(a_n + a_{n+1})/2
+//! is exactly the change of the kinetic energy, and the forces a_n and a_{n+1} balance are those of
+//! t_n and t_{n+1}; a pulse booked at t_{n+1} alone misses a share of its work). The loads' and reactions'
 //! work comes from the nodes (`assembly::StepForces::work`). The porosity gradient's term of the
 //! mass balance, ∇n·(ΔU − Δu), joins the volumetric terms beside p̄ ([003] Eq. 3; `kernels::flow`).
 //! The work of a prescribed non-zero boundary pressure is not counted.
@@ -32,13 +36,13 @@ pub struct ParticleStep {
 }
 
 /// The stress and body-force work of one particle over a converged step: `before` is its kernel
-/// input at t_n, `step` the converged result, `dp` its pressure increment and `v_after` its volume
-/// at t_{n+1}.
+/// input at t_n (with the body acceleration of t_n), `step` the converged result, `dp` its
+/// pressure increment, `v_after` its volume and `body_after` its body acceleration at t_{n+1}.
 pub fn particle_step<const D: usize>(
     before: &ParticleInput<D>,
     step: &StepResult<D>,
     dp: f64,
-    v_after: f64,
+    (v_after, body_after): (f64, [f64; D]),
 ) -> ParticleStep {
     // Δε = [xx, yy, γxy, zz, γyz, γzx] (engineering shears) and the stress [xx, yy, xy, zz, yz, zx]:
     // the first four in two dimensions.
@@ -53,7 +57,7 @@ pub fn particle_step<const D: usize>(
     let g = step.grad_n;
     let gradient = (0..D).map(|d| g[d] * (it.dw[d] - it.du[d])).sum::<f64>();
     let water = if before.water_mass > 0.0 { p * ((1.0 - n) * it.dvol_u + n * it.dvol_w + gradient) } else { 0.0 };
-    let b = before.body_acc;
+    let b: [f64; D] = std::array::from_fn(|d| mean(before.body_acc[d], body_after[d]));
     let dot = |u: &[f64; D]| (0..D).map(|d| b[d] * u[d]).sum::<f64>();
     let body = before.mass * dot(&it.du) + before.water_mass * dot(&it.dw);
     ParticleStep { internal: v * (effective - water), body }
@@ -175,23 +179,26 @@ mod tests {
             jbar: None,
             velocity: None,
         };
-        let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &step, 20.0, 1.98);
+        let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &step, 20.0, (1.98, [0.0, -10.0]));
         let v = 1.99;
         let expected = v * (-200.0 * -0.01 - 20.0 * (0.75 * -0.01 + 0.25 * -0.02));
         assert!((e.internal - expected).abs() < 1e-12, "{e:?} vs {expected}");
         // Body work: g = −10 on m Δu = 3 × −0.1 and m_w ΔU = 0.5 × −0.2.
         assert!((e.body - (3.0 * 1.0 + 0.5 * 2.0)).abs() < 1e-12, "{e:?}");
+        // A body force that changes over the step does the work of its mean: −10 at t_n, −30 at t_{n+1}.
+        let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &step, 20.0, (1.98, [0.0, -30.0]));
+        assert!((e.body - 2.0 * (3.0 * 1.0 + 0.5 * 2.0)).abs() < 1e-12, "{e:?}");
         // Shear: σ_xy Δγ_xy.
         let shear = StepResult {
             deps: [0.0, 0.0, 0.02, 0.0, 0.0, 0.0],
             stress: crate::model::soil::plane([0.0, 0.0, 50.0, 0.0]),
             ..step
         };
-        let e = particle_step(&input([0.0, 0.0, 50.0, 0.0], 0.0), &shear, 0.0, 1.98);
+        let e = particle_step(&input([0.0, 0.0, 50.0, 0.0], 0.0), &shear, 0.0, (1.98, [0.0, -10.0]));
         assert!((e.internal - 1.99 * (50.0 * 0.02 - 0.0)).abs() < 1e-9, "{e:?}");
         // The porosity gradient's term: ∇n·(ΔU − Δu) = 0.5 × (−0.2 + 0.1) beside the volumetric ones.
         let graded = StepResult { grad_n: [0.0, 0.5], ..step };
-        let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &graded, 20.0, 1.98);
+        let e = particle_step(&input([0.0, -100.0, 0.0, 0.0], 10.0), &graded, 20.0, (1.98, [0.0, -10.0]));
         let expected = v * (-200.0 * -0.01 - 20.0 * (0.75 * -0.01 + 0.25 * -0.02 + 0.5 * -0.1));
         assert!((e.internal - expected).abs() < 1e-12, "{e:?} vs {expected}");
     }

@@ -211,7 +211,8 @@ where
         sim.advance(&active, stage.dt())?.map_err(RunError::Failed)?;
         sim.t += stage.dt();
     }
-    let step = sim.system.prepare(&sim.model, &active, sim.t + stage.dt(), stage.dt(), sim.coll).map_err(failed)?;
+    let step =
+        sim.system.prepare(&sim.model, &active, (sim.t + stage.dt(), stage.dt()), false, sim.coll).map_err(failed)?;
     let blocks = sim.system.jacobian_check(&step, &sim.model, sim.coll, 0.7, flip).map_err(failed)?;
     Ok((blocks, sim.model.particles.eps_pd.iter().filter(|&&e| e > 0.0).count()))
 }
@@ -242,6 +243,8 @@ struct Simulation<'a, const D: usize, const M: usize, const N: usize> {
     /// The filled fraction of each moving boundary's nodes when it was first seen, and whether
     /// the run has warned that the material left them.
     grip: Vec<(Option<f64>, bool)>,
+    /// Whether the next step is the first of its stage.
+    stage_start: bool,
 }
 
 /// The outcome of a step that converged and was admitted: its Newton and Krylov iterations and
@@ -312,6 +315,7 @@ where
     /// the points to the ranks that own their cells and the load balance.
     fn accept(&mut self, dt: f64, control: &mut StepControl, newton: usize) -> Result<(), RunError> {
         self.system.accept_increment(dt).map_err(failed)?;
+        self.stage_start = false;
         self.migrate_particles()?;
         self.balance_load()?;
         self.t = control.advance(self.t, dt);

@@ -40,12 +40,12 @@ impl Restart {
         self.resume.map_or(0, |r| r.stage)
     }
 
-    /// A restarted run's step control from its checkpoint (once).
-    pub fn resume(&mut self, control: &mut StepControl) {
-        if let Some(r) = self.resume.take() {
-            control.dt = r.dt;
-            control.successes = r.successes;
-        }
+    /// A restarted run's step control from its checkpoint (once); whether there was one.
+    pub fn resume(&mut self, control: &mut StepControl) -> bool {
+        let Some(r) = self.resume.take() else { return false };
+        control.dt = r.dt;
+        control.successes = r.successes;
+        true
     }
 
     /// Whether any rank was sent SIGINT or SIGTERM (collective).

@@ -109,6 +109,7 @@ where
             balance: balance::Balance::new(req.balance_threshold),
             restart: restart::Restart::new(req.checkpoint_every, req.interrupt.clone()),
             grip: Vec::new(),
+            stage_start: false,
         };
         let warnings = crate::diagnostics::physics::warnings(case, &sim.model);
         sim.journal.warn(warnings);
@@ -137,7 +138,11 @@ where
         }
         let end: f64 = self.case.stages[..=index].iter().map(|s| s.duration).sum();
         let mut control = StepControl::new(stage, end, analysis.dt_limit);
-        self.restart.resume(&mut control);
+        let resumed = self.restart.resume(&mut control);
+        let active = self.model.active(stage);
+        // The ledger books the first step of a stage from the balance of its start (not of a
+        // stage a restart resumes, whose start was booked before).
+        self.stage_start = !resumed;
         self.journal.progress(&format!(
             "stage `{}` ({}): t = {:.6e} → {:.6e} s, Δt = {:.3e} s",
             stage.name,
@@ -146,7 +151,7 @@ where
             control.t_end,
             control.dt
         ));
-        Ok((self.model.active(stage), control))
+        Ok((active, control))
     }
 
     /// A new global system with `layout` on the distribution `owners`, keeping the count of reused

@@ -20,6 +20,15 @@ pub(super) struct Updated {
     pub field_scales: Vec<f64>,
 }
 
+/// How far this process's resident peak has risen since it was `before` [MiB] (0 where the system
+/// does not report it).
+fn rise_since(before: Option<f64>) -> f64 {
+    match (before, crate::io::peak_memory_mib()) {
+        (Some(b), Some(a)) => a - b,
+        _ => 0.0,
+    }
+}
+
 /// Fraction of its first filled fraction below which a moving boundary's nodes have lost their grip
 /// on the material (see [`Simulation::check_boundary_grip`]).
 const GRIP_FRACTION: f64 = 0.5;
@@ -32,12 +41,19 @@ where
     /// moving boundary whose nodes the material left.
     pub(super) fn prepare(&mut self, active: &Active, dt: f64) -> Result<Step<D, M>, RunError> {
         let t0 = Instant::now();
+        let peak = crate::io::peak_memory_mib();
+        let rise = &mut self.journal.summary.memory.peak_rise;
+        if rise.setup_mib == 0.0 {
+            rise.setup_mib = peak.unwrap_or(0.0);
+        }
         let step = {
             let _stage = self.system.phase(Phase::StepSetup).map_err(failed)?;
-            self.system.prepare(&self.model, active, self.t + dt, dt, self.coll).map_err(RunError::Failed)?
+            let times = (self.t + dt, dt);
+            self.system.prepare(&self.model, active, times, self.stage_start, self.coll).map_err(RunError::Failed)?
         };
         let summary = &mut *self.journal.summary;
         summary.timings.step_setup_s += t0.elapsed().as_secs_f64();
+        summary.memory.peak_rise.step_setup_mib += rise_since(peak);
         summary.dofs = step.free_dofs();
         self.check_boundary_grip(&step.boundary_fill);
         Ok(step)
@@ -47,11 +63,13 @@ where
     /// solve with PETSc's solver, its description, the warning of a Krylov solver on an
     /// unstabilised equal-order system, and the refusal of PETSc options no solver object used.
     pub(super) fn solve(&mut self, step: &Step<D, M>) -> Result<(StepSolve, Solution), RunError> {
+        let peak = crate::io::peak_memory_mib();
         let (solved, solution) = self
             .system
             .solve(step, &self.model, self.coll)
             .map_err(|e| RunError::Failed(format!("Newton solve at t = {:.6e} s: {e}", self.t)))?;
         let summary = &mut *self.journal.summary;
+        summary.memory.peak_rise.solve_mib += rise_since(peak);
         summary.matrix_structure_reuses = self.system.reused_patterns;
         summary.timings.assembly_s += solved.assembly_seconds;
         summary.timings.linear_solve_s += solved.solve_seconds - solved.assembly_seconds;
@@ -133,6 +151,7 @@ where
         active: &Active,
         dt: f64,
     ) -> Result<Result<Updated, String>, RunError> {
+        let peak = crate::io::peak_memory_mib();
         let diagnostics = self.case.output.fields_every > 0 || self.recorders.iter().any(|r| r.needs_nodes());
         let forces = self
             .system
@@ -162,10 +181,11 @@ where
         }
         let pressure = self.system.pressure_increments(step, solution, &self.model).map_err(failed)?;
         let dynamic = matches!(self.model.integration, Integration::Dynamic { .. });
+        let body_after = if dynamic { self.model.body_accelerations(active, self.t + dt) } else { Vec::new() };
         let before: Vec<_> = if dynamic {
-            let body_acc = self.model.body_accelerations(active, self.t + dt);
+            let body_before = self.model.body_accelerations(active, self.t);
             let ps = &self.model.particles;
-            (0..n).map(|k| (ParticleInput::of(&self.model, k, &body_acc), ps.vel[k], ps.vel_w[k])).collect()
+            (0..n).map(|k| (ParticleInput::of(&self.model, k, &body_before), ps.vel[k], ps.vel_w[k])).collect()
         } else {
             Vec::new()
         };
@@ -175,7 +195,8 @@ where
             crate::update::update_particle(&mut self.model, k, r, dp, dt).map_err(|e| RunError::Failed(e.0))?;
             if let Some((input, v, vw)) = before.get(k) {
                 let ps = &self.model.particles;
-                let e = energy::particle_step(input, r, dp, ps.volume[k]);
+                let b = body_after[ps.body[k] as usize];
+                let e = energy::particle_step(input, r, dp, (ps.volume[k], b));
                 let k_old = energy::kinetic(input.mass, input.water_mass, *v, *vw);
                 let k_new = energy::kinetic(ps.mass[k], self.model.water_mass(k), ps.vel[k], ps.vel_w[k]);
                 let d = if input.water_mass > 0.0 { energy::darcy(input.drag, dt, r) } else { 0.0 };
@@ -187,7 +208,24 @@ where
             }
         }
         self.journal.summary.timings.particle_update_s += t0.elapsed().as_secs_f64();
+        let held = crate::algebra::heap::capacity(&results) + crate::algebra::heap::capacity(&before);
+        self.observe_memory(step, held)?;
+        self.journal.summary.memory.peak_rise.particle_update_mib += rise_since(peak);
         Ok(Ok(Updated { energy: dynamic.then_some((forces.work, terms)), field_scales: forces.field_scales }))
+    }
+
+    /// Folds this step's memory by structure into the summary's largest (collective): the points'
+    /// state, the step's stencils and other data, the matrix and `held`, the bytes of the per-point
+    /// results and start states the particle update holds.
+    fn observe_memory(&mut self, step: &Step<D, M>, held: usize) -> Result<(), RunError> {
+        let (stencils, data) = step.heap_bytes();
+        let (petsc, assembly) = self.system.matrix_memory().map_err(failed)?;
+        let local = [self.model.particles.heap_bytes(), stencils, data, 0, assembly, held].map(|b| b as f64);
+        let s = self.coll.sum(&local).map_err(RunError::Failed)?;
+        let now = crate::summary::MemoryUse::of_bytes([s[0], s[1], s[2], petsc, s[4], s[5]]);
+        let m = &mut self.journal.summary.memory;
+        *m = m.max(now);
+        Ok(())
     }
 
     /// Warns (once per boundary) when the material has moved away from the grid nodes that carry a

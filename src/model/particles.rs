@@ -63,6 +63,23 @@ pub struct Particles<const D: usize = 2> {
     pub jbar: Vec<f64>,
 }
 
+/// `[f(v) for every per-point vector v of the points]`, with `v` bound to `&` (or, after `mut`,
+/// `&mut`) each vector in turn: one list of the fields for every pass over all of them.
+macro_rules! per_point_vectors {
+    ($s:expr, $v:ident => $body:expr) => {
+        per_point_vectors!(@each $s, $v, $body, &, id, body, material, x, x0, disp, lp, lp0, def_grad, volume, porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p, jbar)
+    };
+    (mut $s:expr, $v:ident => $body:expr) => {
+        per_point_vectors!(@each $s, $v, $body, &mut, id, body, material, x, x0, disp, lp, lp0, def_grad, volume, porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p, jbar)
+    };
+    (@each $s:expr, $v:ident, $body:expr, &, $($f:ident),*) => {
+        [$({ let $v = &$s.$f; $body }),*]
+    };
+    (@each $s:expr, $v:ident, $body:expr, &mut, $($f:ident),*) => {
+        [$({ let $v = &mut $s.$f; $body }),*]
+    };
+}
+
 impl<const D: usize> Default for Particles<D> {
     fn default() -> Self {
         Particles {
@@ -93,6 +110,17 @@ impl<const D: usize> Default for Particles<D> {
 }
 
 impl<const D: usize> Particles<D> {
+    /// The bytes the points' state holds on the heap (every vector at its capacity).
+    pub fn heap_bytes(&self) -> usize {
+        per_point_vectors!(self, v => crate::algebra::heap::capacity(v)).iter().sum()
+    }
+
+    /// Frees what the vectors hold beyond their points (growing by pushes leaves up to as much
+    /// again).
+    pub fn shrink_to_fit(&mut self) {
+        per_point_vectors!(mut self, v => v.shrink_to_fit());
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.x.len()
@@ -154,6 +182,7 @@ impl<const D: usize> Particles<D> {
                 }
             });
         }
+        ps.shrink_to_fit();
         ps
     }
 
@@ -327,6 +356,19 @@ mod tests {
         let half = Particles::generate(&c, &g, |c| c[1] < 5);
         assert_eq!(half.len(), 20);
         assert!(half.x.iter().all(|x| x[1] < 0.5));
+    }
+
+    #[test]
+    fn the_heap_count_covers_every_vector_and_generation_leaves_no_slack() {
+        // Every field is a vector (a 24-byte header): the list the passes share names them all.
+        let none = Particles::<2>::default();
+        assert_eq!(std::mem::size_of::<Particles<2>>(), 24 * per_point_vectors!(none, v => v.len()).len());
+        let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &[]).unwrap();
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
+        let ps = Particles::generate(&c, &g, |_| true);
+        // In two dimensions: id 8, body and material 2 + 2, ten [f64; 2] 160, F 32, seven scalars
+        // 56, the stress 48.
+        assert_eq!(ps.heap_bytes(), ps.len() * 308);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! model's parameters in their own table with the checks of their ranges.
 
 use crate::case::check::{
-    at, in_closed_open, in_open, magnitude, modulus, non_negative, positive, Checked, MAX_DENSITY,
+    at, in_closed_open, in_open, magnitude, modulus, non_negative, positive, strength, viscosity, Checked, MAX_DENSITY,
 };
 use serde::{Deserialize, Serialize};
 
@@ -119,9 +119,9 @@ pub struct MohrCoulomb {
     pub poisson_ratio: f64,
     /// Friction angle φ [degrees], in [0, 90).
     pub friction_angle: f64,
-    /// Peak cohesion c_p [Pa], ≥ 0 (> 0 when φ = 0).
+    /// Peak cohesion c_p [Pa], in [0, 1e13] (> 0 when φ = 0).
     pub cohesion: f64,
-    /// Residual cohesion c_r [Pa], ≥ 0 (default: c_p, no softening).
+    /// Residual cohesion c_r [Pa], in [0, 1e13] (default: c_p, no softening).
     pub residual_cohesion: Option<f64>,
     /// Accumulated deviatoric plastic strain ε_p^r at which c_r is reached [-], > 0; required when
     /// c_r differs from c_p.
@@ -147,9 +147,9 @@ pub struct VonMises {
     pub young_modulus: f64,
     /// Poisson's ratio ν [-], in (−1, 0.5).
     pub poisson_ratio: f64,
-    /// Peak shear strength c_p [Pa], > 0.
+    /// Peak shear strength c_p [Pa], in (0, 1e13].
     pub cohesion: f64,
-    /// Residual shear strength c_r [Pa], ≥ 0 (default: c_p).
+    /// Residual shear strength c_r [Pa], in [0, 1e13] (default: c_p).
     pub residual_cohesion: Option<f64>,
     /// Softening modulus H_s = dc/dε̄ [Pa], in (−√3 G, 0] with G the shear modulus (default 0).
     #[serde(default)]
@@ -164,7 +164,7 @@ pub struct HenckyJ2 {
     pub young_modulus: f64,
     /// Poisson's ratio ν [-], in (−1, 0.5).
     pub poisson_ratio: f64,
-    /// Peak shear strength c_p [Pa], > 0.
+    /// Peak shear strength c_p [Pa], in (0, 1e13].
     pub cohesion: f64,
     /// Residual shear strength c_r [Pa], in [0, c_p] (default: c_p, no softening).
     pub residual_cohesion: Option<f64>,
@@ -181,9 +181,9 @@ pub struct NewtonianFluid {
     /// Bulk modulus K [Pa], in (0, 1e13] (water: 2.0e9 Pa; a smaller K is the usual weakly
     /// compressible substitute when the flow's Mach number v/√(K/ρ) stays below 0.1).
     pub bulk_modulus: f64,
-    /// Dynamic viscosity μ_v [Pa s], ≥ 0 (water: 1.0e-3 Pa s).
+    /// Dynamic viscosity μ_v [Pa s], in [0, 1e13] (water: 1.0e-3 Pa s).
     pub viscosity: f64,
-    /// Bulk viscosity ζ [Pa s], ≥ 0 (default 0): σ gains ζ tr d 1. Water has none (Stokes);
+    /// Bulk viscosity ζ [Pa s], in [0, 1e13] (default 0): σ gains ζ tr d 1. Water has none (Stokes);
     /// explicit codes add ζ = b₁ ρ c_p h (Abaqus/Explicit: b₁ = 0.06) to damp the volumetric
     /// ringing of a stiff fluid at the grid's scale.
     #[serde(default)]
@@ -295,7 +295,7 @@ impl MohrCoulomb {
         let k = |f: &str| at(key, f);
         check_elastic(key, self.young_modulus, self.poisson_ratio)?;
         in_closed_open(&k("friction_angle"), self.friction_angle, 0.0, 90.0)?;
-        non_negative(&k("cohesion"), self.cohesion)?;
+        strength(&k("cohesion"), self.cohesion, true)?;
         let phi = self.friction_angle;
         for (f, v) in
             [("dilation_angle", Some(self.dilation_angle)), ("critical_dilation_angle", self.critical_dilation_angle)]
@@ -306,7 +306,7 @@ impl MohrCoulomb {
         }
         non_negative(&k("dilation_decay"), self.dilation_decay)?;
         if let Some(r) = self.residual_cohesion {
-            non_negative(&k("residual_cohesion"), r)?;
+            strength(&k("residual_cohesion"), r, true)?;
             if r != self.cohesion && self.softening_strain.is_none() {
                 return Err(format!(
                     "key `{}`: required when residual_cohesion differs from cohesion",
@@ -373,9 +373,9 @@ impl VonMises {
     pub fn check(&self, key: &str) -> Checked {
         let k = |f: &str| at(key, f);
         check_elastic(key, self.young_modulus, self.poisson_ratio)?;
-        positive(&k("cohesion"), self.cohesion)?;
+        strength(&k("cohesion"), self.cohesion, false)?;
         if let Some(r) = self.residual_cohesion {
-            non_negative(&k("residual_cohesion"), r)?;
+            strength(&k("residual_cohesion"), r, true)?;
         }
         // Softening steeper than the elastic shear stiffness has no unique return.
         let g = self.young_modulus / (2.0 * (1.0 + self.poisson_ratio));
@@ -411,7 +411,7 @@ impl HenckyJ2 {
     pub fn check(&self, key: &str) -> Checked {
         let k = |f: &str| at(key, f);
         check_elastic(key, self.young_modulus, self.poisson_ratio)?;
-        positive(&k("cohesion"), self.cohesion)?;
+        strength(&k("cohesion"), self.cohesion, false)?;
         let residual = self.residual();
         if !(0.0..=self.cohesion).contains(&residual) {
             return Err(format!(
@@ -440,8 +440,8 @@ impl NewtonianFluid {
     /// Checks the parameters' ranges; `key` is the model's table.
     pub fn check(&self, key: &str) -> Checked {
         modulus(&at(key, "bulk_modulus"), self.bulk_modulus)?;
-        non_negative(&at(key, "viscosity"), self.viscosity)?;
-        non_negative(&at(key, "bulk_viscosity"), self.bulk_viscosity)
+        viscosity(&at(key, "viscosity"), self.viscosity)?;
+        viscosity(&at(key, "bulk_viscosity"), self.bulk_viscosity)
     }
 
     /// The model in words and numbers.

@@ -84,13 +84,13 @@ pub struct Terzaghi {
     /// and settlement errors; default [0.1, 0.5]).
     #[serde(default = "default_tv")]
     pub time_factors: Vec<f64>,
-    /// Pass threshold for e_p ([003] Eq. 33) [-], > 0 (default 0.01).
+    /// Pass threshold for e_p ([003] Eq. 33) [-], in (0, 1] (default 0.01).
     #[serde(default = "default_ep_tol")]
     pub e_p_tolerance: f64,
-    /// Pass threshold for the plain RMS of the normalised pressure error [-], > 0 (default 0.05).
+    /// Pass threshold for the plain RMS of the normalised pressure error [-], in (0, 1] (default 0.05).
     #[serde(default = "default_rms_tol")]
     pub p_rms_tolerance: f64,
-    /// Pass threshold for the relative settlement error [-], > 0 (default 0.05).
+    /// Pass threshold for the relative settlement error [-], in (0, 1] (default 0.05).
     #[serde(default = "default_settle_tol")]
     pub settlement_tolerance: f64,
 }
@@ -107,7 +107,7 @@ pub struct HarmonicColumn {
     /// Number of final load periods over which the amplitude is measured [-], ≥ 1 (default 3).
     #[serde(default = "default_periods")]
     pub measure_periods: usize,
-    /// Pass threshold for the maximum amplitude error relative to the peak amplitude [-], > 0.
+    /// Pass threshold for the maximum amplitude error relative to the peak amplitude [-], in (0, 1].
     pub tolerance: f64,
 }
 
@@ -121,10 +121,10 @@ pub struct ElasticColumn {
     pub gravity: String,
     /// The name of the surface load (a particle or nodal traction), if any.
     pub surcharge: Option<String>,
-    /// Pass threshold for max |σ_yy − σ*| / max |σ*| over the column [-], > 0 (default 0.01).
+    /// Pass threshold for max |σ_yy − σ*| / max |σ*| over the column [-], in (0, 1] (default 0.01).
     #[serde(default = "default_column_tol")]
     pub stress_tolerance: f64,
-    /// Pass threshold for the relative settlement error [-], > 0 (default 0.01).
+    /// Pass threshold for the relative settlement error [-], in (0, 1] (default 0.01).
     #[serde(default = "default_column_tol")]
     pub settlement_tolerance: f64,
 }
@@ -164,7 +164,7 @@ pub struct BearingCapacity {
     /// Reference q_ult/c [-], > 0 (default 2 + π, Prandtl).
     #[serde(default = "default_prandtl")]
     pub reference: f64,
-    /// Largest accepted |(q_ult/c)/reference − 1| [-], > 0 (default 0.03).
+    /// Largest accepted |(q_ult/c)/reference − 1| [-], in (0, 1] (default 0.03).
     #[serde(default = "default_bearing_tol")]
     pub tolerance: f64,
     /// d/B values [-], each > 0, at which q/c is reported in summary.json `results`.
@@ -192,13 +192,13 @@ pub struct LargeStrainConsolidation {
     /// (default [0.5]).
     #[serde(default = "default_us")]
     pub degrees: Vec<f64>,
-    /// Pass threshold for e_p ([003] Eq. 33) [-], > 0 (default 0.01).
+    /// Pass threshold for e_p ([003] Eq. 33) [-], in (0, 1] (default 0.01).
     #[serde(default = "default_ep_tol")]
     pub e_p_tolerance: f64,
-    /// Pass threshold for the plain RMS of the normalised pressure error [-], > 0 (default 0.05).
+    /// Pass threshold for the plain RMS of the normalised pressure error [-], in (0, 1] (default 0.05).
     #[serde(default = "default_rms_tol")]
     pub p_rms_tolerance: f64,
-    /// Pass threshold for the relative settlement error [-], > 0 (default 0.03).
+    /// Pass threshold for the relative settlement error [-], in (0, 1] (default 0.03).
     #[serde(default = "default_ls_settle_tol")]
     pub settlement_tolerance: f64,
 }
@@ -211,11 +211,11 @@ pub struct Patch {
     pub body: String,
     /// The name of the boundary whose homogeneous flow (`velocity_gradient`) drives it.
     pub boundary: String,
-    /// Largest accepted spread of the particles' stresses, max ‖σ_p − σ̄‖/‖σ̄‖ [-], > 0 (default
+    /// Largest accepted spread of the particles' stresses, max ‖σ_p − σ̄‖/‖σ̄‖ [-], in (0, 1] (default
     /// 1e-9).
     #[serde(default = "default_spread_tol")]
     pub spread_tolerance: f64,
-    /// Largest accepted ‖σ̄ − σ*‖/‖σ*‖ against the linear-elastic stress of the flow [-], > 0
+    /// Largest accepted ‖σ̄ − σ*‖/‖σ*‖ against the linear-elastic stress of the flow [-], in (0, 1]
     /// (default 1e-6).
     #[serde(default = "default_patch_tol")]
     pub tolerance: f64,
@@ -236,10 +236,10 @@ pub struct Lame {
     pub inner_radius: f64,
     /// Outer radius b [m], > a.
     pub outer_radius: f64,
-    /// Largest accepted relative L2 error of u_r [-], > 0 (default 0.05).
+    /// Largest accepted relative L2 error of u_r [-], in (0, 1] (default 0.05).
     #[serde(default = "default_lame_tol")]
     pub displacement_tolerance: f64,
-    /// Largest accepted relative L2 error of σ_rr and of σ_θθ [-], > 0 (default 0.05).
+    /// Largest accepted relative L2 error of σ_rr and of σ_θθ [-], in (0, 1] (default 0.05).
     #[serde(default = "default_lame_tol")]
     pub stress_tolerance: f64,
 }
@@ -257,11 +257,11 @@ pub struct HollowCylinder {
     pub inner_radius: f64,
     /// Outer radius b [m] (held radially), > a.
     pub outer_radius: f64,
-    /// Largest accepted relative error of u_r at the inner radius [-], > 0 (default 0.05).
+    /// Largest accepted relative error of u_r at the inner radius [-], in (0, 1] (default 0.05).
     #[serde(default = "default_lame_tol")]
     pub displacement_tolerance: f64,
     /// Largest accepted relative error of Δσ_rr at the innermost points (mp1) and volume-weighted
-    /// RMS of the relative error of Δσ_rr over the body [-], > 0 (default 0.25).
+    /// RMS of the relative error of Δσ_rr over the body [-], in (0, 1] (default 0.25).
     #[serde(default = "default_hollow_stress_tol")]
     pub stress_tolerance: f64,
     /// Checks every load step as an increment of the remaining cylinder ([001]'s 25 increments):
@@ -298,7 +298,7 @@ pub struct StiffnessMap {
     pub center: [f64; 2],
     /// The radius within which nodes are evaluated [m], > 0.
     pub radius: f64,
-    /// Largest accepted relative deviation of K_mag at any of those nodes [-], > 0 (default 0.01).
+    /// Largest accepted relative deviation of K_mag at any of those nodes [-], in (0, 1] (default 0.01).
     #[serde(default = "default_stiffness_map_tol")]
     pub tolerance: f64,
 }
@@ -354,7 +354,7 @@ pub struct DamBreak {
     /// hydrostatic pressure and after which it flows.
     pub settle_stage: String,
     /// Largest accepted |p − ρ g d| / (ρ g H) over the points more than one cell above the base
-    /// at the end of the settling stage [-], > 0 (default 0.02).
+    /// at the end of the settling stage [-], in (0, 1] (default 0.02).
     #[serde(default = "default_hydrostatic_tol")]
     pub hydrostatic_tolerance: f64,
     /// x of the wall the front runs into [m]; the front's speed bound applies while the front is
@@ -363,7 +363,7 @@ pub struct DamBreak {
     /// A measured front position to compare with: `"martin_moyce_1952"` (Martin & Moyce 1952,
     /// the column of height 2a on width a, n² = 2; the body must have that aspect ratio).
     pub experiment: Option<String>,
-    /// Largest accepted mean |Z/Z_exp − 1| of the front against `experiment` [-], > 0 (default
+    /// Largest accepted mean |Z/Z_exp − 1| of the front against `experiment` [-], in (0, 1] (default
     /// 0.1).
     #[serde(default = "default_front_tol")]
     pub front_tolerance: f64,
@@ -413,10 +413,10 @@ pub struct ShockWave {
     pub load: String,
     /// Depth of the observation point below the initial surface [m], > 0.
     pub probe_depth: f64,
-    /// Pass threshold for the fast (undrained) wave arrival error [-], > 0 (default 0.02).
+    /// Pass threshold for the fast (undrained) wave arrival error [-], in (0, 1] (default 0.02).
     #[serde(default = "default_fast_tol")]
     pub fast_tolerance: f64,
-    /// Pass threshold for the slow (damped) wave arrival error [-], > 0 (default 0.05).
+    /// Pass threshold for the slow (damped) wave arrival error [-], in (0, 1] (default 0.05).
     #[serde(default = "default_slow_tol")]
     pub slow_tolerance: f64,
 }
@@ -514,7 +514,25 @@ fn each_positive(key: &str, values: &[f64]) -> Checked {
 
 /// Each `(field, value)` above zero.
 fn all_positive(key: &str, fields: &[(&str, f64)]) -> Checked {
-    fields.iter().try_for_each(|&(f, v)| positive(&at(key, f), v))
+    fields.iter().try_for_each(|&(f, v)| {
+        if f.ends_with("tolerance") {
+            tolerance(&at(key, f), v)
+        } else {
+            positive(&at(key, f), v)
+        }
+    })
+}
+
+/// A verification tolerance: every one bounds a normalised error, so it is positive and at most 1
+/// (a tolerance of 100 % or more lets any answer pass).
+fn tolerance(key: &str, v: f64) -> Checked {
+    positive(key, v)?;
+    if v > 1.0 {
+        return Err(format!(
+            "key `{key}`: must be at most 1 (it bounds a normalised error, and 100 % or more lets any answer pass), got {v:e}"
+        ));
+    }
+    Ok(())
 }
 
 /// The spray fraction's range [0, 0.05].
@@ -547,7 +565,7 @@ impl Terzaghi {
 impl HarmonicColumn {
     /// Checks the tolerance and the periods; `key` is the table (`verification`).
     pub fn check(&self, key: &str) -> Checked {
-        positive(&at(key, "tolerance"), self.tolerance)?;
+        tolerance(&at(key, "tolerance"), self.tolerance)?;
         if self.measure_periods == 0 {
             return Err(format!("key `{}`: must be at least 1", at(key, "measure_periods")));
         }
@@ -714,9 +732,9 @@ pub const DAM_BREAK_EXPERIMENTS: [&str; 1] = ["martin_moyce_1952"];
 impl DamBreak {
     /// Checks the tolerances, the wall and the experiment; `key` is the table (`verification`).
     pub fn check(&self, key: &str) -> Checked {
-        positive(&at(key, "hydrostatic_tolerance"), self.hydrostatic_tolerance)?;
+        tolerance(&at(key, "hydrostatic_tolerance"), self.hydrostatic_tolerance)?;
         spray(key, self.spray_fraction)?;
-        positive(&at(key, "front_tolerance"), self.front_tolerance)?;
+        tolerance(&at(key, "front_tolerance"), self.front_tolerance)?;
         if let Some(x) = self.far_wall {
             finite2(&at(key, "far_wall"), [x, 0.0])?;
         }
