@@ -31,6 +31,7 @@ enum Kind {
     Number,
     Count,
     Flag,
+    Object,
 }
 
 impl Kind {
@@ -40,6 +41,7 @@ impl Kind {
             Kind::Number => x.is_number(),
             Kind::Count => x.is_u64(),
             Kind::Flag => x.is_boolean(),
+            Kind::Object => x.is_object(),
         }
     }
 
@@ -49,16 +51,26 @@ impl Kind {
             Kind::Number => "a number",
             Kind::Count => "a whole number ≥ 0",
             Kind::Flag => "true or false",
+            Kind::Object => "an object",
+        }
+    }
+
+    /// The value `x` at `path` is of this kind, absent or null (which stands for "none" or a
+    /// non-finite number anywhere); the error names the path.
+    fn check(self, path: &str, x: Option<&Value>) -> Result<(), String> {
+        match x {
+            Some(x) if !x.is_null() && !self.holds(x) => {
+                Err(format!("`{path}` is {}, expected {}", describe(x), self.name()))
+            }
+            _ => Ok(()),
         }
     }
 }
 
-/// Every value the report reads has its summary's kind (null stands for "none" or a non-finite
-/// number anywhere); an error names the first key that does not, so that a file of another shape
-/// is refused rather than shown in part.
+/// Every value the report reads has its summary's kind; an error names the first key that does
+/// not, so that a file of another shape is refused rather than shown in part.
 fn check_shape(v: &Value) -> Result<(), String> {
     use Kind::*;
-    let wrong = |key: &str, kind: Kind| format!("`{key}` is {}, expected {}", describe(&v[key]), kind.name());
     let top = [
         ("status", Text),
         ("case", Text),
@@ -80,46 +92,22 @@ fn check_shape(v: &Value) -> Result<(), String> {
         ("checkerboard_index_max", Number),
         ("stopped", Text),
         ("verification_passed", Flag),
+        ("restarted_from", Object),
     ];
     for (key, kind) in top {
-        if v.get(key).is_some_and(|x| !x.is_null() && !kind.holds(x)) {
-            return Err(wrong(key, kind));
-        }
+        kind.check(key, v.get(key))?;
     }
-    let object = |key: &str| -> Result<Option<&serde_json::Map<String, Value>>, String> {
-        match v.get(key) {
-            None | Some(Value::Null) => Ok(None),
-            Some(Value::Object(m)) => Ok(Some(m)),
-            Some(x) => Err(format!("`{key}` is {}, expected an object", describe(x))),
-        }
-    };
-    let entries = |key: &str, kind: Kind| -> Result<(), String> {
-        for (name, x) in object(key)?.into_iter().flatten() {
-            if !x.is_null() && !kind.holds(x) {
-                return Err(format!("`{key}.{name}` is {}, expected {}", describe(x), kind.name()));
-            }
-        }
-        Ok(())
-    };
-    entries("timings", Number)?;
-    if let Some(m) = object("memory")? {
-        for (name, x) in m.iter().filter(|(k, _)| *k != "peak_rise") {
-            if !x.is_null() && !Number.holds(x) {
-                return Err(format!("`memory.{name}` is {}, expected {}", describe(x), Number.name()));
-            }
-        }
+    for key in ["timings", "results", "memory"] {
+        numbers(key, v.get(key), "peak_rise")?;
     }
-    entries("results", Number)?;
-    for (name, m) in object("verification")?.into_iter().flatten() {
-        let Value::Object(m) = m else {
-            return Err(format!("`verification.{name}` is {}, expected an object", describe(m)));
-        };
+    numbers("memory.peak_rise", v.get("memory").and_then(|m| m.get("peak_rise")), "")?;
+    for (name, m) in object("verification", v.get("verification"))?.into_iter().flatten() {
+        let path = format!("verification.{name}");
+        let m = object(&path, Some(m))?;
         for (key, kind) in
             [("value", Number), ("reference", Number), ("tolerance", Number), ("pass", Flag), ("detail", Text)]
         {
-            if let Some(x) = m.get(key).filter(|x| !x.is_null() && !kind.holds(x)) {
-                return Err(format!("`verification.{name}.{key}` is {}, expected {}", describe(x), kind.name()));
-            }
+            kind.check(&format!("{path}.{key}"), m.and_then(|m| m.get(key)))?;
         }
     }
     if let Some(o) = v.get("overrides").filter(|o| !o.is_null()) {
@@ -127,7 +115,20 @@ fn check_shape(v: &Value) -> Result<(), String> {
             return Err(format!("`overrides` is {}, expected a list of strings", describe(o)));
         }
     }
-    object("restarted_from")?;
+    Ok(())
+}
+
+/// The object `x` at `path`, if there is one (an error names the path if `x` is something else).
+fn object<'a>(path: &str, x: Option<&'a Value>) -> Result<Option<&'a serde_json::Map<String, Value>>, String> {
+    Kind::Object.check(path, x)?;
+    Ok(x.and_then(Value::as_object))
+}
+
+/// Every entry of the object `x` at `path` but `except` is a number (or null).
+fn numbers(path: &str, x: Option<&Value>, except: &str) -> Result<(), String> {
+    for (name, x) in object(path, x)?.into_iter().flatten().filter(|(k, _)| *k != except) {
+        Kind::Number.check(&format!("{path}.{name}"), Some(x))?;
+    }
     Ok(())
 }
 

@@ -303,6 +303,16 @@ fn the_energies_are_the_same_on_one_two_and_three_ranks_with_repartitioning() {
             })
             .collect();
         assert_eq!(runs[1].summary["repartitions"], 1, "{case}: the two-rank run repartitions");
+        // The matrix's storage summed over ranks is the one rank's, but for the ranks' row offsets.
+        let matrix = |r: &Run| r.summary["memory"]["matrix_mib"].as_f64().unwrap();
+        for (n, r) in runs.iter().enumerate().skip(1) {
+            let (one, many) = (matrix(&runs[0]), matrix(r));
+            assert!(
+                one > 0.0 && (many / one - 1.0).abs() < 0.01,
+                "{case}: matrix {many} MiB on {} ranks, {one} on one",
+                n + 1
+            );
+        }
         for name in ["energy_external", "energy_internal", "energy_kinetic", "energy_balance_error"] {
             let one = runs[0].column(name);
             for (n, r) in runs.iter().enumerate().skip(1) {

@@ -1,11 +1,6 @@
 //! Bytes a container holds on the heap (its capacity times its element's size), for the memory
 //! breakdown of a run (`summary.json`'s `memory`).
 
-/// The heap bytes of `v`'s own buffer (not of what its elements own).
-pub fn bytes<T>(v: &[T]) -> usize {
-    std::mem::size_of_val(v)
-}
-
 /// The heap bytes of a vector's buffer at its capacity (not of what its elements own).
 pub fn capacity<T>(v: &Vec<T>) -> usize {
     v.capacity() * std::mem::size_of::<T>()
@@ -25,7 +20,6 @@ mod tests {
         let mut v: Vec<[f64; 3]> = Vec::with_capacity(10);
         v.push([0.0; 3]);
         assert_eq!(capacity(&v), 240);
-        assert_eq!(bytes(&v), 24);
         let n = vec![vec![1u32; 4], Vec::with_capacity(2)];
         assert_eq!(nested(&n), 2 * 24 + 16 + 8);
     }

@@ -226,9 +226,9 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.space.layout
     }
 
-    /// The matrix's memory: PETSc's (values, indices and its own bookkeeping, summed over ranks,
-    /// `MatGetInfo`) and this rank's in the program (the block pattern and the assembly's buffer
-    /// of block values, one value per stored entry), in bytes; zeros without a matrix.
+    /// This rank's matrix memory in bytes: its compressed-row storage in PETSc (`petsc::mat::MatStats`)
+    /// and the program's side of it (the block pattern and the assembly's buffer of block values,
+    /// one value per stored entry); zeros without a matrix. Not collective.
     pub fn matrix_memory(&self) -> Result<(f64, usize), Error> {
         let Some(m) = &self.matrix else { return Ok((0.0, 0)) };
         let nd = self.space.layout.nd;
@@ -250,7 +250,6 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     /// Prepares the step t_n → t_{n+1} = `t_new` of length `dt` with the stage's `active` loads and
     /// boundaries ([`Step::prepare`]); `stage_start` says it is the first of its stage.
     /// Collective; every rank returns the same outcome.
-    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
         &mut self,
         model: &Model<D>,

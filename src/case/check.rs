@@ -36,8 +36,14 @@ pub fn positive(key: &str, v: f64) -> Checked {
 /// A positive physical magnitude of at most `hi` (in `unit`), with the reason for the bound.
 pub fn magnitude(key: &str, v: f64, hi: f64, unit: &str, why: &str) -> Checked {
     positive(key, v)?;
+    at_most(key, v, hi, unit, why)
+}
+
+/// At most `hi` (in `unit`, empty for a pure number), with the reason for the bound.
+pub fn at_most(key: &str, v: f64, hi: f64, unit: &str, why: &str) -> Checked {
     if v > hi {
-        return Err(format!("key `{key}`: must be at most {hi:e} {unit} ({why}), got {v:e}"));
+        let bound = if unit.is_empty() { format!("{hi:e}") } else { format!("{hi:e} {unit}") };
+        return Err(format!("key `{key}`: must be at most {bound} ({why}), got {v:e}"));
     }
     Ok(())
 }
@@ -55,13 +61,13 @@ pub fn strength(key: &str, v: f64, zero: bool) -> Checked {
     } else {
         positive(key, v)?;
     }
-    if v > MAX_MODULUS {
-        return Err(format!(
-            "key `{key}`: must be at most {MAX_MODULUS:e} Pa (a strength above the stiffest modulus a case may give: \
-             the material would never yield), got {v:e}"
-        ));
-    }
-    Ok(())
+    at_most(
+        key,
+        v,
+        MAX_MODULUS,
+        "Pa",
+        "a strength above the stiffest modulus a case may give: the material would never yield",
+    )
 }
 
 /// The largest dynamic viscosity a case may give [Pa s]: about glacier ice's.
@@ -70,13 +76,8 @@ pub const MAX_VISCOSITY: f64 = 1e13;
 /// A dynamic viscosity in [0, [`MAX_VISCOSITY`]] Pa s.
 pub fn viscosity(key: &str, v: f64) -> Checked {
     non_negative(key, v)?;
-    if v > MAX_VISCOSITY {
-        return Err(format!(
-            "key `{key}`: must be at most {MAX_VISCOSITY:e} Pa s (about glacier ice's: a fluid more viscous is a \
-             solid over any duration a run resolves), got {v:e}"
-        ));
-    }
-    Ok(())
+    let why = "about glacier ice's: a fluid more viscous is a solid over any duration a run resolves";
+    at_most(key, v, MAX_VISCOSITY, "Pa s", why)
 }
 
 /// A number above zero, or `inf`.

@@ -118,6 +118,7 @@ where
             None => sim.model.set_load_increments(0.0, crate::model::LoadsAt::Start, coll).map_err(RunError::Input)?,
         }
         sim.observe(0.0, (0, 0), None, true)?;
+        sim.journal.summary.memory.peak_rise.setup_mib = crate::io::peak_memory_mib().unwrap_or(0.0);
         sim.milestone()?;
         Ok(sim)
     }

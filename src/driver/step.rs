@@ -42,10 +42,6 @@ where
     pub(super) fn prepare(&mut self, active: &Active, dt: f64) -> Result<Step<D, M>, RunError> {
         let t0 = Instant::now();
         let peak = crate::io::peak_memory_mib();
-        let rise = &mut self.journal.summary.memory.peak_rise;
-        if rise.setup_mib == 0.0 {
-            rise.setup_mib = peak.unwrap_or(0.0);
-        }
         let step = {
             let _stage = self.system.phase(Phase::StepSetup).map_err(failed)?;
             let times = (self.t + dt, dt);
@@ -219,10 +215,12 @@ where
     /// results and start states the particle update holds.
     fn observe_memory(&mut self, step: &Step<D, M>, held: usize) -> Result<(), RunError> {
         let (stencils, data) = step.heap_bytes();
-        let (petsc, assembly) = self.system.matrix_memory().map_err(failed)?;
-        let local = [self.model.particles.heap_bytes(), stencils, data, 0, assembly, held].map(|b| b as f64);
+        let (matrix, assembly) = self.system.matrix_memory().map_err(failed)?;
+        let ours = |b: usize| b as f64;
+        let local =
+            [ours(self.model.particles.heap_bytes()), ours(stencils), ours(data), matrix, ours(assembly), ours(held)];
         let s = self.coll.sum(&local).map_err(RunError::Failed)?;
-        let now = crate::summary::MemoryUse::of_bytes([s[0], s[1], s[2], petsc, s[4], s[5]]);
+        let now = crate::summary::MemoryUse::of_bytes(std::array::from_fn(|i| s[i]));
         let m = &mut self.journal.summary.memory;
         *m = m.max(now);
         Ok(())

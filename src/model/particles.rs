@@ -67,15 +67,19 @@ pub struct Particles<const D: usize = 2> {
 /// `&mut`) each vector in turn: one list of the fields for every pass over all of them.
 macro_rules! per_point_vectors {
     ($s:expr, $v:ident => $body:expr) => {
-        per_point_vectors!(@each $s, $v, $body, &, id, body, material, x, x0, disp, lp, lp0, def_grad, volume, porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p, jbar)
+        per_point_vectors!(@fields ref $s, $v, $body)
     };
     (mut $s:expr, $v:ident => $body:expr) => {
-        per_point_vectors!(@each $s, $v, $body, &mut, id, body, material, x, x0, disp, lp, lp0, def_grad, volume, porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p, jbar)
+        per_point_vectors!(@fields mut $s, $v, $body)
     };
-    (@each $s:expr, $v:ident, $body:expr, &, $($f:ident),*) => {
+    (@fields $mode:tt $s:expr, $v:ident, $body:expr) => {
+        per_point_vectors!(@each $mode $s, $v, $body; id, body, material, x, x0, disp, lp, lp0, def_grad, volume,
+            porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p, jbar)
+    };
+    (@each ref $s:expr, $v:ident, $body:expr; $($f:ident),*) => {
         [$({ let $v = &$s.$f; $body }),*]
     };
-    (@each $s:expr, $v:ident, $body:expr, &mut, $($f:ident),*) => {
+    (@each mut $s:expr, $v:ident, $body:expr; $($f:ident),*) => {
         [$({ let $v = &mut $s.$f; $body }),*]
     };
 }

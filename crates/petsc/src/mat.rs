@@ -29,13 +29,14 @@ impl Drop for Mat {
     }
 }
 
-/// Sparsity statistics of an assembled matrix (summed over ranks).
+/// Sparsity statistics of this rank's part of an assembled matrix.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct MatStats {
     /// Stored nonzeros in use.
     pub nonzeros: f64,
-    /// The bytes of its compressed-row storage, summed over ranks: a value and a column index per
-    /// allocated nonzero and a row offset per row (what PETSc reports as the matrix's memory is
+    /// The bytes of its compressed-row storage: a value and a column index per allocated nonzero
+    /// (per stored one where PETSc reports none allocated, as for a distributed matrix built from
+    /// coordinate lists) and a row offset per row (what PETSc reports as the matrix's memory is
     /// not tracked in optimised builds; this is what AIJ storage takes).
     pub memory_bytes: f64,
 }
@@ -160,13 +161,16 @@ pub trait MatOps {
         Ok((lo, out))
     }
 
-    /// Nonzeros and memory, summed over ranks.
+    /// This rank's nonzeros and memory (not collective).
     fn stats(&self) -> Result<MatStats> {
         let mut info = sys::MatInfo::default();
-        call!(MatGetInfo(self.raw(), sys::MatInfoType::MAT_GLOBAL_SUM, &mut info))?;
-        let (rows, _) = self.size()?;
+        call!(MatGetInfo(self.raw(), sys::MatInfoType::MAT_LOCAL, &mut info))?;
+        let (mut rows, mut cols): (Int, Int) = (0, 0);
+        call!(MatGetLocalSize(self.raw(), &mut rows, &mut cols))?;
+        let rows = rows as usize;
         let entry = (std::mem::size_of::<sys::PetscScalar>() + std::mem::size_of::<Int>()) as f64;
-        let memory_bytes = info.nz_allocated * entry + ((rows + 1) * std::mem::size_of::<Int>()) as f64;
+        let memory_bytes =
+            info.nz_allocated.max(info.nz_used) * entry + ((rows + 1) * std::mem::size_of::<Int>()) as f64;
         Ok(MatStats { nonzeros: info.nz_used, memory_bytes })
     }
 

@@ -1,7 +1,7 @@
 //! `[verification]`: the analytical reference a run is checked against, chosen by its `kind`,
 //! each kind's parameters in their own table with the checks of their ranges.
 
-use crate::case::check::{at, finite2, positive, Checked};
+use crate::case::check::{at, at_most, finite2, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// The analytical reference of a case.
@@ -512,7 +512,7 @@ fn each_positive(key: &str, values: &[f64]) -> Checked {
     values.iter().enumerate().try_for_each(|(j, &v)| positive(&format!("{key}[{j}]"), v))
 }
 
-/// Each `(field, value)` above zero.
+/// Each `(field, value)` above zero, and a tolerance at most 1 ([`tolerance`]).
 fn all_positive(key: &str, fields: &[(&str, f64)]) -> Checked {
     fields.iter().try_for_each(|&(f, v)| {
         if f.ends_with("tolerance") {
@@ -527,12 +527,7 @@ fn all_positive(key: &str, fields: &[(&str, f64)]) -> Checked {
 /// (a tolerance of 100 % or more lets any answer pass).
 fn tolerance(key: &str, v: f64) -> Checked {
     positive(key, v)?;
-    if v > 1.0 {
-        return Err(format!(
-            "key `{key}`: must be at most 1 (it bounds a normalised error, and 100 % or more lets any answer pass), got {v:e}"
-        ));
-    }
-    Ok(())
+    at_most(key, v, 1.0, "", "it bounds a normalised error, and 100 % or more lets any answer pass")
 }
 
 /// The spray fraction's range [0, 0.05].
