@@ -39,13 +39,13 @@ pub fn write_csv(dir: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) 
 /// Where a run's figures go, inside its output directory.
 pub const PLOTS_DIR: &str = "plots";
 
-/// The peak resident memory of this process so far [MiB] (`VmHWM` of `/proc/self/status`), if the
-/// system reports it.
+/// The peak resident memory of this process so far [MiB] (`ru_maxrss` of getrusage(2), the
+/// `VmHWM` of `/proc/self/status`), if the system reports it. One system call: the driver reads it
+/// around every phase of every step (reading `/proc/self/status` took 6 % of a small case's run).
 pub fn peak_memory_mib() -> Option<f64> {
-    let status = fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
+    use nix::sys::resource::{getrusage, UsageWho};
+    let kib = getrusage(UsageWho::RUSAGE_SELF).ok()?.max_rss();
+    (kib > 0).then(|| kib as f64 / 1024.0)
 }
 
 /// The memory this machine has available for a new run [B] (`MemAvailable` of `/proc/meminfo`),
