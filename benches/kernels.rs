@@ -22,8 +22,8 @@ use porompm::case::{self, Override};
 use porompm::kernels::{self, NodeBasis, NodeState, Predictors};
 use porompm::model::patch::PatchField;
 use porompm::model::shape::{self, Basis};
-use porompm::model::soil::Region;
 use porompm::model::Model;
+use porompm::soils::Region;
 use std::path::Path;
 use std::time::Duration;
 
@@ -160,7 +160,7 @@ fn particle_kernels(c: &mut Criterion) {
         })
     });
     let footing = load("cases/footing_sd.toml", &["materials.clay.model.friction_angle=30"]);
-    let mc = porompm::model::material::soil_model(&footing.materials[0].model);
+    let mc = footing.materials[0].model.law();
     let stress0 = [-2e3, -2e3, 0.0, -2e3, 0.0, 0.0];
     // Isochoric (the soil is nearly incompressible, ν = 0.49): ε_xx = −ε_yy.
     let shear: Vec<[f64; 6]> = (0..n)

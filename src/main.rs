@@ -489,7 +489,7 @@ fn element_test(material: &Path, path: &Path, out: &Path) -> Result<(), Failure>
     let ptext = io::read_text(path).map_err(input)?;
     let p = porompm::element_test::input::parse_path(&ptext, &path.display().to_string())
         .map_err(|e| input(e.to_string()))?;
-    let model = porompm::model::material::soil_model(&m.model);
+    let model = m.model.law();
     let rows = porompm::element_test::run(&model, &p).map_err(failed)?;
     let file =
         io::write_csv(out, "element_test.csv", &porompm::element_test::HEADER, &porompm::element_test::table(&rows))

@@ -5,8 +5,9 @@
 
 use crate::algebra::{cofactor_mul, det, product};
 use crate::kernels::StepResult;
-use crate::model::{finite_strain, position_text, shape, Model};
+use crate::model::{position_text, shape, Model};
 use crate::scheme::Integration;
+use crate::soils::finite_strain;
 
 /// Why a particle update was refused.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,8 +187,9 @@ fn porosity_after<const D: usize>(model: &Model<D>, k: usize, j: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::kernels::Interp;
+    use crate::model::grid;
     use crate::model::particles::Particles;
-    use crate::model::{grid, soil};
+    use crate::soils;
 
     /// The two-phase column of the case tests, with gravity's pore-pressure gradient on its points.
     fn column() -> Model {
@@ -256,7 +258,7 @@ mod tests {
         f_inc: [[f64; D]; D],
         x: [f64; D],
         grad_dp: [f64; D],
-        stress: soil::Stress,
+        stress: soils::Stress,
     ) -> StepResult<D> {
         let du = std::array::from_fn(|a| (0..D).map(|b| f_inc[a][b] * x[b]).sum::<f64>() - x[a]);
         StepResult {
@@ -265,7 +267,7 @@ mod tests {
             eps_pd: 0.01,
             f_inc,
             jacobian: det(&f_inc),
-            deps: [0.0; soil::NS],
+            deps: [0.0; soils::NS],
             grad_n: [0.0; D],
             jbar: None,
             velocity: None,
@@ -281,7 +283,7 @@ mod tests {
         let mut m3 = lift(&m2, 0.2);
         let f2 = [[1.01, 0.03], [-0.02, 0.97]];
         let f3 = [[1.01, 0.03, 0.0], [-0.02, 0.97, 0.0], [0.0, 0.0, 1.0]];
-        let s = soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]);
+        let s = soils::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]);
         for k in 0..m2.particles.len() {
             let x2 = m2.particles.x[k];
             update_particle(&mut m2, k, &step(f2, x2, [10.0, -20.0], s), 40.0, 0.5).unwrap();
@@ -346,7 +348,7 @@ mod tests {
         // A rigid rotation about a tilted axis: U = I.
         let axis: [f64; 3] = [0.3, -0.5, 0.81];
         let len: f64 = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-        let r = soil::principal::rotation(axis.map(|a| a / len), 0.7);
+        let r = soils::principal::rotation(axis.map(|a| a / len), 0.7);
         let u = shape::stretch_diagonal(&r);
         assert!(u.iter().all(|v| (v - 1.0).abs() < 1e-14), "{u:?}");
     }

@@ -1,7 +1,8 @@
 //! docs/case_reference.md, the user's reference of every table and key of a case file, is the
 //! case schema's doc comments rendered: its JSON Schema (`schemars`, which reads the doc comments
 //! and follows the serde attributes: tags, defaults, optional keys) turned into tables of key,
-//! type, default and meaning, in the order the keys are declared in src/case/schema/.
+//! type, default and meaning, in the order the keys are declared in src/case/schema/ and, for the
+//! soil models' parameters, src/soils/.
 //!
 //! The test fails, naming the first line that differs, when the file is not what the schema says;
 //! `PORO_DOC_REFRESH=1 cargo test --release --test case_reference` rewrites it.
@@ -14,8 +15,8 @@ const REFERENCE: &str = "docs/case_reference.md";
 
 const HEADER: &str = "# Case file reference
 
-<!-- Generated from the doc comments of src/case/schema/ by tests/case_reference.rs; do not edit
-by hand. After changing the schema, rewrite it with
+<!-- Generated from the doc comments of src/case/schema/ and src/soils/ by tests/case_reference.rs;
+do not edit by hand. After changing the schema, rewrite it with
 `PORO_DOC_REFRESH=1 cargo test --release --test case_reference`. -->
 
 A case is a TOML file with the tables below (`cases/` holds examples). Units are SI: m, s, kg, Pa,
@@ -359,33 +360,70 @@ fn prose(doc: &str) -> String {
     out + rest
 }
 
-/// The declaration order of each struct's fields in src/case/schema/, and the struct of each
-/// tagged variant (`SoilModel::mohr_coulomb` → `MohrCoulomb`).
+/// The declaration order of each struct's fields in src/case/schema/ and src/soils/ (the soil
+/// models' parameters), and the struct of each tagged variant (`SoilModel::mohr_coulomb` →
+/// `MohrCoulomb`, from the enum's declaration or the lines `Variant(module::Type) = "tag",` of the
+/// registry `soil_models!`). A newtype
+/// (`pub struct LinearElasticParameters(pub Elasticity);`, serde-transparent) takes the order of
+/// the struct it wraps.
 fn declaration_order() -> (BTreeMap<String, Vec<String>>, BTreeMap<String, String>) {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/case/schema");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let (mut order, mut variants) = (BTreeMap::new(), BTreeMap::new());
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
-        let mut current: Option<(bool, String)> = None;
-        for line in text.lines() {
-            let t = line.trim();
-            if let Some(rest) = t.strip_prefix("pub struct ").or(t.strip_prefix("pub enum ")) {
-                let name = rest.split([' ', '{', '<']).next().unwrap().to_string();
-                current = Some((t.starts_with("pub struct"), name));
-            } else if t == "}" && !line.starts_with(' ') {
-                current = None;
-            } else if let Some((is_struct, name)) = &current {
-                if *is_struct {
-                    if let Some(field) = t.strip_prefix("pub ").and_then(|f| f.split(':').next()) {
-                        order.entry(name.clone()).or_insert_with(Vec::new).push(field.to_string());
-                    }
-                } else if let Some((variant, ty)) = t.strip_suffix("),").and_then(|v| v.split_once('(')) {
-                    variants.insert(format!("{name}::{}", snake(variant)), ty.to_string());
-                }
+    let mut newtypes = Vec::new();
+    for dir in ["src/case/schema", "src/soils"] {
+        for entry in std::fs::read_dir(root.join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
             }
+            read_declarations(&std::fs::read_to_string(path).unwrap(), &mut order, &mut variants, &mut newtypes);
+        }
+    }
+    for (name, inner) in newtypes {
+        if let Some(fields) = order.get(&inner).cloned() {
+            order.insert(name, fields);
         }
     }
     (order, variants)
+}
+
+/// The fields of each struct of one source file (into `order`), the struct of each tagged
+/// variant (into `variants`) and the newtypes with the struct they wrap (into `newtypes`).
+fn read_declarations(
+    text: &str,
+    order: &mut BTreeMap<String, Vec<String>>,
+    variants: &mut BTreeMap<String, String>,
+    newtypes: &mut Vec<(String, String)>,
+) {
+    let mut current: Option<(bool, String)> = None;
+    for line in text.lines() {
+        let t = line.trim();
+        if t == "soil_models! {" {
+            current = Some((false, "SoilModel".to_string()));
+        } else if let Some(rest) = t.strip_prefix("pub struct ").or(t.strip_prefix("pub enum ")) {
+            let name = rest.split([' ', '{', '<', '(']).next().unwrap().to_string();
+            if let Some(inner) = rest.strip_prefix(&format!("{name}(pub ")).and_then(|r| r.strip_suffix(");")) {
+                newtypes.push((name, inner.to_string()));
+                current = None;
+            } else {
+                current = Some((t.starts_with("pub struct"), name));
+            }
+        } else if t == "}" && !line.starts_with(' ') {
+            current = None;
+        } else if let Some((is_struct, name)) = &current {
+            if *is_struct {
+                if let Some(field) = t.strip_prefix("pub ").and_then(|f| f.split(':').next()) {
+                    order.entry(name.clone()).or_default().push(field.to_string());
+                }
+            } else if let Some((variant, ty)) = t.strip_suffix("),").and_then(|v| v.split_once('(')) {
+                variants.insert(format!("{name}::{}", snake(variant)), ty.to_string());
+            } else if let Some((declared, tag)) = t.strip_suffix("\",").and_then(|v| v.split_once(") = \"")) {
+                // A registry line: `Variant(module::Type) = "tag",`.
+                let ty = declared.split_once('(').map_or("", |(_, ty)| ty).rsplit("::").next().unwrap();
+                variants.insert(format!("{name}::{tag}"), ty.to_string());
+            }
+        }
+    }
 }
 
 /// `HenckyJ2` → `hencky_j2`, as serde's `rename_all = "snake_case"`.

@@ -13,13 +13,15 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[(&str, usize)] = &[
     // Foundations: no physics, no PETSc.
     ("algebra", 0),
+    ("check", 0),
     ("layout", 0),
     ("scheme", 0),
     ("parallel", 0),
     ("progress", 0),
     ("plot", 0),
-    // The case file as data.
+    // The case file as data; the soil models, their parameters and their laws.
     ("case", 1),
+    ("soils", 1),
     // The physical model: grid, materials, soil models, points, loads, boundaries.
     ("model", 2),
     ("analysis", 3),

@@ -1,7 +1,7 @@
 //! Small dense algebra shared by the model and the kernels: D × D matrices (D = 2 or 3) and
 //! their determinant, cofactors, inverse and products; small linear solves and the matrix
 //! exponential ([`linalg`]); the inverse of a dense block ([`dense`]); the heap bytes of a
-//! container ([`heap`]).
+//! container ([`heap`]); the right stretch of a 2 × 2 deformation gradient.
 
 pub mod dense;
 pub mod heap;
@@ -71,4 +71,18 @@ pub fn cofactor_mul<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
 /// aᵀ v.
 pub fn mul_t<const D: usize>(a: &Mat<D>, v: [f64; D]) -> [f64; D] {
     std::array::from_fn(|j| (1..D).fold(a[0][j] * v[0], |s, k| s + a[k][j] * v[k]))
+}
+
+/// The right stretch tensor U = sqrt(FᵀF) of an in-plane deformation gradient F (polar
+/// decomposition F = RU), in closed form for 2 × 2: with C = FᵀF, s = sqrt(det C) and
+/// t = sqrt(tr C + 2s), U = (C + s I)/t. Its diagonal scales the GIMP domains (iGIMP, Charlton et
+/// al. 2017): a rigid rotation leaves them unchanged, a stretch along an axis scales that axis.
+pub fn right_stretch(f: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let c = [
+        [f[0][0] * f[0][0] + f[1][0] * f[1][0], f[0][0] * f[0][1] + f[1][0] * f[1][1]],
+        [f[0][1] * f[0][0] + f[1][1] * f[1][0], f[0][1] * f[0][1] + f[1][1] * f[1][1]],
+    ];
+    let s = (c[0][0] * c[1][1] - c[0][1] * c[1][0]).max(0.0).sqrt();
+    let t = (c[0][0] + c[1][1] + 2.0 * s).sqrt();
+    [[(c[0][0] + s) / t, c[0][1] / t], [c[1][0] / t, (c[1][1] + s) / t]]
 }

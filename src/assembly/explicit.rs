@@ -32,7 +32,7 @@
 //!    stored value (`Kinematics::with_volume_scale`, on the stress's volumetric strain only); a
 //!    hyperelastic one the total F̄ = s_p F_{n+1} with s_p = (J̄_p^{n+1}/(J_p^n ΔJ_p))^{1/2}
 //!    (`ParticleInput::fbar_total`), Hencky–J2 the increment c_p ΔF and the volume ratio
-//!    det(s_p F_{n+1}) = J̄_p^{n+1} (`soil::Constitutive::finite`). The point stores J̄_p^{n+1} (`Particles::jbar`), so that the
+//!    det(s_p F_{n+1}) = J̄_p^{n+1} (`soils::Constitutive::finite`). The point stores J̄_p^{n+1} (`Particles::jbar`), so that the
 //!    next step's start sees the stress it was left with (to round-off), and the rate form's
 //!    volumetric increments telescope to ln J̄. Only the stress sees F̄ ([002] L237): the volume stays
 //!    det(F) V⁰ and the points keep F. Two departures from [002] Algorithm 1, each measured:

@@ -32,7 +32,8 @@ use super::stencils::Stencils;
 use crate::case::Stiffness;
 use crate::kernels::cell::{mapped_force_operators, mapped_stiffness, q4, CellGeometry, Moduli};
 use crate::kernels::NodeBasis;
-use crate::model::{shape, soil, Model};
+use crate::model::{shape, Model};
+use crate::soils;
 use petsc::GhostedRange;
 
 /// A cell (its lower-left node) and a point's weights w_i W_p of its four nodes.
@@ -164,7 +165,7 @@ impl MappedStiffness {
             let (factor, cells) = mapping.of(k)?;
             out.material.push(factor);
             let (nodes, _) = st.get(k);
-            let d: &Moduli = &soil::plane_block(&model.materials[ps.material[k] as usize].model.elastic().d);
+            let d: &Moduli = &soils::plane_block(&model.materials[ps.material[k] as usize].model.elastic().d);
             for (cell, weights) in cells {
                 let slots = mapping.slots(k, nodes, cell)?;
                 let d_nodes: [Moduli; 4] = std::array::from_fn(|n| d.map(|row| row.map(|v| v * weights[n])));

@@ -3,10 +3,10 @@
 //! [`parse`] turns the text of a case file plus the command line's overrides into a
 //! [`CaseFile`], the file as written; [`crate::validation`] checks it and makes the [`Case`] every
 //! other module takes, its names resolved to typed ids ([`ids`]). Every error names the file, the
-//! key and what is wrong, in one line. This module is the bottom of the house: it imports nothing
-//! of the physics.
+//! key and what is wrong, in one line. This module is the bottom of the house: of the physics it
+//! imports only the soil models' parameters ([`crate::soils`], on its layer), the table
+//! `materials.model`.
 
-pub mod check;
 pub mod ids;
 pub mod overrides;
 pub mod parameters;
@@ -229,46 +229,5 @@ mod tests {
         let r = Region { min: [0.0, 1.0], max: [1.0, 1.0], z: None };
         assert!(r.contains([0.5, 1.0 + 1e-12]));
         assert!(!r.contains([0.5, 1.01]));
-    }
-
-    /// A strength reduction factor F divides c_p and tan φ, keeps ψ ≤ φ' and c_r ≤ c_p/F, leaves
-    /// the stiffness and a residual below the reduced peak alone, and leaves models without a
-    /// strength unchanged.
-    #[test]
-    fn a_strength_reduction_divides_the_peak_strength() {
-        let mc = MohrCoulomb {
-            young_modulus: 1e7,
-            poisson_ratio: 0.3,
-            friction_angle: 30.0,
-            cohesion: 10e3,
-            residual_cohesion: Some(8e3),
-            softening_strain: Some(0.1),
-            dilation_angle: 25.0,
-            critical_dilation_angle: Some(5.0),
-            dilation_decay: 0.0,
-            tension_cutoff: None,
-        };
-        let SoilModel::MohrCoulomb(r) = SoilModel::MohrCoulomb(mc).with_strength_reduced(2.0) else { unreachable!() };
-        assert_eq!(r.young_modulus, 1e7);
-        assert_eq!(r.cohesion, 5e3);
-        let phi = (30f64.to_radians().tan() / 2.0).atan().to_degrees();
-        assert!((r.friction_angle - phi).abs() < 1e-12 && (phi - 16.102).abs() < 1e-3, "{}", r.friction_angle);
-        assert_eq!(r.dilation_angle, r.friction_angle);
-        assert_eq!(r.critical_dilation_angle, Some(5.0));
-        assert_eq!(r.residual_cohesion, Some(5e3));
-        let hj = HenckyJ2 {
-            young_modulus: 25e6,
-            poisson_ratio: 0.499,
-            cohesion: 28868.0,
-            residual_cohesion: Some(1732.0),
-            softening_rate: 5.0,
-        };
-        let SoilModel::HenckyJ2(r) = SoilModel::HenckyJ2(hj).with_strength_reduced(1.65) else { unreachable!() };
-        assert!((r.cohesion - 28868.0 / 1.65).abs() < 1e-9);
-        assert_eq!((r.residual_cohesion, r.softening_rate), (Some(1732.0), 5.0));
-        let el = Elasticity { young_modulus: 1e6, poisson_ratio: 0.3 };
-        assert!(
-            matches!(SoilModel::LinearElastic(el).with_strength_reduced(3.0), SoilModel::LinearElastic(e) if e == el)
-        );
     }
 }

@@ -147,7 +147,7 @@ mod tests {
             mobility: 0.0,
             water_density: 1000.0,
             grad_p: [0.0; 2],
-            stress: crate::model::soil::plane(stress),
+            stress: crate::soils::plane(stress),
             def_grad: [[1.0, 0.0], [0.0, 1.0]],
             eps_pd: 0.0,
             p,
@@ -170,7 +170,7 @@ mod tests {
         let it = Interp { du: [0.0, -0.1], dw: [0.0, -0.2], dvol_u: -0.01, dvol_w: -0.02, ..Interp::default() };
         let step = StepResult {
             interp: it,
-            stress: crate::model::soil::plane([0.0, -300.0, 0.0, 0.0]),
+            stress: crate::soils::plane([0.0, -300.0, 0.0, 0.0]),
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 0.99]],
             jacobian: 0.99,
@@ -191,7 +191,7 @@ mod tests {
         // Shear: σ_xy Δγ_xy.
         let shear = StepResult {
             deps: [0.0, 0.0, 0.02, 0.0, 0.0, 0.0],
-            stress: crate::model::soil::plane([0.0, 0.0, 50.0, 0.0]),
+            stress: crate::soils::plane([0.0, 0.0, 50.0, 0.0]),
             ..step
         };
         let e = particle_step(&input([0.0, 0.0, 50.0, 0.0], 0.0), &shear, 0.0, (1.98, [0.0, -10.0]));
@@ -215,11 +215,11 @@ mod tests {
         let it = Interp { v_u: [1.0, 0.0], v_w: [3.0, 0.0], ..Interp::default() };
         let step = StepResult {
             interp: it,
-            stress: [0.0; crate::model::soil::NS],
+            stress: [0.0; crate::soils::NS],
             eps_pd: 0.0,
             f_inc: [[1.0, 0.0], [0.0, 1.0]],
             jacobian: 1.0,
-            deps: [0.0; crate::model::soil::NS],
+            deps: [0.0; crate::soils::NS],
             grad_n: [0.0; 2],
             jbar: None,
             velocity: None,

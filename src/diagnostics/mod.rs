@@ -11,9 +11,9 @@
 pub mod energy;
 pub mod physics;
 
-use crate::model::soil::{principal::Principal, Stress};
 use crate::model::Model;
 use crate::parallel::Collective;
+use crate::soils::{principal::Principal, Stress};
 use serde::{Deserialize, Serialize};
 
 /// A warning of the run: a diagnostic past its threshold, or a case that is known to misbehave.

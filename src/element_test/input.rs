@@ -10,7 +10,7 @@
 //! `element_tests/`.
 
 use crate::case::{CaseError, SoilModel};
-use crate::model::soil::{Stress, NS};
+use crate::soils::{Stress, NS};
 use serde::{Deserialize, Serialize};
 
 /// MATERIAL.toml.
@@ -113,7 +113,7 @@ fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Resul
 /// Parses and validates MATERIAL.toml.
 pub fn parse_material(text: &str, origin: &str) -> Result<MaterialFile, CaseError> {
     let m: MaterialFile = parse_toml(text, origin)?;
-    crate::validation::soil_model("model", &m.model).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
+    m.model.check("model").map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
     if m.model.is_finite_strain() {
         return Err(CaseError::new(format!(
             "{origin}: key `model.type`: the element test drives incremental models along strain increments; \

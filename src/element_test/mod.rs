@@ -8,7 +8,7 @@
 
 pub mod input;
 
-use crate::model::soil::{Constitutive, Region, Stress, NS};
+use crate::soils::{Constitutive, Region, Stress, NS};
 use input::{Control, LoadPath};
 
 /// The state after one increment.
@@ -170,10 +170,9 @@ pub fn table(rows: &[Row]) -> Vec<Vec<String>> {
 mod tests {
     use super::input::{parse_material, parse_path};
     use super::*;
-    use crate::model::material::soil_model;
 
     fn model(text: &str) -> Constitutive {
-        soil_model(&parse_material(text, "m").unwrap().model)
+        parse_material(text, "m").unwrap().model.law()
     }
 
     const SAND: &str = r#"
@@ -296,7 +295,7 @@ mod tests {
     /// three-dimensional state, and an isotropic one does not care about the frame.
     #[test]
     fn a_path_in_a_turned_frame_gives_the_turned_stresses() {
-        use crate::model::soil::principal;
+        use crate::soils::principal;
         // Strain-controlled compression with a lateral stretch, in principal axes, from a
         // geostatic start: the loose sand softens, dilates and reaches its edge regions.
         let axes = [-0.02, 0.006, 0.003];

@@ -101,7 +101,7 @@ pub fn mapped_stiffness(cell: &CellGeometry, d_nodes: &[Moduli; 4]) -> [[f64; 8]
                 }
             }
         }
-        let b: [[[f64; 2]; crate::model::soil::NS]; 4] = std::array::from_fn(|i| {
+        let b: [[[f64; 2]; crate::soils::NS]; 4] = std::array::from_fn(|i| {
             let t = n[i] * hoop;
             if cell.bbar {
                 bbar(g[i], gc[i], (t, hoop_c))

@@ -22,7 +22,7 @@
 //! size would take, so that Newton's residual norm sees it.
 
 use super::{Point, Scheme};
-use crate::model::finite_strain::{det, embed};
+use crate::soils::finite_strain::{det, embed};
 
 /// Adds the projection rows R_i of one point (see the module documentation), weighted as the
 /// water's mass balance (1; the generalized-α history has none).
@@ -66,8 +66,8 @@ mod tests {
     use crate::model::fbar::{gather, scatter};
     use crate::model::grid::Grid;
     use crate::model::shape::{self, Basis};
-    use crate::model::soil::{Constitutive, LinearElastic};
     use crate::scheme::Integration;
+    use crate::soils::{Constitutive, LinearElastic};
 
     /// The kernels' sample particle with the volume, deformation gradient and J̄ of a point of
     /// the cloud, and the projection rows' scale.
@@ -137,7 +137,7 @@ mod tests {
             for (basis, ids, part) in &points {
                 let st = states(ids, &theta);
                 let pt = Point::<2>::new(basis, &st, part, &model, layout);
-                own.push(crate::model::finite_strain::det2(part.def_grad) * pt.kin.j);
+                own.push(crate::soils::finite_strain::det2(part.def_grad) * pt.kin.j);
                 jbar.push(super::super::StepResult::of(&pt).jbar.expect("an F̄ layout carries J̄"));
                 shares.push(ids.iter().zip(basis).map(|(&n, b)| (n, b.s)).collect::<Vec<_>>());
             }

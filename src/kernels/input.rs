@@ -2,8 +2,8 @@
 
 use super::Predictors;
 use crate::algebra::det;
-use crate::model::soil::Stress;
 use crate::model::{fbar, Model};
+use crate::soils::Stress;
 
 /// The particle quantities the kernels need (at t_n), in `D` dimensions (two unless it says
 /// otherwise).

@@ -22,7 +22,7 @@
 //! and the soil model starts from the rotated stress R σ_n Rᵀ. In two dimensions R is the turn by
 //! θ = 2 atan(ω/2), ω = ½(L_yx − L_xy), about z. A rigid rotation Q gives sym L = 0 and R = Q
 //! exactly, so the stress turns with the material to round-off. The strain increment is the
-//! 6-vector of [`crate::model::soil::Stress`] ([xx, yy, γxy, zz, γyz, γzx]); in two dimensions its
+//! 6-vector of [`crate::soils::Stress`] ([xx, yy, γxy, zz, γyz, γzx]); in two dimensions its
 //! zz component is the hoop rate (axial symmetry) or zero, and yz, zx are zero.
 //!
 //! **Geometrically linear steps** (`linear = true`, `analysis.kinematics = "linear_increments"`,
@@ -42,7 +42,7 @@
 
 use super::NodeBasis;
 use crate::algebra::{det, identity, inverse, mul, mul_t, Mat};
-use crate::model::soil::{principal, Stress, NS};
+use crate::soils::{principal, Stress, NS};
 
 /// I + s a.
 fn plus_identity<const D: usize>(a: &Mat<D>, s: f64) -> Mat<D> {
@@ -721,8 +721,8 @@ mod tests {
         let s = [3.0, -1.0, 0.7, 2.0, 0.4, -1.3];
         let r = rotate(&s, 0.3);
         // It is R σ Rᵀ with R the turn about z.
-        let rz = crate::model::soil::principal::rotation([0.0, 0.0, 1.0], 0.3);
-        let full = crate::model::soil::principal::rotate(&rz, &s);
+        let rz = crate::soils::principal::rotation([0.0, 0.0, 1.0], 0.3);
+        let full = crate::soils::principal::rotate(&rz, &s);
         assert!(r.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-14), "{r:?} vs {full:?}");
         // Invariants in the plane are kept.
         assert!(((r[0] + r[1]) - (s[0] + s[1])).abs() < 1e-14);

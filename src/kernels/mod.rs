@@ -59,10 +59,10 @@ pub mod kinematics;
 pub mod stress;
 
 use crate::layout::{Layout, MAX_DOF, MAX_DOF_3D};
-use crate::model::finite_strain;
 use crate::model::shape::Stencil;
-use crate::model::soil::{self, Constitutive, Stress, StressUpdate};
 use crate::scheme::Scheme;
+use crate::soils::finite_strain;
+use crate::soils::{self, Constitutive, Stress, StressUpdate};
 pub use input::ParticleInput;
 pub use kinematics::Kinematics;
 
@@ -76,14 +76,14 @@ pub const MAX_NODES_3D: usize = crate::model::shape::MAX_STENCIL_3D;
 pub const MAX_LOCAL: usize = MAX_NODES * MAX_DOF;
 
 /// The number of strain (and stress) components a point of dimension `D` uses: the first four of
-/// [`soil::Stress`] in two dimensions (plane strain or axial symmetry, the fourth the
+/// [`soils::Stress`] in two dimensions (plane strain or axial symmetry, the fourth the
 /// out-of-plane or hoop component), all six in three.
 #[inline]
 pub const fn strain_rows<const D: usize>() -> usize {
     if D == 2 {
-        soil::NS_PLANE
+        soils::NS_PLANE
     } else {
-        soil::NS
+        soils::NS
     }
 }
 
@@ -210,8 +210,8 @@ impl<const D: usize> Predictors<D> {
 /// (docs/axisymmetry.md); in three the zz row of B is [0, 0, ∂_z S] and the shear
 /// rows [0, ∂_z S, ∂_y S] and [∂_z S, 0, ∂_x S].
 #[inline]
-pub fn bbar<const D: usize>(g: [f64; D], gv: [f64; D], hoop: (f64, f64)) -> [[f64; D]; soil::NS] {
-    let mut out = [[0.0; D]; soil::NS];
+pub fn bbar<const D: usize>(g: [f64; D], gv: [f64; D], hoop: (f64, f64)) -> [[f64; D]; soils::NS] {
+    let mut out = [[0.0; D]; soils::NS];
     let (tt, tv) = hoop;
     let t = 1.0 / 3.0;
     // ⅓(mᵀB̄_v − mᵀB): the volumetric correction of every normal row (the hoop term radially).
@@ -517,7 +517,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let interp = interpolate(basis, &AT_REST[..basis.len()], &part.pred, layout);
         let kin = Kinematics::rest();
         let (spatial, hoop) = on_new_configuration(&kin, basis);
-        let zero = [[0.0; soil::NS]; soil::NS];
+        let zero = [[0.0; soils::NS]; soils::NS];
         Point {
             basis,
             part,
@@ -531,7 +531,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
                 tangent: zero,
                 trial_tangent: zero,
                 eps_pd: part.eps_pd,
-                region: crate::model::soil::Region::Elastic,
+                region: crate::soils::Region::Elastic,
             },
             spatial,
             hoop,

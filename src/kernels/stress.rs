@@ -28,7 +28,7 @@
 
 use super::{bbar, kinematics, strain_rows, Point, Scheme};
 use crate::algebra::Mat;
-use crate::model::soil::{principal, Stress, NS};
+use crate::soils::{principal, Stress, NS};
 
 /// The deviatoric stress (its in-plane part in two dimensions) and the mean stress (σ_zz
 /// included) of `s`.

@@ -1,9 +1,8 @@
 //! Materials: phase properties of the mixture, permeability laws and the skeleton's soil model
-//! ([`super::soil`]).
+//! ([`crate::soils`]).
 
-use super::finite_strain;
-use super::soil::{Constitutive, LinearElastic, MohrCoulomb, VonMises};
-use crate::case::{self, Formulation, SoilModel};
+use crate::case::{self, Formulation};
+use crate::soils::Constitutive;
 
 /// A material as the solver uses it.
 #[derive(Debug, Clone)]
@@ -33,7 +32,7 @@ pub struct Material {
 impl Material {
     /// Builds the solver's material from the case's.
     pub fn from_case(m: &case::Material, formulation: Formulation) -> Material {
-        let model = soil_model(&m.model);
+        let model = m.model.law();
         let two = formulation == Formulation::TwoPhase;
         let kw = if two { m.water_bulk_modulus.unwrap_or(f64::INFINITY) } else { f64::INFINITY };
         let ks = m.solid_bulk_modulus.unwrap_or(f64::INFINITY);
@@ -69,62 +68,6 @@ impl Material {
     pub fn inv_q_at(&self, n: f64) -> f64 {
         inv_q(n, self.water_bulk_modulus, self.solid_bulk_modulus)
     }
-}
-
-/// The solver's soil model for the case's (angles from degrees to radians).
-pub fn soil_model(m: &SoilModel) -> Constitutive {
-    let elastic = |e: f64, nu: f64| LinearElastic::new(e, nu);
-    match m {
-        SoilModel::LinearElastic(p) => Constitutive::LinearElastic(elastic(p.young_modulus, p.poisson_ratio)),
-        SoilModel::MohrCoulomb(p) => mohr_coulomb(p),
-        SoilModel::VonMises(p) => {
-            let el = elastic(p.young_modulus, p.poisson_ratio);
-            let strength = VonMises {
-                shear: el.shear_modulus(),
-                cohesion: p.cohesion,
-                residual_cohesion: p.residual_cohesion.unwrap_or(p.cohesion),
-                softening_modulus: p.softening_modulus,
-            };
-            Constitutive::VonMises(el, strength)
-        }
-        SoilModel::HenckyJ2(p) => Constitutive::HenckyJ2(
-            elastic(p.young_modulus, p.poisson_ratio),
-            finite_strain::HenckyJ2::new(p.young_modulus, p.poisson_ratio, p.cohesion, p.residual(), p.softening_rate),
-        ),
-        SoilModel::NewtonianFluid(p) => Constitutive::NewtonianFluid(
-            LinearElastic::from_bulk_shear(p.bulk_modulus, 0.0),
-            finite_strain::NewtonianFluid {
-                bulk: p.bulk_modulus,
-                viscosity: p.viscosity,
-                bulk_viscosity: p.bulk_viscosity,
-            },
-        ),
-        SoilModel::NeoHookean(p) => Constitutive::NeoHookean(
-            elastic(p.young_modulus, p.poisson_ratio),
-            finite_strain::NeoHookean::new(p.young_modulus, p.poisson_ratio),
-        ),
-    }
-}
-
-/// The solver's Mohr–Coulomb model for the case's parameters.
-fn mohr_coulomb(p: &case::MohrCoulomb) -> Constitutive {
-    let el = LinearElastic::new(p.young_modulus, p.poisson_ratio);
-    let psi = p.dilation_angle.to_radians();
-    Constitutive::MohrCoulomb(
-        el,
-        MohrCoulomb {
-            shear: el.shear_modulus(),
-            lame: el.lame(),
-            phi: p.friction_angle.to_radians(),
-            cohesion: p.cohesion,
-            residual_cohesion: p.residual_cohesion.unwrap_or(p.cohesion),
-            softening_strain: p.softening_strain.unwrap_or(f64::INFINITY),
-            psi_ini: psi,
-            psi_crit: p.critical_dilation_angle.map_or(psi, f64::to_radians),
-            eta: p.dilation_decay,
-            tension: p.tension_cutoff,
-        },
-    )
 }
 
 /// 1/Q = n/K_w + (1 − n)/K_s ([003] Eq. 5); infinite moduli contribute nothing.

@@ -1,10 +1,9 @@
-//! The physical model of a run: grid geometry, bases, materials and soil models, material points,
-//! loads and Dirichlet conditions. Pure Rust; the particle update after a converged step is
+//! The physical model of a run: grid geometry, bases, materials (their soil models are
+//! [`crate::soils`]'), material points, loads and Dirichlet conditions. Pure Rust; the particle update after a converged step is
 //! [`crate::update`]'s, the global system [`crate::assembly`]'s.
 
 pub mod cmpm;
 pub mod fbar;
-pub mod finite_strain;
 pub mod grid;
 pub mod loads;
 pub mod material;
@@ -12,7 +11,6 @@ pub mod memory;
 pub mod particles;
 pub mod patch;
 pub mod shape;
-pub mod soil;
 
 use crate::case::{Case, Formulation, ShapeFunctions, Side};
 use grid::Grid;
@@ -544,7 +542,7 @@ mod tests {
         let c = crate::validation::load(crate::case::tests_support::MINIMAL, "t", &sets).unwrap();
         let mut m = Model::build(&c, |_, _| true);
         let strength = |m: &Model| match &m.materials[0].model {
-            crate::model::soil::Constitutive::MohrCoulomb(_, mc) => (mc.cohesion, mc.phi.tan()),
+            crate::soils::Constitutive::MohrCoulomb(mc) => (mc.cohesion, mc.phi.tan()),
             _ => unreachable!(),
         };
         assert_eq!(strength(&m), (1.0e4, 30f64.to_radians().tan()));

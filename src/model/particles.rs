@@ -47,7 +47,7 @@ pub struct Particles<const D: usize = 2> {
     pub acc_w: Vec<[f64; D]>,
     /// Effective stress [xx, yy, xy, zz, yz, zx] (total stress in one-phase analyses; yz = zx = 0 in
     /// plane strain and axial symmetry) [Pa].
-    pub stress: Vec<crate::model::soil::Stress>,
+    pub stress: Vec<crate::soils::Stress>,
     /// Pore pressure (compression positive) [Pa].
     pub p: Vec<f64>,
     /// Pore pressure at t = 0 [Pa] (the excess pore pressure is p − p₀).
@@ -154,7 +154,7 @@ impl<const D: usize> Particles<D> {
         self.acc.push([0.0; D]);
         self.vel_w.push([0.0; D]);
         self.acc_w.push([0.0; D]);
-        self.stress.push([0.0; crate::model::soil::NS]);
+        self.stress.push([0.0; crate::soils::NS]);
         self.p.push(0.0);
         self.p0.push(0.0);
         self.eps_pd.push(0.0);
@@ -226,7 +226,7 @@ impl<const D: usize> Particles<D> {
         let (stress, p, grad_p) = match (&body.initial_stress, body.uniform_stress_vector()) {
             (Some(init), _) => {
                 let (s, p, grad_p) = geostatic(case, grid, init, x, pore_water);
-                (crate::model::soil::plane(s), p, grad_p)
+                (crate::soils::plane(s), p, grad_p)
             }
             (None, Some(s)) => (s, 0.0, [0.0; D]),
             (None, None) => ([0.0; 6], 0.0, [0.0; D]),

@@ -8,6 +8,7 @@
 //! 1D ones. Nodes outside the grid are dropped (the domain integral is over Ω_p ∩ Ω).
 
 use super::grid::Grid;
+use crate::algebra::right_stretch;
 
 /// Which basis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -284,20 +285,6 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
     (out, n)
 }
 
-/// The right stretch tensor U = sqrt(FᵀF) of an in-plane deformation gradient F (polar
-/// decomposition F = RU), in closed form for 2 × 2: with C = FᵀF, s = sqrt(det C) and
-/// t = sqrt(tr C + 2s), U = (C + s I)/t. Its diagonal scales the GIMP domains (iGIMP, Charlton et
-/// al. 2017): a rigid rotation leaves them unchanged, a stretch along an axis scales that axis.
-pub fn right_stretch(f: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
-    let c = [
-        [f[0][0] * f[0][0] + f[1][0] * f[1][0], f[0][0] * f[0][1] + f[1][0] * f[1][1]],
-        [f[0][1] * f[0][0] + f[1][1] * f[1][0], f[0][1] * f[0][1] + f[1][1] * f[1][1]],
-    ];
-    let s = (c[0][0] * c[1][1] - c[0][1] * c[1][0]).max(0.0).sqrt();
-    let t = (c[0][0] + c[1][1] + 2.0 * s).sqrt();
-    [[(c[0][0] + s) / t, c[0][1] / t], [c[1][0] / t, (c[1][1] + s) / t]]
-}
-
 /// The diagonal of the right stretch tensor U = sqrt(FᵀF) of a deformation gradient of any
 /// dimension: [`right_stretch`]'s in two dimensions, through the principal frame of C = FᵀF in
 /// three (U_dd = Σ_k sqrt(λ_k) (e_k)_d²).
@@ -307,7 +294,7 @@ pub fn stretch_diagonal<const D: usize>(f: &[[f64; D]; D]) -> [f64; D] {
         return std::array::from_fn(|d| u[d][d]);
     }
     let c = |a: usize, b: usize| (0..D).map(|k| f[k][a] * f[k][b]).sum::<f64>();
-    let pr = crate::model::soil::principal::Principal::of(&[c(0, 0), c(1, 1), c(0, 1), c(2, 2), c(1, 2), c(2, 0)]);
+    let pr = crate::soils::principal::Principal::of(&[c(0, 0), c(1, 1), c(0, 1), c(2, 2), c(1, 2), c(2, 0)]);
     std::array::from_fn(|d| (0..3).map(|k| pr.values[k].max(0.0).sqrt() * pr.vectors[k][d] * pr.vectors[k][d]).sum())
 }
 

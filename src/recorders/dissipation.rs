@@ -10,17 +10,12 @@
 //! are not counted.
 
 use super::{Converged, FromCheckpoint, Moment, Recorder, Restored, Sink};
-use crate::model::soil::{Constitutive, Stress};
+use crate::soils::Stress;
 
 /// Whether a model has points whose plastic work this recorder counts (a Mohr–Coulomb or von
 /// Mises material).
 pub fn applies<const D: usize>(model: &crate::model::Model<D>) -> bool {
-    model.materials.iter().any(|m| counted(&m.model))
-}
-
-/// Whether the points of a material of `model` are counted.
-fn counted(model: &Constitutive) -> bool {
-    matches!(model, Constitutive::MohrCoulomb(..) | Constitutive::VonMises(..))
+    model.materials.iter().any(|m| m.model.dissipates())
 }
 
 /// The plastic dissipation so far.
@@ -62,7 +57,7 @@ impl<const D: usize> Recorder<D> for Dissipation {
         self.pending = 0.0;
         for (k, r) in at.results.iter().enumerate() {
             let model = &at.model.materials[ps.material[k] as usize].model;
-            if !counted(model) {
+            if !model.dissipates() {
                 continue;
             }
             let e = model.elastic();

@@ -2,11 +2,11 @@
 //! kinematics and the stages.
 
 use crate::analysis::StageAnalysis;
-use crate::case::check::Checked;
 use crate::case::{
     AnalysisType, Case, Formulation, Geometry, InternalForce, KinematicsKind, PressureUpdate, ShapeFunctions,
     Stiffness, StressRecovery,
 };
+use crate::check::Checked;
 
 /// The analysis and stabilisation tables, then what they need of each other and of the stages.
 pub(super) fn check(c: &Case) -> Checked {

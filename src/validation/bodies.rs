@@ -2,8 +2,8 @@
 //! along z, and that they lie inside the grid.
 
 use super::grid::Bounds;
-use crate::case::check::Checked;
 use crate::case::{Body, Case};
+use crate::check::Checked;
 
 /// Every body.
 pub(super) fn check(c: &Case) -> Checked {

@@ -4,8 +4,8 @@
 //! one case file can switch formulation with `--set analysis.formulation`.
 
 use super::grid::{grid_lines_in, Bounds};
-use crate::case::check::Checked;
 use crate::case::{Boundary, Case, Dof};
+use crate::check::Checked;
 
 /// Every boundary.
 pub(super) fn check(c: &Case) -> Checked {

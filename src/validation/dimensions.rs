@@ -2,8 +2,8 @@
 //! (line pressures, which are plane by nature) or not yet (the plane benchmarks' checks, [001]'s
 //! CMPM and mapped stiffnesses), and the conditions of an axisymmetric one.
 
-use crate::case::check::Checked;
 use crate::case::{Case, Geometry, Load, Stiffness, StressRecovery, Verification};
+use crate::check::Checked;
 
 /// A plane (or axisymmetric) case's load regions have no extent along z: one given would be
 /// ignored (the boundaries' regions are checked with their other z keys).

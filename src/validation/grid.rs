@@ -2,8 +2,8 @@
 //! (whether a point lies inside, which grid lines a box holds).
 
 use super::dimensions;
-use crate::case::check::Checked;
 use crate::case::{Case, Region};
+use crate::check::Checked;
 
 /// The grid's checks, then what its dimension allows ([`dimensions`]).
 pub(super) fn check(c: &Case) -> Checked {

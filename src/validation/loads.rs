@@ -3,8 +3,8 @@
 //! inside the grid.
 
 use super::grid::{grid_lines_in, Bounds};
-use crate::case::check::{components, Checked};
 use crate::case::{Case, Load, Region};
+use crate::check::{components, Checked};
 
 /// Every load.
 pub(super) fn check(c: &Case) -> Checked {

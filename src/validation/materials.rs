@@ -2,9 +2,8 @@
 //! ranges, whether a softening model has a unique return, and where the finite-strain models may
 //! be used.
 
-use crate::case::check::{at, in_closed_open, in_open, magnitude, modulus, positive_or_inf, Checked, MAX_CONDUCTIVITY};
-use crate::case::{AnalysisType, Case, Formulation, Geometry, Material, SoilModel};
-use crate::model::finite_strain;
+use crate::case::{AnalysisType, Case, Formulation, Geometry, Material};
+use crate::check::{at, in_closed_open, in_open, magnitude, modulus, positive_or_inf, Checked, MAX_CONDUCTIVITY};
 
 /// Every material, then where its model may be used.
 pub(super) fn check(c: &Case) -> Checked {
@@ -25,7 +24,6 @@ fn material(key: &str, m: &Material, pore_water: bool) -> Checked {
         in_closed_open(&k("porosity"), m.porosity, 0.0, 1.0)?;
     }
     m.check(key)?;
-    soil_model(&k("model"), &m.model)?;
     if !pore_water {
         return Ok(());
     }
@@ -40,27 +38,6 @@ fn material(key: &str, m: &Material, pore_water: bool) -> Checked {
         ks if ks.is_infinite() => positive_or_inf(&k("solid_bulk_modulus"), ks),
         ks => modulus(&k("solid_bulk_modulus"), ks),
     }
-}
-
-/// Checks a soil model's parameters; `key` is the key of its table (e.g. `materials[0].model`):
-/// its own ranges, and for Hencky–J2 whether the softening keeps the return unique, which the
-/// model says.
-pub fn soil_model(key: &str, model: &SoilModel) -> Checked {
-    model.check(key)?;
-    let SoilModel::HenckyJ2(p) = model else {
-        return Ok(());
-    };
-    let residual = p.residual();
-    let m = finite_strain::HenckyJ2::new(p.young_modulus, p.poisson_ratio, p.cohesion, residual, p.softening_rate);
-    if !m.well_posed() {
-        return Err(format!(
-            "key `{}`: the softening outpaces the elastic unloading (3μ ≤ √3 η (c_p − c_r)), so the return is not \
-             unique; it must be below {:.4e}",
-            at(key, "softening_rate"),
-            3.0 * m.shear / (3f64.sqrt() * (p.cohesion - residual))
-        ));
-    }
-    Ok(())
 }
 
 /// Where a finite-strain material (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) may be used: in
@@ -84,19 +61,18 @@ fn finite_strain_materials(c: &Case) -> Checked {
                  axisymmetric"
             ));
         }
-        if matches!(m.model, SoilModel::HenckyJ2(_)) {
+        let Some(function_of) = m.model.stress_function_of() else {
             continue;
-        }
+        };
         let stressed = c.body_ids().find(|&b| {
             let body = c.body(b);
             c.material_id_of(b).index() == i && (body.initial_stress.is_some() || body.uniform_stress.is_some())
         });
         if let Some(b) = stressed {
             return Err(format!(
-                "key `bodies.{}`: a {name} body takes no initial stress (its stress is a function of its \
-                 deformation{}; reach a stressed state with a settling stage)",
-                c.body(b).name,
-                if matches!(m.model, SoilModel::NewtonianFluid(_)) { " and its rate" } else { "" }
+                "key `bodies.{}`: a {name} body takes no initial stress (its stress is a function of \
+                 {function_of}; reach a stressed state with a settling stage)",
+                c.body(b).name
             ));
         }
     }

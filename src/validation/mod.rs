@@ -22,11 +22,9 @@ mod names;
 mod stages;
 mod verification;
 
-pub use materials::soil_model;
-
-use crate::case::check::{components, Checked};
 use crate::case::ids::Links;
 use crate::case::{self, Case, CaseError, CaseFile, Override};
+use crate::check::{components, Checked};
 use names::Names;
 
 /// Parses and validates a case: [`case::parse`], then [`validate`]. `origin` names the file in

@@ -1,9 +1,9 @@
 //! Names: every array of named tables is there and names each table once, and every name a table
 //! gives resolves, once, to the id of the table it names.
 
-use crate::case::check::{unique, Checked};
 use crate::case::ids::{BoundaryLinks, LoadLinks};
 use crate::case::{BodyId, BoundaryId, CaseFile, LoadId, MaterialId, StageId, TimeFunctionId};
+use crate::check::{unique, Checked};
 
 /// The names of a file's tables, to resolve the names its other tables give.
 pub(super) struct Names<'a> {

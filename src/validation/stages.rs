@@ -1,8 +1,8 @@
 //! Stages: their own values, the case's time integration, and what each analysis type needs of
 //! the formulation and, for an explicit two-phase stage, of the boundaries.
 
-use crate::case::check::Checked;
 use crate::case::{AnalysisType, Case, Dof, Explicit, ExplicitPressure, Formulation, Stage};
+use crate::check::Checked;
 
 /// Every stage, and the time integration of the case's dynamic stages.
 pub(super) fn check(c: &Case) -> Checked {

@@ -2,11 +2,11 @@
 //! bodies, loads, boundaries and stages it names and of the analysis ([`check`]).
 
 use super::names::Names;
-use crate::case::check::{components, Checked};
 use crate::case::{
     BearingCapacity, BodyAndLoad, BodyId, Case, DamBreakIds, ElasticColumnIds, FootingIds, Formulation, Geometry,
     LinkedVerification, Load, LoadId, Loading, PatchIds, RunoutIds, Shape, SoilModel, Verification,
 };
+use crate::check::{components, Checked};
 
 /// The verification with the ids of what it names, after its own ranges.
 pub(super) fn link(v: &Verification, names: &Names) -> Result<LinkedVerification, String> {

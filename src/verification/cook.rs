@@ -18,10 +18,10 @@
 
 use super::{Check, Findings, Metric};
 use crate::case::{BodyId, Case, CookMembrane};
-use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;
+use crate::soils::invariants;
 
 /// The Cook's-membrane check of a case.
 pub struct CookCheck {

@@ -29,10 +29,10 @@
 
 use super::{Check, Findings, Metric};
 use crate::case::{Case, DamBreak, DamBreakIds, Load, Rectangle, Shape};
-use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::{Axis, ColourMap, Figure, MapPoints, Series, Style};
+use crate::soils::invariants;
 
 /// Martin & Moyce (1952), the collapse of a water column of height 2a on width a (n² = 2,
 /// a = 2.25 in): the surge front Z = z/a at T = n t √(g/a), read from their Fig. 3 (as tabulated

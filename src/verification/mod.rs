@@ -145,7 +145,7 @@ pub trait Check<const D: usize = 2> {
 /// closed forms.
 pub(crate) fn elastic_body(c: &Case, body: BodyId) -> Result<(f64, f64), String> {
     match &c.material_of(body).model {
-        SoilModel::LinearElastic(e) => Ok((e.young_modulus, e.poisson_ratio)),
+        SoilModel::LinearElastic(e) => Ok((e.0.young_modulus, e.0.poisson_ratio)),
         _ => Err(format!("body `{}` is not linear elastic", c.body(body).name)),
     }
 }

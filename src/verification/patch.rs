@@ -12,13 +12,13 @@
 //!   stress of F itself, exact to round-off.
 
 use super::{Check, Findings, Metric};
-use crate::case::{Case, Patch, PatchIds, SoilModel};
-use crate::model::finite_strain::{embed, mul, M3};
+use crate::case::{Case, Patch, PatchIds};
 use crate::model::loads::Motion;
-use crate::model::soil::principal::{self, Principal};
-use crate::model::soil::{LinearElastic, Stress, NS};
 use crate::model::Model;
 use crate::parallel::Collective;
+use crate::soils::finite_strain::{embed, mul, M3};
+use crate::soils::principal::{self, Principal};
+use crate::soils::{Constitutive, LinearElastic, NeoHookeanLaw, Stress, NS};
 
 /// The patch check of a case of dimension `D`.
 pub struct PatchCheck<const D: usize = 2> {
@@ -26,7 +26,7 @@ pub struct PatchCheck<const D: usize = 2> {
     motion: Motion<D>,
     elastic: LinearElastic,
     /// A neo-Hookean body's model (its σ* is the model's stress of F).
-    hyperelastic: Option<crate::model::finite_strain::NeoHookean>,
+    hyperelastic: Option<NeoHookeanLaw>,
     initial: Stress,
     spread_tolerance: f64,
     tolerance: f64,
@@ -52,12 +52,9 @@ fn log_stretch_and_rotation(f: &M3) -> (Stress, M3) {
 impl<const D: usize> PatchCheck<D> {
     /// The check of a `patch` verification `spec`, whose names resolve to `ids`.
     pub fn new(c: &Case, model: &Model<D>, spec: &Patch, ids: &PatchIds) -> Result<PatchCheck<D>, String> {
-        let (elastic, hyperelastic) = match &c.material_of(ids.body).model {
-            SoilModel::LinearElastic(e) => (LinearElastic::new(e.young_modulus, e.poisson_ratio), None),
-            SoilModel::NeoHookean(e) => (
-                LinearElastic::new(e.young_modulus, e.poisson_ratio),
-                Some(crate::model::finite_strain::NeoHookean::new(e.young_modulus, e.poisson_ratio)),
-            ),
+        let (elastic, hyperelastic) = match c.material_of(ids.body).model.law() {
+            Constitutive::LinearElastic(el) => (el, None),
+            Constitutive::NeoHookean(nh) => (nh.elastic, Some(nh)),
             _ => return Err(format!("body `{}` is not elastic (linear or neo-Hookean)", spec.body)),
         };
         let motion = model.boundaries[ids.boundary.index()]
@@ -185,7 +182,7 @@ impl<const D: usize> Check<D> for PatchCheck<D> {
 mod tests {
     use super::*;
     use crate::model::loads::TimeFn;
-    use crate::model::soil;
+    use crate::soils;
 
     fn check<const D: usize>(l: [[f64; D]; D], initial: Stress) -> PatchCheck<D> {
         PatchCheck {
@@ -213,7 +210,7 @@ mod tests {
     fn the_reference_of_a_rotation_and_of_a_stretch() {
         // A quarter turn turns the stress.
         let w = std::f64::consts::FRAC_PI_2;
-        let s = check([[0.0, -w], [w, 0.0]], soil::plane([3.0, 1.0, 0.5, 2.0])).theory(1.0);
+        let s = check([[0.0, -w], [w, 0.0]], soils::plane([3.0, 1.0, 0.5, 2.0])).theory(1.0);
         assert!((s[0] - 1.0).abs() < 1e-12 && (s[1] - 3.0).abs() < 1e-12 && (s[2] + 0.5).abs() < 1e-12);
         // A stretch along x: ε_xx = ln λ, plane strain.
         let s = check([[1e-3, 0.0], [0.0, 0.0]], [0.0; NS]).theory(1.0);
@@ -242,9 +239,9 @@ mod tests {
         assert!(close(&s, &expected, 1e-9), "{s:?} against {expected:?}");
 
         let plane = [[1e-3, 3e-4], [-2e-4, -5e-4]];
-        let s2 = check(plane, soil::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
+        let s2 = check(plane, soils::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
         let s3 =
-            check([[1e-3, 3e-4, 0.0], [-2e-4, -5e-4, 0.0], [0.0; 3]], soil::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
+            check([[1e-3, 3e-4, 0.0], [-2e-4, -5e-4, 0.0], [0.0; 3]], soils::plane([3.0, 1.0, 0.5, 2.0])).theory(0.7);
         assert!(close(&s2, &s3, 1e-9), "{s2:?} against {s3:?}");
 
         let l = [[0.02, -0.3, 0.1], [0.25, -0.01, 0.05], [-0.08, 0.15, 0.03]];

@@ -19,10 +19,10 @@
 use super::{Check, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::case::{BodyId, Case, SoilModel, VerticalCut};
-use crate::model::soil::invariants;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;
+use crate::soils::invariants;
 
 /// How far inside the material (in cells from the outermost well-filled nodes) a node of the
 /// roughness must be: 3, so that every node of its Laplacian's stencil has its whole support (a

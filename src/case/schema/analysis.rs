@@ -1,7 +1,7 @@
 //! `[analysis]` and `[grid]`: the physics switches that shape the discrete system, and the
 //! background grid.
 
-use crate::case::check::{finite2, positive, Checked};
+use crate::check::{finite2, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// Physics switches.

@@ -1,7 +1,7 @@
 //! `[[bodies]]`: the regions filled with material points at t = 0, their initial stress, and the
 //! planar shapes and boxes the case uses to select points and nodes.
 
-use crate::case::check::{at, finite, finite2, positive, Checked};
+use crate::check::{at, finite, finite2, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// A body filled with material points.

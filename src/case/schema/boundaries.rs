@@ -2,7 +2,7 @@
 //! degrees of freedom they name.
 
 use super::bodies::Region;
-use crate::case::check::{at, Checked};
+use crate::check::{at, Checked};
 use serde::{Deserialize, Serialize};
 
 /// Dirichlet conditions on the grid nodes of a side, of a box or of a body's moving surface: the

@@ -3,7 +3,7 @@
 
 use super::bodies::Region;
 use super::boundaries::Side;
-use crate::case::check::{at, finite, finite2, positive, Checked};
+use crate::check::{at, finite, finite2, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// A load, scaled in time by a named time function (default: constant 1), chosen by its `kind`.

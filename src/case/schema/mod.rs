@@ -3,8 +3,9 @@
 //!
 //! Every table denies unknown keys, so a misspelt key is an error naming it. A table's own ranges
 //! are checked by its `check` method, next to its definition; what several tables say together is
-//! checked by [`crate::validation`]. The doc comments here are the user's reference:
-//! docs/case_reference.md is generated from them.
+//! checked by [`crate::validation`]. The doc comments here, and those of the soil models'
+//! parameters in [`crate::soils`], are the user's reference: docs/case_reference.md is generated
+//! from them.
 
 mod analysis;
 mod bodies;

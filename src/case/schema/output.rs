@@ -1,6 +1,6 @@
 //! `[solver]`, `[output]` and `[[probes]]`: the solver's options file and what a run writes.
 
-use crate::case::check::Checked;
+use crate::check::Checked;
 use serde::{Deserialize, Serialize};
 
 /// Solver strategy.

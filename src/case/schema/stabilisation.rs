@@ -1,7 +1,7 @@
 //! `[stabilisation]`: the stabilisation of the equal-order u–p–U discretisation, the remedies of
 //! volumetric locking, and [001]'s mapped stiffnesses and strain recoveries.
 
-use crate::case::check::{magnitude, Checked, MAX_PROJECTION};
+use crate::check::{magnitude, Checked, MAX_PROJECTION};
 use serde::{Deserialize, Serialize};
 
 /// Stabilisation switches.

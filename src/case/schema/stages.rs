@@ -1,7 +1,7 @@
 //! `[[stages]]`, `[time]` and `[time_integration]`: what each stage solves, its steps, and the
 //! time schemes of dynamic and explicit stages.
 
-use crate::case::check::{at, in_open, positive, Checked};
+use crate::check::{at, in_open, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none

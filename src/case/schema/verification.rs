@@ -1,7 +1,7 @@
 //! `[verification]`: the analytical reference a run is checked against, chosen by its `kind`,
 //! each kind's parameters in their own table with the checks of their ranges.
 
-use crate::case::check::{at, at_most, finite2, positive, Checked};
+use crate::check::{at, at_most, finite2, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// The analytical reference of a case.

@@ -4,15 +4,13 @@
 //! whole point (rest, rigid rotation, Newmark).
 
 use super::*;
-use crate::case::{self, SoilModel};
 use crate::layout::MAX_DOF_3D;
-use crate::model::material::soil_model;
-use crate::model::soil::LinearElastic;
 use crate::scheme::Integration;
+use crate::soils::{LinearElastic, MohrCoulomb, SoilModel};
 
 /// A non-associated Mohr–Coulomb soil with softening.
 fn mohr_coulomb(cohesion: f64) -> Constitutive {
-    soil_model(&SoilModel::MohrCoulomb(case::MohrCoulomb {
+    SoilModel::MohrCoulomb(MohrCoulomb {
         young_modulus: 1e7,
         poisson_ratio: 0.3,
         friction_angle: 30.0,
@@ -23,7 +21,8 @@ fn mohr_coulomb(cohesion: f64) -> Constitutive {
         critical_dilation_angle: Some(0.0),
         dilation_decay: 10.0,
         tension_cutoff: None,
-    }))
+    })
+    .law()
 }
 
 /// The agreement of one (row field, column field) block of a tangent with finite differences.
@@ -153,7 +152,7 @@ pub(super) fn part() -> ParticleInput {
         mobility: 2.0e-7,
         water_density: 1000.0,
         grad_p: [300.0, -9.0e3],
-        stress: soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]),
+        stress: soils::plane([-1.0e3, -2.0e3, 150.0, -1.2e3]),
         def_grad: [[1.02, 0.01], [-0.03, 0.97]],
         eps_pd: 0.0,
         p: 500.0,
@@ -255,8 +254,8 @@ fn models() -> Vec<(&'static str, Constitutive, Stress)> {
     let el = LinearElastic::new(1e7, 0.3);
     // A Mohr–Coulomb point close to its yield surface, so the step returns plastically.
     vec![
-        ("elastic", Constitutive::LinearElastic(el), soil::plane([-1.0e3, -2.0e3, 150.0, -1.2e3])),
-        ("mohr-coulomb", mohr_coulomb(1.0e3), soil::plane([-1.0e4, -4.0e4, 9.0e3, -2.0e4])),
+        ("elastic", Constitutive::LinearElastic(el), soils::plane([-1.0e3, -2.0e3, 150.0, -1.2e3])),
+        ("mohr-coulomb", mohr_coulomb(1.0e3), soils::plane([-1.0e4, -4.0e4, 9.0e3, -2.0e4])),
     ]
 }
 
@@ -633,7 +632,7 @@ fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
         b.s /= total;
     }
     let mut p = part();
-    p.stress = [0.0; soil::NS];
+    p.stress = [0.0; soils::NS];
     p.p = 0.0;
     p.grad_n = [0.0; 2];
     p.pred = Predictors::default();
@@ -670,7 +669,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
     let pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
     let st: Vec<NodeState> = pts.iter().map(|&(x, y)| NodeState::new(&[-0.01 * x, -0.02 * y], &nm)).collect();
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
-    let p = ParticleInput { stress: [0.0; soil::NS], ..part() };
+    let p = ParticleInput { stress: [0.0; soils::NS], ..part() };
     let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::U);
     let r = StepResult::of(&pt);
     assert!((r.jacobian - 0.99 * 0.98).abs() < 1e-14);
@@ -686,7 +685,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
 fn a_rigid_rotation_turns_the_stress_with_the_material() {
     for model in [Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3)), mohr_coulomb(1.0e5)] {
         for n in [10usize, 100] {
-            let s0 = soil::plane([-3.0e4, -1.0e4, 4.0e3, -2.0e4]);
+            let s0 = soils::plane([-3.0e4, -1.0e4, 4.0e3, -2.0e4]);
             let mut s = s0;
             let alpha = std::f64::consts::FRAC_PI_2 / n as f64;
             let (c, sn) = (alpha.cos(), alpha.sin());
@@ -707,8 +706,8 @@ fn a_rigid_rotation_turns_the_stress_with_the_material() {
                 s = Point::<2>::new(&basis, &st, &p, &model, Layout::U).upd.stress;
             }
             // A quarter turn: σ_xx ↔ σ_yy, σ_xy → −σ_xy.
-            let expected = soil::plane([s0[1], s0[0], -s0[2], s0[3]]);
-            let worst = (0..soil::NS).map(|i| (s[i] - expected[i]).abs()).fold(0.0, f64::max);
+            let expected = soils::plane([s0[1], s0[0], -s0[2], s0[3]]);
+            let worst = (0..soils::NS).map(|i| (s[i] - expected[i]).abs()).fold(0.0, f64::max);
             assert!(worst < 1e-9 * 3.0e4, "{n} steps: {s:?} vs {expected:?}");
         }
     }

@@ -353,7 +353,7 @@ fn the_forces_of_a_homogeneous_state_in_three_dimensions_are_its_stress() {
             let mut f = vec![0.0; d.len()];
             stress::residual(&pt, &nm, &mut f);
             stress::pore_pressure::residual(&pt, &nm, &mut f);
-            let s = crate::model::soil::principal::tensor(&pt.upd.stress);
+            let s = crate::soils::principal::tensor(&pt.upd.stress);
             let v = pt.volume_new();
             let mut moment = [[0.0; 3]; 3];
             for (k, y) in nodes.iter().enumerate() {

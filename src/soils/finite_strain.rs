@@ -1,17 +1,20 @@
-//! Finite-strain materials of [002]'s examples (§4.1–4.4; the paper names them but omits their
-//! forms, so these are the standard ones): compressible neo-Hookean, Hencky elasticity
-//! with J2 plasticity and exponential softening, and a Newtonian fluid. The deformation gradient is
-//! 3 × 3 ([`M3`]; a plane-strain point's is [`plane`], F_zz = 1); stresses are the 6-vectors
-//! [xx, yy, xy, zz, yz, zx] of [`super::soil`] (Cauchy, tension positive).
+//! The kinematics of the finite-strain models of [002]'s examples (§4.1–4.4; the paper names them
+//! but omits their forms, so these are the standard ones): compressible neo-Hookean
+//! ([`super::neo_hookean`]), Hencky elasticity with J2 plasticity and exponential softening
+//! ([`super::hencky_j2`]), and a Newtonian fluid ([`super::newtonian_fluid`]). The deformation
+//! gradient is 3 × 3 ([`M3`]; a plane-strain point's is [`plane`], F_zz = 1); stresses are the
+//! 6-vectors [xx, yy, xy, zz, yz, zx] of [`super::stress`] (Cauchy, tension positive).
 //!
 //! They are total (hyperelastic) or multiplicative forms driven by the deformation gradient (with
-//! [002]'s F̄, by F̄; [`super::fbar`]); they are used by the explicit integrator, which needs
+//! [002]'s F̄, by F̄); they are used by the explicit integrator, which needs
 //! no tangent. Each is objective by construction: the neo-Hookean and Hencky
 //! stresses are isotropic functions of b = F Fᵀ (or b^e), so a rotation R of the deformation turns
 //! the stress into R σ Rᵀ.
 
-use super::soil::principal::{self, Principal};
-use super::soil::stress::{Stress, NS};
+use super::principal::{self, Principal};
+use super::stress::{Stress, IDENTITY6, NS};
+use super::{LinearElastic, Region, StressUpdate};
+use crate::algebra::right_stretch;
 
 /// An in-plane 2 × 2 matrix.
 pub type M2 = [[f64; 2]; 2];
@@ -58,7 +61,7 @@ pub fn mul(a: M3, b: M3) -> M3 {
 }
 
 /// F S Fᵀ for a symmetric S given as a stress vector; the result as a stress vector.
-fn push(f: M3, s: &Stress) -> Stress {
+pub(super) fn push(f: M3, s: &Stress) -> Stress {
     let sm = principal::tensor(s);
     let fs: M3 =
         std::array::from_fn(|i| std::array::from_fn(|j| f[i][0] * sm[0][j] + f[i][1] * sm[1][j] + f[i][2] * sm[2][j]));
@@ -66,230 +69,28 @@ fn push(f: M3, s: &Stress) -> Stress {
 }
 
 /// The stress vector of the identity.
-const UNIT: Stress = [1.0, 1.0, 0.0, 1.0, 0.0, 0.0];
+pub(super) const UNIT: Stress = [1.0, 1.0, 0.0, 1.0, 0.0, 0.0];
 
 /// Whether component `c` of a stress vector is a normal one (xx, yy, zz).
-fn normal(c: usize) -> bool {
+pub(super) fn normal(c: usize) -> bool {
     matches!(c, 0 | 1 | 3)
 }
 
-/// Compressible neo-Hookean elasticity (Cook's membrane, [002] §4.1): Kirchhoff stress
-/// τ = μ(b − 1) + λ ln J 1 with b = F Fᵀ, σ = τ/J (Bonet & Wood 2008, Eq. 6.28). Its small-strain
-/// limit is linear elasticity with the same λ, μ.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NeoHookean {
-    /// Shear modulus μ [Pa].
-    pub shear: f64,
-    /// Lamé's λ [Pa].
-    pub lame: f64,
-}
-
-impl NeoHookean {
-    /// From Young's modulus [Pa] and Poisson's ratio.
-    pub fn new(e: f64, nu: f64) -> NeoHookean {
-        NeoHookean { shear: e / (2.0 * (1.0 + nu)), lame: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
-    }
-
-    /// The Cauchy stress of the deformation gradient `f`. `None` when J ≤ 0.
-    pub fn stress(&self, f: M3) -> Option<Stress> {
-        let j = det(f);
-        if j <= 0.0 {
-            return None;
-        }
-        let b = push(f, &UNIT);
-        let vol = self.lame * j.ln();
-        let (mu, inv) = (self.shear, 1.0 / j);
-        Some(std::array::from_fn(|c| if normal(c) { (mu * (b[c] - 1.0) + vol) * inv } else { mu * b[c] * inv }))
-    }
-}
-
-/// The state of a Hencky–J2 point: the elastic left Cauchy–Green tensor b^e (a stress vector;
-/// 1 at rest) and the accumulated equivalent plastic strain ε̄ = Σ √(2/3) |Δε^p|.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlasticState {
-    /// b^e as [xx, yy, xy, zz, yz, zx].
-    pub be: Stress,
-    /// ε̄ [-].
-    pub eps: f64,
-}
-
-impl Default for PlasticState {
-    fn default() -> Self {
-        PlasticState { be: UNIT, eps: 0.0 }
-    }
-}
-
-/// Hencky elasticity with J2 (von Mises) plasticity and exponential softening (the footing and
-/// the landslide of [002] §4.2, §4.4): multiplicative plasticity in principal logarithmic strains
-/// (Simo 1992; de Souza Neto, Perić & Owen 2008, §14.5). Per step: b^e_trial = ΔF b^e_n ΔFᵀ,
-/// ε^e = ½ ln b^e (principal), τ = K tr ε^e 1 + 2μ dev ε^e, radial return of dev τ onto
-/// q = √3 c(ε̄) with c(ε̄) = c_r + (c_p − c_r) exp(−η ε̄) ([002] L357, κ read as the strength), then
-/// b^e = exp(2ε^e) and σ = τ/J. c is the plane-strain shear strength (s_u: under plane strain and
-/// incompressible flow q = √3 τ_max).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HenckyJ2 {
-    /// Shear modulus μ [Pa].
-    pub shear: f64,
-    /// Bulk modulus K [Pa].
-    pub bulk: f64,
-    /// Peak shear strength c_p [Pa].
-    pub cohesion: f64,
-    /// Residual shear strength c_r [Pa] (c_p for no softening).
-    pub residual_cohesion: f64,
-    /// Softening rate η [-].
-    pub softening_rate: f64,
-}
-
-/// The result of a Hencky–J2 update.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HenckyUpdate {
-    /// Cauchy stress [Pa].
-    pub stress: Stress,
-    /// The state after the step.
-    pub state: PlasticState,
-    /// Whether the step flowed plastically.
-    pub plastic: bool,
-}
-
-impl HenckyJ2 {
-    /// From Young's modulus, Poisson's ratio and the strengths.
-    pub fn new(e: f64, nu: f64, cohesion: f64, residual_cohesion: f64, softening_rate: f64) -> HenckyJ2 {
-        let shear = e / (2.0 * (1.0 + nu));
-        HenckyJ2 { shear, bulk: e / (3.0 * (1.0 - 2.0 * nu)), cohesion, residual_cohesion, softening_rate }
-    }
-
-    /// The shear strength at ε̄ and its slope dc/dε̄.
-    pub fn cohesion_at(&self, eps: f64) -> (f64, f64) {
-        let e = (-self.softening_rate * eps).exp();
-        let drop = self.cohesion - self.residual_cohesion;
-        (self.residual_cohesion + drop * e, -self.softening_rate * drop * e)
-    }
-
-    /// Whether the return is unique: the softening never outpaces the elastic unloading,
-    /// 3μ > √3 η (c_p − c_r) (otherwise the return equation has several roots).
-    pub fn well_posed(&self) -> bool {
-        3.0 * self.shear > 3f64.sqrt() * self.softening_rate * (self.cohesion - self.residual_cohesion)
-    }
-
-    /// The elastic left Cauchy–Green tensor b^e of a point with Cauchy stress
-    /// `stress` at volume ratio `j` (with F̄, J̄): τ = J σ determines the elastic logarithmic strain,
-    /// ε^e = dev τ/(2μ) + tr τ/(9K) 1 (the inverse of Hencky's law, in τ's principal frame, which is
-    /// b^e's), and b^e = exp(2ε^e). The inverse of [`HenckyJ2::update`]'s stress to round-off, so
-    /// that a point's stress and J are its whole elastic state.
-    pub fn elastic_left_cauchy_green(&self, stress: &Stress, j: f64) -> Stress {
-        let frame = Principal::of(stress);
-        let tau = frame.values.map(|v| v * j);
-        let mean = (tau[0] + tau[1] + tau[2]) / 3.0;
-        let (mu2, k3) = (2.0 * self.shear, 3.0 * self.bulk);
-        frame.compose(&tau.map(|t| (2.0 * ((t - mean) / mu2 + mean / k3)).exp()))
-    }
-
-    /// One step: the increment `df` of the deformation gradient from `state`, with `j` the volume ratio det F of the point after the step (with F̄, J̄) by which
-    /// the Kirchhoff stress is divided. `None` when b^e or J is not positive definite.
-    pub fn update(&self, df: M3, state: &PlasticState, j: f64) -> Option<HenckyUpdate> {
-        if j <= 0.0 {
-            return None;
-        }
-        let trial = push(df, &state.be);
-        // b^e's principal values and frame.
-        let frame = Principal::of(&trial);
-        let lam = frame.values;
-        if lam.iter().any(|&l| l <= 0.0) {
-            return None;
-        }
-        // Principal logarithmic elastic strains.
-        let eps = [0.5 * lam[0].ln(), 0.5 * lam[1].ln(), 0.5 * lam[2].ln()];
-        let tr = eps[0] + eps[1] + eps[2];
-        let dev = [eps[0] - tr / 3.0, eps[1] - tr / 3.0, eps[2] - tr / 3.0];
-        let mu2 = 2.0 * self.shear;
-        let s_trial = [mu2 * dev[0], mu2 * dev[1], mu2 * dev[2]];
-        let q_trial = (1.5 * (s_trial[0].powi(2) + s_trial[1].powi(2) + s_trial[2].powi(2))).sqrt();
-        let r3 = 3f64.sqrt();
-        let (c_n, _) = self.cohesion_at(state.eps);
-        let mut out_eps = state.eps;
-        let mut factor = 1.0;
-        let plastic = q_trial - r3 * c_n > 1e-12 * (q_trial + c_n);
-        if plastic {
-            // g(Δ) = q_trial − 3μΔ − √3 c(ε̄_n + Δ) = 0 on [0, q_trial/3μ], where g(0) > 0 and the
-            // upper end gives −√3 c < 0: Newton kept inside the bracket, bisection otherwise.
-            let g3 = 3.0 * self.shear;
-            let g = |d: f64| {
-                let (c, dc) = self.cohesion_at(state.eps + d);
-                (q_trial - g3 * d - r3 * c, -g3 - r3 * dc)
-            };
-            let (mut lo, mut hi) = (0.0, q_trial / g3);
-            let mut d = (q_trial - r3 * c_n) / g3;
-            for _ in 0..100 {
-                let (r, dr) = g(d);
-                if r > 0.0 {
-                    lo = d;
-                } else {
-                    hi = d;
-                }
-                if r.abs() <= 1e-14 * q_trial || hi - lo <= 1e-16 * q_trial / g3 {
-                    break;
-                }
-                let next = d - r / dr;
-                d = if dr < 0.0 && next > lo && next < hi { next } else { 0.5 * (lo + hi) };
-            }
-            factor = 1.0 - g3 * d / q_trial;
-            out_eps += d;
-        }
-        // The returned deviator is the trial one scaled (radial return); the volume is elastic.
-        let e = [factor * dev[0] + tr / 3.0, factor * dev[1] + tr / 3.0, factor * dev[2] + tr / 3.0];
-        let tau = frame.compose(&std::array::from_fn(|k| (self.bulk * tr + factor * s_trial[k]) / j));
-        let be = frame.compose(&std::array::from_fn(|k| (2.0 * e[k]).exp()));
-        Some(HenckyUpdate { stress: tau, state: PlasticState { be, eps: out_eps }, plastic })
-    }
-}
-
-/// A weakly compressible Newtonian fluid (the dam break, [002] §4.3):
-/// σ = −p 1 + 2μ_v dev d + ζ tr d 1 with the pressure of the equation of state
-/// p = K max(1 − J, 0) (water takes no tension: a stretched point is separating, not pulling) and
-/// the rate of deformation d = sym L ([002] does not state its equation of state; for the
-/// |J − 1| ~ 1e-5 of water any one is the same).
-/// The bulk viscosity ζ is the explicit codes' damping of volumetric ringing (Abaqus/Explicit's
-/// linear bulk viscosity ζ = b₁ ρ c h, b₁ = 0.06 by default; Stokes' hypothesis gives water none).
-/// With F̄, the pressure sees J̄ and the bulk viscosity the rate of J̄.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NewtonianFluid {
-    /// Bulk modulus K [Pa].
-    pub bulk: f64,
-    /// Dynamic viscosity μ_v [Pa s].
-    pub viscosity: f64,
-    /// Bulk viscosity ζ [Pa s].
-    pub bulk_viscosity: f64,
-}
-
-impl NewtonianFluid {
-    /// The Cauchy stress at volume ratio `j` and velocity gradient `l` [1/s].
-    pub fn stress(&self, j: f64, l: M3) -> Stress {
-        let p = self.bulk * (1.0 - j).max(0.0);
-        let d = principal::TENSOR_INDEX.map(|(a, b)| 0.5 * (l[a][b] + l[b][a]));
-        let m = (d[0] + d[1] + d[3]) / 3.0;
-        let mu2 = 2.0 * self.viscosity;
-        std::array::from_fn(|c| if normal(c) { -p + mu2 * (d[c] - m) } else { mu2 * d[c] })
-    }
-
-    /// The fluid's pressure at volume ratio `j` [Pa].
-    pub fn pressure(&self, j: f64) -> f64 {
-        self.bulk * (1.0 - j)
-    }
-
-    /// The stress after a step of deformation gradient `df` over `dt` seconds that leaves the
-    /// fluid at the total deformation `f`: the pressure of J = det f and the viscous
-    /// stress of the step's rate of deformation ([`rate_of_deformation`]).
-    pub fn stress_after(&self, df: M3, f: M3, dt: f64) -> Stress {
-        let mut s = self.stress(det(f), rate_of_deformation(df, dt));
-        // ζ tr d with tr d = ln(det ΔF)/Δt (with F̄, det ΔF̄ = J̄_{n+1}/J̄_n).
-        let dj = det(df);
-        if dt > 0.0 && dj > 0.0 && self.bulk_viscosity > 0.0 {
-            let q = self.bulk_viscosity * dj.ln() / dt;
-            for c in (0..NS).filter(|&c| normal(c)) {
-                s[c] += q;
-            }
-        }
-        s
+/// A finite-strain model's update ([`super::SoilLaw::finite`]): its stress after the step (NaN
+/// when the step is inadmissible, `None`), ε̄ and region, with the small-strain elasticity
+/// `elastic` of its moduli as the tangent.
+pub(super) fn finite_update(
+    elastic: &LinearElastic,
+    stress: Option<Stress>,
+    eps_pd: f64,
+    region: Region,
+) -> StressUpdate {
+    StressUpdate {
+        stress: stress.unwrap_or([f64::NAN; NS]),
+        tangent: elastic.d,
+        trial_tangent: IDENTITY6,
+        eps_pd,
+        region,
     }
 }
 
@@ -308,7 +109,7 @@ pub fn rate_of_deformation(df: M3, dt: f64) -> M3 {
     if is_plane(&df) {
         let s = j.sqrt();
         // V = sqrt(ΔF ΔFᵀ) is the right stretch of ΔFᵀ.
-        let v = super::shape::right_stretch([[df[0][0] / s, df[1][0] / s], [df[0][1] / s, df[1][1] / s]]);
+        let v = right_stretch([[df[0][0] / s, df[1][0] / s], [df[0][1] / s, df[1][1] / s]]);
         return [[(v[0][0] - 1.0) / dt, v[0][1] / dt, 0.0], [v[1][0] / dt, (v[1][1] - 1.0) / dt, 0.0], [0.0; 3]];
     }
     // V_iso = (ΔF ΔFᵀ)^½ / J^⅓, in the principal frame of ΔF ΔFᵀ.
@@ -322,7 +123,8 @@ pub fn rate_of_deformation(df: M3, dt: f64) -> M3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::soil::{Constitutive, LinearElastic, VonMises};
+    use crate::soils::hencky_j2::PlasticState;
+    use crate::soils::{Constitutive, HenckyJ2Law, LinearElastic, NeoHookeanLaw, NewtonianFluidLaw, VonMisesLaw};
 
     /// The rotation by `a` about z.
     fn rot(a: f64) -> M3 {
@@ -360,12 +162,12 @@ mod tests {
     }
 
     fn q_of(s: Stress) -> f64 {
-        crate::model::soil::invariants(&s).1
+        crate::soils::invariants(&s).1
     }
 
     #[test]
     fn neo_hooke_is_objective_and_linear_elastic_for_small_strains() {
-        let m = NeoHookean::new(70.0, 0.499);
+        let m = NeoHookeanLaw::new(70.0, 0.499);
         let f = plane([[1.12, 0.31], [-0.05, 0.93]]);
         let s = m.stress(f).unwrap();
         for a in [0.3, 1.7, -2.2] {
@@ -384,22 +186,22 @@ mod tests {
 
     #[test]
     fn hencky_j2_is_objective_and_leaves_a_rigidly_rotated_stress_unrotated_in_the_material_frame() {
-        let m = HenckyJ2::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
+        let m = HenckyJ2Law::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
         // A state with stress and plastic history from a plastic shearing step.
-        let first = m.update(plane([[1.0, 0.01], [0.0, 1.0]]), &PlasticState::default(), 1.0).unwrap();
+        let first = m.step(plane([[1.0, 0.01], [0.0, 1.0]]), &PlasticState::default(), 1.0).unwrap();
         assert!(first.plastic);
         let df = plane([[1.003, 0.004], [-0.002, 0.999]]);
         let j = det(df);
-        let base = m.update(df, &first.state, j).unwrap();
+        let base = m.step(df, &first.state, j).unwrap();
         for a in [0.4, -1.3, 3.0] {
             let r = rot(a);
-            let turned = m.update(mul(r, df), &first.state, j).unwrap();
+            let turned = m.step(mul(r, df), &first.state, j).unwrap();
             assert!(close(&turned.stress, &rotate(r, base.stress), 1e-12), "{a}");
             assert!((turned.state.eps - base.state.eps).abs() <= 1e-14);
             let be = rotate(r, base.state.be);
             assert!(close(&turned.state.be, &be, 1e-12));
             // A rigid rotation alone: the stress turns with the material, Rᵀ σ R = σ_n.
-            let spun = m.update(r, &first.state, 1.0).unwrap();
+            let spun = m.step(r, &first.state, 1.0).unwrap();
             assert!(!spun.plastic);
             assert!(close(&rotate(rot(-a), spun.stress), &first.stress, 1e-12), "{a}");
             assert_eq!(spun.state.eps, first.state.eps);
@@ -408,7 +210,7 @@ mod tests {
 
     #[test]
     fn hencky_j2_returns_onto_the_softened_yield_surface() {
-        let m = HenckyJ2::new(25e6, 0.45, 40.82e3, 2.45e3, 5.0);
+        let m = HenckyJ2Law::new(25e6, 0.45, 40.82e3, 2.45e3, 5.0);
         assert!(m.well_posed());
         let mut state = PlasticState::default();
         let mut j = 1.0;
@@ -416,7 +218,7 @@ mod tests {
         for k in 0..200 {
             let df = plane([[1.0 + 2e-4, 3e-3], [1e-3, 1.0 - 1.5e-4]]);
             j *= det(df);
-            let u = m.update(df, &state, j).unwrap();
+            let u = m.step(df, &state, j).unwrap();
             let q = q_of(u.stress) * j; // q of the Kirchhoff stress
             let (c, _) = m.cohesion_at(u.state.eps);
             if u.plastic {
@@ -443,18 +245,20 @@ mod tests {
         // Perfect plasticity (c_r = c_p): a small-strain shear path against the small-strain von
         // Mises model of porompm's soil models, to O(ε) relative (strains up to 2e-3).
         let (e, nu, c) = (1e7, 0.3, 5e3);
-        let m = HenckyJ2::new(e, nu, c, c, 0.0);
+        let m = HenckyJ2Law::new(e, nu, c, c, 0.0);
         let el = LinearElastic::new(e, nu);
-        let vm = Constitutive::VonMises(
-            el,
-            VonMises { shear: el.shear_modulus(), cohesion: c, residual_cohesion: c, softening_modulus: 0.0 },
-        );
+        let vm = Constitutive::VonMises(VonMisesLaw {
+            elastic: el,
+            cohesion: c,
+            residual_cohesion: c,
+            softening_modulus: 0.0,
+        });
         let (mut state, mut small, mut eps_small, mut j) = (PlasticState::default(), [0.0; NS], 0.0, 1.0);
         for _ in 0..20 {
             let (a, g) = (5e-5, 1e-4);
             let df = plane([[1.0 + a, g], [0.0, 1.0]]);
             j *= det(df);
-            let u = m.update(df, &state, j).unwrap();
+            let u = m.step(df, &state, j).unwrap();
             state = u.state;
             let up = vm.update(&small, eps_small, &[a, 0.0, g, 0.0, 0.0, 0.0]);
             small = up.stress;
@@ -469,13 +273,13 @@ mod tests {
     fn a_hencky_points_stress_and_volume_ratio_determine_its_elastic_state() {
         // After elastic and plastic steps (with softening), b^e recovered from σ and J is the b^e
         // the update left, to round-off.
-        let m = HenckyJ2::new(25e6, 0.45, 40.82e3, 2.45e3, 5.0);
+        let m = HenckyJ2Law::new(25e6, 0.45, 40.82e3, 2.45e3, 5.0);
         let (mut state, mut j) = (PlasticState::default(), 1.0);
         let mut plastic = 0;
         for k in 0..60 {
             let df = plane([[1.0 + 4e-4 * (k as f64 * 0.3).cos(), 2e-3], [-1e-3, 1.0 - 1e-4]]);
             j *= det(df);
-            let u = m.update(df, &state, j).unwrap();
+            let u = m.step(df, &state, j).unwrap();
             plastic += usize::from(u.plastic);
             let be = m.elastic_left_cauchy_green(&u.stress, j);
             assert!(close(&be, &u.state.be, 1e-13), "step {k}: {be:?} vs {:?}", u.state.be);
@@ -484,7 +288,7 @@ mod tests {
         assert!(plastic > 20 && state.eps > 0.0);
         // And the path run through `Constitutive::finite`, which stores only σ, F and ε̄ (F̄ = F
         // here), is the path run with the stored b^e.
-        let model = Constitutive::HenckyJ2(LinearElastic::new(25e6, 0.45), m);
+        let model = Constitutive::HenckyJ2(m);
         let (mut stress, mut f, mut eps) = ([0.0; NS], plane([[1.0, 0.0], [0.0, 1.0]]), 0.0);
         let (mut state, mut j) = (PlasticState::default(), 1.0);
         for k in 0..60 {
@@ -492,7 +296,7 @@ mod tests {
             f = mul(df, f);
             j *= det(df);
             let u = model.finite(&df, &f, &stress, eps, 1e-3).unwrap();
-            let direct = m.update(df, &state, j).unwrap();
+            let direct = m.step(df, &state, j).unwrap();
             assert!(close(&u.stress, &direct.stress, 1e-11), "step {k}: {:?} vs {:?}", u.stress, direct.stress);
             assert!((u.eps_pd - direct.state.eps).abs() <= 1e-12 * direct.state.eps.max(1e-300) + 1e-18);
             (stress, eps, state) = (u.stress, u.eps_pd, direct.state);
@@ -503,7 +307,7 @@ mod tests {
         // J̄^n = det F̄_{n+1}/det ΔF̄ and give the direct update with ΔF̄ divided by J̄^{n+1}.
         let f_n = plane([[1.02, 0.03], [-0.01, 0.97]]);
         let (jbar_n, jbar_new) = (0.9981, 0.9975);
-        let pre = m.update(plane([[1.0, 0.004], [0.002, 1.0]]), &PlasticState::default(), jbar_n).unwrap();
+        let pre = m.step(plane([[1.0, 0.004], [0.002, 1.0]]), &PlasticState::default(), jbar_n).unwrap();
         let df = plane([[1.001, 0.0015], [0.0005, 0.9985]]);
         let (j_n, dj) = (det(f_n), det(df));
         let c = (jbar_new / (jbar_n * dj)).sqrt();
@@ -512,7 +316,7 @@ mod tests {
         let dfbar = scale_plane(df, c);
         let fbar_new = scale_plane(mul(df, f_n), s);
         let u = model.finite(&dfbar, &fbar_new, &pre.stress, pre.state.eps, 1e-3).unwrap();
-        let direct = m.update(dfbar, &pre.state, jbar_new).unwrap();
+        let direct = m.step(dfbar, &pre.state, jbar_new).unwrap();
         assert!(close(&u.stress, &direct.stress, 1e-11), "{:?} vs {:?}", u.stress, direct.stress);
         // The incremental models have no finite-strain stress.
         assert!(Constitutive::LinearElastic(LinearElastic::new(1.0, 0.3)).finite(&f, &f, &stress, 0.0, 1e-3).is_none());
@@ -520,7 +324,7 @@ mod tests {
 
     #[test]
     fn the_newtonian_fluid_has_its_pressure_and_viscous_shear() {
-        let w = NewtonianFluid { bulk: 2e9, viscosity: 1e-3, bulk_viscosity: 0.0 };
+        let w = NewtonianFluidLaw::new(2e9, 1e-3, 0.0);
         let s = w.stress(1.0 - 1e-5, gradient([[0.0, 0.0], [0.0, 0.0]]));
         assert!(close(&s, &[-2e4, -2e4, 0.0, -2e4], 1e-9), "{s:?}");
         // Simple shear v_x = γ̇ y: σ_xy = μ γ̇, no normal stress; a rigid spin carries no stress.
@@ -541,9 +345,8 @@ mod tests {
     /// the same viscous stress when F̄ scales the step (c ΔF), only the pressure following J̄.
     #[test]
     fn the_fluid_step_is_objective_and_its_viscosity_does_not_see_fbar() {
-        use crate::model::soil::Constitutive;
-        let w = NewtonianFluid { bulk: 2e9, viscosity: 0.5, bulk_viscosity: 0.0 };
-        let model = Constitutive::NewtonianFluid(LinearElastic::from_bulk_shear(2e9, 0.0), w);
+        let w = NewtonianFluidLaw::new(2e9, 0.5, 0.0);
+        let model = Constitutive::NewtonianFluid(w);
         let dt = 1e-3;
         let f = plane([[0.99999, 0.0], [0.0, 1.0]]);
         let spin = model.finite(&rot(0.7), &f, &[0.0; NS], 0.0, dt).unwrap();
@@ -566,7 +369,7 @@ mod tests {
         assert_eq!(model.elastic().constrained_modulus(), 2e9);
         assert_eq!(model.elastic().shear_modulus(), 0.0);
         // A bulk viscosity adds ζ tr d = ζ ln(det ΔF)/Δt to the mean stress, nothing to the shear.
-        let zeta = NewtonianFluid { bulk_viscosity: 300.0, ..w };
+        let zeta = NewtonianFluidLaw { bulk_viscosity: 300.0, ..w };
         let squeeze = plane([[1.0 - 2e-4, 0.0], [0.0, 1.0]]);
         let (plain, damped) = (w.stress_after(squeeze, squeeze, dt), zeta.stress_after(squeeze, squeeze, dt));
         let expected = 300.0 * (1.0f64 - 2e-4).ln() / dt;
@@ -586,7 +389,7 @@ mod tests {
     #[test]
     fn the_models_are_objective_and_consistent_in_three_dimensions() {
         let f = [[1.05, 0.12, -0.04], [0.03, 0.96, 0.08], [-0.06, 0.02, 1.02]];
-        let nh = NeoHookean::new(70.0, 0.45);
+        let nh = NeoHookeanLaw::new(70.0, 0.45);
         let s = nh.stress(f).unwrap();
         assert!(s[4].abs() > 1e-3 && s[5].abs() > 1e-3, "{s:?}");
         for a in [0.4, -1.9] {
@@ -594,12 +397,12 @@ mod tests {
             assert!(close(&nh.stress(mul(r, f)).unwrap(), &rotate(r, s), 1e-13));
         }
         // Hencky–J2 along a 3D path with out-of-plane shears.
-        let m = HenckyJ2::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
+        let m = HenckyJ2Law::new(25e6, 0.3, 40e3, 2.45e3, 5.0);
         let (mut state, mut j, mut plastic) = (PlasticState::default(), 1.0, 0);
         for k in 0..80 {
             let df = [[1.0 + 2e-4, 1e-3, 5e-4], [2e-4, 1.0 - 1e-4, 2e-3 * (k as f64 * 0.1).cos()], [-1e-3, 4e-4, 1.0]];
             j *= det(df);
-            let u = m.update(df, &state, j).unwrap();
+            let u = m.step(df, &state, j).unwrap();
             let (c, _) = m.cohesion_at(u.state.eps);
             let q = q_of(u.stress) * j;
             if u.plastic {
@@ -613,7 +416,7 @@ mod tests {
             // Objective: the same step turned by R gives R σ Rᵀ and R b^e Rᵀ from R b^e_n Rᵀ.
             let r = tilt(0.7);
             let turned_state = PlasticState { be: rotate(r, state.be), eps: state.eps };
-            let turned = m.update(mul(mul(r, df), transpose(r)), &turned_state, j).unwrap();
+            let turned = m.step(mul(mul(r, df), transpose(r)), &turned_state, j).unwrap();
             assert!(close(&turned.stress, &rotate(r, u.stress), 1e-11), "step {k}");
             state = u.state;
         }
@@ -622,7 +425,7 @@ mod tests {
         // gives μ_v γ̇ in σ_yz.
         let spin = rate_of_deformation(tilt(0.3), 1e-3);
         assert!(spin.iter().flatten().all(|v| v.abs() < 1e-9), "{spin:?}");
-        let w = NewtonianFluid { bulk: 2e9, viscosity: 0.5, bulk_viscosity: 0.0 };
+        let w = NewtonianFluidLaw::new(2e9, 0.5, 0.0);
         let dt = 1e-3;
         let shear = [[1.0, 0.0, 0.0], [0.0, 1.0, 10.0 * dt], [0.0, 0.0, 1.0]];
         let st = w.stress_after(shear, shear, dt);

@@ -1,4 +1,5 @@
-//! Mohr–Coulomb with cohesion softening, evolving dilatancy and an optional tension cut-off:
+//! Mohr–Coulomb with cohesion softening, evolving dilatancy and an optional tension cut-off,
+//! `type = "mohr_coulomb"`: its parameters ([`MohrCoulomb`]) and its law ([`MohrCoulombLaw`]), the
 //! implicit return mapping in principal stresses and its consistent tangent.
 //!
 //! Tension is positive; with sorted principal stresses σ₁ ≥ σ₂ ≥ σ₃ the yield function and the
@@ -24,16 +25,147 @@
 //! implicit function theorem on that local system: dσ/dσ_trial = I + D N J⁻¹ Aᵀ with A, N the
 //! yield and flow normals of the active planes and J the local Jacobian.
 
-use super::{Region, ReturnResult};
+use super::elasticity::check_elastic;
+use super::{
+    isotropic_return, reduced_strength, LinearElastic, Region, ReturnResult, SoilLaw, SoilParameters, Stress,
+    StressUpdate,
+};
 use crate::algebra::linalg::solve;
+use crate::check::{at, in_closed_open, non_negative, positive, strength, Checked};
+use serde::{Deserialize, Serialize};
 
-/// Mohr–Coulomb parameters (angles in radians, stresses in Pa).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The parameters of `type = "mohr_coulomb"`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct MohrCoulomb {
-    /// Shear modulus G.
-    pub shear: f64,
-    /// Lamé's λ.
-    pub lame: f64,
+    /// Young's modulus E [Pa], in (0, 1e13].
+    pub young_modulus: f64,
+    /// Poisson's ratio ν [-], in (−1, 0.5).
+    pub poisson_ratio: f64,
+    /// Friction angle φ [degrees], in [0, 90).
+    pub friction_angle: f64,
+    /// Peak cohesion c_p [Pa], in [0, 1e13] (> 0 when φ = 0).
+    pub cohesion: f64,
+    /// Residual cohesion c_r [Pa], in [0, 1e13] (default: c_p, no softening).
+    pub residual_cohesion: Option<f64>,
+    /// Accumulated deviatoric plastic strain ε_p^r at which c_r is reached [-], > 0; required when
+    /// c_r differs from c_p.
+    pub softening_strain: Option<f64>,
+    /// Initial dilation angle ψ_ini [degrees], in (−90, φ] (default 0).
+    #[serde(default)]
+    pub dilation_angle: f64,
+    /// Critical-state dilation angle ψ_crit [degrees], in (−90, φ] (default: ψ_ini, a constant
+    /// dilation angle).
+    pub critical_dilation_angle: Option<f64>,
+    /// Decay rate η of ψ = ψ_crit + (ψ_ini − ψ_crit) exp(−η ε̄) [-], ≥ 0 (default 0).
+    #[serde(default)]
+    pub dilation_decay: f64,
+    /// Tensile strength t of a cut-off σ_i ≤ t [Pa], ≥ 0 (default: no cut-off).
+    pub tension_cutoff: Option<f64>,
+}
+
+impl SoilParameters for MohrCoulomb {
+    type Law = MohrCoulombLaw;
+
+    fn law(&self) -> MohrCoulombLaw {
+        let elastic = LinearElastic::new(self.young_modulus, self.poisson_ratio);
+        let psi = self.dilation_angle.to_radians();
+        MohrCoulombLaw {
+            elastic,
+            phi: self.friction_angle.to_radians(),
+            cohesion: self.cohesion,
+            residual_cohesion: self.residual_cohesion.unwrap_or(self.cohesion),
+            softening_strain: self.softening_strain.unwrap_or(f64::INFINITY),
+            psi_ini: psi,
+            psi_crit: self.critical_dilation_angle.map_or(psi, f64::to_radians),
+            eta: self.dilation_decay,
+            tension: self.tension_cutoff,
+        }
+    }
+
+    fn check(&self, key: &str) -> Checked {
+        let k = |f: &str| at(key, f);
+        check_elastic(key, self.young_modulus, self.poisson_ratio)?;
+        in_closed_open(&k("friction_angle"), self.friction_angle, 0.0, 90.0)?;
+        strength(&k("cohesion"), self.cohesion, true)?;
+        let phi = self.friction_angle;
+        for (f, v) in
+            [("dilation_angle", Some(self.dilation_angle)), ("critical_dilation_angle", self.critical_dilation_angle)]
+        {
+            if let Some(v) = v.filter(|&v| !(v > -90.0 && v <= phi)) {
+                return Err(format!("key `{}`: must be in (-90, friction_angle = {phi}], got {v}", k(f)));
+            }
+        }
+        non_negative(&k("dilation_decay"), self.dilation_decay)?;
+        if let Some(r) = self.residual_cohesion {
+            strength(&k("residual_cohesion"), r, true)?;
+            if r != self.cohesion && self.softening_strain.is_none() {
+                return Err(format!(
+                    "key `{}`: required when residual_cohesion differs from cohesion",
+                    k("softening_strain")
+                ));
+            }
+        }
+        if let Some(e) = self.softening_strain {
+            positive(&k("softening_strain"), e)?;
+        }
+        if let Some(t) = self.tension_cutoff {
+            non_negative(&k("tension_cutoff"), t)?;
+        }
+        if phi == 0.0 && self.cohesion == 0.0 {
+            return Err(format!(
+                "key `{}`: a Tresca material (friction_angle = 0) needs a positive cohesion",
+                k("cohesion")
+            ));
+        }
+        Ok(())
+    }
+
+    fn describe(&self) -> String {
+        let mut t = format!(
+            "{}, E = {:.4e} Pa, ν = {}, φ = {}°, c = {:.4e} Pa, ψ = {}°",
+            if self.friction_angle == 0.0 { "Tresca (Mohr–Coulomb with φ = 0)" } else { "Mohr–Coulomb" },
+            self.young_modulus,
+            self.poisson_ratio,
+            self.friction_angle,
+            self.cohesion,
+            self.dilation_angle
+        );
+        if let (Some(r), Some(e)) = (self.residual_cohesion, self.softening_strain) {
+            t += &format!(", softening to c_r = {r:.4e} Pa at ε̄ = {e}");
+        }
+        if let Some(pc) = self.critical_dilation_angle {
+            t += &format!(", ψ → {pc}° with η = {}", self.dilation_decay);
+        }
+        if let Some(tc) = self.tension_cutoff {
+            t += &format!(", tension cut-off {tc:.4e} Pa");
+        }
+        t
+    }
+
+    fn cohesion(&self) -> Option<f64> {
+        Some(self.cohesion)
+    }
+
+    fn with_strength_reduced(&self, f: f64) -> MohrCoulomb {
+        let (cohesion, residual_cohesion) = reduced_strength(self.cohesion, self.residual_cohesion, f);
+        let friction_angle = (self.friction_angle.to_radians().tan() / f).atan().to_degrees();
+        MohrCoulomb {
+            cohesion,
+            friction_angle,
+            dilation_angle: self.dilation_angle.min(friction_angle),
+            critical_dilation_angle: self.critical_dilation_angle.map(|psi| psi.min(friction_angle)),
+            residual_cohesion,
+            ..self.clone()
+        }
+    }
+}
+
+/// Mohr–Coulomb as the solver runs it (angles in radians, stresses in Pa).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MohrCoulombLaw {
+    /// The elasticity, D^e.
+    pub elastic: LinearElastic,
     /// Friction angle φ.
     pub phi: f64,
     /// Peak cohesion c_p.
@@ -98,7 +230,7 @@ fn norm(v: &[f64; 3]) -> f64 {
     dot(v, v).sqrt()
 }
 
-impl MohrCoulomb {
+impl MohrCoulombLaw {
     /// Cohesion at ε̄ and its slope dc/dε̄.
     pub fn cohesion_at(&self, eps: f64) -> (f64, f64) {
         if self.softening_strain.is_finite() && eps < self.softening_strain {
@@ -118,11 +250,8 @@ impl MohrCoulomb {
 
     fn d_times(&self, v: &[f64; 3]) -> [f64; 3] {
         let tr = v[0] + v[1] + v[2];
-        [
-            self.lame * tr + 2.0 * self.shear * v[0],
-            self.lame * tr + 2.0 * self.shear * v[1],
-            self.lame * tr + 2.0 * self.shear * v[2],
-        ]
+        let (lame, shear) = (self.elastic.lame(), self.elastic.shear_modulus());
+        [lame * tr + 2.0 * shear * v[0], lame * tr + 2.0 * shear * v[1], lame * tr + 2.0 * shear * v[2]]
     }
 
     /// The yield planes in sorted principal space for dilation angle `psi`: main, left edge
@@ -274,7 +403,7 @@ impl MohrCoulomb {
     fn apex(&self, trial: &[f64; 3], eps: f64) -> ReturnResult {
         let d = dev(trial);
         let dn = norm(&d);
-        let k = (2.0f64 / 3.0).sqrt() / (2.0 * self.shear);
+        let k = (2.0f64 / 3.0).sqrt() / (2.0 * self.elastic.shear_modulus());
         let de = k * dn;
         let (c, dc) = self.cohesion_at(eps + de);
         let cot = 1.0 / self.phi.tan();
@@ -289,5 +418,33 @@ impl MohrCoulomb {
             }
         }
         ReturnResult { stress: [p, p, p], tangent, eps: eps + de, region: Region::Apex }
+    }
+}
+
+impl SoilLaw for MohrCoulombLaw {
+    const DISSIPATES: bool = true;
+
+    #[inline]
+    fn update(&self, stress: &Stress, eps_pd: f64, deps: &Stress) -> StressUpdate {
+        isotropic_return(&self.elastic, stress, eps_pd, deps, |l, e| {
+            // Sort descending, return, and map back.
+            let mut order = [0usize, 1, 2];
+            order.sort_by(|&a, &b| l[b].total_cmp(&l[a]));
+            let sorted = [l[order[0]], l[order[1]], l[order[2]]];
+            let r = self.return_sorted(&sorted, e);
+            let mut stress = [0.0; 3];
+            let mut tangent = [[0.0; 3]; 3];
+            for i in 0..3 {
+                stress[order[i]] = r.stress[i];
+                for j in 0..3 {
+                    tangent[order[i]][order[j]] = r.tangent[i][j];
+                }
+            }
+            ReturnResult { stress, tangent, ..r }
+        })
+    }
+
+    fn elastic(&self) -> &LinearElastic {
+        &self.elastic
     }
 }

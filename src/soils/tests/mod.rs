@@ -4,49 +4,40 @@ use principal::Principal;
 const KPA: f64 = 1e3;
 
 fn mc(phi_deg: f64, c: f64, psi_deg: f64, tension: Option<f64>) -> Constitutive {
-    let el = LinearElastic::new(10e3 * KPA, 0.3);
-    Constitutive::MohrCoulomb(
-        el,
-        MohrCoulomb {
-            shear: el.shear_modulus(),
-            lame: el.lame(),
-            phi: phi_deg.to_radians(),
-            cohesion: c,
-            residual_cohesion: c,
-            softening_strain: f64::INFINITY,
-            psi_ini: psi_deg.to_radians(),
-            psi_crit: psi_deg.to_radians(),
-            eta: 0.0,
-            tension,
-        },
-    )
+    Constitutive::MohrCoulomb(MohrCoulombLaw {
+        elastic: LinearElastic::new(10e3 * KPA, 0.3),
+        phi: phi_deg.to_radians(),
+        cohesion: c,
+        residual_cohesion: c,
+        softening_strain: f64::INFINITY,
+        psi_ini: psi_deg.to_radians(),
+        psi_crit: psi_deg.to_radians(),
+        eta: 0.0,
+        tension,
+    })
 }
 
 fn softening_mc() -> Constitutive {
-    let el = LinearElastic::new(10e3 * KPA, 0.3);
-    Constitutive::MohrCoulomb(
-        el,
-        MohrCoulomb {
-            shear: el.shear_modulus(),
-            lame: el.lame(),
-            phi: 25f64.to_radians(),
-            cohesion: 20.0 * KPA,
-            residual_cohesion: 5.0 * KPA,
-            softening_strain: 0.05,
-            psi_ini: (-5f64).to_radians(),
-            psi_crit: 0.0,
-            eta: 25.0,
-            tension: Some(2.0 * KPA),
-        },
-    )
+    Constitutive::MohrCoulomb(MohrCoulombLaw {
+        elastic: LinearElastic::new(10e3 * KPA, 0.3),
+        phi: 25f64.to_radians(),
+        cohesion: 20.0 * KPA,
+        residual_cohesion: 5.0 * KPA,
+        softening_strain: 0.05,
+        psi_ini: (-5f64).to_radians(),
+        psi_crit: 0.0,
+        eta: 25.0,
+        tension: Some(2.0 * KPA),
+    })
 }
 
 fn vm(c: f64, c_r: f64, h: f64) -> Constitutive {
-    let el = LinearElastic::new(1e3 * KPA, 0.35);
-    Constitutive::VonMises(
-        el,
-        VonMises { shear: el.shear_modulus(), cohesion: c, residual_cohesion: c_r, softening_modulus: h },
-    )
+    Constitutive::VonMises(VonMisesLaw {
+        elastic: LinearElastic::new(1e3 * KPA, 0.35),
+        cohesion: c,
+        residual_cohesion: c_r,
+        softening_modulus: h,
+    })
 }
 
 /// The plane stress [xx, yy, xy, zz, 0, 0] with principal values `l` (l[2] out of plane) rotated by
@@ -107,7 +98,7 @@ fn principal_sorted(s: &Stress) -> [f64; 3] {
     v
 }
 
-fn mc_f(m: &MohrCoulomb, s: &[f64; 3], eps: f64) -> f64 {
+fn mc_f(m: &MohrCoulombLaw, s: &[f64; 3], eps: f64) -> f64 {
     let (c, _) = m.cohesion_at(eps);
     (s[0] - s[2]) + (s[0] + s[2]) * m.phi.sin() - 2.0 * c * m.phi.cos()
 }
@@ -148,7 +139,7 @@ fn mohr_coulomb_returns_to_the_surface_in_every_region_with_the_exact_tangent() 
         (mc(0.0, 10.0 * KPA, 0.0, None), [-10.0, -30.0, -60.0], Region::Plane),
     ];
     for (model, l, region) in cases {
-        let Constitutive::MohrCoulomb(_, p) = model else { unreachable!() };
+        let Constitutive::MohrCoulomb(p) = model else { unreachable!() };
         for (perm, theta) in [([0, 1, 2], 0.3), ([2, 0, 1], -1.1), ([1, 2, 0], 2.0)] {
             let trial = stress_with([l[perm[0]] * KPA, l[perm[1]] * KPA, l[perm[2]] * KPA], theta);
             let (s0, de) = start_for(&model, trial);
@@ -182,7 +173,7 @@ fn mohr_coulomb_returns_to_the_surface_in_every_region_with_the_exact_tangent() 
 #[test]
 fn softening_and_dilatancy_evolve_and_the_tangent_stays_exact() {
     let model = softening_mc();
-    let Constitutive::MohrCoulomb(_, p) = model else { unreachable!() };
+    let Constitutive::MohrCoulomb(p) = model else { unreachable!() };
     // Cohesion falls linearly to the residual value, ψ decays towards ψ_crit.
     assert_eq!(p.cohesion_at(0.0).0, 20.0 * KPA);
     assert!((p.cohesion_at(0.025).0 - 12.5 * KPA).abs() < 1e-9);
@@ -263,8 +254,8 @@ fn tresca_limits_the_largest_shear_stress_to_the_cohesion() {
 #[test]
 fn von_mises_returns_radially_and_softens_to_the_residual_strength() {
     let model = vm(12.0 * KPA, 3.0 * KPA, -30.0 * KPA);
-    let Constitutive::VonMises(_, p) = model else { unreachable!() };
-    let q = |s: &Stress| crate::model::soil::invariants(s).1;
+    let Constitutive::VonMises(p) = model else { unreachable!() };
+    let q = |s: &Stress| crate::soils::invariants(s).1;
     for (eps0, l) in [
         (0.0, [0.0, -40.0, -10.0]),
         (0.1, [5.0, -60.0, -20.0]),
@@ -358,4 +349,57 @@ fn the_structured_elastic_products_are_the_full_ones() {
         let dv: f64 = (0..NS).map(|c| el.d[r][c] * v[c]).sum();
         assert!((trial[r] - dv).abs() <= 1e-15 * el.d[0][0], "D v [{r}]");
     }
+}
+
+/// A strength reduction factor F divides c_p and tan φ, keeps ψ ≤ φ' and c_r ≤ c_p/F, leaves
+/// the stiffness and a residual below the reduced peak alone, and leaves models without a
+/// strength unchanged.
+#[test]
+fn a_strength_reduction_divides_the_peak_strength() {
+    let mc = MohrCoulomb {
+        young_modulus: 1e7,
+        poisson_ratio: 0.3,
+        friction_angle: 30.0,
+        cohesion: 10e3,
+        residual_cohesion: Some(8e3),
+        softening_strain: Some(0.1),
+        dilation_angle: 25.0,
+        critical_dilation_angle: Some(5.0),
+        dilation_decay: 0.0,
+        tension_cutoff: None,
+    };
+    let SoilModel::MohrCoulomb(r) = SoilModel::MohrCoulomb(mc).with_strength_reduced(2.0) else { unreachable!() };
+    assert_eq!(r.young_modulus, 1e7);
+    assert_eq!(r.cohesion, 5e3);
+    let phi = (30f64.to_radians().tan() / 2.0).atan().to_degrees();
+    assert!((r.friction_angle - phi).abs() < 1e-12 && (phi - 16.102).abs() < 1e-3, "{}", r.friction_angle);
+    assert_eq!(r.dilation_angle, r.friction_angle);
+    assert_eq!(r.critical_dilation_angle, Some(5.0));
+    assert_eq!(r.residual_cohesion, Some(5e3));
+    let hj = HenckyJ2 {
+        young_modulus: 25e6,
+        poisson_ratio: 0.499,
+        cohesion: 28868.0,
+        residual_cohesion: Some(1732.0),
+        softening_rate: 5.0,
+    };
+    let SoilModel::HenckyJ2(r) = SoilModel::HenckyJ2(hj).with_strength_reduced(1.65) else { unreachable!() };
+    assert!((r.cohesion - 28868.0 / 1.65).abs() < 1e-9);
+    assert_eq!((r.residual_cohesion, r.softening_rate), (Some(1732.0), 5.0));
+    let el = LinearElasticParameters(Elasticity { young_modulus: 1e6, poisson_ratio: 0.3 });
+    assert!(matches!(SoilModel::LinearElastic(el).with_strength_reduced(3.0), SoilModel::LinearElastic(e) if e == el));
+}
+
+/// Each model's `type` in the registry ([`SoilModel::kind`]) is the tag serde reads and the JSON
+/// schema (the case reference) shows, in the registry's order.
+#[test]
+fn every_kind_is_the_type_its_table_is_chosen_by() {
+    let schema = serde_json::to_value(schemars::schema_for!(SoilModel)).unwrap();
+    let tags: Vec<&str> = schema["oneOf"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["properties"]["type"]["const"].as_str().unwrap())
+        .collect();
+    assert_eq!(tags, SoilModel::KINDS);
 }
