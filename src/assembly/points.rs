@@ -147,6 +147,13 @@ pub(super) fn run_bands<R: Send>(
     })
 }
 
+/// Grows `v` with zeros to at least `n` values.
+fn at_least(v: &mut Vec<f64>, n: usize) {
+    if v.len() < n {
+        v.resize(n, 0.0);
+    }
+}
+
 /// The scratch of [`Points::add_tangent`]: the map of raw to effective dofs, the effective
 /// block, the effective nodes' grid indices.
 struct Scratch<const D: usize> {
@@ -329,13 +336,11 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let step = self.step;
         let nm = step.scheme;
         let layout = step.layout;
-        let mut block = vec![0.0; M * N * M * N];
-        let max_eff = (M + EXTRA_MASTERS) * N;
-        let mut scratch = Scratch {
-            transform: Vec::new(),
-            block: vec![0.0; max_eff * max_eff],
-            indices: Vec::with_capacity(M + EXTRA_MASTERS),
-        };
+        // Sized by the largest block met, not by the bounds M and N: a three-dimensional
+        // one-phase point's block is 192² values, the bounds' 875² (6 MB a thread).
+        let mut block = Vec::new();
+        let mut scratch =
+            Scratch { transform: Vec::new(), block: Vec::new(), indices: Vec::with_capacity(M + EXTRA_MASTERS) };
         let first = step.pattern.row_start(band.lo);
         for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
             let (nodes, basis) = step.stencils.get(k);
@@ -354,6 +359,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
             pt.set_forces(step.stencils.forces_of(k));
             pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
             let m = pt.size();
+            at_least(&mut block, m * m);
             if self.model.stiffness_in_jacobian {
                 kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
                 step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
@@ -385,6 +391,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let eff = step.stencils.effective(k);
         let (me, kb): (usize, &[f64]) = if has_ext {
             let me = transform(step, k, tr);
+            at_least(eff_block, me * me);
             eff_block[..me * me].fill(0.0);
             for a in 0..m {
                 for &(ea, wa) in &tr[a] {
@@ -556,13 +563,14 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let step = self.step;
         let plain = step.scheme.unweighted();
         let nd = step.dofs.nd;
-        let mut block = vec![0.0; M * N * M * N];
+        let mut block = Vec::new();
         let mut buf = vec![0.0; M * N];
         let ps = self;
         for p in 0..step.stencils.len() {
             let (nodes, _) = step.stencils.get(p);
             ps.with_point(p, xl, |pt| {
                 let m = pt.size();
+                at_least(&mut block, m * m);
                 block[..m * m].fill(0.0);
                 buf[..m].fill(0.0);
                 kernels::stress::tangent_with(pt, &plain, &mut block[..m * m], step.stiffness.material(p));
