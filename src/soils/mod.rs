@@ -23,6 +23,7 @@
 //! of [`Constitutive`], and everything else asks the two traits. This module imports only
 //! [`crate::algebra`] and [`crate::check`]: the case file's schema and the model both build on it.
 
+pub mod bulk_shear;
 pub mod elasticity;
 pub mod finite_strain;
 pub mod hencky_j2;
@@ -342,6 +343,8 @@ macro_rules! soil_models {
 soil_models! {
     /// Isotropic linear elasticity.
     LinearElastic(linear_elastic::LinearElasticParameters) = "linear_elastic",
+    /// Isotropic linear elasticity given by its bulk and shear moduli K and G (λ = K − 2G/3, μ = G).
+    ElasticBulkShear(bulk_shear::BulkShear) = "elastic_bulk_shear",
     /// Mohr–Coulomb, non-associated, with linear cohesion softening, a dilation angle decaying with
     /// plastic strain and an optional tension cut-off ([000] §4; Tresca with `friction_angle = 0`,
     /// the cohesion being the undrained strength).
