@@ -317,12 +317,26 @@ impl<const D: usize> DmDa<D> {
         if rows.len() != cols.len() {
             return Err(Error::new("COO preallocation: row and column lists differ in length"));
         }
-        let aij = cstring("aij")?;
-        call!(DMSetMatType(self.raw, aij.as_ptr()))?;
-        call!(DMSetMatrixPreallocateSkip(self.raw, sys::PetscBool::PETSC_TRUE))?;
+        // The matrix is made here rather than by DMCreateMatrix, which in PETSc 3.18 preallocates
+        // the DMDA's whole box stencil in three dimensions even when told to skip it, only for
+        // the COO preallocation to replace it (18 MB of a 3D run's 83 MB heap peak at 4096
+        // points): the DMDA's row layout, block size and local-to-global mapping, and the DM
+        // attached as DMCreateMatrix attaches it.
+        let mut comm = Comm::self_().raw();
+        call!(PetscObjectGetComm(self.raw as sys::PetscObject, &mut comm))?;
+        let dof = self.info.dof;
+        let local = (self.info.owned_count.iter().product::<usize>() * dof) as Int;
+        let global = (self.info.nodes.iter().product::<usize>() * dof) as Int;
         let mut raw = std::ptr::null_mut();
-        call!(DMCreateMatrix(self.raw, &mut raw))?;
+        call!(MatCreate(comm, &mut raw))?;
         let m = Mat { raw };
+        call!(MatSetSizes(m.raw, local, local, global, global))?;
+        call!(MatSetBlockSize(m.raw, dof as Int))?;
+        call!(MatSetType(m.raw, sys::MATAIJ.as_ptr() as *const _))?;
+        let mut ltog = std::ptr::null_mut();
+        call!(DMGetLocalToGlobalMapping(self.raw, &mut ltog))?;
+        call!(MatSetLocalToGlobalMapping(m.raw, ltog, ltog))?;
+        call!(MatSetDM(m.raw, self.raw))?;
         // PETSc may reorder the index arrays in place: hand it copies.
         let (mut i, mut j) = (rows.to_vec(), cols.to_vec());
         call!(MatSetPreallocationCOO(m.raw, i.len() as sys::PetscCount, i.as_mut_ptr(), j.as_mut_ptr()))?;
