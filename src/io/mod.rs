@@ -40,8 +40,8 @@ pub fn write_csv(dir: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) 
 pub const PLOTS_DIR: &str = "plots";
 
 /// The peak resident memory of this process so far [MiB] (`ru_maxrss` of getrusage(2), the
-/// `VmHWM` of `/proc/self/status`), if the system reports it. One system call: the driver reads it
-/// around every phase of every step (reading `/proc/self/status` took 6 % of a small case's run).
+/// `VmHWM` of `/proc/self/status`), if the system reports it. One system call, cheap enough for
+/// the driver to read it around every phase of every step.
 pub fn peak_memory_mib() -> Option<f64> {
     use nix::sys::resource::{getrusage, UsageWho};
     let kib = getrusage(UsageWho::RUSAGE_SELF).ok()?.max_rss();

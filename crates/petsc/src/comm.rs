@@ -35,6 +35,13 @@ impl Comm {
         Comm(raw)
     }
 
+    /// The communicator a PETSc object (a Mat, a DM, ...) lives on.
+    pub(crate) fn of(object: sys::PetscObject) -> Result<Comm> {
+        let mut comm = Comm::self_().raw();
+        call!(PetscObjectGetComm(object, &mut comm))?;
+        Ok(Comm(comm))
+    }
+
     /// The raw handle, for `petsc-sys` calls.
     pub fn raw(&self) -> sys::MPI_Comm {
         self.0

@@ -322,13 +322,12 @@ impl<const D: usize> DmDa<D> {
         // the COO preallocation to replace it (18 MB of a 3D run's 83 MB heap peak at 4096
         // points): the DMDA's row layout, block size and local-to-global mapping, and the DM
         // attached as DMCreateMatrix attaches it.
-        let mut comm = Comm::self_().raw();
-        call!(PetscObjectGetComm(self.raw as sys::PetscObject, &mut comm))?;
+        let comm = Comm::of(self.raw as sys::PetscObject)?;
         let dof = self.info.dof;
         let local = (self.info.owned_count.iter().product::<usize>() * dof) as Int;
         let global = (self.info.nodes.iter().product::<usize>() * dof) as Int;
         let mut raw = std::ptr::null_mut();
-        call!(MatCreate(comm, &mut raw))?;
+        call!(MatCreate(comm.raw(), &mut raw))?;
         let m = Mat { raw };
         call!(MatSetSizes(m.raw, local, local, global, global))?;
         call!(MatSetBlockSize(m.raw, dof as Int))?;

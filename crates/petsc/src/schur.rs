@@ -250,9 +250,7 @@ fn block_inverse(
     let d_nnz: Vec<Int> =
         (0..n).map(|i| if member[i] == usize::MAX { 1 } else { groups[member[i]].len() as Int }).collect();
     let o_nnz = vec![0 as Int; n];
-    let mut comm = Comm::self_().raw();
-    call!(PetscObjectGetComm(a.raw() as sys::PetscObject, &mut comm))?;
-    let mut binv = Mat::new_aij(Comm::from_raw(comm), n, first.global_len()?, &d_nnz, &o_nnz)?;
+    let mut binv = Mat::new_aij(Comm::of(a.raw() as sys::PetscObject)?, n, first.global_len()?, &d_nnz, &o_nnz)?;
     let (first_row, _) = binv.ownership_range()?;
     for i in (0..n).filter(|&i| member[i] == usize::MAX) {
         let aii = values[rows[i] as usize - start];
