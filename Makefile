@@ -17,9 +17,16 @@ build: setup
 run: build
 	./target/release/porompm run $(CASE) --out $(OUT)
 
-# The whole test suite (unit, PETSc smoke, CLI and MPI, verification against analytical solutions).
+# The whole test suite (unit, PETSc smoke, CLI and MPI, verification against analytical solutions),
+# by cargo-nextest where it is installed (every test its own process, two at a time across all
+# test files, the longest first: .config/nextest.toml), else by cargo test.
 test: setup
-	cargo test --release --locked
+	@if cargo nextest --version >/dev/null 2>&1; then \
+		cargo nextest run --release --locked; \
+	else \
+		echo "cargo-nextest not found: cargo test runs the suite (one test file after the other)"; \
+		cargo test --release --locked; \
+	fi
 
 # Long convergence studies (tables in target/studies/) and the long runs the default suite leaves
 # out (README, "Tests and studies").

@@ -47,7 +47,7 @@ fn write_gold(case: &str, gold: &Gold) {
 /// Runs a case with its gold overrides (and `extra` ones) into a fresh directory; returns the
 /// directory and the run's summary.
 fn run(case: &str, label: &str, sets: &[String], extra: &[String], options: &[&str]) -> (PathBuf, Value) {
-    let _cores = common::CORES.read().unwrap_or_else(|e| e.into_inner());
+    let _cores = common::Cores::shared();
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gold").join(label);
     let _ = std::fs::remove_dir_all(&out);
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_porompm"));
@@ -389,7 +389,7 @@ fn gold_values_on_ranks(runs: &[(&str, usize)], table_name: &str) {
             .to_string(),
         "|---|---|---|---|---|---|---|---|".to_string(),
     ];
-    let _cores = common::CORES.write().unwrap_or_else(|e| e.into_inner());
+    let _cores = common::Cores::exclusive();
     for &(case, ranks) in runs {
         let gold = read_gold(case);
         let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("ranks").join(format!("{case}-{ranks}"));

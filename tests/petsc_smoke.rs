@@ -9,6 +9,8 @@
 //! * errors from PETSc, from callbacks and from panics in callbacks come back as `Err` with a message;
 //!   a domain error ends the solve as diverged; unused options are reported.
 
+mod common;
+
 use petsc::ksp::KspOps;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
@@ -489,7 +491,28 @@ fn a_three_dimensional_dmda_numbers_and_exchanges_its_nodes() -> TestResult {
     Ok(())
 }
 
+/// The tests of this file, in the order they run.
+const TESTS: &[(&str, TestFn)] = &[
+    ("every_options_file_solves_the_saddle_system", every_options_file_solves_the_saddle_system),
+    (
+        "hand_tangent_matches_finite_differences_and_newton_is_quadratic",
+        hand_tangent_matches_finite_differences_and_newton_is_quadratic,
+    ),
+    ("callback_errors_panics_and_domain_errors_are_reported", callback_errors_panics_and_domain_errors_are_reported),
+    ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
+    (
+        "a_failed_mumps_factorisation_leaves_the_next_solve_free",
+        a_failed_mumps_factorisation_leaves_the_next_solve_free,
+    ),
+    ("unused_options_are_reported", unused_options_are_reported),
+    (
+        "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",
+        a_three_dimensional_dmda_numbers_and_exchanges_its_nodes,
+    ),
+];
+
 fn main() {
+    let Some(chosen) = common::harness::selected(TESTS) else { return };
     let petsc = match Petsc::initialize(&[], None, "porompm PETSc smoke tests") {
         Ok(p) => p,
         Err(err) => {
@@ -497,44 +520,7 @@ fn main() {
             std::process::exit(1);
         }
     };
-    let tests: &[(&str, TestFn)] = &[
-        ("every_options_file_solves_the_saddle_system", every_options_file_solves_the_saddle_system),
-        (
-            "hand_tangent_matches_finite_differences_and_newton_is_quadratic",
-            hand_tangent_matches_finite_differences_and_newton_is_quadratic,
-        ),
-        (
-            "callback_errors_panics_and_domain_errors_are_reported",
-            callback_errors_panics_and_domain_errors_are_reported,
-        ),
-        ("petsc_errors_carry_petsc_messages", petsc_errors_carry_petsc_messages),
-        (
-            "a_failed_mumps_factorisation_leaves_the_next_solve_free",
-            a_failed_mumps_factorisation_leaves_the_next_solve_free,
-        ),
-        ("unused_options_are_reported", unused_options_are_reported),
-        (
-            "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",
-            a_three_dimensional_dmda_numbers_and_exchanges_its_nodes,
-        ),
-    ];
-    let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
-    let mut failed = 0;
-    let mut ran = 0;
-    for (name, t) in tests {
-        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
-            continue;
-        }
-        ran += 1;
-        match t() {
-            Ok(()) => println!("test {name} ... ok"),
-            Err(msg) => {
-                failed += 1;
-                println!("test {name} ... FAILED\n    {msg}");
-            }
-        }
-    }
+    let ok = common::harness::run(&chosen, |t| t());
     drop(petsc);
-    println!("\npetsc_smoke: {} passed; {failed} failed", ran - failed);
-    std::process::exit(if failed == 0 { 0 } else { 1 });
+    std::process::exit(if ok { 0 } else { 101 });
 }

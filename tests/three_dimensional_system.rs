@@ -23,6 +23,8 @@
 //! Run: `cargo test --release --test three_dimensional_system` (harness-free: PETSc is
 //! initialised once for all tests).
 
+mod common;
+
 use porompm::algebra::det;
 use porompm::analysis::StageAnalysis;
 use porompm::assembly::{StepDim, StepForces, System};
@@ -874,7 +876,38 @@ fn a_two_phase_explicit_slab_steps_as_its_plane_twin(coll: &Collective) -> Resul
 
 type TestFn = fn(&Collective) -> Result<(), String>;
 
+/// The tests of this file, in the order they run.
+const TESTS: &[(&str, TestFn)] = &[
+    ("a_slab_steps_as_its_plane_twin", a_slab_steps_as_its_plane_twin),
+    (
+        "a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin",
+        a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin,
+    ),
+    (
+        "a_slab_with_the_pressure_projection_steps_as_its_plane_twin",
+        a_slab_with_the_pressure_projection_steps_as_its_plane_twin,
+    ),
+    ("a_slab_with_moving_surfaces_steps_as_its_plane_twin", a_slab_with_moving_surfaces_steps_as_its_plane_twin),
+    ("a_block_squeezed_from_three_sides_is_homogeneous", a_block_squeezed_from_three_sides_is_homogeneous),
+    (
+        "a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage",
+        a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage,
+    ),
+    (
+        "the_slab_solves_alike_with_the_fixed_stress_field_split",
+        the_slab_solves_alike_with_the_fixed_stress_field_split,
+    ),
+    ("the_cube_solves_alike_with_gamg", the_cube_solves_alike_with_gamg),
+    ("an_explicit_slab_steps_as_its_plane_twin", an_explicit_slab_steps_as_its_plane_twin),
+    (
+        "an_explicit_slab_with_fbar_conserves_the_projected_volume",
+        an_explicit_slab_with_fbar_conserves_the_projected_volume,
+    ),
+    ("a_two_phase_explicit_slab_steps_as_its_plane_twin", a_two_phase_explicit_slab_steps_as_its_plane_twin),
+];
+
 fn main() {
+    let Some(chosen) = common::harness::selected(TESTS) else { return };
     let petsc = match petsc::Petsc::initialize(&[], None, "porompm three-dimensional system tests") {
         Ok(p) => p,
         Err(err) => {
@@ -888,50 +921,7 @@ fn main() {
         std::process::exit(1);
     }
     let coll = Collective::world();
-    let tests: &[(&str, TestFn)] = &[
-        ("a_slab_steps_as_its_plane_twin", a_slab_steps_as_its_plane_twin),
-        (
-            "a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin",
-            a_slab_pressed_by_a_nodal_traction_steps_as_its_plane_twin,
-        ),
-        (
-            "a_slab_with_the_pressure_projection_steps_as_its_plane_twin",
-            a_slab_with_the_pressure_projection_steps_as_its_plane_twin,
-        ),
-        ("a_slab_with_moving_surfaces_steps_as_its_plane_twin", a_slab_with_moving_surfaces_steps_as_its_plane_twin),
-        ("a_block_squeezed_from_three_sides_is_homogeneous", a_block_squeezed_from_three_sides_is_homogeneous),
-        (
-            "a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage",
-            a_lying_slab_moves_as_its_plane_twin_in_a_dynamic_stage,
-        ),
-        (
-            "the_slab_solves_alike_with_the_fixed_stress_field_split",
-            the_slab_solves_alike_with_the_fixed_stress_field_split,
-        ),
-        ("the_cube_solves_alike_with_gamg", the_cube_solves_alike_with_gamg),
-        ("an_explicit_slab_steps_as_its_plane_twin", an_explicit_slab_steps_as_its_plane_twin),
-        (
-            "an_explicit_slab_with_fbar_conserves_the_projected_volume",
-            an_explicit_slab_with_fbar_conserves_the_projected_volume,
-        ),
-        ("a_two_phase_explicit_slab_steps_as_its_plane_twin", a_two_phase_explicit_slab_steps_as_its_plane_twin),
-    ];
-    let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
-    let (mut ran, mut failed) = (0, 0);
-    for (name, t) in tests {
-        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
-            continue;
-        }
-        ran += 1;
-        match t(&coll) {
-            Ok(()) => println!("test {name} ... ok"),
-            Err(msg) => {
-                failed += 1;
-                println!("test {name} ... FAILED\n    {msg}");
-            }
-        }
-    }
+    let ok = common::harness::run(&chosen, |t| t(&coll));
     drop(petsc);
-    println!("\ntest result: {}. {} passed; {failed} failed", if failed == 0 { "ok" } else { "FAILED" }, ran - failed);
-    std::process::exit(if failed == 0 { 0 } else { 1 });
+    std::process::exit(if ok { 0 } else { 101 });
 }

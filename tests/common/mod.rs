@@ -37,17 +37,47 @@ impl Run {
     }
 }
 
-/// The machine's cores, shared by the tests of one test binary: a one-rank run holds them for
-/// reading (two may run side by side, as the test harness runs two tests at a time on two cores), a
-/// run on several ranks for writing, alone. Two or three ranks beside another run oversubscribe
-/// the cores, and the ranks, waiting on each other, slow down several times (cases/footing_ld.toml
-/// on three ranks: 12 s alone, 49 s beside a one-rank run).
-pub static CORES: std::sync::RwLock<()> = std::sync::RwLock::new(());
+pub mod harness;
+
+/// The machine's cores, shared by every test of every test binary (the runner may run tests of
+/// several binaries at once, each in its own process): a one-rank run holds them shared (two may
+/// run side by side, as two tests run at a time on two cores), a run on several ranks holds them
+/// exclusively, alone. Two or three ranks beside another run oversubscribe the cores, and the
+/// ranks, waiting on each other, slow down several times (cases/footing_ld.toml on three ranks:
+/// 12 s alone, 49 s beside a one-rank run). The hold is an advisory lock on one file of the
+/// target directory, released when the guard is dropped (or its process ends).
+pub struct Cores(std::fs::File);
+
+impl Cores {
+    fn file() -> std::fs::File {
+        let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cores.lock");
+        std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .unwrap_or_else(|e| panic!("cannot open {}: {e}", path.display()))
+    }
+
+    /// Holds the cores beside at most one other one-rank run.
+    pub fn shared() -> Cores {
+        let f = Cores::file();
+        f.lock_shared().expect("the cores' lock is taken");
+        Cores(f)
+    }
+
+    /// Holds the cores alone.
+    pub fn exclusive() -> Cores {
+        let f = Cores::file();
+        f.lock().expect("the cores' lock is taken");
+        Cores(f)
+    }
+}
 
 /// Runs `porompm run CASE --out DIR --quiet` with `args` after it (e.g. `--set` pairs, an options
 /// file, PETSc options after `--`) into `dir`, emptied first.
 pub fn run_case(case: &str, dir: &Path, args: &[String]) -> Run {
-    let _cores = CORES.read().unwrap_or_else(|e| e.into_inner());
+    let _cores = Cores::shared();
     let _ = std::fs::remove_dir_all(dir);
     let mut all =
         vec!["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()];
@@ -108,13 +138,13 @@ pub fn mpi_env(cmd: &mut Command) -> &mut Command {
 }
 
 /// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`, alone on
-/// the [`CORES`]; one rank runs the binary directly), with a 600 s limit so that a hang fails the
+/// the [`Cores`]; one rank runs the binary directly), with a 600 s limit so that a hang fails the
 /// test instead of holding it.
 pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run {
     if ranks == 1 {
         return run_case(case, dir, args);
     }
-    let _cores = CORES.write().unwrap_or_else(|e| e.into_inner());
+    let _cores = Cores::exclusive();
     let _ = std::fs::remove_dir_all(dir);
     let np = ranks.to_string();
     let mut all: Vec<String> = ["600", "mpirun", "--oversubscribe", "-n", np.as_str(), env!("CARGO_BIN_EXE_porompm")]
