@@ -19,7 +19,7 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use porompm::case::{self, Override};
-use porompm::kernels::{self, NodeBasis, NodeState, Predictors};
+use porompm::kernels::{self, Motion, NodeBasis, NodeState};
 use porompm::model::patch::PatchField;
 use porompm::model::shape::{self, Basis};
 use porompm::model::Model;
@@ -46,7 +46,16 @@ fn bases(model: &Model) -> Vec<Vec<NodeBasis>> {
     (0..ps.len())
         .map(|k| {
             let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-            let gv = shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j));
+            let gv = shape::volumetric_operators(
+                model.basis,
+                &model.grid,
+                ps.x[k],
+                ps.lp[k],
+                &mut st,
+                &|i, j| (i, j),
+                false,
+            )
+            .0;
             (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n], t: 0.0, tv: 0.0 }).collect()
         })
         .collect()
@@ -76,8 +85,16 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-                let gv =
-                    shape::volumetric_gradients(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j));
+                let gv = shape::volumetric_operators(
+                    model.basis,
+                    &model.grid,
+                    ps.x[k],
+                    ps.lp[k],
+                    &mut st,
+                    &|i, j| (i, j),
+                    false,
+                )
+                .0;
                 sum += st.w[0] + gv[0][0];
             }
             black_box(sum)
@@ -109,7 +126,7 @@ fn particle_kernels(c: &mut Criterion) {
     let inputs: Vec<kernels::ParticleInput> = (0..n)
         .map(|k| {
             let mut input = kernels::ParticleInput::of(&model, k, &body_acc);
-            input.pred = Predictors::new(&nm, [0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
+            input.pred = Motion::predicted(&nm, [0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
             input
         })
         .collect();

@@ -44,7 +44,7 @@ pub fn nonfinite<const D: usize>(model: &Model<D>, k: usize, step: &StepResult<D
     let j = step.jacobian;
     let finite = [
         ("displacement increment", it.du.iter().all(|u| u.is_finite())),
-        ("velocity", it.v_u.iter().all(|v| v.is_finite()) && it.a_u.iter().all(|a| a.is_finite())),
+        ("velocity", it.motion.v_u.iter().all(|v| v.is_finite()) && it.motion.a_u.iter().all(|a| a.is_finite())),
         ("effective stress", step.stress.iter().all(|s| s.is_finite())),
         ("pore pressure increment", it.dp.is_finite()),
         ("volume ratio", j.is_finite()),
@@ -88,30 +88,30 @@ pub fn update_particle<const D: usize>(
     match model.integration {
         Integration::Dynamic { gamma: g, .. } => {
             for c in 0..D {
-                ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.a_u[c]);
-                ps.acc[k][c] = it.a_u[c];
+                ps.vel[k][c] += dt * ((1.0 - g) * ps.acc[k][c] + g * it.motion.a_u[c]);
+                ps.acc[k][c] = it.motion.a_u[c];
                 if model.pore_water {
-                    ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * it.a_w[c]);
-                    ps.acc_w[k][c] = it.a_w[c];
+                    ps.vel_w[k][c] += dt * ((1.0 - g) * ps.acc_w[k][c] + g * it.motion.a_w[c]);
+                    ps.acc_w[k][c] = it.motion.a_w[c];
                 }
             }
         }
         Integration::Explicit { flip, .. } => {
             // [002] Eqs. 11–13: FLIP v_p + Σ S (v_i^{n+1} − v_i^n) blended with PIC Σ S v_i^{n+1};
             // Σ S v_i^{n+1} = Δu_p/Δt, and Σ S v_i^n is the interpolated nodal velocity of the
-            // grid update's start (`interp.v_u`, set by `Points::result` from the
+            // grid update's start (`interp.motion.v_u`, set by `Points::result` from the
             // lumped velocities, `assembly::explicit`); the water's likewise
-            // (Δw_p/Δt and `interp.v_w`). XPIC sets the solid's velocity itself
+            // (Δw_p/Δt and `interp.motion.v_w`). XPIC sets the solid's velocity itself
             // (`StepResult::velocity`; one-phase only).
             for c in 0..D {
                 let pic = it.du[c] / dt;
-                let blend = flip * (ps.vel[k][c] + pic - it.v_u[c]) + (1.0 - flip) * pic;
+                let blend = flip * (ps.vel[k][c] + pic - it.motion.v_u[c]) + (1.0 - flip) * pic;
                 let v = step.velocity.map_or(blend, |v| v[c]);
                 ps.acc[k][c] = (v - ps.vel[k][c]) / dt;
                 ps.vel[k][c] = v;
                 if model.pore_water {
                     let pic = it.dw[c] / dt;
-                    let v = flip * (ps.vel_w[k][c] + pic - it.v_w[c]) + (1.0 - flip) * pic;
+                    let v = flip * (ps.vel_w[k][c] + pic - it.motion.v_w[c]) + (1.0 - flip) * pic;
                     ps.acc_w[k][c] = (v - ps.vel_w[k][c]) / dt;
                     ps.vel_w[k][c] = v;
                 }

@@ -5,6 +5,7 @@
 use super::points::Points;
 use super::space::NodeSpace;
 use super::step::{Solution, Step};
+use super::System;
 use crate::model::Model;
 use crate::parallel::Collective;
 
@@ -59,110 +60,113 @@ impl<const D: usize> Default for StepForces<D> {
     }
 }
 
-/// The forces of the converged `step` (collective): the moment of the external, reaction and
-/// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
-/// reaction; with `diagnostics` also K_mag and F^int_mag per owned node. `last_reactions` are the
-/// reactions per ghosted dof of the last step on the same node space (empty after a new one).
-/// Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia" is then
-/// everything in it but the internal and external forces at t_{n+1} (see
-/// [`Points::nodal_terms`]).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn of_step<const D: usize, const M: usize, const N: usize>(
-    space: &mut NodeSpace<D>,
-    step: &Step<D, M>,
-    solution: &Solution,
-    model: &Model<D>,
-    coll: &Collective,
-    diagnostics: bool,
-    last_reactions: &[f64],
-) -> Result<StepForces<D>, String> {
-    let nd = space.layout.nd;
-    let ng = space.ghost.len() * nd;
-    // An explicit step's forces are those of its start (σ_n on x_n, [`super::explicit`]): its
-    // balance is taken there, against the stress before the particle update
-    // (`StepForces::at_start`).
-    let at_start = model.integration.is_explicit();
-    let xl = if at_start { vec![0.0; ng] } else { solution.increments.clone() };
-    let (mut all, mut inertia, mut magnitude) = if at_start {
-        let start = &step.start_terms;
-        (start.all.clone(), start.inertia.clone(), start.magnitude.clone())
-    } else {
-        (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng])
-    };
-    let points = Points::<D, M, N>::new(model, step);
-    if !at_start {
-        points.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
-    }
-    let node_diagnostics = if diagnostics { nodal_diagnostics(space, &points, &xl)? } else { Vec::new() };
-    let walls = points.wall_shares(&xl, at_start);
-    let mut fext = step.fext.clone();
-    let mut fext_old = step.fext_old.clone();
-    for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
-        space.sum_over_ranks(v).map_err(|e| e.to_string())?;
-    }
-    // An explicit step's inertia is its lumped nodal update's (already summed over ranks).
-    for (i, m) in inertia.iter_mut().zip(&solution.explicit_inertia) {
-        *i += m;
-    }
-    let field_scales = space.field_norms(step, &magnitude, coll)?;
-    let g = &model.grid;
-    let hi = g.extent_max();
-    // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
-    // stress is only defined there).
-    let mut origin: [f64; D] = std::array::from_fn(|d| 0.5 * (g.origin[d] + hi[d]));
-    if model.geometry.axisymmetric() {
-        origin[0] = 0.0;
-    }
-    let nb = model.boundaries.len();
-    // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
-    // boundary (D nb)]
-    let dd = D * D;
-    let mut local = vec![0.0; 4 * dd + 1 + D * nb];
-    let mut reactions = vec![0.0; ng];
-    // (dof component, in-plane direction) of the solid and water motion.
-    let motion: Vec<(usize, usize)> =
-        space.motion().into_iter().map(|c| (c, if c < D { c } else { c - space.layout.w.unwrap_or(0) })).collect();
-    for &a in &space.owned_nodes {
-        let l = a as usize;
-        let p = g.position(space.ghost.indices(l));
-        let u = &xl[l * nd..l * nd + D];
-        let xr: [f64; D] = std::array::from_fn(|d| p[d] + u[d] - origin[d]);
-        for &(c, dir) in &motion {
-            let q = l * nd + c;
-            let b = step.dofs.boundary[q];
-            let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
-            reactions[q] = reaction;
-            let reaction_old = last_reactions.get(q).copied().unwrap_or(reaction);
-            // The first step of a Newmark stage: the force its start is in balance with is
-            // f_n + r_n (r_n = `start_imbalance`, zero where a boundary holds the dof).
-            let start = if (b as usize) < nb { 0.0 } else { step.start_imbalance.get(q).copied().unwrap_or(0.0) };
-            local[4 * dd] += 0.5 * (fext_old[q] + start + fext[q] + reaction_old + reaction) * solution.increments[q];
-            book_node_forces(&mut local, nb, b as usize, &xr, dir, [fext[q], reaction, inertia[q]]);
+impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
+    /// The forces of the converged `step` (collective): the moment of the external, reaction and
+    /// inertia forces about the grid's centre for the equilibrium identity, and each boundary's
+    /// reaction; with `diagnostics` also K_mag and F^int_mag per owned node. `last_reactions` are the
+    /// reactions per ghosted dof of the last step on the same node space (empty after a new one).
+    /// Under the generalized-α method the balance holds at t_{n+1−α_f}; the "inertia" is then
+    /// everything in it but the internal and external forces at t_{n+1} (see
+    /// [`Points::nodal_terms`]).
+    pub fn forces(
+        &mut self,
+        step: &Step<D, M>,
+        solution: &Solution,
+        model: &Model<D>,
+        coll: &Collective,
+        diagnostics: bool,
+        last_reactions: &[f64],
+    ) -> Result<StepForces<D>, String> {
+        let space = &mut self.space;
+        let nd = space.layout.nd;
+        let ng = space.ghost.len() * nd;
+        // An explicit step's forces are those of its start (σ_n on x_n, [`super::explicit`]): its
+        // balance is taken there, against the stress before the particle update
+        // (`StepForces::at_start`).
+        let at_start = model.integration.is_explicit();
+        let xl = if at_start { vec![0.0; ng] } else { solution.increments.clone() };
+        let (mut all, mut inertia, mut magnitude) = if at_start {
+            let start = &step.start_terms;
+            (start.all.clone(), start.inertia.clone(), start.magnitude.clone())
+        } else {
+            (vec![0.0; ng], vec![0.0; ng], vec![0.0; ng])
+        };
+        let points = Points::<D, M, N>::new(model, step);
+        if !at_start {
+            points.nodal_terms(&xl, &mut all, &mut inertia, &mut magnitude);
         }
-    }
-    // The held nodes beyond the grid that GIMP supports reach past a wall (this rank's
-    // particles'): they do not move, and their share of the particles' forces is the wall's
-    // reaction, booked on the boundary that holds the wall node next to them.
-    for (w, share) in step.stencils.beyond.iter().zip(walls.chunks_exact(2 * nd)) {
-        let b = step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
-        let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
-        for &(c, dir) in &motion {
-            book_node_forces(&mut local, nb, b, &xr, dir, [0.0, share[c], share[c] - share[nd + c]]);
+        let node_diagnostics = if diagnostics { nodal_diagnostics(space, &points, &xl)? } else { Vec::new() };
+        let walls = points.wall_shares(&xl, at_start);
+        let mut fext = step.fext.clone();
+        let mut fext_old = step.fext_old.clone();
+        for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
+            space.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
+        // An explicit step's inertia is its lumped nodal update's (already summed over ranks).
+        for (i, m) in inertia.iter_mut().zip(&solution.explicit_inertia) {
+            *i += m;
+        }
+        let field_scales = space.field_norms(step, &magnitude, coll)?;
+        let g = &model.grid;
+        let hi = g.extent_max();
+        // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
+        // stress is only defined there).
+        let mut origin: [f64; D] = std::array::from_fn(|d| 0.5 * (g.origin[d] + hi[d]));
+        if model.geometry.axisymmetric() {
+            origin[0] = 0.0;
+        }
+        let nb = model.boundaries.len();
+        // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
+        // boundary (D nb)]
+        let dd = D * D;
+        let mut local = vec![0.0; 4 * dd + 1 + D * nb];
+        let mut reactions = vec![0.0; ng];
+        // (dof component, in-plane direction) of the solid and water motion.
+        let motion: Vec<(usize, usize)> =
+            space.motion().into_iter().map(|c| (c, if c < D { c } else { c - space.layout.w.unwrap_or(0) })).collect();
+        for &a in &space.owned_nodes {
+            let l = a as usize;
+            let p = g.position(space.ghost.indices(l));
+            let u = &xl[l * nd..l * nd + D];
+            let xr: [f64; D] = std::array::from_fn(|d| p[d] + u[d] - origin[d]);
+            for &(c, dir) in &motion {
+                let q = l * nd + c;
+                let b = step.dofs.boundary[q];
+                let reaction = if (b as usize) < nb { all[q] - fext[q] } else { 0.0 };
+                reactions[q] = reaction;
+                let reaction_old = last_reactions.get(q).copied().unwrap_or(reaction);
+                // The first step of a Newmark stage: the force its start is in balance with is
+                // f_n + r_n (r_n = `start_imbalance`, zero where a boundary holds the dof).
+                let start = if (b as usize) < nb { 0.0 } else { step.start_imbalance.get(q).copied().unwrap_or(0.0) };
+                local[4 * dd] +=
+                    0.5 * (fext_old[q] + start + fext[q] + reaction_old + reaction) * solution.increments[q];
+                book_node_forces(&mut local, nb, b as usize, &xr, dir, [fext[q], reaction, inertia[q]]);
+            }
+        }
+        // The held nodes beyond the grid that GIMP supports reach past a wall (this rank's
+        // particles'): they do not move, and their share of the particles' forces is the wall's
+        // reaction, booked on the boundary that holds the wall node next to them.
+        for (w, share) in step.stencils.beyond.iter().zip(walls.chunks_exact(2 * nd)) {
+            let b = step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
+            let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
+            for &(c, dir) in &motion {
+                book_node_forces(&mut local, nb, b, &xr, dir, [0.0, share[c], share[c] - share[nd + c]]);
+            }
+        }
+        let s = coll.sum(&local)?;
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok(StepForces {
+            moment: std::array::from_fn(|a| std::array::from_fn(|b| s[a * D + b])),
+            scale: norm(&s[dd..2 * dd]).max(norm(&s[2 * dd..3 * dd])).max(norm(&s[3 * dd..4 * dd])),
+            origin,
+            reactions: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * b + d])).collect(),
+            reactions_by_dof: reactions,
+            work: s[4 * dd],
+            field_scales,
+            at_start,
+            node_diagnostics,
+        })
     }
-    let s = coll.sum(&local)?;
-    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    Ok(StepForces {
-        moment: std::array::from_fn(|a| std::array::from_fn(|b| s[a * D + b])),
-        scale: norm(&s[dd..2 * dd]).max(norm(&s[2 * dd..3 * dd])).max(norm(&s[3 * dd..4 * dd])),
-        origin,
-        reactions: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * b + d])).collect(),
-        reactions_by_dof: reactions,
-        work: s[4 * dd],
-        field_scales,
-        at_start,
-        node_diagnostics,
-    })
 }
 
 /// K_mag and F^int_mag ([001] Eqs. 25–26) per owned node: the magnitudes of the nodal diagonal of
@@ -184,7 +188,7 @@ fn nodal_diagnostics<const D: usize, const M: usize, const N: usize>(
 }
 
 /// Books one node's forces in direction `dir`, `[external, reaction, inertia]`, at `xr` (its position
-/// about the moments' origin) into [`of_step`]'s local sums: the first moments of the total
+/// about the moments' origin) into [`System::forces`]'s local sums: the first moments of the total
 /// (external + reaction − inertia), external, reaction and inertia forces (D² each, in that order)
 /// and, for a node held by boundary `boundary` < `nb`, that boundary's reaction (after the work).
 fn book_node_forces<const D: usize>(

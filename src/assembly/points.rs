@@ -30,7 +30,7 @@ pub(super) fn particle_input<const D: usize, const M: usize>(
     }
     let nm = &step.scheme;
     let s = &step.smooth[k];
-    input.pred = kernels::Predictors::new(nm, s[0], s[1], s[2], s[3]);
+    input.pred = kernels::Motion::predicted(nm, s[0], s[1], s[2], s[3]);
     input.dt = nm.dt();
     if step.layout.jbar.is_some() {
         // An implicit F̄ step's projection rows weigh as much as the forces (`kernels::fbar`).
@@ -629,7 +629,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
             let mut input = particle_input(ps.model, step, k);
             if smooth {
                 let s = &step.smooth[k];
-                input.pred = kernels::Predictors { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
+                input.pred = kernels::Motion { v_u: s[0], a_u: s[1], v_w: s[2], a_w: s[3] };
             }
             input.body_acc = body_acc_old[ps.model.particles.body[k] as usize];
             // With an implicit F̄ the point at Δd = 0, ϑ = 0 sees r = 1/J̄_n: J̄_n = 1 makes it the
@@ -804,8 +804,8 @@ impl<const D: usize, const M: usize> Step<D, M> {
             // own grid update (the predictors' nodal velocities are those of the raw projection,
             // without the barely filled nodes' shares moved to their masters).
             let v = self.interpolated::<N>(k, &solution.start_velocity);
-            result.interp.v_u = v.du;
-            result.interp.v_w = v.dw;
+            result.interp.motion.v_u = v.du;
+            result.interp.motion.v_w = v.dw;
         }
         if !solution.xpic_correction.is_empty() {
             // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.

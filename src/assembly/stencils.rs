@@ -167,7 +167,7 @@ impl<const D: usize> Stencils<D> {
 
 /// Fraction of a cell's area the material (the union of the particles' domains) must fill for the
 /// cell's centre to give B̄ a volumetric strain of its own; a sparser cell takes that of a
-/// well-filled neighbour (see `shape::volumetric_gradients`).
+/// well-filled neighbour (see `shape::volumetric_operators`).
 pub const CELL_FILLED_FRACTION: f64 = 0.5;
 
 /// For every cell of the ghosted box, the cell whose volumetric strain it takes in B̄.

@@ -5,7 +5,6 @@
 
 use super::callbacks::{Callbacks, Workspace};
 use super::dim::StepDim;
-use super::forces::{self, StepForces};
 use super::pattern::Pattern;
 use super::prepare::StepRequest;
 use super::pressure::{self, L2Projection};
@@ -104,7 +103,7 @@ pub struct System<
     const M: usize = { kernels::MAX_NODES },
     const N: usize = { crate::layout::MAX_DOF },
 > {
-    space: NodeSpace<D>,
+    pub(super) space: NodeSpace<D>,
     x: Vector,
     x_local: Vector,
     f_local: Vector,
@@ -452,21 +451,6 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     /// or the analysis, so the last rate says nothing about the next step).
     pub fn forget_increment(&mut self) {
         self.last_increment = None;
-    }
-
-    /// The forces of the converged `step` ([`forces::of_step`]): reactions, the equilibrium
-    /// identity's moments, the work and, with `diagnostics`, K_mag and F^int_mag per owned node;
-    /// `last_reactions` are the last step's on this system (empty after a new one). Collective.
-    pub fn forces(
-        &mut self,
-        step: &Step<D, M>,
-        solution: &Solution,
-        model: &Model<D>,
-        coll: &Collective,
-        diagnostics: bool,
-        last_reactions: &[f64],
-    ) -> Result<StepForces<D>, String> {
-        forces::of_step::<D, M, N>(&mut self.space, step, solution, model, coll, diagnostics, last_reactions)
     }
 
     /// The pore-pressure increments the points take from the converged step: each point's

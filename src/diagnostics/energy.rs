@@ -73,7 +73,8 @@ pub fn kinetic<const D: usize>(mass: f64, water_mass: f64, v: [f64; D], v_w: [f6
 /// grid (`step.interp`), d = n²γ_w V/k the drag coefficient [J per m].
 pub fn darcy<const D: usize>(drag: f64, dt: f64, step: &StepResult<D>) -> f64 {
     let it = &step.interp;
-    dt * drag * (0..D).map(|d| (it.v_w[d] - it.v_u[d]) * (it.v_w[d] - it.v_u[d])).sum::<f64>()
+    dt * drag
+        * (0..D).map(|d| (it.motion.v_w[d] - it.motion.v_u[d]) * (it.motion.v_w[d] - it.motion.v_u[d])).sum::<f64>()
 }
 
 /// The running energy balance of the dynamic steps of a run (every rank holds its particles'
@@ -142,24 +143,10 @@ mod tests {
             porosity: 0.25,
             mass: 3.0,
             water_mass: 0.5,
-            drag: 0.0,
-            inv_q: 0.0,
-            mobility: 0.0,
-            water_density: 1000.0,
-            grad_p: [0.0; 2],
             stress: crate::soils::plane(stress),
-            def_grad: [[1.0, 0.0], [0.0, 1.0]],
-            eps_pd: 0.0,
             p,
             body_acc: [0.0, -10.0],
-            grad_n: [0.0; 2],
-            pred: Default::default(),
-            linear: false,
-            fbar: 1.0,
-            fbar_total: 1.0,
-            dt: 0.0,
-            jbar: 1.0,
-            fbar_rows: 0.0,
+            ..ParticleInput::at_rest()
         }
     }
 
@@ -212,7 +199,10 @@ mod tests {
         let b = l.balance(&l.local, 4.0);
         assert!((b.error - 1.2 / 12.0).abs() < 1e-12, "{b:?}");
         assert_eq!(Ledger::default().balance(&[0.0; 5], 0.0).error, 0.0);
-        let it = Interp { v_u: [1.0, 0.0], v_w: [3.0, 0.0], ..Interp::default() };
+        let it = Interp {
+            motion: crate::kernels::Motion { v_u: [1.0, 0.0], v_w: [3.0, 0.0], ..Default::default() },
+            ..Interp::default()
+        };
         let step = StepResult {
             interp: it,
             stress: [0.0; crate::soils::NS],

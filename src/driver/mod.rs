@@ -18,6 +18,20 @@
 //! step control and recorders' states from the checkpoint ([`crate::state`]) and continues in that
 //! stage.
 
+/// The run between steps ([`Moment::between`]) of a `Simulation`, borrowing only the fields it
+/// reads, so that the recorders can be borrowed mutably beside it.
+macro_rules! moment_between {
+    ($sim:expr) => {
+        crate::recorders::Moment::between(
+            &$sim.model,
+            $sim.coll,
+            $sim.system.space().owners(),
+            ($sim.t, $sim.step),
+            &$sim.nodes,
+        )
+    };
+}
+
 mod balance;
 mod control;
 mod journal;
@@ -408,8 +422,7 @@ where
 
     /// The recorders at a milestone: the run's start, a stage's end, an early stop, an interrupt.
     fn milestone(&mut self) -> Result<(), RunError> {
-        let at =
-            Moment::between(&self.model, self.coll, self.system.space().owners(), (self.t, self.step), &self.nodes);
+        let at = moment_between!(self);
         let recorded = self.journal.with_sink(|sink: &mut Sink| {
             for r in self.recorders.iter_mut() {
                 r.milestone(&at, sink)?;
@@ -428,8 +441,7 @@ where
             self.journal.summary.solver = "none (explicit steps only)".into();
         }
         let _stage = self.system.phase(crate::assembly::Phase::Output).map_err(failed)?;
-        let at =
-            Moment::between(&self.model, self.coll, self.system.space().owners(), (self.t, self.step), &self.nodes);
+        let at = moment_between!(self);
         let mut figures = Vec::new();
         let recorded = self.journal.with_sink(|sink: &mut Sink| {
             let mut first_error = Ok(());

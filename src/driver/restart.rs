@@ -91,13 +91,7 @@ where
         let t0 = Instant::now();
         let local = state::records_of(&self.model.particles);
         let slab = self.coll.sorted_slab(&local, state::record_len(D));
-        let at = super::Moment::between(
-            &self.model,
-            self.coll,
-            self.system.space().owners(),
-            (self.t, self.step),
-            &self.nodes,
-        );
+        let at = moment_between!(self);
         let mut recorders = Vec::new();
         for r in &self.recorders {
             if let Some(s) = r.state(&at).map_err(RunError::Failed)? {
@@ -179,13 +173,7 @@ where
 
     /// Every recorder's state from `cp`; what one could not restore, if anything.
     fn restore_recorders(&mut self, cp: &Checkpoint) -> Result<Option<String>, String> {
-        let at = super::Moment::between(
-            &self.model,
-            self.coll,
-            self.system.space().owners(),
-            (self.t, self.step),
-            &self.nodes,
-        );
+        let at = moment_between!(self);
         let mut notes = Vec::new();
         for r in self.recorders.iter_mut() {
             let state = cp.recorders.iter().find(|(name, _)| name == r.name()).map(|(_, s)| &s[..]);

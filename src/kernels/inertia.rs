@@ -14,9 +14,9 @@ pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, o
     let (wm, wf) = (nm.w_inertia, nm.w_force);
     for (k, b) in pt.basis.iter().enumerate() {
         for c in 0..D {
-            out[k * nd + c] += b.s * part.mass * (wm * it.a_u[c] - wf * part.body_acc[c]);
+            out[k * nd + c] += b.s * part.mass * (wm * it.motion.a_u[c] - wf * part.body_acc[c]);
             if let Some(w) = pt.layout.w {
-                out[k * nd + w + c] += b.s * part.water_mass * (wm * it.a_w[c] - wf * part.body_acc[c]);
+                out[k * nd + w + c] += b.s * part.water_mass * (wm * it.motion.a_w[c] - wf * part.body_acc[c]);
             }
         }
     }
@@ -55,7 +55,7 @@ pub mod drag {
         let (nd, it) = (pt.layout.nd, &pt.interp);
         for (k, b) in pt.basis.iter().enumerate() {
             for c in 0..D {
-                let f = nm.w_force * b.s * pt.part.drag * (it.v_u[c] - it.v_w[c]);
+                let f = nm.w_force * b.s * pt.part.drag * (it.motion.v_u[c] - it.motion.v_w[c]);
                 out[k * nd + c] += f;
                 out[k * nd + w + c] -= f;
             }

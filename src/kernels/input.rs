@@ -1,6 +1,6 @@
 //! What a kernel knows of one material point at the start of a step ([`ParticleInput`]).
 
-use super::Predictors;
+use super::Motion;
 use crate::algebra::det;
 use crate::model::{fbar, Model};
 use crate::soils::Stress;
@@ -41,7 +41,7 @@ pub struct ParticleInput<const D: usize = 2> {
     /// Porosity gradient ∇n at t_n [1/m] (two-phase).
     pub grad_n: [f64; D],
     /// Newmark predictors of the point.
-    pub pred: Predictors<D>,
+    pub pred: Motion<D>,
     /// A geometrically linear step (`analysis.kinematics = "linear_increments"`, [001] Eqs. 5, 7,
     /// 11): see [`kinematics`].
     pub linear: bool,
@@ -61,6 +61,38 @@ pub struct ParticleInput<const D: usize = 2> {
     pub jbar: f64,
     /// The scale κ [Pa/m] of an implicit F̄ step's projection rows ([`fbar`]; 0 otherwise).
     pub fbar_rows: f64,
+}
+
+#[cfg(test)]
+impl<const D: usize> ParticleInput<D> {
+    /// A point of unit volume and mass at rest: dry, unstressed, undeformed, without body force,
+    /// for tests to fill in what they need.
+    pub fn at_rest() -> ParticleInput<D> {
+        ParticleInput {
+            volume: 1.0,
+            porosity: 0.0,
+            mass: 1.0,
+            water_mass: 0.0,
+            drag: 0.0,
+            inv_q: 0.0,
+            mobility: 0.0,
+            water_density: 1000.0,
+            grad_p: [0.0; D],
+            stress: [0.0; crate::soils::NS],
+            def_grad: crate::algebra::identity(),
+            eps_pd: 0.0,
+            p: 0.0,
+            body_acc: [0.0; D],
+            grad_n: [0.0; D],
+            pred: Motion::default(),
+            linear: false,
+            fbar: 1.0,
+            fbar_total: 1.0,
+            dt: 0.0,
+            jbar: 1.0,
+            fbar_rows: 0.0,
+        }
+    }
 }
 
 impl<const D: usize> ParticleInput<D> {

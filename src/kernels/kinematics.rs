@@ -159,22 +159,22 @@ impl<const D: usize> Kinematics<D> {
         };
         let d = trace(&h, 0.0) + minors + det(&h);
         let dj = d + ht + d * ht;
+        let gradients = Kinematics {
+            f,
+            j: det(&f) * (1.0 + ht),
+            dj,
+            fv,
+            jv: det(&fv) * (1.0 + hvt),
+            f_hoop: 1.0 + ht,
+            fv_hoop: 1.0 + hvt,
+            linear,
+            ..Kinematics::rest()
+        };
         if linear {
             let tr = trace(&h, ht);
             let trv = trace(&hv, hvt);
             let vol = (trv - tr) / 3.0;
-            return Kinematics {
-                f,
-                j: det(&f) * (1.0 + ht),
-                dj,
-                fv,
-                jv: det(&fv) * (1.0 + hvt),
-                f_hoop: 1.0 + ht,
-                fv_hoop: 1.0 + hvt,
-                deps: strain_of(&h, ht, vol),
-                linear,
-                ..Kinematics::rest()
-            };
+            return Kinematics { deps: strain_of(&h, ht, vol), ..gradients };
         }
         let (fh_inv, fvh_inv) = (inverse(&plus_identity(&h, 0.5)), inverse(&plus_identity(&hv, 0.5)));
         let l = mul(&h, &fh_inv);
@@ -194,13 +194,6 @@ impl<const D: usize> Kinematics<D> {
             (identity(), identity())
         };
         Kinematics {
-            f,
-            j: det(&f) * (1.0 + ht),
-            dj,
-            fv,
-            jv: det(&fv) * (1.0 + hvt),
-            f_hoop: 1.0 + ht,
-            fv_hoop: 1.0 + hvt,
             f_inv: inverse(&f),
             fv_inv: inverse(&fv),
             fh_inv,
@@ -212,8 +205,7 @@ impl<const D: usize> Kinematics<D> {
             theta: if D == 2 { 2.0 * (0.5 * omega).atan() } else { 0.0 },
             half_spin_inv,
             rotation,
-            linear,
-            projected: None,
+            ..gradients
         }
     }
 

@@ -10,7 +10,7 @@
 //!   a = a₀ Σ S_i Δd_i + ã_n,  v = a₁ Σ S_i Δd_i + ṽ_n,   a₀ = 1/(βΔt²), a₁ = γ/(βΔt),
 //! with predictors ã_n = −v_n/(βΔt) − (1/(2β) − 1) a_n and ṽ_n = −(γ/β − 1) v_n − (γ/(2β) − 1)Δt a_n
 //! of the nodal v_n, a_n of [003] Eq. 19, interpolated to the point (the caller passes them as
-//! [`Predictors`]).
+//! a [`Motion`], [`Motion::predicted`]).
 //!
 //! The residual of a particle is a sum of terms, each in its own module with its exact tangent and
 //! its own finite-difference test:
@@ -172,33 +172,34 @@ impl<const N: usize> NodeState<N> {
     }
 }
 
-/// Newmark predictors at a material point: the acceleration and velocity at t_{n+1} for a zero
-/// displacement increment.
+/// The accelerations and velocities of the solid and the water at a material point: its Newmark
+/// predictors (those at t_{n+1} for a zero displacement increment, [`Motion::predicted`]), or its
+/// motion at t_{n+1} ([`Interp::motion`]).
 #[derive(Debug, Clone, Copy)]
-pub struct Predictors<const D: usize = 2> {
-    /// ã_n of the solid [m/s²].
+pub struct Motion<const D: usize = 2> {
+    /// Acceleration of the solid [m/s²].
     pub a_u: [f64; D],
-    /// ṽ_n of the solid [m/s].
+    /// Velocity of the solid [m/s].
     pub v_u: [f64; D],
-    /// ã_n of the water [m/s²] (two-phase).
+    /// Acceleration of the water [m/s²] (two-phase).
     pub a_w: [f64; D],
-    /// ṽ_n of the water [m/s] (two-phase).
+    /// Velocity of the water [m/s] (two-phase).
     pub v_w: [f64; D],
 }
 
-impl<const D: usize> Default for Predictors<D> {
+impl<const D: usize> Default for Motion<D> {
     fn default() -> Self {
-        Predictors { a_u: [0.0; D], v_u: [0.0; D], a_w: [0.0; D], v_w: [0.0; D] }
+        Motion { a_u: [0.0; D], v_u: [0.0; D], a_w: [0.0; D], v_w: [0.0; D] }
     }
 }
 
-impl<const D: usize> Predictors<D> {
-    /// The predictors for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and accelerations
-    /// at t_n (the nodal values interpolated to the point).
-    pub fn new(nm: &Scheme, v_u: [f64; D], a_u: [f64; D], v_w: [f64; D], a_w: [f64; D]) -> Predictors<D> {
+impl<const D: usize> Motion<D> {
+    /// The predictors ã_n, ṽ_n for solid (`v_u`, `a_u`) and water (`v_w`, `a_w`) velocities and
+    /// accelerations at t_n (the nodal values interpolated to the point).
+    pub fn predicted(nm: &Scheme, v_u: [f64; D], a_u: [f64; D], v_w: [f64; D], a_w: [f64; D]) -> Motion<D> {
         let (pa_u, pv_u) = nm.predict(v_u, a_u);
         let (pa_w, pv_w) = nm.predict(v_w, a_w);
-        Predictors { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
+        Motion { a_u: pa_u, v_u: pv_u, a_w: pa_w, v_w: pv_w }
     }
 }
 
@@ -254,32 +255,14 @@ pub struct Interp<const D: usize = 2> {
     pub grad_dp: [f64; D],
     /// The projected volume ratio's excess at t_{n+1}, J̄_{n+1} − 1 = Σ S ϑ (implicit F̄ steps).
     pub jbar: f64,
-    /// Solid acceleration at t_{n+1}.
-    pub a_u: [f64; D],
-    /// Water acceleration at t_{n+1}.
-    pub a_w: [f64; D],
-    /// Solid velocity at t_{n+1}.
-    pub v_u: [f64; D],
-    /// Water velocity at t_{n+1}.
-    pub v_w: [f64; D],
+    /// The accelerations and velocities at t_{n+1}.
+    pub motion: Motion<D>,
 }
 
 impl<const D: usize> Default for Interp<D> {
     fn default() -> Self {
         let z = [0.0; D];
-        Interp {
-            du: z,
-            dw: z,
-            dp: 0.0,
-            dvol_u: 0.0,
-            dvol_w: 0.0,
-            grad_dp: z,
-            jbar: 0.0,
-            a_u: z,
-            a_w: z,
-            v_u: z,
-            v_w: z,
-        }
+        Interp { du: z, dw: z, dp: 0.0, dvol_u: 0.0, dvol_w: 0.0, grad_dp: z, jbar: 0.0, motion: Motion::default() }
     }
 }
 
@@ -287,19 +270,21 @@ impl<const D: usize> Default for Interp<D> {
 pub fn interpolate<const D: usize, const N: usize>(
     basis: &[NodeBasis<D>],
     states: &[NodeState<N>],
-    pred: &Predictors<D>,
+    pred: &Motion<D>,
     layout: Layout,
 ) -> Interp<D> {
-    let mut k = Interp { a_u: pred.a_u, v_u: pred.v_u, ..Interp::default() };
+    let mut k = Interp::default();
+    k.motion.a_u = pred.a_u;
+    k.motion.v_u = pred.v_u;
     if layout.w.is_some() {
-        k.a_w = pred.a_w;
-        k.v_w = pred.v_w;
+        k.motion.a_w = pred.a_w;
+        k.motion.v_w = pred.v_w;
     }
     for (b, st) in basis.iter().zip(states) {
         k.dvol_u += b.tv * st.d[0];
         for c in 0..D {
-            k.a_u[c] += b.s * st.a[c];
-            k.v_u[c] += b.s * st.v[c];
+            k.motion.a_u[c] += b.s * st.a[c];
+            k.motion.v_u[c] += b.s * st.v[c];
             k.du[c] += b.s * st.d[c];
             k.dvol_u += b.gv[c] * st.d[c];
         }
@@ -316,8 +301,8 @@ pub fn interpolate<const D: usize, const N: usize>(
             k.dvol_w += b.tv * st.d[w];
             for c in 0..D {
                 k.dvol_w += b.gv[c] * st.d[w + c];
-                k.a_w[c] += b.s * st.a[w + c];
-                k.v_w[c] += b.s * st.v[w + c];
+                k.motion.a_w[c] += b.s * st.a[w + c];
+                k.motion.v_w[c] += b.s * st.v[w + c];
                 k.dw[c] += b.s * st.d[w + c];
             }
         }

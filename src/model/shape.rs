@@ -521,19 +521,7 @@ pub fn face_weights_in<const D: usize, const M: usize>(basis: Basis, grid: &Grid
 /// it, and nearly incompressible bodies showed alternating pressure spikes along curved free
 /// surfaces). Standard MPM (`Linear`) uses the one cell holding the particle. Nodes of a root cell
 /// that are not in `st` are appended to it with zero weight and gradient. Returns the gradients in
-/// the order of `st.nodes`.
-pub fn volumetric_gradients(
-    basis: Basis,
-    grid: &Grid,
-    x: [f64; 2],
-    lp: [f64; 2],
-    st: &mut Stencil,
-    root: &dyn Fn(usize, usize) -> (usize, usize),
-) -> [[f64; 2]; MAX_STENCIL] {
-    volumetric_operators(basis, grid, x, lp, st, root, false).0
-}
-
-/// [`volumetric_gradients`] with, in axial symmetry (`hoop`), the volumetric hoop operator of
+/// the order of `st.nodes` and, in axial symmetry (`hoop`), the volumetric hoop operator of
 /// each node: the cell-centre values N_i(x_c)/r_c = 1/(4 r_c) of the same cells with the same
 /// weights, so that B̄'s volumetric strain ∇̄·u + ū_r/r is the cell-centre one of the whole
 /// divergence (zero without `hoop`).

@@ -158,13 +158,8 @@ pub(super) fn part() -> ParticleInput {
         p: 500.0,
         body_acc: [0.0, -9.81],
         grad_n: [0.7, -1.3],
-        pred: Predictors { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
-        linear: false,
-        fbar: 1.0,
-        fbar_total: 1.0,
-        dt: 0.0,
-        jbar: 1.0,
-        fbar_rows: 0.0,
+        pred: Motion { a_u: [0.3, -0.2], v_u: [0.01, 0.02], a_w: [-0.1, 0.4], v_w: [0.03, -0.01] },
+        ..ParticleInput::at_rest()
     }
 }
 
@@ -610,14 +605,14 @@ fn newmark_reproduces_a_uniformly_accelerated_motion() {
     for (beta, gamma) in [(0.25, 0.5), (0.3025, 0.6)] {
         let (dt, v, a) = (2e-3, [0.4, -1.1], [3.0, -9.81]);
         let nm = Scheme::newmark(beta, gamma, dt);
-        let pred = Predictors::new(&nm, v, a, v, a);
+        let pred = Motion::predicted(&nm, v, a, v, a);
         let d = [v[0] * dt + 0.5 * a[0] * dt * dt, v[1] * dt + 0.5 * a[1] * dt * dt];
         let basis = [NodeBasis { s: 1.0, ..NodeBasis::default() }];
         let st = states(&[d[0], d[1], 0.0, d[0], d[1]], 5, &nm);
         let k = interpolate(&basis, &st, &pred, Layout::UPU);
         for c in 0..2 {
-            assert!((k.a_u[c] - a[c]).abs() < 1e-9 && (k.a_w[c] - a[c]).abs() < 1e-9, "{k:?}");
-            assert!((k.v_u[c] - (v[c] + a[c] * dt)).abs() < 1e-12, "{k:?}");
+            assert!((k.motion.a_u[c] - a[c]).abs() < 1e-9 && (k.motion.a_w[c] - a[c]).abs() < 1e-9, "{k:?}");
+            assert!((k.motion.v_u[c] - (v[c] + a[c] * dt)).abs() < 1e-12, "{k:?}");
         }
     }
 }
@@ -635,7 +630,7 @@ fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
     p.stress = [0.0; soils::NS];
     p.p = 0.0;
     p.grad_n = [0.0; 2];
-    p.pred = Predictors::default();
+    p.pred = Motion::default();
     let st = vec![NodeState::<MAX_DOF>::default(); 4];
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
     let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::UPU);

@@ -47,7 +47,7 @@ mod samples {
             def_grad: [[1.02, 0.01, -0.02], [-0.03, 0.97, 0.015], [0.01, -0.02, 1.01]],
             body_acc: [0.0, 0.0, -9.81],
             grad_n: [0.7, -1.3, 0.4],
-            pred: Predictors {
+            pred: Motion {
                 a_u: [0.3, -0.2, 0.1],
                 v_u: [0.01, 0.02, -0.015],
                 a_w: [-0.1, 0.4, 0.2],
@@ -77,7 +77,7 @@ mod samples {
             p: p.p,
             body_acc: v(p.body_acc),
             grad_n: v(p.grad_n),
-            pred: Predictors { a_u: v(p.pred.a_u), v_u: v(p.pred.v_u), a_w: v(p.pred.a_w), v_w: v(p.pred.v_w) },
+            pred: Motion { a_u: v(p.pred.a_u), v_u: v(p.pred.v_u), a_w: v(p.pred.a_w), v_w: v(p.pred.v_w) },
             linear: p.linear,
             fbar: p.fbar,
             fbar_total: p.fbar_total,

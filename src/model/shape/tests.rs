@@ -217,7 +217,7 @@ fn volumetric_gradients_average_the_cell_centre_divergence() {
         (Basis::Linear, [1.3, 0.6], [0.0, 0.0]),
     ] {
         let mut st = stencil(basis, &g, x, lp);
-        let gv = volumetric_gradients(basis, &g, x, lp, &mut st, &|i, j| (i, j));
+        let gv = volumetric_operators(basis, &g, x, lp, &mut st, &|i, j| (i, j), false).0;
         // Σ ∇̄S_i = 0 and Σ ∇̄S_i ⊗ x_i = I: a linear displacement field gives its exact divergence.
         let sum: [f64; 2] = (0..st.len).fold([0.0; 2], |a, k| [a[0] + gv[k][0], a[1] + gv[k][1]]);
         assert!(sum[0].abs() < 1e-12 && sum[1].abs() < 1e-12, "{basis:?} {sum:?}");
@@ -237,7 +237,7 @@ fn volumetric_gradients_average_the_cell_centre_divergence() {
     }
     // A domain inside one cell takes that cell's centre gradients: ±1/(2h).
     let mut st = stencil(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625]);
-    let gv = volumetric_gradients(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &mut st, &|i, j| (i, j));
+    let gv = volumetric_operators(Basis::Gimp, &g, [1.25, 0.625], [0.125, 0.0625], &mut st, &|i, j| (i, j), false).0;
     let k = st.nodes[..st.len].iter().position(|&n| n == [2, 2]).unwrap();
     assert!((gv[k][0] + 1.0).abs() < 1e-12 && (gv[k][1] + 2.0).abs() < 1e-12, "{:?}", gv[k]);
 }
