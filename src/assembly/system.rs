@@ -141,9 +141,9 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     /// Creates the node space for the grid and dof layout on the run's communicator, and the SNES
     /// with porompm's defaults, then lets the PETSc options database override them. Defaults:
     /// Newton with full steps, relative residual tolerance 1e-6 as in [003] Algorithm 1; sparse LU
-    /// by UMFPACK on one rank (the fastest of the measured strategies on the verification cases,
-    /// see docs/solvers.md) up to [`super::UMFPACK_MAX_GRID_DOFS`], and by MUMPS beyond and on
-    /// several ranks (UMFPACK is sequential).
+    /// by UMFPACK (the fastest of the measured strategies on the verification cases, see
+    /// docs/solvers.md) up to [`super::UMFPACK_MAX_GRID_DOFS`], on several ranks each rank on its
+    /// own copy of the matrix, and by MUMPS beyond ([`super::default_factor`]).
     ///
     /// `partition` distributes the nodes over the ranks (None: PETSc's even split); see
     /// [`crate::distribution::balanced`]. The Newton iterations allowed per step are
@@ -169,9 +169,20 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             let mut ksp = snes.ksp()?;
             ksp.set_type("preonly")?;
             let mut pc = ksp.pc()?;
-            pc.set_type("lu")?;
-            let grid_dofs = grid.node_count() * layout.nd;
-            pc.set_factor_solver_type(super::default_factor_package(comm, grid_dofs))?;
+            match super::default_factor(comm, grid.node_count() * layout.nd) {
+                super::DefaultFactor::Lu(package) => {
+                    pc.set_type("lu")?;
+                    pc.set_factor_solver_type(package)?;
+                }
+                super::DefaultFactor::Redundant(package) => {
+                    pc.set_type("redundant")?;
+                    let mut own = pc.redundant_ksp()?;
+                    own.set_type("preonly")?;
+                    let mut own_pc = own.pc()?;
+                    own_pc.set_type("lu")?;
+                    own_pc.set_factor_solver_type(package)?;
+                }
+            }
         }
         snes.set_from_options()?;
         let positions = space.owned_positions(grid);
@@ -493,12 +504,23 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         let lag = self.snes.lag_jacobian()?;
         let mut ksp = self.snes.ksp()?;
         let ksp_type = ksp.type_name()?;
-        let pc = ksp.pc()?;
+        let mut pc = ksp.pc()?;
         let pc_type = pc.type_name()?;
-        let factor = if pc_type == "lu" || pc_type == "cholesky" {
-            pc.factor_solver_type()?.map(|s| format!(" ({s})")).unwrap_or_default()
+        let factor_of = |pc: &petsc::PcRef| -> Result<String, Error> {
+            let pc_type = pc.type_name()?;
+            Ok(if pc_type == "lu" || pc_type == "cholesky" {
+                pc.factor_solver_type()?.map(|s| format!(" ({s})")).unwrap_or_default()
+            } else {
+                String::new()
+            })
+        };
+        let factor = if pc_type == "redundant" {
+            let mut own = pc.redundant_ksp()?;
+            let own_type = own.type_name()?;
+            let own_pc = own.pc()?;
+            format!(" of {own_type} {}{}", own_pc.type_name()?, factor_of(&own_pc)?)
         } else {
-            String::new()
+            factor_of(&pc)?
         };
         let newton = if lag > 1 || lag == -1 || lag == -2 { "modified Newton (lagged Jacobian)" } else { "Newton" };
         Ok((format!("{snes_type} {newton}; KSP {ksp_type}; PC {pc_type}{factor}"), ksp_type != "preonly"))

@@ -168,6 +168,15 @@ impl PcRef<'_> {
         call!(PCFactorSetMatSolverType(self.raw, c.as_ptr()))
     }
 
+    /// For a redundant preconditioner (`"redundant"`): the solver each rank runs on its own copy
+    /// of the whole system (options prefix `-redundant_`; preonly with LU unless set), created
+    /// here if it is not yet (`PCRedundantGetKSP`; collective).
+    pub fn redundant_ksp(&mut self) -> Result<KspRef<'_>> {
+        let mut raw: sys::KSP = std::ptr::null_mut();
+        call!(PCRedundantGetKSP(self.raw, &mut raw))?;
+        Ok(KspRef::new(raw))
+    }
+
     /// For a field split: defines the split `name` (options prefix `-fieldsplit_<name>_`) as the
     /// rows of `is`. Splits are added in call order.
     pub fn field_split_set_is(&mut self, name: &str, is: &crate::IndexSet) -> Result<()> {
