@@ -8,6 +8,7 @@
 //! `materials.model`.
 
 pub mod ids;
+mod names;
 pub mod overrides;
 pub mod parameters;
 pub mod schema;

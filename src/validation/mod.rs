@@ -63,7 +63,7 @@ fn resolve(file: &CaseFile) -> Result<Links, String> {
         body_materials: names.body_materials()?,
         boundaries: names.boundaries()?,
         loads: names.loads()?,
-        verification: file.verification.as_ref().map(|v| verification::link(v, &names)).transpose()?,
+        verification: file.verification.as_ref().map(|v| verification::link(v, file)).transpose()?,
     };
     names.check_stages()?;
     Ok(links)

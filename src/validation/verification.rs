@@ -1,18 +1,17 @@
 //! The verification: the names it gives resolved ([`link`]), and what its reference needs of the
 //! bodies, loads, boundaries and stages it names and of the analysis ([`check`]).
 
-use super::names::Names;
 use crate::case::{
-    BearingCapacity, BodyAndLoad, BodyId, Case, DamBreakIds, ElasticColumnIds, FootingIds, Formulation, Geometry,
-    LinkedVerification, Load, LoadId, Loading, PatchIds, RunoutIds, Shape, SoilModel, Verification,
+    BearingCapacity, BodyAndLoad, BodyId, Case, CaseFile, DamBreakIds, ElasticColumnIds, FootingIds, Formulation,
+    Geometry, LinkedVerification, Load, LoadId, Loading, PatchIds, RunoutIds, Shape, SoilModel, Verification,
 };
 use crate::check::{components, Checked};
 
 /// The verification with the ids of what it names, after its own ranges.
-pub(super) fn link(v: &Verification, names: &Names) -> Result<LinkedVerification, String> {
+pub(super) fn link(v: &Verification, file: &CaseFile) -> Result<LinkedVerification, String> {
     v.check("verification")?;
-    let body = |name: &str| names.body("verification.body", name);
-    let load = |name: &str| names.load("verification.load", name);
+    let body = |name: &str| file.body_named("verification.body", name);
+    let load = |name: &str| file.load_named("verification.load", name);
     let column = |b: &str, l: &str| Ok::<_, String>(BodyAndLoad { body: body(b)?, load: load(l)? });
     Ok(match v {
         Verification::Terzaghi(t) => LinkedVerification::Terzaghi(t.clone(), column(&t.body, &t.load)?),
@@ -26,15 +25,15 @@ pub(super) fn link(v: &Verification, names: &Names) -> Result<LinkedVerification
         Verification::ElasticColumn(e) => {
             let ids = ElasticColumnIds {
                 body: body(&e.body)?,
-                gravity: names.load("verification.gravity", &e.gravity)?,
-                surcharge: e.surcharge.as_ref().map(|s| names.load("verification.surcharge", s)).transpose()?,
+                gravity: file.load_named("verification.gravity", &e.gravity)?,
+                surcharge: e.surcharge.as_ref().map(|s| file.load_named("verification.surcharge", s)).transpose()?,
             };
             LinkedVerification::ElasticColumn(e.clone(), ids)
         }
         Verification::BearingCapacity(b) => {
-            let soil = names.body("verification.soil", &b.soil)?;
+            let soil = file.body_named("verification.soil", &b.soil)?;
             let loading = match (&b.load, &b.footing) {
-                (None, Some(f)) => Loading::Footing(names.boundary("verification.footing", f)?),
+                (None, Some(f)) => Loading::Footing(file.boundary_named("verification.footing", f)?),
                 (Some(l), None) => Loading::Load(load(l)?),
                 _ => return Err(BearingCapacity::loading_refused("verification")),
             };
@@ -42,7 +41,7 @@ pub(super) fn link(v: &Verification, names: &Names) -> Result<LinkedVerification
         }
         Verification::Patch(p) => {
             let ids =
-                PatchIds { body: body(&p.body)?, boundary: names.boundary("verification.boundary", &p.boundary)? };
+                PatchIds { body: body(&p.body)?, boundary: file.boundary_named("verification.boundary", &p.boundary)? };
             LinkedVerification::Patch(p.clone(), ids)
         }
         Verification::StiffnessMap(s) => LinkedVerification::StiffnessMap(s.clone(), body(&s.body)?),
@@ -51,15 +50,15 @@ pub(super) fn link(v: &Verification, names: &Names) -> Result<LinkedVerification
         Verification::DamBreak(d) => {
             let ids = DamBreakIds {
                 body: body(&d.body)?,
-                gravity: names.load("verification.gravity", &d.gravity)?,
-                settle_stage: names.stage("verification.settle_stage", &d.settle_stage)?,
+                gravity: file.load_named("verification.gravity", &d.gravity)?,
+                settle_stage: file.stage_named("verification.settle_stage", &d.settle_stage)?,
             };
             LinkedVerification::DamBreak(d.clone(), ids)
         }
         Verification::Runout(r) => {
             let ids = RunoutIds {
                 body: body(&r.body)?,
-                trigger_stage: names.stage("verification.trigger_stage", &r.trigger_stage)?,
+                trigger_stage: file.stage_named("verification.trigger_stage", &r.trigger_stage)?,
             };
             LinkedVerification::Runout(r.clone(), ids)
         }
