@@ -69,8 +69,7 @@ pub fn describe(case: &Case, label: &str) -> String {
     for w in crate::diagnostics::physics::warnings(case, &model) {
         let _ = writeln!(s, "warning [{}]: {}", w.kind, w.message);
     }
-    let verification = case.verification.as_ref().map_or("none".to_string(), |v| v.describe());
-    let _ = writeln!(s, "verification: {verification}");
+    let _ = writeln!(s, "verification: {}", crate::verification::describe(case));
     s
 }
 

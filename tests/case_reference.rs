@@ -2,7 +2,9 @@
 //! case schema's doc comments rendered: its JSON Schema (`schemars`, which reads the doc comments
 //! and follows the serde attributes: tags, defaults, optional keys) turned into tables of key,
 //! type, default and meaning, in the order the keys are declared in src/case/schema/ and, for the
-//! soil models' parameters, src/soils/.
+//! soil models' parameters, src/soils/. The case file keeps `[verification]` untyped; its kinds
+//! and keys are the schema of the checks' registry (`porompm::verification::Verification`, the
+//! parameters declared in src/verification/), put in its place ([`schema`]).
 //!
 //! The test fails, naming the first line that differs, when the file is not what the schema says;
 //! `PORO_DOC_REFRESH=1 cargo test --release --test case_reference` rewrites it.
@@ -15,8 +17,8 @@ const REFERENCE: &str = "docs/case_reference.md";
 
 const HEADER: &str = "# Case file reference
 
-<!-- Generated from the doc comments of src/case/schema/ and src/soils/ by tests/case_reference.rs;
-do not edit by hand. After changing the schema, rewrite it with
+<!-- Generated from the doc comments of src/case/schema/, src/soils/ and src/verification/ by
+tests/case_reference.rs; do not edit by hand. After changing the schema, rewrite it with
 `PORO_DOC_REFRESH=1 cargo test --release --test case_reference`. -->
 
 A case is a TOML file with the tables below (`cases/` holds examples). Units are SI: m, s, kg, Pa,
@@ -33,7 +35,7 @@ the feature is off, or the text says what happens without it). Where a table is 
 
 #[test]
 fn the_case_reference_is_the_schema_s_doc_comments() {
-    let schema = serde_json::to_value(schemars::schema_for!(porompm::case::CaseFile)).unwrap();
+    let schema = schema();
     let text = Reference::new(&schema).render();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
     if std::env::var_os("PORO_DOC_REFRESH").is_some() {
@@ -59,7 +61,7 @@ fn the_case_reference_is_the_schema_s_doc_comments() {
 /// lists is a key of the schema: the rendering drops nothing.
 #[test]
 fn the_reference_shows_every_table_and_key() {
-    let schema = serde_json::to_value(schemars::schema_for!(porompm::case::CaseFile)).unwrap();
+    let schema = schema();
     let text = Reference::new(&schema).render();
     for (name, def) in schema["$defs"].as_object().unwrap() {
         for key in def["properties"].as_object().into_iter().flat_map(|p| p.keys()) {
@@ -78,7 +80,7 @@ fn the_reference_shows_every_table_and_key() {
 /// count), in the doc comment the reference shows.
 #[test]
 fn every_number_has_its_unit() {
-    let schema = serde_json::to_value(schemars::schema_for!(porompm::case::CaseFile)).unwrap();
+    let schema = schema();
     let mut tables: Vec<(String, &Value)> = vec![("the top level".into(), &schema)];
     for (name, def) in schema["$defs"].as_object().unwrap() {
         tables.push((name.clone(), def));
@@ -93,6 +95,29 @@ fn every_number_has_its_unit() {
             }
         }
     }
+}
+
+/// The case file's JSON Schema with the schema of the checks' registry, every kind with its keys,
+/// as the definition `Verification` in place of the untyped table `[verification]` the case file
+/// keeps (`VerificationTable`, whose schema takes that name). The registry's own definitions (the
+/// tables its kinds name) join the case file's, whose names they must not take.
+fn schema() -> Value {
+    let mut root = serde_json::to_value(schemars::schema_for!(porompm::case::CaseFile)).unwrap();
+    let mut checks = serde_json::to_value(schemars::schema_for!(porompm::verification::Verification)).unwrap();
+    let checks_table = checks.as_object_mut().unwrap();
+    let named = checks_table.remove("$defs").unwrap_or_default();
+    checks_table.remove("$schema");
+    checks_table.remove("title");
+    let defs = root["$defs"].as_object_mut().unwrap();
+    assert!(defs.contains_key("Verification"), "the case file's schema has no `Verification` table to replace");
+    for (name, def) in named.as_object().into_iter().flatten() {
+        assert!(
+            defs.insert(name.clone(), def.clone()).is_none(),
+            "the table `{name}` is the case file's and a check's"
+        );
+    }
+    defs.insert("Verification".into(), checks);
+    root
 }
 
 /// The tags of the tagged tables (`type = "mohr_coulomb"`, `kind = "terzaghi"`, ...).
@@ -149,7 +174,7 @@ impl<'a> Reference<'a> {
     /// The whole file: the top level, then every table after the one that first names it.
     fn walk(&mut self) -> String {
         let mut out = String::from(HEADER);
-        let root = serde_json::to_value(schemars::schema_for!(porompm::case::CaseFile)).unwrap();
+        let root = schema();
         out += "\n<a id=\"top-level\"></a>\n\n## The top level\n\n";
         out += &self.table(&root, "CaseFile", "");
         let mut i = 0;
@@ -360,17 +385,18 @@ fn prose(doc: &str) -> String {
     out + rest
 }
 
-/// The declaration order of each struct's fields in src/case/schema/ and src/soils/ (the soil
-/// models' parameters), and the struct of each tagged variant (`SoilModel::mohr_coulomb` →
-/// `MohrCoulomb`, from the enum's declaration or the lines `Variant(module::Type) = "tag",` of the
-/// registry `soil_models!`). A newtype
+/// The declaration order of each struct's fields in src/case/schema/, src/soils/ (the soil
+/// models' parameters) and src/verification/ (the checks' parameters), and the struct of each
+/// tagged variant (`SoilModel::mohr_coulomb` → `MohrCoulomb`, from the enum's declaration or the
+/// lines `Variant(module::Type) = "tag",` of the registries `soil_models!` and
+/// `verification_kinds!`). A newtype
 /// (`pub struct LinearElasticParameters(pub Elasticity);`, serde-transparent) takes the order of
 /// the struct it wraps.
 fn declaration_order() -> (BTreeMap<String, Vec<String>>, BTreeMap<String, String>) {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let (mut order, mut variants) = (BTreeMap::new(), BTreeMap::new());
     let mut newtypes = Vec::new();
-    for dir in ["src/case/schema", "src/soils"] {
+    for dir in ["src/case/schema", "src/soils", "src/verification"] {
         for entry in std::fs::read_dir(root.join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_none_or(|e| e != "rs") {
@@ -400,6 +426,8 @@ fn read_declarations(
         let t = line.trim();
         if t == "soil_models! {" {
             current = Some((false, "SoilModel".to_string()));
+        } else if t == "verification_kinds! {" {
+            current = Some((false, "Verification".to_string()));
         } else if let Some(rest) = t.strip_prefix("pub struct ").or(t.strip_prefix("pub enum ")) {
             let name = rest.split([' ', '{', '<', '(']).next().unwrap().to_string();
             if let Some(inner) = rest.strip_prefix(&format!("{name}(pub ")).and_then(|r| r.strip_suffix(");")) {

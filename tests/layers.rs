@@ -25,8 +25,7 @@ const LAYERS: &[(&str, usize)] = &[
     // The physical model: grid, materials, soil models, points, loads, boundaries.
     ("model", 2),
     ("analysis", 3),
-    // Checks of a case against the model it builds; the per-point kernels.
-    ("validation", 4),
+    // The per-point kernels.
     ("kernels", 4),
     // The particle update, checkpoints' state, the points' distribution over ranks.
     ("update", 5),
@@ -41,8 +40,10 @@ const LAYERS: &[(&str, usize)] = &[
     ("fields", 7),
     ("recorders", 7),
     ("summary", 7),
-    // The algorithm.
+    // The algorithm; the checks of a case across its sections, which ask the model it builds and
+    // the verification checks it names.
     ("driver", 8),
+    ("validation", 8),
     // The commands.
     ("describe", 9),
     ("report", 9),

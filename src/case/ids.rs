@@ -1,11 +1,8 @@
-//! Typed ids: what the names of a case file resolve to. Validation resolves every name once and
-//! stores the ids in the [`super::Case`] it makes; the modules past it look tables up by id, a
-//! lookup that cannot fail.
-
-use super::schema::{
-    BearingCapacity, CookMembrane, DamBreak, ElasticColumn, HarmonicColumn, HollowCylinder, Lame,
-    LargeStrainConsolidation, Patch, Runout, ShockWave, StiffnessMap, Terzaghi, VerticalCut,
-};
+//! Typed ids: what the names of a case file resolve to. Validation resolves the names of the
+//! sections once and stores the ids in the [`super::Case`] it makes; the modules past it look
+//! tables up by id, a lookup that cannot fail. The names of `[verification]`, whose kinds the case
+//! does not know, its check resolves into ids of its own with the same lookups
+//! ([`super::CaseFile::body_named`] and the like), which validation has seen succeed.
 
 macro_rules! id {
     ($(#[$doc:meta])* $name:ident) => {
@@ -62,8 +59,6 @@ pub(crate) struct Links {
     pub boundaries: Vec<BoundaryLinks>,
     /// What each load names.
     pub loads: Vec<LoadLinks>,
-    /// The verification with what it names.
-    pub verification: Option<LinkedVerification>,
 }
 
 /// What a boundary names.
@@ -82,105 +77,4 @@ pub(crate) struct LoadLinks {
     pub bodies: Option<Vec<BodyId>>,
     /// Its time function.
     pub time_function: Option<TimeFunctionId>,
-}
-
-/// The case's verification with the tables its names resolve to: each kind's parameters beside
-/// its ids.
-#[derive(Debug, Clone)]
-pub enum LinkedVerification {
-    /// `terzaghi`.
-    Terzaghi(Terzaghi, BodyAndLoad),
-    /// `harmonic_column`.
-    HarmonicColumn(HarmonicColumn, BodyAndLoad),
-    /// `elastic_column`.
-    ElasticColumn(ElasticColumn, ElasticColumnIds),
-    /// `bearing_capacity`.
-    BearingCapacity(BearingCapacity, FootingIds),
-    /// `large_strain_consolidation`.
-    LargeStrainConsolidation(LargeStrainConsolidation, BodyAndLoad),
-    /// `patch`.
-    Patch(Patch, PatchIds),
-    /// `lame`.
-    Lame(Lame, BodyAndLoad),
-    /// `hollow_cylinder`.
-    HollowCylinder(HollowCylinder, BodyAndLoad),
-    /// `stiffness_map`: its body.
-    StiffnessMap(StiffnessMap, BodyId),
-    /// `vertical_cut`: its body.
-    VerticalCut(VerticalCut, BodyId),
-    /// `cook_membrane`: its body.
-    CookMembrane(CookMembrane, BodyId),
-    /// `dam_break`.
-    DamBreak(DamBreak, DamBreakIds),
-    /// `runout`.
-    Runout(Runout, RunoutIds),
-    /// `shock_wave`.
-    ShockWave(ShockWave, BodyAndLoad),
-}
-
-/// The body a check follows and the load it compares with.
-#[derive(Debug, Clone, Copy)]
-pub struct BodyAndLoad {
-    /// `body`.
-    pub body: BodyId,
-    /// `load`.
-    pub load: LoadId,
-}
-
-/// What an elastic column names.
-#[derive(Debug, Clone, Copy)]
-pub struct ElasticColumnIds {
-    /// `body`.
-    pub body: BodyId,
-    /// `gravity`: a body force.
-    pub gravity: LoadId,
-    /// `surcharge`: a particle or nodal traction.
-    pub surcharge: Option<LoadId>,
-}
-
-/// What a bearing-capacity check names.
-#[derive(Debug, Clone, Copy)]
-pub struct FootingIds {
-    /// `soil`.
-    pub soil: BodyId,
-    /// What loads the footing.
-    pub loading: Loading,
-}
-
-/// What loads a footing.
-#[derive(Debug, Clone, Copy)]
-pub enum Loading {
-    /// `load`: a traction, or a body force on the footing body.
-    Load(LoadId),
-    /// `footing`: a boundary that moves the nodes under the footing (displacement control).
-    Footing(BoundaryId),
-}
-
-/// What a patch test names.
-#[derive(Debug, Clone, Copy)]
-pub struct PatchIds {
-    /// `body`.
-    pub body: BodyId,
-    /// `boundary`: it has a `velocity_gradient`.
-    pub boundary: BoundaryId,
-}
-
-/// What a dam break names.
-#[derive(Debug, Clone, Copy)]
-pub struct DamBreakIds {
-    /// `body`: a rectangle.
-    pub body: BodyId,
-    /// `gravity`: a body force.
-    pub gravity: LoadId,
-    /// `settle_stage`: not the last stage.
-    pub settle_stage: StageId,
-}
-
-/// What a run-out check names.
-#[derive(Debug, Clone, Copy)]
-pub struct RunoutIds {
-    /// `body`.
-    pub body: BodyId,
-    /// `trigger_stage`.
-    pub trigger_stage: StageId,
 }

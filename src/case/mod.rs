@@ -5,7 +5,8 @@
 //! other module takes, its names resolved to typed ids ([`ids`]). Every error names the file, the
 //! key and what is wrong, in one line. This module is the bottom of the house: of the physics it
 //! imports only the soil models' parameters ([`crate::soils`], on its layer), the table
-//! `materials.model`.
+//! `materials.model`; the table `[verification]` it keeps untyped, for the checks' registry
+//! ([`crate::verification`]) to read with [`CaseFile::table_as`].
 
 pub mod ids;
 mod names;
@@ -14,10 +15,7 @@ pub mod parameters;
 pub mod schema;
 mod validated;
 
-pub use ids::{
-    BodyAndLoad, BodyId, BoundaryId, DamBreakIds, ElasticColumnIds, FootingIds, LinkedVerification, LoadId, Loading,
-    MaterialId, PatchIds, RunoutIds, StageId, TimeFunctionId,
-};
+pub use ids::{BodyId, BoundaryId, LoadId, MaterialId, StageId, TimeFunctionId};
 pub use overrides::Override;
 pub use schema::*;
 pub use validated::Case;
@@ -62,18 +60,41 @@ pub fn parse(text: &str, origin: &str, overrides: &[Override]) -> Result<CaseFil
         set_paths.push((path, ov.key.clone()));
     }
     parameters::expand(&mut doc).map_err(|e| CaseError::new(format!("{origin}: {e}")))?;
-    serde_path_to_error::deserialize(doc).map_err(|e| {
-        let path = e.path().to_string();
-        let msg = e.inner().message().trim().to_string();
-        let from_set = set_paths
-            .iter()
-            .find(|(p, _)| path == *p || path.starts_with(&format!("{p}.")) || path.starts_with(&format!("{p}[")));
-        match from_set {
-            Some((_, key)) => CaseError::new(format!("{origin}: --set {key}: {msg}")),
-            None if path == "." || path.is_empty() => CaseError::new(format!("{origin}: {msg}")),
-            None => CaseError::new(format!("{origin}: key `{path}`: {msg}")),
-        }
-    })
+    let mut file: CaseFile = serde_path_to_error::deserialize(doc).map_err(|e| {
+        let msg = misfit(&set_paths, &e.path().to_string(), e.inner().message());
+        CaseError::new(format!("{origin}: {msg}"))
+    })?;
+    file.overridden = set_paths;
+    Ok(file)
+}
+
+/// The message of a value at key `path` that does not fit its type (`msg`): ``key `PATH`: MSG``,
+/// or ``--set KEY: MSG`` where the override `KEY` of `set` (its path, its key as given) wrote it.
+fn misfit(set: &[(String, String)], path: &str, msg: &str) -> String {
+    let msg = msg.trim();
+    let from_set = set
+        .iter()
+        .find(|(p, _)| path == *p || path.starts_with(&format!("{p}.")) || path.starts_with(&format!("{p}[")));
+    match from_set {
+        Some((_, key)) => format!("--set {key}: {msg}"),
+        None if path == "." || path.is_empty() => msg.to_string(),
+        None => format!("key `{path}`: {msg}"),
+    }
+}
+
+impl CaseFile {
+    /// `value`, the table at `key` of the file, deserialized as a `T`; a value that does not fit
+    /// is one line naming its key (``key `verification.kind`: unknown variant ...``) or the
+    /// override that gave it, as [`parse`] names the keys of the file's own tables.
+    pub fn table_as<T: serde::de::DeserializeOwned>(&self, key: &str, value: toml::Value) -> Result<T, String> {
+        serde_path_to_error::deserialize(value).map_err(|e| {
+            let path = match e.path().to_string().as_str() {
+                "" | "." => key.to_string(),
+                inner => format!("{key}.{inner}"),
+            };
+            misfit(&self.overridden, &path, e.inner().message())
+        })
+    }
 }
 
 /// Case texts shared by unit tests.

@@ -1,9 +1,9 @@
 //! The validated case: a case file whose ranges, combinations and names validation has checked,
-//! with every name resolved to a typed id. Every module past validation takes a [`Case`]; it reads
+//! with the names of its sections resolved to typed ids. Every module past validation takes a [`Case`]; it reads
 //! the file's tables through `Deref` (`case.grid`, `case.stages`), and the tables a name points at
 //! through the ids (`case.material_of(body)`).
 
-use super::ids::{BodyId, BoundaryId, LinkedVerification, Links, LoadId, MaterialId, StageId, TimeFunctionId};
+use super::ids::{BodyId, BoundaryId, Links, LoadId, MaterialId, StageId, TimeFunctionId};
 use super::schema::{Body, Boundary, CaseFile, Load, Material, Stage, TimeFunction};
 
 /// A validated case (only `crate::validation` makes one).
@@ -106,11 +106,6 @@ impl Case {
     /// `bodies`).
     pub fn load_bodies(&self, load: LoadId) -> Option<&[BodyId]> {
         self.links.loads[load.index()].bodies.as_deref()
-    }
-
-    /// The case's verification with the tables it names, if it has one.
-    pub fn linked_verification(&self) -> Option<&LinkedVerification> {
-        self.links.verification.as_ref()
     }
 
     /// The first body containing `p` (bodies earlier in the file take precedence), if any, in a case

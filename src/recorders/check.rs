@@ -15,7 +15,8 @@ pub struct Verification<const D: usize> {
 }
 
 impl<const D: usize> Verification<D> {
-    /// The check of `case`, if it asks for one (collective).
+    /// The check of `case`, if it asks for one (collective): the registry types the case's
+    /// `[verification]` and resolves its names again ([`verification::for_case_in`]).
     pub fn new(case: &Case, model: &Model<D>, coll: &Collective) -> Result<Option<Verification<D>>, String>
     where
         Dim<D>: CaseChecks<D>,

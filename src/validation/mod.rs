@@ -5,11 +5,14 @@
 //! [`crate::case::schema`]); this module checks what tables say together, one file per section,
 //! in the order a reader meets them: the analysis switches and their stabilisation
 //! ([`analysis`]), the grid and what its dimension allows ([`grid`], [`dimensions`]), then the
-//! materials, bodies, boundaries, loads, stages, probes and the verification. Before the checks,
-//! every name the file gives is resolved once ([`names`]) into the typed ids the `Case` keeps, so
-//! no module past this one looks a name up again. It may ask the physics: the analysis of a stage
-//! (`analysis::StageAnalysis`), whether an increment factor evaluates, whether a softening model
-//! has a unique return.
+//! materials, bodies, boundaries, loads, stages, probes and the verification, whose checks are
+//! its registry's ([`crate::verification::Verification::validate`]: the table's kind and keys,
+//! their ranges, what the check needs of the case and of what it names). Before the checks, every
+//! name the other sections give is resolved once ([`names`]) into the typed ids the `Case` keeps,
+//! so no module past this one looks those up again. It may ask the physics: the analysis of a
+//! stage (`analysis::StageAnalysis`), whether an increment factor evaluates, whether a softening
+//! model has a unique return. It sits above the checks it asks, below the commands that load a
+//! case.
 
 mod analysis;
 mod bodies;
@@ -20,7 +23,6 @@ mod loads;
 mod materials;
 mod names;
 mod stages;
-mod verification;
 
 use crate::case::ids::Links;
 use crate::case::{self, Case, CaseError, CaseFile, Override};
@@ -59,12 +61,8 @@ fn default_steps(file: &mut CaseFile) -> Checked {
 /// Every name of the file resolved to the id of the table it names.
 fn resolve(file: &CaseFile) -> Result<Links, String> {
     let names = Names::of(file)?;
-    let links = Links {
-        body_materials: names.body_materials()?,
-        boundaries: names.boundaries()?,
-        loads: names.loads()?,
-        verification: file.verification.as_ref().map(|v| verification::link(v, file)).transpose()?,
-    };
+    let links =
+        Links { body_materials: names.body_materials()?, boundaries: names.boundaries()?, loads: names.loads()? };
     names.check_stages()?;
     Ok(links)
 }
@@ -83,7 +81,7 @@ fn check(c: &Case) -> Checked {
     stages::check(c)?;
     c.output.check("output")?;
     probes(c)?;
-    verification::check(c)
+    crate::verification::Verification::validate(c)
 }
 
 /// Each probe's point: one coordinate per dimension, inside the grid.

@@ -21,11 +21,212 @@
 //! (interpolated), the settlement d [m] at each q/c of `report_loads` and the largest q/c reached. With `stop_settlement` the run ends (completed) once
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
-use super::{Check, Findings, Metric, Table};
-use crate::case::{BearingCapacity, Case, FootingIds, Load, LoadId, Loading};
+use super::{all_positive, each_positive, load_name, plain_load, Check, CheckParameters, Findings, Metric, Table};
+use crate::case::{BodyId, BoundaryId, Case, Dof, Load, LoadId};
+use crate::check::{at, components, positive, Checked};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "bearing_capacity"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BearingCapacity {
+    /// The name of the soil body (its cohesion normalises the pressure).
+    pub soil: String,
+    /// The name of the load: a traction (its pressure), or a body force on the footing body (its
+    /// weight over `loaded_width`; the body force must name its bodies). Give `load` or `footing`.
+    pub load: Option<String>,
+    /// The name of a rigid footing pushed into the soil under displacement control: a boundary
+    /// that fixes `uy` and moves it vertically (`velocity` or `displacement`); the pressure is its
+    /// vertical reaction on the soil over `loaded_width` ([002] §4.2). Give `load` or `footing`.
+    pub footing: Option<String>,
+    /// Width carrying the load in the model [m], > 0 (the half-width in a half model).
+    pub loaded_width: f64,
+    /// In three dimensions, the loaded area's extent along z in the model [m], > 0 (the
+    /// half-length of a footing in a quarter model): the pressure is the force over
+    /// `loaded_width` × `loaded_depth`. Required in three dimensions; two-dimensional cases do not
+    /// take it.
+    pub loaded_depth: Option<f64>,
+    /// Footing breadth B [m], > 0 (normalises the settlement).
+    pub breadth: f64,
+    /// The settlement is the downward displacement of the material point nearest to this point
+    /// at t = 0 [m] (one coordinate per dimension).
+    pub settlement_point: Vec<f64>,
+    /// d/B [-], > 0, at which q_ult is read for the metric `bearing_capacity_ratio` (a
+    /// load-controlled footing; give this or `plateau`, or neither for no metric).
+    pub failure_settlement: Option<f64>,
+    /// The range [d/B_from, d/B_to] [-], 0 ≤ d/B_from < d/B_to, over which the mean of q is q_ult
+    /// for the metric `bearing_capacity_ratio` (a displacement-controlled footing, whose load
+    /// levels off at the limit load).
+    pub plateau: Option<[f64; 2]>,
+    /// Reference q_ult/c [-], > 0 (default 2 + π, Prandtl).
+    #[serde(default = "default_prandtl")]
+    pub reference: f64,
+    /// Largest accepted |(q_ult/c)/reference − 1| [-], in (0, 1] (default 0.03).
+    #[serde(default = "default_bearing_tol")]
+    pub tolerance: f64,
+    /// d/B values [-], each > 0, at which q/c is reported in summary.json `results`.
+    #[serde(default)]
+    pub report_settlements: Vec<f64>,
+    /// q/c values [-], each > 0, at which the settlement of the point d [m] is reported in
+    /// summary.json `results` as `settlement_at_qc<value>`.
+    #[serde(default)]
+    pub report_loads: Vec<f64>,
+    /// d/B [-], > 0, at which the run ends, completed (a load-controlled footing beyond its limit
+    /// load runs away; default: run to the end).
+    pub stop_settlement: Option<f64>,
+}
+
+fn default_prandtl() -> f64 {
+    2.0 + std::f64::consts::PI
+}
+fn default_bearing_tol() -> f64 {
+    0.03
+}
+
+/// What a bearing-capacity check names.
+#[derive(Debug, Clone, Copy)]
+pub struct FootingIds {
+    /// `soil`.
+    pub soil: BodyId,
+    /// What loads the footing.
+    pub loading: Loading,
+}
+
+/// What loads a footing.
+#[derive(Debug, Clone, Copy)]
+pub enum Loading {
+    /// `load`: a traction, or a body force on the footing body.
+    Load(LoadId),
+    /// `footing`: a boundary that moves the nodes under the footing (displacement control).
+    Footing(BoundaryId),
+}
+
+impl CheckParameters for BearingCapacity {
+    type Ids = FootingIds;
+    const SOLID: bool = true;
+
+    /// Checks the geometry, the settlements and loads to report, and that the footing is loaded
+    /// one way.
+    fn check(&self, key: &str) -> Checked {
+        positive(&at(key, "loaded_width"), self.loaded_width)?;
+        if let Some(d) = self.loaded_depth {
+            positive(&at(key, "loaded_depth"), d)?;
+        }
+        if let Some([from, to]) = self.plateau {
+            if !(from >= 0.0 && to > from && to.is_finite()) {
+                return Err(format!("key `{}`: give 0 ≤ d/B_from < d/B_to, got [{from}, {to}]", at(key, "plateau")));
+            }
+            if self.failure_settlement.is_some() {
+                return Err(format!("key `{}`: give `plateau` or `failure_settlement`, not both", at(key, "plateau")));
+            }
+        }
+        for (f, v) in [("stop_settlement", self.stop_settlement), ("failure_settlement", self.failure_settlement)] {
+            if let Some(v) = v {
+                positive(&at(key, f), v)?;
+            }
+        }
+        all_positive(key, &[("breadth", self.breadth), ("reference", self.reference), ("tolerance", self.tolerance)])?;
+        each_positive(&at(key, "report_settlements"), &self.report_settlements)?;
+        each_positive(&at(key, "report_loads"), &self.report_loads)?;
+        if self.load.is_some() == self.footing.is_some() {
+            return Err(loading_refused(key));
+        }
+        Ok(())
+    }
+
+    fn describe(&self) -> String {
+        match (self.failure_settlement, self.plateau) {
+            (Some(f), _) => format!("bearing capacity: q_ult/c at d/B = {f} against {:.4}", self.reference),
+            (None, Some([a, b])) => {
+                format!("bearing capacity: q_ult/c, the mean q/c over d/B in [{a}, {b}], against {:.4}", self.reference)
+            }
+            (None, None) => "load–settlement curve of a footing".into(),
+        }
+    }
+
+    /// The soil and what loads the footing: a load (a traction, or a body force naming the footing
+    /// body) or a boundary that moves it down; the loaded depth as the case's dimension asks, a
+    /// settlement point of as many coordinates.
+    fn link(&self, c: &Case) -> Result<FootingIds, String> {
+        let soil = c.body_named("verification.soil", &self.soil)?;
+        let loading = match (&self.load, &self.footing) {
+            (None, Some(f)) => Loading::Footing(c.boundary_named("verification.footing", f)?),
+            (Some(l), None) => Loading::Load(c.load_named("verification.load", l)?),
+            _ => return Err(loading_refused("verification")),
+        };
+        self.dimensions(c)?;
+        match loading {
+            Loading::Footing(f) => footing_boundary(c, f)?,
+            Loading::Load(l) => {
+                plain_load(c, l)?;
+                if matches!(c.load(l), Load::BodyForce(f) if f.bodies.is_none()) {
+                    return Err(format!(
+                        "key `verification.load`: the body force `{}` must name the footing body in `bodies`",
+                        load_name(c, l)
+                    ));
+                }
+            }
+        }
+        Ok(FootingIds { soil, loading })
+    }
+
+    fn plane(&self, c: &Case, ids: &FootingIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(BearingCheck::new(c, model, coll, self, ids)?))
+    }
+
+    fn solid(
+        &self,
+        c: &Case,
+        ids: &FootingIds,
+        model: &Model<3>,
+        coll: &Collective,
+    ) -> Result<Box<dyn Check<3>>, String> {
+        Ok(Box::new(BearingCheck::new(c, model, coll, self, ids)?))
+    }
+}
+
+impl BearingCapacity {
+    /// The loaded depth as the case's dimension asks, and a settlement point of as many
+    /// coordinates.
+    fn dimensions(&self, c: &Case) -> Checked {
+        match (self.loaded_depth, c.dimension()) {
+            (None, 3) => {
+                return Err("key `verification.loaded_depth`: a three-dimensional footing needs the loaded area's \
+                            extent along z"
+                    .into())
+            }
+            (Some(_), 2) => {
+                return Err("key `verification.loaded_depth`: only a three-dimensional case takes it (a plane \
+                            footing's pressure is its force per unit length over `loaded_width`)"
+                    .into())
+            }
+            _ => {}
+        }
+        components("verification.settlement_point", &self.settlement_point, c.dimension())
+    }
+}
+
+/// The message of a footing given both or neither of `load` and `footing`; `key` is the table.
+fn loading_refused(key: &str) -> String {
+    format!("key `{key}`: a bearing_capacity check takes either `load` (load control) or `footing` (a moving boundary)")
+}
+
+/// A footing's boundary: it fixes `uy` and moves it vertically, so that its reaction is the load.
+fn footing_boundary(c: &Case, f: BoundaryId) -> Checked {
+    let b = c.boundary(f);
+    let vertical = |v: &Option<Vec<f64>>| v.as_ref().is_some_and(|v| v.get(1).is_some_and(|&y| y != 0.0));
+    if !b.fix.contains(&Dof::Uy) || !(vertical(&b.velocity) || vertical(&b.displacement)) {
+        return Err(format!(
+            "key `verification.footing`: the boundary `{}` must fix `uy` and move it vertically (`velocity` or \
+             `displacement`): its reaction is the footing's load",
+            b.name
+        ));
+    }
+    Ok(())
+}
 
 /// The load–settlement check, of a footing in D dimensions.
 pub struct BearingCheck<const D: usize = 2> {

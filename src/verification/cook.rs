@@ -16,12 +16,75 @@
 //!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which `make study-cook`
 //!   compares between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
 
-use super::{Check, Findings, Metric};
-use crate::case::{BodyId, Case, CookMembrane};
+use super::{Check, CheckParameters, Findings, Metric};
+use crate::case::{BodyId, Case, Formulation};
+use crate::check::{at, finite2, positive, Checked};
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;
 use crate::soils::invariants;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "cook_membrane"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CookMembrane {
+    /// The name of the membrane's body.
+    pub body: String,
+    /// The tip at t = 0 [m].
+    pub tip: [f64; 2],
+    /// The tip's vertical displacement at rest [m], > 0 (0.2765 for [002]'s membrane: plane-strain
+    /// Q9 finite elements, `scripts/cook_membrane_neo_hookean.py`).
+    pub reference: f64,
+    /// Largest accepted relative error of the tip's displacement [-], in (0, 1) (default 0.03).
+    #[serde(default = "default_cook_tol")]
+    pub tolerance: f64,
+    /// The radius around the tip within which the points' displacements are fitted [cells], in
+    /// [1, 10] (default 2).
+    #[serde(default = "default_cook_radius")]
+    pub fit_radius: f64,
+}
+
+fn default_cook_tol() -> f64 {
+    0.03
+}
+fn default_cook_radius() -> f64 {
+    2.0
+}
+
+impl CheckParameters for CookMembrane {
+    type Ids = BodyId;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "Cook's membrane is for a one_phase analysis"));
+
+    fn check(&self, key: &str) -> Checked {
+        finite2(&at(key, "tip"), self.tip)?;
+        positive(&at(key, "reference"), self.reference)?;
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(format!("key `{}`: must be in (0, 1), got {}", at(key, "tolerance"), self.tolerance));
+        }
+        if !(1.0..=10.0).contains(&self.fit_radius) {
+            return Err(format!("key `{}`: must be in [1, 10] cells, got {}", at(key, "fit_radius"), self.fit_radius));
+        }
+        Ok(())
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "Cook's membrane ([002] §4.1): the tip ({}, {})'s vertical displacement at rest against {} m, the mean \
+             stress's chequerboard index",
+            self.tip[0], self.tip[1], self.reference
+        )
+    }
+
+    fn link(&self, c: &Case) -> Result<BodyId, String> {
+        c.body_named("verification.body", &self.body)
+    }
+
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(CookCheck::new(c, self, *body)))
+    }
+}
 
 /// The Cook's-membrane check of a case.
 pub struct CookCheck {

@@ -27,12 +27,129 @@
 //! The comparison of two runs (F̄ with uGIMP against F̄ with B-splines, [002] Fig. 13; F̄ against
 //! standard MPM) reads the history columns and the results of both.
 
-use super::{Check, Findings, Metric};
-use crate::case::{Case, DamBreak, DamBreakIds, Load, Rectangle, Shape};
+use super::{spray, tolerance, Check, CheckParameters, Findings, Metric};
+use crate::case::{BodyId, Case, Formulation, Load, LoadId, Rectangle, Shape, StageId};
+use crate::check::{at, finite2, Checked};
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::{Axis, ColourMap, Figure, MapPoints, Series, Style};
 use crate::soils::invariants;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "dam_break"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DamBreak {
+    /// The name of the water body (a rectangle at t = 0 against the back wall at its left).
+    pub body: String,
+    /// The name of the body-force load carrying gravity.
+    pub gravity: String,
+    /// The name of the settling stage (not the last), at whose end the water is checked for the
+    /// hydrostatic pressure and after which it flows.
+    pub settle_stage: String,
+    /// Largest accepted |p − ρ g d| / (ρ g H) over the points more than one cell above the base
+    /// at the end of the settling stage [-], in (0, 1] (default 0.02).
+    #[serde(default = "default_hydrostatic_tol")]
+    pub hydrostatic_tolerance: f64,
+    /// x of the wall the front runs into [m]; the front's speed bound applies while the front is
+    /// more than a cell from it (default: no wall, the whole run).
+    pub far_wall: Option<f64>,
+    /// A measured front position to compare with: `"martin_moyce_1952"` (Martin & Moyce 1952,
+    /// the column of height 2a on width a, n² = 2; the body must have that aspect ratio).
+    pub experiment: Option<String>,
+    /// Largest accepted mean |Z/Z_exp − 1| of the front against `experiment` [-], in (0, 1] (default
+    /// 0.1).
+    #[serde(default = "default_front_tol")]
+    pub front_tolerance: f64,
+    /// The share of the water's mass that may lie ahead of the front, as spray shed from its
+    /// tip [-], in [0, 0.05] (default 0.005).
+    #[serde(default = "default_spray")]
+    pub spray_fraction: f64,
+}
+
+fn default_hydrostatic_tol() -> f64 {
+    0.02
+}
+fn default_front_tol() -> f64 {
+    0.1
+}
+fn default_spray() -> f64 {
+    0.005
+}
+
+/// The laboratory series a dam break's front can be compared with.
+pub const DAM_BREAK_EXPERIMENTS: [&str; 1] = ["martin_moyce_1952"];
+
+/// What a dam break names.
+#[derive(Debug, Clone, Copy)]
+pub struct DamBreakIds {
+    /// `body`: a rectangle.
+    pub body: BodyId,
+    /// `gravity`: a body force.
+    pub gravity: LoadId,
+    /// `settle_stage`: not the last stage.
+    pub settle_stage: StageId,
+}
+
+impl CheckParameters for DamBreak {
+    type Ids = DamBreakIds;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the dam break is for a one_phase analysis"));
+
+    /// Checks the tolerances, the wall and the experiment.
+    fn check(&self, key: &str) -> Checked {
+        tolerance(&at(key, "hydrostatic_tolerance"), self.hydrostatic_tolerance)?;
+        spray(key, self.spray_fraction)?;
+        tolerance(&at(key, "front_tolerance"), self.front_tolerance)?;
+        if let Some(x) = self.far_wall {
+            finite2(&at(key, "far_wall"), [x, 0.0])?;
+        }
+        match &self.experiment {
+            Some(e) if !DAM_BREAK_EXPERIMENTS.contains(&e.as_str()) => Err(format!(
+                "key `{}`: unknown experiment `{e}` (known: {})",
+                at(key, "experiment"),
+                DAM_BREAK_EXPERIMENTS.join(", ")
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "dam break ([002] §4.3): the hydrostatic pressure at the end of stage `{}`, the mass, the front's \
+             advance against the shallow-water speed 2√(gH){}",
+            self.settle_stage,
+            self.experiment.as_ref().map_or(String::new(), |e| format!(", the front against `{e}`"))
+        )
+    }
+
+    /// A rectangular column, gravity a body force, a settling stage that is not the last.
+    fn link(&self, c: &Case) -> Result<DamBreakIds, String> {
+        let ids = DamBreakIds {
+            body: c.body_named("verification.body", &self.body)?,
+            gravity: c.load_named("verification.gravity", &self.gravity)?,
+            settle_stage: c.stage_named("verification.settle_stage", &self.settle_stage)?,
+        };
+        let body = c.body(ids.body);
+        if !matches!(body.shape, Shape::Rectangle(_)) {
+            return Err(format!("key `verification.body`: the dam break's column `{}` must be a rectangle", body.name));
+        }
+        if !matches!(c.load(ids.gravity), Load::BodyForce(_)) {
+            return Err(format!("key `verification.gravity`: `{}` must be a body_force load", self.gravity));
+        }
+        if ids.settle_stage.index() + 1 == c.stages.len() {
+            return Err(format!(
+                "key `verification.settle_stage`: `{}` is the last stage, so the water never flows",
+                self.settle_stage
+            ));
+        }
+        Ok(ids)
+    }
+
+    fn plane(&self, c: &Case, ids: &DamBreakIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(DamBreakCheck::new(c, model, coll, self, ids)?))
+    }
+}
 
 /// Martin & Moyce (1952), the collapse of a water column of height 2a on width a (n² = 2,
 /// a = 2.25 in): the surge front Z = z/a at T = n t √(g/a), read from their Fig. 3 (as tabulated

@@ -1,10 +1,93 @@
 //! The elastic column under its self-weight and a surcharge (one-phase), at rest at the end of
 //! the run.
 
-use super::{figures, load_factor, Check, Findings, Metric};
-use crate::case::{self, Case, ElasticColumnIds, Load};
+use super::{all_positive, figures, load_factor, load_name, plain_load, Check, CheckParameters, Findings, Metric};
+use crate::case::{BodyId, Case, Formulation, Load, LoadId};
+use crate::check::Checked;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "elastic_column"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ElasticColumn {
+    /// The name of the column body (laterally confined, fixed base).
+    pub body: String,
+    /// The name of the body-force load carrying gravity.
+    pub gravity: String,
+    /// The name of the surface load (a particle or nodal traction), if any.
+    pub surcharge: Option<String>,
+    /// Pass threshold for max |σ_yy − σ*| / max |σ*| over the column [-], in (0, 1] (default 0.01).
+    #[serde(default = "default_column_tol")]
+    pub stress_tolerance: f64,
+    /// Pass threshold for the relative settlement error [-], in (0, 1] (default 0.01).
+    #[serde(default = "default_column_tol")]
+    pub settlement_tolerance: f64,
+}
+
+fn default_column_tol() -> f64 {
+    0.01
+}
+
+/// What an elastic column names.
+#[derive(Debug, Clone, Copy)]
+pub struct ElasticColumnIds {
+    /// `body`.
+    pub body: BodyId,
+    /// `gravity`: a body force.
+    pub gravity: LoadId,
+    /// `surcharge`: a particle or nodal traction.
+    pub surcharge: Option<LoadId>,
+}
+
+impl CheckParameters for ElasticColumn {
+    type Ids = ElasticColumnIds;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the elastic column reference is for a one_phase analysis"));
+    const AXISYMMETRIC: bool = true;
+
+    fn check(&self, key: &str) -> Checked {
+        let (st, se) = (self.stress_tolerance, self.settlement_tolerance);
+        all_positive(key, &[("stress_tolerance", st), ("settlement_tolerance", se)])
+    }
+
+    fn describe(&self) -> String {
+        "static elastic column under self-weight and surcharge".into()
+    }
+
+    /// The names, gravity a body force and a surcharge a traction.
+    fn link(&self, c: &Case) -> Result<ElasticColumnIds, String> {
+        let ids = ElasticColumnIds {
+            body: c.body_named("verification.body", &self.body)?,
+            gravity: c.load_named("verification.gravity", &self.gravity)?,
+            surcharge: self.surcharge.as_ref().map(|s| c.load_named("verification.surcharge", s)).transpose()?,
+        };
+        plain_load(c, ids.gravity)?;
+        if !matches!(c.load(ids.gravity), Load::BodyForce(_)) {
+            return Err(format!(
+                "key `verification.gravity`: `{}` must be a body_force load",
+                load_name(c, ids.gravity)
+            ));
+        }
+        match ids.surcharge {
+            Some(s) if c.load(s).traction().is_none() => {
+                Err(format!("key `verification.surcharge`: no traction load named `{}`", load_name(c, s)))
+            }
+            _ => Ok(ids),
+        }
+    }
+
+    fn plane(
+        &self,
+        c: &Case,
+        ids: &ElasticColumnIds,
+        model: &Model,
+        coll: &Collective,
+    ) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(ElasticColumnCheck::new(c, model, coll, self, ids)?))
+    }
+}
 
 /// Elastic column under self-weight and surcharge (one-phase), checked against the static solution
 /// at the end of the run: σ_yy = −(ρ g d + q) at initial depth d, settlement ρ g H²/(2E_c) + q H/E_c
@@ -33,7 +116,7 @@ impl ElasticColumnCheck {
         c: &Case,
         model: &Model,
         coll: &Collective,
-        spec: &case::ElasticColumn,
+        spec: &ElasticColumn,
         ids: &ElasticColumnIds,
     ) -> Result<ElasticColumnCheck, String> {
         let bi = ids.body.index();

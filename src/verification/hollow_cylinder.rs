@@ -17,11 +17,121 @@
 //! geometrically nonlinear answer differs by 3.6 % in u_r(a); the case applies a small
 //! increment.
 
-use super::{Check, Findings, Metric};
-use crate::case::{BodyAndLoad, Case, HollowCylinder, IncrementTolerances};
+use super::{all_positive, linear_elastic, load_name, radii, BodyAndLoad, Check, CheckParameters, Findings, Metric};
+use crate::case::{Case, Formulation, Geometry};
+use crate::check::{at, positive, Checked};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "hollow_cylinder"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HollowCylinder {
+    /// The name of the cylinder's body (linear elastic; the analysis axisymmetric).
+    pub body: String,
+    /// The name of the internal pressure (a `nodal_traction` or `particle_traction` whose x
+    /// component is the pressure on the inner face, times its time function).
+    pub load: String,
+    /// Inner radius a [m], > 0.
+    pub inner_radius: f64,
+    /// Outer radius b [m] (held radially), > a.
+    pub outer_radius: f64,
+    /// Largest accepted relative error of u_r at the inner radius [-], in (0, 1] (default 0.05).
+    #[serde(default = "default_displacement_tol")]
+    pub displacement_tolerance: f64,
+    /// Largest accepted relative error of Δσ_rr at the innermost points (mp1) and volume-weighted
+    /// RMS of the relative error of Δσ_rr over the body [-], in (0, 1] (default 0.25).
+    #[serde(default = "default_stress_tol")]
+    pub stress_tolerance: f64,
+    /// Checks every load step as an increment of the remaining cylinder ([001]'s 25 increments):
+    /// by uniqueness, the closed form of the original cylinder restricted to [r_i, b] is the
+    /// small-strain increment of the wall whose inner face has moved to r_i when the load applied
+    /// there is the original Δσ_rr(r_i) (an `increment_factor` `A / x^2 + 2 * C`). Without it only
+    /// the first step is checked.
+    pub increments: Option<IncrementTolerances>,
+}
+
+/// Tolerances of the hollow cylinder's step-by-step comparison (the innermost column of points,
+/// mp1, against the closed form at its radius at the start of each step).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct IncrementTolerances {
+    /// Largest accepted relative error of Δq, the von Mises stress of the step's stress increment,
+    /// over the steps ([001]: 10 %) [-], > 0.
+    pub q: f64,
+    /// Largest accepted error of Δσ_m over the steps, relative to the step's pressure at r = a
+    /// ([001]: 5 kPa per 100 kPa) [-], > 0.
+    pub mean_stress: f64,
+    /// Largest accepted relative error of mp1's radius after the last step against the closed-form
+    /// path r_{k+1} = r_k + u_r(r_k) ([001]: 5 %) [-], > 0.
+    pub radius: f64,
+}
+
+fn default_displacement_tol() -> f64 {
+    0.05
+}
+fn default_stress_tol() -> f64 {
+    0.25
+}
+
+impl CheckParameters for HollowCylinder {
+    type Ids = BodyAndLoad;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the hollow cylinder's reference is for a one_phase analysis"));
+    const AXISYMMETRIC: bool = true;
+
+    fn check(&self, key: &str) -> Checked {
+        positive(&at(key, "inner_radius"), self.inner_radius)?;
+        radii(key, self.inner_radius, self.outer_radius)?;
+        let (d, s) = (self.displacement_tolerance, self.stress_tolerance);
+        all_positive(key, &[("displacement_tolerance", d), ("stress_tolerance", s)])?;
+        match self.increments {
+            Some(t) => {
+                let k = at(key, "increments");
+                all_positive(&k, &[("q", t.q), ("mean_stress", t.mean_stress), ("radius", t.radius)])
+            }
+            None => Ok(()),
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "axisymmetric hollow cylinder with a fixed outer wall ([001] §3.1), a = {} m, b = {} m: u_r(a) and \
+             Δσ_rr after the first load step{}",
+            self.inner_radius,
+            self.outer_radius,
+            if self.increments.is_some() {
+                "; every step's Δq and Δσ_m at mp1 and mp1's radius against the closed form of the remaining cylinder"
+            } else {
+                ""
+            }
+        )
+    }
+
+    /// A traction on a linear elastic body, in an axisymmetric analysis.
+    fn link(&self, c: &Case) -> Result<BodyAndLoad, String> {
+        let ids = BodyAndLoad::named(c, &self.body, &self.load)?;
+        if c.load(ids.load).traction().is_none() {
+            return Err(format!(
+                "key `verification.load`: `{}` must be a nodal_traction or particle_traction load",
+                load_name(c, ids.load)
+            ));
+        }
+        linear_elastic(c, ids.body, "the hollow cylinder's reference")?;
+        if c.analysis.geometry != Geometry::Axisymmetric {
+            return Err("key `verification`: the hollow cylinder's reference needs `analysis.geometry = \
+                        \"axisymmetric\"`"
+                .into());
+        }
+        Ok(ids)
+    }
+
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(HollowCylinderCheck::new(c, self, ids)?))
+    }
+}
 
 /// The closed-form solution (compression positive).
 #[derive(Debug, Clone, Copy)]

@@ -10,11 +10,72 @@
 //! initial radial direction), σ_rr and σ_θθ (the stress projected on the radial and hoop directions
 //! there), at the end of the run.
 
-use super::{Check, Findings, Metric};
-use crate::case::{self, BodyAndLoad, Case, Load};
+use super::{all_positive, linear_elastic, load_name, radii, BodyAndLoad, Check, CheckParameters, Findings, Metric};
+use crate::case::{Case, Formulation, Load};
+use crate::check::{at, finite2, Checked};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "lame"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LameCylinder {
+    /// The name of the cylinder's body (linear elastic).
+    pub body: String,
+    /// The name of the internal pressure (a `line_pressure`; p at the run's end).
+    pub load: String,
+    /// The cylinder's axis [m] (default: the origin).
+    #[serde(default)]
+    pub center: [f64; 2],
+    /// Inner radius a [m], > 0.
+    pub inner_radius: f64,
+    /// Outer radius b [m], > a.
+    pub outer_radius: f64,
+    /// Largest accepted relative L2 error of u_r [-], in (0, 1] (default 0.05).
+    #[serde(default = "default_lame_tol")]
+    pub displacement_tolerance: f64,
+    /// Largest accepted relative L2 error of σ_rr and of σ_θθ [-], in (0, 1] (default 0.05).
+    #[serde(default = "default_lame_tol")]
+    pub stress_tolerance: f64,
+}
+
+fn default_lame_tol() -> f64 {
+    0.05
+}
+
+impl CheckParameters for LameCylinder {
+    type Ids = BodyAndLoad;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the Lamé reference is for a one_phase analysis"));
+
+    fn check(&self, key: &str) -> Checked {
+        finite2(&at(key, "center"), self.center)?;
+        all_positive(key, &[("inner_radius", self.inner_radius), ("outer_radius", self.outer_radius)])?;
+        radii(key, self.inner_radius, self.outer_radius)?;
+        let (d, s) = (self.displacement_tolerance, self.stress_tolerance);
+        all_positive(key, &[("displacement_tolerance", d), ("stress_tolerance", s)])
+    }
+
+    fn describe(&self) -> String {
+        format!("Lamé cylinder, a = {} m, b = {} m: u_r, σ_rr, σ_θθ", self.inner_radius, self.outer_radius)
+    }
+
+    /// A linear elastic body and a line pressure.
+    fn link(&self, c: &Case) -> Result<BodyAndLoad, String> {
+        let ids = BodyAndLoad::named(c, &self.body, &self.load)?;
+        if !matches!(c.load(ids.load), Load::LinePressure(_)) {
+            return Err(format!("key `verification.load`: `{}` must be a line_pressure load", load_name(c, ids.load)));
+        }
+        linear_elastic(c, ids.body, "the Lamé reference")?;
+        Ok(ids)
+    }
+
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(LameCheck::new(c, self, ids)?))
+    }
+}
 
 /// The closed-form solution.
 #[derive(Debug, Clone, Copy)]
@@ -54,7 +115,7 @@ pub struct LameCheck {
 
 impl LameCheck {
     /// The check of a `lame` verification `spec`, whose names resolve to `ids`.
-    pub fn new(c: &Case, spec: &case::Lame, ids: &BodyAndLoad) -> Result<LameCheck, String> {
+    pub fn new(c: &Case, spec: &LameCylinder, ids: &BodyAndLoad) -> Result<LameCheck, String> {
         let (e, nu) = super::elastic_body(c, ids.body)?;
         let Load::LinePressure(load) = c.load(ids.load) else {
             return Err(format!("`{}` is not a line_pressure load", spec.load));

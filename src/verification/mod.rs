@@ -2,31 +2,30 @@
 //!
 //! A [`Check`] watches the run after every converged step and computes its metrics from the run's
 //! own particles at the end; nothing is copied from a table. The analytical solutions live in
-//! [`terzaghi`], [`biot_harmonic`] and [`waves`], each with its own unit tests.
+//! [`terzaghi`], [`xie_leo`], [`biot_harmonic`] and [`waves`], each with its own unit tests; each
+//! check's file says what it measures.
 //!
-//! * Terzaghi ([003] §4.1.1): `e_p_Tv<T>` is [003] Eq. 33, sqrt(Σ (P*−P)²)/N over the particles of
-//!   the column (note: divided by N, not √N), with P = p/q; `p_rms_error_Tv<T>` is the plain RMS
-//!   sqrt(Σ (P*−P)²/N) at every T_v; `settlement_rel_error_Tv<T>` (at the last T_v) compares the
-//!   settlement with Terzaghi's. The
-//!   settlement of the laterally confined column is its loss of volume per unit width,
-//!   (Σ V₀ − Σ V)/w, which follows every particle's J. The analytical P* is evaluated at each
-//!   particle's initial depth below the drained top, at the time the run reaches T_v (the time
-//!   stepping lands on it exactly).
-//! * Harmonic column ([003] §4.1.2): over the last `measure_periods` whole load periods each
-//!   particle's pressure is projected on cos ωt and sin ωt with a Hann window w(t) = sin²(π(t−t₀)/T_w),
-//!   A = 2 |∫ w p e^{-iωt} dt| / ∫ w dt. For a pure tone at ω over whole periods this is exact; free
-//!   vibrations at other frequencies ω' leak into it only like 1/((ω'−ω)T_w)³ (a rectangular window
-//!   leaks like 1/((ω'−ω)T_w)). `p_amplitude_max_rel_error` is max_z |A − A*| / max_z A* over the
-//!   depth profile (particles at the same depth averaged).
-//! * Shock wave ([003] §4.1.3): see [`shock`] for how arrival times are picked.
+//! A case asks for a check by its table `[verification]` and that table's `kind`. A new check is
+//! one file in this folder and one line in the registry `verification_kinds!` (with the `pub mod`
+//! line that compiles the file). The file holds the check's parameters as a case file gives them,
+//! a serde table whose doc comments the case reference renders, implementing [`CheckParameters`]
+//! (their ranges, their description, what the check needs of the analysis and of the bodies,
+//! loads, boundaries and stages its names give, the ids of those, and the [`Check`] it builds in
+//! two and, where it can, three dimensions), and the check itself. The registry's line
+//! `Variant(file::Parameters) = "kind",` makes the check a variant of [`Verification`], through
+//! which validation ([`Verification::validate`]) and the run ([`for_case_in`]) ask the trait. The
+//! case file's schema keeps the table untyped ([`crate::case::VerificationTable`]): the checks
+//! build on the model, which builds on the case.
 
 pub mod bearing;
 pub mod biot_harmonic;
 pub mod checkerboard;
+pub mod consolidation;
 pub mod cook;
 pub mod dam_break;
 pub mod elastic_column;
 pub mod figures;
+pub mod harmonic_column;
 pub mod hollow_cylinder;
 pub mod lame;
 pub mod patch;
@@ -38,14 +37,13 @@ pub mod vertical_cut;
 pub mod waves;
 pub mod xie_leo;
 
-use crate::case::{
-    self, BodyAndLoad, BodyId, Case, ConductivityLaw, LinkedVerification, LoadId, SoilModel, TimeFunction,
-};
+use crate::case::{BodyId, Case, CaseFile, Formulation, Geometry, LoadId, SoilModel};
+use crate::check::{at, at_most, positive, Checked};
 use crate::layout::Dim;
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// One verification metric as written to `summary.json`.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -221,9 +219,365 @@ impl Column {
     }
 }
 
-/// The checks a case of dimension D may ask for: every check in the plane ([`for_case`]); in
-/// three dimensions those validation lets a three-dimensional case ask for (the consolidating
-/// column against Terzaghi, the bearing capacity, the run-out and the patch test).
+/// The body a check follows and the load it compares with (the keys `body` and `load`).
+#[derive(Debug, Clone, Copy)]
+pub struct BodyAndLoad {
+    /// `body`.
+    pub body: BodyId,
+    /// `load`.
+    pub load: LoadId,
+}
+
+impl BodyAndLoad {
+    /// The ids of the body called `body` and the load called `load`.
+    fn named(c: &Case, body: &str, load: &str) -> Result<BodyAndLoad, String> {
+        Ok(BodyAndLoad {
+            body: c.body_named("verification.body", body)?,
+            load: c.load_named("verification.load", load)?,
+        })
+    }
+
+    /// [`BodyAndLoad::named`], the load one whose reference follows its time function
+    /// ([`plain_load`]).
+    fn plain(c: &Case, body: &str, load: &str) -> Result<BodyAndLoad, String> {
+        let ids = BodyAndLoad::named(c, body, load)?;
+        plain_load(c, ids.load)?;
+        Ok(ids)
+    }
+}
+
+/// The name of a load.
+fn load_name(c: &Case, load: LoadId) -> &str {
+    c.load(load).name()
+}
+
+/// A load whose reference follows its time function: without an `increment_factor` (only the
+/// hollow cylinder's check follows one).
+fn plain_load(c: &Case, load: LoadId) -> Checked {
+    if c.load(load).increment_factor().is_some() {
+        return Err(format!(
+            "key `verification.load`: the check's reference follows the load's time function, and `{}` has an \
+             `increment_factor` (only the hollow_cylinder check follows one)",
+            load_name(c, load)
+        ));
+    }
+    Ok(())
+}
+
+/// A linear elastic body, which `reference` needs.
+fn linear_elastic(c: &Case, body: BodyId, reference: &str) -> Checked {
+    if !matches!(c.material_of(body).model, SoilModel::LinearElastic(_)) {
+        return Err(format!(
+            "key `verification.body`: {reference} needs a linear elastic body, and `{}` is not",
+            c.body(body).name
+        ));
+    }
+    Ok(())
+}
+
+/// Each of `values` above zero, named `key[j]`.
+fn each_positive(key: &str, values: &[f64]) -> Checked {
+    values.iter().enumerate().try_for_each(|(j, &v)| positive(&format!("{key}[{j}]"), v))
+}
+
+/// Each `(field, value)` above zero, and a tolerance at most 1 ([`tolerance`]).
+fn all_positive(key: &str, fields: &[(&str, f64)]) -> Checked {
+    fields.iter().try_for_each(|&(f, v)| {
+        if f.ends_with("tolerance") {
+            tolerance(&at(key, f), v)
+        } else {
+            positive(&at(key, f), v)
+        }
+    })
+}
+
+/// A verification tolerance: every one bounds a normalised error, so it is positive and at most 1
+/// (a tolerance of 100 % or more lets any answer pass).
+fn tolerance(key: &str, v: f64) -> Checked {
+    positive(key, v)?;
+    at_most(key, v, 1.0, "", "it bounds a normalised error, and 100 % or more lets any answer pass")
+}
+
+/// The spray fraction's range [0, 0.05].
+fn spray(key: &str, v: f64) -> Checked {
+    if !(0.0..=0.05).contains(&v) {
+        return Err(format!("key `{}`: must be in [0, 0.05], got {v}", at(key, "spray_fraction")));
+    }
+    Ok(())
+}
+
+/// An outer radius beyond the inner one.
+fn radii(key: &str, inner: f64, outer: f64) -> Checked {
+    if outer <= inner {
+        return Err(format!("key `{}`: must exceed `inner_radius`", at(key, "outer_radius")));
+    }
+    Ok(())
+}
+
+/// A check's parameters as the case file gives them (the table `[verification]` beside its
+/// `kind`): their ranges, their description, what the check needs of the case, the names they give
+/// resolved to ids, and the check they make.
+pub trait CheckParameters {
+    /// The ids of the bodies, loads, boundaries and stages the parameters name.
+    type Ids;
+
+    /// The formulation the check is for, with the message of a case of the other (after
+    /// ``key `verification`: ``); `None` where either will do.
+    const FORMULATION: Option<(Formulation, &'static str)> = None;
+
+    /// Whether a three-dimensional case may ask for the check ([`CheckParameters::solid`] builds
+    /// it there).
+    const SOLID: bool = false;
+
+    /// Whether an axisymmetric case may ask for the check (a plane-strain reference cannot check
+    /// one).
+    const AXISYMMETRIC: bool = false;
+
+    /// Checks the ranges of the parameters and what they require of each other; `key` is the
+    /// table (`verification`).
+    fn check(&self, key: &str) -> Checked;
+
+    /// The check in words and numbers, for `porompm check`.
+    fn describe(&self) -> String;
+
+    /// The ids of what the parameters name (``key `verification.body`: no body named `x` ``
+    /// otherwise), after checking what the check needs of those tables and of the case beyond
+    /// its formulation and dimension (a linear elastic body, a body-force load, ...). Validation
+    /// asks it, and the run again to build the check.
+    fn link(&self, c: &Case) -> Result<Self::Ids, String>;
+
+    /// The check of a plane or axisymmetric case whose names resolve to `ids` (collective).
+    fn plane(&self, c: &Case, ids: &Self::Ids, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String>;
+
+    /// The check of a three-dimensional case whose names resolve to `ids` (collective); a check
+    /// with [`CheckParameters::SOLID`] builds it, and validation refuses the others' cases.
+    fn solid(
+        &self,
+        _c: &Case,
+        _ids: &Self::Ids,
+        _model: &Model<3>,
+        _coll: &Collective,
+    ) -> Result<Box<dyn Check<3>>, String> {
+        Err("the check is two-dimensional".into())
+    }
+}
+
+/// What a check needs of a case's analysis: [`CheckParameters`]'s constants.
+#[derive(Debug, Clone, Copy)]
+struct Needs {
+    formulation: Option<(Formulation, &'static str)>,
+    solid: bool,
+    axisymmetric: bool,
+}
+
+impl Needs {
+    /// The needs of the check of parameters `P`.
+    const fn of<P: CheckParameters>() -> Needs {
+        Needs { formulation: P::FORMULATION, solid: P::SOLID, axisymmetric: P::AXISYMMETRIC }
+    }
+
+    /// Whether case `c`'s dimension, geometry and formulation are the check's (`kind` names it).
+    fn check(&self, c: &Case, kind: &str) -> Checked {
+        if c.dimension() == 3 && !self.solid {
+            return Err(format!(
+                "key `verification.kind = \"{kind}\"`: not available in a three-dimensional case yet \
+                 (docs/dimensions.md)"
+            ));
+        }
+        if c.analysis.geometry == Geometry::Axisymmetric && !self.axisymmetric {
+            let can: Vec<String> =
+                Verification::NEEDS.iter().filter(|(_, n)| n.axisymmetric).map(|(k, _)| format!("`{k}`")).collect();
+            let can = match can.split_last() {
+                Some((last, [])) => last.clone(),
+                Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+                None => "none".into(),
+            };
+            return Err(format!(
+                "key `verification`: the `{kind}` reference is a plane-strain solution and cannot check an \
+                 axisymmetric analysis (of the checks, {can} can)"
+            ));
+        }
+        match self.formulation {
+            Some((f, message)) if f != c.analysis.formulation => Err(format!("key `verification`: {message}")),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The registry of the checks: each line names a check's variant, its parameters' type and the
+/// `kind` a case file chooses it by (with the variant's doc comment, which the case reference
+/// shows). It makes [`Verification`], the case file's table `[verification]` typed, internally
+/// tagged by `kind`, whose methods ask the variant's [`CheckParameters`].
+macro_rules! verification_kinds {
+    ($($(#[$attr:meta])* $variant:ident($params:ty) = $kind:literal,)*) => {
+        /// The analytical reference of a case.
+        #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+        #[serde(tag = "kind")]
+        pub enum Verification {
+            $($(#[$attr])* #[serde(rename = $kind)] $variant($params),)*
+        }
+
+        impl Verification {
+            /// The `kind` of every check with what it needs of the analysis, in the registry's
+            /// order.
+            const NEEDS: &'static [(&'static str, Needs)] = &[$(($kind, Needs::of::<$params>()),)*];
+
+            /// The `kind` the case file names.
+            pub fn kind(&self) -> &'static str {
+                match self {
+                    $(Verification::$variant(_) => $kind,)*
+                }
+            }
+
+            /// Checks the ranges of the check's parameters; `key` is its table (`verification`).
+            pub fn check(&self, key: &str) -> Checked {
+                match self {
+                    $(Verification::$variant(p) => CheckParameters::check(p, key),)*
+                }
+            }
+
+            /// The check in words and numbers, for `porompm check`.
+            pub fn describe(&self) -> String {
+                match self {
+                    $(Verification::$variant(p) => CheckParameters::describe(p),)*
+                }
+            }
+
+            /// What the check needs of the analysis.
+            fn needs(&self) -> Needs {
+                match self {
+                    $(Verification::$variant(_) => Needs::of::<$params>(),)*
+                }
+            }
+
+            /// Whether the names resolve and the tables they name are what the check needs
+            /// ([`CheckParameters::link`]).
+            fn link(&self, c: &Case) -> Checked {
+                match self {
+                    $(Verification::$variant(p) => CheckParameters::link(p, c).map(drop),)*
+                }
+            }
+
+            /// The check of a plane or axisymmetric case (collective).
+            fn plane(&self, c: &Case, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+                match self {
+                    $(Verification::$variant(p) => p.plane(c, &p.link(c)?, model, coll),)*
+                }
+            }
+
+            /// The check of a three-dimensional case (collective).
+            fn solid(&self, c: &Case, model: &Model<3>, coll: &Collective) -> Result<Box<dyn Check<3>>, String> {
+                if !self.needs().solid {
+                    return Err(format!("the `{}` check is two-dimensional", self.kind()));
+                }
+                match self {
+                    $(Verification::$variant(p) => p.solid(c, &p.link(c)?, model, coll),)*
+                }
+            }
+        }
+    };
+}
+
+verification_kinds! {
+    /// One-dimensional consolidation ([003] §4.1.1, Eqs. 31–33); two-phase.
+    Terzaghi(consolidation::TerzaghiConsolidation) = "terzaghi",
+    /// Steady-state harmonic column (Zienkiewicz, Chang & Bettess 1980; [003] §4.1.2); two-phase.
+    HarmonicColumn(harmonic_column::HarmonicColumn) = "harmonic_column",
+    /// Elastic column under its self-weight and a surcharge, at rest at the end of the run: the
+    /// vertical stress is −(ρ g d + q) at depth d and the settlement ρ g H²/(2 E_c) + q H/E_c;
+    /// one-phase.
+    ElasticColumn(elastic_column::ElasticColumn) = "elastic_column",
+    /// Load–settlement of a strip (or, in three dimensions, a rectangular) footing and its bearing
+    /// capacity ([000] §4.1, §4.3).
+    BearingCapacity(bearing::BearingCapacity) = "bearing_capacity",
+    /// Large-strain one-dimensional consolidation (Xie & Leo 2004; [003] §4.2); two-phase.
+    LargeStrainConsolidation(consolidation::LargeStrainConsolidation) = "large_strain_consolidation",
+    /// A homogeneous deformation (patch test, rigid rotation): a body whose boundary nodes follow a
+    /// boundary's `velocity_gradient` must carry one uniform stress, equal to the linear-elastic
+    /// one of the flow, R σ₀ Rᵀ + D ln V with F = exp(L ∫f) = V R (exact for a pure stretch and for
+    /// a pure rotation); one-phase.
+    Patch(patch::Patch) = "patch",
+    /// A thick-walled cylinder under internal pressure in plane strain (Lamé): a quarter of it
+    /// (symmetry on the axes through `center`), linear elastic, loaded by a `line_pressure` on its
+    /// inner circle. Metrics: the relative L2 errors (weighted by the points' volumes) of the radial
+    /// displacement and of σ_rr and σ_θθ over the body's points against
+    /// u_r = (1 + ν) p a² ((1 − 2ν) r + b²/r) / (E (b² − a²)),
+    /// σ_rr = p a² (1 − b²/r²)/(b² − a²), σ_θθ = p a² (1 + b²/r²)/(b² − a²); one-phase.
+    Lame(lame::LameCylinder) = "lame",
+    /// A thick-walled hollow cylinder under internal pressure in axial symmetry, its outer wall held
+    /// radially and plane strain along the axis ([001] §3.1): Lamé's closed form with u_r(b) = 0,
+    /// compared after the first load step (the first increment of [001]); one-phase.
+    HollowCylinder(hollow_cylinder::HollowCylinder) = "hollow_cylinder",
+    /// The nodal stiffness diagnostic K_mag = √(K_x² + K_y²) ([001] Eq. 25, §6) of a block of
+    /// material points in plane strain against the finite-element value of an interior node of a
+    /// uniform Q4 mesh of square cells, (4/3)(D₁₁ + G)√2, over the nodes within `radius` of
+    /// `center`, after the last step.
+    StiffnessMap(stiffness_map::StiffnessMap) = "stiffness_map",
+    /// The vertical cut of [001] §3.2 and §7.2: no closed form; the run stops when the toe has
+    /// moved `stop_displacement`, and reports the constitutive check q ≤ √3 c(ε̄) at every point
+    /// and step, the largest ε̄, the smoothness of the nodal K_mag and F^int_mag when the toe passes
+    /// each of `snapshots`, and the total variation of σ_m at the points `b` and `c`.
+    VerticalCut(vertical_cut::VerticalCut) = "vertical_cut",
+    /// Cook's membrane of [002] §4.1: the tapered plate clamped on its left edge and sheared on its
+    /// right, brought to rest. The vertical displacement of the tip (the upper-right corner), by a
+    /// linear least-squares fit of the points' displacements around it, against `reference`; the
+    /// chequerboard index of the mean stress over the body's points; one-phase.
+    CookMembrane(cook::CookMembrane) = "cook_membrane",
+    /// The collapse of a water column after a gate is removed ([002] §4.3). A settling stage brings
+    /// the water to rest behind the gate (the stage names it; the gate is a boundary the next
+    /// stages leave out); at its end the pressure must be hydrostatic. After it, the front and the
+    /// centre of mass are followed, the front's advance is bounded by the shallow-water (Ritter)
+    /// speed 2√(gH), and the mass must not change. With `experiment`, the front is compared with a
+    /// laboratory series; one-phase.
+    DamBreak(dam_break::DamBreak) = "dam_break",
+    /// The run-out of a slope that fails after a trigger ([002] §4.4, the landslide). Before the
+    /// trigger stage the slope must stand (its front advances by at most `standing_advance` and no
+    /// point moves faster than `standing_speed` at the trigger); the body's mass must keep. From the
+    /// trigger on, the front (the leading edge along +x with at most `spray_fraction` of the mass
+    /// ahead of it, as the dam break's), its advance R(t) (the run-out), the foremost point, the
+    /// centre of mass, the largest accumulated plastic strain and the rearmost point that has failed
+    /// are followed. There is no reference solution: the run-out is a result, compared between
+    /// runs; one-phase.
+    Runout(runout::Runout) = "runout",
+    /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35); two-phase.
+    ShockWave(shock::ShockWave) = "shock_wave",
+}
+
+impl Verification {
+    /// The case's `[verification]` as its check's typed parameters, if it has one; a table that
+    /// does not fit is one line naming its key (``key `verification.kind`: unknown variant ...``,
+    /// ``key `verification`: unknown field ...``).
+    pub fn of(c: &CaseFile) -> Result<Option<Verification>, String> {
+        let Some(table) = &c.verification else {
+            return Ok(None);
+        };
+        c.table_as("verification", table.as_value()).map(Some)
+    }
+
+    /// Validation's checks of the case's verification, if it has one: the table fits its kind,
+    /// the parameters' ranges, the case's dimension, geometry and formulation, and the names with
+    /// what the check needs of the tables they name.
+    pub fn validate(c: &Case) -> Checked {
+        let Some(v) = Verification::of(c)? else {
+            return Ok(());
+        };
+        v.check("verification")?;
+        v.needs().check(c, v.kind())?;
+        v.link(c)
+    }
+}
+
+/// The case's verification in words and numbers (`none` without one), for `porompm check`.
+pub fn describe(c: &Case) -> String {
+    match Verification::of(c) {
+        Ok(Some(v)) => v.describe(),
+        Ok(None) => "none".into(),
+        Err(e) => e,
+    }
+}
+
+/// The checks a case of dimension D may ask for: every check in the plane; in three dimensions
+/// those whose parameters say [`CheckParameters::SOLID`].
 pub trait CaseChecks<const D: usize> {
     /// The check the case asks for, if any (collective).
     fn for_case(c: &Case, model: &Model<D>, coll: &Collective) -> Result<Option<Box<dyn Check<D>>>, String>;
@@ -231,28 +585,18 @@ pub trait CaseChecks<const D: usize> {
 
 impl CaseChecks<2> for Dim<2> {
     fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box<dyn Check>>, String> {
-        for_case(c, model, coll)
+        Verification::of(c)?.map(|v| v.plane(c, model, coll)).transpose()
     }
 }
 
 impl CaseChecks<3> for Dim<3> {
     fn for_case(c: &Case, model: &Model<3>, coll: &Collective) -> Result<Option<Box<dyn Check<3>>>, String> {
-        use LinkedVerification as V;
-        Ok(Some(match c.linked_verification() {
-            None => return Ok(None),
-            Some(V::Terzaghi(t, ids)) => Box::new(terzaghi_check(c, model, coll, t, ids)?),
-            Some(V::BearingCapacity(b, ids)) => Box::new(bearing::BearingCheck::new(c, model, coll, b, ids)?),
-            Some(V::Runout(r, ids)) => Box::new(runout::RunoutCheck::new(c, model, coll, r, ids)?),
-            Some(V::Patch(p, ids)) => Box::new(patch::PatchCheck::new(c, model, p, ids)?),
-            Some(_) => {
-                let kind = c.verification.as_ref().map_or("", |v| v.kind());
-                return Err(format!("the `{kind}` check is two-dimensional"));
-            }
-        }))
+        Verification::of(c)?.map(|v| v.solid(c, model, coll)).transpose()
     }
 }
 
-/// The check the case asks for in dimension D ([`CaseChecks`]).
+/// The check the case asks for in dimension D ([`CaseChecks`]), its parameters typed and its names
+/// resolved by the registry from the case's table.
 pub fn for_case_in<const D: usize>(
     c: &Case,
     model: &Model<D>,
@@ -262,534 +606,4 @@ where
     Dim<D>: CaseChecks<D>,
 {
     <Dim<D> as CaseChecks<D>>::for_case(c, model, coll)
-}
-
-/// The consolidating column of the case's `terzaghi` verification, in any dimension.
-fn terzaghi_check<const D: usize>(
-    c: &Case,
-    model: &Model<D>,
-    coll: &Collective,
-    spec: &case::Terzaghi,
-    ids: &BodyAndLoad,
-) -> Result<ConsolidationCheck, String> {
-    let col = Column::from_case(c, model, ids)?;
-    let theory = terzaghi::Terzaghi::new(
-        col.load * load_factor(c, ids.load, c.end_time()).abs(),
-        col.height,
-        col.constrained_modulus,
-        col.inv_q,
-        col.conductivity,
-        col.water_density * col.g,
-    );
-    theory.validate()?;
-    let targets = spec
-        .time_factors
-        .iter()
-        .enumerate()
-        .map(|(i, &tv)| Target {
-            label: format!("Tv{}", tv_name(tv)),
-            t: theory.time_for(tv),
-            full: i + 1 == spec.time_factors.len(),
-            result: None,
-            profile: Vec::new(),
-        })
-        .collect();
-    let tol = (spec.e_p_tolerance, spec.p_rms_tolerance, spec.settlement_tolerance);
-    ConsolidationCheck::new(col, Theory::Terzaghi(theory), targets, tol, model, coll)
-}
-
-/// The large-strain column of the case's `large_strain_consolidation` verification.
-fn large_strain_check(
-    c: &Case,
-    model: &Model,
-    coll: &Collective,
-    spec: &case::LargeStrainConsolidation,
-    ids: &BodyAndLoad,
-) -> Result<ConsolidationCheck, String> {
-    let col = Column::from_case(c, model, ids)?;
-    if c.material_of(ids.body).hydraulic_conductivity_law != ConductivityLaw::XieLeo {
-        return Err(format!(
-            "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{}`",
-            c.body(ids.body).name
-        ));
-    }
-    let theory = xie_leo::XieLeo {
-        load: col.load * load_factor(c, ids.load, c.end_time()).abs(),
-        height: col.height,
-        m_v: 1.0 / col.constrained_modulus,
-        conductivity: col.conductivity,
-        water_unit_weight: col.water_density * col.g,
-    };
-    theory.validate()?;
-    let targets = spec
-        .degrees
-        .iter()
-        .map(|&u| Target {
-            label: format!("Us{}", tv_name(u)),
-            t: theory.time_for_degree(u),
-            full: true,
-            result: None,
-            profile: Vec::new(),
-        })
-        .collect();
-    let tol = (spec.e_p_tolerance, spec.p_rms_tolerance, spec.settlement_tolerance);
-    ConsolidationCheck::new(col, Theory::XieLeo(theory), targets, tol, model, coll)
-}
-
-/// The check the case asks for, if any.
-pub fn for_case(c: &Case, model: &Model, coll: &Collective) -> Result<Option<Box<dyn Check>>, String> {
-    use LinkedVerification as V;
-    let Some(v) = c.linked_verification() else {
-        return Ok(None);
-    };
-    Ok(Some(match v {
-        V::Patch(p, ids) => Box::new(patch::PatchCheck::new(c, model, p, ids)?),
-        V::Lame(l, ids) => Box::new(lame::LameCheck::new(c, l, ids)?),
-        V::HollowCylinder(h, ids) => Box::new(hollow_cylinder::HollowCylinderCheck::new(c, h, ids)?),
-        V::StiffnessMap(s, body) => Box::new(stiffness_map::StiffnessMapCheck::new(c, s, *body)?),
-        V::VerticalCut(v, body) => Box::new(vertical_cut::VerticalCutCheck::new(c, v, *body)?),
-        V::CookMembrane(m, body) => Box::new(cook::CookCheck::new(c, m, *body)),
-        V::DamBreak(d, ids) => Box::new(dam_break::DamBreakCheck::new(c, model, coll, d, ids)?),
-        V::Runout(r, ids) => Box::new(runout::RunoutCheck::new(c, model, coll, r, ids)?),
-        V::Terzaghi(t, ids) => Box::new(terzaghi_check(c, model, coll, t, ids)?),
-        V::LargeStrainConsolidation(x, ids) => Box::new(large_strain_check(c, model, coll, x, ids)?),
-        V::HarmonicColumn(h, ids) => {
-            let col = Column::from_case(c, model, ids)?;
-            let Some(TimeFunction::Harmonic(f)) = c.load_time_function(ids.load) else {
-                let name = c.load(ids.load).name();
-                return Err(format!("verification load `{name}` must have a harmonic time function"));
-            };
-            Box::new(HarmonicCheck::new(col, f.angular_frequency, c.end_time(), h.measure_periods, h.tolerance)?)
-        }
-        V::ElasticColumn(e, ids) => Box::new(elastic_column::ElasticColumnCheck::new(c, model, coll, e, ids)?),
-        V::BearingCapacity(b, ids) => Box::new(bearing::BearingCheck::new(c, model, coll, b, ids)?),
-        V::ShockWave(s, ids) => {
-            let col = Column::from_case(c, model, ids)?;
-            Box::new(shock::ShockCheck::new(col, s.probe_depth, s.fast_tolerance, s.slow_tolerance, model, coll)?)
-        }
-    }))
-}
-
-/// Format of a time factor in metric names (`0.1`, `0.5`).
-fn tv_name(tv: f64) -> String {
-    format!("{tv}")
-}
-
-/// The consolidation theory a [`ConsolidationCheck`] compares with.
-enum Theory {
-    /// Small strain, compressible pore fluid.
-    Terzaghi(terzaghi::Terzaghi),
-    /// Large strain (Xie & Leo 2004).
-    XieLeo(xie_leo::XieLeo),
-}
-
-impl Theory {
-    fn load(&self) -> f64 {
-        match self {
-            Theory::Terzaghi(t) => t.load,
-            Theory::XieLeo(x) => x.load,
-        }
-    }
-    fn pressure(&self, depth: f64, t: f64) -> f64 {
-        match self {
-            Theory::Terzaghi(th) => th.pressure(depth, t),
-            Theory::XieLeo(x) => x.pressure(depth, t),
-        }
-    }
-    fn settlement(&self, t: f64) -> f64 {
-        match self {
-            Theory::Terzaghi(th) => th.settlement(t),
-            Theory::XieLeo(x) => x.settlement(t),
-        }
-    }
-    fn degree(&self, t: f64) -> f64 {
-        match self {
-            Theory::Terzaghi(th) => th.degree_of_consolidation(t),
-            Theory::XieLeo(x) => x.degree_of_consolidation(t),
-        }
-    }
-    fn time_factor(&self, t: f64) -> f64 {
-        match self {
-            Theory::Terzaghi(th) => th.time_factor(t),
-            Theory::XieLeo(x) => x.cv() * t / (x.height * x.height),
-        }
-    }
-    fn name(&self) -> &'static str {
-        match self {
-            Theory::Terzaghi(_) => "Terzaghi",
-            Theory::XieLeo(_) => "Xie & Leo",
-        }
-    }
-}
-
-/// A time at which a consolidation check evaluates its metrics.
-struct Target {
-    /// Suffix of the metric names (`Tv0.1`, `Us0.5`).
-    label: String,
-    /// Time [s].
-    t: f64,
-    /// Whether the RMS and settlement errors are reported at this time too.
-    full: bool,
-    /// (e_p, rms, settlement error, settlement) once the run has passed the time.
-    result: Option<(f64, f64, f64, f64)>,
-    /// (initial depth, p/q) of every particle of the column at that time.
-    profile: Vec<(f64, f64)>,
-}
-
-/// Consolidation of a column (Terzaghi, or large strain after Xie & Leo), compared at given times.
-pub struct ConsolidationCheck {
-    col: Column,
-    theory: Theory,
-    prefix: &'static str,
-    targets: Vec<Target>,
-    tolerances: (f64, f64, f64),
-    volume0: f64,
-    /// (t, settlement, reference settlement) after every step.
-    history: Vec<(f64, f64, f64)>,
-}
-
-impl ConsolidationCheck {
-    fn new<const D: usize>(
-        col: Column,
-        theory: Theory,
-        targets: Vec<Target>,
-        tolerances: (f64, f64, f64),
-        model: &Model<D>,
-        coll: &Collective,
-    ) -> Result<Self, String> {
-        let v0: f64 = col.particles(model).map(|k| model.particles.volume[k]).sum();
-        let volume0 = coll.sum(&[v0])?[0];
-        let prefix = match theory {
-            Theory::Terzaghi(_) => "terzaghi",
-            Theory::XieLeo(_) => "large_strain",
-        };
-        Ok(ConsolidationCheck { col, theory, prefix, targets, tolerances, volume0, history: Vec::new() })
-    }
-
-    fn settlement<const D: usize>(&self, model: &Model<D>, coll: &Collective) -> Result<f64, String> {
-        let v: f64 = self.col.particles(model).map(|k| model.particles.volume[k]).sum();
-        Ok((self.volume0 - coll.sum(&[v])?[0]) / self.col.width)
-    }
-}
-
-impl<const D: usize> Check<D> for ConsolidationCheck {
-    fn columns(&self) -> Vec<String> {
-        ["Tv", "settlement", "settlement_analytical", "U_analytical"]
-            .iter()
-            .map(|c| format!("{}.{c}", self.prefix))
-            .collect()
-    }
-
-    fn event_times(&self) -> Vec<f64> {
-        self.targets.iter().map(|t| t.t).collect()
-    }
-
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
-        let s = self.settlement(model, coll)?;
-        let q = self.theory.load();
-        for i in 0..self.targets.len() {
-            let tt = self.targets[i].t;
-            if (t - tt).abs() <= 1e-9 * tt {
-                let local: Vec<f64> = self
-                    .col
-                    .particles(model)
-                    .flat_map(|k| [self.col.top - model.particles.x0[k][1], model.particles.p[k]])
-                    .collect();
-                let all = coll.gather(&local)?;
-                let n = all.len() / 2;
-                let sq: f64 = all.chunks(2).map(|d| (self.theory.pressure(d[0], t) / q - d[1] / q).powi(2)).sum();
-                let s_ana = self.theory.settlement(t);
-                self.targets[i].result =
-                    Some((sq.sqrt() / n as f64, (sq / n as f64).sqrt(), (s - s_ana).abs() / s_ana.abs(), s));
-                self.targets[i].profile = all.chunks(2).map(|d| (d[0], d[1] / q)).collect();
-            }
-        }
-        self.history.push((t, s, self.theory.settlement(t)));
-        Ok(vec![self.theory.time_factor(t), s, self.theory.settlement(t), self.theory.degree(t)])
-    }
-
-    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        Ok(Some(
-            self.targets
-                .iter()
-                .flat_map(|t| match t.result {
-                    Some((a, b, c, d)) => [1.0, a, b, c, d],
-                    None => [0.0; 5],
-                })
-                .collect(),
-        ))
-    }
-
-    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
-        if state.len() != 5 * self.targets.len() {
-            return Err(format!("{} values for {} consolidation targets", state.len(), self.targets.len()));
-        }
-        for (t, r) in self.targets.iter_mut().zip(state.chunks(5)) {
-            t.result = (r[0] > 0.5).then_some((r[1], r[2], r[3], r[4]));
-        }
-        Ok(())
-    }
-
-    fn finish(&mut self, _model: &Model<D>, _coll: &Collective) -> Result<Findings, String> {
-        let (ep_tol, rms_tol, s_tol) = self.tolerances;
-        let mut out = Vec::new();
-        for tg in &self.targets {
-            let missing = || format!("{} (t = {:.6e} s) was not reached by the run", tg.label, tg.t);
-            let (e_p, rms, se) = match tg.result {
-                Some((e_p, rms, se, s)) => (
-                    Metric::error(
-                        e_p,
-                        ep_tol,
-                        format!("[003] Eq. 33 over the column's particles at t = {:.6e} s", tg.t),
-                    ),
-                    Metric::error(rms, rms_tol, "RMS of (P* - P) over particles, P = p/q".into()),
-                    Metric::error(
-                        se,
-                        s_tol,
-                        format!(
-                            "settlement {s:.6e} m vs {} {:.6e} m",
-                            self.theory.name(),
-                            self.theory.settlement(tg.t)
-                        ),
-                    ),
-                ),
-                None => (
-                    Metric::error(f64::NAN, ep_tol, missing()),
-                    Metric::error(f64::NAN, rms_tol, missing()),
-                    Metric::error(f64::NAN, s_tol, missing()),
-                ),
-            };
-            out.push((format!("e_p_{}", tg.label), e_p));
-            // The RMS over the particles (not divided by their number) beside e_p at every time:
-            // e_p falls as 1/√N with the particle count for the same pointwise error.
-            out.push((format!("p_rms_error_{}", tg.label), rms));
-            if tg.full {
-                out.push((format!("settlement_rel_error_{}", tg.label), se));
-            }
-        }
-        Ok((out, Vec::new()))
-    }
-
-    fn figures(&self) -> Vec<crate::plot::Figure> {
-        let q = self.theory.load();
-        let h = self.col.height;
-        let (what, stem, depth) = match self.theory {
-            Theory::Terzaghi(_) => ("Terzaghi consolidation", "terzaghi", "depth below the drained top [m]"),
-            Theory::XieLeo(_) => {
-                ("Large-strain consolidation", "large_strain", "initial depth below the drained top [m]")
-            }
-        };
-        let profiles: Vec<_> = self
-            .targets
-            .iter()
-            .filter(|tg| !tg.profile.is_empty())
-            .map(|tg| {
-                let label = format!(
-                    "{} (t = {:.4e} s)",
-                    tg.label.replacen("Tv", "T_v = ", 1).replacen("Us", "U_s = ", 1),
-                    tg.t
-                );
-                let depths = figures::sample(0.0, h, 200, |d| d);
-                let ana = depths.iter().map(|&d| (d, self.theory.pressure(d, tg.t) / q)).collect();
-                (label, tg.profile.clone(), ana)
-            })
-            .collect();
-        let computed: Vec<(f64, f64)> = self.history.iter().map(|r| (r.0, r.1)).collect();
-        let reference: Vec<(f64, f64)> = self.history.iter().map(|r| (r.0, r.2)).collect();
-        vec![
-            figures::pressure_profiles(
-                &format!("{stem}_pressure_profiles.png"),
-                &format!("{what}: pore pressure profiles"),
-                depth,
-                self.theory.name(),
-                &profiles,
-            ),
-            figures::settlement_history(
-                &format!("{stem}_settlement.png"),
-                &format!("{what}: settlement of the column"),
-                &computed,
-                Some((self.theory.name(), &reference)),
-            ),
-        ]
-    }
-}
-
-/// Steady-state harmonic column check.
-pub struct HarmonicCheck {
-    col: Column,
-    omega: f64,
-    window: (f64, f64),
-    tolerance: f64,
-    theory: biot_harmonic::BiotSolution,
-    /// Per local particle: (∫ w p cos ωt, ∫ w p sin ωt) over the window.
-    sums: Vec<(f64, f64)>,
-    /// ∫ w dt.
-    weight: f64,
-    /// (depth, computed |p|/q) after [`Check::finish`].
-    profile: Vec<(f64, f64)>,
-}
-
-impl HarmonicCheck {
-    fn new(col: Column, omega: f64, end: f64, periods: usize, tolerance: f64) -> Result<HarmonicCheck, String> {
-        if col.inv_q <= 0.0 {
-            return Err("the harmonic column needs a compressible pore fluid (finite water_bulk_modulus)".into());
-        }
-        let period = 2.0 * std::f64::consts::PI / omega;
-        let start = end - periods as f64 * period;
-        if start <= 0.0 {
-            return Err(format!(
-                "the run ({end} s) is shorter than the {periods} measured load periods ({period:.4e} s each)"
-            ));
-        }
-        let theory = biot_harmonic::BiotColumn {
-            height: col.height,
-            constrained_modulus: col.constrained_modulus,
-            q_modulus: 1.0 / col.inv_q,
-            porosity: col.porosity,
-            solid_density: col.solid_density,
-            water_density: col.water_density,
-            conductivity: col.conductivity,
-            gravity: col.g,
-            omega,
-            load_amplitude: col.load,
-        }
-        .solve()?;
-        Ok(HarmonicCheck {
-            col,
-            omega,
-            window: (start, end),
-            tolerance,
-            theory,
-            sums: Vec::new(),
-            weight: 0.0,
-            profile: Vec::new(),
-        })
-    }
-}
-
-impl Check for HarmonicCheck {
-    fn columns(&self) -> Vec<String> {
-        Vec::new()
-    }
-
-    fn event_times(&self) -> Vec<f64> {
-        vec![self.window.0]
-    }
-
-    fn observe(&mut self, t: f64, dt: f64, model: &Model, _coll: &Collective) -> Result<Vec<f64>, String> {
-        if self.sums.len() != model.particles.len() {
-            self.sums = vec![(0.0, 0.0); model.particles.len()];
-        }
-        // Right-endpoint sums (the window vanishes at both ends, so this is the trapezoidal rule).
-        if t > self.window.0 + 1e-9 * dt && t <= self.window.1 + 1e-9 * dt {
-            let tw = self.window.1 - self.window.0;
-            let w = (std::f64::consts::PI * (t - self.window.0) / tw).sin().powi(2);
-            self.weight += w * dt;
-            let (c, s) = ((self.omega * t).cos(), (self.omega * t).sin());
-            for k in self.col.particles(model) {
-                self.sums[k].0 += w * model.particles.p[k] * c * dt;
-                self.sums[k].1 += w * model.particles.p[k] * s * dt;
-            }
-        }
-        Ok(Vec::new())
-    }
-
-    /// ∫ w dt, then (particle id, ∫ w p cos ωt dt, ∫ w p sin ωt dt) of every particle of the column.
-    fn checkpoint_state(&self, model: &Model, coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        let local: Vec<f64> = self
-            .col
-            .particles(model)
-            .flat_map(|k| {
-                let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
-                [model.particles.id[k] as f64, c, s]
-            })
-            .collect();
-        let mut state = vec![self.weight];
-        state.extend(coll.gather(&local)?);
-        Ok(Some(state))
-    }
-
-    fn restore_state(&mut self, state: &[f64], model: &Model) -> Result<(), String> {
-        if state.is_empty() || !(state.len() - 1).is_multiple_of(3) {
-            return Err(format!("{} values do not make the harmonic sums", state.len()));
-        }
-        self.weight = state[0];
-        let sums: std::collections::HashMap<u64, (f64, f64)> =
-            state[1..].chunks(3).map(|r| (r[0] as u64, (r[1], r[2]))).collect();
-        self.sums = (0..model.particles.len())
-            .map(|k| sums.get(&model.particles.id[k]).copied().unwrap_or((0.0, 0.0)))
-            .collect();
-        Ok(())
-    }
-
-    fn finish(&mut self, model: &Model, coll: &Collective) -> Result<Findings, String> {
-        if self.weight <= 0.0 {
-            return Err("the measurement window of the harmonic column was never reached".into());
-        }
-        let norm = 2.0 / self.weight;
-        let local: Vec<f64> = self
-            .col
-            .particles(model)
-            .flat_map(|k| {
-                let (c, s) = self.sums.get(k).copied().unwrap_or((0.0, 0.0));
-                [self.col.top - model.particles.x0[k][1], norm * (c * c + s * s).sqrt()]
-            })
-            .collect();
-        let all = coll.gather(&local)?;
-        // Average the particles at the same depth.
-        let mut rows: Vec<(f64, f64, usize)> = Vec::new();
-        for d in all.chunks(2) {
-            match rows.iter_mut().find(|r| (r.0 - d[0]).abs() < 1e-9 * self.col.height) {
-                Some(r) => {
-                    r.1 += d[1];
-                    r.2 += 1;
-                }
-                None => rows.push((d[0], d[1], 1)),
-            }
-        }
-        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let q = self.col.load;
-        let table: Vec<Vec<f64>> =
-            rows.iter().map(|r| vec![r.0, r.1 / r.2 as f64 / q, self.theory.pressure_amplitude(r.0) / q]).collect();
-        let peak = table.iter().map(|r| r[2]).fold(0.0, f64::max);
-        let (worst, at) =
-            table.iter().map(|r| ((r[1] - r[2]).abs(), r[0])).fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
-        let err = worst / peak;
-        self.profile = table.iter().map(|r| (r[0], r[1])).collect();
-        let metric = Metric::error(
-            err,
-            self.tolerance,
-            format!(
-                "largest |A - A*| = {worst:.4e} q at depth {at:.3} m; peak A* = {peak:.4e} q; ω = {:.4e} rad/s",
-                self.omega
-            ),
-        );
-        Ok((
-            vec![("p_amplitude_max_rel_error".into(), metric)],
-            vec![Table {
-                name: "amplitude_profile.csv".into(),
-                header: vec!["depth_m", "computed_p_amplitude_over_q", "analytical_p_amplitude_over_q"],
-                rows: table,
-            }],
-        ))
-    }
-
-    fn figures(&self) -> Vec<crate::plot::Figure> {
-        let q = self.col.load;
-        let h = self.col.height;
-        let reference: Vec<(f64, f64)> = figures::sample(0.0, h, 400, |d| d)
-            .into_iter()
-            .map(|d| (d, self.theory.pressure_amplitude(d) / q))
-            .collect();
-        vec![figures::depth_profile(
-            "harmonic_amplitude_profile.png",
-            &format!("Harmonic column: pore pressure amplitude (ω = {:.4e} rad/s)", self.omega),
-            "pore pressure amplitude |p|/q [-]",
-            "depth below the loaded top [m]",
-            "MPM (particles at one depth averaged)",
-            &self.profile,
-            "Biot, steady state",
-            &reference,
-        )]
-    }
 }

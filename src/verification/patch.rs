@@ -11,14 +11,99 @@
 //!   step, and for a pure rotation, which it rotates exactly); for a neo-Hookean body σ* is its
 //!   stress of F itself, exact to round-off.
 
-use super::{Check, Findings, Metric};
-use crate::case::{Case, Patch, PatchIds};
+use super::{all_positive, Check, CheckParameters, Findings, Metric};
+use crate::case::{BodyId, BoundaryId, Case, Formulation, SoilModel};
+use crate::check::Checked;
 use crate::model::loads::Motion;
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::soils::finite_strain::{embed, mul, M3};
 use crate::soils::principal::{self, Principal};
 use crate::soils::{Constitutive, LinearElastic, NeoHookeanLaw, Stress, NS};
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "patch"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Patch {
+    /// The name of the body (linear elastic or neo-Hookean).
+    pub body: String,
+    /// The name of the boundary whose homogeneous flow (`velocity_gradient`) drives it.
+    pub boundary: String,
+    /// Largest accepted spread of the particles' stresses, max ‖σ_p − σ̄‖/‖σ̄‖ [-], in (0, 1] (default
+    /// 1e-9).
+    #[serde(default = "default_spread_tol")]
+    pub spread_tolerance: f64,
+    /// Largest accepted ‖σ̄ − σ*‖/‖σ*‖ against the linear-elastic stress of the flow [-], in (0, 1]
+    /// (default 1e-6).
+    #[serde(default = "default_patch_tol")]
+    pub tolerance: f64,
+}
+
+fn default_spread_tol() -> f64 {
+    1e-9
+}
+fn default_patch_tol() -> f64 {
+    1e-6
+}
+
+/// What a patch test names.
+#[derive(Debug, Clone, Copy)]
+pub struct PatchIds {
+    /// `body`.
+    pub body: BodyId,
+    /// `boundary`: it has a `velocity_gradient`.
+    pub boundary: BoundaryId,
+}
+
+impl CheckParameters for Patch {
+    type Ids = PatchIds;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the patch reference is for a one_phase analysis"));
+    const SOLID: bool = true;
+
+    fn check(&self, key: &str) -> Checked {
+        all_positive(key, &[("spread_tolerance", self.spread_tolerance), ("tolerance", self.tolerance)])
+    }
+
+    fn describe(&self) -> String {
+        format!("patch test: uniform stress under the homogeneous flow of boundary `{}`", self.boundary)
+    }
+
+    /// The body, linear elastic or neo-Hookean, and the boundary, with a `velocity_gradient`.
+    fn link(&self, c: &Case) -> Result<PatchIds, String> {
+        let ids = PatchIds {
+            body: c.body_named("verification.body", &self.body)?,
+            boundary: c.boundary_named("verification.boundary", &self.boundary)?,
+        };
+        if !matches!(c.material_of(ids.body).model, SoilModel::LinearElastic(_) | SoilModel::NeoHookean(_)) {
+            return Err(format!(
+                "key `verification.body`: the patch reference needs a linear elastic or neo-Hookean body, and `{}` is \
+                 neither",
+                c.body(ids.body).name
+            ));
+        }
+        let b = c.boundary(ids.boundary);
+        if b.velocity_gradient.is_none() {
+            return Err(format!("key `verification.boundary`: `{}` has no `velocity_gradient`", b.name));
+        }
+        Ok(ids)
+    }
+
+    fn plane(&self, c: &Case, ids: &PatchIds, model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(PatchCheck::new(c, model, self, ids)?))
+    }
+
+    fn solid(
+        &self,
+        c: &Case,
+        ids: &PatchIds,
+        model: &Model<3>,
+        _coll: &Collective,
+    ) -> Result<Box<dyn Check<3>>, String> {
+        Ok(Box::new(PatchCheck::new(c, model, self, ids)?))
+    }
+}
 
 /// The patch check of a case of dimension `D`.
 pub struct PatchCheck<const D: usize = 2> {

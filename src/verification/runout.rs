@@ -20,10 +20,115 @@
 //! solution; `make study-landslide` compares the run-outs of the bases and of F̄ against standard
 //! MPM (assertions on their ratios, which do not depend on the slope's geometry).
 
-use super::{Check, Findings, Metric};
-use crate::case::{Case, Runout, RunoutIds};
+use super::{all_positive, spray, Check, CheckParameters, Findings, Metric};
+use crate::case::{BodyId, Case, Formulation, StageId};
+use crate::check::Checked;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "runout"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Runout {
+    /// The name of the sliding body (its material moves along +x).
+    pub body: String,
+    /// The name of the stage whose start triggers the failure (e.g. by its
+    /// `strength_reduction`); the run-out counts from the front's position then.
+    pub trigger_stage: String,
+    /// Largest accepted advance of the front before the trigger (the slope stands) [m], > 0
+    /// (default 0.05).
+    #[serde(default = "default_standing_advance")]
+    pub standing_advance: f64,
+    /// Largest accepted speed of any point of the body at the trigger [m/s], > 0 (default 0.01).
+    #[serde(default = "default_standing_speed")]
+    pub standing_speed: f64,
+    /// Times after the trigger at which the run-out is reported as a result (`runout_t<τ>`,
+    /// the stepping lands on them) [s], each in (0, the time from the trigger to the end].
+    #[serde(default)]
+    pub snapshot_times: Vec<f64>,
+    /// Accumulated plastic strain ε̄ beyond which a point counts as failed (the rearmost
+    /// failed point marks the retrogression of the failure) [-], > 0 (default 0.5).
+    #[serde(default = "default_failed_strain")]
+    pub failed_strain: f64,
+    /// The share of the body's mass that may lie ahead of the front [-], in [0, 0.05] (default
+    /// 1e-3).
+    #[serde(default = "default_runout_spray")]
+    pub spray_fraction: f64,
+}
+
+fn default_standing_advance() -> f64 {
+    0.05
+}
+fn default_standing_speed() -> f64 {
+    0.01
+}
+fn default_failed_strain() -> f64 {
+    0.5
+}
+fn default_runout_spray() -> f64 {
+    1.0e-3
+}
+
+/// What a run-out check names.
+#[derive(Debug, Clone, Copy)]
+pub struct RunoutIds {
+    /// `body`.
+    pub body: BodyId,
+    /// `trigger_stage`.
+    pub trigger_stage: StageId,
+}
+
+impl CheckParameters for Runout {
+    type Ids = RunoutIds;
+    const FORMULATION: Option<(Formulation, &'static str)> =
+        Some((Formulation::OnePhase, "the run-out check is for a one_phase analysis"));
+    const SOLID: bool = true;
+
+    /// Checks the standing limits, the failed strain and the spray.
+    fn check(&self, key: &str) -> Checked {
+        let (a, s, f) = (self.standing_advance, self.standing_speed, self.failed_strain);
+        all_positive(key, &[("standing_advance", a), ("standing_speed", s), ("failed_strain", f)])?;
+        spray(key, self.spray_fraction)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "run-out of a slope failing from stage `{}` on ([002] §4.4): the slope standing before it, the mass, \
+             the front's advance (no reference solution)",
+            self.trigger_stage
+        )
+    }
+
+    /// The body and the trigger stage, with the snapshot times within the stages from it on.
+    fn link(&self, c: &Case) -> Result<RunoutIds, String> {
+        let ids = RunoutIds {
+            body: c.body_named("verification.body", &self.body)?,
+            trigger_stage: c.stage_named("verification.trigger_stage", &self.trigger_stage)?,
+        };
+        let after: f64 = c.stages[ids.trigger_stage.index()..].iter().map(|s| s.duration).sum();
+        match self.snapshot_times.iter().find(|&&t| !(t > 0.0 && t <= after * (1.0 + 1e-12))) {
+            Some(t) => {
+                Err(format!("key `verification.snapshot_times`: {t} s is not within the {after} s after the trigger"))
+            }
+            None => Ok(ids),
+        }
+    }
+
+    fn plane(&self, c: &Case, ids: &RunoutIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(RunoutCheck::new(c, model, coll, self, ids)?))
+    }
+
+    fn solid(
+        &self,
+        c: &Case,
+        ids: &RunoutIds,
+        model: &Model<3>,
+        coll: &Collective,
+    ) -> Result<Box<dyn Check<3>>, String> {
+        Ok(Box::new(RunoutCheck::new(c, model, coll, self, ids)?))
+    }
+}
 
 /// Bins per cell of the leading edges' histogram.
 pub(crate) const FRONT_BINS: usize = 20;

@@ -8,9 +8,62 @@
 //! How an arrival is picked from p(t) (a step smeared by the discretisation and followed by Gibbs
 //! ringing) is documented at [`pick_arrival`].
 
-use super::{Check, Column, Findings, Metric};
+use super::consolidation::TWO_PHASE;
+use super::{all_positive, BodyAndLoad, Check, CheckParameters, Column, Findings, Metric};
+use crate::case::{Case, Formulation};
+use crate::check::Checked;
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "shock_wave"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ShockWave {
+    /// The name of the column body.
+    pub body: String,
+    /// The name of the step surface load, a particle or nodal traction.
+    pub load: String,
+    /// Depth of the observation point below the initial surface [m], > 0.
+    pub probe_depth: f64,
+    /// Pass threshold for the fast (undrained) wave arrival error [-], in (0, 1] (default 0.02).
+    #[serde(default = "default_fast_tol")]
+    pub fast_tolerance: f64,
+    /// Pass threshold for the slow (damped) wave arrival error [-], in (0, 1] (default 0.05).
+    #[serde(default = "default_slow_tol")]
+    pub slow_tolerance: f64,
+}
+
+fn default_fast_tol() -> f64 {
+    0.02
+}
+fn default_slow_tol() -> f64 {
+    0.05
+}
+
+impl CheckParameters for ShockWave {
+    type Ids = BodyAndLoad;
+    const FORMULATION: Option<(Formulation, &'static str)> = TWO_PHASE;
+
+    fn check(&self, key: &str) -> Checked {
+        let (d, f, s) = (self.probe_depth, self.fast_tolerance, self.slow_tolerance);
+        all_positive(key, &[("probe_depth", d), ("fast_tolerance", f), ("slow_tolerance", s)])
+    }
+
+    fn describe(&self) -> String {
+        format!("shock-wave arrival at {} m depth", self.probe_depth)
+    }
+
+    fn link(&self, c: &Case) -> Result<BodyAndLoad, String> {
+        BodyAndLoad::plain(c, &self.body, &self.load)
+    }
+
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+        let col = Column::from_case(c, model, ids)?;
+        let (depth, fast, slow) = (self.probe_depth, self.fast_tolerance, self.slow_tolerance);
+        Ok(Box::new(ShockCheck::new(col, depth, fast, slow, model, coll)?))
+    }
+}
 
 /// Time at which a front passes, picked from samples `(t, p)` restricted to `[t0, t1]`:
 /// the first time p crosses the mid-level between its value at `t0` and the level it settles at

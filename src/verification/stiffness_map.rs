@@ -8,11 +8,69 @@
 //! counted once, so that neither shrinks with more points); `results` has the smallest and largest
 //! ratio and the number of nodes.
 
-use super::{Check, Findings, Metric};
+use super::{all_positive, linear_elastic, Check, CheckParameters, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
-use crate::case::{BodyId, Case, StiffnessMap};
+use crate::case::{BodyId, Case, Geometry};
+use crate::check::{at, finite2, Checked};
 use crate::model::Model;
 use crate::parallel::Collective;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "stiffness_map"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StiffnessMap {
+    /// The name of the block (linear elastic, on square cells, in plane strain).
+    pub body: String,
+    /// The centre of the evaluated nodes [m].
+    pub center: [f64; 2],
+    /// The radius within which nodes are evaluated [m], > 0.
+    pub radius: f64,
+    /// Largest accepted relative deviation of K_mag at any of those nodes [-], in (0, 1] (default 0.01).
+    #[serde(default = "default_stiffness_map_tol")]
+    pub tolerance: f64,
+}
+
+fn default_stiffness_map_tol() -> f64 {
+    0.01
+}
+
+impl CheckParameters for StiffnessMap {
+    type Ids = BodyId;
+
+    fn check(&self, key: &str) -> Checked {
+        finite2(&at(key, "center"), self.center)?;
+        all_positive(key, &[("radius", self.radius), ("tolerance", self.tolerance)])
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "nodal stiffness K_mag ([001] Eq. 25) within {} m of ({}, {}) against the finite-element value",
+            self.radius, self.center[0], self.center[1]
+        )
+    }
+
+    /// A linear elastic block on square cells in plane strain.
+    fn link(&self, c: &Case) -> Result<BodyId, String> {
+        let body = c.body_named("verification.body", &self.body)?;
+        linear_elastic(c, body, "the stiffness map's reference")?;
+        let h = c.cell_size();
+        if (h[0] - h[1]).abs() > 1e-9 * h[0] {
+            return Err(format!(
+                "key `grid`: the stiffness map's reference is for square cells, got {} × {} m",
+                h[0], h[1]
+            ));
+        }
+        if c.analysis.geometry != Geometry::PlaneStrain {
+            return Err("key `verification`: the stiffness map's reference is for plane strain".into());
+        }
+        Ok(body)
+    }
+
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(StiffnessMapCheck::new(c, self, *body)?))
+    }
+}
 
 /// The stiffness-map check of a case.
 pub struct StiffnessMapCheck {

@@ -16,13 +16,70 @@
 //! * the total variation Σ|Δσ_m| over the run of the mean stress at the points nearest `b` (in
 //!   the shear band) and `c` (in the sliding block), [001]'s p–q paths of Figs. 30–31 in one number.
 
-use super::{Check, Findings, Metric};
+use super::{each_positive, Check, CheckParameters, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
-use crate::case::{BodyId, Case, SoilModel, VerticalCut};
+use crate::case::{BodyId, Case, SoilModel};
+use crate::check::{at, finite2, positive, Checked};
 use crate::model::Model;
 use crate::parallel::Collective;
 use crate::plot::MapPoints;
 use crate::soils::invariants;
+use serde::{Deserialize, Serialize};
+
+/// The parameters of `kind = "vertical_cut"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VerticalCut {
+    /// The name of the soil (von Mises).
+    pub body: String,
+    /// The toe's point at t = 0 (the nearest material point is followed) [m].
+    pub toe: [f64; 2],
+    /// The point B (in the shear band) at t = 0 [m].
+    pub b: [f64; 2],
+    /// The point C (in the sliding block) at t = 0 [m].
+    pub c: [f64; 2],
+    /// The toe's horizontal displacement that ends the run [m], > 0.
+    pub stop_displacement: f64,
+    /// Toe displacements at which the nodal fields' smoothness is measured [m], each > 0.
+    #[serde(default)]
+    pub snapshots: Vec<f64>,
+}
+
+impl CheckParameters for VerticalCut {
+    type Ids = BodyId;
+
+    fn check(&self, key: &str) -> Checked {
+        for (f, v) in [("toe", self.toe), ("b", self.b), ("c", self.c)] {
+            finite2(&at(key, f), v)?;
+        }
+        positive(&at(key, "stop_displacement"), self.stop_displacement)?;
+        each_positive(&at(key, "snapshots"), &self.snapshots)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "vertical cut ([001] §7.2) to a toe displacement of {} m: yield check, smoothness of K_mag and \
+             F^int_mag",
+            self.stop_displacement
+        )
+    }
+
+    /// A von Mises body.
+    fn link(&self, c: &Case) -> Result<BodyId, String> {
+        let body = c.body_named("verification.body", &self.body)?;
+        if !matches!(c.material_of(body).model, SoilModel::VonMises(_)) {
+            return Err(format!(
+                "key `verification.body`: the vertical cut's checks need a von_mises body, and `{}` is not",
+                c.body(body).name
+            ));
+        }
+        Ok(body)
+    }
+
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+        Ok(Box::new(VerticalCutCheck::new(c, self, *body)?))
+    }
+}
 
 /// How far inside the material (in cells from the outermost well-filled nodes) a node of the
 /// roughness must be: 3, so that every node of its Laplacian's stencil has its whole support (a

@@ -76,7 +76,11 @@ pub struct CaseFile {
     #[serde(default)]
     pub probes: Vec<Probe>,
     /// The analytical reference the run is checked against, if any.
-    pub verification: Option<Verification>,
+    pub verification: Option<VerificationTable>,
+    /// The key path each `--set` override reached (`verification.kind`) with the key as the command
+    /// line gave it, so that a table deserialized after parsing names the override as parsing does.
+    #[serde(skip)]
+    pub(crate) overridden: Vec<(String, String)>,
 }
 
 impl CaseFile {
