@@ -265,3 +265,23 @@ fn one_and_sixteen_points_per_cell_run() {
     assert!(s["status"] == "failed" && err.contains("did not converge") && !err.contains("malloc"), "{err}");
     assert!(s["steps"].as_u64().unwrap() >= 10, "{}", s["steps"]);
 }
+
+/// A saturated column at rest under its own weight (tests/cases/hydrostatic_column.toml): once the
+/// excess pore pressure of the sudden gravity has drained (T_v = 3), the check `hydrostatic` finds
+/// p = ρ_w g (H − y) at every point within its 1 %; stopped while the column still consolidates
+/// (T_v = 0.1), the same check fails, so the metric sees the excess.
+#[test]
+fn a_drained_column_carries_the_hydrostatic_pore_pressure() {
+    let case = "tests/cases/hydrostatic_column.toml";
+    let r = common::run_case(case, &out_dir("hydrostatic_column"), &[]);
+    assert!(r.completed(), "{}", r.stderr());
+    let m = metrics(&r.summary);
+    assert_eq!(m.keys().map(String::as_str).collect::<Vec<_>>(), ["p_rel_error"]);
+    let (error, pass, tolerance) = m["p_rel_error"];
+    assert!(pass && error <= tolerance && tolerance == 0.01, "drained: p_rel_error = {error:e} against {tolerance:e}");
+    let early =
+        common::run_case(case, &out_dir("hydrostatic_column-early"), &common::set_args(&["stages.0.duration=0.1"]));
+    assert!(early.completed(), "{}", early.stderr());
+    let (error, pass, _) = metrics(&early.summary)["p_rel_error"];
+    assert!(!pass && error > 0.1, "still consolidating: p_rel_error = {error:e} passes");
+}

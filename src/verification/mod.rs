@@ -27,6 +27,7 @@ pub mod elastic_column;
 pub mod figures;
 pub mod harmonic_column;
 pub mod hollow_cylinder;
+pub mod hydrostatic;
 pub mod lame;
 pub mod patch;
 pub mod runout;
@@ -541,6 +542,11 @@ verification_kinds! {
     Runout(runout::Runout) = "runout",
     /// Shock wave in a saturated column ([003] §4.1.3, Eqs. 34–35); two-phase.
     ShockWave(shock::ShockWave) = "shock_wave",
+    /// A saturated body at rest under gravity (after a geostatic or a consolidation stage has
+    /// drained): its pore pressure must be hydrostatic, p* = ρ_w g (h_w − y) below the water table
+    /// h_w; the metric `p_rel_error` is the largest |p − p*| over the body's points relative to the
+    /// largest |p*|; two-phase.
+    Hydrostatic(hydrostatic::Hydrostatic) = "hydrostatic",
 }
 
 impl Verification {
