@@ -711,6 +711,14 @@ fn bad_values_across_the_case_are_named() {
             ("verification.body=nonesuch", "key `verification.body`: no body named `nonesuch`"),
         ],
     );
+    // Xie & Leo's reference needs their conductivity law.
+    assert_sets_refused(
+        "cases/large_strain_consolidation.toml",
+        &[(
+            "materials.0.hydraulic_conductivity_law=constant",
+            "key `verification.body`: the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\"",
+        )],
+    );
 }
 
 /// `porompm check` lists the physics warnings of a case (what would lock or oscillate), and a

@@ -172,17 +172,19 @@ impl CheckParameters for LargeStrainConsolidation {
     }
 
     fn link(&self, c: &Case) -> Result<BodyAndLoad, String> {
-        BodyAndLoad::plain(c, &self.body, &self.load)
+        let ids = BodyAndLoad::plain(c, &self.body, &self.load)?;
+        if c.material_of(ids.body).hydraulic_conductivity_law != ConductivityLaw::XieLeo {
+            return Err(format!(
+                "key `verification.body`: the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" \
+                 for the material of `{}`",
+                c.body(ids.body).name
+            ));
+        }
+        Ok(ids)
     }
 
     fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
         let col = Column::from_case(c, model, ids)?;
-        if c.material_of(ids.body).hydraulic_conductivity_law != ConductivityLaw::XieLeo {
-            return Err(format!(
-                "the large-strain reference assumes hydraulic_conductivity_law = \"xie_leo\" for the material of `{}`",
-                c.body(ids.body).name
-            ));
-        }
         let theory = xie_leo::XieLeo {
             load: col.load * load_factor(c, ids.load, c.end_time()).abs(),
             height: col.height,
