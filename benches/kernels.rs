@@ -40,22 +40,19 @@ fn noise(i: usize) -> f64 {
     2.0 * (x - x.floor()) - 1.0
 }
 
+/// Particle `k`'s stencil and B̄'s volumetric gradients (every cell its own root, plane strain).
+fn stencil_of(model: &Model, k: usize) -> (shape::Stencil, [[f64; 2]; shape::MAX_STENCIL]) {
+    let ps = &model.particles;
+    let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
+    let gv = shape::volumetric_operators(model.basis, &model.grid, ps.x[k], ps.lp[k], &mut st, &|i, j| (i, j), false).0;
+    (st, gv)
+}
+
 /// The GIMP basis with B̄ of every particle.
 fn bases(model: &Model) -> Vec<Vec<NodeBasis>> {
-    let ps = &model.particles;
-    (0..ps.len())
+    (0..model.particles.len())
         .map(|k| {
-            let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-            let gv = shape::volumetric_operators(
-                model.basis,
-                &model.grid,
-                ps.x[k],
-                ps.lp[k],
-                &mut st,
-                &|i, j| (i, j),
-                false,
-            )
-            .0;
+            let (st, gv) = stencil_of(model, k);
             (0..st.len).map(|n| NodeBasis { s: st.w[n], g: st.dw[n], gv: gv[n], t: 0.0, tv: 0.0 }).collect()
         })
         .collect()
@@ -84,17 +81,7 @@ fn particle_kernels(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = 0.0;
             for k in 0..n {
-                let mut st = shape::stencil(model.basis, &model.grid, ps.x[k], ps.lp[k]);
-                let gv = shape::volumetric_operators(
-                    model.basis,
-                    &model.grid,
-                    ps.x[k],
-                    ps.lp[k],
-                    &mut st,
-                    &|i, j| (i, j),
-                    false,
-                )
-                .0;
+                let (st, gv) = stencil_of(&model, k);
                 sum += st.w[0] + gv[0][0];
             }
             black_box(sum)
