@@ -18,8 +18,10 @@
 //! [Pa] and `dU` [m]), and [001]'s nodal diagnostics `K_mag` = √(K_x² + K_y²) (Eq. 25, the diagonal
 //! of the skeleton's stiffness at the node's x and y dofs [N/m per m]) and `Fint_mag` (Eq. 26 with its
 //! squares, the skeleton's internal force [N/m per m]) from the particles that reach the node; all zero
-//! before the first step (e.g. at t = 0 and at the restart time). Node coordinates are the grid's
-//! geometry.
+//! before the first step (e.g. at t = 0 and at the restart time). The diagnostics are computed for
+//! the frames written every `output.fields_every` steps and at each stage's end; a frame written
+//! when a run stops early or is interrupted between those carries NaN for them. Node coordinates
+//! are the grid's geometry.
 
 use crate::assembly::{node_values, NodeBlock};
 use crate::io::fields::{Field, Frame, GridGeometry, Values};

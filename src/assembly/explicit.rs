@@ -68,7 +68,7 @@
 //!
 //! The nodal sums are local (each rank's points) and summed over ranks like every nodal vector.
 
-use super::points::{node_states, particle_input, Points};
+use super::points::{node_displacements, node_states, particle_input, Points};
 use super::prepare::start_value;
 use super::space::NodeSpace;
 use super::stencils::Stencils;
@@ -246,9 +246,8 @@ fn fbar_scales<const D: usize, const M: usize, const N: usize>(
     let dj: Vec<f64> = (0..st.len())
         .map(|k| {
             let (nodes, _) = st.get(k);
-            let states = node_states::<D, M, N>(step, k, &solution.increments);
-            let d = states[..nodes.len()].iter().map(|s| std::array::from_fn(|c| s.d[c]));
-            Kinematics::new(st.strain_of(k), d, false).j
+            let d = node_displacements(step, k, &solution.increments);
+            Kinematics::new(st.strain_of(k), d[..nodes.len()].iter().copied(), false).j
         })
         .collect();
     let own: Vec<f64> = (0..dj.len()).map(|k| det(&ps.def_grad[k]) * dj[k]).collect();

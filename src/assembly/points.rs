@@ -66,6 +66,31 @@ pub(super) fn node_states<const D: usize, const M: usize, const N: usize>(
     out
 }
 
+/// The solid displacement increments (the first D dofs) of particle `k`'s raw stencil from the
+/// ghosted increments `xl`, extended nodes taken from their masters: [`node_states`]' `d` of
+/// the solid, without the rest of a node's state (what the kinematics of the point need).
+#[inline]
+pub(super) fn node_displacements<const D: usize, const M: usize>(
+    step: &Step<D, M>,
+    k: usize,
+    xl: &[f64],
+) -> [[f64; D]; M] {
+    let nd = step.dofs.nd;
+    let (nodes, _) = step.stencils.get(k);
+    let eff = step.stencils.effective(k);
+    let mut out = [[0.0; D]; M];
+    for (s, &node) in out.iter_mut().zip(nodes) {
+        s.copy_from_slice(&xl[node as usize * nd..node as usize * nd + D]);
+    }
+    for e in step.stencils.extensions(k) {
+        for c in (0..D).filter(|&c| e.mask & (1 << c) != 0) {
+            out[e.slot as usize][c] =
+                (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
+        }
+    }
+    out
+}
+
 /// For every raw local dof of particle `k`, where it goes among the effective dofs: one (dof, 1)
 /// pair, or the masters of an extended component. Returns the number of effective dofs.
 fn transform<const D: usize, const M: usize>(step: &Step<D, M>, k: usize, out: &mut Vec<Vec<(usize, f64)>>) -> usize {

@@ -192,7 +192,7 @@ impl<const D: usize> NodeSpace<D> {
     /// The block of nodes this rank owns and, per node (x fastest), [`node_values`] values: the
     /// active (well-filled) flag (1 or 0) of `step`, its nodal increments Δd (ux, uy, [uz,] p,
     /// Ux, Uy[, Uz]; zeros beyond the dofs of the layout), and the nodal diagnostics K_mag and
-    /// F^int_mag (`diagnostics`, per owned node; zeros where it is empty).
+    /// F^int_mag (`diagnostics`, per owned node; NaN, not computed, where it is empty).
     pub fn node_block<const M: usize>(
         &self,
         step: &Step<D, M>,
@@ -211,7 +211,7 @@ impl<const D: usize> NodeSpace<D> {
                 let v = own[..nd].iter().position(|n| n == name).map_or(0.0, |c| solution.increments[l * nd + c]);
                 values.push(v);
             }
-            values.extend(diagnostics.get(o).copied().unwrap_or([0.0; 2]));
+            values.extend(diagnostics.get(o).copied().unwrap_or([f64::NAN; 2]));
         }
         self.block(values)
     }

@@ -79,6 +79,11 @@ impl StepControl {
         }
     }
 
+    /// Whether a step of `dt` from `t`, once accepted, ends the stage.
+    pub(super) fn ends_stage(&self, t: f64, dt: f64) -> bool {
+        self.finished(self.advance(t, dt))
+    }
+
     /// After an accepted step that took `newton` iterations: reset the cut count, and after
     /// [`GROW_AFTER`] accepted steps at the same Δt let it grow back towards the stage's (growing
     /// after every step would retry the Δt that just failed at once, which costs a full failed

@@ -222,7 +222,7 @@ where
     let stage = &req.case.stages[0];
     let (active, _) = sim.begin_stage(0, stage)?;
     for _ in 0..steps {
-        sim.advance(&active, stage.dt())?.map_err(RunError::Failed)?;
+        sim.advance(&active, stage.dt(), false)?.map_err(RunError::Failed)?;
         sim.t += stage.dt();
     }
     let step =
@@ -292,7 +292,7 @@ where
         while !control.finished(self.t) {
             let events: Vec<f64> = self.recorders.iter().flat_map(|r| r.event_times()).collect();
             let dt = control.next(self.t, &events);
-            match self.advance(&active, dt)? {
+            match self.advance(&active, dt, control.ends_stage(self.t, dt))? {
                 Ok(admitted) => {
                     self.accept(dt, &mut control, admitted.iterations.0)?;
                     if let Some(why) = self.record(stage, index, &control, dt, admitted)? {
@@ -306,16 +306,17 @@ where
     }
 
     /// One step t → t + dt: the step set-up, the nonlinear solve, the step's forces and the
-    /// particle update. `Ok(Err(reason))`: the step was not admitted (no convergence, or a point
-    /// would become inadmissible), and nothing changed.
-    fn advance(&mut self, active: &Active, dt: f64) -> Result<Result<Admitted, String>, RunError> {
+    /// particle update (`stage_end`: the step, once accepted, ends its stage). `Ok(Err(reason))`:
+    /// the step was not admitted (no convergence, or a point would become inadmissible), and
+    /// nothing changed.
+    fn advance(&mut self, active: &Active, dt: f64, stage_end: bool) -> Result<Result<Admitted, String>, RunError> {
         let step = self.prepare(active, dt)?;
         let (solved, solution) = self.solve(&step)?;
         if !solved.converged {
             return Ok(Err(self.why_not(solved)?));
         }
         let iterations = (solved.newton_iterations, solved.linear_iterations);
-        let updated = self.update_particles(&step, &solution, active, dt)?;
+        let updated = self.update_particles(&step, &solution, active, (dt, stage_end))?;
         Ok(updated.map(|u| {
             let fields = self.system.layout().fields();
             let scales = (&solved.field_scales[..], &u.field_scales[..]);

@@ -139,16 +139,17 @@ where
     /// The particle update of a converged step ([`crate::update`]) after the step's forces and
     /// the recorders' look at it: `Ok(Err(..))` if a particle would become inadmissible (the step
     /// is then cut), in which case no particle is changed; otherwise what the update leaves for
-    /// the record ([`Updated`]).
+    /// the record ([`Updated`]). The nodal diagnostics are computed when a recorder needs the
+    /// nodes of this step (`stage_end`: it ends its stage).
     pub(super) fn update_particles(
         &mut self,
         step: &Step<D, M>,
         solution: &Solution,
         active: &Active,
-        dt: f64,
+        (dt, stage_end): (f64, bool),
     ) -> Result<Result<Updated, String>, RunError> {
         let peak = crate::io::peak_memory_mib();
-        let diagnostics = self.case.output.fields_every > 0 || self.recorders.iter().any(|r| r.needs_nodes());
+        let diagnostics = self.recorders.iter().any(|r| r.needs_nodes(self.step + 1, stage_end));
         let forces = self
             .system
             .forces(step, solution, &self.model, self.coll, diagnostics, &self.last_reactions)

@@ -86,7 +86,7 @@ impl<const D: usize> Recorder<D> for Verification<D> {
         self.check.stop()
     }
 
-    fn needs_nodes(&self) -> bool {
+    fn needs_nodes(&self, _step: usize, _stage_end: bool) -> bool {
         self.check.needs_nodes()
     }
 }

@@ -43,6 +43,10 @@ impl<const D: usize> Recorder<D> for Fields {
         Ok(Vec::new())
     }
 
+    fn needs_nodes(&self, step: usize, stage_end: bool) -> bool {
+        self.every > 0 && (step.is_multiple_of(self.every) || stage_end)
+    }
+
     fn milestone(&mut self, at: &Moment<D>, sink: &mut Sink) -> Result<(), String> {
         self.write(at, sink)
     }

@@ -37,8 +37,7 @@ pub struct Converged<'a, const D: usize> {
     pub forces: &'a StepForces<D>,
     /// What the step does to each of this rank's points (in the model's order).
     pub results: &'a [StepResult<D>],
-    /// This rank's nodal values of the step, when a recorder [`Recorder::needs_nodes`] or fields
-    /// are written.
+    /// This rank's nodal values of the step, when a recorder [`Recorder::needs_nodes`] them.
     pub nodes: Option<&'a NodeBlock>,
     pub coll: &'a Collective,
 }
@@ -155,8 +154,10 @@ pub trait Recorder<const D: usize> {
         None
     }
 
-    /// Whether it reads the step's nodal values ([`Converged::nodes`]).
-    fn needs_nodes(&self) -> bool {
+    /// Whether it reads the nodal values ([`Converged::nodes`], [`Moment::nodes`]) of the step
+    /// that becomes accepted step number `step`, the last of its stage when `stage_end`. The nodal
+    /// diagnostics, a second pass over the points, are computed only for such steps.
+    fn needs_nodes(&self, _step: usize, _stage_end: bool) -> bool {
         false
     }
 }
