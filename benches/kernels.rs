@@ -125,8 +125,14 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt =
-                    kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, porompm::layout::Layout::UPU);
+                let pt = kernels::Point::<2>::with_recovery(
+                    &basis[k],
+                    &basis[k],
+                    &states[k],
+                    &inputs[k],
+                    soil,
+                    porompm::layout::Layout::UPU,
+                );
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -139,8 +145,14 @@ fn particle_kernels(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * 5;
-                let pt =
-                    kernels::Point::<2>::new(&basis[k], &states[k], &inputs[k], soil, porompm::layout::Layout::UPU);
+                let pt = kernels::Point::<2>::with_recovery(
+                    &basis[k],
+                    &basis[k],
+                    &states[k],
+                    &inputs[k],
+                    soil,
+                    porompm::layout::Layout::UPU,
+                );
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }
@@ -300,7 +312,8 @@ fn particle_kernels_3d(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * layout.nd;
-                let pt = kernels::Point::<3, M>::new(&basis[k], &states[k], &inputs[k], soil, layout);
+                let pt =
+                    kernels::Point::<3, M>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout);
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -313,7 +326,8 @@ fn particle_kernels_3d(c: &mut Criterion) {
             let mut sum = 0.0;
             for k in 0..n {
                 let m = basis[k].len() * layout.nd;
-                let pt = kernels::Point::<3, M>::new(&basis[k], &states[k], &inputs[k], soil, layout);
+                let pt =
+                    kernels::Point::<3, M>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout);
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }

@@ -206,33 +206,34 @@ pub fn write_record<const D: usize>(ps: &Particles<D>, k: usize, r: &mut [f64]) 
     }
 }
 
+/// A particle field read from the values of a record, in order.
+trait FromValues {
+    fn take(rest: &mut impl Iterator<Item = f64>) -> Self;
+}
+
+impl FromValues for f64 {
+    fn take(rest: &mut impl Iterator<Item = f64>) -> f64 {
+        rest.next().expect("RECORD values")
+    }
+}
+
+impl<T: FromValues, const N: usize> FromValues for [T; N] {
+    fn take(rest: &mut impl Iterator<Item = f64>) -> [T; N] {
+        std::array::from_fn(|_| T::take(rest))
+    }
+}
+
 /// Overwrites particle `k` with record `r` (same id, body and material, checked by the caller).
 fn unpack<const D: usize>(ps: &mut Particles<D>, k: usize, r: &[f64]) {
-    // The fields after id, body and material, in the order of `particle_fields`.
-    fn take<const N: usize>(rest: &mut impl Iterator<Item = f64>) -> [f64; N] {
-        std::array::from_fn(|_| rest.next().expect("RECORD values"))
-    }
     let rest = &mut r[3..].iter().copied();
-    let one = |rest: &mut _| take::<1>(rest)[0];
-    ps.x[k] = take(rest);
-    ps.x0[k] = take(rest);
-    ps.disp[k] = take(rest);
-    ps.lp[k] = take(rest);
-    ps.lp0[k] = take(rest);
-    ps.def_grad[k] = std::array::from_fn(|_| take(rest));
-    ps.volume[k] = one(rest);
-    ps.porosity[k] = one(rest);
-    ps.mass[k] = one(rest);
-    ps.vel[k] = take(rest);
-    ps.acc[k] = take(rest);
-    ps.vel_w[k] = take(rest);
-    ps.acc_w[k] = take(rest);
-    ps.stress[k] = take(rest);
-    ps.p[k] = one(rest);
-    ps.p0[k] = one(rest);
-    ps.eps_pd[k] = one(rest);
-    ps.grad_p[k] = take(rest);
-    ps.jbar[k] = one(rest);
+    // The fields after id, body and material, in the order of `particle_fields`.
+    macro_rules! read {
+        ($($field:ident),*) => { $(ps.$field[k] = FromValues::take(rest);)* };
+    }
+    read!(
+        x, x0, disp, lp, lp0, def_grad, volume, porosity, mass, vel, acc, vel_w, acc_w, stress, p, p0, eps_pd, grad_p,
+        jbar
+    );
 }
 
 /// The points of dimension D of the records laid end to end in `flat` ([`record_len`] values

@@ -119,7 +119,7 @@ mod tests {
             let zero = vec![0.0; nodes];
             for (basis, ids, part) in &points {
                 let st = states(ids, &zero);
-                let pt = Point::<2>::new(basis, &st, part, &model, layout);
+                let pt = Point::<2>::with_recovery(basis, basis, &st, part, &model, layout);
                 let m = pt.size();
                 let (mut r, mut t) = (vec![0.0; m], vec![0.0; m * m]);
                 super::residual(&pt, &nm, &mut r);
@@ -136,7 +136,7 @@ mod tests {
             let mut shares = Vec::new();
             for (basis, ids, part) in &points {
                 let st = states(ids, &theta);
-                let pt = Point::<2>::new(basis, &st, part, &model, layout);
+                let pt = Point::<2>::with_recovery(basis, basis, &st, part, &model, layout);
                 own.push(crate::soils::finite_strain::det2(part.def_grad) * pt.kin.j);
                 jbar.push(super::super::StepResult::of(&pt).jbar.expect("an F̄ layout carries J̄"));
                 shares.push(ids.iter().zip(basis).map(|(&n, b)| (n, b.s)).collect::<Vec<_>>());

@@ -405,27 +405,16 @@ pub struct DrainedFace<const D: usize = 2, const M: usize = MAX_NODES> {
 }
 
 impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
-    /// Evaluates the point for the nodal `states` (same order as `basis`).
-    pub fn new<const N: usize>(
-        basis: &'a [NodeBasis<D>],
-        states: &[NodeState<N>],
-        part: &'a ParticleInput<D>,
-        model: &Constitutive,
-        layout: Layout,
-    ) -> Point<'a, D, M> {
-        Point::with_recovery(basis, basis, states, part, model, layout)
-    }
-
-    /// [`Point::new`] with the strain recovered by the operators `strain` (one per node of
-    /// `basis`, in its order; its `g`, `gv`, `t`, `tv` are used, its `s` is not): the stress sees
+    /// Evaluates the point for the nodal `states` (same order as `basis`), with the strain
+    /// recovered by the operators `strain` (one per node of `basis`, in its order; its `g`, `gv`,
+    /// `t`, `tv` are used, its `s` is not): the stress sees
     /// the deformation gradient F̃ = I + Σ Δu_i ⊗ e_i, e_i = `strain[i].g`, so the strain
     /// increment the soil model takes and the rotation of the stress are the recovered ones; the
     /// motion keeps the basis: the step's F, its volume ratio, the gradients on x_{n+1}, the
     /// deformation and volume the particle keeps, and the forces f_i = B̄'_iᵀσ V. This is [001]'s
     /// reading (docs/stiffness.md: the strain is recovered for the stress only; positions, F and
-    /// volume as without it). [001]'s CMPM recovery
-    /// (`stabilisation.stress_recovery = "cmpm"`) passes its patch functions; `strain = basis` is
-    /// the usual point.
+    /// volume as without it). [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
+    /// passes its patch functions; `strain = basis` is the usual point.
     #[inline]
     pub fn with_recovery<const N: usize>(
         basis: &'a [NodeBasis<D>],
@@ -466,6 +455,48 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let upd = model
             .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));
+        Point::of_parts(basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd), jbar_nodes)
+    }
+
+    /// The point at its step's start (Δd = 0) with the stress it carries, σ_n on x_n, as an
+    /// explicit step's forces take it (update-stress-last, [002] Algorithm 1): no soil-model call
+    /// (the stored stress is the one the last step's update left, the viscous part of a fluid's
+    /// included, which a model evaluated again at a zero increment would drop) and no tangent (an
+    /// explicit step builds no matrix). The interpolated velocities and accelerations are the
+    /// point's predictors, as at Δd = 0.
+    pub fn at_start(
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        part: &'a ParticleInput<D>,
+        layout: Layout,
+    ) -> Point<'a, D, M> {
+        let interp = interpolate(basis, &AT_REST[..basis.len()], &part.pred, layout);
+        let zero = [[0.0; soils::NS]; soils::NS];
+        let upd = StressUpdate {
+            stress: part.stress,
+            tangent: zero,
+            trial_tangent: zero,
+            eps_pd: part.eps_pd,
+            region: crate::soils::Region::Elastic,
+        };
+        let kin = (Kinematics::rest(), None);
+        Point::of_parts(basis, strain, part, layout, interp, kin, (part.stress, upd), [0.0; M])
+    }
+
+    /// The point of its parts: the kinematics (and the recovered strain's, if any), the rotated
+    /// stress σ_n and the soil model's update; the gradients on the new configuration follow
+    /// from the kinematics, and the pore pressure is p_n + Δp.
+    #[allow(clippy::too_many_arguments)]
+    fn of_parts(
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        part: &'a ParticleInput<D>,
+        layout: Layout,
+        interp: Interp<D>,
+        (kin, recovered_kin): (Kinematics<D>, Option<Kinematics<D>>),
+        (rotated, upd): (Stress, StressUpdate),
+        jbar_nodes: [f64; M],
+    ) -> Point<'a, D, M> {
         let (spatial, hoop) = on_new_configuration(&kin, basis);
         Point {
             basis,
@@ -484,48 +515,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             faces: &[],
             face_dp: [0.0; MAX_FACES],
             jbar_nodes,
-        }
-    }
-
-    /// The point at its step's start (Δd = 0) with the stress it carries, σ_n on x_n, as an
-    /// explicit step's forces take it (update-stress-last, [002] Algorithm 1): no soil-model call
-    /// (the stored stress is the one the last step's update left, the viscous part of a fluid's
-    /// included, which a model evaluated again at a zero increment would drop) and no tangent (an
-    /// explicit step builds no matrix). The interpolated velocities and accelerations are the
-    /// point's predictors, as at Δd = 0.
-    pub fn at_start(
-        basis: &'a [NodeBasis<D>],
-        strain: &'a [NodeBasis<D>],
-        part: &'a ParticleInput<D>,
-        layout: Layout,
-    ) -> Point<'a, D, M> {
-        let interp = interpolate(basis, &AT_REST[..basis.len()], &part.pred, layout);
-        let kin = Kinematics::rest();
-        let (spatial, hoop) = on_new_configuration(&kin, basis);
-        let zero = [[0.0; soils::NS]; soils::NS];
-        Point {
-            basis,
-            part,
-            layout,
-            interp,
-            kin,
-            recovered_kin: None,
-            rotated: part.stress,
-            upd: StressUpdate {
-                stress: part.stress,
-                tangent: zero,
-                trial_tangent: zero,
-                eps_pd: part.eps_pd,
-                region: crate::soils::Region::Elastic,
-            },
-            spatial,
-            hoop,
-            strain,
-            motion: None,
-            p: part.p,
-            faces: &[],
-            face_dp: [0.0; MAX_FACES],
-            jbar_nodes: [0.0; M],
         }
     }
 

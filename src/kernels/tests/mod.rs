@@ -468,7 +468,7 @@ fn linear_increments_have_an_affine_residual_and_a_matching_tangent() {
         let p = ParticleInput { stress, linear, ..part() };
         let d: Vec<f64> = d0.iter().map(|x| 30.0 * s * x).collect();
         let st = states(&d, 2, &nm);
-        let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::U);
+        let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::U);
         let mut r = vec![0.0; m];
         stress::residual(&pt, &nm, &mut r);
         (r, pt.upd.stress, pt.kin.theta)
@@ -499,7 +499,7 @@ fn the_plastic_sample_really_returns() {
     p.stress = stress;
     let d0 = increments(basis.len() * 5, Layout::UPU);
     let st = states(&d0, 5, &nm);
-    let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::UPU);
+    let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::UPU);
     assert!(pt.upd.eps_pd > 0.0, "{:?}", pt.upd.region);
     assert!(pt.kin.theta.abs() > 1e-4, "the sample must rotate: θ = {}", pt.kin.theta);
 }
@@ -517,8 +517,8 @@ fn a_recovered_strain_moves_the_stress_and_leaves_the_motion_to_the_basis() {
         let p = ParticleInput { stress, ..part() };
         let st = states(&increments(basis.len() * 2, Layout::U), 2, &nm);
         let recovered = Point::<2>::with_recovery(&basis, &strain, &st, &p, &model, Layout::U);
-        let own = Point::<2>::new(&basis, &st, &p, &model, Layout::U);
-        let of_strain = Point::<2>::new(&strain, &st, &p, &model, Layout::U);
+        let own = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::U);
+        let of_strain = Point::<2>::with_recovery(&strain, &strain, &st, &p, &model, Layout::U);
         let (r, b, s) = (StepResult::of(&recovered), StepResult::of(&own), StepResult::of(&of_strain));
         // The sample's two sets of operators give different motions and strains.
         assert!((b.jacobian - s.jacobian).abs() > 1e-3 && (b.deps[0] - s.deps[0]).abs() > 1e-3, "{hoop}");
@@ -583,13 +583,13 @@ fn a_wrong_sign_in_any_block_of_any_term_is_caught() {
         let faces = sample_faces(basis.len());
         let res = |d: &[f64]| {
             let st = states(d, nd, &nm);
-            let pt = Point::<2>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
+            let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, layout).with_faces(&faces, &st);
             let mut r = vec![0.0; m];
             (term.1)(&pt, &nm, &mut r);
             r
         };
         let st = states(&d0, nd, &nm);
-        let pt = Point::<2>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
+        let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, layout).with_faces(&faces, &st);
         let mut t = vec![0.0; m * m];
         (term.2)(&pt, &nm, &mut t);
         let what = format!("{} (nd = {nd}, axisymmetric {hoop})", term.0);
@@ -633,7 +633,7 @@ fn residual_vanishes_at_rest_in_equilibrium_and_balances_gravity() {
     p.pred = Motion::default();
     let st = vec![NodeState::<MAX_DOF>::default(); 4];
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
-    let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::UPU);
+    let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::UPU);
     let mut r = vec![0.0; 20];
     residual(&pt, &Scheme::newmark(0.25, 0.5, 1e-3), &mut r);
     let fy: f64 = (0..4).map(|k| r[k * 5 + 1] + r[k * 5 + 4]).sum();
@@ -665,7 +665,7 @@ fn volume_ratio_and_strain_of_a_uniform_compression() {
     let st: Vec<NodeState> = pts.iter().map(|&(x, y)| NodeState::new(&[-0.01 * x, -0.02 * y], &nm)).collect();
     let model = Constitutive::LinearElastic(LinearElastic::new(1e7, 0.3));
     let p = ParticleInput { stress: [0.0; soils::NS], ..part() };
-    let pt = Point::<2>::new(&basis, &st, &p, &model, Layout::U);
+    let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::U);
     let r = StepResult::of(&pt);
     assert!((r.jacobian - 0.99 * 0.98).abs() < 1e-14);
     assert!((r.f_inc[0][0] - 0.99).abs() < 1e-14 && (r.f_inc[1][1] - 0.98).abs() < 1e-14);
@@ -698,7 +698,7 @@ fn a_rigid_rotation_turns_the_stress_with_the_material() {
                 .collect();
             for _ in 0..n {
                 let p = ParticleInput { stress: s, ..part() };
-                s = Point::<2>::new(&basis, &st, &p, &model, Layout::U).upd.stress;
+                s = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, Layout::U).upd.stress;
             }
             // A quarter turn: σ_xx ↔ σ_yy, σ_xy → −σ_xy.
             let expected = soils::plane([s0[1], s0[0], -s0[2], s0[3]]);

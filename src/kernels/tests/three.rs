@@ -207,7 +207,7 @@ fn the_three_dimensional_samples_return_rotate_and_shear_out_of_plane() {
     let layout = Layout::UPU.in_dim(3);
     let d0 = increments(basis.len() * layout.nd, layout);
     let st = states3(&d0, layout.nd, &nm);
-    let pt = Point::<3, { samples::M3 }>::new(&basis, &st, &p, &model, layout);
+    let pt = Point::<3, { samples::M3 }>::with_recovery(&basis, &basis, &st, &p, &model, layout);
     assert!(pt.upd.eps_pd > 0.0, "{:?}", pt.upd.region);
     let spin = pt.kin.rotation;
     assert!(
@@ -233,13 +233,15 @@ fn a_wrong_sign_in_any_block_is_caught_in_three_dimensions() {
         for term in terms_in::<3, { samples::M3 }>() {
             let res = |d: &[f64]| {
                 let st = states3(d, nd, &nm);
-                let pt = Point::<3, { samples::M3 }>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
+                let pt = Point::<3, { samples::M3 }>::with_recovery(&basis, &basis, &st, &p, &model, layout)
+                    .with_faces(&faces, &st);
                 let mut r = vec![0.0; m];
                 (term.1)(&pt, &nm, &mut r);
                 r
             };
             let st = states3(&d0, nd, &nm);
-            let pt = Point::<3, { samples::M3 }>::new(&basis, &st, &p, &model, layout).with_faces(&faces, &st);
+            let pt = Point::<3, { samples::M3 }>::with_recovery(&basis, &basis, &st, &p, &model, layout)
+                .with_faces(&faces, &st);
             let mut t = vec![0.0; m * m];
             (term.2)(&pt, &nm, &mut t);
             flipped_blocks += flip_every_block(nd, &d0, layout, &res, &t, &format!("{} ({sname})", term.0));
@@ -282,8 +284,8 @@ fn a_plane_point_is_a_three_dimensional_point_without_z() {
                 d3[(i / n2) * n3 + lift_dof(i % n2)] = *x;
             }
             let (s2, s3) = (states(&d2, n2, &nm), states3(&d3, n3, &nm));
-            let pt2 = Point::<2>::new(&b2, &s2, &p2, &model, l2);
-            let pt3 = Point::<3, { samples::M3 }>::new(&b3, &s3, &p3, &model, l3);
+            let pt2 = Point::<2>::with_recovery(&b2, &b2, &s2, &p2, &model, l2);
+            let pt3 = Point::<3, { samples::M3 }>::with_recovery(&b3, &b3, &s3, &p3, &model, l3);
             let (m2, m3) = (d2.len(), d3.len());
             let (mut r2, mut r3, mut t2, mut t3) =
                 (vec![0.0; m2], vec![0.0; m3], vec![0.0; m2 * m2], vec![0.0; m3 * m3]);
@@ -349,7 +351,7 @@ fn the_forces_of_a_homogeneous_state_in_three_dimensions_are_its_stress() {
                 .collect();
             let states = states3(&d, layout.nd, &nm);
             let p = ParticleInput { stress: [-3.0e4, -1.0e4, 4.0e3, -2.0e4, -2.5e3, 1.5e3], ..samples::part() };
-            let pt = Point::<3, { samples::M3 }>::new(&basis, &states, &p, &model, layout);
+            let pt = Point::<3, { samples::M3 }>::with_recovery(&basis, &basis, &states, &p, &model, layout);
             let mut f = vec![0.0; d.len()];
             stress::residual(&pt, &nm, &mut f);
             stress::pore_pressure::residual(&pt, &nm, &mut f);
