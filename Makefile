@@ -31,7 +31,7 @@ test: setup
 # Long convergence studies (tables in target/studies/) and the long runs the default suite leaves
 # out (README, "Tests and studies").
 study: build
-	cargo test --release --locked --test studies --test gold --test extreme --test explicit --test stiffness_options --test three_dimensions -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13 --skip footing_fbar_item_14 --skip dam_break_item_15 --skip footing_square_3d_finest --skip landslide_item_16
+	cargo test --release --locked --test studies --test gold --test verification --test extreme --test explicit --test stiffness_options --test three_dimensions -- --ignored --nocapture --test-threads=1 --skip cook_membrane_item_13 --skip footing_fbar_item_14 --skip dam_break_item_15 --skip footing_square_3d_finest --skip landslide_item_16
 	python3 scripts/terzaghi_family.py
 
 # [002] §4.1 Cook's membrane: the tip's displacement and the stress chequerboard of F̄ and standard

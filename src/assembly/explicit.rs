@@ -214,7 +214,8 @@ fn xpic_correction<const D: usize, const M: usize, const N: usize>(
         binomial *= f64::from(m - k + 1) / f64::from(k);
         if k > 1 {
             // S⁺S u: u at the points, their momenta back to the nodes.
-            let at_points: Vec<[f64; D]> = (0..step.stencils.len()).map(|p| step.interpolated::<N>(p, &u).du).collect();
+            let at_points: Vec<[f64; D]> =
+                (0..step.stencils.len()).map(|p| step.interpolated_vector(p, &u, 0)).collect();
             let mut lumped = points.lumped_mass_and_momentum(&at_points, None);
             for v in [&mut lumped.mass, &mut lumped.momentum] {
                 space.sum_over_ranks(v)?;

@@ -75,17 +75,32 @@ pub(super) fn node_displacements<const D: usize, const M: usize>(
     k: usize,
     xl: &[f64],
 ) -> [[f64; D]; M] {
+    node_vectors(step, k, xl, 0)
+}
+
+/// The D components from `first` of each node's dofs (a vector field: the solid's from 0, the
+/// water's from the layout's `w`) of particle `k`'s raw stencil from the ghosted nodal field `xl`,
+/// extended nodes taken from their masters.
+#[inline]
+fn node_vectors<const D: usize, const M: usize>(
+    step: &Step<D, M>,
+    k: usize,
+    xl: &[f64],
+    first: usize,
+) -> [[f64; D]; M] {
     let nd = step.dofs.nd;
     let (nodes, _) = step.stencils.get(k);
     let eff = step.stencils.effective(k);
     let mut out = [[0.0; D]; M];
     for (s, &node) in out.iter_mut().zip(nodes) {
-        s.copy_from_slice(&xl[node as usize * nd..node as usize * nd + D]);
+        let b = node as usize * nd + first;
+        s.copy_from_slice(&xl[b..b + D]);
     }
     for e in step.stencils.extensions(k) {
-        for c in (0..D).filter(|&c| e.mask & (1 << c) != 0) {
-            out[e.slot as usize][c] =
-                (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
+        for c in (0..D).filter(|&c| e.mask & (1 << (first + c)) != 0) {
+            out[e.slot as usize][c] = (0..e.n as usize)
+                .map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + first + c])
+                .sum();
         }
     }
     out
@@ -786,12 +801,19 @@ pub(super) struct Lumped {
 
 /// The particle side of the converged step: each point's result for the particle update.
 impl<const D: usize, const M: usize> Step<D, M> {
-    /// Σ S_ip u_i at particle `k` of a nodal field `u` per ghosted dof (barely filled nodes
-    /// extended from their masters): its solid components (`du`) and water components (`dw`).
-    pub(super) fn interpolated<const N: usize>(&self, k: usize, u: &[f64]) -> kernels::Interp<D> {
+    /// Σ S_ip u_i at particle `k` of the D components from `first` of a nodal field `u` per
+    /// ghosted dof (barely filled nodes extended from their masters): [`kernels::interpolate`]'s
+    /// `du` (`first` = 0) or `dw` (the layout's `w`), without the rest of the nodes' states.
+    pub(super) fn interpolated_vector(&self, k: usize, u: &[f64], first: usize) -> [f64; D] {
         let (nodes, basis) = self.stencils.get(k);
-        let states = node_states::<D, M, N>(self, k, u);
-        kernels::interpolate(basis, &states[..nodes.len()], &Default::default(), self.layout)
+        let d = node_vectors(self, k, u, first);
+        let mut du = [0.0; D];
+        for (b, d) in basis.iter().zip(&d[..nodes.len()]) {
+            for c in 0..D {
+                du[c] += b.s * d[c];
+            }
+        }
+        du
     }
 
     /// The converged step at particle `k` for the particle update: exactly the point the converged
@@ -828,13 +850,15 @@ impl<const D: usize, const M: usize> Step<D, M> {
             // An explicit step's FLIP increment Σ S (v_i^{n+1} − v_i^n) takes the v_i^n of its
             // own grid update (the predictors' nodal velocities are those of the raw projection,
             // without the barely filled nodes' shares moved to their masters).
-            let v = self.interpolated::<N>(k, &solution.start_velocity);
-            result.interp.motion.v_u = v.du;
-            result.interp.motion.v_w = v.dw;
+            result.interp.motion.v_u = self.interpolated_vector(k, &solution.start_velocity, 0);
+            result.interp.motion.v_w = match self.layout.w {
+                Some(w) => self.interpolated_vector(k, &solution.start_velocity, w),
+                None => [0.0; D],
+            };
         }
         if !solution.xpic_correction.is_empty() {
             // XPIC: v_p = S v^{n+1} + S (w − v^n), S v^{n+1} = Δu_p/Δt.
-            let c = self.interpolated::<N>(k, &solution.xpic_correction).du;
+            let c = self.interpolated_vector(k, &solution.xpic_correction, 0);
             let dt = self.dt;
             result.velocity = Some(std::array::from_fn(|d| result.interp.du[d] / dt + c[d]));
         }
