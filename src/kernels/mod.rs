@@ -487,6 +487,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// stress σ_n and the soil model's update; the gradients on the new configuration follow
     /// from the kinematics, and the pore pressure is p_n + Δp.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn of_parts(
         basis: &'a [NodeBasis<D>],
         strain: &'a [NodeBasis<D>],
