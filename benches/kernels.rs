@@ -118,21 +118,19 @@ fn particle_kernels(c: &mut Criterion) {
         })
         .collect();
     let soil = &model.materials[ps.material[0] as usize].model;
+    // The point of particle `k` at its nodal states, as the residual and tangent benchmarks evaluate it.
+    let point = |k: usize| {
+        let layout = porompm::layout::Layout::UPU;
+        kernels::Point::<2>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout)
+    };
     let mut g = group(c, "kernels", n);
     g.bench_function("residual", |b| {
         let mut buf = [0.0; kernels::MAX_LOCAL];
         b.iter(|| {
             let mut sum = 0.0;
-            for k in 0..n {
-                let m = basis[k].len() * 5;
-                let pt = kernels::Point::<2>::with_recovery(
-                    &basis[k],
-                    &basis[k],
-                    &states[k],
-                    &inputs[k],
-                    soil,
-                    porompm::layout::Layout::UPU,
-                );
+            for (k, own) in basis.iter().enumerate() {
+                let m = own.len() * 5;
+                let pt = point(k);
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -143,16 +141,9 @@ fn particle_kernels(c: &mut Criterion) {
         let mut block = vec![0.0; kernels::MAX_LOCAL * kernels::MAX_LOCAL];
         b.iter(|| {
             let mut sum = 0.0;
-            for k in 0..n {
-                let m = basis[k].len() * 5;
-                let pt = kernels::Point::<2>::with_recovery(
-                    &basis[k],
-                    &basis[k],
-                    &states[k],
-                    &inputs[k],
-                    soil,
-                    porompm::layout::Layout::UPU,
-                );
+            for (k, own) in basis.iter().enumerate() {
+                let m = own.len() * 5;
+                let pt = point(k);
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }
@@ -306,14 +297,15 @@ fn particle_kernels_3d(c: &mut Criterion) {
         (0..n).map(|k| kernels::ParticleInput::of(&model, k, &body_acc)).collect();
     let soil = &model.materials[0].model;
     let largest = basis.iter().map(|b| b.len() * layout.nd).max().unwrap_or(0);
+    let point =
+        |k: usize| kernels::Point::<3, M>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout);
     g.bench_function("residual", |b| {
         let mut buf = vec![0.0; largest];
         b.iter(|| {
             let mut sum = 0.0;
-            for k in 0..n {
-                let m = basis[k].len() * layout.nd;
-                let pt =
-                    kernels::Point::<3, M>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout);
+            for (k, own) in basis.iter().enumerate() {
+                let m = own.len() * layout.nd;
+                let pt = point(k);
                 kernels::residual(&pt, &nm, &mut buf[..m]);
                 sum += buf[0];
             }
@@ -324,10 +316,9 @@ fn particle_kernels_3d(c: &mut Criterion) {
         let mut block = vec![0.0; largest * largest];
         b.iter(|| {
             let mut sum = 0.0;
-            for k in 0..n {
-                let m = basis[k].len() * layout.nd;
-                let pt =
-                    kernels::Point::<3, M>::with_recovery(&basis[k], &basis[k], &states[k], &inputs[k], soil, layout);
+            for (k, own) in basis.iter().enumerate() {
+                let m = own.len() * layout.nd;
+                let pt = point(k);
                 kernels::tangent(&pt, &nm, &mut block[..m * m]);
                 sum += block[0];
             }

@@ -58,9 +58,7 @@ pub(super) fn node_states<const D: usize, const M: usize, const N: usize>(
     }
     for e in step.stencils.extensions(k) {
         for c in (0..nd).filter(|&c| e.mask & (1 << c) != 0) {
-            let x: f64 =
-                (0..e.n as usize).map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + c]).sum();
-            out[e.slot as usize].set(c, x, &nm);
+            out[e.slot as usize].set(c, e.of_masters(eff, |n| xl[n * nd + c]), &nm);
         }
     }
     out
@@ -98,9 +96,7 @@ fn node_vectors<const D: usize, const M: usize>(
     }
     for e in step.stencils.extensions(k) {
         for c in (0..D).filter(|&c| e.mask & (1 << (first + c)) != 0) {
-            out[e.slot as usize][c] = (0..e.n as usize)
-                .map(|m| e.masters[m].1 * xl[eff[e.masters[m].0 as usize] as usize * nd + first + c])
-                .sum();
+            out[e.slot as usize][c] = e.of_masters(eff, |n| xl[n * nd + first + c]);
         }
     }
     out

@@ -468,11 +468,7 @@ fn predictors<const D: usize>(
             let e = ext.iter().find(|e| e.slot as usize == slot);
             // The masters' sum of `f` where the node is extended (zero where it is not, which
             // the callers never ask for).
-            let of_masters = |f: &dyn Fn(usize) -> f64| -> f64 {
-                e.map_or(0.0, |e| {
-                    (0..e.n as usize).map(|m| e.masters[m].1 * f(eff[e.masters[m].0 as usize] as usize)).sum()
-                })
-            };
+            let of_masters = |f: &dyn Fn(usize) -> f64| -> f64 { e.map_or(0.0, |e| e.of_masters(eff, f)) };
             for &(c, s, comp) in &comps {
                 let extended = e.is_some_and(|e| e.mask & (1 << c) != 0);
                 let (v, a) = if extended {

@@ -53,6 +53,15 @@ pub struct Extension {
     pub mask: u8,
 }
 
+impl Extension {
+    /// Σ_m c_m f(n_m) over the masters: the extended value of a nodal field `f` of the ghosted
+    /// node numbering, `eff` the particle's effective nodes ([`Stencils::effective`]).
+    #[inline]
+    pub fn of_masters(&self, eff: &[u32], f: impl Fn(usize) -> f64) -> f64 {
+        (0..self.n as usize).map(|m| self.masters[m].1 * f(eff[self.masters[m].0 as usize] as usize)).sum()
+    }
+}
+
 /// The stencils of all particles for one step, in this rank's ghosted node numbering, stored flat:
 /// particle k uses entries `offsets[k]..offsets[k + 1]` of `nodes` and `basis` (the raw stencil),
 /// `eff_offsets[k]..eff_offsets[k + 1]` of `eff_nodes` (its raw nodes, in the same order, then the

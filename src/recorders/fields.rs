@@ -17,6 +17,11 @@ impl Fields {
         Fields { every, written: None }
     }
 
+    /// Whether step `step` is one of the every-`every` steps (never when fields are off).
+    fn due(&self, step: usize) -> bool {
+        self.every > 0 && step.is_multiple_of(self.every)
+    }
+
     /// Writes the fields of `at`, unless they are off or written already.
     fn write<const D: usize>(&mut self, at: &Moment<D>, sink: &mut Sink) -> Result<(), String> {
         if self.every == 0 || self.written == Some(at.step) {
@@ -37,14 +42,14 @@ impl<const D: usize> Recorder<D> for Fields {
     }
 
     fn record(&mut self, at: &Moment<D>, _row: bool, sink: &mut Sink) -> Result<Vec<f64>, String> {
-        if self.every > 0 && at.step > 0 && at.step.is_multiple_of(self.every) {
+        if at.step > 0 && self.due(at.step) {
             self.write(at, sink)?;
         }
         Ok(Vec::new())
     }
 
     fn needs_nodes(&self, step: usize, stage_end: bool) -> bool {
-        self.every > 0 && (step.is_multiple_of(self.every) || stage_end)
+        self.due(step) || (self.every > 0 && stage_end)
     }
 
     fn milestone(&mut self, at: &Moment<D>, sink: &mut Sink) -> Result<(), String> {
