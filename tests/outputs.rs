@@ -360,6 +360,29 @@ fn k_mag_of_a_full_block_is_the_particle_integrated_stiffness() {
 /// pure shear past its elastic limit dissipates √3 c ε̄ V (every point at q = √3 c, ε̄ the probe's
 /// equivalent plastic strain, V the block's area), to round-off, at every row; nothing while it is
 /// elastic; and a restart from the middle ends with the same total.
+/// The nodal diagnostics are computed for the frames the schedule writes: every
+/// `output.fields_every` steps and at the stage's end, here steps 2 and 3 of a three-step stage
+/// written every two steps; both frames carry the full block's K_mag (the first test's), not the
+/// NaN of a frame written between them.
+#[test]
+fn k_mag_is_computed_for_the_scheduled_frames_and_the_stage_end() {
+    let dir = out_dir("stiffness-block-schedule");
+    let sets = ["stages.hold.duration=3.0", "output.fields_every=2"];
+    let r = common::run_case("tests/cases/stiffness_block.toml", &dir, &common::set_args(&sets));
+    assert!(r.completed(), "{}", r.stderr());
+    let h = h5::File::open(dir.join("fields.h5")).expect("fields.h5 opens");
+    let frames = h.group("grid").unwrap().member_names().unwrap().iter().filter(|n| n.parse::<usize>().is_ok()).count();
+    assert_eq!(frames, 3, "frames at t = 0, step 2 and step 3");
+    let (e, nu) = (1.0e6, 0.3);
+    let f = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let expected = (15.0 / 16.0) * (4.0 / 3.0) * (f * (1.0 - nu) + e / (2.0 * (1.0 + nu))) * 2f64.sqrt();
+    for frame in [1, 2] {
+        let k = h.dataset(&format!("grid/{frame}/K_mag")).unwrap().read_raw::<f64>().unwrap();
+        let v = k[4 * 9 + 4];
+        assert!((v / expected - 1.0).abs() < 1e-10, "frame {frame}: K_mag at the centre = {v}, {expected} expected");
+    }
+}
+
 #[test]
 fn the_plastic_dissipation_of_a_sheared_von_mises_block_is_its_closed_form() {
     let dir = out_dir("plastic_shear");
