@@ -5,6 +5,14 @@
 //! small dense block at a time); [`assembly`] is the only module that talks to PETSc; [`io`] is the
 //! only module that touches files; [`driver`] is the algorithm on one page.
 
+/// Defines the functions that serde's `#[serde(default = "name")]` calls for a field's default:
+/// `serde_defaults! { default_cfl: f64 = 0.5, default_cuts: usize = 4 }`.
+macro_rules! serde_defaults {
+    ($($name:ident: $t:ty = $value:expr),* $(,)?) => {
+        $(fn $name() -> $t { $value })*
+    };
+}
+
 pub mod algebra;
 pub mod analysis;
 pub mod assembly;

@@ -239,7 +239,10 @@ fn every_two_phase_family_meets_its_targets_with_fieldsplit_schur() {
 
 #[test]
 fn shock_wave_at_low_permeability_shows_the_fast_wave_only() {
-    let s = run("shock_wave", "shock_wave-k1e-5", None, &["materials.soil.hydraulic_conductivity=1e-5"]);
+    // The fast wave passes the probe at 1.8e-4 s; over the first 3e-4 s the picked arrival is the
+    // whole run's to the last digit (measured), at half its cost.
+    let sets = ["materials.soil.hydraulic_conductivity=1e-5", "stages.shock.duration=3e-4"];
+    let s = run("shock_wave", "shock_wave-k1e-5", None, &sets);
     let m = metrics(&s);
     assert!(m["fast_wave_arrival_rel_error"].1, "{m:?}");
     assert!(m["fast_wave_arrival_rel_error"].0 <= 0.02);

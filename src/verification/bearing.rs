@@ -21,7 +21,9 @@
 //! (interpolated), the settlement d [m] at each q/c of `report_loads` and the largest q/c reached. With `stop_settlement` the run ends (completed) once
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
-use super::{all_positive, each_positive, load_name, plain_load, Check, CheckParameters, Findings, Metric, Table};
+use super::{
+    all_positive, each_positive, load_name, plain_load, BuiltCheck, Check, CheckParameters, Findings, Metric, Table,
+};
 use crate::case::{BodyId, BoundaryId, Case, Dof, Load, LoadId};
 use crate::check::{at, components, positive, Checked};
 use crate::model::loads::TimeFn;
@@ -79,12 +81,7 @@ pub struct BearingCapacity {
     pub stop_settlement: Option<f64>,
 }
 
-fn default_prandtl() -> f64 {
-    2.0 + std::f64::consts::PI
-}
-fn default_bearing_tol() -> f64 {
-    0.03
-}
+serde_defaults! { default_prandtl: f64 = 2.0 + std::f64::consts::PI, default_bearing_tol: f64 = 0.03 }
 
 /// What a bearing-capacity check names.
 #[derive(Debug, Clone, Copy)]
@@ -173,17 +170,11 @@ impl CheckParameters for BearingCapacity {
         Ok(FootingIds { soil, loading })
     }
 
-    fn plane(&self, c: &Case, ids: &FootingIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &FootingIds, model: &Model, coll: &Collective) -> BuiltCheck {
         Ok(Box::new(BearingCheck::new(c, model, coll, self, ids)?))
     }
 
-    fn solid(
-        &self,
-        c: &Case,
-        ids: &FootingIds,
-        model: &Model<3>,
-        coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, c: &Case, ids: &FootingIds, model: &Model<3>, coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(BearingCheck::new(c, model, coll, self, ids)?))
     }
 }

@@ -74,7 +74,7 @@ impl BiotColumn {
         if !self.load_amplitude.is_finite() {
             return Err(format!("load_amplitude must be finite, got {}", self.load_amplitude));
         }
-        let positive = [
+        super::positive_finite(&[
             ("height", self.height),
             ("constrained_modulus", self.constrained_modulus),
             ("q_modulus", self.q_modulus),
@@ -83,12 +83,7 @@ impl BiotColumn {
             ("conductivity", self.conductivity),
             ("gravity", self.gravity),
             ("omega", self.omega),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(format!("{name} must be positive and finite, got {value}"));
-            }
-        }
+        ])?;
         if !(self.porosity > 0.0 && self.porosity < 1.0) {
             return Err(format!("porosity must lie strictly between 0 and 1, got {}", self.porosity));
         }

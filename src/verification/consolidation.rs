@@ -11,8 +11,8 @@
 //! consolidation U_s (`e_p_Us<U>`, ...).
 
 use super::{
-    all_positive, figures, load_factor, terzaghi, xie_leo, BodyAndLoad, Check, CheckParameters, Column, Findings,
-    Metric,
+    all_positive, figures, load_factor, terzaghi, xie_leo, BodyAndLoad, BuiltCheck, Check, CheckParameters, Column,
+    Findings, FormulationNeed, Metric,
 };
 use crate::case::{Case, ConductivityLaw, Formulation};
 use crate::check::{at, Checked};
@@ -67,32 +67,22 @@ pub struct LargeStrainConsolidation {
     pub settlement_tolerance: f64,
 }
 
-fn default_tv() -> Vec<f64> {
-    vec![0.1, 0.5]
-}
-fn default_ep_tol() -> f64 {
-    1e-2
-}
-fn default_rms_tol() -> f64 {
-    5e-2
-}
-fn default_settle_tol() -> f64 {
-    5e-2
-}
-fn default_us() -> Vec<f64> {
-    vec![0.5]
-}
-fn default_ls_settle_tol() -> f64 {
-    0.03
+serde_defaults! {
+    default_tv: Vec<f64> = vec![0.1, 0.5],
+    default_ep_tol: f64 = 1e-2,
+    default_rms_tol: f64 = 5e-2,
+    default_settle_tol: f64 = 5e-2,
+    default_us: Vec<f64> = vec![0.5],
+    default_ls_settle_tol: f64 = 0.03,
 }
 
 /// What the consolidation and wave references need of the analysis.
-pub(super) const TWO_PHASE: Option<(Formulation, &str)> =
+pub(super) const TWO_PHASE: FormulationNeed =
     Some((Formulation::TwoPhase, "the consolidation and wave references need a two_phase analysis"));
 
 impl CheckParameters for TerzaghiConsolidation {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> = TWO_PHASE;
+    const FORMULATION: FormulationNeed = TWO_PHASE;
     const SOLID: bool = true;
     const AXISYMMETRIC: bool = true;
 
@@ -112,17 +102,11 @@ impl CheckParameters for TerzaghiConsolidation {
         BodyAndLoad::plain(c, &self.body, &self.load)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> BuiltCheck {
         Ok(Box::new(self.column(c, ids, model, coll)?))
     }
 
-    fn solid(
-        &self,
-        c: &Case,
-        ids: &BodyAndLoad,
-        model: &Model<3>,
-        coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, c: &Case, ids: &BodyAndLoad, model: &Model<3>, coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(self.column(c, ids, model, coll)?))
     }
 }
@@ -157,7 +141,7 @@ impl TerzaghiConsolidation {
 
 impl CheckParameters for LargeStrainConsolidation {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> = TWO_PHASE;
+    const FORMULATION: FormulationNeed = TWO_PHASE;
 
     fn check(&self, key: &str) -> Checked {
         if self.degrees.is_empty() || self.degrees.iter().any(|u| !(*u > 0.0 && *u < 1.0)) {
@@ -183,7 +167,7 @@ impl CheckParameters for LargeStrainConsolidation {
         Ok(ids)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> BuiltCheck {
         let col = Column::from_case(c, model, ids)?;
         let theory = xie_leo::XieLeo {
             load: col.load * load_factor(c, ids.load, c.end_time()).abs(),

@@ -16,7 +16,7 @@
 //!   (`checkerboard::fit_of`, every rank fitting the same gathered points), which `make study-cook`
 //!   compares between F̄ and standard MPM, and the map of σ_m ([002] Figs. 3–5).
 
-use super::{Check, CheckParameters, Findings, Metric};
+use super::{BuiltCheck, Check, CheckParameters, Findings, FormulationNeed, Metric};
 use crate::case::{BodyId, Case, Formulation};
 use crate::check::{at, finite2, positive, Checked};
 use crate::model::Model;
@@ -45,17 +45,11 @@ pub struct CookMembrane {
     pub fit_radius: f64,
 }
 
-fn default_cook_tol() -> f64 {
-    0.03
-}
-fn default_cook_radius() -> f64 {
-    2.0
-}
+serde_defaults! { default_cook_tol: f64 = 0.03, default_cook_radius: f64 = 2.0 }
 
 impl CheckParameters for CookMembrane {
     type Ids = BodyId;
-    const FORMULATION: Option<(Formulation, &'static str)> =
-        Some((Formulation::OnePhase, "Cook's membrane is for a one_phase analysis"));
+    const FORMULATION: FormulationNeed = Some((Formulation::OnePhase, "Cook's membrane is for a one_phase analysis"));
 
     fn check(&self, key: &str) -> Checked {
         finite2(&at(key, "tip"), self.tip)?;
@@ -81,7 +75,7 @@ impl CheckParameters for CookMembrane {
         c.body_named("verification.body", &self.body)
     }
 
-    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(CookCheck::new(c, self, *body)))
     }
 }

@@ -27,7 +27,7 @@
 //! The comparison of two runs (F̄ with uGIMP against F̄ with B-splines, [002] Fig. 13; F̄ against
 //! standard MPM) reads the history columns and the results of both.
 
-use super::{spray, tolerance, Check, CheckParameters, Findings, Metric};
+use super::{spray, tolerance, BuiltCheck, Check, CheckParameters, Findings, FormulationNeed, Metric};
 use crate::case::{BodyId, Case, Formulation, Load, LoadId, Rectangle, Shape, StageId};
 use crate::check::{at, finite2, Checked};
 use crate::model::Model;
@@ -67,15 +67,7 @@ pub struct DamBreak {
     pub spray_fraction: f64,
 }
 
-fn default_hydrostatic_tol() -> f64 {
-    0.02
-}
-fn default_front_tol() -> f64 {
-    0.1
-}
-fn default_spray() -> f64 {
-    0.005
-}
+serde_defaults! { default_hydrostatic_tol: f64 = 0.02, default_front_tol: f64 = 0.1, default_spray: f64 = 0.005 }
 
 /// The laboratory series a dam break's front can be compared with.
 pub const DAM_BREAK_EXPERIMENTS: [&str; 1] = ["martin_moyce_1952"];
@@ -93,8 +85,7 @@ pub struct DamBreakIds {
 
 impl CheckParameters for DamBreak {
     type Ids = DamBreakIds;
-    const FORMULATION: Option<(Formulation, &'static str)> =
-        Some((Formulation::OnePhase, "the dam break is for a one_phase analysis"));
+    const FORMULATION: FormulationNeed = Some((Formulation::OnePhase, "the dam break is for a one_phase analysis"));
 
     /// Checks the tolerances, the wall and the experiment.
     fn check(&self, key: &str) -> Checked {
@@ -146,7 +137,7 @@ impl CheckParameters for DamBreak {
         Ok(ids)
     }
 
-    fn plane(&self, c: &Case, ids: &DamBreakIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &DamBreakIds, model: &Model, coll: &Collective) -> BuiltCheck {
         Ok(Box::new(DamBreakCheck::new(c, model, coll, self, ids)?))
     }
 }

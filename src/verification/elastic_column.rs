@@ -1,7 +1,10 @@
 //! The elastic column under its self-weight and a surcharge (one-phase), at rest at the end of
 //! the run.
 
-use super::{all_positive, figures, load_factor, load_name, plain_load, Check, CheckParameters, Findings, Metric};
+use super::{
+    all_positive, figures, load_factor, load_name, plain_load, BuiltCheck, Check, CheckParameters, Findings,
+    FormulationNeed, Metric,
+};
 use crate::case::{BodyId, Case, Formulation, Load, LoadId};
 use crate::check::Checked;
 use crate::model::Model;
@@ -26,9 +29,7 @@ pub struct ElasticColumn {
     pub settlement_tolerance: f64,
 }
 
-fn default_column_tol() -> f64 {
-    0.01
-}
+serde_defaults! { default_column_tol: f64 = 0.01 }
 
 /// What an elastic column names.
 #[derive(Debug, Clone, Copy)]
@@ -43,7 +44,7 @@ pub struct ElasticColumnIds {
 
 impl CheckParameters for ElasticColumn {
     type Ids = ElasticColumnIds;
-    const FORMULATION: Option<(Formulation, &'static str)> =
+    const FORMULATION: FormulationNeed =
         Some((Formulation::OnePhase, "the elastic column reference is for a one_phase analysis"));
     const AXISYMMETRIC: bool = true;
 
@@ -78,13 +79,7 @@ impl CheckParameters for ElasticColumn {
         }
     }
 
-    fn plane(
-        &self,
-        c: &Case,
-        ids: &ElasticColumnIds,
-        model: &Model,
-        coll: &Collective,
-    ) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &ElasticColumnIds, model: &Model, coll: &Collective) -> BuiltCheck {
         Ok(Box::new(ElasticColumnCheck::new(c, model, coll, self, ids)?))
     }
 }

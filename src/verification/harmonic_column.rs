@@ -7,8 +7,11 @@
 //! depth profile (particles at the same depth averaged), A* from [`biot_harmonic`].
 
 use super::consolidation::TWO_PHASE;
-use super::{biot_harmonic, figures, tolerance, BodyAndLoad, Check, CheckParameters, Column, Findings, Metric, Table};
-use crate::case::{Case, Formulation, TimeFunction};
+use super::{
+    biot_harmonic, figures, tolerance, BodyAndLoad, BuiltCheck, Check, CheckParameters, Column, Findings,
+    FormulationNeed, Metric, Table,
+};
+use crate::case::{Case, TimeFunction};
 use crate::check::{at, Checked};
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -30,13 +33,11 @@ pub struct HarmonicColumn {
     pub tolerance: f64,
 }
 
-fn default_periods() -> usize {
-    3
-}
+serde_defaults! { default_periods: usize = 3 }
 
 impl CheckParameters for HarmonicColumn {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> = TWO_PHASE;
+    const FORMULATION: FormulationNeed = TWO_PHASE;
 
     fn check(&self, key: &str) -> Checked {
         tolerance(&at(key, "tolerance"), self.tolerance)?;
@@ -54,7 +55,7 @@ impl CheckParameters for HarmonicColumn {
         BodyAndLoad::plain(c, &self.body, &self.load)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, _coll: &Collective) -> BuiltCheck {
         let col = Column::from_case(c, model, ids)?;
         let Some(TimeFunction::Harmonic(f)) = c.load_time_function(ids.load) else {
             let name = c.load(ids.load).name();

@@ -17,7 +17,10 @@
 //! geometrically nonlinear answer differs by 3.6 % in u_r(a); the case applies a small
 //! increment.
 
-use super::{all_positive, linear_elastic, load_name, radii, BodyAndLoad, Check, CheckParameters, Findings, Metric};
+use super::{
+    all_positive, linear_elastic, load_name, radii, BodyAndLoad, BuiltCheck, Check, CheckParameters, Findings,
+    FormulationNeed, Metric,
+};
 use crate::case::{Case, Formulation, Geometry};
 use crate::check::{at, positive, Checked};
 use crate::model::loads::TimeFn;
@@ -69,16 +72,11 @@ pub struct IncrementTolerances {
     pub radius: f64,
 }
 
-fn default_displacement_tol() -> f64 {
-    0.05
-}
-fn default_stress_tol() -> f64 {
-    0.25
-}
+serde_defaults! { default_displacement_tol: f64 = 0.05, default_stress_tol: f64 = 0.25 }
 
 impl CheckParameters for HollowCylinder {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> =
+    const FORMULATION: FormulationNeed =
         Some((Formulation::OnePhase, "the hollow cylinder's reference is for a one_phase analysis"));
     const AXISYMMETRIC: bool = true;
 
@@ -128,7 +126,7 @@ impl CheckParameters for HollowCylinder {
         Ok(ids)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(HollowCylinderCheck::new(c, self, ids)?))
     }
 }

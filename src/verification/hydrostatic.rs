@@ -10,7 +10,7 @@
 //! `p_rel_error` is max_p |p_p − p*_p| / max_p |p*_p| over the body's points and ranks; each
 //! point's (y, p) goes to the figure of the profile.
 
-use super::{figures, load_factor, tolerance, Check, CheckParameters, Findings, Metric};
+use super::{figures, load_factor, tolerance, BuiltCheck, Check, CheckParameters, Findings, FormulationNeed, Metric};
 use crate::case::{BodyId, Case, Formulation, Load, LoadId};
 use crate::check::{at, finite, Checked};
 use crate::model::Model;
@@ -34,9 +34,7 @@ pub struct Hydrostatic {
     pub tolerance: f64,
 }
 
-fn default_tolerance() -> f64 {
-    0.01
-}
+serde_defaults! { default_tolerance: f64 = 0.01 }
 
 /// What a hydrostatic check names.
 #[derive(Debug, Clone, Copy)]
@@ -49,7 +47,7 @@ pub struct HydrostaticIds {
 
 impl CheckParameters for Hydrostatic {
     type Ids = HydrostaticIds;
-    const FORMULATION: Option<(Formulation, &'static str)> =
+    const FORMULATION: FormulationNeed =
         Some((Formulation::TwoPhase, "the hydrostatic pore pressure needs a two_phase analysis"));
     const SOLID: bool = true;
     const AXISYMMETRIC: bool = true;
@@ -98,23 +96,11 @@ impl CheckParameters for Hydrostatic {
         Ok(ids)
     }
 
-    fn plane(
-        &self,
-        c: &Case,
-        ids: &HydrostaticIds,
-        _model: &Model,
-        _coll: &Collective,
-    ) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &HydrostaticIds, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(HydrostaticCheck::new(c, self, ids)?))
     }
 
-    fn solid(
-        &self,
-        c: &Case,
-        ids: &HydrostaticIds,
-        _model: &Model<3>,
-        _coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, c: &Case, ids: &HydrostaticIds, _model: &Model<3>, _coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(HydrostaticCheck::new(c, self, ids)?))
     }
 }

@@ -10,7 +10,10 @@
 //! initial radial direction), σ_rr and σ_θθ (the stress projected on the radial and hoop directions
 //! there), at the end of the run.
 
-use super::{all_positive, linear_elastic, load_name, radii, BodyAndLoad, Check, CheckParameters, Findings, Metric};
+use super::{
+    all_positive, linear_elastic, load_name, radii, BodyAndLoad, BuiltCheck, Check, CheckParameters, Findings,
+    FormulationNeed, Metric,
+};
 use crate::case::{Case, Formulation, Load};
 use crate::check::{at, finite2, Checked};
 use crate::model::loads::TimeFn;
@@ -41,13 +44,11 @@ pub struct LameCylinder {
     pub stress_tolerance: f64,
 }
 
-fn default_lame_tol() -> f64 {
-    0.05
-}
+serde_defaults! { default_lame_tol: f64 = 0.05 }
 
 impl CheckParameters for LameCylinder {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> =
+    const FORMULATION: FormulationNeed =
         Some((Formulation::OnePhase, "the Lamé reference is for a one_phase analysis"));
 
     fn check(&self, key: &str) -> Checked {
@@ -72,7 +73,7 @@ impl CheckParameters for LameCylinder {
         Ok(ids)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(LameCheck::new(c, self, ids)?))
     }
 }

@@ -281,6 +281,15 @@ fn each_positive(key: &str, values: &[f64]) -> Checked {
     values.iter().enumerate().try_for_each(|(j, &v)| positive(&format!("{key}[{j}]"), v))
 }
 
+/// Each `(name, value)` of a reference solution's parameters positive and finite, or a message naming
+/// the first that is not.
+fn positive_finite(fields: &[(&str, f64)]) -> Result<(), String> {
+    match fields.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+        Some((name, value)) => Err(format!("{name} must be positive and finite, got {value}")),
+        None => Ok(()),
+    }
+}
+
 /// Each `(field, value)` above zero, and a tolerance at most 1 ([`tolerance`]).
 fn all_positive(key: &str, fields: &[(&str, f64)]) -> Checked {
     fields.iter().try_for_each(|&(f, v)| {
@@ -315,6 +324,13 @@ fn radii(key: &str, inner: f64, outer: f64) -> Checked {
     Ok(())
 }
 
+/// The formulation a check is for, with the message for a case of the other; `None` where either
+/// will do.
+pub type FormulationNeed = Option<(Formulation, &'static str)>;
+
+/// A check built for a case of dimension `D`, or why it cannot be.
+pub type BuiltCheck<const D: usize = 2> = Result<Box<dyn Check<D>>, String>;
+
 /// A check's parameters as the case file gives them (the table `[verification]` beside its
 /// `kind`): their ranges, their description, what the check needs of the case, the names they give
 /// resolved to ids, and the check they make.
@@ -324,7 +340,7 @@ pub trait CheckParameters {
 
     /// The formulation the check is for, with the message of a case of the other (after
     /// ``key `verification`: ``); `None` where either will do.
-    const FORMULATION: Option<(Formulation, &'static str)> = None;
+    const FORMULATION: FormulationNeed = None;
 
     /// Whether a three-dimensional case may ask for the check ([`CheckParameters::solid`] builds
     /// it there).
@@ -348,17 +364,11 @@ pub trait CheckParameters {
     fn link(&self, c: &Case) -> Result<Self::Ids, String>;
 
     /// The check of a plane or axisymmetric case whose names resolve to `ids` (collective).
-    fn plane(&self, c: &Case, ids: &Self::Ids, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String>;
+    fn plane(&self, c: &Case, ids: &Self::Ids, model: &Model, coll: &Collective) -> BuiltCheck;
 
     /// The check of a three-dimensional case whose names resolve to `ids` (collective); a check
     /// with [`CheckParameters::SOLID`] builds it, and validation refuses the others' cases.
-    fn solid(
-        &self,
-        _c: &Case,
-        _ids: &Self::Ids,
-        _model: &Model<3>,
-        _coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, _c: &Case, _ids: &Self::Ids, _model: &Model<3>, _coll: &Collective) -> BuiltCheck<3> {
         Err("the check is two-dimensional".into())
     }
 }
@@ -366,7 +376,7 @@ pub trait CheckParameters {
 /// What a check needs of a case's analysis: [`CheckParameters`]'s constants.
 #[derive(Debug, Clone, Copy)]
 struct Needs {
-    formulation: Option<(Formulation, &'static str)>,
+    formulation: FormulationNeed,
     solid: bool,
     axisymmetric: bool,
 }
@@ -460,14 +470,14 @@ macro_rules! verification_kinds {
             }
 
             /// The check of a plane or axisymmetric case (collective).
-            fn plane(&self, c: &Case, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+            fn plane(&self, c: &Case, model: &Model, coll: &Collective) -> BuiltCheck {
                 match self {
                     $(Verification::$variant(p) => p.plane(c, &p.link(c)?, model, coll),)*
                 }
             }
 
             /// The check of a three-dimensional case (collective).
-            fn solid(&self, c: &Case, model: &Model<3>, coll: &Collective) -> Result<Box<dyn Check<3>>, String> {
+            fn solid(&self, c: &Case, model: &Model<3>, coll: &Collective) -> BuiltCheck<3> {
                 if !self.needs().solid {
                     return Err(format!("the `{}` check is two-dimensional", self.kind()));
                 }

@@ -11,7 +11,7 @@
 //!   step, and for a pure rotation, which it rotates exactly); for a neo-Hookean body σ* is its
 //!   stress of F itself, exact to round-off.
 
-use super::{all_positive, Check, CheckParameters, Findings, Metric};
+use super::{all_positive, BuiltCheck, Check, CheckParameters, Findings, FormulationNeed, Metric};
 use crate::case::{BodyId, BoundaryId, Case, Formulation, SoilModel};
 use crate::check::Checked;
 use crate::model::loads::Motion;
@@ -40,12 +40,7 @@ pub struct Patch {
     pub tolerance: f64,
 }
 
-fn default_spread_tol() -> f64 {
-    1e-9
-}
-fn default_patch_tol() -> f64 {
-    1e-6
-}
+serde_defaults! { default_spread_tol: f64 = 1e-9, default_patch_tol: f64 = 1e-6 }
 
 /// What a patch test names.
 #[derive(Debug, Clone, Copy)]
@@ -58,7 +53,7 @@ pub struct PatchIds {
 
 impl CheckParameters for Patch {
     type Ids = PatchIds;
-    const FORMULATION: Option<(Formulation, &'static str)> =
+    const FORMULATION: FormulationNeed =
         Some((Formulation::OnePhase, "the patch reference is for a one_phase analysis"));
     const SOLID: bool = true;
 
@@ -90,17 +85,11 @@ impl CheckParameters for Patch {
         Ok(ids)
     }
 
-    fn plane(&self, c: &Case, ids: &PatchIds, model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &PatchIds, model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(PatchCheck::new(c, model, self, ids)?))
     }
 
-    fn solid(
-        &self,
-        c: &Case,
-        ids: &PatchIds,
-        model: &Model<3>,
-        _coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, c: &Case, ids: &PatchIds, model: &Model<3>, _coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(PatchCheck::new(c, model, self, ids)?))
     }
 }

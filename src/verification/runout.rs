@@ -20,7 +20,7 @@
 //! solution; `make study-landslide` compares the run-outs of the bases and of F̄ against standard
 //! MPM (assertions on their ratios, which do not depend on the slope's geometry).
 
-use super::{all_positive, spray, Check, CheckParameters, Findings, Metric};
+use super::{all_positive, spray, BuiltCheck, Check, CheckParameters, Findings, FormulationNeed, Metric};
 use crate::case::{BodyId, Case, Formulation, StageId};
 use crate::check::Checked;
 use crate::model::Model;
@@ -57,17 +57,11 @@ pub struct Runout {
     pub spray_fraction: f64,
 }
 
-fn default_standing_advance() -> f64 {
-    0.05
-}
-fn default_standing_speed() -> f64 {
-    0.01
-}
-fn default_failed_strain() -> f64 {
-    0.5
-}
-fn default_runout_spray() -> f64 {
-    1.0e-3
+serde_defaults! {
+    default_standing_advance: f64 = 0.05,
+    default_standing_speed: f64 = 0.01,
+    default_failed_strain: f64 = 0.5,
+    default_runout_spray: f64 = 1.0e-3,
 }
 
 /// What a run-out check names.
@@ -81,8 +75,7 @@ pub struct RunoutIds {
 
 impl CheckParameters for Runout {
     type Ids = RunoutIds;
-    const FORMULATION: Option<(Formulation, &'static str)> =
-        Some((Formulation::OnePhase, "the run-out check is for a one_phase analysis"));
+    const FORMULATION: FormulationNeed = Some((Formulation::OnePhase, "the run-out check is for a one_phase analysis"));
     const SOLID: bool = true;
 
     /// Checks the standing limits, the failed strain and the spray.
@@ -115,17 +108,11 @@ impl CheckParameters for Runout {
         }
     }
 
-    fn plane(&self, c: &Case, ids: &RunoutIds, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &RunoutIds, model: &Model, coll: &Collective) -> BuiltCheck {
         Ok(Box::new(RunoutCheck::new(c, model, coll, self, ids)?))
     }
 
-    fn solid(
-        &self,
-        c: &Case,
-        ids: &RunoutIds,
-        model: &Model<3>,
-        coll: &Collective,
-    ) -> Result<Box<dyn Check<3>>, String> {
+    fn solid(&self, c: &Case, ids: &RunoutIds, model: &Model<3>, coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(RunoutCheck::new(c, model, coll, self, ids)?))
     }
 }

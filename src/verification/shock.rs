@@ -9,8 +9,8 @@
 //! ringing) is documented at [`pick_arrival`].
 
 use super::consolidation::TWO_PHASE;
-use super::{all_positive, BodyAndLoad, Check, CheckParameters, Column, Findings, Metric};
-use crate::case::{Case, Formulation};
+use super::{all_positive, BodyAndLoad, BuiltCheck, Check, CheckParameters, Column, Findings, FormulationNeed, Metric};
+use crate::case::Case;
 use crate::check::Checked;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -34,16 +34,11 @@ pub struct ShockWave {
     pub slow_tolerance: f64,
 }
 
-fn default_fast_tol() -> f64 {
-    0.02
-}
-fn default_slow_tol() -> f64 {
-    0.05
-}
+serde_defaults! { default_fast_tol: f64 = 0.02, default_slow_tol: f64 = 0.05 }
 
 impl CheckParameters for ShockWave {
     type Ids = BodyAndLoad;
-    const FORMULATION: Option<(Formulation, &'static str)> = TWO_PHASE;
+    const FORMULATION: FormulationNeed = TWO_PHASE;
 
     fn check(&self, key: &str) -> Checked {
         let (d, f, s) = (self.probe_depth, self.fast_tolerance, self.slow_tolerance);
@@ -58,7 +53,7 @@ impl CheckParameters for ShockWave {
         BodyAndLoad::plain(c, &self.body, &self.load)
     }
 
-    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, ids: &BodyAndLoad, model: &Model, coll: &Collective) -> BuiltCheck {
         let col = Column::from_case(c, model, ids)?;
         let (depth, fast, slow) = (self.probe_depth, self.fast_tolerance, self.slow_tolerance);
         Ok(Box::new(ShockCheck::new(col, depth, fast, slow, model, coll)?))
@@ -158,6 +153,20 @@ impl ShockCheck {
             col,
         })
     }
+
+    /// The relative error of the arrival `picked` of the wave of speed `speed` (named `v`) at the
+    /// probe, against depth / speed; NaN with `missing` where no front was picked.
+    fn arrival(&self, picked: Option<f64>, speed: f64, v: &str, tol: f64, missing: String) -> Metric {
+        let expected = self.depth / speed;
+        match picked {
+            Some(t) => Metric::error(
+                (t - expected).abs() / expected,
+                tol,
+                format!("arrival {t:.5e} s vs depth/{v} = {:.4} m / {speed:.1} m/s = {expected:.5e} s", self.depth),
+            ),
+            None => Metric::error(f64::NAN, tol, missing),
+        }
+    }
 }
 
 impl Check for ShockCheck {
@@ -202,41 +211,16 @@ impl Check for ShockCheck {
         let split = 0.5 * (t_fast + t_slow);
         let fast = pick_arrival(&self.samples, 0.0, split);
         self.picked.0 = fast;
-        out.push((
-            "fast_wave_arrival_rel_error".to_string(),
-            match fast {
-                Some(t) => Metric::error(
-                    (t - t_fast).abs() / t_fast,
-                    tf,
-                    format!(
-                        "arrival {t:.5e} s vs depth/V_u = {:.4} m / {:.1} m/s = {t_fast:.5e} s",
-                        self.depth, self.fast_speed
-                    ),
-                ),
-                None => Metric::error(f64::NAN, tf, "no fast front found in p(t) (run too short?)".into()),
-            },
-        ));
+        let missing = "no fast front found in p(t) (run too short?)".to_string();
+        out.push(("fast_wave_arrival_rel_error".to_string(), self.arrival(fast, self.fast_speed, "V_u", tf, missing)));
         if self.slow_expected {
             let end = split + 2.0 * (t_slow - split);
             let slow = pick_arrival(&self.samples, split, end);
             self.picked.1 = slow;
+            let missing = format!("no slow front found in p(t) up to {end:.4e} s (run too short?)");
             out.push((
                 "slow_wave_arrival_rel_error".to_string(),
-                match slow {
-                    Some(t) => Metric::error(
-                        (t - t_slow).abs() / t_slow,
-                        ts,
-                        format!(
-                            "arrival {t:.5e} s vs depth/V_d = {:.4} m / {:.1} m/s = {t_slow:.5e} s",
-                            self.depth, self.slow_speed
-                        ),
-                    ),
-                    None => Metric::error(
-                        f64::NAN,
-                        ts,
-                        format!("no slow front found in p(t) up to {end:.4e} s (run too short?)"),
-                    ),
-                },
+                self.arrival(slow, self.slow_speed, "V_d", ts, missing),
             ));
         }
         Ok((out, Vec::new()))

@@ -8,7 +8,7 @@
 //! counted once, so that neither shrinks with more points); `results` has the smallest and largest
 //! ratio and the number of nodes.
 
-use super::{all_positive, linear_elastic, Check, CheckParameters, Findings, Metric};
+use super::{all_positive, linear_elastic, BuiltCheck, Check, CheckParameters, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::case::{BodyId, Case, Geometry};
 use crate::check::{at, finite2, Checked};
@@ -31,9 +31,7 @@ pub struct StiffnessMap {
     pub tolerance: f64,
 }
 
-fn default_stiffness_map_tol() -> f64 {
-    0.01
-}
+serde_defaults! { default_stiffness_map_tol: f64 = 0.01 }
 
 impl CheckParameters for StiffnessMap {
     type Ids = BodyId;
@@ -67,7 +65,7 @@ impl CheckParameters for StiffnessMap {
         Ok(body)
     }
 
-    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(StiffnessMapCheck::new(c, self, *body)?))
     }
 }

@@ -51,17 +51,12 @@ impl Terzaghi {
         if !self.load.is_finite() {
             return Err(format!("load must be finite, got {}", self.load));
         }
-        let positive = [
+        super::positive_finite(&[
             ("height", self.height),
             ("constrained_modulus", self.constrained_modulus),
             ("conductivity", self.conductivity),
             ("water_unit_weight", self.water_unit_weight),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(format!("{name} must be positive and finite, got {value}"));
-            }
-        }
+        ])?;
         if !(self.inv_q.is_finite() && self.inv_q >= 0.0) {
             return Err(format!("inv_q must be non-negative and finite, got {}", self.inv_q));
         }

@@ -16,7 +16,7 @@
 //! * the total variation Σ|Δσ_m| over the run of the mean stress at the points nearest `b` (in
 //!   the shear band) and `c` (in the sliding block), [001]'s p–q paths of Figs. 30–31 in one number.
 
-use super::{each_positive, Check, CheckParameters, Findings, Metric};
+use super::{each_positive, BuiltCheck, Check, CheckParameters, Findings, Metric};
 use crate::assembly::{NodeBlock, NODE_VALUES};
 use crate::case::{BodyId, Case, SoilModel};
 use crate::check::{at, finite2, positive, Checked};
@@ -76,7 +76,7 @@ impl CheckParameters for VerticalCut {
         Ok(body)
     }
 
-    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> Result<Box<dyn Check>, String> {
+    fn plane(&self, c: &Case, body: &BodyId, _model: &Model, _coll: &Collective) -> BuiltCheck {
         Ok(Box::new(VerticalCutCheck::new(c, self, *body)?))
     }
 }

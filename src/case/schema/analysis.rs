@@ -79,12 +79,7 @@ pub enum AxisymmetricWeights {
     RWeighted,
 }
 
-fn default_shape() -> ShapeFunctions {
-    ShapeFunctions::Gimp
-}
-fn default_g() -> f64 {
-    9.81
-}
+serde_defaults! { default_shape: ShapeFunctions = ShapeFunctions::Gimp, default_g: f64 = 9.81 }
 
 /// The discrete system to build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]

@@ -52,9 +52,7 @@ pub enum Overlap {
     Yield,
 }
 
-fn default_ppc() -> usize {
-    2
-}
+serde_defaults! { default_ppc: usize = 2 }
 
 /// A geostatic initial state in equilibrium with gravity g = `analysis.g` acting from t = 0 (the
 /// case must apply that gravity in full from the start): at a point at height y under a column of

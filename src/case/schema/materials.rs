@@ -49,9 +49,7 @@ pub enum ConductivityLaw {
     XieLeo,
 }
 
-fn default_rho_w() -> f64 {
-    1000.0
-}
+serde_defaults! { default_rho_w: f64 = 1000.0 }
 
 impl Material {
     /// Checks the densities and the model's parameters; `key` is the material's table

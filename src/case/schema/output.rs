@@ -27,16 +27,12 @@ pub struct Output {
     pub fields_every: usize,
 }
 
-fn default_every() -> usize {
-    1
-}
+serde_defaults! { default_every: usize = 1 }
 
 /// Field output every 100 steps unless the case says otherwise.
 pub const DEFAULT_FIELDS_EVERY: usize = 100;
 
-fn default_fields_every() -> usize {
-    DEFAULT_FIELDS_EVERY
-}
+serde_defaults! { default_fields_every: usize = DEFAULT_FIELDS_EVERY }
 
 impl Default for Output {
     fn default() -> Self {

@@ -136,12 +136,7 @@ impl Default for Explicit {
     }
 }
 
-fn default_cfl() -> f64 {
-    0.5
-}
-fn default_flip() -> f64 {
-    1.0
-}
+serde_defaults! { default_cfl: f64 = 0.5, default_flip: f64 = 1.0 }
 
 /// What a stage solves (see [`Stage::analysis`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
@@ -169,12 +164,7 @@ pub enum Drainage {
     Undrained,
 }
 
-fn default_cuts() -> usize {
-    4
-}
-fn default_cut_factor() -> f64 {
-    0.5
-}
+serde_defaults! { default_cuts: usize = 4, default_cut_factor: f64 = 0.5 }
 
 /// The time integration of dynamic stages: the generalized-α method of Chung & Hulbert (1993) with
 /// spectral radius `rho_inf` (default 0.2, [`DEFAULT_RHO_INF`]), or Newmark ([003] Eqs. 20–22)
