@@ -62,7 +62,7 @@ pub struct Stabilisation {
     /// stiffness: each point's stress goes to the nodes of the cells it maps to with the weights
     /// of `stabilisation.stiffness`, σ_i^e = Σ_p w_ip W_p σ_p, from there to the cell's 2 × 2 Gauss
     /// points, σ_g = Σ_i N_i(x_g) σ_i^e, and F_e = Σ_g B_gᵀ σ_g |J|, as [001] Eqs. 16–20 map D_p).
-    /// FormulationNeed a mapped `stiffness` (`gauss_mapping`, `double_mapping` or `double_mapping_gimp`), a
+    /// Needs a mapped `stiffness` (`gauss_mapping`, `double_mapping` or `double_mapping_gimp`), a
     /// one-phase plane case without B-splines; the residual and its exact tangent change together.
     pub internal_force: InternalForce,
 }
