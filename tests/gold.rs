@@ -1,11 +1,11 @@
 //! Gold values: every case in `cases/` has its key numbers stored in `cases/gold/<case>.json` — the
 //! verification metrics and whether each meets its target (`pass.<metric>`, 1 or 0), the
-//! `results`, the number of steps, and the probe, reaction and boundary
-//! values of `history.csv` at the middle and at the end of the run — and the default test run
-//! compares a fresh run with them at a relative tolerance near a direct solver's round-off (each
-//! file's `rtol`, measured between the default solver and `direct-lu.opts`). This is the habit of
-//! PETSc's test output files and MOOSE's CSVDiff: a change of any number shows up here, and a
-//! refresh shows up in the diff.
+//! `results`, the number of steps and of warnings, a dynamic run's energy imbalance, and the probe,
+//! reaction and boundary values of `history.csv` at the middle and at the end of the run — and
+//! the default test run compares a fresh run with them at a relative tolerance near a direct
+//! solver's round-off (each file's `rtol`, measured between the default solver and
+//! `direct-lu.opts`). This is the habit of PETSc's test output files and MOOSE's CSVDiff: a change
+//! of any number shows up here, and a refresh shows up in the diff.
 //!
 //! Refresh (after a change that is meant to move the numbers; review the diff of `cases/gold/`):
 //!
@@ -65,10 +65,10 @@ fn run(case: &str, label: &str, sets: &[String], extra: &[String], options: &[&s
 
 /// The kind of a value, for the scale of its absolute floor.
 fn kind(key: &str) -> &'static str {
-    if key.starts_with("verification.") {
+    if key.starts_with("verification.") || key == "summary.energy_balance_error" {
         return "verification";
     }
-    if key.starts_with("results.") || key.starts_with("pass.") || key == "steps" {
+    if key.starts_with("results.") || key.starts_with("pass.") || key == "steps" || key == "summary.warnings" {
         return "exact";
     }
     let last = key.rsplit('.').next().unwrap();
@@ -91,6 +91,10 @@ fn kept_column(name: &str) -> bool {
 fn values_of(out: &Path, s: &Value) -> BTreeMap<String, Option<f64>> {
     let mut v = BTreeMap::new();
     v.insert("steps".to_string(), s["steps"].as_f64());
+    v.insert("summary.warnings".to_string(), s["warnings"].as_array().map(|w| w.len() as f64));
+    if let Some(e) = s["energy_balance_error"].as_f64() {
+        v.insert("summary.energy_balance_error".to_string(), Some(e));
+    }
     for (k, m) in s["verification"].as_object().into_iter().flatten() {
         v.insert(format!("verification.{k}"), m["value"].as_f64());
         v.insert(format!("pass.{k}"), m["pass"].as_bool().map(|p| if p { 1.0 } else { 0.0 }));

@@ -1,13 +1,12 @@
 //! The residual and Jacobian callbacks of a step's Newton solve: the particle side's sums
 //! ([`Points`]) at PETSc's iterate, added into a ghosted vector (summed over ranks by PETSc) and
-//! into the COO value array of the matrix, in PETSc's scaling of the pressure unknowns.
+//! into the value array of the matrix's blocks, in PETSc's scaling of the pressure unknowns.
 
 use super::points::{run_bands, Points};
 use super::step::Step;
 use crate::model::Model;
-use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
-use petsc::{CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
+use petsc::{BlockOps, BlockPlaces, CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
 use std::time::Instant;
 
 fn fatal(e: petsc::Error) -> CallbackError {
@@ -28,25 +27,29 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
     values: Vec<f64>,
     /// The fixed-stress Schur preconditioner, refilled after every Jacobian.
     schur: Option<&'a mut petsc::SchurUser>,
+    /// Where the pattern's blocks sit in the matrix.
+    places: &'a BlockPlaces,
     /// The first material point whose residual block was not finite in this solve (on this
     /// rank), with the quantity that was not.
     pub(super) nonfinite: Option<String>,
 }
 
 /// What the callbacks borrow from the solver: the node space's DMDA, the local work vectors, the
-/// assembly's log stage and the user-built Schur preconditioner, if any.
+/// assembly's log stage, the user-built Schur preconditioner, if any, and the places of the
+/// pattern's blocks in the matrix.
 pub(super) struct Workspace<'a, const D: usize> {
     pub dm: &'a DmDa<D>,
     pub x_local: &'a mut Vector,
     pub f_local: &'a mut Vector,
     pub stage: &'a LogStage,
     pub schur: Option<&'a mut petsc::SchurUser>,
+    pub places: &'a BlockPlaces,
 }
 
 impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> {
     /// The callbacks of `step` of `model` on the solver's `work`.
     pub(super) fn new(model: &'a Model<D>, step: &'a Step<D, M>, work: Workspace<'a, D>) -> Callbacks<'a, D, M, N> {
-        let Workspace { dm, x_local, f_local, stage, schur } = work;
+        let Workspace { dm, x_local, f_local, stage, schur, places } = work;
         Callbacks {
             points: Points::new(model, step),
             step,
@@ -57,6 +60,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> 
             stage,
             values: Vec::new(),
             schur,
+            places,
             nonfinite: None,
         }
     }
@@ -165,7 +169,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         for &(blk, c) in &step.fixed_diagonals {
             values[blk as usize * nd * nd + c * nd + c] = 1.0;
         }
-        j.set_values_coo(&values, false).map_err(fatal)?;
+        j.set_blocks(self.places, &values).map_err(fatal)?;
         self.values = values;
         if let Some(schur) = self.schur.as_deref_mut() {
             if schur.has_blocks() {

@@ -1,12 +1,12 @@
-//! The matrix pattern of a step as a coordinate (COO) list, and where each particle adds its
+//! The matrix pattern of a step as a list of node-pair blocks, and where each particle adds its
 //! tangent into it (step 5 of a step), in any dimension.
 //!
 //! The list holds each (node a, node b) block of dofs once: the pairs of every particle's effective
 //! stencil and the diagonal block of every owned node (so that fixed dofs always find their unit
 //! diagonal). Each particle keeps a slot map: the block of every pair of its effective nodes. A
-//! Jacobian then adds every particle's dense block into one value array in list order and hands it
-//! to PETSc at once (`MatSetValuesCOO`), which is several times faster than inserting the blocks
-//! one by one (docs/solvers.md). A particle finds the block of a pair through a
+//! Jacobian then adds every particle's dense block into one value array in list order, whose
+//! blocks are written in place into the matrix ([`super::matrix`]), which is several times faster
+//! than inserting the blocks one by one (docs/solvers.md). A particle finds the block of a pair through a
 //! dense table indexed by the first node and the pair's offset on the grid (no per-particle map:
 //! that map cost more memory than the particles themselves on the peer footing). The table holds
 //! (2·3 + 1)^D entries per ghosted node: 49 in two dimensions, 343 (1.4 kB) in three, against the

@@ -367,7 +367,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     }
 
     /// The tangent blocks of every particle that reaches `band`, added into the band's part
-    /// `values` of the COO value array.
+    /// `values` of the block value array.
     pub(super) fn tangent_band(&self, band: Band, values: &mut [f64], xl: &[f64]) {
         let step = self.step;
         let nm = step.scheme;
@@ -408,7 +408,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     }
 
     /// Adds the rows of `band` of particle `k`'s tangent block to the band's part `values` of the
-    /// COO values, which starts at block `first`.
+    /// block values, which starts at block `first`.
     #[allow(clippy::too_many_arguments)]
     fn add_tangent(
         &self,

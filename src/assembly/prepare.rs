@@ -12,7 +12,7 @@
 //!    pressure-projection blocks and the external forces at t_{n+1} ([`loads`]), with the check that
 //!    every applied force reaches a node that carries it, the generalized-α history, the force scale
 //!    and the drained faces and nodes ([`pressure`]);
-//! 5. `matrix_pattern` ([`pattern`]): the COO pattern of the matrix, kept from the last step while it
+//! 5. `matrix_pattern` ([`pattern`]): the block pattern of the matrix, kept from the last step while it
 //!    holds every pair the particles need.
 //!
 //! The analysis type enters only through the layout (which fields a node carries) and the

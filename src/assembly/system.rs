@@ -5,7 +5,7 @@
 
 use super::callbacks::{Callbacks, Workspace};
 use super::dim::StepDim;
-use super::pattern::Pattern;
+use super::matrix::Matrix;
 use super::prepare::StepRequest;
 use super::pressure::{self, L2Projection};
 use super::space::{NodeBlock, NodeSpace};
@@ -88,12 +88,6 @@ pub struct StepSolve {
     pub line_search_retry: bool,
     /// Why the direct solver was given more workspace and the step solved again, if it was.
     pub workspace_retry: Option<String>,
-}
-
-/// The Jacobian matrix and the pattern it was made for.
-struct Matrix<const D: usize> {
-    mat: Mat,
-    pattern: Arc<Pattern<D>>,
 }
 
 /// The global system on a grid of dimension D whose points have at most M stencil nodes of at
@@ -237,13 +231,14 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     }
 
     /// This rank's matrix memory in bytes: its compressed-row storage in PETSc (`petsc::mat::MatStats`)
-    /// and the program's side of it (the block pattern and the assembly's buffer of block values,
-    /// one value per stored entry); zeros without a matrix. Not collective.
+    /// and the program's side of it (the block pattern, the blocks' places in the matrix and the
+    /// assembly's buffer of block values, one value per block entry); zeros without a matrix. Not
+    /// collective.
     pub fn matrix_memory(&self) -> Result<(f64, usize), Error> {
         let Some(m) = &self.matrix else { return Ok((0.0, 0)) };
         let nd = self.space.layout.nd;
         let values = m.pattern.len() * nd * nd * std::mem::size_of::<f64>();
-        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + values))
+        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + m.places.heap_bytes() + values))
     }
 
     /// Enters a log stage until the guard is dropped.
@@ -392,18 +387,17 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             return Ok(());
         }
         self.matrix = None;
-        let (rows, cols) = step.pattern.coo(step.layout.nd, &self.space.l2g);
-        let made = self.space.dm.create_matrix_coo(&rows, &cols).and_then(|mut jac| {
-            if !self.near_null.is_empty() {
-                jac.set_near_null_space(self.space.comm, &self.near_null)?;
-            }
-            Ok(jac)
-        });
-        let mat = coll.agree(made.map_err(|e| e.to_string())).map_err(Error::new)?;
+        let mut matrix = Matrix::of(&step.pattern, &self.space, coll).map_err(Error::new)?;
+        let null = if self.near_null.is_empty() {
+            Ok(())
+        } else {
+            matrix.mat.set_near_null_space(self.space.comm, &self.near_null)
+        };
+        coll.agree(null.map_err(|e| e.to_string())).map_err(Error::new)?;
         if let Some(schur) = &mut self.schur {
             schur.forget();
         }
-        self.matrix = Some(Matrix { mat, pattern: step.pattern.clone() });
+        self.matrix = Some(matrix);
         Ok(())
     }
 
@@ -422,8 +416,9 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     /// residual was not finite, and the callbacks' wall time.
     fn newton(&mut self, step: &Step<D, M>, model: &Model<D>) -> Result<(SolveOutcome, Option<String>, f64), Error> {
         let System { space, x, x_local, f_local, snes, matrix, schur, stages, .. } = self;
-        let jac = &mut matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?.mat;
-        let work = Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut() };
+        let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
+        let work =
+            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
         let mut callbacks = Callbacks::<D, M, N>::new(model, step, work);
         let out = snes.solve(x, jac, &mut callbacks)?;
         Ok((out, callbacks.nonfinite.take(), callbacks.seconds))
@@ -542,8 +537,9 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     ) -> Result<(&'a mut Vector, &'a mut Mat, Callbacks<'a, D, M, N>), Error> {
         self.matrix_for(step, coll)?;
         let System { space, x, x_local, f_local, matrix, schur, stages, .. } = self;
-        let jac = &mut matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?.mat;
-        let work = Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut() };
+        let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
+        let work =
+            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
         Ok((x, jac, Callbacks::new(model, step, work)))
     }
 }

@@ -17,6 +17,7 @@ macro_rules! call {
     };
 }
 
+pub mod blocks;
 pub mod callback;
 pub mod comm;
 pub mod dm;
@@ -33,6 +34,7 @@ pub mod snes;
 pub mod vector;
 pub mod viewer;
 
+pub use blocks::{BlockOps, BlockPlaces};
 pub use comm::Comm;
 pub use dm::{DmDa, DmDaInfo, GhostedRange};
 pub use error::{Error, Result};
