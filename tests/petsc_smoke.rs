@@ -14,7 +14,7 @@ mod common;
 use petsc::ksp::KspOps;
 use petsc::mat::MatOps;
 use petsc::snes::NonlinearProblem;
-use petsc::{CallbackError, Comm, DmDa, IndexSet, Mat, MatRef, Options, Petsc, Snes, VecOps, VecRef, Vector};
+use petsc::{BlockOps, CallbackError, Comm, DmDa, IndexSet, Mat, MatRef, Options, Petsc, Snes, VecOps, VecRef, Vector};
 use std::path::{Path, PathBuf};
 
 type TestResult = Result<(), String>;
@@ -491,6 +491,60 @@ fn a_three_dimensional_dmda_numbers_and_exchanges_its_nodes() -> TestResult {
     Ok(())
 }
 
+/// A matrix of node-pair blocks (on one rank; the gold values on two and three ranks cover the
+/// blocks of rows another rank owns): preallocated from its block rows, every block lands where
+/// its nodes say whatever the order it is listed in, a second fill replaces the first instead of
+/// adding to it, and a block outside the pattern or an unsorted block row is refused.
+fn a_block_matrix_holds_its_blocks_where_they_belong() -> TestResult {
+    let comm = Comm::world();
+    if comm.size() != 1 {
+        return Ok(());
+    }
+    let (nx, ny, bs) = (4usize, 3usize, 2usize);
+    let dm = DmDa::new_2d(comm, [nx, ny], 1, &["a", "b"]).map_err(e)?;
+    let n = nx * ny;
+    let near = |a: usize, b: usize| (a % nx).abs_diff(b % nx) <= 1 && (a / nx).abs_diff(b / nx) <= 1;
+    let (mut starts, mut cols) = (vec![0 as petsc::Int], Vec::new());
+    for a in 0..n {
+        cols.extend((0..n).filter(|&b| near(a, b)).map(|b| b as petsc::Int));
+        starts.push(cols.len() as petsc::Int);
+    }
+    let mut m = dm.create_matrix_blocks(&starts, &cols).map_err(e)?;
+    // The blocks listed from the last row to the first.
+    let blocks: Vec<(petsc::Int, petsc::Int)> = (0..n)
+        .rev()
+        .flat_map(|a| (0..n).filter(move |&b| near(a, b)).map(move |b| (a as petsc::Int, b as petsc::Int)))
+        .collect();
+    let value = |a: usize, c: usize, b: usize, d: usize| (a * n + b) as f64 + 0.1 * c as f64 + 0.01 * d as f64;
+    let values: Vec<f64> = blocks
+        .iter()
+        .flat_map(|&(a, b)| (0..bs * bs).map(move |k| value(a as usize, k / bs, b as usize, k % bs)))
+        .collect();
+    let places = m.block_places(bs, &blocks).map_err(e)?;
+    m.set_blocks(&places, &values).map_err(e)?;
+    m.set_blocks(&places, &values).map_err(e)?;
+    let (_, dense) = m.local_rows_dense().map_err(e)?;
+    for (r, row) in dense.chunks_exact(n * bs).enumerate() {
+        for (q, &v) in row.iter().enumerate() {
+            let (a, c, b, d) = (r / bs, r % bs, q / bs, q % bs);
+            let want = if near(a, b) { value(a, c, b, d) } else { 0.0 };
+            if v != want {
+                return Err(format!("entry ({r}, {q}) is {v}, {want} expected"));
+            }
+        }
+    }
+    match m.block_places(bs, &[(0, n as petsc::Int - 1)]) {
+        Err(err) if err.to_string().contains("not in the matrix's pattern") => {}
+        other => return Err(format!("a block outside the pattern was placed: {:?}", other.map(|p| p.len()))),
+    }
+    let mut unsorted = cols.clone();
+    unsorted.swap(0, 1);
+    if dm.create_matrix_blocks(&starts, &unsorted).is_ok() {
+        return Err("an unsorted block row was accepted".into());
+    }
+    Ok(())
+}
+
 /// The tests of this file, in the order they run.
 const TESTS: &[(&str, TestFn)] = &[
     ("every_options_file_solves_the_saddle_system", every_options_file_solves_the_saddle_system),
@@ -509,6 +563,7 @@ const TESTS: &[(&str, TestFn)] = &[
         "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",
         a_three_dimensional_dmda_numbers_and_exchanges_its_nodes,
     ),
+    ("a_block_matrix_holds_its_blocks_where_they_belong", a_block_matrix_holds_its_blocks_where_they_belong),
 ];
 
 fn main() {
