@@ -6,10 +6,10 @@
 //! dof map, loads, pattern; see [`step`]) and [`System::solve`] hands to PETSc's SNES, whose
 //! residual and Jacobian callbacks ([`callbacks`]) run every point's pure kernels of
 //! [`crate::kernels`] ([`points`]), map their blocks through the extensions of barely filled nodes
-//! ([`stencils`]) and add them into a ghosted vector (summed over ranks by PETSc) and one value array
-//! written into the matrix in place ([`matrix`]). The converged step's forces and reactions ([`forces`]), the pressure increments its
-//! points take ([`pressure`]) and each point's result ([`Step::result`]) are read from the step and
-//! its [`Solution`]. Every decision that leads to a collective is agreed across ranks first
+//! ([`stencils`]) and add them into a ghosted vector (summed over ranks by PETSc) and one value
+//! array written into the matrix in place ([`matrix`]). The converged step's forces and reactions
+//! ([`forces`]), the pressure increments its points take ([`pressure`]) and each point's result
+//! ([`Step::result`]) are read from the step and its [`Solution`]. Every decision that leads to a collective is agreed across ranks first
 //! (`Collective::agree`).
 
 mod aggregates;

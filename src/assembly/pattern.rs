@@ -6,9 +6,10 @@
 //! diagonal). Each particle keeps a slot map: the block of every pair of its effective nodes. A
 //! Jacobian then adds every particle's dense block into one value array in list order, whose
 //! blocks are written in place into the matrix ([`super::matrix`]), which is several times faster
-//! than inserting the blocks one by one (docs/solvers.md). A particle finds the block of a pair through a
-//! dense table indexed by the first node and the pair's offset on the grid (no per-particle map:
-//! that map cost more memory than the particles themselves on the peer footing). The table holds
+//! than inserting the blocks one by one (docs/solvers.md). A particle finds the block of a pair
+//! through a dense table indexed by the first node and the pair's offset on the grid (no
+//! per-particle map: that map cost more memory than the particles themselves on the peer
+//! footing). The table holds
 //! (2·3 + 1)^D entries per ghosted node: 49 in two dimensions, 343 (1.4 kB) in three, against the
 //! matrix's own 7 × 875 entries per node of a three-dimensional u–p–U system (about 73 kB): 2 %.
 //!

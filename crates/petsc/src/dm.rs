@@ -317,7 +317,7 @@ impl<const D: usize> DmDa<D> {
         let m = self.matrix_shell()?;
         let bs = self.info.dof;
         let owned = starts.len().saturating_sub(1);
-        if owned * bs != self.info.owned_count.iter().product::<usize>() * bs || starts.first() != Some(&0) {
+        if owned != self.info.owned_count.iter().product::<usize>() || starts.first() != Some(&0) {
             return Err(Error::new("block preallocation: one row start per owned node and a leading zero are needed"));
         }
         // The scalar compressed rows: every row of block row r has bs columns per block.
