@@ -494,7 +494,8 @@ fn a_three_dimensional_dmda_numbers_and_exchanges_its_nodes() -> TestResult {
 /// A matrix of node-pair blocks (on one rank; the gold values on two and three ranks cover the
 /// blocks of rows another rank owns): preallocated from its block rows, every block lands where
 /// its nodes say whatever the order it is listed in, a second fill replaces the first instead of
-/// adding to it, and a block outside the pattern or an unsorted block row is refused.
+/// adding to it, threads filling bands of rising rows give the same matrix, and bands of falling
+/// rows, a block outside the pattern or an unsorted block row are refused.
 fn a_block_matrix_holds_its_blocks_where_they_belong() -> TestResult {
     let comm = Comm::world();
     if comm.size() != 1 {
@@ -532,6 +533,42 @@ fn a_block_matrix_holds_its_blocks_where_they_belong() -> TestResult {
                 return Err(format!("entry ({r}, {q}) is {v}, {want} expected"));
             }
         }
+    }
+    // Bands of blocks written as threads write them: the blocks listed by rising rows, cut in
+    // three bands, give the same matrix; bands whose rows fall are refused.
+    let rising: Vec<(petsc::Int, petsc::Int)> = blocks.iter().rev().copied().collect();
+    let rising_places = m.block_places(bs, &rising).map_err(e)?;
+    let third = rising.partition_point(|&(a, _)| a < (n / 3) as petsc::Int);
+    let two_thirds = rising.partition_point(|&(a, _)| a < (2 * n / 3) as petsc::Int);
+    let cuts = [0, third, two_thirds, rising.len()];
+    m.fill_blocks(&rising_places, |fill| -> Result<(), String> {
+        let bands = fill.bands(&cuts).map_err(e)?;
+        std::thread::scope(|scope| {
+            for (w, mut band) in cuts.windows(2).zip(bands) {
+                let rising = &rising;
+                scope.spawn(move || {
+                    for (k, &(a, b)) in rising.iter().enumerate().take(w[1]).skip(w[0]) {
+                        let (a, b) = (a as usize, b as usize);
+                        for c in 0..bs {
+                            for (d, v) in band.row_mut(k, c).iter_mut().enumerate() {
+                                *v += value(a, c, b, d);
+                            }
+                        }
+                    }
+                });
+            }
+        });
+        Ok(())
+    })
+    .map_err(e)??;
+    let (_, banded) = m.local_rows_dense().map_err(e)?;
+    if banded != dense {
+        return Err("the banded fill differs from the listed one".into());
+    }
+    let falling =
+        m.fill_blocks(&places, |fill| fill.bands(&[0, blocks.len() / 2, blocks.len()]).map(|b| b.len())).map_err(e)?;
+    if falling.is_ok() {
+        return Err("bands of falling rows were accepted".into());
     }
     match m.block_places(bs, &[(0, n as petsc::Int - 1)]) {
         Err(err) if err.to_string().contains("not in the matrix's pattern") => {}

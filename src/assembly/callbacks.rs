@@ -1,8 +1,8 @@
 //! The residual and Jacobian callbacks of a step's Newton solve: the particle side's sums
 //! ([`Points`]) at PETSc's iterate, added into a ghosted vector (summed over ranks by PETSc) and
-//! into the value array of the matrix's blocks, in PETSc's scaling of the pressure unknowns.
+//! into the matrix's blocks in place, in PETSc's scaling of the pressure unknowns.
 
-use super::points::{run_bands, Points};
+use super::points::{run_bands, run_parts, Points};
 use super::step::Step;
 use crate::model::Model;
 use petsc::snes::NonlinearProblem;
@@ -24,7 +24,6 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
     /// Wall time spent in the callbacks [s].
     pub(super) seconds: f64,
     stage: &'a LogStage,
-    values: Vec<f64>,
     /// The fixed-stress Schur preconditioner, refilled after every Jacobian.
     schur: Option<&'a mut petsc::SchurUser>,
     /// Where the pattern's blocks sit in the matrix.
@@ -58,7 +57,6 @@ impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> 
             f_local,
             seconds: 0.0,
             stage,
-            values: Vec::new(),
             schur,
             places,
             nonfinite: None,
@@ -131,46 +129,35 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         let step = self.step;
         let nd = step.dofs.nd;
         let layout = step.layout;
-        let mut values = std::mem::take(&mut self.values);
-        values.clear();
-        values.resize(step.pattern.len() * nd * nd, 0.0);
         let ps = self.points;
         let pattern = &step.pattern;
-        run_bands(
-            &step.bands,
-            &mut values,
-            |a| pattern.row_start(a) * nd * nd,
-            |band, v| ps.tangent_band(band, v, &xl),
-        );
-        if let Some(p) = layout.p {
-            for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
-                let c = cell.nodes.len();
-                for (a, &na) in cell.nodes.iter().enumerate() {
-                    for (b, &nb) in cell.nodes.iter().enumerate() {
-                        let (ra, cb) = (na as usize * nd + p, nb as usize * nd + p);
-                        if !step.dofs.fixed[ra] && !step.dofs.fixed[cb] {
-                            values[blocks[a * c + b] as usize * nd * nd + p * nd + p] -= cell.s[a * c + b];
+        let mut cuts: Vec<usize> = step.bands.iter().map(|b| pattern.row_start(b.lo)).collect();
+        cuts.push(pattern.len());
+        let filled = j.fill_blocks(self.places, |values| -> Result<(), petsc::Error> {
+            let parts = step.bands.iter().copied().zip(values.bands(&cuts)?).collect();
+            run_parts(parts, |band, mut v| ps.tangent_band(band, &mut v, &xl));
+            if let Some(p) = layout.p {
+                for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
+                    let c = cell.nodes.len();
+                    for (a, &na) in cell.nodes.iter().enumerate() {
+                        for (b, &nb) in cell.nodes.iter().enumerate() {
+                            let (ra, cb) = (na as usize * nd + p, nb as usize * nd + p);
+                            if !step.dofs.fixed[ra] && !step.dofs.fixed[cb] {
+                                values.row_mut(blocks[a * c + b] as usize, p)[p] -= cell.s[a * c + b];
+                            }
                         }
                     }
                 }
+                // PETSc's scaling: the continuity rows and the pressure columns times s.
+                values.scale_row_and_column(p, step.p_scale);
             }
-        }
-        // PETSc's scaling: the continuity rows and the pressure columns times s.
-        if let Some(p) = layout.p {
-            let s = step.p_scale;
-            for block in values.chunks_exact_mut(nd * nd) {
-                for c in 0..nd {
-                    block[p * nd + c] *= s;
-                    block[c * nd + p] *= s;
-                }
+            // Fixed dofs: a unit diagonal (every other entry of their rows and columns stays zero).
+            for &(blk, c) in &step.fixed_diagonals {
+                values.row_mut(blk as usize, c)[c] = 1.0;
             }
-        }
-        // Fixed dofs: a unit diagonal (every other entry of their rows and columns stays zero).
-        for &(blk, c) in &step.fixed_diagonals {
-            values[blk as usize * nd * nd + c * nd + c] = 1.0;
-        }
-        j.set_blocks(self.places, &values).map_err(fatal)?;
-        self.values = values;
+            Ok(())
+        });
+        filled.and_then(|r| r).map_err(fatal)?;
         if let Some(schur) = self.schur.as_deref_mut() {
             if schur.has_blocks() {
                 let mut invert = |block: &mut [f64], n: usize| crate::algebra::dense::invert_in_place(block, n);

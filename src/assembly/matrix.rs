@@ -1,6 +1,6 @@
 //! The Jacobian matrix of a pattern: PETSc AIJ storage preallocated exactly from the node-pair
 //! blocks of every rank's pattern, and the place of each of this rank's blocks in it, so that a
-//! Jacobian writes its blocks in place ([`petsc::BlockOps::set_blocks`]) with no coordinate maps
+//! Jacobian writes its blocks in place ([`petsc::BlockOps::fill_blocks`]) with no coordinate maps
 //! beside the matrix (docs/solvers.md, "Assembly").
 //!
 //! A rank's pattern lists the blocks its points reach, including rows of ghost nodes that another

@@ -3,9 +3,8 @@
 //!
 //! The list holds each (node a, node b) block of dofs once: the pairs of every particle's effective
 //! stencil and the diagonal block of every owned node (so that fixed dofs always find their unit
-//! diagonal). Each particle keeps a slot map: the block of every pair of its effective nodes. A
-//! Jacobian then adds every particle's dense block into one value array in list order, whose
-//! blocks are written in place into the matrix ([`super::matrix`]), which is several times faster
+//! diagonal). A Jacobian adds every particle's dense block straight into the matrix's storage at
+//! the place of each of its node-pair blocks ([`super::matrix`]), which is several times faster
 //! than inserting the blocks one by one (docs/solvers.md). A particle finds the block of a pair
 //! through a dense table indexed by the first node and the pair's offset on the grid (no
 //! per-particle map: that map cost more memory than the particles themselves on the peer

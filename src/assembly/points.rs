@@ -8,6 +8,7 @@ use super::step::{Band, Solution, Step};
 use crate::kernels::{self, NodeState, StepResult};
 use crate::model::Model;
 use crate::scheme::Scheme;
+use petsc::BlockBand;
 use std::marker::PhantomData;
 
 /// Largest number of effective nodes of a particle beyond its raw stencil of at most M nodes (the
@@ -168,6 +169,11 @@ pub(super) fn run_bands<R: Send>(
         rest = tail;
         at = end;
     }
+    run_parts(parts, work)
+}
+
+/// Runs `work` on every band and its part on its own thread (the first on this one).
+pub(super) fn run_parts<P: Send, R: Send>(mut parts: Vec<(Band, P)>, work: impl Fn(Band, P) -> R + Sync) -> Vec<R> {
     if parts.len() == 1 {
         let (b, d) = parts.pop().expect("one band");
         return vec![work(b, d)];
@@ -367,8 +373,8 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     }
 
     /// The tangent blocks of every particle that reaches `band`, added into the band's part
-    /// `values` of the block value array.
-    pub(super) fn tangent_band(&self, band: Band, values: &mut [f64], xl: &[f64]) {
+    /// `values` of the matrix.
+    pub(super) fn tangent_band(&self, band: Band, values: &mut BlockBand<'_>, xl: &[f64]) {
         let step = self.step;
         let nm = step.scheme;
         let layout = step.layout;
@@ -377,7 +383,6 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let mut block = Vec::new();
         let mut scratch =
             Scratch { transform: Vec::new(), block: Vec::new(), indices: Vec::with_capacity(M + EXTRA_MASTERS) };
-        let first = step.pattern.row_start(band.lo);
         for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
             let (nodes, basis) = step.stencils.get(k);
             let input = particle_input(self.model, step, k);
@@ -403,22 +408,20 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
                 // The mapped stiffness serves the diagnostics only: the exact tangent.
                 kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
             }
-            self.add_tangent(k, &block, m, &mut scratch, values, band, first);
+            self.add_tangent(k, &block, m, &mut scratch, values, band);
         }
     }
 
     /// Adds the rows of `band` of particle `k`'s tangent block to the band's part `values` of the
-    /// block values, which starts at block `first`.
-    #[allow(clippy::too_many_arguments)]
+    /// matrix.
     fn add_tangent(
         &self,
         k: usize,
         block: &[f64],
         m: usize,
         scratch: &mut Scratch<D>,
-        values: &mut [f64],
+        values: &mut BlockBand<'_>,
         band: Band,
-        first: usize,
     ) {
         let step = self.step;
         let nd = step.dofs.nd;
@@ -453,20 +456,21 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         let fixed = &step.dofs.fixed;
         for p in (0..ne).filter(|&p| band.holds(eff[p])) {
             let rp = eff[p] as usize * nd;
+            let rows = values.row_places(pattern.block_of(eff[p], indices[p], eff[0], indices[0]) as usize);
             for q in 0..ne {
                 let cq = eff[q] as usize * nd;
-                let base = (pattern.block_of(eff[p], indices[p], eff[q], indices[q]) as usize - first) * nd * nd;
-                for c1 in 0..nd {
+                let at = pattern.block_of(eff[p], indices[p], eff[q], indices[q]) as usize;
+                values.with_rows_at(&rows, at, |c1, out| {
                     if fixed[rp + c1] {
-                        continue;
+                        return;
                     }
                     let row = &kb[(p * nd + c1) * me + q * nd..(p * nd + c1) * me + q * nd + nd];
                     for c2 in 0..nd {
                         if !fixed[cq + c2] {
-                            values[base + c1 * nd + c2] += row[c2];
+                            out[c2] += row[c2];
                         }
                     }
-                }
+                });
             }
         }
     }

@@ -231,14 +231,12 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     }
 
     /// This rank's matrix memory in bytes: its compressed-row storage in PETSc (`petsc::mat::MatStats`)
-    /// and the program's side of it (the block pattern, the blocks' places in the matrix and the
-    /// assembly's buffer of block values, one value per block entry); zeros without a matrix. Not
+    /// and the program's side of it (the block pattern and the blocks' places in the matrix, into
+    /// which a Jacobian writes its blocks with no buffer of its own); zeros without a matrix. Not
     /// collective.
     pub fn matrix_memory(&self) -> Result<(f64, usize), Error> {
         let Some(m) = &self.matrix else { return Ok((0.0, 0)) };
-        let nd = self.space.layout.nd;
-        let values = m.pattern.len() * nd * nd * std::mem::size_of::<f64>();
-        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + m.places.heap_bytes() + values))
+        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + m.places.heap_bytes()))
     }
 
     /// Enters a log stage until the guard is dropped.

@@ -21,12 +21,14 @@ pub struct BlockPlaces {
     /// The block's local block row, or [`REMOTE`].
     row: Vec<u32>,
     /// The offset of the block's first column in each of its rows, within the row's part of the
-    /// compressed-row storage ([`OFF`] set for the off-diagonal part).
+    /// compressed-row storage ([`OFF`] set for the off-diagonal part); for a block of a row
+    /// another rank owns, its index in `remote`.
     at: Vec<u32>,
     /// The first entry of every local row in the diagonal part, then in the off-diagonal part.
     diag_rows: Vec<Int>,
     off_rows: Vec<Int>,
-    /// Blocks of rows other ranks own: (block, global block row, global block column).
+    /// Blocks of rows other ranks own, in the order of the list: (block, global block row,
+    /// global block column).
     remote: Vec<(u32, Int, Int)>,
 }
 
@@ -111,6 +113,9 @@ pub trait BlockOps: MatOps {
     /// with the same columns in the block's `bs` rows (as
     /// [`crate::DmDa::create_matrix_blocks`] makes it). Not collective.
     fn block_places(&self, bs: usize, blocks: &[(Int, Int)]) -> Result<BlockPlaces> {
+        if bs == 0 || bs > MAX_BS {
+            return Err(Error::new(format!("blocks of {bs} rows: 1 to {MAX_BS} are supported")));
+        }
         let (lo, hi) = self.ownership_range()?;
         let (lo, hi) = (lo as Int, hi as Int);
         let b = bs as Int;
@@ -133,7 +138,7 @@ pub trait BlockOps: MatOps {
         for (k, &(r, c)) in blocks.iter().enumerate() {
             if r * b < lo || r * b >= hi {
                 places.row.push(REMOTE);
-                places.at.push(0);
+                places.at.push(places.remote.len() as u32);
                 places.remote.push((k as u32, r, c));
                 continue;
             }
@@ -160,45 +165,231 @@ pub trait BlockOps: MatOps {
         Ok(places)
     }
 
+    /// Sets the matrix to the sum over all ranks of what `fill` writes into its blocks
+    /// ([`BlockFill`], starting from zeros), and assembles it: owned rows are written in place,
+    /// other ranks' rows sent to their owners. Collective.
+    fn fill_blocks<R>(&mut self, places: &BlockPlaces, fill: impl FnOnce(&mut BlockFill<'_>) -> R) -> Result<R> {
+        let bs = places.bs;
+        self.zero_entries()?;
+        let parts = parts(self.raw())?;
+        let mut remote = vec![0.0; places.remote.len() * bs * bs];
+        let nnz = |starts: &[Int]| starts.last().map_or(0, |&n| n as usize);
+        let out = with_values(parts.diag, nnz(&places.diag_rows), |diag| match parts.off {
+            Some((ao, _)) => with_values(ao, nnz(&places.off_rows), |off| {
+                fill(&mut BlockFill { places, diag, off, remote: &mut remote })
+            }),
+            None => Ok(fill(&mut BlockFill { places, diag, off: &mut [], remote: &mut remote })),
+        })??;
+        let mut rows = vec![0 as Int; bs];
+        let mut cols = vec![0 as Int; bs];
+        for (i, &(_, r, c)) in places.remote.iter().enumerate() {
+            for j in 0..bs {
+                rows[j] = r * bs as Int + j as Int;
+                cols[j] = c * bs as Int + j as Int;
+            }
+            self.set_values(&rows, &cols, &remote[i * bs * bs..(i + 1) * bs * bs], true)?;
+        }
+        self.assemble()?;
+        Ok(out)
+    }
+
     /// Sets the matrix to the sum of `values` (block after block in the order of `places`, each
-    /// row-major) over all ranks, and assembles it: owned rows are written in place, other ranks'
-    /// rows sent to their owners. Collective.
+    /// row-major) over all ranks, and assembles it ([`BlockOps::fill_blocks`]). Collective.
     fn set_blocks(&mut self, places: &BlockPlaces, values: &[Real]) -> Result<()> {
         let bs = places.bs;
         if values.len() != places.len() * bs * bs {
             return Err(Error::new("block values do not match their places"));
         }
-        self.zero_entries()?;
-        let parts = parts(self.raw())?;
-        let add = |arr: &mut [Real], starts: &[Int], off: u32| {
-            for (k, (&row, &at)) in places.row.iter().zip(&places.at).enumerate() {
-                if row == REMOTE || at & OFF != off {
-                    continue;
-                }
-                let (row, at) = (row as usize * bs, (at & !OFF) as usize);
-                for i in 0..bs {
-                    let s = starts[row + i] as usize + at;
-                    let v = &values[(k * bs + i) * bs..(k * bs + i + 1) * bs];
-                    arr[s..s + bs].iter_mut().zip(v).for_each(|(a, v)| *a += v);
+        self.fill_blocks(places, |fill| {
+            for (k, block) in values.chunks_exact(bs * bs).enumerate() {
+                for (i, row) in block.chunks_exact(bs).enumerate() {
+                    fill.row_mut(k, i).iter_mut().zip(row).for_each(|(a, v)| *a += v);
                 }
             }
-        };
-        let nnz = |starts: &[Int]| starts.last().map_or(0, |&n| n as usize);
-        with_values(parts.diag, nnz(&places.diag_rows), |arr| add(arr, &places.diag_rows, 0))?;
-        if let Some((ao, _)) = parts.off {
-            with_values(ao, nnz(&places.off_rows), |arr| add(arr, &places.off_rows, OFF))?;
+        })
+    }
+}
+
+/// Where row `i` of block `k` starts: in the diagonal part, the off-diagonal part or the buffer
+/// of other ranks' rows, as an index into the whole array.
+enum Slot {
+    Diag(usize),
+    Off(usize),
+    Remote(usize),
+}
+
+fn slot(places: &BlockPlaces, k: usize, i: usize) -> Slot {
+    let (row, at) = (places.row[k], places.at[k]);
+    let bs = places.bs;
+    if row == REMOTE {
+        return Slot::Remote((at as usize * bs + i) * bs);
+    }
+    let r = row as usize * bs + i;
+    if at & OFF == 0 {
+        Slot::Diag(places.diag_rows[r] as usize + at as usize)
+    } else {
+        Slot::Off(places.off_rows[r] as usize + (at & !OFF) as usize)
+    }
+}
+
+/// The values of a block matrix open for writing ([`BlockOps::fill_blocks`]): each block of the
+/// places' list reached by its index, those of owned rows in the matrix's own arrays, those of
+/// other ranks' rows in a buffer sent to their owners when the fill ends.
+pub struct BlockFill<'a> {
+    places: &'a BlockPlaces,
+    diag: &'a mut [Real],
+    off: &'a mut [Real],
+    remote: &'a mut [Real],
+}
+
+impl BlockFill<'_> {
+    /// Row `i` of block `k` (its `bs` values).
+    pub fn row_mut(&mut self, k: usize, i: usize) -> &mut [Real] {
+        let bs = self.places.bs;
+        match slot(self.places, k, i) {
+            Slot::Diag(s) => &mut self.diag[s..s + bs],
+            Slot::Off(s) => &mut self.off[s..s + bs],
+            Slot::Remote(s) => &mut self.remote[s..s + bs],
         }
-        let mut rows = vec![0 as Int; bs];
-        let mut cols = vec![0 as Int; bs];
-        for &(k, r, c) in &places.remote {
+    }
+
+    /// Multiplies row `c` of every block by `s`, then column `c`.
+    pub fn scale_row_and_column(&mut self, c: usize, s: Real) {
+        for k in 0..self.places.len() {
+            self.row_mut(k, c).iter_mut().for_each(|v| *v *= s);
+            for i in 0..self.places.bs {
+                self.row_mut(k, i)[c] *= s;
+            }
+        }
+    }
+
+    /// The fill cut into bands of consecutive blocks, band `b` holding the blocks from `cuts[b]`
+    /// to `cuts[b + 1]` (`cuts` rising from 0 to the number of blocks), each to be written by its
+    /// own thread: the blocks of a band must sit in block rows no other band's blocks sit in,
+    /// those of the owned rows in a range of rows that rises from band to band (as bands of whole
+    /// node rows of a DMDA's ghosted grid do).
+    pub fn bands(&mut self, cuts: &[usize]) -> Result<Vec<BlockBand<'_>>> {
+        let places = self.places;
+        let bs = places.bs;
+        if cuts.first() != Some(&0) || cuts.last() != Some(&places.len()) || cuts.windows(2).any(|w| w[0] > w[1]) {
+            return Err(Error::new("block bands must rise from the first block to the last"));
+        }
+        let (mut diag, mut off, mut remote): (&mut [Real], &mut [Real], &mut [Real]) =
+            (&mut *self.diag, &mut *self.off, &mut *self.remote);
+        let (mut diag0, mut off0, mut remote0, mut row_end) = (0, 0, 0, 0usize);
+        let mut out = Vec::with_capacity(cuts.len() - 1);
+        for w in cuts.windows(2) {
+            let (blocks, rows) = (w[0]..w[1], places.row[w[0]..w[1]].iter().filter(|&&r| r != REMOTE));
+            let (lo, hi) = rows.fold((usize::MAX, 0), |(lo, hi), &r| (lo.min(r as usize), hi.max(r as usize + 1)));
+            let (lo, hi) = if lo == usize::MAX { (row_end, row_end) } else { (lo, hi) };
+            row_end = hi;
+            let remotes = places.at[blocks.clone()]
+                .iter()
+                .zip(&places.row[blocks.clone()])
+                .filter(|(_, &r)| r == REMOTE)
+                .map(|(&a, _)| a as usize + 1)
+                .max()
+                .map_or(remote0, |end| end * bs * bs);
+            let d = places.diag_rows[hi * bs] as usize;
+            let o = places.off_rows[hi * bs] as usize;
+            let d_first = places.diag_rows[lo * bs] as usize;
+            let o_first = places.off_rows[lo * bs] as usize;
+            take(&mut diag, diag0, d_first)?;
+            take(&mut off, off0, o_first)?;
+            out.push(BlockBand {
+                places,
+                blocks: w[0]..w[1],
+                diag0: d_first,
+                off0: o_first,
+                remote0,
+                diag: take(&mut diag, d_first, d)?,
+                off: take(&mut off, o_first, o)?,
+                remote: take(&mut remote, remote0, remotes)?,
+            });
+            (diag0, off0, remote0) = (d, o, remotes);
+        }
+        Ok(out)
+    }
+}
+
+/// The next `to - from` values of `rest` (which starts at `from`), taken off it.
+fn take<'s>(rest: &mut &'s mut [Real], from: usize, to: usize) -> Result<&'s mut [Real]> {
+    let r = std::mem::take(rest);
+    if to < from || to - from > r.len() {
+        return Err(Error::new("block bands share block rows or do not follow them"));
+    }
+    let (head, tail) = r.split_at_mut(to - from);
+    *rest = tail;
+    Ok(head)
+}
+
+/// The most rows and columns a block may have.
+pub const MAX_BS: usize = 8;
+
+/// Where the rows of one block row start in a band's arrays ([`BlockBand::row_places`]).
+pub struct RowPlaces {
+    remote: bool,
+    diag: [usize; MAX_BS],
+    off: [usize; MAX_BS],
+}
+
+/// One band of a [`BlockFill`]: the blocks of a range of the list, written by one thread.
+pub struct BlockBand<'a> {
+    places: &'a BlockPlaces,
+    blocks: std::ops::Range<usize>,
+    diag0: usize,
+    off0: usize,
+    remote0: usize,
+    diag: &'a mut [Real],
+    off: &'a mut [Real],
+    remote: &'a mut [Real],
+}
+
+impl BlockBand<'_> {
+    /// The places of the rows of block `k`'s block row, one of the band's, which every block of
+    /// that row shares ([`BlockBand::with_rows_at`]).
+    pub fn row_places(&self, k: usize) -> RowPlaces {
+        let places = self.places;
+        let (bs, r) = (places.bs, places.row[k]);
+        let mut out = RowPlaces { remote: r == REMOTE, diag: [0; MAX_BS], off: [0; MAX_BS] };
+        if !out.remote {
             for i in 0..bs {
-                rows[i] = r * bs as Int + i as Int;
-                cols[i] = c * bs as Int + i as Int;
+                out.diag[i] = places.diag_rows[r as usize * bs + i] as usize - self.diag0;
+                out.off[i] = places.off_rows[r as usize * bs + i] as usize - self.off0;
             }
-            let k = k as usize;
-            self.set_values(&rows, &cols, &values[k * bs * bs..(k + 1) * bs * bs], true)?;
         }
-        self.assemble()
+        out
+    }
+
+    /// Calls `row(i, values)` with each row `i` of block `k` (its `bs` values), a block of the
+    /// band's block row whose places are `rows`.
+    pub fn with_rows_at(&mut self, rows: &RowPlaces, k: usize, mut row: impl FnMut(usize, &mut [Real])) {
+        debug_assert!(self.blocks.contains(&k), "block {k} is outside its band {:?}", self.blocks);
+        let places = self.places;
+        let (bs, at) = (places.bs, places.at[k]);
+        if rows.remote {
+            let first = at as usize * bs * bs - self.remote0;
+            for (i, v) in self.remote[first..first + bs * bs].chunks_exact_mut(bs).enumerate() {
+                row(i, v);
+            }
+            return;
+        }
+        let (starts, values) = if at & OFF == 0 { (&rows.diag, &mut *self.diag) } else { (&rows.off, &mut *self.off) };
+        let at = (at & !OFF) as usize;
+        for (i, &start) in starts[..bs].iter().enumerate() {
+            row(i, &mut values[start + at..start + at + bs]);
+        }
+    }
+
+    /// Row `i` of block `k`, one of the band's blocks (its `bs` values).
+    pub fn row_mut(&mut self, k: usize, i: usize) -> &mut [Real] {
+        debug_assert!(self.blocks.contains(&k), "block {k} is outside its band {:?}", self.blocks);
+        let bs = self.places.bs;
+        match slot(self.places, k, i) {
+            Slot::Diag(s) => &mut self.diag[s - self.diag0..s - self.diag0 + bs],
+            Slot::Off(s) => &mut self.off[s - self.off0..s - self.off0 + bs],
+            Slot::Remote(s) => &mut self.remote[s - self.remote0..s - self.remote0 + bs],
+        }
     }
 }
 

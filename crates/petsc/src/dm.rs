@@ -312,7 +312,7 @@ impl<const D: usize> DmDa<D> {
     /// node-pair blocks of `dof` × `dof` entries: block row r (this rank's r-th owned node in
     /// PETSc's order) holds the blocks of global block columns `cols[starts[r]..starts[r + 1]]`,
     /// sorted. Every block row of the matrix that any rank adds to must be listed by its owner.
-    /// The matrix is assembled with zeros; fill it with [`crate::BlockOps::set_blocks`]. Collective.
+    /// The matrix is assembled with zeros; fill it with [`crate::BlockOps::fill_blocks`]. Collective.
     pub fn create_matrix_blocks(&self, starts: &[Int], cols: &[Int]) -> Result<Mat> {
         let m = self.matrix_shell()?;
         let bs = self.info.dof;

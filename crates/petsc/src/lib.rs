@@ -34,7 +34,7 @@ pub mod snes;
 pub mod vector;
 pub mod viewer;
 
-pub use blocks::{BlockOps, BlockPlaces};
+pub use blocks::{BlockBand, BlockFill, BlockOps, BlockPlaces, RowPlaces, MAX_BS};
 pub use comm::Comm;
 pub use dm::{DmDa, DmDaInfo, GhostedRange};
 pub use error::{Error, Result};
