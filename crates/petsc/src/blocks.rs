@@ -75,24 +75,24 @@ fn parts(m: sys::Mat) -> Result<Parts> {
     Ok(Parts { diag: ad, off: Some((ao, garray)) })
 }
 
-/// The compressed rows (row starts, columns) of a sequential AIJ matrix, copied.
-fn rows_of(m: sys::Mat) -> Result<(Vec<Int>, Vec<Int>)> {
+/// `f` of the compressed rows (row starts, columns) of a sequential AIJ matrix, borrowed from it.
+fn with_rows_of<R>(m: sys::Mat, f: impl FnOnce(&[Int], &[Int]) -> R) -> Result<R> {
     let (mut n, mut ia, mut ja) = (0 as Int, std::ptr::null(), std::ptr::null());
     let mut done = sys::PetscBool::PETSC_FALSE;
-    let f = sys::PetscBool::PETSC_FALSE;
-    call!(MatGetRowIJ(m, 0, f, f, &mut n, &mut ia, &mut ja, &mut done))?;
+    let no = sys::PetscBool::PETSC_FALSE;
+    call!(MatGetRowIJ(m, 0, no, no, &mut n, &mut ia, &mut ja, &mut done))?;
     if !crate::from_bool(done) {
         return Err(Error::new("MatGetRowIJ gave no compressed rows"));
     }
     // SAFETY: MatGetRowIJ returned n + 1 row starts and ia[n] column indices, valid until
-    // MatRestoreRowIJ; they are copied before it.
-    let (starts, cols) = unsafe {
-        let starts = std::slice::from_raw_parts(ia, n as usize + 1).to_vec();
-        let cols = std::slice::from_raw_parts(ja, starts[n as usize] as usize).to_vec();
-        (starts, cols)
+    // MatRestoreRowIJ, which follows; the slices do not outlive `f`.
+    let out = unsafe {
+        let starts = std::slice::from_raw_parts(ia, n as usize + 1);
+        let cols = std::slice::from_raw_parts(ja, starts[n as usize] as usize);
+        f(starts, cols)
     };
-    call!(MatRestoreRowIJ(m, 0, f, f, &mut n, &mut ia, &mut ja, &mut done))?;
-    Ok((starts, cols))
+    call!(MatRestoreRowIJ(m, 0, no, no, &mut n, &mut ia, &mut ja, &mut done))?;
+    Ok(out)
 }
 
 /// The value array of a sequential AIJ matrix of `nnz` stored entries for the time of `f`.
@@ -120,49 +120,50 @@ pub trait BlockOps: MatOps {
         let (lo, hi) = (lo as Int, hi as Int);
         let b = bs as Int;
         let parts = parts(self.raw())?;
-        let (diag_rows, diag_cols) = rows_of(parts.diag)?;
         let (off_rows, off_cols) = match parts.off {
-            Some((ao, garray)) => {
-                let (rows, local) = rows_of(ao)?;
+            Some((ao, garray)) => with_rows_of(ao, |rows, local| {
                 let n = local.iter().map(|&c| c + 1).max().unwrap_or(0) as usize;
                 // SAFETY: garray holds the global column of each of the off-diagonal part's
                 // columns, at least as many as its largest local column index + 1.
                 let global = unsafe { std::slice::from_raw_parts(garray, n) };
-                (rows, local.iter().map(|&c| global[c as usize]).collect())
-            }
-            None => (vec![0; diag_rows.len()], Vec::new()),
+                (rows.to_vec(), local.iter().map(|&c| global[c as usize]).collect::<Vec<Int>>())
+            })?,
+            None => (Vec::new(), Vec::new()),
         };
-        let mut places = BlockPlaces { bs, diag_rows, off_rows, ..BlockPlaces::default() };
-        places.row.reserve_exact(blocks.len());
-        places.at.reserve_exact(blocks.len());
-        for (k, &(r, c)) in blocks.iter().enumerate() {
-            if r * b < lo || r * b >= hi {
-                places.row.push(REMOTE);
-                places.at.push(places.remote.len() as u32);
-                places.remote.push((k as u32, r, c));
-                continue;
-            }
-            let local = (r * b - lo) as usize;
-            let (rows, cols, shift, flag) = if c * b >= lo && c * b < hi {
-                (&places.diag_rows, &diag_cols, lo, 0)
-            } else {
-                (&places.off_rows, &off_cols, 0, OFF)
-            };
-            let row = |i: usize| &cols[rows[local + i] as usize..rows[local + i + 1] as usize];
-            let at = row(0)
-                .binary_search(&(c * b - shift))
-                .map_err(|_| Error::new(format!("block ({r}, {c}) is not in the matrix's pattern")))?;
-            // Every row of the block has the block's columns at the same offset.
-            for i in 0..bs {
-                let cs = row(i);
-                if at + bs > cs.len() || (0..bs).any(|j| cs[at + j] != c * b - shift + j as Int) {
-                    return Err(Error::new(format!("block ({r}, {c}) is not whole in row {i} of its block row")));
+        with_rows_of(parts.diag, |diag_rows, diag_cols| {
+            let off_rows = if parts.off.is_some() { off_rows } else { vec![0; diag_rows.len()] };
+            let mut places = BlockPlaces { bs, diag_rows: diag_rows.to_vec(), off_rows, ..BlockPlaces::default() };
+            places.row.reserve_exact(blocks.len());
+            places.at.reserve_exact(blocks.len());
+            for (k, &(r, c)) in blocks.iter().enumerate() {
+                if r * b < lo || r * b >= hi {
+                    places.row.push(REMOTE);
+                    places.at.push(places.remote.len() as u32);
+                    places.remote.push((k as u32, r, c));
+                    continue;
                 }
+                let local = (r * b - lo) as usize;
+                let (rows, cols, shift, flag) = if c * b >= lo && c * b < hi {
+                    (diag_rows, diag_cols, lo, 0)
+                } else {
+                    (&places.off_rows[..], &off_cols[..], 0, OFF)
+                };
+                let row = |i: usize| &cols[rows[local + i] as usize..rows[local + i + 1] as usize];
+                let at = row(0)
+                    .binary_search(&(c * b - shift))
+                    .map_err(|_| Error::new(format!("block ({r}, {c}) is not in the matrix's pattern")))?;
+                // Every row of the block has the block's columns at the same offset.
+                for i in 0..bs {
+                    let cs = row(i);
+                    if at + bs > cs.len() || (0..bs).any(|j| cs[at + j] != c * b - shift + j as Int) {
+                        return Err(Error::new(format!("block ({r}, {c}) is not whole in row {i} of its block row")));
+                    }
+                }
+                places.row.push((local / bs) as u32);
+                places.at.push(at as u32 | flag);
             }
-            places.row.push((local / bs) as u32);
-            places.at.push(at as u32 | flag);
-        }
-        Ok(places)
+            Ok(places)
+        })?
     }
 
     /// Sets the matrix to the sum over all ranks of what `fill` writes into its blocks

@@ -320,22 +320,46 @@ impl<const D: usize> DmDa<D> {
         if owned != self.info.owned_count.iter().product::<usize>() || starts.first() != Some(&0) {
             return Err(Error::new("block preallocation: one row start per owned node and a leading zero are needed"));
         }
-        // The scalar compressed rows: every row of block row r has bs columns per block.
-        let mut ia = Vec::with_capacity(owned * bs + 1);
-        let mut ja = Vec::with_capacity(cols.len() * bs * bs);
-        ia.push(0 as Int);
+        // Every scalar row of block row r has bs columns per block, those of the owned rows in
+        // the diagonal part; the pattern is then set by inserting zeros one block row at a time,
+        // so that no scalar column list of the whole matrix is ever held.
+        let (lo, hi) = crate::VecOps::ownership_range(&self.create_global_vector()?)?;
+        let (first, end) = (lo / bs, hi / bs);
+        let (mut d_nnz, mut o_nnz) = (Vec::with_capacity(owned * bs), Vec::with_capacity(owned * bs));
         for r in 0..owned {
             let blocks = &cols[starts[r] as usize..starts[r + 1] as usize];
             if blocks.windows(2).any(|w| w[0] >= w[1]) {
                 return Err(Error::new("block preallocation: the columns of a block row must be sorted and distinct"));
             }
-            for _ in 0..bs {
-                ja.extend(blocks.iter().flat_map(|&c| (0..bs as Int).map(move |j| c * bs as Int + j)));
-                ia.push(ja.len() as Int);
-            }
+            let d = blocks.iter().filter(|&&c| c as usize >= first && (c as usize) < end).count();
+            d_nnz.extend(std::iter::repeat_n((d * bs) as Int, bs));
+            o_nnz.extend(std::iter::repeat_n(((blocks.len() - d) * bs) as Int, bs));
         }
-        call!(MatSeqAIJSetPreallocationCSR(m.raw, ia.as_ptr(), ja.as_ptr(), std::ptr::null()))?;
-        call!(MatMPIAIJSetPreallocationCSR(m.raw, ia.as_ptr(), ja.as_ptr(), std::ptr::null()))?;
+        call!(MatSeqAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr()))?;
+        call!(MatMPIAIJSetPreallocation(m.raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()))?;
+        drop((d_nnz, o_nnz));
+        let (mut rows, mut columns, mut zeros) = (vec![0 as Int; bs], Vec::new(), Vec::new());
+        for r in 0..owned {
+            let blocks = &cols[starts[r] as usize..starts[r + 1] as usize];
+            for (i, row) in rows.iter_mut().enumerate() {
+                *row = ((first + r) * bs + i) as Int;
+            }
+            columns.clear();
+            columns.extend(blocks.iter().flat_map(|&c| (0..bs as Int).map(move |j| c * bs as Int + j)));
+            zeros.resize(bs * columns.len(), 0.0);
+            let (nr, nc) = (bs as Int, columns.len() as Int);
+            call!(MatSetValues(
+                m.raw,
+                nr,
+                rows.as_ptr(),
+                nc,
+                columns.as_ptr(),
+                zeros.as_ptr(),
+                sys::InsertMode::INSERT_VALUES
+            ))?;
+        }
+        call!(MatAssemblyBegin(m.raw, sys::MatAssemblyType::MAT_FINAL_ASSEMBLY))?;
+        call!(MatAssemblyEnd(m.raw, sys::MatAssemblyType::MAT_FINAL_ASSEMBLY))?;
         call!(MatSetOption(m.raw, sys::MatOption::MAT_NEW_NONZERO_LOCATION_ERR, sys::PetscBool::PETSC_TRUE))?;
         Ok(m)
     }
