@@ -107,24 +107,27 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
     let drot = kinematics::rotate_derivative(&pt.rotated);
     let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics.
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics, stored
+    // by row: `a[r]` holds row r of every node's A_l side by side, flat over the block's columns
+    // j = l D + d, so that a row of the block is one pass over j.
     let sk = pt.strain_kin();
-    let mut a = [[[0.0; D]; R]; M];
-    for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
+    let nb = pt.basis.len();
+    let mut a = [[[0.0; D]; M]; R];
+    for (l, bl) in pt.strain.iter().enumerate().take(nb) {
         let de = sk.deps_derivative(bl);
         let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
         if D == 2 {
             let dt = sk.theta_derivative(bl);
-            for r in 0..nr {
+            for (r, ar) in a.iter_mut().enumerate() {
                 for d in 0..D {
-                    a[l][r][d] = t_drot[r] * dt[d] + material_part(r, d);
+                    ar[l][d] = t_drot[r] * dt[d] + material_part(r, d);
                 }
             }
         } else {
             let dr = sk.rotated_derivative(bl, &pt.rotated);
-            for r in 0..nr {
+            for (r, ar) in a.iter_mut().enumerate() {
                 for d in 0..D {
-                    a[l][r][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
+                    ar[l][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
                 }
             }
         }
@@ -133,30 +136,69 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
     let (motion_spatial, motion_hoop) = pt.motion_operators();
-    for k in 0..pt.basis.len() {
+    // The motion's derivatives with respect to Δu_l go through node l's basis, flat over j like
+    // `a`: ∂J_v/∂Δu_l / J_v (the divergence and, radially, the hoop term), and for each force
+    // component c the geometric part's (dev σ' ∇'S_l)_c and σ'_m (∇̄'S_l)_c.
+    let mut djv = [[0.0; D]; M];
+    let mut dev_g = [[[0.0; D]; M]; D];
+    let mut pm_gv = [[[0.0; D]; M]; D];
+    if !linear {
+        for l in 0..nb {
+            let (gl, gvl) = motion_spatial[l];
+            djv[l] = gvl;
+            djv[l][0] += motion_hoop[l].1;
+            let dev_gl = dev_times(&dev, gl);
+            for c in 0..D {
+                dev_g[c][l] = [dev_gl[c]; D];
+                pm_gv[c][l] = [pm * gvl[c]; D];
+            }
+        }
+    }
+    let n = nb * D;
+    let a_rows: [&[f64]; R] = std::array::from_fn(|r| &a[r].as_flattened()[..n]);
+    let djv = &djv.as_flattened()[..n];
+    // Node k's gradients repeated for every node l, flat over j.
+    let (mut g_k, mut gv_k) = ([[0.0; D]; M], [[0.0; D]; M]);
+    let mut row_values = [[0.0; D]; M];
+    for k in 0..nb {
         let (gk, gvk) = pt.spatial[k];
         let hk = pt.hoop[k];
         let bk = bbar(gk, gvk, hk);
         let mut tk = traction(&dev, pm, gk, gvk);
         tk[0] += hoop_force(s, pm, hk);
-        for l in 0..pt.basis.len() {
-            // The motion's derivatives with respect to Δu_l go through node l's basis.
-            let (gl, gvl) = motion_spatial[l];
-            let hl = motion_hoop[l];
-            let dev_gl = dev_times(&dev, gl);
-            // ∂J_v/∂Δu_l / J_v: the divergence and, radially, the hoop term.
-            let mut djv = gvl;
-            djv[0] += hl.1;
-            for c in 0..D {
-                for d in 0..D {
-                    let material: f64 = (0..nr).map(|r| bk[r][c] * a[l][r][d]).sum();
-                    let volume = tk[c] * djv[d];
-                    let mut geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
-                    if c == 0 && d == 0 {
-                        geometric -= dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1;
+        g_k[..nb].fill(gk);
+        gv_k[..nb].fill(gvk);
+        let (g_k, gv_k) = (&g_k.as_flattened()[..n], &gv_k.as_flattened()[..n]);
+        for c in 0..D {
+            let coef: [f64; R] = std::array::from_fn(|r| v * bk[r][c]);
+            let row = &mut row_values.as_flattened_mut()[..n];
+            for (j, out) in row.iter_mut().enumerate() {
+                *out = (0..R).map(|r| coef[r] * a_rows[r][j]).sum::<f64>();
+            }
+            if !linear {
+                let (dev_gc, pm_gvc) = (&dev_g[c].as_flattened()[..n], &pm_gv[c].as_flattened()[..n]);
+                let vt = v * tk[c];
+                for j in 0..n {
+                    row[j] += vt * djv[j] - v * (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
+                }
+                // ∂T'_k/∂Δu_l,r: the hoop part of the r–r entry (axial symmetry only).
+                if D == 2 && c == 0 {
+                    for l in 0..nb {
+                        let hl = motion_hoop[l];
+                        row[l * D] -= v * (dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1);
                     }
-                    out[(k * nd + c) * m + l * nd + d] +=
-                        v * if linear { material } else { material + volume + geometric };
+                }
+            }
+            let first = (k * nd + c) * m;
+            if nd == D {
+                for (o, x) in out[first..first + n].iter_mut().zip(row.iter()) {
+                    *o += x;
+                }
+            } else {
+                for (l, values) in row_values[..nb].iter().enumerate() {
+                    for (o, x) in out[first + l * nd..first + l * nd + D].iter_mut().zip(values) {
+                        *o += x;
+                    }
                 }
             }
         }
