@@ -110,6 +110,13 @@ impl<const D: usize> Default for NodeBasis<D> {
 }
 
 impl<const D: usize> NodeBasis<D> {
+    /// Whether every operator is zero: a stencil node that the particle's domain only touches,
+    /// kept so that the matrix's pattern does not change when it moves by a hair.
+    #[inline]
+    pub fn is_zero(&self) -> bool {
+        self.s == 0.0 && self.t == 0.0 && self.tv == 0.0 && self.g.iter().chain(&self.gv).all(|&v| v == 0.0)
+    }
+
     /// Adds `factor` times every operator of `other` (value, gradients, hoop operators).
     pub fn add_scaled(&mut self, other: &NodeBasis<D>, factor: f64) {
         self.s += factor * other.s;

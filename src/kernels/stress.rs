@@ -101,107 +101,15 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     let (nd, m) = (pt.layout.nd, pt.size());
     let nr = R;
     let v = pt.volume_new() * nm.w_force;
-    let s = &pt.upd.stress;
-    let (dev, pm) = split::<D>(s);
-    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
-    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
-    let drot = kinematics::rotate_derivative(&pt.rotated);
-    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics, stored
-    // by row: `a[r]` holds row r of every node's A_l side by side, flat over the block's columns
-    // j = l D + d, so that a row of the block is one pass over j.
+    let d_alg = &pt.upd.tangent;
+    // A plane point's block is small (up to 25 nodes of two dofs): it is formed pair of nodes by
+    // pair. A three-dimensional point's is formed row by row over the nodes its operators reach
+    // ([`rows_of_nodes`]), which vectorises and leaves out the nodes its domain only touches.
     let sk = pt.strain_kin();
-    let nb = pt.basis.len();
-    let mut a = [[[0.0; D]; M]; R];
-    for (l, bl) in pt.strain.iter().enumerate().take(nb) {
-        let de = sk.deps_derivative(bl);
-        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
-        if D == 2 {
-            let dt = sk.theta_derivative(bl);
-            for (r, ar) in a.iter_mut().enumerate() {
-                for d in 0..D {
-                    ar[l][d] = t_drot[r] * dt[d] + material_part(r, d);
-                }
-            }
-        } else {
-            let dr = sk.rotated_derivative(bl, &pt.rotated);
-            for (r, ar) in a.iter_mut().enumerate() {
-                for d in 0..D {
-                    ar[l][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
-                }
-            }
-        }
-    }
-    let dev_tt = s[3] - pm;
-    // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
-    let linear = pt.kin.linear;
-    let (motion_spatial, motion_hoop) = pt.motion_operators();
-    // The motion's derivatives with respect to Δu_l go through node l's basis, flat over j like
-    // `a`: ∂J_v/∂Δu_l / J_v (the divergence and, radially, the hoop term), and for each force
-    // component c the geometric part's (dev σ' ∇'S_l)_c and σ'_m (∇̄'S_l)_c.
-    let mut djv = [[0.0; D]; M];
-    let mut dev_g = [[[0.0; D]; M]; D];
-    let mut pm_gv = [[[0.0; D]; M]; D];
-    if !linear {
-        for l in 0..nb {
-            let (gl, gvl) = motion_spatial[l];
-            djv[l] = gvl;
-            djv[l][0] += motion_hoop[l].1;
-            let dev_gl = dev_times(&dev, gl);
-            for c in 0..D {
-                dev_g[c][l] = [dev_gl[c]; D];
-                pm_gv[c][l] = [pm * gvl[c]; D];
-            }
-        }
-    }
-    let n = nb * D;
-    let a_rows: [&[f64]; R] = std::array::from_fn(|r| &a[r].as_flattened()[..n]);
-    let djv = &djv.as_flattened()[..n];
-    // Node k's gradients repeated for every node l, flat over j.
-    let (mut g_k, mut gv_k) = ([[0.0; D]; M], [[0.0; D]; M]);
-    let mut row_values = [[0.0; D]; M];
-    for k in 0..nb {
-        let (gk, gvk) = pt.spatial[k];
-        let hk = pt.hoop[k];
-        let bk = bbar(gk, gvk, hk);
-        let mut tk = traction(&dev, pm, gk, gvk);
-        tk[0] += hoop_force(s, pm, hk);
-        g_k[..nb].fill(gk);
-        gv_k[..nb].fill(gvk);
-        let (g_k, gv_k) = (&g_k.as_flattened()[..n], &gv_k.as_flattened()[..n]);
-        for c in 0..D {
-            let coef: [f64; R] = std::array::from_fn(|r| v * bk[r][c]);
-            let row = &mut row_values.as_flattened_mut()[..n];
-            for (j, out) in row.iter_mut().enumerate() {
-                *out = (0..R).map(|r| coef[r] * a_rows[r][j]).sum::<f64>();
-            }
-            if !linear {
-                let (dev_gc, pm_gvc) = (&dev_g[c].as_flattened()[..n], &pm_gv[c].as_flattened()[..n]);
-                let vt = v * tk[c];
-                for j in 0..n {
-                    row[j] += vt * djv[j] - v * (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
-                }
-                // ∂T'_k/∂Δu_l,r: the hoop part of the r–r entry (axial symmetry only).
-                if D == 2 && c == 0 {
-                    for l in 0..nb {
-                        let hl = motion_hoop[l];
-                        row[l * D] -= v * (dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1);
-                    }
-                }
-            }
-            let first = (k * nd + c) * m;
-            if nd == D {
-                for (o, x) in out[first..first + n].iter_mut().zip(row.iter()) {
-                    *o += x;
-                }
-            } else {
-                for (l, values) in row_values[..nb].iter().enumerate() {
-                    for (o, x) in out[first + l * nd..first + l * nd + D].iter_mut().zip(values) {
-                        *o += x;
-                    }
-                }
-            }
-        }
+    if D == 2 {
+        pairs_of_nodes::<D, M, R>(pt, nm, out, material);
+    } else {
+        rows_of_nodes::<D, M, R>(pt, nm, out, material);
     }
     // An implicit F̄ step ([`super::fbar`]): the stress sees r = (1 + Σ_i S_ip ϑ_i)/J̄_p^n, so
     // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
@@ -217,6 +125,202 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
                 let row = (k * nd + c) * m;
                 for (i, b) in pt.basis.iter().enumerate() {
                     out[row + i * nd + j] += f * b.s;
+                }
+            }
+        }
+    }
+}
+
+/// The material, volume and geometric parts of [`tangent_in`]'s block, pair of nodes by pair.
+#[inline(always)]
+fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(
+    pt: &Point<D, M>,
+    nm: &Scheme,
+    out: &mut [f64],
+    material: f64,
+) {
+    let (nd, m) = (pt.layout.nd, pt.size());
+    let nr = R;
+    let v = pt.volume_new() * nm.w_force;
+    let s = &pt.upd.stress;
+    let (dev, pm) = split::<D>(s);
+    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
+    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
+    let drot = kinematics::rotate_derivative(&pt.rotated);
+    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics.
+    let sk = pt.strain_kin();
+    let mut a = [[[0.0; D]; R]; M];
+    for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
+        let de = sk.deps_derivative(bl);
+        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+        if D == 2 {
+            let dt = sk.theta_derivative(bl);
+            for r in 0..nr {
+                for d in 0..D {
+                    a[l][r][d] = t_drot[r] * dt[d] + material_part(r, d);
+                }
+            }
+        } else {
+            let dr = sk.rotated_derivative(bl, &pt.rotated);
+            for r in 0..nr {
+                for d in 0..D {
+                    a[l][r][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
+                }
+            }
+        }
+    }
+    let dev_tt = s[3] - pm;
+    // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
+    let linear = pt.kin.linear;
+    let (motion_spatial, motion_hoop) = pt.motion_operators();
+    for k in 0..pt.basis.len() {
+        let (gk, gvk) = pt.spatial[k];
+        let hk = pt.hoop[k];
+        let bk = bbar(gk, gvk, hk);
+        let mut tk = traction(&dev, pm, gk, gvk);
+        tk[0] += hoop_force(s, pm, hk);
+        for l in 0..pt.basis.len() {
+            // The motion's derivatives with respect to Δu_l go through node l's basis.
+            let (gl, gvl) = motion_spatial[l];
+            let hl = motion_hoop[l];
+            let dev_gl = dev_times(&dev, gl);
+            // ∂J_v/∂Δu_l / J_v: the divergence and, radially, the hoop term.
+            let mut djv = gvl;
+            djv[0] += hl.1;
+            for c in 0..D {
+                for d in 0..D {
+                    let material: f64 = (0..nr).map(|r| bk[r][c] * a[l][r][d]).sum();
+                    let volume = tk[c] * djv[d];
+                    let mut geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
+                    if c == 0 && d == 0 {
+                        geometric -= dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1;
+                    }
+                    out[(k * nd + c) * m + l * nd + d] +=
+                        v * if linear { material } else { material + volume + geometric };
+                }
+            }
+        }
+    }
+}
+
+/// The material, volume and geometric parts of [`tangent_in`]'s block, row by row: each row of
+/// the block is one pass over the columns of the nodes whose operators are not all zero.
+fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(
+    pt: &Point<D, M>,
+    nm: &Scheme,
+    out: &mut [f64],
+    material: f64,
+) {
+    let (nd, m) = (pt.layout.nd, pt.size());
+    let nr = R;
+    let v = pt.volume_new() * nm.w_force;
+    let s = &pt.upd.stress;
+    let (dev, pm) = split::<D>(s);
+    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
+    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
+    let drot = kinematics::rotate_derivative(&pt.rotated);
+    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
+    let sk = pt.strain_kin();
+    let nb = pt.basis.len();
+    let (motion_spatial, motion_hoop) = pt.motion_operators();
+    // The nodes whose operators are not all zero: a node the particle's domain only touches has
+    // zero rows and columns in this block, which are left out of it (they stay zero).
+    let mut act = [0usize; M];
+    let mut na = 0;
+    for l in 0..nb {
+        let (gl, gvl) = motion_spatial[l];
+        let moves = gl.iter().chain(&gvl).any(|&v| v != 0.0) || motion_hoop[l] != (0.0, 0.0);
+        if !pt.basis[l].is_zero() || !pt.strain[l].is_zero() || moves {
+            act[na] = l;
+            na += 1;
+        }
+    }
+    let act = &act[..na];
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) of every such node, through the strain's kinematics,
+    // stored by row: `a[r]` holds row r of their A_l side by side, flat over the block's columns
+    // j = i D + d of the i-th node of `act`, so that a row of the block is one pass over j.
+    let mut a = [[[0.0; D]; M]; R];
+    for (i, &l) in act.iter().enumerate() {
+        let bl = &pt.strain[l];
+        let de = sk.deps_derivative(bl);
+        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+        if D == 2 {
+            let dt = sk.theta_derivative(bl);
+            for (r, ar) in a.iter_mut().enumerate() {
+                for d in 0..D {
+                    ar[i][d] = t_drot[r] * dt[d] + material_part(r, d);
+                }
+            }
+        } else {
+            let dr = sk.rotated_derivative(bl, &pt.rotated);
+            for (r, ar) in a.iter_mut().enumerate() {
+                for d in 0..D {
+                    ar[i][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
+                }
+            }
+        }
+    }
+    let dev_tt = s[3] - pm;
+    // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
+    let linear = pt.kin.linear;
+    // The motion's derivatives with respect to Δu_l go through node l's basis, flat over j like
+    // `a`: ∂J_v/∂Δu_l / J_v (the divergence and, radially, the hoop term), and for each force
+    // component c the geometric part's (dev σ' ∇'S_l)_c and σ'_m (∇̄'S_l)_c.
+    let mut djv = [[0.0; D]; M];
+    let mut dev_g = [[[0.0; D]; M]; D];
+    let mut pm_gv = [[[0.0; D]; M]; D];
+    if !linear {
+        for (i, &l) in act.iter().enumerate() {
+            let (gl, gvl) = motion_spatial[l];
+            djv[i] = gvl;
+            djv[i][0] += motion_hoop[l].1;
+            let dev_gl = dev_times(&dev, gl);
+            for c in 0..D {
+                dev_g[c][i] = [dev_gl[c]; D];
+                pm_gv[c][i] = [pm * gvl[c]; D];
+            }
+        }
+    }
+    let n = na * D;
+    let a_rows: [&[f64]; R] = std::array::from_fn(|r| &a[r].as_flattened()[..n]);
+    let djv = &djv.as_flattened()[..n];
+    // Node k's gradients repeated for every node of `act`, flat over j.
+    let (mut g_k, mut gv_k) = ([[0.0; D]; M], [[0.0; D]; M]);
+    let mut row_values = [[0.0; D]; M];
+    for &k in act {
+        let (gk, gvk) = pt.spatial[k];
+        let hk = pt.hoop[k];
+        let bk = bbar(gk, gvk, hk);
+        let mut tk = traction(&dev, pm, gk, gvk);
+        tk[0] += hoop_force(s, pm, hk);
+        g_k[..na].fill(gk);
+        gv_k[..na].fill(gvk);
+        let (g_k, gv_k) = (&g_k.as_flattened()[..n], &gv_k.as_flattened()[..n]);
+        for c in 0..D {
+            let coef: [f64; R] = std::array::from_fn(|r| v * bk[r][c]);
+            let row = &mut row_values.as_flattened_mut()[..n];
+            for (j, out) in row.iter_mut().enumerate() {
+                *out = (0..R).map(|r| coef[r] * a_rows[r][j]).sum::<f64>();
+            }
+            if !linear {
+                let (dev_gc, pm_gvc) = (&dev_g[c].as_flattened()[..n], &pm_gv[c].as_flattened()[..n]);
+                let vt = v * tk[c];
+                for j in 0..n {
+                    row[j] += vt * djv[j] - v * (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
+                }
+                // ∂T'_k/∂Δu_l,r: the hoop part of the r–r entry (axial symmetry only).
+                if D == 2 && c == 0 {
+                    for (i, &l) in act.iter().enumerate() {
+                        let hl = motion_hoop[l];
+                        row[i * D] -= v * (dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1);
+                    }
+                }
+            }
+            let first = (k * nd + c) * m;
+            for (&l, values) in act.iter().zip(&row_values[..na]) {
+                for (o, x) in out[first + l * nd..first + l * nd + D].iter_mut().zip(values) {
+                    *o += x;
                 }
             }
         }
