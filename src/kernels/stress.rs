@@ -106,10 +106,11 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     // pair. A three-dimensional point's is formed row by row over the nodes its operators reach
     // ([`rows_of_nodes`]), which vectorises and leaves out the nodes its domain only touches.
     let sk = pt.strain_kin();
+    let block = Block { pt, v, material, nd, m };
     if D == 2 {
-        pairs_of_nodes::<D, M, R>(pt, nm, out, material);
+        pairs_of_nodes::<D, M, R>(&block, out);
     } else {
-        rows_of_nodes::<D, M, R>(pt, nm, out, material);
+        rows_of_nodes::<D, M, R>(&block, out);
     }
     // An implicit F̄ step ([`super::fbar`]): the stress sees r = (1 + Σ_i S_ip ϑ_i)/J̄_p^n, so
     // ∂f_k/∂ϑ_i = V_{n+1} B̄'_kᵀ D_alg ∂Δε/∂r S_ip/J̄_p^n (the material part, scaled likewise).
@@ -131,44 +132,70 @@ fn tangent_in<const D: usize, const M: usize, const R: usize>(
     }
 }
 
-/// The material, volume and geometric parts of [`tangent_in`]'s block, pair of nodes by pair.
-#[inline(always)]
-fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(
-    pt: &Point<D, M>,
-    nm: &Scheme,
-    out: &mut [f64],
+/// What both ways of forming [`tangent_in`]'s block take: the point, its volume weight
+/// V_{n+1} w_f, the material part's scale, the dofs per node and the block's size.
+#[derive(Clone, Copy)]
+struct Block<'a, const D: usize, const M: usize> {
+    pt: &'a Point<'a, D, M>,
+    v: f64,
     material: f64,
-) {
-    let (nd, m) = (pt.layout.nd, pt.size());
-    let nr = R;
-    let v = pt.volume_new() * nm.w_force;
-    let s = &pt.upd.stress;
-    let (dev, pm) = split::<D>(s);
-    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
-    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
-    let drot = kinematics::rotate_derivative(&pt.rotated);
-    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics.
-    let sk = pt.strain_kin();
-    let mut a = [[[0.0; D]; R]; M];
-    for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
+    nd: usize,
+    m: usize,
+}
+
+/// ∂σ'/∂Δu_l of a point through a node's strain operators ([`tangent_in`]'s material part): the
+/// return's tangents and, in two dimensions, T · d(Rσ_nRᵀ)/dθ.
+struct StressResponse<'p, const R: usize> {
+    t_mat: &'p [[f64; NS]; NS],
+    d_alg: &'p [[f64; NS]; NS],
+    t_drot: [f64; R],
+    material: f64,
+}
+
+impl<'p, const R: usize> StressResponse<'p, R> {
+    /// The response of `pt` with the material part scaled by `material`.
+    fn of<const D: usize, const M: usize>(pt: &'p Point<D, M>, material: f64) -> StressResponse<'p, R> {
+        let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
+        let drot = kinematics::rotate_derivative(&pt.rotated);
+        let t_drot = std::array::from_fn(|r| (0..R).map(|q| t_mat[r][q] * drot[q]).sum());
+        StressResponse { t_mat, d_alg, t_drot, material }
+    }
+
+    /// A_l = ∂σ'/∂Δu_l (strain rows × D) through the operators `bl` and the kinematics `sk`.
+    #[inline]
+    fn to<const D: usize, const M: usize>(
+        &self,
+        pt: &Point<D, M>,
+        sk: &kinematics::Kinematics<D>,
+        bl: &super::NodeBasis<D>,
+    ) -> [[f64; D]; R] {
         let de = sk.deps_derivative(bl);
-        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
+        let material_part =
+            |r: usize, d: usize| self.material * (0..R).map(|q| self.d_alg[r][q] * de[q][d]).sum::<f64>();
         if D == 2 {
             let dt = sk.theta_derivative(bl);
-            for r in 0..nr {
-                for d in 0..D {
-                    a[l][r][d] = t_drot[r] * dt[d] + material_part(r, d);
-                }
-            }
+            std::array::from_fn(|r| std::array::from_fn(|d| self.t_drot[r] * dt[d] + material_part(r, d)))
         } else {
             let dr = sk.rotated_derivative(bl, &pt.rotated);
-            for r in 0..nr {
-                for d in 0..D {
-                    a[l][r][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
-                }
-            }
+            std::array::from_fn(|r| {
+                std::array::from_fn(|d| (0..R).map(|q| self.t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d))
+            })
         }
+    }
+}
+
+/// The material, volume and geometric parts of [`tangent_in`]'s block, pair of nodes by pair.
+#[inline(always)]
+fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'_, D, M>, out: &mut [f64]) {
+    let Block { pt, v, material, nd, m } = *block;
+    let s = &pt.upd.stress;
+    let (dev, pm) = split::<D>(s);
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) for every node, through the strain's kinematics.
+    let sk = pt.strain_kin();
+    let response = StressResponse::<R>::of(pt, material);
+    let mut a = [[[0.0; D]; R]; M];
+    for (l, bl) in pt.strain.iter().enumerate().take(pt.basis.len()) {
+        a[l] = response.to(pt, sk, bl);
     }
     let dev_tt = s[3] - pm;
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
@@ -190,7 +217,7 @@ fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(
             djv[0] += hl.1;
             for c in 0..D {
                 for d in 0..D {
-                    let material: f64 = (0..nr).map(|r| bk[r][c] * a[l][r][d]).sum();
+                    let material: f64 = (0..R).map(|r| bk[r][c] * a[l][r][d]).sum();
                     let volume = tk[c] * djv[d];
                     let mut geometric = -dev_gl[c] * gk[d] - pm * gvl[c] * gvk[d];
                     if c == 0 && d == 0 {
@@ -206,21 +233,10 @@ fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(
 
 /// The material, volume and geometric parts of [`tangent_in`]'s block, row by row: each row of
 /// the block is one pass over the columns of the nodes whose operators are not all zero.
-fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(
-    pt: &Point<D, M>,
-    nm: &Scheme,
-    out: &mut [f64],
-    material: f64,
-) {
-    let (nd, m) = (pt.layout.nd, pt.size());
-    let nr = R;
-    let v = pt.volume_new() * nm.w_force;
+fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'_, D, M>, out: &mut [f64]) {
+    let Block { pt, v, material, nd, m } = *block;
     let s = &pt.upd.stress;
     let (dev, pm) = split::<D>(s);
-    let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
-    // In two dimensions ∂σ'/∂θ through the return: T · d(Rσ_nRᵀ)/dθ.
-    let drot = kinematics::rotate_derivative(&pt.rotated);
-    let t_drot: [f64; R] = std::array::from_fn(|r| (0..nr).map(|q| t_mat[r][q] * drot[q]).sum());
     let sk = pt.strain_kin();
     let nb = pt.basis.len();
     let (motion_spatial, motion_hoop) = pt.motion_operators();
@@ -240,25 +256,11 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(
     // A_l = ∂σ'/∂Δu_l (strain rows × D) of every such node, through the strain's kinematics,
     // stored by row: `a[r]` holds row r of their A_l side by side, flat over the block's columns
     // j = i D + d of the i-th node of `act`, so that a row of the block is one pass over j.
+    let response = StressResponse::<R>::of(pt, material);
     let mut a = [[[0.0; D]; M]; R];
     for (i, &l) in act.iter().enumerate() {
-        let bl = &pt.strain[l];
-        let de = sk.deps_derivative(bl);
-        let material_part = |r: usize, d: usize| material * (0..nr).map(|q| d_alg[r][q] * de[q][d]).sum::<f64>();
-        if D == 2 {
-            let dt = sk.theta_derivative(bl);
-            for (r, ar) in a.iter_mut().enumerate() {
-                for d in 0..D {
-                    ar[i][d] = t_drot[r] * dt[d] + material_part(r, d);
-                }
-            }
-        } else {
-            let dr = sk.rotated_derivative(bl, &pt.rotated);
-            for (r, ar) in a.iter_mut().enumerate() {
-                for d in 0..D {
-                    ar[i][d] = (0..nr).map(|q| t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d);
-                }
-            }
+        for (ar, row) in a.iter_mut().zip(response.to(pt, sk, &pt.strain[l])) {
+            ar[i] = row;
         }
     }
     let dev_tt = s[3] - pm;
