@@ -232,7 +232,9 @@ fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<
 }
 
 /// The material, volume and geometric parts of [`tangent_in`]'s block, row by row: each row of
-/// the block is one pass over the columns of the nodes whose operators are not all zero.
+/// the block is one pass over the columns of the nodes whose operators are not all zero. For
+/// three-dimensional points, which have no hoop terms (the axisymmetric ones take
+/// [`pairs_of_nodes`]).
 fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'_, D, M>, out: &mut [f64]) {
     let Block { pt, v, material, nd, m } = *block;
     let s = &pt.upd.stress;
@@ -263,7 +265,6 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
             ar[i] = row;
         }
     }
-    let dev_tt = s[3] - pm;
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
     // The motion's derivatives with respect to Δu_l go through node l's basis, flat over j like
@@ -310,13 +311,6 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
                 let vt = v * tk[c];
                 for j in 0..n {
                     row[j] += vt * djv[j] - v * (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
-                }
-                // ∂T'_k/∂Δu_l,r: the hoop part of the r–r entry (axial symmetry only).
-                if D == 2 && c == 0 {
-                    for (i, &l) in act.iter().enumerate() {
-                        let hl = motion_hoop[l];
-                        row[i * D] -= v * (dev_tt * hk.0 * hl.0 + pm * hk.1 * hl.1);
-                    }
                 }
             }
             let first = (k * nd + c) * m;
