@@ -197,12 +197,11 @@ fn at_least(v: &mut Vec<f64>, n: usize) {
 }
 
 /// The scratch of [`Points::add_tangent`]: the map of raw to effective dofs, the effective
-/// block, the effective nodes' grid indices, which of their rows and columns hold values.
+/// block, the effective nodes' grid indices.
 struct Scratch<const D: usize> {
     transform: Vec<Vec<(usize, f64)>>,
     block: Vec<f64>,
     indices: Vec<[i64; D]>,
-    live: Vec<bool>,
 }
 
 /// The particle side of the callbacks: the model and the prepared step (shared by the threads);
@@ -382,12 +381,8 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         // Sized by the largest block met, not by the bounds M and N: a three-dimensional
         // one-phase point's block is 192² values, the bounds' 875² (6 MB a thread).
         let mut block = Vec::new();
-        let mut scratch = Scratch {
-            transform: Vec::new(),
-            block: Vec::new(),
-            indices: Vec::with_capacity(M + EXTRA_MASTERS),
-            live: Vec::with_capacity(2 * (M + EXTRA_MASTERS)),
-        };
+        let mut scratch =
+            Scratch { transform: Vec::new(), block: Vec::new(), indices: Vec::with_capacity(M + EXTRA_MASTERS) };
         for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
             let (nodes, basis) = step.stencils.get(k);
             let input = particle_input(self.model, step, k);
@@ -430,7 +425,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     ) {
         let step = self.step;
         let nd = step.dofs.nd;
-        let Scratch { transform: tr, block: eff_block, indices, live } = scratch;
+        let Scratch { transform: tr, block: eff_block, indices } = scratch;
         let has_ext = !step.stencils.extensions(k).is_empty();
         let eff = step.stencils.effective(k);
         let (me, kb): (usize, &[f64]) = if has_ext {
@@ -455,29 +450,14 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
             (m, &block[..m * m])
         };
         let ne = me / nd;
-        // In three dimensions, the nodes whose rows, and those whose columns, hold a nonzero value:
-        // a node the particle's domain only touches adds nothing (its blocks stay in the pattern).
-        // A plane point's block is small and its nodes nearly all reached: every node is taken.
-        live.clear();
-        live.resize(2 * ne, D < 3);
-        if D == 3 {
-            for (r, row) in kb.chunks_exact(me).enumerate() {
-                for (q, block_row) in row.chunks_exact(nd).enumerate() {
-                    if block_row.iter().any(|&v| v != 0.0) {
-                        live[r / nd] = true;
-                        live[ne + q] = true;
-                    }
-                }
-            }
-        }
         let pattern = &step.pattern;
         indices.clear();
         indices.extend(eff.iter().map(|&a| pattern.indices(a)));
         let fixed = &step.dofs.fixed;
-        for p in (0..ne).filter(|&p| live[p] && band.holds(eff[p])) {
+        for p in (0..ne).filter(|&p| band.holds(eff[p])) {
             let rp = eff[p] as usize * nd;
             let rows = values.row_places(pattern.block_of(eff[p], indices[p], eff[0], indices[0]) as usize);
-            for q in (0..ne).filter(|&q| live[ne + q]) {
+            for q in 0..ne {
                 let cq = eff[q] as usize * nd;
                 let at = pattern.block_of(eff[p], indices[p], eff[q], indices[q]) as usize;
                 values.with_rows_at(&rows, at, |c1, out| {

@@ -110,8 +110,7 @@ impl<const D: usize> Default for NodeBasis<D> {
 }
 
 impl<const D: usize> NodeBasis<D> {
-    /// Whether every operator is zero: a stencil node that the particle's domain only touches,
-    /// kept so that the matrix's pattern does not change when it moves by a hair.
+    /// Whether every operator is zero: a stencil node that the particle's domain only touches.
     #[inline]
     pub fn is_zero(&self) -> bool {
         self.s == 0.0 && self.t == 0.0 && self.tv == 0.0 && self.g.iter().chain(&self.gv).all(|&v| v == 0.0)

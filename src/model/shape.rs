@@ -272,8 +272,9 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
             for i in first.max(0)..=last.min(ncells as i64) {
                 let r = x - (origin + i as f64 * h);
                 // Nodes the particle domain only touches (weight exactly zero) are kept, so that the
-                // stencil, and with it the matrix structure, does not change when the particle moves
-                // by a hair across the grid line its domain ends on.
+                // stencil's shape does not change when the particle moves by a hair across the grid
+                // line its domain ends on (a step's stored stencils leave them out where no other
+                // operator needs them, `assembly::stencils::only_reached_nodes`).
                 if r.abs() <= h + lp + tol && n < 4 {
                     let (w, g) = gimp_1d(r, lp, h);
                     out[n] = (i as u32, w, g);
