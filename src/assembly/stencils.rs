@@ -902,14 +902,15 @@ mod tests {
         // weight and gradients: the stored stencils leave them out and keep every other node.
         assert!(only_reached_nodes(&model));
         assert!(st.basis.iter().all(|b| !b.is_zero()));
-        let support: usize = (0..st.len())
-            .map(|k| {
-                let (x, lp) = (model.particles.x[k], model.particles.lp[k]);
-                let raw: shape::Stencil<3, { shape::MAX_STENCIL_3D }> = shape::stencil_in(model.basis, g, x, lp);
-                raw.iter().filter(|(_, w, d)| *w != 0.0 || d.iter().any(|&v| v != 0.0)).count()
-            })
-            .sum();
-        assert!(st.nodes.len() <= support + st.len() * 8, "{} slots for {support} reached nodes", st.nodes.len());
+        for k in 0..st.len() {
+            let (x, lp) = (model.particles.x[k], model.particles.lp[k]);
+            let raw: shape::Stencil<3, { shape::MAX_STENCIL_3D }> = shape::stencil_in(model.basis, g, x, lp);
+            let (nodes, _) = st.get(k);
+            for (n, w, d) in raw.iter().filter(|(_, w, d)| *w != 0.0 || d.iter().any(|&v| v != 0.0)) {
+                let l = ghost.local(n.map(|v| v as usize)).unwrap() as u32;
+                assert!(nodes.contains(&l), "point {k}: node {n:?} (S = {w}, ∇S = {d:?}) left out");
+            }
+        }
         assert!(2 * st.nodes.len() < 27 * st.len(), "{} slots for {} points", st.nodes.len(), st.len());
         // Domains end on the grid's planes: none is past them. Moved past x_min and z_max, two are.
         assert!(crossings.is_empty());
