@@ -8,9 +8,12 @@
 //! than inserting the blocks one by one (docs/solvers.md). A particle finds the block of a pair
 //! through a dense table indexed by the first node and the pair's offset on the grid (no
 //! per-particle map: that map cost more memory than the particles themselves on the peer
-//! footing). The table holds
-//! (2·3 + 1)^D entries per ghosted node: 49 in two dimensions, 343 (1.4 kB) in three, against the
-//! matrix's own 7 × 875 entries per node of a three-dimensional u–p–U system (about 73 kB): 2 %.
+//! footing). The table spans the offsets of the pairs within the raw stencils of 99 % of the
+//! particles, at most ±3 nodes: it holds (2r + 1)^D entries per ghosted node for that offset r
+//! (r = 2 for GIMP and quadratic B-splines, 125 entries, 500 bytes, in three dimensions; r = 3 for
+//! cubic B-splines, 343), against the matrix's own 3 × 375 entries per node of a three-dimensional
+//! solid (about 13 kB) or 7 × 875 of a u–p–U system (about 73 kB). The few pairs farther apart (the
+//! rest of the particles, an extended node's masters, the nodes of a tied face) are kept in a map.
 //!
 //! The pattern is kept from step to step while every pair a particle needs is already in it (the
 //! matrix then keeps its structure, and a direct solver its symbolic factorisation); otherwise a
@@ -23,18 +26,23 @@ use std::collections::HashMap;
 /// No block.
 const NONE: u32 = u32::MAX;
 
-/// Offsets (Δi, Δj, Δk) within ±REACH nodes are looked up in a dense table; farther ones in a map.
+/// Offsets (Δi, Δj, Δk) within ±`reach` ≤ REACH nodes are looked up in a dense table; farther
+/// ones in a map.
 const REACH: i64 = 3;
-const WIDTH: usize = (2 * REACH + 1) as usize;
 
 /// The node-pair blocks of the matrix, on a ghosted grid of dimension `D`.
 #[derive(Debug, Clone)]
 pub struct Pattern<const D: usize = 2> {
     /// Ghosted-node pairs (a, b), one nd × nd block each, in list order.
     pub pairs: Vec<(u32, u32)>,
-    /// Dense lookup: `near[a · WIDTH^D + offset(a, b)]` is the block of (a, b).
+    /// Dense lookup: `near[a · (2 reach + 1)^D + offset(a, b)]` is the block of (a, b).
     near: Vec<u32>,
-    /// Pairs whose nodes are farther apart than REACH.
+    /// The largest offset per direction the dense table spans (at most REACH).
+    reach: i64,
+    /// The table's width per direction, 2 reach + 1, and its entries per node, width^D.
+    width: usize,
+    stride: usize,
+    /// Pairs whose nodes are farther apart than `reach`.
     far: HashMap<(u32, u32), u32>,
     /// Nodes of the ghosted grid per direction (to turn node numbers into indices).
     counts: [usize; D],
@@ -45,7 +53,16 @@ pub struct Pattern<const D: usize = 2> {
 
 impl<const D: usize> Default for Pattern<D> {
     fn default() -> Self {
-        Pattern { pairs: Vec::new(), near: Vec::new(), far: HashMap::new(), counts: [0; D], row_start: Vec::new() }
+        Pattern {
+            pairs: Vec::new(),
+            near: Vec::new(),
+            reach: REACH,
+            width: 2 * REACH as usize + 1,
+            stride: (2 * REACH as usize + 1).pow(D as u32),
+            far: HashMap::new(),
+            counts: [0; D],
+            row_start: Vec::new(),
+        }
     }
 }
 
@@ -82,22 +99,23 @@ impl<const D: usize> Pattern<D> {
     }
 
     /// The place in the dense table of the pair of nodes a (indices `ia`) and b (indices `ib`),
-    /// if their offset is within REACH in every direction.
+    /// if their offset is within the table's reach in every direction.
     #[inline]
-    fn near_index(a: u32, ia: [i64; D], ib: [i64; D]) -> Option<usize> {
+    fn near_index(&self, a: u32, ia: [i64; D], ib: [i64; D]) -> Option<usize> {
+        let (reach, width) = (self.reach, self.width);
         let mut at = 0usize;
         for d in (0..D).rev() {
             let o = ib[d] - ia[d];
-            if o.abs() > REACH {
+            if o.abs() > reach {
                 return None;
             }
-            at = at * WIDTH + (o + REACH) as usize;
+            at = at * width + (o + reach) as usize;
         }
-        Some(a as usize * WIDTH.pow(D as u32) + at)
+        Some(a as usize * self.stride + at)
     }
 
     fn offset(&self, a: u32, b: u32) -> Option<usize> {
-        Self::near_index(a, self.indices(a), self.indices(b))
+        self.near_index(a, self.indices(a), self.indices(b))
     }
 
     /// The grid indices of ghosted node `a` (x fastest).
@@ -114,7 +132,7 @@ impl<const D: usize> Pattern<D> {
     /// `u32::MAX` if the pattern lacks it.
     #[inline]
     pub fn block_of(&self, a: u32, ia: [i64; D], b: u32, ib: [i64; D]) -> u32 {
-        match Self::near_index(a, ia, ib) {
+        match self.near_index(a, ia, ib) {
             Some(o) => self.near[o],
             None => *self.far.get(&(a, b)).unwrap_or(&NONE),
         }
@@ -149,13 +167,24 @@ impl<const D: usize> Pattern<D> {
     /// of `counts` nodes per direction.
     pub fn build_in(st: &Stencils<D>, owned: &[u32], groups: &[Vec<u32>], counts: [usize; D]) -> Pattern<D> {
         let nodes: usize = counts.iter().product();
-        let mut p = Pattern {
-            pairs: Vec::new(),
-            near: vec![NONE; nodes * WIDTH.pow(D as u32)],
-            far: HashMap::new(),
-            counts,
-            row_start: Vec::new(),
-        };
+        let mut p = Pattern { counts, ..Pattern::default() };
+        // The table spans the raw stencils of all but at most one in a hundred particles (the
+        // basis's support; B̄'s cells that take a neighbour's volumetric strain reach one node
+        // farther); the pairs beyond it, of those particles, of an extension's masters or of a
+        // group, go to the map.
+        let mut count = [0usize; REACH as usize + 1];
+        for k in 0..st.len() {
+            count[p.extent(&st.nodes[st.offsets[k]..st.offsets[k + 1]]).min(REACH) as usize] += 1;
+        }
+        let (mut covered, mut r) = (0, 0);
+        while r < REACH as usize && (covered + count[r]) * 100 < st.len() * 99 {
+            covered += count[r];
+            r += 1;
+        }
+        p.reach = (r as i64).max(1);
+        p.width = 2 * p.reach as usize + 1;
+        p.stride = p.width.pow(D as u32);
+        p.near = vec![NONE; nodes * p.stride];
         for &a in owned {
             p.insert(a, a);
         }
@@ -176,6 +205,22 @@ impl<const D: usize> Pattern<D> {
         }
         p.sort(nodes);
         p
+    }
+
+    /// The largest offset in any direction between two of the ghosted `nodes`.
+    fn extent(&self, nodes: &[u32]) -> i64 {
+        if nodes.is_empty() {
+            return 0;
+        }
+        let (mut lo, mut hi) = ([i64::MAX; D], [i64::MIN; D]);
+        for &a in nodes {
+            let i = self.indices(a);
+            for d in 0..D {
+                lo[d] = lo[d].min(i[d]);
+                hi[d] = hi[d].max(i[d]);
+            }
+        }
+        (0..D).map(|d| hi[d] - lo[d]).max().unwrap_or(0)
     }
 
     /// Sorts the list by (a, b) and renumbers the blocks accordingly.
@@ -323,5 +368,34 @@ mod tests {
         assert_eq!(p.indices(node(4, 3, 5)), [4, 3, 5]);
         assert_eq!(p.block(node(0, 0, 0), node(4, 0, 0)), None);
         assert_eq!(p.row_start(node(5, 4, 6) + 1), p.len());
+        // The far pair (6 nodes apart) needs the widest table, ±3 nodes, and the map.
+        assert_eq!((p.reach, p.near.len(), p.far.len()), (3, 210 * 343, 2));
+        // The two 27-node stencils alone span ±2 nodes: a table of 125 entries per node, every
+        // pair found in it.
+        let two = Stencils::<3> {
+            offsets: vec![0, 27, 54],
+            nodes: [&a[..], &b[..]].concat(),
+            eff_offsets: vec![0, 0, 0],
+            ..Default::default()
+        };
+        let q = Pattern::build_in(&two, &[], &[], counts);
+        assert_eq!((q.reach, q.near.len(), q.far.len(), q.len()), (2, 210 * 125, 0, 27 * 27 * 2 - 16));
+        assert!(q.covers(&two));
+        assert!(q.pairs.iter().all(|&(x, y)| q.pairs[q.block(x, y).unwrap() as usize] == (x, y)));
+        assert!(!q.covers(&st));
+        // A master beyond the raw stencil (three nodes from its first): the table keeps its raw
+        // reach, the master's pairs three apart are in the map and found.
+        let extended = Stencils::<3> {
+            offsets: vec![0, 27],
+            nodes: a.clone(),
+            eff_offsets: vec![0, 28],
+            eff_nodes: [&a[..], &[node(3, 0, 0)]].concat(),
+            ..Default::default()
+        };
+        let e = Pattern::build_in(&extended, &[], &[], counts);
+        assert_eq!((e.reach, e.len()), (2, 28 * 28));
+        assert_eq!(e.far.len(), 2 * 9);
+        assert!(e.covers(&extended));
+        assert_eq!(e.pairs[e.block(node(0, 1, 2), node(3, 0, 0)).unwrap() as usize], (node(0, 1, 2), node(3, 0, 0)));
     }
 }

@@ -65,7 +65,8 @@ impl Extension {
 /// The stencils of all particles for one step, in this rank's ghosted node numbering, stored flat:
 /// particle k uses entries `offsets[k]..offsets[k + 1]` of `nodes` and `basis` (the raw stencil),
 /// `eff_offsets[k]..eff_offsets[k + 1]` of `eff_nodes` (its raw nodes, in the same order, then the
-/// masters of its extended nodes that are not in the raw stencil), and `ext_offsets[k]..` of `ext`.
+/// masters of its extended nodes that are not in the raw stencil; an empty range where there are
+/// no such masters, the effective nodes then being the raw ones), and `ext_offsets[k]..` of `ext`.
 #[derive(Debug, Clone, Default)]
 pub struct Stencils<const D: usize = 2> {
     pub offsets: Vec<usize>,
@@ -157,7 +158,12 @@ impl<const D: usize> Stencils<D> {
 
     /// Effective nodes of particle `k` (its raw nodes first).
     pub fn effective(&self, k: usize) -> &[u32] {
-        &self.eff_nodes[self.eff_offsets[k]..self.eff_offsets[k + 1]]
+        let (a, b) = (self.eff_offsets[k], self.eff_offsets[k + 1]);
+        if a == b {
+            &self.nodes[self.offsets[k]..self.offsets[k + 1]]
+        } else {
+            &self.eff_nodes[a..b]
+        }
     }
 
     /// Extensions of particle `k`.
@@ -754,6 +760,10 @@ pub fn extend<const D: usize>(
                 e.masters[m] = (pos as u8, c);
             }
             st.ext.push(e);
+        }
+        if st.eff_nodes.len() - start == raw.len() {
+            // No master beyond the raw stencil: the effective nodes are the raw ones.
+            st.eff_nodes.truncate(start);
         }
         st.eff_offsets.push(st.eff_nodes.len());
         st.ext_offsets.push(st.ext.len());
