@@ -53,16 +53,18 @@ pub struct Pattern<const D: usize = 2> {
 
 impl<const D: usize> Default for Pattern<D> {
     fn default() -> Self {
-        Pattern {
+        let mut p = Pattern {
             pairs: Vec::new(),
             near: Vec::new(),
-            reach: REACH,
-            width: 2 * REACH as usize + 1,
-            stride: (2 * REACH as usize + 1).pow(D as u32),
+            reach: 0,
+            width: 0,
+            stride: 0,
             far: HashMap::new(),
             counts: [0; D],
             row_start: Vec::new(),
-        }
+        };
+        p.set_reach(REACH);
+        p
     }
 }
 
@@ -181,9 +183,7 @@ impl<const D: usize> Pattern<D> {
             covered += count[r];
             r += 1;
         }
-        p.reach = (r as i64).max(1);
-        p.width = 2 * p.reach as usize + 1;
-        p.stride = p.width.pow(D as u32);
+        p.set_reach((r as i64).max(1));
         p.near = vec![NONE; nodes * p.stride];
         for &a in owned {
             p.insert(a, a);
@@ -205,6 +205,14 @@ impl<const D: usize> Pattern<D> {
         }
         p.sort(nodes);
         p
+    }
+
+    /// Sets the dense table's reach and the width and stride derived from it (kept so that a
+    /// lookup does not form them).
+    fn set_reach(&mut self, reach: i64) {
+        self.reach = reach;
+        self.width = 2 * reach as usize + 1;
+        self.stride = self.width.pow(D as u32);
     }
 
     /// The largest offset in any direction between two of the ghosted `nodes`.
