@@ -429,6 +429,7 @@ fn check_petsc_words(args: &[String]) -> Result<(), String> {
 fn start_mpi_and_petsc(args: &[String]) -> Result<(mpi::environment::Universe, Collective, petsc::Petsc), Failure> {
     check_petsc_words(args).map_err(input)?;
     quick_singleton_start();
+    no_shared_file_pointers();
     let universe = mpi::initialize().ok_or_else(|| input("MPI could not be initialised (already initialised?)"))?;
     let coll = Collective::world();
     if coll.size() > 1 {
@@ -462,6 +463,20 @@ fn quick_singleton_start() {
         if std::env::var_os(key).is_none() {
             std::env::set_var(key, value);
         }
+    }
+}
+
+/// Open MPI's MPI-I/O leaves out its `sm` shared-file-pointer component, unless the environment
+/// chooses one (`OMPI_MCA_sharedfp`). HDF5's files never use shared file pointers, but `sm` sets
+/// one up at every open, guarded by a POSIX semaphore named after the file's base name alone
+/// (`/dev/shm/sem.OMPIO_checkpoint.h5.tmp`) and shared by every process on the machine: a run
+/// killed while the file is open leaves it taken, and two runs opening files of the same name at
+/// once can race for it (Open MPI report 11934); either way every later open of that name waits for
+/// ever. The remaining components (`individual`, `lockedfile`) keep no state between processes.
+/// Called before MPI starts, while the process has one thread, on every rank alike.
+fn no_shared_file_pointers() {
+    if std::env::var_os("OMPI_MCA_sharedfp").is_none() {
+        std::env::set_var("OMPI_MCA_sharedfp", "^sm");
     }
 }
 

@@ -411,3 +411,29 @@ fn the_plastic_dissipation_of_a_sheared_von_mises_block_is_its_closed_form() {
     let (a, b) = (w[w.len() - 1], again.column("plastic_dissipation"));
     assert!((b[b.len() - 1] - a).abs() <= 1e-12 * a, "restarted {} against {a}", b[b.len() - 1]);
 }
+
+/// A checkpoint is written past the semaphore a killed run leaves behind. Open MPI's `sm`
+/// shared-file-pointer component guards every MPI-I/O open with a POSIX semaphore named after the
+/// file's base name and shared by the whole machine; a run killed while `checkpoint.h5.tmp` is open
+/// leaves `/dev/shm/sem.OMPIO_checkpoint.h5.tmp` taken (32 zero bytes are such a semaphore), and
+/// every later open of that name waited for ever (the CI run that hung two tests). porompm leaves
+/// the component out, so the run ends in its usual fraction of a second; with
+/// `OMPI_MCA_sharedfp=sm` in the environment it hangs until the limit.
+#[test]
+fn a_checkpoint_is_written_past_a_semaphore_a_killed_run_left_taken() {
+    struct Taken(std::path::PathBuf);
+    impl Drop for Taken {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+    let sem = Taken("/dev/shm/sem.OMPIO_checkpoint.h5.tmp".into());
+    std::fs::write(&sem.0, [0u8; 32]).expect("/dev/shm takes a file");
+    let dir = out_dir("checkpoint_past_a_taken_semaphore");
+    let mut args = common::set_args(&["stages.shear.duration=0.5"]);
+    args.extend(["--checkpoint-every".into(), "5".into()]);
+    let run = common::run_case_within(60, "tests/cases/plastic_shear.toml", &dir, &args);
+    assert!(run.completed(), "{}", run.stderr());
+    assert!(dir.join("checkpoint.h5").is_file());
+    assert!(sem.0.is_file(), "the taken semaphore is left as it was");
+}

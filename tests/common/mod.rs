@@ -75,15 +75,24 @@ impl Cores {
 }
 
 /// Runs `porompm run CASE --out DIR --quiet` with `args` after it (e.g. `--set` pairs, an options
-/// file, PETSc options after `--`) into `dir`, emptied first.
+/// file, PETSc options after `--`) into `dir`, emptied first, with a 900 s limit so that a hang
+/// fails the test instead of holding the suite.
 pub fn run_case(case: &str, dir: &Path, args: &[String]) -> Run {
+    run_case_within(900, case, dir, args)
+}
+
+/// [`run_case`] with a limit of `seconds`: then the run is stopped (SIGTERM, which porompm honours
+/// after a complete step, and SIGKILL 10 s later) and the test fails, naming the hang.
+pub fn run_case_within(seconds: u32, case: &str, dir: &Path, args: &[String]) -> Run {
     let _cores = Cores::shared();
     let _ = std::fs::remove_dir_all(dir);
+    let limit = seconds.to_string();
     let mut all =
-        vec!["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()];
+        ["-k", "10", limit.as_str(), env!("CARGO_BIN_EXE_porompm"), "run", case, "--out"].map(String::from).to_vec();
+    all.extend([dir.display().to_string(), "--quiet".into()]);
     all.extend(args.iter().cloned());
-    let output =
-        Command::new(env!("CARGO_BIN_EXE_porompm")).args(&all).current_dir(root()).output().expect("porompm runs");
+    let output = Command::new("timeout").args(&all).current_dir(root()).output().expect("porompm runs");
+    assert!(!timed_out(&output), "{case}: no end within {seconds} s (a hang)");
     let summary = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap_or_default())
         .unwrap_or(Value::Null);
     let (header, rows) = read_history(dir);
@@ -137,9 +146,16 @@ pub fn mpi_env(cmd: &mut Command) -> &mut Command {
         .env("OMPI_MCA_osc", "^ucx")
 }
 
+/// Whether `timeout` ended the command: exit code 124 after SIGTERM, or killed by the SIGKILL that
+/// follows (`timeout` then ends itself by the same signal).
+fn timed_out(output: &Output) -> bool {
+    use std::os::unix::process::ExitStatusExt;
+    matches!(output.status.code(), Some(124) | Some(137)) || output.status.signal() == Some(9)
+}
+
 /// Runs `porompm run CASE --out DIR --quiet ARGS` on `ranks` MPI ranks (through `mpirun`, alone on
-/// the [`Cores`]; one rank runs the binary directly), with a 600 s limit so that a hang fails the
-/// test instead of holding it.
+/// the [`Cores`]; one rank runs as [`run_case`] does), with a 600 s limit (then SIGTERM, and
+/// SIGKILL 30 s later) so that a hang fails the test instead of holding it.
 pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run {
     if ranks == 1 {
         return run_case(case, dir, args);
@@ -147,13 +163,14 @@ pub fn run_case_on(ranks: usize, case: &str, dir: &Path, args: &[String]) -> Run
     let _cores = Cores::exclusive();
     let _ = std::fs::remove_dir_all(dir);
     let np = ranks.to_string();
-    let mut all: Vec<String> = ["600", "mpirun", "--oversubscribe", "-n", np.as_str(), env!("CARGO_BIN_EXE_porompm")]
-        .map(String::from)
-        .to_vec();
+    let mut all: Vec<String> =
+        ["-k", "30", "600", "mpirun", "--oversubscribe", "-n", np.as_str(), env!("CARGO_BIN_EXE_porompm")]
+            .map(String::from)
+            .to_vec();
     all.extend(["run".to_string(), case.to_string(), "--out".into(), dir.display().to_string(), "--quiet".into()]);
     all.extend(args.iter().cloned());
     let output = mpi_env(&mut Command::new("timeout")).args(&all).current_dir(root()).output().expect("mpirun runs");
-    assert_ne!(output.status.code(), Some(124), "{case} on {ranks} ranks: no end within 600 s (a hang)");
+    assert!(!timed_out(&output), "{case} on {ranks} ranks: no end within 600 s (a hang)");
     let summary = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap_or_default())
         .unwrap_or(Value::Null);
     let (header, rows) = read_history(dir);
