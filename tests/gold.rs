@@ -184,6 +184,7 @@ macro_rules! gold_tests {
 
 gold_tests!(
     consolidation_layer,
+    consolidation_layer_3d,
     cook_membrane,
     dam_break,
     dam_break_martin_moyce,

@@ -296,6 +296,30 @@ fn gimp_reaches_across_cell_edges_and_keeps_touched_nodes() {
     assert!((s.iter().map(|(_, w, _)| w).sum::<f64>() - 1.0).abs() < 1e-12);
 }
 
+/// Two points per cell and direction, at a quarter and three quarters of their cell: each domain
+/// reaches the two nodes of its cell and only touches the one beyond. On grids whose spacing is not
+/// a binary fraction (1/13, 1/7, 0.3) the touching edge lands a few ulps either side of the node's
+/// support; the touched node must still carry exact zeros, or every stored stencil and the matrix
+/// grow from 2 to 3 nodes per direction (3.4 times the nonzeros of a three-dimensional u–p matrix).
+#[test]
+fn a_domain_touching_a_support_by_round_off_has_exactly_zero_weight_there() {
+    for (cells, size) in [(13usize, 1.0), (7, 1.0), (10, 3.0), (62, 1.0), (8, 1.0)] {
+        let h = size / cells as f64;
+        let lp = h / 4.0;
+        for c in 0..cells {
+            for q in [0.25, 0.75] {
+                let x = (c as f64 + q) * h;
+                let (out, n) = weights_1d(Basis::Gimp, x, lp, 0.0, h, cells);
+                let reached = out[..n].iter().filter(|(_, w, g)| *w != 0.0 || *g != 0.0).count();
+                assert_eq!(reached, 2, "{cells} cells of {h}: the point at {x} reaches {:?}", &out[..n]);
+                let sum: f64 = out[..n].iter().map(|o| o.1).sum();
+                let slope: f64 = out[..n].iter().map(|o| o.2).sum();
+                assert!((sum - 1.0).abs() < 1e-14 && slope.abs() < 1e-12 / h, "{cells} cells: {sum} {slope}");
+            }
+        }
+    }
+}
+
 /// The bilinear functions of a cell's four nodes sum to one with gradients summing to zero at
 /// any point, and on a grid line the gradient is the one of the side asked for.
 #[test]
