@@ -4,7 +4,7 @@
 //! the factors) does not fit in the memory the machine has available; `porompm check` prints the
 //! whole estimate.
 
-use crate::case::{AnalysisType, Case, Formulation, ShapeFunctions};
+use crate::case::{AnalysisType, Case, Drainage, Formulation, ShapeFunctions};
 
 /// What every rank takes before the case's own data: PETSc, MPI, HDF5 and the program (measured:
 /// 50–60 MiB for the smallest cases on one rank) [B].
@@ -14,8 +14,12 @@ pub const BASE_BYTES: f64 = 60.0 * 1024.0 * 1024.0;
 /// (peak memory of the shipped plane cases against their points: 6–9 kB) [B].
 pub const POINT_BYTES_2D: f64 = 6.0e3;
 
-/// The same in three dimensions (the square footing at 21 952 points: 21 kB) [B].
-pub const POINT_BYTES_3D: f64 = 21.0e3;
+/// The same in three dimensions, with the solver's copies and hierarchies of the matrix that the
+/// estimate's entries leave out (measured: the consolidating layer of
+/// `cases/consolidation_layer_3d.toml` at n = 29, 195 112 points under the fixed-stress field
+/// split, peaks at 1.30 GiB, 5.5 kB per point besides the libraries, matrix entries and grid
+/// vectors; the square footing at k = 6 at 4.6 kB per point besides PETSc's allocations) [B].
+pub const POINT_BYTES_3D: f64 = 6.0e3;
 
 /// Vectors of the grid's dofs a step keeps (solution, residual, local copies, predictors,
 /// projections, forces and reactions), 8 B each.
@@ -47,16 +51,38 @@ impl Estimate {
         let cells: Vec<f64> = (0..dim).map(|d| case.grid.cells[d] as f64).collect();
         let nodes: f64 = cells.iter().map(|c| c + 1.0).product();
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
-        let nd = if pore_water { 2 * dim + 1 } else { dim } as f64;
+        // Unknowns per node of each stage: u, u–p (quasi-static, undrained static), u–p–U
+        // (dynamic two-phase) or u–U (explicit two-phase, no matrix); F̄ adds J̄ to the implicit
+        // u and u–p systems.
+        let fbar = if case.stabilisation.fbar { 1 } else { 0 };
+        let per_node = |s: &crate::case::Stage| -> (usize, bool) {
+            match s.analysis {
+                AnalysisType::Dynamic if pore_water => (2 * dim + 1, true),
+                AnalysisType::Dynamic => (dim + fbar, true),
+                AnalysisType::QuasiStatic => (dim + 1 + fbar, true),
+                AnalysisType::Static if pore_water && s.drainage == Some(Drainage::Undrained) => (dim + 1 + fbar, true),
+                AnalysisType::Static => (dim + fbar, true),
+                AnalysisType::DynamicExplicit => (if pore_water { 2 * dim } else { dim }, false),
+            }
+        };
+        let nd = case.stages.iter().map(|s| per_node(s).0).max().unwrap_or(dim) as f64;
+        let nd_matrix = case.stages.iter().filter(|s| per_node(s).1).map(|s| per_node(s).0).max();
         let grid_dofs = nodes * nd;
+        // How far a node's matrix row reaches at the start, in nodes per direction: a GIMP point
+        // reaches the nodes of its own cell (those its domain only touches are left out), B̄ one
+        // cell further; a B-spline of degree p reaches p + 1 nodes per direction. Points that
+        // cross grid lines widen it during the run.
         let reach = match case.analysis.shape_functions {
             ShapeFunctions::Linear => 1.0,
+            ShapeFunctions::Bspline2 => 2.0,
             ShapeFunctions::Bspline3 => 3.0,
-            _ => 2.0,
+            _ if case.stabilisation.bbar => 2.0,
+            _ => 1.0,
         };
-        let implicit = case.stages.iter().any(|s| s.analysis != AnalysisType::DynamicExplicit);
-        let per_row = (2.0f64 * reach + 1.0).powi(dim as i32) * nd;
-        let matrix_entries = if implicit { grid_dofs * per_row } else { 0.0 };
+        let matrix_entries = match nd_matrix {
+            Some(n) => grid_dofs / nd * n as f64 * (2.0f64 * reach + 1.0).powi(dim as i32) * n as f64,
+            None => 0.0,
+        };
         let points = points_of(case);
         let point_bytes = if dim == 3 { POINT_BYTES_3D } else { POINT_BYTES_2D };
         let needed =
@@ -159,6 +185,16 @@ mod tests {
             &[crate::case::Override::parse("grid.cells=[4000,4000]").unwrap()],
         )
         .unwrap();
+        // Quasi-static u–p: 3 dofs per node, and a GIMP point's row reaches the 3 × 3 nodes
+        // around its node (B̄ off).
+        let up = crate::validation::load(
+            crate::case::tests_support::MINIMAL,
+            "t",
+            &[crate::case::Override::parse("stages.0.analysis=quasi_static").unwrap()],
+        )
+        .unwrap();
+        let e = Estimate::of(&up);
+        assert_eq!((e.grid_dofs, e.matrix_entries), (66.0, 66.0 * 9.0 * 3.0));
         let b = Estimate::of(&big);
         assert!(b.needed > 1e11, "a 4000 × 4000 grid needs over 100 GB: {}", human(b.needed));
         assert_eq!(human(1536.0), "1.500 KiB");
