@@ -16,7 +16,11 @@ four ranks (four oversubscribe the 2 cores: only counts are read there, not time
 PETSc's messages, bytes and reductions per rank and step (ghost updates of the residual and tangent
 assembly, off-rank COO entries, the Krylov solver's mat-vecs and dot products), porompm's own
 collectives (summary.json.collectives, rank 0) and the points migrated; each the difference of a
-10-step and a 5-step run over 5 steps, so that the set-up (first matrix, repartition) drops out. Writes target/bench/scaling.md and scaling.json.
+10-step and a 5-step run over 5 steps, so that the set-up (first matrix, repartition) drops out.
+
+Part 3, the same counts in three dimensions (COMM3D=1; off by default): the consolidating layer of
+cases/consolidation_layer_3d.toml on 13^3, 21^3 and 29^3 cells, per Krylov iteration. Writes
+target/bench/scaling.md and scaling.json.
 """
 import json, os, re, statistics, subprocess, sys
 
@@ -33,10 +37,14 @@ CONFIGS = [(1, 1), (1, 2), (2, 1)]  # (ranks, threads per rank)
 PHASES = ["step_setup_s", "assembly_s", "linear_solve_s", "particle_update_s", "output_s"]
 
 
-def run(name, ranks, threads, cells, duration, extra=()):
+def run(name, ranks, threads, cells, duration, extra=(), case=None):
+    """One run of the slumping block on `cells` for `duration`, or of `case` = (file, its --set
+    arguments) instead."""
     out = os.path.join(OUT, "scaling", name)
-    cmd = [EXE, "run", CASE, "--out", out, "--quiet", "--threads", str(threads),
-           "--set", f"grid.cells=[{cells[0]},{cells[1]}]", "--set", f"stages.slump.duration={duration}"] + BASE
+    if case is None:
+        case = (CASE, ["--set", f"grid.cells=[{cells[0]},{cells[1]}]", "--set", f"stages.slump.duration={duration}"]
+                + BASE)
+    cmd = [EXE, "run", case[0], "--out", out, "--quiet", "--threads", str(threads)] + case[1]
     cmd += list(extra)
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     if ranks > 1:
@@ -86,11 +94,11 @@ LOG = {"messages": r"^MPI Msg Count:\s+(\S+)\s+\S+\s+(\S+)\s+(\S+)",
        "reductions": r"^MPI Reductions:\s+(\S+)"}
 
 
-def counts(cells, ranks, duration):
+def counts(cells, ranks, duration, case=None, options="fieldsplit-schur-amg"):
     """One run with -log_view: its summary and PETSc's message counts (per rank: messages, bytes;
     reductions)."""
     s, log = run(f"comm-{cells[0]}-{ranks}-{duration}", ranks, 1, cells, duration,
-                 ["--options-file", "petsc_options/fieldsplit-schur-amg.opts", "--", "-log_view"])
+                 ["--options-file", f"petsc_options/{options}.opts", "--", "-log_view"], case)
     found = {}
     for key, pat in LOG.items():
         m = re.search(pat, log, re.M)
@@ -127,6 +135,38 @@ def comm():
     return "\n".join(lines), table
 
 
+def comm3d():
+    """Part 3 (COMM3D=1): the same counts for the three-dimensional consolidating layer
+    (cases/consolidation_layer_3d.toml, quasi-static u-p, fixed-stress split) on n^3 cells, per step
+    and per Krylov iteration, steps 6-10 (Delta t = 2e-4 s for steps 4-6, 4e-4 s for 7-9, 8e-4 s for
+    the tenth)."""
+    lines = ["| n | ranks | unknowns | points per rank | Krylov / Newton | PETSc messages / rank / Krylov | "
+             "PETSc kB / rank / Krylov | PETSc reductions / Krylov | porompm collectives / step |", "|" + "---|" * 9]
+    table = []
+    for n in [13, 21, 29]:
+        for ranks in (2, 4):
+            runs = []
+            for steps, duration in [(5, 7e-4), (10, 2.9e-3)]:
+                case = ("cases/consolidation_layer_3d.toml", ["--set", f"parameters.n={n}", "--set",
+                        f"stages.consolidation.duration={duration}", "--set", "output.fields_every=0"])
+                s, c = counts((n, n), ranks, duration, case, "fieldsplit-fixed-stress")
+                if s["steps"] != steps:
+                    sys.exit(f"bench-scaling: {steps} steps expected, {s['steps']} taken")
+                runs.append((s, c))
+            (_, a), (s10, b) = runs
+            d = {k: b[k] - a[k] for k in a}
+            row = {"n": n, "ranks": ranks, "dofs": s10["dofs"], "points_per_rank": s10["particles"] / ranks,
+                   "krylov_per_newton": d["krylov"] / d["newton"],
+                   **{f"{k}_per_krylov": d[k] / d["krylov"] for k in ("messages", "bytes", "reductions")},
+                   "own_calls_per_step": d["own_calls"] / 5}
+            table.append(row)
+            lines.append(f"| {n} | {ranks} | {s10['dofs']} | {row['points_per_rank']:.0f} | "
+                         f"{row['krylov_per_newton']:.1f} | {row['messages_per_krylov']:.1f} | "
+                         f"{row['bytes_per_krylov'] / 1e3:.0f} | {row['reductions_per_krylov']:.1f} | "
+                         f"{row['own_calls_per_step']:.0f} |")
+    return "\n".join(lines), table
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     text, result = "", {}
@@ -139,6 +179,10 @@ def main():
         text += ("\n\nCommunication per step (fieldsplit-schur-amg, -log_view, steps 6-10; 4 ranks oversubscribe "
                  "2 cores):\n\n" + ctext)
         result["comm"] = comm_rows
+    if os.environ.get("COMM3D", "0") != "0":
+        ctext, result["comm3d"] = comm3d()
+        print("\n" + ctext)
+        text += "\n\nCommunication per Krylov iteration, three-dimensional u-p layer (fieldsplit-fixed-stress):\n\n" + ctext
     open(os.path.join(OUT, "scaling.md"), "w").write(text + "\n")
     json.dump(result, open(os.path.join(OUT, "scaling.json"), "w"), indent=1)
 

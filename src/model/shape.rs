@@ -275,13 +275,14 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
                 // stencil's shape does not change when the particle moves by a hair across the grid
                 // line its domain ends on (a step's stored stencils leave them out where no other
                 // operator needs them, `assembly::stencils::only_reached_nodes`). A domain whose
-                // edge lies within round-off of the node's support (1e-11 of a cell: positions and
-                // half-widths on grids whose spacing is not a binary fraction, h = 1/13, land a few
-                // ulps either side) touches it: its weight (at most 1e-22) and gradient (at most
-                // 1e-11 / (2 lp) of 1/h) are set to exact zeros, so that the stencil does not
-                // grow by round-off from 2 to 3 nodes per direction.
+                // edge lies within the round-off of r = x − x_i of the node's support touches it
+                // (on grids whose spacing is not a binary fraction, h = 1/13, the edges of points
+                // at rest land a few ulps either side): its weight and gradient, of the order of
+                // the round-off and its square, are set to exact zeros, so that the stencil does
+                // not grow by round-off from 2 to 3 nodes per direction.
                 if r.abs() <= h + lp + tol && n < 4 {
-                    let touched = r.abs() >= h + lp - 1e-11 * h;
+                    let round_off = 16.0 * f64::EPSILON * (x.abs() + origin.abs() + h);
+                    let touched = r.abs() >= h + lp - round_off;
                     let (w, g) = if touched { (0.0, 0.0) } else { gimp_1d(r, lp, h) };
                     out[n] = (i as u32, w, g);
                     n += 1;
