@@ -21,7 +21,7 @@
 //! positions) to the next, whatever the types: e.g. a drained static gravity stage, a
 //! quasi-static consolidation and a dynamic failure in one case.
 
-use crate::case::{AnalysisType, Case, Drainage, Formulation, Stage};
+use crate::case::{AnalysisType, Case, Formulation, Stage};
 use crate::layout::Layout;
 use crate::scheme::Integration;
 
@@ -41,29 +41,26 @@ impl StageAnalysis {
     /// stage of a two-phase case says its drainage).
     pub fn of(case: &Case, stage: &Stage) -> StageAnalysis {
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
-        let mut analysis = match stage.analysis {
+        // [002]'s F̄ in an implicit stage: the projected volume ratio joins the unknowns
+        // (`kernels::fbar`) of the u and u–p systems; validation refuses F̄ in a stage whose
+        // layout has no such form (u–p–U), which it finds by this function.
+        let layout = stage.layout(pore_water, case.stabilisation.fbar);
+        match stage.analysis {
             AnalysisType::Dynamic => StageAnalysis {
-                layout: if pore_water { Layout::UPU } else { Layout::U },
+                layout,
                 integration: stage.time_integration.as_ref().unwrap_or(&case.time_integration).integration(),
                 dt_limit: None,
             },
             AnalysisType::QuasiStatic => StageAnalysis {
-                layout: Layout::UP,
+                layout,
                 integration: Integration::QuasiStatic { theta: stage.theta.unwrap_or(DEFAULT_THETA) },
                 dt_limit: None,
             },
-            AnalysisType::Static => StageAnalysis {
-                layout: match (pore_water, stage.drainage) {
-                    (true, Some(Drainage::Undrained)) => Layout::UP,
-                    _ => Layout::U,
-                },
-                integration: Integration::Static,
-                dt_limit: None,
-            },
+            AnalysisType::Static => StageAnalysis { layout, integration: Integration::Static, dt_limit: None },
             AnalysisType::DynamicExplicit => {
                 let e = stage.explicit.unwrap_or_default();
                 StageAnalysis {
-                    layout: if pore_water { Layout::UW } else { Layout::U },
+                    layout,
                     integration: Integration::Explicit {
                         flip: e.flip_blend,
                         damping: e.local_damping,
@@ -73,16 +70,7 @@ impl StageAnalysis {
                     dt_limit: Some(e.cfl * wave_step(case)),
                 }
             }
-        };
-        // [002]'s F̄ in an implicit stage: the projected volume ratio joins the unknowns
-        // (`kernels::fbar`) of the u and u–p systems; validation refuses F̄ in a stage whose
-        // layout has no such form (u–p–U), which it finds by this function.
-        if case.stabilisation.fbar && stage.analysis != AnalysisType::DynamicExplicit {
-            if let Some(layout) = analysis.layout.with_fbar() {
-                analysis.layout = layout;
-            }
         }
-        analysis
     }
 
     /// A short description for progress lines and `porompm check`.

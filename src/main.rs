@@ -459,10 +459,15 @@ fn quick_singleton_start() {
     if launched {
         return;
     }
-    for (key, value) in [("OMPI_MCA_pml", "ob1"), ("OMPI_MCA_osc", "^ucx")] {
-        if std::env::var_os(key).is_none() {
-            std::env::set_var(key, value);
-        }
+    default_env("OMPI_MCA_pml", "ob1");
+    default_env("OMPI_MCA_osc", "^ucx");
+}
+
+/// Sets the environment variable `key` to `value` unless the environment already sets it (the
+/// user's choice wins). Called before MPI starts, while the process has one thread.
+fn default_env(key: &str, value: &str) {
+    if std::env::var_os(key).is_none() {
+        std::env::set_var(key, value);
     }
 }
 
@@ -475,9 +480,7 @@ fn quick_singleton_start() {
 /// ever. The remaining components (`individual`, `lockedfile`) keep no state between processes.
 /// Called before MPI starts, while the process has one thread, on every rank alike.
 fn no_shared_file_pointers() {
-    if std::env::var_os("OMPI_MCA_sharedfp").is_none() {
-        std::env::set_var("OMPI_MCA_sharedfp", "^sm");
-    }
+    default_env("OMPI_MCA_sharedfp", "^sm");
 }
 
 /// A panic on one rank of a parallel run (a bug: every expected failure is an agreed error) would

@@ -4,7 +4,7 @@
 //! the factors) does not fit in the memory the machine has available; `porompm check` prints the
 //! whole estimate.
 
-use crate::case::{AnalysisType, Case, Drainage, Formulation, ShapeFunctions};
+use crate::case::{AnalysisType, Case, Formulation, ShapeFunctions};
 
 /// What every rank takes before the case's own data: PETSc, MPI, HDF5 and the program (measured:
 /// 50–60 MiB for the smallest cases on one rank) [B].
@@ -51,22 +51,11 @@ impl Estimate {
         let cells: Vec<f64> = (0..dim).map(|d| case.grid.cells[d] as f64).collect();
         let nodes: f64 = cells.iter().map(|c| c + 1.0).product();
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
-        // Unknowns per node of each stage: u, u–p (quasi-static, undrained static), u–p–U
-        // (dynamic two-phase) or u–U (explicit two-phase, no matrix); F̄ adds J̄ to the implicit
-        // u and u–p systems.
-        let fbar = if case.stabilisation.fbar { 1 } else { 0 };
-        let per_node = |s: &crate::case::Stage| -> (usize, bool) {
-            match s.analysis {
-                AnalysisType::Dynamic if pore_water => (2 * dim + 1, true),
-                AnalysisType::Dynamic => (dim + fbar, true),
-                AnalysisType::QuasiStatic => (dim + 1 + fbar, true),
-                AnalysisType::Static if pore_water && s.drainage == Some(Drainage::Undrained) => (dim + 1 + fbar, true),
-                AnalysisType::Static => (dim + fbar, true),
-                AnalysisType::DynamicExplicit => (if pore_water { 2 * dim } else { dim }, false),
-            }
-        };
-        let nd = case.stages.iter().map(|s| per_node(s).0).max().unwrap_or(dim) as f64;
-        let nd_matrix = case.stages.iter().filter(|s| per_node(s).1).map(|s| per_node(s).0).max();
+        // Unknowns per node of each stage (`Stage::layout`); the explicit ones form no matrix.
+        let fbar = case.stabilisation.fbar;
+        let per_node = |s: &crate::case::Stage| s.layout(pore_water, fbar).in_dim(dim).nd;
+        let nd = case.stages.iter().map(per_node).max().unwrap_or(dim) as f64;
+        let nd_matrix = case.stages.iter().filter(|s| s.analysis != AnalysisType::DynamicExplicit).map(per_node).max();
         let grid_dofs = nodes * nd;
         // How far a node's matrix row reaches at the start, in nodes per direction: a GIMP point
         // reaches the nodes of its own cell (those its domain only touches are left out), B̄ one
@@ -80,7 +69,7 @@ impl Estimate {
             _ => 1.0,
         };
         let matrix_entries = match nd_matrix {
-            Some(n) => grid_dofs / nd * n as f64 * (2.0f64 * reach + 1.0).powi(dim as i32) * n as f64,
+            Some(n) => nodes * n as f64 * (2.0f64 * reach + 1.0).powi(dim as i32) * n as f64,
             None => 0.0,
         };
         let points = points_of(case);

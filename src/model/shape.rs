@@ -267,6 +267,9 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
         }
         Basis::Gimp => {
             let tol = 1e-9 * h;
+            // The round-off of r = x − x_i: a domain whose edge lies within it of a node's support
+            // only touches that node (below).
+            let round_off = 16.0 * f64::EPSILON * (x.abs() + origin.abs() + h);
             let first = ((x - lp - tol - origin) / h).floor() as i64;
             let last = ((x + lp + tol - origin) / h).floor() as i64 + 1;
             for i in first.max(0)..=last.min(ncells as i64) {
@@ -281,7 +284,6 @@ fn weights_1d(basis: Basis, x: f64, lp: f64, origin: f64, h: f64, ncells: usize)
                 // the round-off and its square, are set to exact zeros, so that the stencil does
                 // not grow by round-off from 2 to 3 nodes per direction.
                 if r.abs() <= h + lp + tol && n < 4 {
-                    let round_off = 16.0 * f64::EPSILON * (x.abs() + origin.abs() + h);
                     let touched = r.abs() >= h + lp - round_off;
                     let (w, g) = if touched { (0.0, 0.0) } else { gimp_1d(r, lp, h) };
                     out[n] = (i as u32, w, g);

@@ -2,6 +2,7 @@
 //! time schemes of dynamic and explicit stages.
 
 use crate::check::{at, in_open, positive, Checked};
+use crate::layout::Layout;
 use serde::{Deserialize, Serialize};
 
 /// Time-stepping defaults (`--set time.dt=5e-4` changes the step of every stage that has none
@@ -256,6 +257,26 @@ impl TimeIntegration {
 }
 
 impl Stage {
+    /// The unknowns per node of the stage (in two dimensions; [`Layout::in_dim`] gives the others):
+    /// u, u–p (quasi-static, undrained static) or u–p–U (dynamic two-phase), each with the
+    /// projected volume ratio of an implicit F̄ step where it has that form (u and u–p), or u–U in
+    /// an explicit two-phase stage. `pore_water` and `fbar` are the case's formulation and
+    /// `stabilisation.fbar`.
+    pub fn layout(&self, pore_water: bool, fbar: bool) -> Layout {
+        let layout = match self.analysis {
+            AnalysisType::Dynamic if pore_water => Layout::UPU,
+            AnalysisType::QuasiStatic => Layout::UP,
+            AnalysisType::Static if pore_water && self.drainage == Some(Drainage::Undrained) => Layout::UP,
+            AnalysisType::DynamicExplicit if pore_water => return Layout::UW,
+            AnalysisType::DynamicExplicit => return Layout::U,
+            _ => Layout::U,
+        };
+        match layout.with_fbar() {
+            Some(with) if fbar => with,
+            _ => layout,
+        }
+    }
+
     /// The stage's time step [s]: its own `dt`, else `time.dt` (validation fills it in).
     pub fn dt(&self) -> f64 {
         self.dt.unwrap_or(f64::NAN)
