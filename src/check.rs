@@ -134,6 +134,15 @@ pub fn finite2(key: &str, v: [f64; 2]) -> Checked {
     }
 }
 
+/// At least `min` finite points in the plane under `key`.`field` (`what` names the figure they
+/// make in the message: "a polygon needs at least 3 vertices").
+pub fn finite_points(key: &str, field: &str, points: &[[f64; 2]], min: usize, what: &str) -> Checked {
+    if points.len() < min {
+        return Err(format!("key `{}`: {what} needs at least {min} {field}", at(key, field)));
+    }
+    points.iter().enumerate().try_for_each(|(j, p)| finite2(&format!("{key}.{field}[{j}]"), *p))
+}
+
 /// A vector of `dim` finite components (one per direction of the grid).
 pub fn components(key: &str, v: &[f64], dim: usize) -> Checked {
     if v.len() != dim {
@@ -158,4 +167,20 @@ pub fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> Checked {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::finite_points;
+
+    #[test]
+    fn too_few_or_non_finite_points_are_refused_with_the_key_named() {
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]];
+        assert!(finite_points("bodies[0].polygon", "vertices", &square, 3, "a polygon").is_ok());
+        let short = finite_points("bodies[0].polygon", "vertices", &square[..2], 3, "a polygon").unwrap_err();
+        assert_eq!(short, "key `bodies[0].polygon.vertices`: a polygon needs at least 3 vertices");
+        let nan = [[0.0, 0.0], [f64::NAN, 1.0]];
+        let bad = finite_points("loads[1]", "points", &nan, 2, "a line").unwrap_err();
+        assert!(bad.starts_with("key `loads[1].points[1]`: must be finite"), "{bad}");
+    }
 }

@@ -89,39 +89,26 @@ impl Parser<'_> {
         self.skip();
         self.s.get(self.i).copied()
     }
-    fn sum(&mut self) -> Result<f64, String> {
-        let mut v = self.product()?;
-        while let Some(c) = self.peek() {
-            match c {
-                b'+' => {
-                    self.i += 1;
-                    v += self.product()?;
-                }
-                b'-' => {
-                    self.i += 1;
-                    v -= self.product()?;
-                }
-                _ => break,
-            }
+    /// A left-associative chain `operand (op operand)*` of the two operators `ops`, `apply`
+    /// combining the value so far with the next operand.
+    fn chain(
+        &mut self,
+        ops: [u8; 2],
+        operand: fn(&mut Self) -> Result<f64, String>,
+        apply: fn(u8, f64, f64) -> f64,
+    ) -> Result<f64, String> {
+        let mut v = operand(self)?;
+        while let Some(c) = self.peek().filter(|c| ops.contains(c)) {
+            self.i += 1;
+            v = apply(c, v, operand(self)?);
         }
         Ok(v)
     }
+    fn sum(&mut self) -> Result<f64, String> {
+        self.chain([b'+', b'-'], Self::product, |op, a, b| if op == b'+' { a + b } else { a - b })
+    }
     fn product(&mut self) -> Result<f64, String> {
-        let mut v = self.unary()?;
-        while let Some(c) = self.peek() {
-            match c {
-                b'*' => {
-                    self.i += 1;
-                    v *= self.unary()?;
-                }
-                b'/' => {
-                    self.i += 1;
-                    v /= self.unary()?;
-                }
-                _ => break,
-            }
-        }
-        Ok(v)
+        self.chain([b'*', b'/'], Self::unary, |op, a, b| if op == b'*' { a * b } else { a / b })
     }
     /// `^` binds tighter than a unary sign on its left (−2^2 = −4) and is right-associative.
     fn power(&mut self) -> Result<f64, String> {

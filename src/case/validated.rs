@@ -21,6 +21,32 @@ impl std::ops::Deref for Case {
     }
 }
 
+/// The table an id points at, one accessor per section (`case.body(id)`, `case.stage(id)`).
+macro_rules! table_accessors {
+    ($($(#[$doc:meta])* $name:ident($id:ty) -> $table:ident: $ty:ty;)*) => {
+        impl Case {
+            $($(#[$doc])* pub fn $name(&self, id: $id) -> &$ty {
+                &self.file.$table[id.index()]
+            })*
+        }
+    };
+}
+
+table_accessors! {
+    /// A body.
+    body(BodyId) -> bodies: Body;
+    /// A material.
+    material(MaterialId) -> materials: Material;
+    /// A load.
+    load(LoadId) -> loads: Load;
+    /// A boundary.
+    boundary(BoundaryId) -> boundaries: Boundary;
+    /// A stage.
+    stage(StageId) -> stages: Stage;
+    /// A time function.
+    time_function(TimeFunctionId) -> time_functions: TimeFunction;
+}
+
 impl Case {
     /// The case of `file` with its names resolved to `links`; validation's last step.
     pub(crate) fn new(file: CaseFile, links: Links) -> Case {
@@ -45,36 +71,6 @@ impl Case {
     /// The boundaries' ids, in the file's order.
     pub fn boundary_ids(&self) -> impl Iterator<Item = BoundaryId> + use<> {
         (0..self.file.boundaries.len()).map(BoundaryId::new)
-    }
-
-    /// A body.
-    pub fn body(&self, id: BodyId) -> &Body {
-        &self.file.bodies[id.index()]
-    }
-
-    /// A material.
-    pub fn material(&self, id: MaterialId) -> &Material {
-        &self.file.materials[id.index()]
-    }
-
-    /// A load.
-    pub fn load(&self, id: LoadId) -> &Load {
-        &self.file.loads[id.index()]
-    }
-
-    /// A boundary.
-    pub fn boundary(&self, id: BoundaryId) -> &Boundary {
-        &self.file.boundaries[id.index()]
-    }
-
-    /// A stage.
-    pub fn stage(&self, id: StageId) -> &Stage {
-        &self.file.stages[id.index()]
-    }
-
-    /// A time function.
-    pub fn time_function(&self, id: TimeFunctionId) -> &TimeFunction {
-        &self.file.time_functions[id.index()]
     }
 
     /// The id of `body`'s material.

@@ -476,6 +476,21 @@ impl<const D: usize> Model<D> {
                 && case.stabilisation.patch_recovery.unwrap_or(DEFAULT_PATCH_RECOVERY),
         }
     }
+    /// The identifier of the material point nearest to `point` at t = 0 over all ranks, the lowest
+    /// identifier among equally near ones; None without material points (collective).
+    pub fn nearest_point(&self, coll: &crate::parallel::Collective, point: &[f64]) -> Result<Option<u64>, String> {
+        let ps = &self.particles;
+        let local: Vec<f64> = (0..ps.len())
+            .flat_map(|k| {
+                let distance = (0..D).map(|d| (ps.x0[k][d] - point[d]).powi(2)).sum::<f64>().sqrt();
+                [distance, ps.id[k] as f64]
+            })
+            .collect();
+        let all = coll.gather(&local)?;
+        let best = all.chunks(2).min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+        Ok(best.map(|b| b[1] as u64))
+    }
+
     /// The area of particle `k` in the (x, y) plane: its volume over the geometry's measure at its
     /// radius (the volume itself in plane strain and in three dimensions) [m² or m³].
     #[inline]

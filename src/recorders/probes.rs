@@ -28,21 +28,12 @@ impl Probes {
     /// The probes of the case: each the point nearest its `point` at t = 0 (the lowest identifier
     /// among equally near ones), in any dimension (collective).
     pub fn new<const D: usize>(case: &Case, model: &Model<D>, coll: &Collective) -> Result<Probes, String> {
-        let ps = &model.particles;
         let mut probes = Vec::new();
         for p in &case.probes {
-            let local: Vec<f64> = (0..ps.len())
-                .flat_map(|k| {
-                    let distance = (0..D).map(|d| (ps.x0[k][d] - p.point[d]).powi(2)).sum::<f64>().sqrt();
-                    [distance, ps.id[k] as f64]
-                })
-                .collect();
-            let all = coll.gather(&local)?;
-            let best = all
-                .chunks(2)
-                .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
+            let id = model
+                .nearest_point(coll, &p.point)?
                 .ok_or(format!("probe `{}`: there are no material points", p.name))?;
-            probes.push(Probe { name: p.name.clone(), id: best[1] as u64, last: Vec::new(), excess_extreme: 0.0 });
+            probes.push(Probe { name: p.name.clone(), id, last: Vec::new(), excess_extreme: 0.0 });
         }
         Ok(Probes { probes, pore_water: model.pore_water })
     }

@@ -280,7 +280,7 @@ impl<const D: usize> BearingCheck<D> {
             time_fn,
             cohesion,
             breadth: spec.breadth,
-            point_id: nearest_point(model, coll, &spec.settlement_point)?,
+            point_id: model.nearest_point(coll, &spec.settlement_point)?.ok_or("there are no material points")?,
             failure: spec.failure_settlement,
             plateau: spec.plateau,
             reference: spec.reference,
@@ -327,23 +327,6 @@ impl<const D: usize> BearingCheck<D> {
     }
 }
 
-/// The id of the material point nearest to `point` at t = 0, over all ranks (collective).
-fn nearest_point<const D: usize>(model: &Model<D>, coll: &Collective, point: &[f64]) -> Result<u64, String> {
-    let ps = &model.particles;
-    let local: Vec<f64> = (0..ps.len())
-        .flat_map(|k| {
-            let d = (0..D).map(|c| (ps.x0[k][c] - point[c]).powi(2)).sum::<f64>().sqrt();
-            [d, ps.id[k] as f64]
-        })
-        .collect();
-    let all = coll.gather(&local)?;
-    let best = all
-        .chunks(2)
-        .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
-        .ok_or("there are no material points")?;
-    Ok(best[1] as u64)
-}
-
 /// The pressure of the case's load `id` on the footing, over the loaded `width`.
 fn load_of(c: &Case, id: LoadId, width: f64) -> Result<LoadKind, String> {
     if let Some(traction) = c.load(id).traction() {
@@ -361,10 +344,6 @@ fn load_of(c: &Case, id: LoadId, width: f64) -> Result<LoadKind, String> {
 impl<const D: usize> Check<D> for BearingCheck<D> {
     fn columns(&self) -> Vec<String> {
         ["bearing.q", "bearing.q_over_c", "bearing.d_over_B"].iter().map(|s| s.to_string()).collect()
-    }
-
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
     }
 
     fn observe_reactions(&mut self, reactions: &[[f64; D]]) {

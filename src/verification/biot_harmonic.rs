@@ -71,9 +71,7 @@ impl BiotColumn {
     /// Checks that all parameters are finite and physically admissible, and returns a description of the first
     /// violation otherwise.
     pub fn validate(&self) -> Result<(), String> {
-        if !self.load_amplitude.is_finite() {
-            return Err(format!("load_amplitude must be finite, got {}", self.load_amplitude));
-        }
+        super::finite_parameter("load_amplitude", self.load_amplitude)?;
         super::positive_finite(&[
             ("height", self.height),
             ("constrained_modulus", self.constrained_modulus),

@@ -183,10 +183,6 @@ impl Check for CookCheck {
         vec!["cook.tip_uy".into()]
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let (fit, near) = self.tip_displacement(model, coll)?;
         self.history.push([t, fit, near]);

@@ -164,10 +164,6 @@ impl Check for ElasticColumnCheck {
         Ok(Some(Vec::new()))
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let v: f64 = (0..model.particles.len())
             .filter(|&k| model.particles.body[k] == self.body)

@@ -446,10 +446,6 @@ impl Check for HollowCylinderCheck {
             .to_vec()
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let [first, _] = self.find_columns(model, coll)?;
         let mp1 = self.mp1(first, model, coll)?;

@@ -145,10 +145,6 @@ impl<const D: usize> Check<D> for HydrostaticCheck {
         Vec::new()
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, _t: f64, _dt: f64, _model: &Model<D>, _coll: &Collective) -> Result<Vec<f64>, String> {
         Ok(Vec::new())
     }

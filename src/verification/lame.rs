@@ -164,10 +164,6 @@ impl Check for LameCheck {
         vec!["lame.u_r_error".into(), "lame.sigma_rr_error".into(), "lame.sigma_tt_error".into()]
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let e = self.errors(t, model, coll)?;
         self.last = [e[0], e[1], e[2], t];

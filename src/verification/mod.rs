@@ -87,8 +87,10 @@ pub type Findings = (Vec<(String, Metric)>, Vec<Table>);
 pub trait Check<const D: usize = 2> {
     /// Extra `history.csv` columns this check fills after every step.
     fn columns(&self) -> Vec<String>;
-    /// Times the time stepping must land on exactly.
-    fn event_times(&self) -> Vec<f64>;
+    /// Times the time stepping must land on exactly (none unless the check says).
+    fn event_times(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// Called after every converged step at time `t`; returns the values of [`Check::columns`].
     fn observe(&mut self, t: f64, dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String>;
     /// The metrics (name, metric) and tables at the end of the run.
@@ -287,6 +289,15 @@ fn positive_finite(fields: &[(&str, f64)]) -> Result<(), String> {
     match fields.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
         Some((name, value)) => Err(format!("{name} must be positive and finite, got {value}")),
         None => Ok(()),
+    }
+}
+
+/// A reference solution's parameter `name` finite, or a message naming it.
+fn finite_parameter(name: &str, value: f64) -> Result<(), String> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{name} must be finite, got {value}"))
     }
 }
 

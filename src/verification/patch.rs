@@ -196,10 +196,6 @@ impl<const D: usize> Check<D> for PatchCheck<D> {
         vec!["patch.stress_spread".into(), "patch.stress_rel_error".into()]
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
         let (spread, mean) = self.measure(model, coll)?;
         let theory = self.theory(t);

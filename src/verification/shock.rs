@@ -174,10 +174,6 @@ impl Check for ShockCheck {
         vec!["shock.p_probe".into(), "shock.p_probe_over_q".into()]
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let local: f64 = (0..model.particles.len())
             .filter(|&k| model.particles.id[k] == self.probe)

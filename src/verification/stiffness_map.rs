@@ -113,10 +113,6 @@ impl Check for StiffnessMapCheck {
         Vec::new()
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, _t: f64, _dt: f64, _model: &Model, _coll: &Collective) -> Result<Vec<f64>, String> {
         Ok(Vec::new())
     }

@@ -48,9 +48,7 @@ impl Terzaghi {
     /// Checks that all parameters are finite and physically admissible, and returns a description of the first
     /// violation otherwise.
     pub fn validate(&self) -> Result<(), String> {
-        if !self.load.is_finite() {
-            return Err(format!("load must be finite, got {}", self.load));
-        }
+        super::finite_parameter("load", self.load)?;
         super::positive_finite(&[
             ("height", self.height),
             ("constrained_modulus", self.constrained_modulus),

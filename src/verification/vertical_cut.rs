@@ -196,10 +196,6 @@ impl Check for VerticalCutCheck {
         vec!["cut.toe_displacement".into(), "cut.yield_ratio".into()]
     }
 
-    fn event_times(&self) -> Vec<f64> {
-        Vec::new()
-    }
-
     fn observe(&mut self, _t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
         let ps = &model.particles;
         self.toe = self.nearest(model, coll, self.points[0], |k| ps.disp[k][0])?;

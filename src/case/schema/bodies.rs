@@ -1,7 +1,7 @@
 //! `[[bodies]]`: the regions filled with material points at t = 0, their initial stress, and the
 //! planar shapes and boxes the case uses to select points and nodes.
 
-use crate::check::{at, finite, finite2, positive, Checked};
+use crate::check::{at, finite, finite2, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// A body filled with material points.
@@ -248,12 +248,7 @@ impl Rectangle {
 impl Polygon {
     /// Checks the number of vertices and that they are finite; `key` is the polygon's table.
     pub fn check(&self, key: &str) -> Checked {
-        if self.vertices.len() < 3 {
-            return Err(format!("key `{}`: a polygon needs at least 3 vertices", at(key, "vertices")));
-        }
-        for (j, v) in self.vertices.iter().enumerate() {
-            finite2(&format!("{key}.vertices[{j}]"), *v)?;
-        }
+        finite_points(key, "vertices", &self.vertices, 3, "a polygon")?;
         // A simple polygon: no two edges meet but neighbours at their shared vertex (even-odd
         // filling would otherwise give a crossed outline holes and double layers, silently).
         let n = self.vertices.len();

@@ -3,7 +3,7 @@
 
 use super::bodies::Region;
 use super::boundaries::Side;
-use crate::check::{at, finite, finite2, positive, Checked};
+use crate::check::{at, finite, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
 
 /// A load, scaled in time by a named time function (default: constant 1), chosen by its `kind`.
@@ -181,12 +181,7 @@ impl Load {
 impl LinePressure {
     /// Checks the points and the pressure; `key` is the load's table.
     pub fn check(&self, key: &str) -> Checked {
-        if self.points.len() < 2 {
-            return Err(format!("key `{}`: a line needs at least two points", at(key, "points")));
-        }
-        for (j, p) in self.points.iter().enumerate() {
-            finite2(&format!("{key}.points[{j}]"), *p)?;
-        }
+        finite_points(key, "points", &self.points, 2, "a line")?;
         finite(&at(key, "pressure"), self.pressure)
     }
 }
