@@ -193,6 +193,7 @@ gold_tests!(
     footing_ld,
     footing_near_slope,
     footing_peer,
+    footing_peer_3d,
     footing_sd,
     harmonic_column_zone1,
     harmonic_column_zone2,
@@ -362,7 +363,7 @@ const RANKS_FLOOR: f64 = 1e-9;
 
 /// The cases the default suite runs on three ranks rather than two: those whose three-rank run takes a few
 /// seconds (the plane and 3D patch tests, rotations and cylinders, Terzaghi's column in the plane
-/// and in 3D, the static elastic column, the peer footing) and the explicit F̄ footing (7 s; the
+/// and in 3D, the static elastic column, the peer footings in the plane and in 3D) and the explicit F̄ footing (7 s; the
 /// explicit path with points crossing rank boundaries). Every other case's three-rank run took 7 to
 /// 60 s, 650 s together, where three processes share the two cores of the CI machine: the default
 /// suite runs those on two ranks, `make study` on three as well, and these on two
@@ -371,6 +372,7 @@ const THREE_RANKS_BY_DEFAULT: &[&str] = &[
     "elastic_column",
     "footing_fbar",
     "footing_peer",
+    "footing_peer_3d",
     "hollow_cylinder",
     "hollow_cylinder_increments",
     "lame_cylinder",
