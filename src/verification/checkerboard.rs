@@ -122,10 +122,14 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
         bins.entry(cell_of(&points[k], origin, h)).or_default().push(k);
     }
     let (mut r2, mut s2, mut worst) = (0.0, 0.0, 0.0f64);
+    // Scratch reused from cell to cell: the neighbourhood's points, the normal equations (at most
+    // ten terms: 1, three linear, three quadratic, three cross).
+    let mut nb: Vec<usize> = Vec::new();
+    let (mut a, mut rhs) = ([0.0; MAX_TERMS * MAX_TERMS], [0.0; MAX_TERMS]);
     for (&(i, j, k, body), members) in bins.iter().filter(|((i, j, k, _), _)| evaluate([*i, *j, *k])) {
         let centre: [f64; 3] = std::array::from_fn(|d| origin[d] + ([i, j, k][d] as f64 + 0.5) * h[d]);
         let local = |p: &FitPoint| -> [f64; 3] { std::array::from_fn(|d| (p[d] - centre[d]) / h[d]) };
-        let mut nb: Vec<usize> = Vec::new();
+        nb.clear();
         for dk in -1..=1 {
             for dj in -1..=1 {
                 for di in -1..=1 {
@@ -135,47 +139,75 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
                 }
             }
         }
-        let spread = |d: usize| {
-            let v: Vec<f64> = nb.iter().map(|&n| local(&points[n])[d]).collect();
-            v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min) > 1.0
-        };
-        let spreads: Vec<usize> = (0..3).filter(|&d| spread(d)).collect();
-        let basis = |q: [f64; 3]| -> Vec<f64> {
-            let mut b = vec![1.0];
-            for &d in &spreads {
-                b.extend([q[d], q[d] * q[d]]);
+        let mut spreads = [0usize; 3];
+        let mut directions = 0;
+        for d in 0..3 {
+            let (lo, hi) = nb
+                .iter()
+                .map(|&n| local(&points[n])[d])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+            if hi - lo > 1.0 {
+                spreads[directions] = d;
+                directions += 1;
             }
-            for (a, &d) in spreads.iter().enumerate() {
-                for &e in &spreads[a + 1..] {
-                    b.push(q[d] * q[e]);
-                }
-            }
-            b
-        };
-        let m = basis([0.0; 3]).len();
+        }
+        let spreads = &spreads[..directions];
+        let m = 1 + 2 * directions + directions * directions.saturating_sub(1) / 2;
         if nb.len() < m + 2 {
             continue;
         }
-        let mut a = vec![0.0; m * m];
-        let mut rhs = vec![0.0; m];
+        let (a, rhs) = (&mut a[..m * m], &mut rhs[..m]);
+        a.fill(0.0);
+        rhs.fill(0.0);
+        // The normal matrix is symmetric: its upper triangle is summed and mirrored (the same
+        // products in the same order as the full matrix, so the same values to the last bit).
         for &n in &nb {
-            let q = basis(local(&points[n]));
+            let q = basis(local(&points[n]), spreads);
             for r in 0..m {
                 rhs[r] += q[r] * points[n][3];
-                for c in 0..m {
+                for c in r..m {
                     a[r * m + c] += q[r] * q[c];
                 }
             }
         }
-        let Some(coef) = solve(&mut a, &mut rhs, m) else { continue };
+        for r in 0..m {
+            for c in 0..r {
+                a[r * m + c] = a[c * m + r];
+            }
+        }
+        let Some(coef) = solve(a, rhs, m) else { continue };
         for &n in members {
-            let s: f64 = basis(local(&points[n])).iter().zip(&coef).map(|(q, c)| q * c).sum();
+            let s: f64 = basis(local(&points[n]), spreads)[..m].iter().zip(&coef).map(|(q, c)| q * c).sum();
             r2 += (points[n][3] - s).powi(2);
             s2 += s * s;
             worst = worst.max((points[n][3] - s).abs());
         }
     }
     (r2, s2, worst)
+}
+
+/// The most terms of a cell's polynomial: 1 and, in three directions, three linear, three
+/// quadratic and three cross terms.
+const MAX_TERMS: usize = 10;
+
+/// The polynomial's terms at the offsets `q` (in cells) for the directions `spreads`: 1, then each
+/// direction's linear and quadratic term, then the cross terms of each pair (zero beyond them).
+fn basis(q: [f64; 3], spreads: &[usize]) -> [f64; MAX_TERMS] {
+    let mut b = [0.0; MAX_TERMS];
+    b[0] = 1.0;
+    let mut n = 1;
+    for &d in spreads {
+        b[n] = q[d];
+        b[n + 1] = q[d] * q[d];
+        n += 2;
+    }
+    for (a, &d) in spreads.iter().enumerate() {
+        for &e in &spreads[a + 1..] {
+            b[n] = q[d] * q[e];
+            n += 1;
+        }
+    }
+    b
 }
 
 /// Solves the m × m system by Gaussian elimination with partial pivoting; `None` if singular.
