@@ -139,20 +139,22 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
                 }
             }
         }
-        let mut spreads = [0usize; 3];
-        let mut directions = 0;
-        for d in 0..3 {
-            let (lo, hi) = nb
-                .iter()
-                .map(|&n| local(&points[n])[d])
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
-            if hi - lo > 1.0 {
-                spreads[directions] = d;
-                directions += 1;
+        // The directions in which the neighbourhood's points spread over more than a cell.
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for &n in &nb {
+            let q = local(&points[n]);
+            for d in 0..3 {
+                (lo[d], hi[d]) = (lo[d].min(q[d]), hi[d].max(q[d]));
             }
         }
+        let mut spreads = [0usize; 3];
+        let mut directions = 0;
+        for d in (0..3).filter(|&d| hi[d] - lo[d] > 1.0) {
+            spreads[directions] = d;
+            directions += 1;
+        }
         let spreads = &spreads[..directions];
-        let m = 1 + 2 * directions + directions * directions.saturating_sub(1) / 2;
+        let m = basis([0.0; 3], spreads).1;
         if nb.len() < m + 2 {
             continue;
         }
@@ -162,7 +164,7 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
         // The normal matrix is symmetric: its upper triangle is summed and mirrored (the same
         // products in the same order as the full matrix, so the same values to the last bit).
         for &n in &nb {
-            let q = basis(local(&points[n]), spreads);
+            let (q, _) = basis(local(&points[n]), spreads);
             for r in 0..m {
                 rhs[r] += q[r] * points[n][3];
                 for c in r..m {
@@ -177,7 +179,7 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
         }
         let Some(coef) = solve(a, rhs, m) else { continue };
         for &n in members {
-            let s: f64 = basis(local(&points[n]), spreads)[..m].iter().zip(&coef).map(|(q, c)| q * c).sum();
+            let s: f64 = basis(local(&points[n]), spreads).0[..m].iter().zip(&coef).map(|(q, c)| q * c).sum();
             r2 += (points[n][3] - s).powi(2);
             s2 += s * s;
             worst = worst.max((points[n][3] - s).abs());
@@ -191,8 +193,9 @@ fn sums_of(points: &[FitPoint], origin: [f64; 3], h: [f64; 3], evaluate: impl Fn
 const MAX_TERMS: usize = 10;
 
 /// The polynomial's terms at the offsets `q` (in cells) for the directions `spreads`: 1, then each
-/// direction's linear and quadratic term, then the cross terms of each pair (zero beyond them).
-fn basis(q: [f64; 3], spreads: &[usize]) -> [f64; MAX_TERMS] {
+/// direction's linear and quadratic term, then the cross terms of each pair (zero beyond them),
+/// and how many there are.
+fn basis(q: [f64; 3], spreads: &[usize]) -> ([f64; MAX_TERMS], usize) {
     let mut b = [0.0; MAX_TERMS];
     b[0] = 1.0;
     let mut n = 1;
@@ -207,7 +210,7 @@ fn basis(q: [f64; 3], spreads: &[usize]) -> [f64; MAX_TERMS] {
             n += 1;
         }
     }
-    b
+    (b, n)
 }
 
 /// Solves the m × m system by Gaussian elimination with partial pivoting; `None` if singular.
