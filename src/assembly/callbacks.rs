@@ -96,7 +96,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         }
         let ps = self.points;
         let nd = self.step.dofs.nd;
-        let block = |k: usize, buf: &mut [f64]| ps.residual_of(k, &xl, buf);
+        let block = |k: usize, buf: &mut [f64], states: &mut [_]| ps.residual_of(k, &xl, buf, states);
         let bad =
             run_bands(&self.step.bands, &mut fl, |a| a as usize * nd, |band, f| ps.residual_band(band, f, &block));
         if let Some(k) = bad.into_iter().flatten().min() {

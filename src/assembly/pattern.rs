@@ -140,6 +140,55 @@ impl<const D: usize> Pattern<D> {
         }
     }
 
+    /// The blocks of the pairs (nodes[p], nodes[q]) for every node q of one stencil, whose grid
+    /// indices are `indices` ([`Pattern::indices`]), into `out` (`u32::MAX` where the pattern
+    /// lacks a pair). `codes` are [`Pattern::codes`] of the stencil: where it spans no more than
+    /// the dense table's reach, every block is one load of the table.
+    pub fn row_blocks(
+        &self,
+        nodes: &[u32],
+        indices: &[[i64; D]],
+        codes: Option<&[usize]>,
+        p: usize,
+        out: &mut Vec<usize>,
+    ) {
+        out.clear();
+        match codes {
+            Some(codes) => {
+                let base = nodes[p] as usize * self.stride + self.centre() - codes[p];
+                out.extend(codes.iter().map(|&c| self.near[base + c] as usize));
+            }
+            None => {
+                out.extend((0..nodes.len()).map(|q| self.block_of(nodes[p], indices[p], nodes[q], indices[q]) as usize))
+            }
+        }
+    }
+
+    /// The places in the dense table of a stencil's nodes with grid indices `indices` relative to
+    /// its first corner, Σ_d i_d width^d, if the stencil spans no more than the table's reach in
+    /// every direction (so that the place of a pair is the difference of theirs plus the centre's).
+    pub fn codes(&self, indices: &[[i64; D]], out: &mut Vec<usize>) -> bool {
+        out.clear();
+        let Some(first) = indices.first() else { return true };
+        let (mut lo, mut hi) = (*first, *first);
+        for ix in indices {
+            for d in 0..D {
+                lo[d] = lo[d].min(ix[d]);
+                hi[d] = hi[d].max(ix[d]);
+            }
+        }
+        if (0..D).any(|d| hi[d] - lo[d] > self.reach) {
+            return false;
+        }
+        out.extend(indices.iter().map(|ix| (0..D).rev().fold(0, |at, d| at * self.width + (ix[d] - lo[d]) as usize)));
+        true
+    }
+
+    /// The place in the dense table of a node's pair with itself (every offset zero).
+    fn centre(&self) -> usize {
+        (0..D).fold(0, |at, _| at * self.width + self.reach as usize)
+    }
+
     /// The block of pair (a, b), if the pattern has it.
     pub fn block(&self, a: u32, b: u32) -> Option<u32> {
         let v = match self.offset(a, b) {

@@ -4,7 +4,7 @@
 //! callbacks ([`super::callbacks`]) and the step's preparation, balance and explicit update call it.
 
 use super::stencils::Stencils;
-use super::step::{Band, Solution, Step};
+use super::step::{Band, Runs, Solution, Step};
 use crate::kernels::{self, NodeState, StepResult};
 use crate::model::Model;
 use crate::scheme::Scheme;
@@ -166,6 +166,26 @@ pub(super) fn bands<const D: usize>(st: &Stencils<D>, counts: [usize; D], n: usi
     out
 }
 
+/// The points of `st` in runs of one stencil ([`Runs`]): the points without extensions sorted by
+/// their effective nodes, those with the same nodes in one run in increasing order, and every
+/// point with extensions a run of its own. The runs depend on the points only, not on the bands,
+/// so that every matrix entry is the same sum for any number of threads.
+pub(super) fn runs<const D: usize>(st: &Stencils<D>) -> Runs {
+    let alone = |k: usize| !st.extensions(k).is_empty();
+    let mut order: Vec<u32> = (0..st.len() as u32).collect();
+    // (With extensions, ordered by the point itself and never equal to another.)
+    let key = |k: u32| (alone(k as usize), if alone(k as usize) { &[][..] } else { st.effective(k as usize) });
+    order.sort_by(|&a, &b| key(a).cmp(&key(b)).then(a.cmp(&b)));
+    let mut starts = Vec::new();
+    for (i, &k) in order.iter().enumerate() {
+        if i == 0 || alone(k as usize) || key(k) != key(order[i - 1]) {
+            starts.push(i as u32);
+        }
+    }
+    starts.push(order.len() as u32);
+    Runs { order, starts }
+}
+
 /// Runs `work` on every band on its own thread (the first on this one), each with its part of
 /// `data`: entries `start(band.lo)..start(band.hi)` (the bands cover `data` in order).
 pub(super) fn run_bands<R: Send>(
@@ -211,11 +231,14 @@ fn at_least(v: &mut Vec<f64>, n: usize) {
 }
 
 /// The scratch of [`Points::add_tangent`]: the map of raw to effective dofs, the effective
-/// block, the effective nodes' grid indices.
+/// block, the effective nodes' grid indices and places in the pattern's table, the pattern
+/// blocks of one block row.
 struct Scratch<const D: usize> {
     transform: Vec<Vec<(usize, f64)>>,
     block: Vec<f64>,
     indices: Vec<[i64; D]>,
+    codes: Vec<usize>,
+    blocks: Vec<usize>,
 }
 
 /// The particle side of the callbacks: the model and the prepared step (shared by the threads);
@@ -237,20 +260,24 @@ impl<const D: usize, const M: usize, const N: usize> Copy for Points<'_, D, M, N
 impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
     pub(super) fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point<D, M>) -> R) -> R {
-        self.with_point_of(k, xl, particle_input(self.model, self.step, k), f)
+        let mut states = [NodeState::default(); M];
+        self.with_point_of(k, xl, particle_input(self.model, self.step, k), &mut states, f)
     }
 
-    /// [`Self::with_point`] with the particle's kernel input given.
+    /// [`Self::with_point`] with the particle's kernel input given and its nodal states written
+    /// into `states` (at least as many as its stencil's nodes), which a loop over points keeps
+    /// ([`node_states_into`]).
     fn with_point_of<R>(
         &self,
         k: usize,
         xl: &[f64],
         input: kernels::ParticleInput<D>,
+        states: &mut [NodeState<N>],
         f: impl FnOnce(&kernels::Point<D, M>) -> R,
     ) -> R {
         let step = self.step;
         let (nodes, basis) = step.stencils.get(k);
-        let states = node_states::<D, M, N>(step, k, xl);
+        node_states_into::<D, M, N>(step, k, xl, states);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         let strain = step.stencils.strain_of(k);
         let layout = step.layout;
@@ -318,10 +345,12 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         f(&pt)
     }
 
-    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length.
-    pub(super) fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64]) -> usize {
+    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length (`states`: the
+    /// nodal states' scratch, see [`Self::with_point_of`]).
+    pub(super) fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64], states: &mut [NodeState<N>]) -> usize {
         let nm = self.step.scheme;
-        self.with_point(k, xl, |pt| {
+        let input = particle_input(self.model, self.step, k);
+        self.with_point_of(k, xl, input, states, |pt| {
             kernels::residual(pt, &nm, buf);
             pt.size()
         })
@@ -366,18 +395,19 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     }
 
     /// The residual rows of `band` (its part `f` of a ghosted array) from every particle that
-    /// reaches it, each particle's block given by `block(k, buf) -> length`; returns the first
-    /// particle whose block was not finite.
+    /// reaches it, each particle's block given by `block(k, buf, states) -> length` (`states`: the
+    /// nodal states' scratch); returns the first particle whose block was not finite.
     pub(super) fn residual_band(
         &self,
         band: Band,
         f: &mut [f64],
-        block: &(impl Fn(usize, &mut [f64]) -> usize + Sync),
+        block: &(impl Fn(usize, &mut [f64], &mut [NodeState<N>]) -> usize + Sync),
     ) -> Option<usize> {
         let mut buf = vec![0.0; M * N];
+        let mut states = vec![NodeState::<N>::default(); M];
         let mut nonfinite = None;
         for k in (0..self.step.stencils.len()).filter(|&k| self.touches(k, band)) {
-            let m = block(k, &mut buf);
+            let m = block(k, &mut buf, &mut states);
             if nonfinite.is_none() && !buf[..m].iter().all(|r| r.is_finite()) {
                 nonfinite = Some(k);
             }
@@ -395,44 +425,56 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         // Sized by the largest block met, not by the bounds M and N: a three-dimensional
         // one-phase point's block is 192² values, the bounds' 875² (6 MB a thread).
         let mut block = Vec::new();
-        let mut scratch =
-            Scratch { transform: Vec::new(), block: Vec::new(), indices: Vec::with_capacity(M + EXTRA_MASTERS) };
+        let mut scratch = Scratch {
+            transform: Vec::new(),
+            block: Vec::new(),
+            indices: Vec::with_capacity(M + EXTRA_MASTERS),
+            codes: Vec::with_capacity(M + EXTRA_MASTERS),
+            blocks: Vec::with_capacity(M + EXTRA_MASTERS),
+        };
         let mut states = vec![NodeState::<N>::default(); M];
-        for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
-            let (nodes, basis) = step.stencils.get(k);
-            let input = particle_input(self.model, step, k);
-            let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            node_states_into::<D, M, N>(step, k, xl, &mut states);
-            let strain = step.stencils.strain_of(k);
-            let mut pt = kernels::Point::<D, M>::with_recovery(
-                basis,
-                strain,
-                &states[..nodes.len()],
-                &input,
-                &mat.model,
-                layout,
-            );
-            pt.set_forces(step.stencils.forces_of(k));
-            pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
-            let m = pt.size();
+        // The blocks of a run's points (one stencil) are summed here in increasing point order,
+        // and the sum reaches the matrix once.
+        for run in step.runs.iter().filter(|run| self.touches(run[0] as usize, band)) {
+            let m = step.stencils.get(run[0] as usize).0.len() * layout.nd;
             at_least(&mut block, m * m);
-            if self.model.stiffness_in_jacobian {
-                kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
-                step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
-            } else {
-                // The mapped stiffness serves the diagnostics only: the exact tangent.
-                kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
+            block[..m * m].fill(0.0);
+            for k in run.iter().map(|&k| k as usize) {
+                let (nodes, basis) = step.stencils.get(k);
+                let input = particle_input(self.model, step, k);
+                let mat = &self.model.materials[self.model.particles.material[k] as usize];
+                node_states_into::<D, M, N>(step, k, xl, &mut states);
+                let strain = step.stencils.strain_of(k);
+                let mut pt = kernels::Point::<D, M>::with_recovery(
+                    basis,
+                    strain,
+                    &states[..nodes.len()],
+                    &input,
+                    &mat.model,
+                    layout,
+                );
+                pt.set_forces(step.stencils.forces_of(k));
+                pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
+                debug_assert_eq!(pt.size(), m, "a run of one stencil");
+                if self.model.stiffness_in_jacobian {
+                    kernels::add_tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
+                    step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
+                } else {
+                    // The mapped stiffness serves the diagnostics only: the exact tangent.
+                    kernels::add_tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
+                }
             }
-            self.add_tangent(k, &block, m, &mut scratch, values, band);
+            self.add_tangent(run[0] as usize, &mut block[..m * m], m, &mut scratch, values, band);
         }
     }
 
-    /// Adds the rows of `band` of particle `k`'s tangent block to the band's part `values` of the
-    /// matrix.
+    /// Adds the rows of `band` of the tangent block of a run of points whose first is `k` (one
+    /// stencil: `k`'s; overwritten: its rows and columns of fixed dofs are zeroed) to the band's
+    /// part `values` of the matrix.
     fn add_tangent(
         &self,
         k: usize,
-        block: &[f64],
+        block: &mut [f64],
         m: usize,
         scratch: &mut Scratch<D>,
         values: &mut BlockBand<'_>,
@@ -440,10 +482,10 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     ) {
         let step = self.step;
         let nd = step.dofs.nd;
-        let Scratch { transform: tr, block: eff_block, indices } = scratch;
+        let Scratch { transform: tr, block: eff_block, indices, codes, blocks } = scratch;
         let has_ext = !step.stencils.extensions(k).is_empty();
         let eff = step.stencils.effective(k);
-        let (me, kb): (usize, &[f64]) = if has_ext {
+        let (me, kb): (usize, &mut [f64]) = if has_ext {
             let me = transform(step, k, tr);
             at_least(eff_block, me * me);
             eff_block[..me * me].fill(0.0);
@@ -460,32 +502,40 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
                     }
                 }
             }
-            (me, &eff_block[..me * me])
+            (me, &mut eff_block[..me * me])
         } else {
-            (m, &block[..m * m])
+            (m, &mut block[..m * m])
         };
         let ne = me / nd;
+        // A fixed dof keeps its row (x − prescribed, unit diagonal) and takes nothing from the
+        // points: its row and column of the block are zeroed, and every value is then added as
+        // it is (adding a zero leaves a value unchanged).
+        let fixed = &step.dofs.fixed;
+        for (a, _) in (0..me).map(|a| (a, eff[a / nd] as usize * nd + a % nd)).filter(|&(_, g)| fixed[g]) {
+            kb[a * me..(a + 1) * me].fill(0.0);
+            for row in kb.chunks_exact_mut(me) {
+                row[a] = 0.0;
+            }
+        }
         let pattern = &step.pattern;
         indices.clear();
         indices.extend(eff.iter().map(|&a| pattern.indices(a)));
-        let fixed = &step.dofs.fixed;
+        let compact = pattern.codes(indices, codes);
         for p in (0..ne).filter(|&p| band.holds(eff[p])) {
-            let rp = eff[p] as usize * nd;
-            let rows = values.row_places(pattern.block_of(eff[p], indices[p], eff[0], indices[0]) as usize);
-            for q in 0..ne {
-                let cq = eff[q] as usize * nd;
-                let at = pattern.block_of(eff[p], indices[p], eff[q], indices[q]) as usize;
-                values.with_rows_at(&rows, at, |c1, out| {
-                    if fixed[rp + c1] {
-                        return;
-                    }
-                    let row = &kb[(p * nd + c1) * me + q * nd..(p * nd + c1) * me + q * nd + nd];
-                    for c2 in 0..nd {
-                        if !fixed[cq + c2] {
-                            out[c2] += row[c2];
-                        }
+            pattern.row_blocks(eff, indices, compact.then_some(&codes[..]), p, blocks);
+            let rows = values.row_places(blocks[0]);
+            // Nodes whose blocks lie side by side in the matrix's rows (a stencil's nodes along x)
+            // are added together: a row of the block is a few runs of values, not ne pieces.
+            let mut q = 0;
+            while q < ne {
+                let n = 1 + (q + 1..ne).take_while(|&r| values.follows(blocks[r - 1], blocks[r])).count();
+                values.with_rows_of_run(&rows, blocks[q], n, |c1, out| {
+                    let first = (p * nd + c1) * me + q * nd;
+                    for (o, x) in out.iter_mut().zip(&kb[first..first + n * nd]) {
+                        *o += x;
                     }
                 });
+                q += n;
             }
         }
     }
@@ -655,8 +705,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let mut out: Vec<f64> = step.fext.iter().map(|f| f.abs()).collect();
         let ps = self;
         let weight = nm.w_force.max(nm.w_inertia);
-        let block = |k: usize, buf: &mut [f64]| {
-            let m = ps.residual_of(k, &xl, buf);
+        let block = |k: usize, buf: &mut [f64], states: &mut [NodeState<N>]| {
+            let m = ps.residual_of(k, &xl, buf, states);
             for v in &mut buf[..m] {
                 *v = v.abs() * weight;
             }
@@ -680,7 +730,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let xl = vec![0.0; fext_old.len()];
         let mut out: Vec<f64> = fext_old.iter().map(|f| -scheme.w_force * f).collect();
         let ps = self;
-        let block = |k: usize, buf: &mut [f64]| {
+        let block = |k: usize, buf: &mut [f64], states: &mut [NodeState<N>]| {
             let mut input = particle_input(ps.model, step, k);
             if smooth {
                 let s = &step.smooth[k];
@@ -690,7 +740,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
             // With an implicit F̄ the point at Δd = 0, ϑ = 0 sees r = 1/J̄_n: J̄_n = 1 makes it the
             // point at rest, with the stress it carries.
             input.jbar = 1.0;
-            ps.with_point_of(k, &xl, input, |pt| {
+            ps.with_point_of(k, &xl, input, states, |pt| {
                 kernels::residual(pt, scheme, &mut buf[..pt.size()]);
                 pt.size()
             })

@@ -22,8 +22,11 @@ pub fn residual<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, o
     }
 }
 
-/// Adds w_m a₀ M_u and w_m a₀ M_U.
+/// Adds w_m a₀ M_u and w_m a₀ M_U (nothing in a stage without inertia, a₀ w_m = 0).
 pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64]) {
+    if nm.a0 * nm.w_inertia == 0.0 {
+        return;
+    }
     let (nd, m) = (pt.layout.nd, pt.size());
     for (k, bk) in pt.basis.iter().enumerate() {
         for (l, bl) in pt.basis.iter().enumerate() {

@@ -402,7 +402,8 @@ impl<const D: usize> Kinematics<D> {
     /// z, [`rotate_derivative`].)
     pub fn rotated_derivative(&self, b: &NodeBasis<D>, rotated: &Stress) -> [[f64; D]; NS] {
         let mut out = [[0.0; D]; NS];
-        if self.linear {
+        // (Zero without the step's rotation, and for operators without a gradient ∇S.)
+        if self.linear || b.g.iter().all(|&g| g == 0.0) {
             return out;
         }
         if D == 2 {

@@ -323,7 +323,7 @@ pub fn interpolate<const D: usize, const N: usize>(
 /// its per-node scratch holds, at least the stencil's ([`MAX_NODES`] in two dimensions,
 /// [`MAX_NODES_3D`] in three), so that a plane point does not carry the scratch of the largest
 /// three-dimensional stencil.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     /// The stencil's basis on x_n.
     pub basis: &'a [NodeBasis<D>],
@@ -357,7 +357,7 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     pub strain: &'a [NodeBasis<D>],
     /// `spatial` and `hoop` of the basis where they are not the force operators (see
     /// [`Point::motion_operators`]; `None`: the same, not copied).
-    motion: Option<OnNew<D, M>>,
+    motion: Option<Box<OnNew<D, M>>>,
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
@@ -376,17 +376,21 @@ pub type Gradients<const D: usize> = ([f64; D], [f64; D]);
 /// [`Point::hoop`], or their strain operators').
 type OnNew<const D: usize, const M: usize> = ([([f64; D], [f64; D]); M], [(f64, f64); M]);
 
-/// The gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each node of
-/// `nodes` ([`Point::spatial`] and [`Point::hoop`], or the strain operators').
-fn on_new_configuration<const D: usize, const M: usize>(kin: &Kinematics<D>, nodes: &[NodeBasis<D>]) -> OnNew<D, M> {
-    assert!(nodes.len() <= M, "a stencil of {} nodes in a point of {M}", nodes.len());
-    let mut spatial = [([0.0; D], [0.0; D]); M];
-    let mut hoop = [(0.0, 0.0); M];
+/// Writes the gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each
+/// node of `nodes` into the first entries of `spatial` and `hoop` ([`Point::spatial`] and
+/// [`Point::hoop`], or the strain operators'), in place: a point's arrays are of the bound M,
+/// which moving costs more than a stencil of 8 to 27 nodes.
+fn on_new_configuration<const D: usize>(
+    kin: &Kinematics<D>,
+    nodes: &[NodeBasis<D>],
+    spatial: &mut [Gradients<D>],
+    hoop: &mut [(f64, f64)],
+) {
+    assert!(nodes.len() <= spatial.len(), "a stencil of {} nodes in a point of {}", nodes.len(), spatial.len());
     for ((s, t), b) in spatial.iter_mut().zip(hoop.iter_mut()).zip(nodes) {
         *s = kin.spatial(b);
         *t = kin.hoop(b);
     }
-    (spatial, hoop)
 }
 
 /// Largest number of drained faces of one particle (all sides of its domain: four in two
@@ -504,8 +508,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         (rotated, upd): (Stress, StressUpdate),
         jbar_nodes: [f64; M],
     ) -> Point<'a, D, M> {
-        let (spatial, hoop) = on_new_configuration(&kin, basis);
-        Point {
+        let mut pt = Point {
             basis,
             part,
             layout,
@@ -514,15 +517,17 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             recovered_kin,
             rotated,
             upd,
-            spatial,
-            hoop,
+            spatial: [([0.0; D], [0.0; D]); M],
+            hoop: [(0.0, 0.0); M],
             strain,
             motion: None,
             p: part.p + interp.dp,
             faces: &[],
             face_dp: [0.0; MAX_FACES],
             jbar_nodes,
-        }
+        };
+        on_new_configuration(&pt.kin, basis, &mut pt.spatial, &mut pt.hoop);
+        pt
     }
 
     /// The point with its drained `faces` (at most [`MAX_FACES`]), their pressure increments
@@ -568,9 +573,9 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         debug_assert_eq!(forces.len(), self.basis.len(), "force operators for another stencil");
         if self.motion.is_none() {
             // The basis's operators on x_{n+1}, held in `spatial` and `hoop` until now.
-            self.motion = Some((self.spatial, self.hoop));
+            self.motion = Some(Box::new((self.spatial, self.hoop)));
         }
-        (self.spatial, self.hoop) = on_new_configuration(&self.kin, forces);
+        on_new_configuration(&self.kin, forces, &mut self.spatial, &mut self.hoop);
     }
 
     /// The gradients ∇'S, ∇̄'S and hoop operators T', T̄' on x_{n+1} of the basis, per node: the
@@ -581,7 +586,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     #[inline]
     pub fn motion_operators(&self) -> (&[Gradients<D>], &[(f64, f64)]) {
         match &self.motion {
-            Some((s, h)) => (s, h),
+            Some(m) => (&m.0, &m.1),
             None => (&self.spatial, &self.hoop),
         }
     }
@@ -666,6 +671,11 @@ pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, ou
 pub fn tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
     let m = pt.size();
     out[..m * m].fill(0.0);
+    add_tangent_with(pt, nm, out, material);
+}
+
+/// Adds [`tangent_with`]'s block to `out` (the blocks of points with one stencil summed in place).
+pub fn add_tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
     inertia::tangent(pt, nm, out);
     stress::tangent_with(pt, nm, out, material);
     stress::pore_pressure::tangent(pt, nm, out);

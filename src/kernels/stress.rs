@@ -231,10 +231,26 @@ fn pairs_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<
     }
 }
 
+/// Column c of a three-dimensional node's B̄ ([`bbar`]) with gradients (g, gv): the volumetric
+/// correction ⅓(gv_c − g_c), which every normal row (xx, yy, zz) holds, and the three other
+/// entries as (strain row, value): g_c on c's own normal row and the gradients on the two shear
+/// rows that hold c. The rest of the column is zero.
+#[inline]
+fn bbar_column<const D: usize>(g: [f64; D], gv: [f64; D], c: usize) -> (f64, [(usize, f64); 3]) {
+    debug_assert_eq!(D, 3, "a three-dimensional node's B̄");
+    // The normal row of each component, and each component's shear rows with the gradient
+    // component they take (bbar's rows [xx, yy, γxy, zz, γyz, γzx]).
+    const NORMAL: [usize; 3] = [0, 1, 3];
+    const SHEAR: [[(usize, usize); 2]; 3] = [[(2, 1), (5, 2)], [(2, 0), (4, 2)], [(4, 1), (5, 0)]];
+    let [(r1, d1), (r2, d2)] = SHEAR[c];
+    ((gv[c] - g[c]) / 3.0, [(NORMAL[c], g[c]), (r1, g[d1]), (r2, g[d2])])
+}
+
 /// The material, volume and geometric parts of [`tangent_in`]'s block, row by row: each row of
 /// the block is one pass over the columns of the nodes whose operators are not all zero. For
 /// three-dimensional points, which have no hoop terms (the axisymmetric ones take
-/// [`pairs_of_nodes`]).
+/// [`pairs_of_nodes`]). B̄'s structure ([`bbar_column`]) makes the material part of a row
+/// corr_c Σ_normal A_r + three rows of A instead of six.
 fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'_, D, M>, out: &mut [f64]) {
     let Block { pt, v, material, nd, m } = *block;
     let s = &pt.upd.stress;
@@ -255,68 +271,110 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
         }
     }
     let act = &act[..na];
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) of every such node, through the strain's kinematics,
-    // stored by row: `a[r]` holds row r of their A_l side by side, flat over the block's columns
+    let n = na * D;
+    // The scratch, as long as the columns of the nodes of `act` (not of the bound M: zeroing
+    // arrays of 125 nodes cost more than a GIMP point's 8 to 27), flat over the block's columns
     // j = i D + d of the i-th node of `act`, so that a row of the block is one pass over j.
+    let mut scratch = vec![0.0; (R + 2 * D + 5) * n];
+    let (a, rest) = scratch.split_at_mut(R * n);
+    let (a_normal, rest) = rest.split_at_mut(n);
+    let (djv, rest) = rest.split_at_mut(n);
+    let (dev_g, rest) = rest.split_at_mut(D * n);
+    let (pm_gv, rest) = rest.split_at_mut(D * n);
+    let (g_k, rest) = rest.split_at_mut(n);
+    let (gv_k, row_values) = rest.split_at_mut(n);
+    // A_l = ∂σ'/∂Δu_l (strain rows × D) of every such node, through the strain's kinematics,
+    // stored by row: row r of every A_l side by side from a[r n]; and the sum of the normal rows,
+    // which B̄'s volumetric correction multiplies. A_l is linear in node l's strain operators
+    // (∇S_l, ∇̄S_l; no hoop operators in three dimensions): the responses to unit gradients,
+    // formed once for the point, combine into every node's.
     let response = StressResponse::<R>::of(pt, material);
-    let mut a = [[[0.0; D]; M]; R];
+    let unit = |m: usize, volumetric: bool| {
+        let mut b = super::NodeBasis::<D>::default();
+        if volumetric {
+            b.gv[m] = 1.0;
+        } else {
+            b.g[m] = 1.0;
+        }
+        response.to(pt, sk, &b)
+    };
+    let per_g: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, false));
+    let per_gv: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, true));
     for (i, &l) in act.iter().enumerate() {
-        for (ar, row) in a.iter_mut().zip(response.to(pt, sk, &pt.strain[l])) {
-            ar[i] = row;
+        let bl = &pt.strain[l];
+        debug_assert!(bl.t == 0.0 && bl.tv == 0.0, "hoop operators at a three-dimensional point");
+        let mut al = [[0.0; D]; R];
+        for m in 0..D {
+            let (g, gv) = (bl.g[m], bl.gv[m]);
+            for r in 0..R {
+                for d in 0..D {
+                    al[r][d] += g * per_g[m][r][d] + gv * per_gv[m][r][d];
+                }
+            }
+        }
+        for (r, row) in al.iter().enumerate() {
+            a[r * n + i * D..r * n + i * D + D].copy_from_slice(row);
+        }
+        for d in 0..D {
+            a_normal[i * D + d] = al[0][d] + al[1][d] + al[3][d];
         }
     }
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
-    // The motion's derivatives with respect to Δu_l go through node l's basis, flat over j like
-    // `a`: ∂J_v/∂Δu_l / J_v (the divergence and, radially, the hoop term), and for each force
-    // component c the geometric part's (dev σ' ∇'S_l)_c and σ'_m (∇̄'S_l)_c.
-    let mut djv = [[0.0; D]; M];
-    let mut dev_g = [[[0.0; D]; M]; D];
-    let mut pm_gv = [[[0.0; D]; M]; D];
+    // The motion's derivatives with respect to Δu_l go through node l's basis: ∂J_v/∂Δu_l / J_v,
+    // and for each force component c the geometric part's V (dev σ' ∇'S_l)_c and
+    // V σ'_m (∇̄'S_l)_c (from dev_g[c n] and pm_gv[c n]).
     if !linear {
         for (i, &l) in act.iter().enumerate() {
             let (gl, gvl) = motion_spatial[l];
-            djv[i] = gvl;
-            djv[i][0] += motion_hoop[l].1;
+            djv[i * D..i * D + D].copy_from_slice(&gvl);
             let dev_gl = dev_times(&dev, gl);
             for c in 0..D {
-                dev_g[c][i] = [dev_gl[c]; D];
-                pm_gv[c][i] = [pm * gvl[c]; D];
+                dev_g[c * n + i * D..c * n + i * D + D].fill(v * dev_gl[c]);
+                pm_gv[c * n + i * D..c * n + i * D + D].fill(v * pm * gvl[c]);
             }
         }
     }
-    let n = na * D;
-    let a_rows: [&[f64]; R] = std::array::from_fn(|r| &a[r].as_flattened()[..n]);
-    let djv = &djv.as_flattened()[..n];
-    // Node k's gradients repeated for every node of `act`, flat over j.
-    let (mut g_k, mut gv_k) = ([[0.0; D]; M], [[0.0; D]; M]);
-    let mut row_values = [[0.0; D]; M];
+    let a_rows: [&[f64]; R] = std::array::from_fn(|r| &a[r * n..(r + 1) * n]);
+    let (a_normal, djv) = (&*a_normal, &*djv);
+    // The columns of `act` are the block's own (in order, of D dofs each): a row is added to the
+    // block as it is formed.
+    let direct = na == nb && nd == D;
     for &k in act {
         let (gk, gvk) = pt.spatial[k];
-        let hk = pt.hoop[k];
-        let bk = bbar(gk, gvk, hk);
-        let mut tk = traction(&dev, pm, gk, gvk);
-        tk[0] += hoop_force(s, pm, hk);
-        g_k[..na].fill(gk);
-        gv_k[..na].fill(gvk);
-        let (g_k, gv_k) = (&g_k.as_flattened()[..n], &gv_k.as_flattened()[..n]);
+        let tk = traction(&dev, pm, gk, gvk);
+        // Node k's gradients repeated for every node of `act`.
+        for i in 0..na {
+            g_k[i * D..i * D + D].copy_from_slice(&gk);
+            gv_k[i * D..i * D + D].copy_from_slice(&gvk);
+        }
+        let (g_k, gv_k) = (&*g_k, &*gv_k);
         for c in 0..D {
-            let coef: [f64; R] = std::array::from_fn(|r| v * bk[r][c]);
-            let row = &mut row_values.as_flattened_mut()[..n];
-            for (j, out) in row.iter_mut().enumerate() {
-                *out = (0..R).map(|r| coef[r] * a_rows[r][j]).sum::<f64>();
+            let (corr, terms) = bbar_column(gk, gvk, c);
+            let (cv, [(r0, c0), (r1, c1), (r2, c2)]) = (v * corr, terms.map(|(r, x)| (r, v * x)));
+            let (a0, a1, a2) = (a_rows[r0], a_rows[r1], a_rows[r2]);
+            let first = (k * nd + c) * m;
+            let row = if direct { &mut out[first..first + n] } else { &mut row_values[..] };
+            if !direct {
+                row.fill(0.0);
             }
-            if !linear {
-                let (dev_gc, pm_gvc) = (&dev_g[c].as_flattened()[..n], &pm_gv[c].as_flattened()[..n]);
+            if linear {
+                for j in 0..n {
+                    row[j] += cv * a_normal[j] + c0 * a0[j] + c1 * a1[j] + c2 * a2[j];
+                }
+            } else {
+                let (dev_gc, pm_gvc) = (&dev_g[c * n..(c + 1) * n], &pm_gv[c * n..(c + 1) * n]);
                 let vt = v * tk[c];
                 for j in 0..n {
-                    row[j] += vt * djv[j] - v * (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
+                    row[j] += cv * a_normal[j] + c0 * a0[j] + c1 * a1[j] + c2 * a2[j] + vt * djv[j]
+                        - (dev_gc[j] * g_k[j] + pm_gvc[j] * gv_k[j]);
                 }
             }
-            let first = (k * nd + c) * m;
-            for (&l, values) in act.iter().zip(&row_values[..na]) {
-                for (o, x) in out[first + l * nd..first + l * nd + D].iter_mut().zip(values) {
-                    *o += x;
+            if !direct {
+                for (&l, values) in act.iter().zip(row_values.chunks_exact(D)) {
+                    for (o, x) in out[first + l * nd..first + l * nd + D].iter_mut().zip(values) {
+                        *o += x;
+                    }
                 }
             }
         }

@@ -382,6 +382,33 @@ impl BlockBand<'_> {
         }
     }
 
+    /// Whether block `b` lies right after block `a` in every row of their block row (the next
+    /// `bs` columns of the same part of the matrix; never for rows another rank owns), so that
+    /// [`BlockBand::with_rows_of_run`] can take them together.
+    #[inline]
+    pub fn follows(&self, a: usize, b: usize) -> bool {
+        let (row, at) = (&self.places.row, &self.places.at);
+        row[a] == row[b] && row[a] != REMOTE && at[b] == at[a] + self.places.bs as u32
+    }
+
+    /// Calls `row(i, values)` with each row `i` of the `n` blocks from block `k` (their `n bs`
+    /// values side by side), blocks of the band's block row whose places are `rows`, each after the
+    /// one before it ([`BlockBand::follows`]; any single block is a run of one).
+    #[inline]
+    pub fn with_rows_of_run(&mut self, rows: &RowPlaces, k: usize, n: usize, mut row: impl FnMut(usize, &mut [Real])) {
+        if n == 1 || rows.remote {
+            debug_assert!(n == 1, "a run of {n} blocks in rows another rank owns");
+            return self.with_rows_at(rows, k, row);
+        }
+        let places = self.places;
+        let (bs, at) = (places.bs, places.at[k]);
+        let (starts, values) = if at & OFF == 0 { (&rows.diag, &mut *self.diag) } else { (&rows.off, &mut *self.off) };
+        let at = (at & !OFF) as usize;
+        for (i, &start) in starts[..bs].iter().enumerate() {
+            row(i, &mut values[start + at..start + at + n * bs]);
+        }
+    }
+
     /// Row `i` of block `k`, one of the band's blocks (its `bs` values).
     pub fn row_mut(&mut self, k: usize, i: usize) -> &mut [Real] {
         debug_assert!(self.blocks.contains(&k), "block {k} is outside its band {:?}", self.blocks);
