@@ -255,7 +255,6 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
     let Block { pt, v, material, nd, m } = *block;
     let s = &pt.upd.stress;
     let (dev, pm) = split::<D>(s);
-    let sk = pt.strain_kin();
     let nb = pt.basis.len();
     let (motion_spatial, motion_hoop) = pt.motion_operators();
     // The nodes whose operators are not all zero: a node the particle's domain only touches has
@@ -283,42 +282,7 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
     let (pm_gv, rest) = rest.split_at_mut(D * n);
     let (g_k, rest) = rest.split_at_mut(n);
     let (gv_k, row_values) = rest.split_at_mut(n);
-    // A_l = ∂σ'/∂Δu_l (strain rows × D) of every such node, through the strain's kinematics,
-    // stored by row: row r of every A_l side by side from a[r n]; and the sum of the normal rows,
-    // which B̄'s volumetric correction multiplies. A_l is linear in node l's strain operators
-    // (∇S_l, ∇̄S_l; no hoop operators in three dimensions): the responses to unit gradients,
-    // formed once for the point, combine into every node's.
-    let response = StressResponse::<R>::of(pt, material);
-    let unit = |m: usize, volumetric: bool| {
-        let mut b = super::NodeBasis::<D>::default();
-        if volumetric {
-            b.gv[m] = 1.0;
-        } else {
-            b.g[m] = 1.0;
-        }
-        response.to(pt, sk, &b)
-    };
-    let per_g: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, false));
-    let per_gv: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, true));
-    for (i, &l) in act.iter().enumerate() {
-        let bl = &pt.strain[l];
-        debug_assert!(bl.t == 0.0 && bl.tv == 0.0, "hoop operators at a three-dimensional point");
-        let mut al = [[0.0; D]; R];
-        for m in 0..D {
-            let (g, gv) = (bl.g[m], bl.gv[m]);
-            for r in 0..R {
-                for d in 0..D {
-                    al[r][d] += g * per_g[m][r][d] + gv * per_gv[m][r][d];
-                }
-            }
-        }
-        for (r, row) in al.iter().enumerate() {
-            a[r * n + i * D..r * n + i * D + D].copy_from_slice(row);
-        }
-        for d in 0..D {
-            a_normal[i * D + d] = al[0][d] + al[1][d] + al[3][d];
-        }
-    }
+    stress_columns::<D, M, R>(pt, material, act, a, a_normal);
     // A geometrically linear step has forces on x_n with V_n: no volume or geometric part.
     let linear = pt.kin.linear;
     // The motion's derivatives with respect to Δu_l go through node l's basis: ∂J_v/∂Δu_l / J_v,
@@ -377,6 +341,53 @@ fn rows_of_nodes<const D: usize, const M: usize, const R: usize>(block: &Block<'
                     }
                 }
             }
+        }
+    }
+}
+
+/// The stress response's columns of [`rows_of_nodes`]: A_l = ∂σ'/∂Δu_l (strain rows × D) of every
+/// node l of `act`, through the strain's kinematics, stored by row (row r of every A_l side by
+/// side from a[r n], n = D × the nodes of `act`), and the sum of its normal rows, which B̄'s
+/// volumetric correction multiplies, into `a_normal`. A_l is linear in node l's strain operators
+/// (∇S_l, ∇̄S_l; no hoop operators in three dimensions): the responses to unit gradients, formed
+/// once for the point, combine into every node's.
+fn stress_columns<const D: usize, const M: usize, const R: usize>(
+    pt: &Point<D, M>,
+    material: f64,
+    act: &[usize],
+    a: &mut [f64],
+    a_normal: &mut [f64],
+) {
+    let (n, sk) = (act.len() * D, pt.strain_kin());
+    let response = StressResponse::<R>::of(pt, material);
+    let unit = |m: usize, volumetric: bool| {
+        let mut b = super::NodeBasis::<D>::default();
+        if volumetric {
+            b.gv[m] = 1.0;
+        } else {
+            b.g[m] = 1.0;
+        }
+        response.to(pt, sk, &b)
+    };
+    let per_g: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, false));
+    let per_gv: [[[f64; D]; R]; D] = std::array::from_fn(|m| unit(m, true));
+    for (i, &l) in act.iter().enumerate() {
+        let bl = &pt.strain[l];
+        debug_assert!(bl.t == 0.0 && bl.tv == 0.0, "hoop operators at a three-dimensional point");
+        let mut al = [[0.0; D]; R];
+        for m in 0..D {
+            let (g, gv) = (bl.g[m], bl.gv[m]);
+            for r in 0..R {
+                for d in 0..D {
+                    al[r][d] += g * per_g[m][r][d] + gv * per_gv[m][r][d];
+                }
+            }
+        }
+        for (r, row) in al.iter().enumerate() {
+            a[r * n + i * D..r * n + i * D + D].copy_from_slice(row);
+        }
+        for d in 0..D {
+            a_normal[i * D + d] = al[0][d] + al[1][d] + al[3][d];
         }
     }
 }
