@@ -4,7 +4,7 @@
 //! callbacks ([`super::callbacks`]) and the step's preparation, balance and explicit update call it.
 
 use super::stencils::Stencils;
-use super::step::{Band, Runs, Solution, Step};
+use super::step::{Band, Solution, Step};
 use crate::kernels::{self, NodeState, StepResult};
 use crate::model::Model;
 use crate::scheme::Scheme;
@@ -164,26 +164,6 @@ pub(super) fn bands<const D: usize>(st: &Stencils<D>, counts: [usize; D], n: usi
     out.push(Band { lo, hi: total });
     out.retain(|b| b.hi > b.lo);
     out
-}
-
-/// The points of `st` in runs of one stencil ([`Runs`]): the points without extensions sorted by
-/// their effective nodes, those with the same nodes in one run in increasing order, and every
-/// point with extensions a run of its own. The runs depend on the points only, not on the bands,
-/// so that every matrix entry is the same sum for any number of threads.
-pub(super) fn runs<const D: usize>(st: &Stencils<D>) -> Runs {
-    let alone = |k: usize| !st.extensions(k).is_empty();
-    let mut order: Vec<u32> = (0..st.len() as u32).collect();
-    // (With extensions, ordered by the point itself and never equal to another.)
-    let key = |k: u32| (alone(k as usize), if alone(k as usize) { &[][..] } else { st.effective(k as usize) });
-    order.sort_by(|&a, &b| key(a).cmp(&key(b)).then(a.cmp(&b)));
-    let mut starts = Vec::new();
-    for (i, &k) in order.iter().enumerate() {
-        if i == 0 || alone(k as usize) || key(k) != key(order[i - 1]) {
-            starts.push(i as u32);
-        }
-    }
-    starts.push(order.len() as u32);
-    Runs { order, starts }
 }
 
 /// Runs `work` on every band on its own thread (the first on this one), each with its part of
@@ -433,44 +413,37 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
             blocks: Vec::with_capacity(M + EXTRA_MASTERS),
         };
         let mut states = vec![NodeState::<N>::default(); M];
-        // The blocks of a run's points (one stencil) are summed here in increasing point order,
-        // and the sum reaches the matrix once.
-        for run in step.runs.iter().filter(|run| self.touches(run[0] as usize, band)) {
-            let m = step.stencils.get(run[0] as usize).0.len() * layout.nd;
+        for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
+            let (nodes, basis) = step.stencils.get(k);
+            let input = particle_input(self.model, step, k);
+            let mat = &self.model.materials[self.model.particles.material[k] as usize];
+            node_states_into::<D, M, N>(step, k, xl, &mut states);
+            let strain = step.stencils.strain_of(k);
+            let mut pt = kernels::Point::<D, M>::with_recovery(
+                basis,
+                strain,
+                &states[..nodes.len()],
+                &input,
+                &mat.model,
+                layout,
+            );
+            pt.set_forces(step.stencils.forces_of(k));
+            pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
+            let m = pt.size();
             at_least(&mut block, m * m);
-            block[..m * m].fill(0.0);
-            for k in run.iter().map(|&k| k as usize) {
-                let (nodes, basis) = step.stencils.get(k);
-                let input = particle_input(self.model, step, k);
-                let mat = &self.model.materials[self.model.particles.material[k] as usize];
-                node_states_into::<D, M, N>(step, k, xl, &mut states);
-                let strain = step.stencils.strain_of(k);
-                let mut pt = kernels::Point::<D, M>::with_recovery(
-                    basis,
-                    strain,
-                    &states[..nodes.len()],
-                    &input,
-                    &mat.model,
-                    layout,
-                );
-                pt.set_forces(step.stencils.forces_of(k));
-                pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
-                debug_assert_eq!(pt.size(), m, "a run of one stencil");
-                if self.model.stiffness_in_jacobian {
-                    kernels::add_tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
-                    step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
-                } else {
-                    // The mapped stiffness serves the diagnostics only: the exact tangent.
-                    kernels::add_tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
-                }
+            if self.model.stiffness_in_jacobian {
+                kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
+                step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
+            } else {
+                // The mapped stiffness serves the diagnostics only: the exact tangent.
+                kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
             }
-            self.add_tangent(run[0] as usize, &mut block[..m * m], m, &mut scratch, values, band);
+            self.add_tangent(k, &mut block[..m * m], m, &mut scratch, values, band);
         }
     }
 
-    /// Adds the rows of `band` of the tangent block of a run of points whose first is `k` (one
-    /// stencil: `k`'s; overwritten: its rows and columns of fixed dofs are zeroed) to the band's
-    /// part `values` of the matrix.
+    /// Adds the rows of `band` of particle `k`'s tangent block (overwritten: its rows and columns
+    /// of fixed dofs are zeroed) to the band's part `values` of the matrix.
     fn add_tangent(
         &self,
         k: usize,

@@ -21,7 +21,7 @@
 use super::dim::StepDim;
 use super::dofs::{self, DofMap};
 use super::pattern::Pattern;
-use super::points::{bands, runs, Points};
+use super::points::{bands, Points};
 use super::pressure;
 use super::space::NodeSpace;
 use super::splits::SchurNeeds;
@@ -167,7 +167,6 @@ impl<const D: usize, const M: usize> Step<D, M> {
     ) -> Result<Step<D, M>, String> {
         let layout = space.layout;
         let bands = bands(&st, space.ghost.count, coll.threads_for(st.len()));
-        let runs = runs(&st);
         let (smooth, grad_n) = predictors(layout, model, &st, &dofs, nodal);
         let projection = pressure::projection_cells(space, model);
         let (fext, applied) = coll.agree(loads::external_forces::<D, M>(space, model, active, t_new, &dofs))?;
@@ -190,7 +189,6 @@ impl<const D: usize, const M: usize> Step<D, M> {
             projection,
             pattern: Arc::default(),
             bands,
-            runs,
             projection_blocks: Vec::new(),
             fixed_diagonals: Vec::new(),
             p_scale: pressure::scale(model),

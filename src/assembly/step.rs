@@ -44,9 +44,6 @@ pub struct Step<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     pub(super) pattern: Arc<Pattern<D>>,
     /// The bands of node rows the threads assemble.
     pub(super) bands: Vec<Band>,
-    /// The points in the order their tangent blocks are summed, in runs of one stencil
-    /// ([`super::points::runs`]).
-    pub(super) runs: Runs,
     /// The pattern block of every corner pair (a, b) of each pressure-projection cell, C a + b for
     /// its C corners.
     pub(super) projection_blocks: Vec<Vec<u32>>,
@@ -125,23 +122,6 @@ pub(super) struct ProjectionCell {
     pub s: Vec<f64>,
 }
 
-/// The points in runs that share their effective nodes and have no extensions (a point with
-/// extensions is a run alone): `order` lists them run by run, each in increasing order, and run r
-/// is `order[starts[r]..starts[r + 1]]`. A run's tangent blocks are summed in one dense block
-/// before it reaches the matrix.
-#[derive(Debug, Default)]
-pub(super) struct Runs {
-    pub order: Vec<u32>,
-    pub starts: Vec<u32>,
-}
-
-impl Runs {
-    /// The points of each run.
-    pub fn iter(&self) -> impl Iterator<Item = &[u32]> {
-        self.starts.windows(2).map(|w| &self.order[w[0] as usize..w[1] as usize])
-    }
-}
-
 /// A range `lo..hi` of ghosted nodes (whole layers of the ghosted grid along its last direction:
 /// rows in two dimensions, planes of constant z in three; so one range of the ghosted numbering)
 /// whose rows of the residual and of the matrix one thread assembles (see [`super::points`]).
@@ -181,8 +161,6 @@ impl<const D: usize, const M: usize> Step<D, M> {
             + faces
             + self.dofs.heap_bytes()
             + c(&self.bands)
-            + c(&self.runs.order)
-            + c(&self.runs.starts)
             + c(&self.fixed_diagonals)
             + self.stiffness.heap_bytes();
         (self.stencils.heap_bytes(), rest)

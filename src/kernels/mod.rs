@@ -671,11 +671,6 @@ pub fn tangent<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, ou
 pub fn tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
     let m = pt.size();
     out[..m * m].fill(0.0);
-    add_tangent_with(pt, nm, out, material);
-}
-
-/// Adds [`tangent_with`]'s block to `out` (the blocks of points with one stencil summed in place).
-pub fn add_tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Scheme, out: &mut [f64], material: f64) {
     inertia::tangent(pt, nm, out);
     stress::tangent_with(pt, nm, out, material);
     stress::pore_pressure::tangent(pt, nm, out);
