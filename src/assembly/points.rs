@@ -484,7 +484,7 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         // points: its row and column of the block are zeroed, and every value is then added as
         // it is (adding a zero leaves a value unchanged).
         let fixed = &step.dofs.fixed;
-        for (a, _) in (0..me).map(|a| (a, eff[a / nd] as usize * nd + a % nd)).filter(|&(_, g)| fixed[g]) {
+        for a in (0..me).filter(|&a| fixed[eff[a / nd] as usize * nd + a % nd]) {
             kb[a * me..(a + 1) * me].fill(0.0);
             for row in kb.chunks_exact_mut(me) {
                 row[a] = 0.0;

@@ -348,7 +348,7 @@ pub struct BlockBand<'a> {
 
 impl BlockBand<'_> {
     /// The places of the rows of block `k`'s block row, one of the band's, which every block of
-    /// that row shares ([`BlockBand::with_rows_at`]).
+    /// that row shares ([`BlockBand::with_rows_of_run`]).
     pub fn row_places(&self, k: usize) -> RowPlaces {
         let places = self.places;
         let (bs, r) = (places.bs, places.row[k]);
@@ -362,26 +362,6 @@ impl BlockBand<'_> {
         out
     }
 
-    /// Calls `row(i, values)` with each row `i` of block `k` (its `bs` values), a block of the
-    /// band's block row whose places are `rows`.
-    pub fn with_rows_at(&mut self, rows: &RowPlaces, k: usize, mut row: impl FnMut(usize, &mut [Real])) {
-        debug_assert!(self.blocks.contains(&k), "block {k} is outside its band {:?}", self.blocks);
-        let places = self.places;
-        let (bs, at) = (places.bs, places.at[k]);
-        if rows.remote {
-            let first = at as usize * bs * bs - self.remote0;
-            for (i, v) in self.remote[first..first + bs * bs].chunks_exact_mut(bs).enumerate() {
-                row(i, v);
-            }
-            return;
-        }
-        let (starts, values) = if at & OFF == 0 { (&rows.diag, &mut *self.diag) } else { (&rows.off, &mut *self.off) };
-        let at = (at & !OFF) as usize;
-        for (i, &start) in starts[..bs].iter().enumerate() {
-            row(i, &mut values[start + at..start + at + bs]);
-        }
-    }
-
     /// Whether block `b` lies right after block `a` in every row of their block row (the next
     /// `bs` columns of the same part of the matrix; never for rows another rank owns), so that
     /// [`BlockBand::with_rows_of_run`] can take them together.
@@ -393,15 +373,21 @@ impl BlockBand<'_> {
 
     /// Calls `row(i, values)` with each row `i` of the `n` blocks from block `k` (their `n bs`
     /// values side by side), blocks of the band's block row whose places are `rows`, each after the
-    /// one before it ([`BlockBand::follows`]; any single block is a run of one).
+    /// one before it ([`BlockBand::follows`]; any single block is a run of one, and the only run in
+    /// rows another rank owns).
     #[inline]
     pub fn with_rows_of_run(&mut self, rows: &RowPlaces, k: usize, n: usize, mut row: impl FnMut(usize, &mut [Real])) {
-        if n == 1 || rows.remote {
-            debug_assert!(n == 1, "a run of {n} blocks in rows another rank owns");
-            return self.with_rows_at(rows, k, row);
-        }
+        debug_assert!(self.blocks.contains(&k), "block {k} is outside its band {:?}", self.blocks);
         let places = self.places;
         let (bs, at) = (places.bs, places.at[k]);
+        if rows.remote {
+            debug_assert!(n == 1, "a run of {n} blocks in rows another rank owns");
+            let first = at as usize * bs * bs - self.remote0;
+            for (i, v) in self.remote[first..first + bs * bs].chunks_exact_mut(bs).enumerate() {
+                row(i, v);
+            }
+            return;
+        }
         let (starts, values) = if at & OFF == 0 { (&rows.diag, &mut *self.diag) } else { (&rows.off, &mut *self.off) };
         let at = (at & !OFF) as usize;
         for (i, &start) in starts[..bs].iter().enumerate() {
