@@ -32,6 +32,11 @@ pub struct Timings {
     pub step_setup_s: f64,
     /// Residual and Jacobian assembly (inside the Newton solves).
     pub assembly_s: f64,
+    /// The Jacobians' part of `assembly_s`: the tangent assemblies (rank 0), `jacobians` of them.
+    pub jacobian_s: f64,
+    /// The Jacobians assembled (the tangent matrices, one per Newton iteration unless PETSc is
+    /// told to lag them).
+    pub jacobians: usize,
     /// Linear solves and the rest of SNES (Newton solve time minus assembly).
     pub linear_solve_s: f64,
     /// Particle updates.

@@ -13,6 +13,27 @@ fn fatal(e: petsc::Error) -> CallbackError {
     CallbackError::Fatal(e.to_string())
 }
 
+/// The wall time of a solve's residual and Jacobian callbacks [s], and of its Jacobians alone with
+/// their number (the cost of one tangent assembly is `jacobian_seconds / jacobians`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AssemblyTime {
+    /// Residuals and Jacobians [s].
+    pub seconds: f64,
+    /// The Jacobians [s].
+    pub jacobian_seconds: f64,
+    /// The Jacobians evaluated.
+    pub jacobians: usize,
+}
+
+impl AssemblyTime {
+    /// Adds another solve's times.
+    pub fn add(&mut self, other: AssemblyTime) {
+        self.seconds += other.seconds;
+        self.jacobian_seconds += other.jacobian_seconds;
+        self.jacobians += other.jacobians;
+    }
+}
+
 /// The callbacks of one step's Newton solve (points of dimension D with at most M nodes of at
 /// most N dofs).
 pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> {
@@ -21,8 +42,8 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
     dm: &'a DmDa<D>,
     x_local: &'a mut Vector,
     f_local: &'a mut Vector,
-    /// Wall time spent in the callbacks [s].
-    pub(super) seconds: f64,
+    /// Wall time spent in the callbacks, and in the Jacobians alone with their number.
+    pub(super) time: AssemblyTime,
     stage: &'a LogStage,
     /// The fixed-stress Schur preconditioner, refilled after every Jacobian.
     schur: Option<&'a mut petsc::SchurUser>,
@@ -55,7 +76,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> 
             dm,
             x_local,
             f_local,
-            seconds: 0.0,
+            time: AssemblyTime::default(),
             stage,
             schur,
             places,
@@ -96,7 +117,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         }
         let ps = self.points;
         let nd = self.step.dofs.nd;
-        let block = |k: usize, buf: &mut [f64], states: &mut [_]| ps.residual_of(k, &xl, buf, states);
+        let block = |k: usize, buf: &mut [f64], scratch: &mut _| ps.residual_of(k, &xl, buf, scratch);
         let bad =
             run_bands(&self.step.bands, &mut fl, |a| a as usize * nd, |band, f| ps.residual_band(band, f, &block));
         if let Some(k) = bad.into_iter().flatten().min() {
@@ -118,7 +139,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                 fo[o] = xo[o] - self.step.dofs.value[q] / self.step.unit(q);
             }
         }
-        self.seconds += t0.elapsed().as_secs_f64();
+        self.time.seconds += t0.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -166,7 +187,10 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                 schur.update(j, &step.fixed_stress).map_err(fatal)?;
             }
         }
-        self.seconds += t0.elapsed().as_secs_f64();
+        let seconds = t0.elapsed().as_secs_f64();
+        self.time.seconds += seconds;
+        self.time.jacobian_seconds += seconds;
+        self.time.jacobians += 1;
         Ok(())
     }
 }

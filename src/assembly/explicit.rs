@@ -156,7 +156,7 @@ pub(super) fn update<const D: usize, const M: usize, const N: usize>(
         residual_history: Vec::new(),
         domain_error: None,
         nonfinite: None,
-        assembly_seconds: seconds,
+        assembly: super::callbacks::AssemblyTime { seconds, ..Default::default() },
         solve_seconds: seconds,
         field_residuals: Vec::new(),
         field_scales: step.field_scales.clone(),

@@ -3,7 +3,7 @@
 //! step (the matrix's pattern, the last increment as the next step's predictor). A step is a value
 //! ([`Step`]) that the system prepares and solves; the system keeps no step of its own.
 
-use super::callbacks::{Callbacks, Workspace};
+use super::callbacks::{AssemblyTime, Callbacks, Workspace};
 use super::dim::StepDim;
 use super::matrix::Matrix;
 use super::prepare::StepRequest;
@@ -69,8 +69,8 @@ pub struct StepSolve {
     /// The first material point (on this rank) whose residual was not finite during the solve,
     /// with the quantity that was not.
     pub nonfinite: Option<String>,
-    /// Wall time spent in the residual and Jacobian callbacks [s].
-    pub assembly_seconds: f64,
+    /// Wall time spent in the residual and Jacobian callbacks, and the Jacobians' share of it.
+    pub assembly: AssemblyTime,
     /// Wall time of the whole SNES solve [s].
     pub solve_seconds: f64,
     /// The norm of the final Newton residual of each field (`Layout::fields`), in PETSc's scaling.
@@ -297,7 +297,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.snes.set_tolerances(Some(atol), None, None, None)?;
         let t0 = Instant::now();
         self.initial_guess(step, model)?;
-        let (mut out, mut nonfinite, mut assembly_seconds) = self.newton(step, model)?;
+        let (mut out, mut nonfinite, mut assembly) = self.newton(step, model)?;
         let mut line_search_retry = false;
         if !out.converged
             && super::DIVERGED_BY_FULL_STEPS.contains(&out.reason_text.as_str())
@@ -310,8 +310,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             self.snes.set_line_search(LINE_SEARCH_RETRY)?;
             let retry = self.newton(step, model);
             self.snes.set_line_search("basic")?;
-            let (second, second_nonfinite, seconds) = retry?;
-            assembly_seconds += seconds;
+            let (second, second_nonfinite, time) = retry?;
+            assembly.add(time);
             // A point that was not finite in the first try names the failure only if the second
             // fails too.
             nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
@@ -322,8 +322,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             let icntl14 = self.enlarge_mumps_workspace(before.icntl14)?;
             workspace_retry = Some(format!("{}; factorised again with ICNTL(14) = {icntl14}", before.cause()));
             self.initial_guess(step, model)?;
-            let (second, second_nonfinite, seconds) = self.newton(step, model)?;
-            assembly_seconds += seconds;
+            let (second, second_nonfinite, time) = self.newton(step, model)?;
+            assembly.add(time);
             nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
             out = SolveOutcome {
                 iterations: out.iterations + second.iterations,
@@ -364,7 +364,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             residual_history: out.residual_history,
             domain_error: out.domain_error,
             nonfinite,
-            assembly_seconds,
+            assembly,
             solve_seconds,
             field_residuals,
             field_scales: step.field_scales.clone(),
@@ -412,14 +412,18 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
 
     /// One SNES solve of `step` from the current iterate: its outcome, the first point whose
     /// residual was not finite, and the callbacks' wall time.
-    fn newton(&mut self, step: &Step<D, M>, model: &Model<D>) -> Result<(SolveOutcome, Option<String>, f64), Error> {
+    fn newton(
+        &mut self,
+        step: &Step<D, M>,
+        model: &Model<D>,
+    ) -> Result<(SolveOutcome, Option<String>, AssemblyTime), Error> {
         let System { space, x, x_local, f_local, snes, matrix, schur, stages, .. } = self;
         let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
         let work =
             Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
         let mut callbacks = Callbacks::<D, M, N>::new(model, step, work);
         let out = snes.solve(x, jac, &mut callbacks)?;
-        Ok((out, callbacks.nonfinite.take(), callbacks.seconds))
+        Ok((out, callbacks.nonfinite.take(), callbacks.time))
     }
 
     /// Sets PETSc's solution vector to the step's first iterate: the last accepted increment

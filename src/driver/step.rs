@@ -67,8 +67,10 @@ where
         let summary = &mut *self.journal.summary;
         summary.memory.peak_rise.solve_mib += rise_since(peak);
         summary.matrix_structure_reuses = self.system.reused_patterns;
-        summary.timings.assembly_s += solved.assembly_seconds;
-        summary.timings.linear_solve_s += solved.solve_seconds - solved.assembly_seconds;
+        summary.timings.assembly_s += solved.assembly.seconds;
+        summary.timings.jacobian_s += solved.assembly.jacobian_seconds;
+        summary.timings.jacobians += solved.assembly.jacobians;
+        summary.timings.linear_solve_s += solved.solve_seconds - solved.assembly.seconds;
         let (count, seconds) = self.system.timed_matvecs();
         if count > 0 {
             summary.timings.tangent_matvec_s = Some(seconds / count as f64);

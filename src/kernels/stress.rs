@@ -147,6 +147,8 @@ struct Block<'a, const D: usize, const M: usize> {
 /// return's tangents and, in two dimensions, T · d(Rσ_nRᵀ)/dθ.
 struct StressResponse<'p, const R: usize> {
     t_mat: &'p [[f64; NS]; NS],
+    /// T = I (an elastic update): T · d(Rσ_nRᵀ) is d(Rσ_nRᵀ) itself, to the bit.
+    t_identity: bool,
     d_alg: &'p [[f64; NS]; NS],
     t_drot: [f64; R],
     material: f64,
@@ -158,7 +160,8 @@ impl<'p, const R: usize> StressResponse<'p, R> {
         let (t_mat, d_alg) = (&pt.upd.trial_tangent, &pt.upd.tangent);
         let drot = kinematics::rotate_derivative(&pt.rotated);
         let t_drot = std::array::from_fn(|r| (0..R).map(|q| t_mat[r][q] * drot[q]).sum());
-        StressResponse { t_mat, d_alg, t_drot, material }
+        let t_identity = *t_mat == crate::soils::IDENTITY6;
+        StressResponse { t_mat, t_identity, d_alg, t_drot, material }
     }
 
     /// A_l = ∂σ'/∂Δu_l (strain rows × D) through the operators `bl` and the kinematics `sk`.
@@ -177,9 +180,14 @@ impl<'p, const R: usize> StressResponse<'p, R> {
             std::array::from_fn(|r| std::array::from_fn(|d| self.t_drot[r] * dt[d] + material_part(r, d)))
         } else {
             let dr = sk.rotated_derivative(bl, &pt.rotated);
-            std::array::from_fn(|r| {
-                std::array::from_fn(|d| (0..R).map(|q| self.t_mat[r][q] * dr[q][d]).sum::<f64>() + material_part(r, d))
-            })
+            let rotation_part = |r: usize, d: usize| {
+                if self.t_identity {
+                    dr[r][d]
+                } else {
+                    (0..R).map(|q| self.t_mat[r][q] * dr[q][d]).sum()
+                }
+            };
+            std::array::from_fn(|r| std::array::from_fn(|d| rotation_part(r, d) + material_part(r, d)))
         }
     }
 }

@@ -374,25 +374,27 @@ soil_models! {
 }
 
 /// Elastic trial, return of the principal values by `ret`, and the tangent through the principal
-/// frame.
+/// frame. `surely_elastic(trial, ε̄)` may tell from the trial's invariants alone that `ret` would
+/// find it elastic (it must never be true where `ret` would not), which spares the principal
+/// decomposition of the many points that stay elastic.
 fn isotropic_return(
     el: &LinearElastic,
     stress: &Stress,
     eps: f64,
     deps: &Stress,
+    surely_elastic: impl Fn(&Stress, f64) -> bool,
     ret: impl Fn(&[f64; 3], f64) -> ReturnResult,
 ) -> StressUpdate {
     let trial = el.trial(stress, deps);
+    let elastic =
+        StressUpdate { stress: trial, tangent: el.d, trial_tangent: IDENTITY6, eps_pd: eps, region: Region::Elastic };
+    if surely_elastic(&trial, eps) {
+        return elastic;
+    }
     let p = Principal::of(&trial);
     let r = ret(&p.values, eps);
     if r.region == Region::Elastic {
-        return StressUpdate {
-            stress: trial,
-            tangent: el.d,
-            trial_tangent: IDENTITY6,
-            eps_pd: eps,
-            region: Region::Elastic,
-        };
+        return elastic;
     }
     let dsdt = p.derivative(&r.stress, &r.tangent);
     StressUpdate {
@@ -402,6 +404,16 @@ fn isotropic_return(
         eps_pd: r.eps,
         region: r.region,
     }
+}
+
+/// The mean stress p and the norm R = |dev σ| (Frobenius, shears counted twice) of a stress: the
+/// invariants that bound its principal values without finding them. With s_1 ≥ s_2 ≥ s_3 the
+/// principal values of dev σ (Σ s_i = 0, Σ s_i² = R²): s_1 − s_3 ≤ √2 R (equality when s_2 = 0)
+/// and |s_i| ≤ √(2/3) R.
+fn mean_and_deviator_norm(s: &Stress) -> (f64, f64) {
+    let p = (s[0] + s[1] + s[3]) / 3.0;
+    let (a, b, c) = (s[0] - p, s[1] - p, s[3] - p);
+    (p, (a * a + b * b + c * c + 2.0 * (s[2] * s[2] + s[4] * s[4] + s[5] * s[5])).sqrt())
 }
 
 /// The peak strength `peak` divided by the strength reduction factor `f`, and the residual

@@ -403,3 +403,77 @@ fn every_kind_is_the_type_its_table_is_chosen_by() {
         .collect();
     assert_eq!(tags, SoilModel::KINDS);
 }
+
+/// Trial stresses about the yield surface: mean stress p, a deviatoric direction u (|u| = 1,
+/// rotated by [`tilt`]) and a norm R about the R* at which `yield_norm(p, u)` puts the surface:
+/// R = R*(1 + δ) with δ from 1e-12 to 1 on both sides, or (`inside`) R from 0 to 0.6 R*.
+fn trials_about_the_surface(c: f64, inside: bool, yield_norm: impl Fn(f64, [f64; 3]) -> f64) -> Vec<Stress> {
+    let mut seed = 12345u64;
+    let mut next = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut out = Vec::new();
+    for i in 0..4000 {
+        let p = c * (2.0 - 60.0 * next());
+        let lode = std::f64::consts::PI * next();
+        // A deviatoric unit vector of Lode angle `lode` (components summing to zero).
+        let u = [0.0, 2.0, 4.0].map(|k: f64| (2.0f64 / 3.0).sqrt() * (lode - k * std::f64::consts::PI / 3.0).cos());
+        let delta = (if i % 2 == 0 { 1.0 } else { -1.0 }) * 10f64.powf(-12.0 * next());
+        let r = yield_norm(p, u) * if inside { 0.6 * next() } else { 1.0 + delta };
+        if r > 0.0 {
+            out.push(stress_in([p + r * u[0], p + r * u[1], p + r * u[2]], &tilt()));
+        }
+    }
+    out
+}
+
+#[test]
+fn the_invariant_pre_check_never_calls_a_plastic_trial_elastic() {
+    let c = 10.0 * KPA;
+    let models = [mc(30.0, c, 10.0, None), mc(0.0, c, 0.0, None), mc(30.0, c, 10.0, Some(0.2 * c)), softening_mc()];
+    for model in models {
+        let Constitutive::MohrCoulomb(law) = model else { unreachable!() };
+        let eps = if law.softening_strain.is_finite() { 0.02 } else { 0.0 };
+        let (c_n, _) = law.cohesion_at(eps);
+        let (sp, cp) = law.phi.sin_cos();
+        // f of σ_i = p + R u_i (u sorted) is linear in R: zero at R*.
+        let yield_norm = |p: f64, mut u: [f64; 3]| {
+            u.sort_by(|a, b| b.total_cmp(a));
+            (2.0 * c_n * cp - 2.0 * sp * p) / ((u[0] - u[2]) + sp * (u[0] + u[2]))
+        };
+        for inside in [false, true] {
+            let (mut sure, mut elastic) = (0, 0);
+            for t in &trials_about_the_surface(c, inside, yield_norm) {
+                let plastic = law.return_sorted(&principal_sorted(t), eps).region != Region::Elastic;
+                let pre = law.surely_elastic(t, eps);
+                assert!(!(pre && plastic), "{law:?}: the trial {t:?} is plastic, the pre-check calls it elastic");
+                sure += pre as usize;
+                elastic += !plastic as usize;
+            }
+            // Well inside the surface, it spares (nearly) every elastic trial the decomposition.
+            assert!(!inside || 10 * sure >= 9 * elastic, "{law:?}: {sure} of {elastic} elastic trials caught");
+        }
+    }
+    // Tresca in pure shear (s_2 = 0), where the bound √2 R is tight: just inside and just outside.
+    let Constitutive::MohrCoulomb(tresca) = mc(0.0, c, 0.0, None) else { unreachable!() };
+    for (x, inside) in [(1.0 - 1e-8, true), (1.0 + 1e-9, false)] {
+        let t = stress_in([-5.0 * c + x * c, -5.0 * c, -5.0 * c - x * c], &tilt());
+        assert_eq!(tresca.surely_elastic(&t, 0.0), inside);
+        assert_eq!(tresca.return_sorted(&principal_sorted(&t), 0.0).region == Region::Elastic, inside);
+    }
+    let Constitutive::VonMises(law) = vm(c, 0.5 * c, -1e5) else { unreachable!() };
+    for eps in [0.0, 0.01] {
+        let (c_n, _) = law.cohesion_at(eps);
+        // The pre-check is exact for von Mises: it misses only trials within its margin.
+        let (mut sure, mut elastic) = (0, 0);
+        for t in &trials_about_the_surface(c, false, |_, _| 2f64.sqrt() * c_n) {
+            let plastic = law.return_principal(&principal_sorted(t), eps).region != Region::Elastic;
+            let pre = law.surely_elastic(t, eps);
+            assert!(!(pre && plastic), "von Mises: the trial {t:?} is plastic, the pre-check calls it elastic");
+            sure += pre as usize;
+            elastic += !plastic as usize;
+        }
+        assert!(100 * sure >= 95 * elastic, "von Mises: {sure} of {elastic} elastic trials caught");
+    }
+}
