@@ -210,6 +210,20 @@ fn at_least(v: &mut Vec<f64>, n: usize) {
     }
 }
 
+/// What a loop over points keeps from one point to the next: the nodal states (at least as many
+/// as a stencil's nodes, [`node_states_into`]) and the point's per-node arrays.
+pub(super) struct PointScratch<const D: usize, const N: usize> {
+    states: Vec<NodeState<N>>,
+    buffers: kernels::PointBuffers<D>,
+}
+
+impl<const D: usize, const N: usize> PointScratch<D, N> {
+    /// Empty scratch (the states grow to the first stencil's length).
+    pub(super) fn new() -> PointScratch<D, N> {
+        PointScratch { states: Vec::new(), buffers: kernels::PointBuffers::default() }
+    }
+}
+
 /// The scratch of [`Points::add_tangent`]: the map of raw to effective dofs, the effective
 /// block, the effective nodes' grid indices and places in the pattern's table, the pattern
 /// blocks of one block row.
@@ -240,43 +254,64 @@ impl<const D: usize, const M: usize, const N: usize> Copy for Points<'_, D, M, N
 impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     /// Calls `f` with the point of particle `k` at the ghosted increments `xl`.
     pub(super) fn with_point<R>(&self, k: usize, xl: &[f64], f: impl FnOnce(&kernels::Point<D, M>) -> R) -> R {
-        let mut states = [NodeState::default(); M];
-        self.with_point_of(k, xl, particle_input(self.model, self.step, k), &mut states, f)
+        let mut scratch = PointScratch::new();
+        self.with_point_of(k, xl, particle_input(self.model, self.step, k), &mut scratch, f)
     }
 
-    /// [`Self::with_point`] with the particle's kernel input given and its nodal states written
-    /// into `states` (at least as many as its stencil's nodes), which a loop over points keeps
-    /// ([`node_states_into`]).
+    /// [`Self::with_point`] with the particle's kernel input given, and its nodal states and
+    /// per-node arrays in `scratch`, which a loop over points keeps.
     fn with_point_of<R>(
         &self,
         k: usize,
         xl: &[f64],
         input: kernels::ParticleInput<D>,
-        states: &mut [NodeState<N>],
+        scratch: &mut PointScratch<D, N>,
         f: impl FnOnce(&kernels::Point<D, M>) -> R,
     ) -> R {
         let step = self.step;
         let (nodes, basis) = step.stencils.get(k);
+        let PointScratch { states, buffers } = scratch;
+        if states.len() < nodes.len() {
+            states.resize(nodes.len(), NodeState::default());
+        }
         node_states_into::<D, M, N>(step, k, xl, states);
         let mat = &self.model.materials[self.model.particles.material[k] as usize];
         let strain = step.stencils.strain_of(k);
         let layout = step.layout;
-        let mut pt =
-            kernels::Point::<D, M>::with_recovery(basis, strain, &states[..nodes.len()], &input, &mat.model, layout);
+        let states = &states[..nodes.len()];
+        let mut pt = kernels::Point::<D, M>::with_recovery_in(
+            std::mem::take(buffers),
+            basis,
+            strain,
+            states,
+            &input,
+            &mat.model,
+            layout,
+        );
         pt.set_forces(step.stencils.forces_of(k));
-        pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
-        f(&pt)
+        pt.set_faces(step.faces_of(k), states);
+        let r = f(&pt);
+        *buffers = pt.into_buffers();
+        r
     }
 
     /// Particle `k` at an explicit step's start with the stress it carries
-    /// ([`kernels::Point::at_start`]).
-    fn with_point_at_start<R>(&self, k: usize, f: impl FnOnce(&kernels::Point<D, M>) -> R) -> R {
+    /// ([`kernels::Point::at_start`]), its per-node arrays in `buffers`.
+    fn with_point_at_start<R>(
+        &self,
+        k: usize,
+        buffers: &mut kernels::PointBuffers<D>,
+        f: impl FnOnce(&kernels::Point<D, M>) -> R,
+    ) -> R {
         let step = self.step;
         let (_, basis) = step.stencils.get(k);
         let input = particle_input(self.model, step, k);
-        let mut pt = kernels::Point::<D, M>::at_start(basis, step.stencils.strain_of(k), &input, step.layout);
+        let strain = step.stencils.strain_of(k);
+        let mut pt = kernels::Point::<D, M>::at_start_in(std::mem::take(buffers), basis, strain, &input, step.layout);
         pt.set_forces(step.stencils.forces_of(k));
-        f(&pt)
+        let r = f(&pt);
+        *buffers = pt.into_buffers();
+        r
     }
 
     /// Calls `f` with the point of particle `k` whose basis also holds its slots beyond the grid
@@ -325,12 +360,12 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
         f(&pt)
     }
 
-    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length (`states`: the
-    /// nodal states' scratch, see [`Self::with_point_of`]).
-    pub(super) fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64], states: &mut [NodeState<N>]) -> usize {
+    /// Adds particle `k`'s residual at `xl` into `buf` and returns its length (`scratch`: see
+    /// [`Self::with_point_of`]).
+    pub(super) fn residual_of(&self, k: usize, xl: &[f64], buf: &mut [f64], scratch: &mut PointScratch<D, N>) -> usize {
         let nm = self.step.scheme;
         let input = particle_input(self.model, self.step, k);
-        self.with_point_of(k, xl, input, states, |pt| {
+        self.with_point_of(k, xl, input, scratch, |pt| {
             kernels::residual(pt, &nm, buf);
             pt.size()
         })
@@ -375,19 +410,19 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     }
 
     /// The residual rows of `band` (its part `f` of a ghosted array) from every particle that
-    /// reaches it, each particle's block given by `block(k, buf, states) -> length` (`states`: the
-    /// nodal states' scratch); returns the first particle whose block was not finite.
+    /// reaches it, each particle's block given by `block(k, buf, scratch) -> length` (`scratch`:
+    /// see [`Self::with_point_of`]); returns the first particle whose block was not finite.
     pub(super) fn residual_band(
         &self,
         band: Band,
         f: &mut [f64],
-        block: &(impl Fn(usize, &mut [f64], &mut [NodeState<N>]) -> usize + Sync),
+        block: &(impl Fn(usize, &mut [f64], &mut PointScratch<D, N>) -> usize + Sync),
     ) -> Option<usize> {
         let mut buf = vec![0.0; M * N];
-        let mut states = vec![NodeState::<N>::default(); M];
+        let mut scratch = PointScratch::new();
         let mut nonfinite = None;
         for k in (0..self.step.stencils.len()).filter(|&k| self.touches(k, band)) {
-            let m = block(k, &mut buf, &mut states);
+            let m = block(k, &mut buf, &mut scratch);
             if nonfinite.is_none() && !buf[..m].iter().all(|r| r.is_finite()) {
                 nonfinite = Some(k);
             }
@@ -412,32 +447,21 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
             codes: Vec::with_capacity(M + EXTRA_MASTERS),
             blocks: Vec::with_capacity(M + EXTRA_MASTERS),
         };
-        let mut states = vec![NodeState::<N>::default(); M];
+        let mut point = PointScratch::new();
         for k in (0..step.stencils.len()).filter(|&k| self.touches(k, band)) {
-            let (nodes, basis) = step.stencils.get(k);
             let input = particle_input(self.model, step, k);
-            let mat = &self.model.materials[self.model.particles.material[k] as usize];
-            node_states_into::<D, M, N>(step, k, xl, &mut states);
-            let strain = step.stencils.strain_of(k);
-            let mut pt = kernels::Point::<D, M>::with_recovery(
-                basis,
-                strain,
-                &states[..nodes.len()],
-                &input,
-                &mat.model,
-                layout,
-            );
-            pt.set_forces(step.stencils.forces_of(k));
-            pt.set_faces(step.faces_of(k), &states[..nodes.len()]);
-            let m = pt.size();
-            at_least(&mut block, m * m);
-            if self.model.stiffness_in_jacobian {
-                kernels::tangent_with(&pt, &nm, &mut block[..m * m], step.stiffness.material(k));
-                step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
-            } else {
-                // The mapped stiffness serves the diagnostics only: the exact tangent.
-                kernels::tangent_with(&pt, &nm, &mut block[..m * m], 1.0);
-            }
+            let m = self.with_point_of(k, xl, input, &mut point, |pt| {
+                let m = pt.size();
+                at_least(&mut block, m * m);
+                if self.model.stiffness_in_jacobian {
+                    kernels::tangent_with(pt, &nm, &mut block[..m * m], step.stiffness.material(k));
+                    step.stiffness.add(k, nm.w_force, &mut block[..m * m], m, layout.nd);
+                } else {
+                    // The mapped stiffness serves the diagnostics only: the exact tangent.
+                    kernels::tangent_with(pt, &nm, &mut block[..m * m], 1.0);
+                }
+                m
+            });
             self.add_tangent(k, &mut block[..m * m], m, &mut scratch, values, band);
         }
     }
@@ -568,6 +592,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let whole = ps.whole();
         // An explicit step's terms are those of its start, with the stress each point carries.
         let at_start = nm.is_explicit();
+        let mut point = PointScratch::new();
         debug_assert!(!at_start || xl.iter().all(|&x| x == 0.0));
         for k in 0..step.stencils.len() {
             let terms = |pt: &kernels::Point<D, M>| {
@@ -579,7 +604,11 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
                 kernels::residual_terms(pt, &plain, kernels::Terms::Forces, &mut fbuf[..m]);
                 m
             };
-            let m = if at_start { ps.with_point_at_start(k, terms) } else { ps.with_point(k, xl, terms) };
+            let m = if at_start {
+                ps.with_point_at_start(k, &mut point.buffers, terms)
+            } else {
+                ps.with_point_of(k, xl, particle_input(ps.model, step, k), &mut point, terms)
+            };
             ps.scatter(k, &buf[..m], all, whole);
             for v in &mut buf[..m] {
                 *v = v.abs();
@@ -678,8 +707,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let mut out: Vec<f64> = step.fext.iter().map(|f| f.abs()).collect();
         let ps = self;
         let weight = nm.w_force.max(nm.w_inertia);
-        let block = |k: usize, buf: &mut [f64], states: &mut [NodeState<N>]| {
-            let m = ps.residual_of(k, &xl, buf, states);
+        let block = |k: usize, buf: &mut [f64], scratch: &mut PointScratch<D, N>| {
+            let m = ps.residual_of(k, &xl, buf, scratch);
             for v in &mut buf[..m] {
                 *v = v.abs() * weight;
             }
@@ -703,7 +732,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         let xl = vec![0.0; fext_old.len()];
         let mut out: Vec<f64> = fext_old.iter().map(|f| -scheme.w_force * f).collect();
         let ps = self;
-        let block = |k: usize, buf: &mut [f64], states: &mut [NodeState<N>]| {
+        let block = |k: usize, buf: &mut [f64], scratch: &mut PointScratch<D, N>| {
             let mut input = particle_input(ps.model, step, k);
             if smooth {
                 let s = &step.smooth[k];
@@ -713,7 +742,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
             // With an implicit F̄ the point at Δd = 0, ϑ = 0 sees r = 1/J̄_n: J̄_n = 1 makes it the
             // point at rest, with the stress it carries.
             input.jbar = 1.0;
-            ps.with_point_of(k, &xl, input, states, |pt| {
+            ps.with_point_of(k, &xl, input, scratch, |pt| {
                 kernels::residual(pt, scheme, &mut buf[..pt.size()]);
                 pt.size()
             })

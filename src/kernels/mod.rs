@@ -346,10 +346,10 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     pub upd: StressUpdate,
     /// Gradients ∇'S and ∇̄'S of each stencil node on x_{n+1}, the operators the forces are
     /// integrated with: the basis's own, or [001]'s double-mapped ones ([`Point::with_forces`]).
-    pub spatial: [([f64; D], [f64; D]); M],
+    pub spatial: Vec<Gradients<D>>,
     /// Hoop operators T' and T̄' of each stencil node on x_{n+1} (zero in plane strain and in three
     /// dimensions), the forces' like [`Point::spatial`].
-    pub hoop: [(f64, f64); M],
+    pub hoop: Vec<(f64, f64)>,
     /// The operators the strain is recovered with (see [`Point::with_recovery`]): the basis
     /// itself, or [001]'s CMPM patch functions; the strain increment, the rotation and the soil
     /// model's update use these (through [`Point::strain_kin`]), the motion and the forces the
@@ -357,7 +357,7 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     pub strain: &'a [NodeBasis<D>],
     /// `spatial` and `hoop` of the basis where they are not the force operators (see
     /// [`Point::motion_operators`]; `None`: the same, not copied).
-    motion: Option<Box<OnNew<D, M>>>,
+    motion: Option<Box<OnNew<D>>>,
     /// Pore pressure at t_{n+1}, p_n + Σ S Δp.
     pub p: f64,
     /// The particle's faces on a drained surface imposed weakly ([`flow::drained_face`]; most
@@ -366,7 +366,18 @@ pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
     /// Σ N_j(x_f) Δp_j at each of `faces`.
     pub face_dp: [f64; MAX_FACES],
     /// The nodal ϑ_i = J̄_i − 1 of an implicit F̄ step, per stencil node (zero otherwise).
-    pub jbar_nodes: [f64; M],
+    pub jbar_nodes: Vec<f64>,
+}
+
+/// The per-node arrays of a point ([`Point::spatial`], [`Point::hoop`], [`Point::jbar_nodes`]), as
+/// long as its stencil. A loop that forms many points hands them from one point to the next
+/// ([`Point::with_recovery_in`], [`Point::into_buffers`]): neither allocated per point nor of the
+/// bound M, whose zeroing and moving cost more than a stencil of 8 to 27 nodes.
+#[derive(Debug, Clone, Default)]
+pub struct PointBuffers<const D: usize> {
+    spatial: Vec<Gradients<D>>,
+    hoop: Vec<(f64, f64)>,
+    jbar_nodes: Vec<f64>,
 }
 
 /// A node's gradients (∇'S, ∇̄'S) on x_{n+1}.
@@ -374,12 +385,11 @@ pub type Gradients<const D: usize> = ([f64; D], [f64; D]);
 
 /// The per-node gradients and hoop operators of a point on x_{n+1} ([`Point::spatial`] and
 /// [`Point::hoop`], or their strain operators').
-type OnNew<const D: usize, const M: usize> = ([([f64; D], [f64; D]); M], [(f64, f64); M]);
+type OnNew<const D: usize> = (Vec<Gradients<D>>, Vec<(f64, f64)>);
 
 /// Writes the gradients and hoop operators on x_{n+1} under the step's kinematics `kin` of each
 /// node of `nodes` into the first entries of `spatial` and `hoop` ([`Point::spatial`] and
-/// [`Point::hoop`], or the strain operators'), in place: a point's arrays are of the bound M,
-/// which moving costs more than a stencil of 8 to 27 nodes.
+/// [`Point::hoop`], or the strain operators'), in place.
 fn on_new_configuration<const D: usize>(
     kin: &Kinematics<D>,
     nodes: &[NodeBasis<D>],
@@ -425,7 +435,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// reading (docs/stiffness.md: the strain is recovered for the stress only; positions, F and
     /// volume as without it). [001]'s CMPM recovery (`stabilisation.stress_recovery = "cmpm"`)
     /// passes its patch functions; `strain = basis` is the usual point.
-    #[inline]
     pub fn with_recovery<const N: usize>(
         basis: &'a [NodeBasis<D>],
         strain: &'a [NodeBasis<D>],
@@ -434,6 +443,22 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         model: &Constitutive,
         layout: Layout,
     ) -> Point<'a, D, M> {
+        Point::with_recovery_in(PointBuffers::default(), basis, strain, states, part, model, layout)
+    }
+
+    /// [`Point::with_recovery`] with its per-node arrays in `buffers` (their earlier contents are
+    /// overwritten; [`Point::into_buffers`] hands them back).
+    #[inline]
+    pub fn with_recovery_in<const N: usize>(
+        buffers: PointBuffers<D>,
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        states: &[NodeState<N>],
+        part: &'a ParticleInput<D>,
+        model: &Constitutive,
+        layout: Layout,
+    ) -> Point<'a, D, M> {
+        let PointBuffers { spatial, hoop, mut jbar_nodes } = buffers;
         debug_assert_eq!(layout.dim, D, "a layout of {} dimensions at a point of {D}", layout.dim);
         let interp = interpolate(basis, states, &part.pred, layout);
         let kinematics_of = |ops: &[NodeBasis<D>]| {
@@ -445,7 +470,8 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         // F̄'s scale and projection all the same, so that every term is defined for any operators.)
         let mut recovered_kin = (!std::ptr::eq(strain, basis)).then(|| kinematics_of(strain));
         // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
-        let mut jbar_nodes = [0.0; M];
+        jbar_nodes.clear();
+        jbar_nodes.resize(basis.len(), 0.0);
         if let Some(j) = layout.jbar {
             for (t, st) in jbar_nodes.iter_mut().zip(states.iter().take(basis.len())) {
                 *t = st.d[j];
@@ -465,7 +491,8 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let upd = model
             .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));
-        Point::of_parts(basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd), jbar_nodes)
+        let buffers = PointBuffers { spatial, hoop, jbar_nodes };
+        Point::of_parts(buffers, basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd))
     }
 
     /// The point at its step's start (Δd = 0) with the stress it carries, σ_n on x_n, as an
@@ -475,6 +502,17 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
     /// explicit step builds no matrix). The interpolated velocities and accelerations are the
     /// point's predictors, as at Δd = 0.
     pub fn at_start(
+        basis: &'a [NodeBasis<D>],
+        strain: &'a [NodeBasis<D>],
+        part: &'a ParticleInput<D>,
+        layout: Layout,
+    ) -> Point<'a, D, M> {
+        Point::at_start_in(PointBuffers::default(), basis, strain, part, layout)
+    }
+
+    /// [`Point::at_start`] with its per-node arrays in `buffers` (see [`Point::with_recovery_in`]).
+    pub fn at_start_in(
+        buffers: PointBuffers<D>,
         basis: &'a [NodeBasis<D>],
         strain: &'a [NodeBasis<D>],
         part: &'a ParticleInput<D>,
@@ -490,15 +528,25 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             region: crate::soils::Region::Elastic,
         };
         let kin = (Kinematics::rest(), None);
-        Point::of_parts(basis, strain, part, layout, interp, kin, (part.stress, upd), [0.0; M])
+        let PointBuffers { spatial, hoop, mut jbar_nodes } = buffers;
+        jbar_nodes.clear();
+        jbar_nodes.resize(basis.len(), 0.0);
+        let buffers = PointBuffers { spatial, hoop, jbar_nodes };
+        Point::of_parts(buffers, basis, strain, part, layout, interp, kin, (part.stress, upd))
+    }
+
+    /// The point's per-node arrays, for the next point ([`Point::with_recovery_in`]).
+    pub fn into_buffers(self) -> PointBuffers<D> {
+        PointBuffers { spatial: self.spatial, hoop: self.hoop, jbar_nodes: self.jbar_nodes }
     }
 
     /// The point of its parts: the kinematics (and the recovered strain's, if any), the rotated
     /// stress σ_n and the soil model's update; the gradients on the new configuration follow
-    /// from the kinematics, and the pore pressure is p_n + Δp.
+    /// from the kinematics (into `buffers`, whose ϑ_i are set), and the pore pressure is p_n + Δp.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn of_parts(
+        buffers: PointBuffers<D>,
         basis: &'a [NodeBasis<D>],
         strain: &'a [NodeBasis<D>],
         part: &'a ParticleInput<D>,
@@ -506,8 +554,12 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         interp: Interp<D>,
         (kin, recovered_kin): (Kinematics<D>, Option<Kinematics<D>>),
         (rotated, upd): (Stress, StressUpdate),
-        jbar_nodes: [f64; M],
     ) -> Point<'a, D, M> {
+        let PointBuffers { mut spatial, mut hoop, jbar_nodes } = buffers;
+        spatial.clear();
+        spatial.resize(basis.len(), ([0.0; D], [0.0; D]));
+        hoop.clear();
+        hoop.resize(basis.len(), (0.0, 0.0));
         let mut pt = Point {
             basis,
             part,
@@ -517,8 +569,8 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             recovered_kin,
             rotated,
             upd,
-            spatial: [([0.0; D], [0.0; D]); M],
-            hoop: [(0.0, 0.0); M],
+            spatial,
+            hoop,
             strain,
             motion: None,
             p: part.p + interp.dp,
@@ -573,7 +625,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         debug_assert_eq!(forces.len(), self.basis.len(), "force operators for another stencil");
         if self.motion.is_none() {
             // The basis's operators on x_{n+1}, held in `spatial` and `hoop` until now.
-            self.motion = Some(Box::new((self.spatial, self.hoop)));
+            self.motion = Some(Box::new((self.spatial.clone(), self.hoop.clone())));
         }
         on_new_configuration(&self.kin, forces, &mut self.spatial, &mut self.hoop);
     }
