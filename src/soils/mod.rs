@@ -373,26 +373,30 @@ soil_models! {
     NewtonianFluid(newtonian_fluid::NewtonianFluid) = "newtonian_fluid",
 }
 
-/// Elastic trial, return of the principal values by `ret`, and the tangent through the principal
-/// frame. `surely_elastic(trial, ε̄)` may tell from the trial's invariants alone that `ret` would
-/// find it elastic (it must never be true where `ret` would not), which spares the principal
-/// decomposition of the many points that stay elastic.
-fn isotropic_return(
-    el: &LinearElastic,
-    stress: &Stress,
-    eps: f64,
-    deps: &Stress,
-    surely_elastic: impl Fn(&Stress, f64) -> bool,
-    ret: impl Fn(&[f64; 3], f64) -> ReturnResult,
-) -> StressUpdate {
+/// A soil law whose return maps the principal values of its elastic trial (an isotropic return,
+/// [`isotropic_return`]).
+trait PrincipalReturn: SoilLaw {
+    /// Whether [`PrincipalReturn::map_principal`] surely finds the trial elastic, told from its
+    /// invariants alone: never true where the return would not find it elastic. It spares the
+    /// principal decomposition of the many points that stay elastic.
+    fn surely_elastic(&self, trial: &Stress, eps: f64) -> bool;
+
+    /// The return of the trial's principal values (in any order) from the state ε̄ = `eps`.
+    fn map_principal(&self, values: &[f64; 3], eps: f64) -> ReturnResult;
+}
+
+/// Elastic trial, return of the principal values by the `law`, and the tangent through the
+/// principal frame.
+fn isotropic_return(law: &impl PrincipalReturn, stress: &Stress, eps: f64, deps: &Stress) -> StressUpdate {
+    let el = law.elastic();
     let trial = el.trial(stress, deps);
     let elastic =
         StressUpdate { stress: trial, tangent: el.d, trial_tangent: IDENTITY6, eps_pd: eps, region: Region::Elastic };
-    if surely_elastic(&trial, eps) {
+    if law.surely_elastic(&trial, eps) {
         return elastic;
     }
     let p = Principal::of(&trial);
-    let r = ret(&p.values, eps);
+    let r = law.map_principal(&p.values, eps);
     if r.region == Region::Elastic {
         return elastic;
     }

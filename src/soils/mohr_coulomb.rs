@@ -27,8 +27,8 @@
 
 use super::elasticity::check_elastic;
 use super::{
-    isotropic_return, reduced_strength, LinearElastic, Region, ReturnResult, SoilLaw, SoilParameters, Stress,
-    StressUpdate,
+    isotropic_return, reduced_strength, LinearElastic, PrincipalReturn, Region, ReturnResult, SoilLaw, SoilParameters,
+    Stress, StressUpdate,
 };
 use crate::algebra::linalg::solve;
 use crate::check::{at, in_closed_open, non_negative, positive, strength, Checked};
@@ -276,22 +276,6 @@ impl MohrCoulombLaw {
         [mc(0, 2), mc(0, 1), mc(1, 2), ten(0), ten(1), ten(2)]
     }
 
-    /// Whether [`Self::return_sorted`] surely finds `trial` elastic, from its invariants p and R
-    /// ([`super::mean_and_deviator_norm`]): the largest plane function is the one of σ₁ and σ₃,
-    /// (σ₁ − σ₃) + sin φ (σ₁ + σ₃) − 2c cos φ ≤ √2 R + sin φ (2p + √(2/3) R) − 2c cos φ (φ ≥ 0), and
-    /// σ₁ ≤ p + √(2/3) R for the tension cut-off. The bound is tested against half the return's
-    /// smallest tolerance (1e-10 (c_p + c_r)), so that round-off cannot tip a point the return
-    /// would find plastic.
-    pub(super) fn surely_elastic(&self, trial: &Stress, eps: f64) -> bool {
-        let (p, r) = super::mean_and_deviator_norm(trial);
-        let (c_n, _) = self.cohesion_at(eps);
-        let (sp, cp) = self.phi.sin_cos();
-        let top = p + (2.0f64 / 3.0).sqrt() * r;
-        let shear = std::f64::consts::SQRT_2 * r + sp * (p + top) - 2.0 * c_n * cp;
-        let margin = 0.5e-10 * (self.cohesion.abs() + self.residual_cohesion.abs());
-        sp >= 0.0 && shear <= margin && self.tension.is_none_or(|t| top - t <= margin)
-    }
-
     /// Returns the sorted trial principal stresses `trial` (σ₁ ≥ σ₂ ≥ σ₃) to the yield surface from
     /// the state ε̄ = `eps`.
     pub fn return_sorted(&self, trial: &[f64; 3], eps: f64) -> ReturnResult {
@@ -442,32 +426,46 @@ impl SoilLaw for MohrCoulombLaw {
 
     #[inline]
     fn update(&self, stress: &Stress, eps_pd: f64, deps: &Stress) -> StressUpdate {
-        isotropic_return(
-            &self.elastic,
-            stress,
-            eps_pd,
-            deps,
-            |t, e| self.surely_elastic(t, e),
-            |l, e| {
-                // Sort descending, return, and map back.
-                let mut order = [0usize, 1, 2];
-                order.sort_by(|&a, &b| l[b].total_cmp(&l[a]));
-                let sorted = [l[order[0]], l[order[1]], l[order[2]]];
-                let r = self.return_sorted(&sorted, e);
-                let mut stress = [0.0; 3];
-                let mut tangent = [[0.0; 3]; 3];
-                for i in 0..3 {
-                    stress[order[i]] = r.stress[i];
-                    for j in 0..3 {
-                        tangent[order[i]][order[j]] = r.tangent[i][j];
-                    }
-                }
-                ReturnResult { stress, tangent, ..r }
-            },
-        )
+        isotropic_return(self, stress, eps_pd, deps)
     }
 
     fn elastic(&self) -> &LinearElastic {
         &self.elastic
+    }
+}
+
+impl PrincipalReturn for MohrCoulombLaw {
+    /// Whether [`Self::return_sorted`] surely finds `trial` elastic, from its invariants p and R
+    /// ([`super::mean_and_deviator_norm`]): the largest plane function is the one of σ₁ and σ₃,
+    /// (σ₁ − σ₃) + sin φ (σ₁ + σ₃) − 2c cos φ ≤ √2 R + sin φ (2p + √(2/3) R) − 2c cos φ (φ ≥ 0), and
+    /// σ₁ ≤ p + √(2/3) R for the tension cut-off. The bound is tested against half the return's
+    /// smallest tolerance (1e-10 (c_p + c_r)), so that round-off cannot tip a point the return
+    /// would find plastic.
+    fn surely_elastic(&self, trial: &Stress, eps: f64) -> bool {
+        let (p, r) = super::mean_and_deviator_norm(trial);
+        let (c_n, _) = self.cohesion_at(eps);
+        let (sp, cp) = self.phi.sin_cos();
+        let top = p + (2.0f64 / 3.0).sqrt() * r;
+        let shear = std::f64::consts::SQRT_2 * r + sp * (p + top) - 2.0 * c_n * cp;
+        let margin = 0.5e-10 * (self.cohesion.abs() + self.residual_cohesion.abs());
+        sp >= 0.0 && shear <= margin && self.tension.is_none_or(|t| top - t <= margin)
+    }
+
+    /// Sorts the values descending, returns them ([`MohrCoulombLaw::return_sorted`]) and maps
+    /// them back.
+    fn map_principal(&self, l: &[f64; 3], eps: f64) -> ReturnResult {
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| l[b].total_cmp(&l[a]));
+        let sorted = [l[order[0]], l[order[1]], l[order[2]]];
+        let r = self.return_sorted(&sorted, eps);
+        let mut stress = [0.0; 3];
+        let mut tangent = [[0.0; 3]; 3];
+        for i in 0..3 {
+            stress[order[i]] = r.stress[i];
+            for j in 0..3 {
+                tangent[order[i]][order[j]] = r.tangent[i][j];
+            }
+        }
+        ReturnResult { stress, tangent, ..r }
     }
 }

@@ -9,8 +9,8 @@
 
 use super::elasticity::check_elastic;
 use super::{
-    isotropic_return, reduced_strength, LinearElastic, Region, ReturnResult, SoilLaw, SoilParameters, Stress,
-    StressUpdate,
+    isotropic_return, reduced_strength, LinearElastic, PrincipalReturn, Region, ReturnResult, SoilLaw, SoilParameters,
+    Stress, StressUpdate,
 };
 use crate::check::{at, strength, Checked};
 use serde::{Deserialize, Serialize};
@@ -106,15 +106,6 @@ impl VonMisesLaw {
         }
     }
 
-    /// Whether [`Self::return_principal`] surely finds `trial` elastic: q = √(3/2) R from the
-    /// trial's invariants ([`super::mean_and_deviator_norm`]) within half its tolerance of the
-    /// yield surface, so that the principal values' round-off cannot tip it.
-    pub(super) fn surely_elastic(&self, trial: &Stress, eps: f64) -> bool {
-        let q = (1.5f64).sqrt() * super::mean_and_deviator_norm(trial).1;
-        let (c_n, _) = self.cohesion_at(eps);
-        q - 3f64.sqrt() * c_n <= 0.5e-12 * (q + c_n)
-    }
-
     /// Returns the principal trial stresses `trial` (any order) from the state ε̄ = `eps`.
     pub fn return_principal(&self, trial: &[f64; 3], eps: f64) -> ReturnResult {
         let p = (trial[0] + trial[1] + trial[2]) / 3.0;
@@ -163,17 +154,25 @@ impl SoilLaw for VonMisesLaw {
 
     #[inline]
     fn update(&self, stress: &Stress, eps_pd: f64, deps: &Stress) -> StressUpdate {
-        isotropic_return(
-            &self.elastic,
-            stress,
-            eps_pd,
-            deps,
-            |t, e| self.surely_elastic(t, e),
-            |l, e| self.return_principal(l, e),
-        )
+        isotropic_return(self, stress, eps_pd, deps)
     }
 
     fn elastic(&self) -> &LinearElastic {
         &self.elastic
+    }
+}
+
+impl PrincipalReturn for VonMisesLaw {
+    /// Whether [`Self::return_principal`] surely finds `trial` elastic: q = √(3/2) R from the
+    /// trial's invariants ([`super::mean_and_deviator_norm`]) within half its tolerance of the
+    /// yield surface, so that the principal values' round-off cannot tip it.
+    fn surely_elastic(&self, trial: &Stress, eps: f64) -> bool {
+        let q = (1.5f64).sqrt() * super::mean_and_deviator_norm(trial).1;
+        let (c_n, _) = self.cohesion_at(eps);
+        q - 3f64.sqrt() * c_n <= 0.5e-12 * (q + c_n)
+    }
+
+    fn map_principal(&self, values: &[f64; 3], eps: f64) -> ReturnResult {
+        self.return_principal(values, eps)
     }
 }
