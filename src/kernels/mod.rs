@@ -458,7 +458,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         model: &Constitutive,
         layout: Layout,
     ) -> Point<'a, D, M> {
-        let PointBuffers { spatial, hoop, mut jbar_nodes } = buffers;
         debug_assert_eq!(layout.dim, D, "a layout of {} dimensions at a point of {D}", layout.dim);
         let interp = interpolate(basis, states, &part.pred, layout);
         let kinematics_of = |ops: &[NodeBasis<D>]| {
@@ -470,12 +469,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         // F̄'s scale and projection all the same, so that every term is defined for any operators.)
         let mut recovered_kin = (!std::ptr::eq(strain, basis)).then(|| kinematics_of(strain));
         // An implicit F̄ step: the stress sees the projected volume ratio J̄_{n+1}/J̄_n.
-        jbar_nodes.clear();
-        jbar_nodes.resize(basis.len(), 0.0);
-        if let Some(j) = layout.jbar {
-            for (t, st) in jbar_nodes.iter_mut().zip(states.iter().take(basis.len())) {
-                *t = st.d[j];
-            }
+        if layout.jbar.is_some() {
             // r − 1 = (1 + Σ S ϑ − J̄_n)/J̄_n, without the cancellation of forming r first.
             let r_minus_one = (interp.jbar - (part.jbar - 1.0)) / part.jbar;
             kin = kin.with_projected_volume(r_minus_one);
@@ -491,8 +485,14 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let upd = model
             .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));
-        let buffers = PointBuffers { spatial, hoop, jbar_nodes };
-        Point::of_parts(buffers, basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd))
+        let mut pt =
+            Point::of_parts(buffers, basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd));
+        if let Some(j) = layout.jbar {
+            for (t, st) in pt.jbar_nodes.iter_mut().zip(states) {
+                *t = st.d[j];
+            }
+        }
+        pt
     }
 
     /// The point at its step's start (Δd = 0) with the stress it carries, σ_n on x_n, as an
@@ -528,10 +528,6 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             region: crate::soils::Region::Elastic,
         };
         let kin = (Kinematics::rest(), None);
-        let PointBuffers { spatial, hoop, mut jbar_nodes } = buffers;
-        jbar_nodes.clear();
-        jbar_nodes.resize(basis.len(), 0.0);
-        let buffers = PointBuffers { spatial, hoop, jbar_nodes };
         Point::of_parts(buffers, basis, strain, part, layout, interp, kin, (part.stress, upd))
     }
 
@@ -542,7 +538,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
 
     /// The point of its parts: the kinematics (and the recovered strain's, if any), the rotated
     /// stress σ_n and the soil model's update; the gradients on the new configuration follow
-    /// from the kinematics (into `buffers`, whose ϑ_i are set), and the pore pressure is p_n + Δp.
+    /// from the kinematics (into `buffers`, whose ϑ_i are zeroed), and the pore pressure is p_n + Δp.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn of_parts(
@@ -555,11 +551,13 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         (kin, recovered_kin): (Kinematics<D>, Option<Kinematics<D>>),
         (rotated, upd): (Stress, StressUpdate),
     ) -> Point<'a, D, M> {
-        let PointBuffers { mut spatial, mut hoop, jbar_nodes } = buffers;
+        let PointBuffers { mut spatial, mut hoop, mut jbar_nodes } = buffers;
         spatial.clear();
         spatial.resize(basis.len(), ([0.0; D], [0.0; D]));
         hoop.clear();
         hoop.resize(basis.len(), (0.0, 0.0));
+        jbar_nodes.clear();
+        jbar_nodes.resize(basis.len(), 0.0);
         let mut pt = Point {
             basis,
             part,
