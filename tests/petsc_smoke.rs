@@ -76,7 +76,7 @@ impl NonlinearProblem for SaddleSystem<'_> {
         Ok(())
     }
 
-    fn jacobian(&mut self, _x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+    fn jacobian(&mut self, _x: &VecRef, j: &mut MatRef, _p: Option<&mut MatRef>) -> Result<(), CallbackError> {
         j.zero_entries().map_err(|e| CallbackError::Fatal(e.to_string()))?;
         self.assemble(j).map_err(|e| CallbackError::Fatal(e.to_string()))?;
         Ok(())
@@ -141,7 +141,7 @@ fn solve_with_options_file(path: &Path) -> TestResult {
     let mut x = dm.create_global_vector().map_err(e)?;
     x.set_all(0.0).map_err(e)?;
     let mut jac = dm.create_matrix().map_err(e)?;
-    let out = snes.solve(&mut x, &mut jac, &mut problem).map_err(e)?;
+    let out = snes.solve(&mut x, &mut jac, None, &mut problem).map_err(e)?;
     if !out.converged {
         return Err(format!("SNES did not converge: {}", out.reason_text));
     }
@@ -150,7 +150,8 @@ fn solve_with_options_file(path: &Path) -> TestResult {
     if err > 1e-7 {
         return Err(format!("solution error {err:.3e} > 1e-7"));
     }
-    let unused = opts.unused().map_err(e)?;
+    // porompm's own options (`-porompm_…`) are read by the application, not by PETSc's objects.
+    let unused: Vec<_> = opts.unused().map_err(e)?.into_iter().filter(|o| !o.name.starts_with("porompm_")).collect();
     drop(snes);
     opts.pop().map_err(e)?;
     if !unused.is_empty() {
@@ -251,7 +252,7 @@ impl NonlinearProblem for Cubic {
         Ok(())
     }
 
-    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef, _p: Option<&mut MatRef>) -> Result<(), CallbackError> {
         let xv = x.read().map_err(|e| CallbackError::Fatal(e.to_string()))?.to_vec();
         let mut t = self.tangent(&xv);
         if self.mode == Mode::Singular {
@@ -281,7 +282,7 @@ fn snes_self(problem: &mut Cubic) -> Result<petsc::SolveOutcome, petsc::Error> {
     snes.set_from_options()?;
     let mut x = Vector::from_slice(&vec![0.5; problem.n])?;
     let mut j = dense_matrix(problem.n)?;
-    snes.solve(&mut x, &mut j, problem)
+    snes.solve(&mut x, &mut j, None, problem)
 }
 
 /// A Newton solve whose MUMPS factorisation fails (a singular Jacobian) ends as diverged, and the
@@ -303,7 +304,7 @@ fn a_failed_mumps_factorisation_leaves_the_next_solve_free() -> TestResult {
     let mut solve = |mode| {
         let mut p = Cubic { n, b: vec![1.0; n], calls: 0, mode };
         let mut x = Vector::from_slice(&vec![0.5; n])?;
-        snes.solve(&mut x, &mut j, &mut p)
+        snes.solve(&mut x, &mut j, None, &mut p)
     };
     let first = solve(Mode::Singular).map_err(e)?;
     if first.converged || first.reason_text != "DIVERGED_LINEAR_SOLVE" {
@@ -407,8 +408,9 @@ fn unused_options_are_reported() -> TestResult {
     snes.set_from_options().map_err(e)?;
     let mut x = Vector::from_slice(&[0.0; 3]).map_err(e)?;
     let mut j = dense_matrix(3).map_err(e)?;
-    snes.solve(&mut x, &mut j, &mut p).map_err(e)?;
-    let unused = opts.unused().map_err(e)?;
+    snes.solve(&mut x, &mut j, None, &mut p).map_err(e)?;
+    // porompm's own options (`-porompm_…`) are read by the application, not by PETSc's objects.
+    let unused: Vec<_> = opts.unused().map_err(e)?.into_iter().filter(|o| !o.name.starts_with("porompm_")).collect();
     drop(snes);
     opts.pop().map_err(e)?;
     let names: Vec<String> = unused.iter().map(|o| o.name.clone()).collect();

@@ -22,7 +22,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         x.set_all(0.0)?;
         let mut f = x.duplicate()?;
         callbacks.residual(&x.as_ref(), &mut f.as_ref()).map_err(error)?;
-        callbacks.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(error)?;
+        callbacks.jacobian(&x.as_ref(), &mut jac.as_ref(), None).map_err(error)?;
         f.norm2()
     }
 }

@@ -49,6 +49,9 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
     schur: Option<&'a mut petsc::SchurUser>,
     /// Where the pattern's blocks sit in the matrix.
     places: &'a BlockPlaces,
+    /// Where the multilinear pattern's blocks sit in the preconditioning matrix, if it is not the
+    /// Jacobian ([`super::lowered`]).
+    lowered_places: Option<&'a BlockPlaces>,
     /// The first material point whose residual block was not finite in this solve (on this
     /// rank), with the quantity that was not.
     pub(super) nonfinite: Option<String>,
@@ -56,20 +59,22 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
 
 /// What the callbacks borrow from the solver: the node space's DMDA, the local work vectors, the
 /// assembly's log stage, the user-built Schur preconditioner, if any, and the places of the
-/// pattern's blocks in the matrix.
+/// patterns' blocks in the matrices.
 pub(super) struct Workspace<'a, const D: usize> {
     pub dm: &'a DmDa<D>,
     pub x_local: &'a mut Vector,
     pub f_local: &'a mut Vector,
     pub stage: &'a LogStage,
     pub schur: Option<&'a mut petsc::SchurUser>,
-    pub places: &'a BlockPlaces,
+    /// Where the pattern's blocks sit in the Jacobian and, if the preconditioner has a matrix of
+    /// its own, in that one.
+    pub places: (&'a BlockPlaces, Option<&'a BlockPlaces>),
 }
 
 impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> {
     /// The callbacks of `step` of `model` on the solver's `work`.
     pub(super) fn new(model: &'a Model<D>, step: &'a Step<D, M>, work: Workspace<'a, D>) -> Callbacks<'a, D, M, N> {
-        let Workspace { dm, x_local, f_local, stage, schur, places } = work;
+        let Workspace { dm, x_local, f_local, stage, schur, places: (places, lowered_places) } = work;
         Callbacks {
             points: Points::new(model, step),
             step,
@@ -80,6 +85,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> 
             stage,
             schur,
             places,
+            lowered_places,
             nonfinite: None,
         }
     }
@@ -143,7 +149,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         Ok(())
     }
 
-    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> Result<(), CallbackError> {
+    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef, p: Option<&mut MatRef>) -> Result<(), CallbackError> {
         let _stage = self.stage.push().map_err(fatal)?;
         let t0 = Instant::now();
         let xl = self.gather(x)?;
@@ -154,9 +160,33 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         let pattern = &step.pattern;
         let mut cuts: Vec<usize> = step.bands.iter().map(|b| pattern.row_start(b.lo)).collect();
         cuts.push(pattern.len());
+        // With a preconditioning matrix of its own ([`super::lowered`]), each point's blocks of
+        // both matrices in one pass over the points.
+        let lowered = match (p, step.lowered.as_ref(), self.lowered_places) {
+            (Some(p), Some(low), Some(places)) => Some((p, low, places)),
+            (None, _, _) => None,
+            _ => return Err(CallbackError::Fatal("the step has no preconditioning matrix of its own".into())),
+        };
         let filled = j.fill_blocks(self.places, |values| -> Result<(), petsc::Error> {
-            let parts = step.bands.iter().copied().zip(values.bands(&cuts)?).collect();
-            run_parts(parts, |band, mut v| ps.tangent_band(band, &mut v, &xl));
+            let parts: Vec<_> = step.bands.iter().copied().zip(values.bands(&cuts)?).collect();
+            match lowered {
+                None => {
+                    run_parts(parts, |band, mut v| ps.tangent_band(band, &mut v, None, &xl));
+                }
+                Some((p, low, places)) => {
+                    let mut lcuts: Vec<usize> = step.bands.iter().map(|b| low.pattern.row_start(b.lo)).collect();
+                    lcuts.push(low.pattern.len());
+                    p.fill_blocks(places, |lvalues| -> Result<(), petsc::Error> {
+                        let both =
+                            parts.into_iter().zip(lvalues.bands(&lcuts)?).map(|((b, v), l)| (b, (v, l))).collect();
+                        run_parts(both, |band, (mut v, mut l)| ps.tangent_band(band, &mut v, Some((&mut l, low)), &xl));
+                        for &(blk, c) in &low.fixed_diagonals {
+                            lvalues.row_mut(blk as usize, c)[c] = 1.0;
+                        }
+                        Ok(())
+                    })??;
+                }
+            }
             if let Some(p) = layout.p {
                 for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
                     let c = cell.nodes.len();

@@ -71,7 +71,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             f
         };
         let free: Vec<usize> = (0..n).filter(|&o| !fixed[o]).collect();
-        asm.jacobian(&x.as_ref(), &mut jac.as_ref()).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
+        asm.jacobian(&x.as_ref(), &mut jac.as_ref(), None).map_err(|e| petsc::Error::new(format!("{e:?}")))?;
         let (_, mut dense) = jac.local_rows_dense()?;
         if let Some((rf, cf)) = flip {
             for &r in free.iter().filter(|&&r| r % nd == rf) {

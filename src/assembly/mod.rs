@@ -21,6 +21,7 @@ pub mod dofs;
 mod explicit;
 mod forces;
 mod loads;
+mod lowered;
 mod matrix;
 pub mod pattern;
 mod points;

@@ -256,6 +256,50 @@ impl<const D: usize> Pattern<D> {
         p
     }
 
+    /// The pattern of the pairs within the first list of each of `groups` and the diagonal blocks
+    /// of the nodes of its second list, with the `owned` nodes' diagonal blocks, on a ghosted grid
+    /// of `counts` nodes per direction; the dense table spans neighbouring nodes (the preconditioning
+    /// matrix of [`super::lowered`], whose first lists are cells' corners).
+    pub fn of_groups<'g>(
+        groups: impl Iterator<Item = (&'g [u32], &'g [u32])>,
+        owned: &[u32],
+        counts: [usize; D],
+    ) -> Pattern<D> {
+        let nodes: usize = counts.iter().product();
+        let mut p = Pattern { counts, ..Pattern::default() };
+        p.set_reach(1);
+        p.near = vec![NONE; nodes * p.stride];
+        for &a in owned {
+            p.insert(a, a);
+        }
+        for (pairs, diagonals) in groups {
+            for &a in pairs {
+                for &b in pairs {
+                    p.insert(a, b);
+                }
+            }
+            for &a in diagonals {
+                p.insert(a, a);
+            }
+        }
+        p.sort(nodes);
+        p
+    }
+
+    /// (diagonal block, component) of each of the owned fixed dofs `owned_fixed` ((owned index,
+    /// ghosted dof) pairs, [`super::dofs::DofMap::owned_fixed`]) of `nd` dofs per node.
+    pub fn fixed_diagonals(&self, owned_fixed: &[(usize, usize)], nd: usize) -> Result<Vec<(u32, usize)>, String> {
+        owned_fixed
+            .iter()
+            .map(|&(_, q)| {
+                let node = (q / nd) as u32;
+                self.block(node, node)
+                    .map(|b| (b, q % nd))
+                    .ok_or_else(|| "an owned diagonal block is not listed".into())
+            })
+            .collect()
+    }
+
     /// Sets the dense table's reach and the width and stride derived from it (kept so that a
     /// lookup does not form them).
     fn set_reach(&mut self, reach: i64) {

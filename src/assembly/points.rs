@@ -3,6 +3,7 @@
 //! dof or into the rows of the matrix, by bands of node layers on threads. Pure Rust: the SNES
 //! callbacks ([`super::callbacks`]) and the step's preparation, balance and explicit update call it.
 
+use super::lowered::Lowered;
 use super::stencils::Stencils;
 use super::step::{Band, Solution, Step};
 use crate::kernels::{self, NodeState, StepResult};
@@ -433,7 +434,14 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
 
     /// The tangent blocks of every particle that reaches `band`, added into the band's part
     /// `values` of the matrix.
-    pub(super) fn tangent_band(&self, band: Band, values: &mut BlockBand<'_>, xl: &[f64]) {
+    pub(super) fn tangent_band(
+        &self,
+        band: Band,
+        values: &mut BlockBand<'_>,
+        mut lowered: Option<(&mut BlockBand<'_>, &Lowered<D>)>,
+        xl: &[f64],
+    ) {
+        let mut cell = Vec::new();
         let step = self.step;
         let nm = step.scheme;
         let layout = step.layout;
@@ -460,9 +468,75 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
                     // The mapped stiffness serves the diagnostics only: the exact tangent.
                     kernels::tangent_with(pt, &nm, &mut block[..m * m], 1.0);
                 }
+                if let Some((pv, low)) = lowered.as_mut() {
+                    self.add_lowered(k, pt, band, pv, low, &mut cell);
+                }
                 m
             });
             self.add_tangent(k, &mut block[..m * m], m, &mut scratch, values, band);
+        }
+    }
+
+    /// Adds point `k`'s multilinear preconditioning blocks ([`kernels::lowered`]) of point `pt`
+    /// whose rows lie in `band` to the band's part `values` of the preconditioning matrix of
+    /// `lowered`: the cell block over its corners and the diagonal block of each stencil node that
+    /// is no point's corner, without the rows and columns of fixed dofs. `cell` is scratch.
+    #[allow(clippy::too_many_arguments)]
+    fn add_lowered(
+        &self,
+        k: usize,
+        pt: &kernels::Point<D, M>,
+        band: Band,
+        values: &mut BlockBand<'_>,
+        lowered: &Lowered<D>,
+        cell: &mut Vec<f64>,
+    ) {
+        let step = self.step;
+        let (nd, grid) = (step.dofs.nd, &self.model.grid);
+        let fixed = &step.dofs.fixed;
+        let free = |a: u32, i: usize| !fixed[a as usize * nd + i];
+        let corners = lowered.corners_of(k);
+        let (raw, _) = step.stencils.get(k);
+        let v = pt.volume_new() * step.scheme.w_force;
+        let d = &pt.upd.tangent;
+        // The point on x_n and its cell's lowest corner (the cell `lowered` took the corners of).
+        let x = self.model.particles.x[k];
+        let lo = grid.position(grid.nearest(x));
+        let n = corners.len() * D;
+        at_least(cell, n * n);
+        let grads = kernels::lowered::corner_gradients(lo, grid.h, x);
+        kernels::lowered::cell_block(&grads[..corners.len()], d, v, &mut cell[..n * n]);
+        for (p, &a) in corners.iter().enumerate().filter(|(_, &a)| band.holds(a)) {
+            let first = lowered.pattern.block(a, a).expect("the pattern holds every pair of corners") as usize;
+            let rows = values.row_places(first);
+            for (q, &b) in corners.iter().enumerate() {
+                let blk = lowered.pattern.block(a, b).expect("the pattern holds every pair of corners") as usize;
+                values.with_rows_of_run(&rows, blk, 1, |i, out| {
+                    if free(a, i) {
+                        let row = &cell[(p * D + i) * n + q * D..][..D];
+                        for (j, (o, x)) in out.iter_mut().zip(row).enumerate() {
+                            if free(b, j) {
+                                *o += x;
+                            }
+                        }
+                    }
+                });
+            }
+        }
+        for (i, &a) in raw.iter().enumerate().filter(|(_, &a)| band.holds(a) && lowered.lone[a as usize]) {
+            let b = kernels::lowered::strain_operator(pt.spatial[i].0);
+            let k3 = kernels::lowered::pair_block(&b, &b, d, v);
+            let blk = lowered.pattern.block(a, a).expect("the pattern holds every stencil node's diagonal") as usize;
+            let rows = values.row_places(blk);
+            values.with_rows_of_run(&rows, blk, 1, |i, out| {
+                if free(a, i) {
+                    for (j, o) in out.iter_mut().enumerate().take(D) {
+                        if free(a, j) {
+                            *o += k3[i][j];
+                        }
+                    }
+                }
+            });
         }
     }
 

@@ -20,6 +20,7 @@
 
 use super::dim::StepDim;
 use super::dofs::{self, DofMap};
+use super::lowered::{Lowered, PcMatrix};
 use super::pattern::Pattern;
 use super::points::{bands, Points};
 use super::pressure;
@@ -54,6 +55,9 @@ pub(super) struct StepRequest<'a, const D: usize, const M: usize> {
     pub times: (f64, f64),
     /// The pattern of the solver's matrix, if it has one.
     pub kept: Option<Arc<Pattern<D>>>,
+    /// The matrix the preconditioner is built from and the pattern of the solver's multilinear
+    /// one, if it has one.
+    pub pc_matrix: (PcMatrix, Option<Arc<Pattern<D>>>),
     pub schur: SchurNeeds,
     /// Whether the step is the first of its stage (the energy ledger's start, see
     /// [`Step::imbalance_at_start`]).
@@ -72,7 +76,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
     where
         Dim<D>: StepDim<D>,
     {
-        let StepRequest { active, times, kept, schur, stage_start } = request;
+        let StepRequest { active, times, kept, pc_matrix, schur, stage_start } = request;
         let (t_old, t_new) = times;
         let dt = t_new - t_old;
         let (mut st, crossings) = stencils_on_xn::<D, M>(space, model, coll)?;
@@ -121,6 +125,9 @@ impl<const D: usize, const M: usize> Step<D, M> {
             return Ok(step);
         }
         step.matrix_pattern(space, kept, coll)?;
+        if pc_matrix.0 == PcMatrix::Multilinear {
+            step.lowered = Some(Lowered::of(&step, model, space, pc_matrix.1, coll)?);
+        }
         Ok(step)
     }
 
@@ -202,6 +209,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
             start_imbalance: Vec::new(),
             drained: Vec::new(),
             boundary_fill: Vec::new(),
+            lowered: None,
         };
         loads::check_loads(space, &step, &applied, t_new, coll)?;
         if model.linear_increments {
@@ -268,15 +276,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
             .collect();
         self.projection_blocks =
             projection_blocks.ok_or("a pressure-projection cell's nodes are not coupled by any particle")?;
-        self.fixed_diagonals = self
-            .dofs
-            .owned_fixed
-            .iter()
-            .map(|&(_, q)| {
-                let node = (q / nd) as u32;
-                pattern.block(node, node).map(|b| (b, q % nd)).ok_or("an owned diagonal block is not listed")
-            })
-            .collect::<Result<_, _>>()?;
+        self.fixed_diagonals = pattern.fixed_diagonals(&self.dofs.owned_fixed, nd)?;
         self.pattern = pattern;
         Ok(())
     }

@@ -3,6 +3,7 @@
 //! what its solve found ([`Solution`]).
 
 use super::dofs::DofMap;
+use super::lowered::Lowered;
 use super::pattern::Pattern;
 use super::stencils::Stencils;
 use super::stiffness::MappedStiffness;
@@ -49,6 +50,9 @@ pub struct Step<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     pub(super) projection_blocks: Vec<Vec<u32>>,
     /// (diagonal block, component) of every owned fixed dof.
     pub(super) fixed_diagonals: Vec<(u32, usize)>,
+    /// The multilinear preconditioning matrix's cells and pattern (`-porompm_pc_matrix
+    /// multilinear`; `None`: the preconditioner is built from the Jacobian).
+    pub(super) lowered: Option<Lowered<D>>,
     /// The pressure unknown's scale s [Pa/m] ([`pressure::scale`]): PETSc sees Δp / s, and the
     /// continuity rows multiplied by s.
     pub(super) p_scale: f64,
@@ -140,8 +144,9 @@ impl Band {
 
 impl<const D: usize, const M: usize> Step<D, M> {
     /// The bytes the step's data hold on the heap, `(stencils, the rest)`: the stencils, and the
-    /// dof map, loads, predictors, bands, projection, faces, mapped stiffness and start terms
-    /// (the matrix pattern, shared with the system's matrix, is the matrix's).
+    /// dof map, loads, predictors, bands, projection, faces, mapped stiffness, start terms and the
+    /// multilinear preconditioning matrix's corners (the matrix patterns, shared with the system's
+    /// matrices, are the matrices').
     pub fn heap_bytes(&self) -> (usize, usize) {
         use crate::algebra::heap::{capacity as c, nested};
         let projection = c(&self.projection) + self.projection.iter().map(|p| c(&p.nodes) + c(&p.s)).sum::<usize>();
@@ -162,6 +167,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
             + self.dofs.heap_bytes()
             + c(&self.bands)
             + c(&self.fixed_diagonals)
+            + self.lowered.as_ref().map_or(0, |l| c(&l.corners) + c(&l.lone) + c(&l.fixed_diagonals))
             + self.stiffness.heap_bytes();
         (self.stencils.heap_bytes(), rest)
     }

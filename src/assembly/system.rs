@@ -5,7 +5,9 @@
 
 use super::callbacks::{AssemblyTime, Callbacks, Workspace};
 use super::dim::StepDim;
+use super::lowered::PcMatrix;
 use super::matrix::Matrix;
+use super::pattern::Pattern;
 use super::prepare::StepRequest;
 use super::pressure::{self, L2Projection};
 use super::space::{NodeBlock, NodeSpace};
@@ -103,6 +105,10 @@ pub struct System<
     f_local: Vector,
     snes: Snes,
     matrix: Option<Matrix<D>>,
+    /// The matrix the preconditioner is built from ([`super::lowered::PC_MATRIX_OPTION`]) and, when it is not the
+    /// Jacobian, that matrix.
+    pc_matrix: PcMatrix,
+    lowered: Option<Matrix<D>>,
     /// The rigid-body modes of the grid, attached to every Jacobian of a system whose unknowns are
     /// all displacements (see [`splits::displacement_near_null_space`]); empty otherwise.
     near_null: Vec<Vector>,
@@ -191,6 +197,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             snes.monitor_fields(layout.fields().into_iter().map(|(_, c)| c).collect(), test)?;
         }
         let user_atol = snes.tolerances()?.0;
+        let pc_matrix = PcMatrix::from_options(layout)?;
         let retry_with_line_search = petsc::Options::global().get_bool(LINE_SEARCH_RETRY_OPTION)?.unwrap_or(true);
         let stages = Stages {
             run_setup: LogStage::register("porompm: setup")?,
@@ -207,6 +214,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             f_local,
             snes,
             matrix: None,
+            pc_matrix,
+            lowered: None,
             near_null,
             schur,
             schur_tuning,
@@ -230,13 +239,18 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.space.layout
     }
 
-    /// This rank's matrix memory in bytes: its compressed-row storage in PETSc (`petsc::mat::MatStats`)
-    /// and the program's side of it (the block pattern and the blocks' places in the matrix, into
-    /// which a Jacobian writes its blocks with no buffer of its own); zeros without a matrix. Not
-    /// collective.
+    /// This rank's matrix memory in bytes: the compressed-row storage in PETSc
+    /// (`petsc::mat::MatStats`) and the program's side of it (the block pattern and the blocks'
+    /// places in the matrix, into which a Jacobian writes its blocks with no buffer of its own), of
+    /// the Jacobian and of the preconditioning matrix where it has one of its own; zeros without a
+    /// matrix. Not collective.
     pub fn matrix_memory(&self) -> Result<(f64, usize), Error> {
-        let Some(m) = &self.matrix else { return Ok((0.0, 0)) };
-        Ok((m.mat.stats()?.memory_bytes, m.pattern.heap_bytes() + m.places.heap_bytes()))
+        let (mut petsc, mut own) = (0.0, 0);
+        for m in self.matrix.iter().chain(&self.lowered) {
+            petsc += m.mat.stats()?.memory_bytes;
+            own += m.pattern.heap_bytes() + m.places.heap_bytes();
+        }
+        Ok((petsc, own))
     }
 
     /// Enters a log stage until the guard is dropped.
@@ -270,7 +284,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             tuning: self.schur_tuning,
         };
         let kept = self.matrix.as_ref().map(|m| m.pattern.clone());
-        let request = StepRequest { active, times: (t_new - dt, t_new), kept, schur, stage_start };
+        let pc_matrix = (self.pc_matrix, self.lowered.as_ref().map(|m| m.pattern.clone()));
+        let request = StepRequest { active, times: (t_new - dt, t_new), kept, pc_matrix, schur, stage_start };
         Step::prepare::<N>(&mut self.space, model, request, coll)
     }
 
@@ -380,23 +395,47 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
     /// one (with the near-null space of a displacement system; the Schur preconditioner then
     /// forgets the old matrix's blocks). Collective.
     fn matrix_for(&mut self, step: &Step<D, M>, coll: &Collective) -> Result<(), Error> {
+        self.lowered_matrix_for(step, coll)?;
         if self.matrix.as_ref().is_some_and(|m| Arc::ptr_eq(&m.pattern, &step.pattern)) {
             self.reused_patterns += 1;
             return Ok(());
         }
         self.matrix = None;
-        let mut matrix = Matrix::of(&step.pattern, &self.space, coll).map_err(Error::new)?;
+        let matrix = self.new_matrix(&step.pattern, coll)?;
+        if let Some(schur) = &mut self.schur {
+            schur.forget();
+        }
+        self.matrix = Some(matrix);
+        Ok(())
+    }
+
+    /// The multilinear preconditioning matrix of `step`'s pattern ([`super::lowered`]), with the
+    /// near-null space the preconditioner reads: the last one while the step shares its pattern,
+    /// else a new one; none when the preconditioner is built from the Jacobian. Collective.
+    fn lowered_matrix_for(&mut self, step: &Step<D, M>, coll: &Collective) -> Result<(), Error> {
+        let Some(lowered) = &step.lowered else {
+            self.lowered = None;
+            return Ok(());
+        };
+        if self.lowered.as_ref().is_some_and(|m| Arc::ptr_eq(&m.pattern, &lowered.pattern)) {
+            return Ok(());
+        }
+        self.lowered = None;
+        self.lowered = Some(self.new_matrix(&lowered.pattern, coll)?);
+        Ok(())
+    }
+
+    /// A matrix of `pattern` with the near-null space of a displacement system attached (which
+    /// GAMG reads from the matrix it builds its hierarchy from). Collective.
+    fn new_matrix(&self, pattern: &Arc<Pattern<D>>, coll: &Collective) -> Result<Matrix<D>, Error> {
+        let mut matrix = Matrix::of(pattern, &self.space, coll).map_err(Error::new)?;
         let null = if self.near_null.is_empty() {
             Ok(())
         } else {
             matrix.mat.set_near_null_space(self.space.comm, &self.near_null)
         };
         coll.agree(null.map_err(|e| e.to_string())).map_err(Error::new)?;
-        if let Some(schur) = &mut self.schur {
-            schur.forget();
-        }
-        self.matrix = Some(matrix);
-        Ok(())
+        Ok(matrix)
     }
 
     /// Sets MUMPS's workspace relaxation ICNTL(14) to [`MUMPS_WORKSPACE_FACTOR`] times `icntl14`
@@ -417,12 +456,17 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         step: &Step<D, M>,
         model: &Model<D>,
     ) -> Result<(SolveOutcome, Option<String>, AssemblyTime), Error> {
-        let System { space, x, x_local, f_local, snes, matrix, schur, stages, .. } = self;
+        let System { space, x, x_local, f_local, snes, matrix, lowered, schur, stages, .. } = self;
         let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
+        let (pmat, pc_places) = match lowered.as_mut() {
+            Some(Matrix { mat, places, .. }) => (Some(mat), Some(&*places)),
+            None => (None, None),
+        };
+        let places = (&*places, pc_places);
         let work =
             Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
         let mut callbacks = Callbacks::<D, M, N>::new(model, step, work);
-        let out = snes.solve(x, jac, &mut callbacks)?;
+        let out = snes.solve(x, jac, pmat, &mut callbacks)?;
         Ok((out, callbacks.nonfinite.take(), callbacks.time))
     }
 
@@ -540,6 +584,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.matrix_for(step, coll)?;
         let System { space, x, x_local, f_local, matrix, schur, stages, .. } = self;
         let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
+        let places = (&*places, None);
         let work =
             Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
         Ok((x, jac, Callbacks::new(model, step, work)))

@@ -56,6 +56,7 @@ pub mod flow;
 pub mod inertia;
 pub mod input;
 pub mod kinematics;
+pub mod lowered;
 pub mod stress;
 
 use crate::layout::{Layout, MAX_DOF, MAX_DOF_3D};

@@ -29,8 +29,15 @@ pub enum CallbackError {
 pub trait NonlinearProblem {
     /// Evaluates `f = F(x)`.
     fn residual(&mut self, x: &VecRef, f: &mut VecRef) -> std::result::Result<(), CallbackError>;
-    /// Assembles the Jacobian `J = dF/dx` at `x` into `j` (the matrix given to [`Snes::solve`]).
-    fn jacobian(&mut self, x: &VecRef, j: &mut MatRef) -> std::result::Result<(), CallbackError>;
+    /// Assembles the Jacobian `J = dF/dx` at `x` into `j` (the matrix given to [`Snes::solve`])
+    /// and, when [`Snes::solve`] was given a preconditioning matrix apart from it, that matrix at
+    /// `x` into `p`.
+    fn jacobian(
+        &mut self,
+        x: &VecRef,
+        j: &mut MatRef,
+        p: Option<&mut MatRef>,
+    ) -> std::result::Result<(), CallbackError>;
 }
 
 /// What one [`Snes::solve`] did.
@@ -144,7 +151,7 @@ unsafe extern "C" fn jacobian_trampoline(
     snes: sys::SNES,
     x: sys::Vec,
     a: sys::Mat,
-    _p: sys::Mat,
+    p: sys::Mat,
     ctx: *mut c_void,
 ) -> sys::PetscErrorCode {
     if ctx.is_null() {
@@ -153,7 +160,10 @@ unsafe extern "C" fn jacobian_trampoline(
     }
     // SAFETY: as in `residual_trampoline`.
     let ctx = unsafe { &mut *(ctx as *mut Context) };
-    let outcome = guarded(|| ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a)));
+    let outcome = guarded(|| {
+        let mut pre = MatRef::new(p);
+        ctx.problem.jacobian(&VecRef::new(x), &mut MatRef::new(a), (p != a).then_some(&mut pre))
+    });
     finish(outcome, "Jacobian assembly", ctx, || {
         // SAFETY: valid SNES handle passed by PETSc.
         unsafe { sys::SNESSetJacobianDomainError(snes) };
@@ -368,24 +378,31 @@ impl Snes {
         Ok(n)
     }
 
-    /// Solves `F(x) = 0` starting from `x`, with `jac` as Jacobian (and preconditioning) matrix.
+    /// Solves `F(x) = 0` starting from `x`, with `jac` as Jacobian matrix and `pmat` as the
+    /// matrix the preconditioner is built from (`None`: `jac` itself).
     ///
     /// Solver failures that PETSc reports as divergence (line search, iteration limit, domain
     /// error) come back as `Ok` with `converged == false`; only genuine errors are `Err`.
-    pub fn solve(&mut self, x: &mut Vector, jac: &mut Mat, problem: &mut dyn NonlinearProblem) -> Result<SolveOutcome> {
+    pub fn solve(
+        &mut self,
+        x: &mut Vector,
+        jac: &mut Mat,
+        pmat: Option<&mut Mat>,
+        problem: &mut dyn NonlinearProblem,
+    ) -> Result<SolveOutcome> {
+        let pre = pmat.map_or(jac.raw, |p| p.raw);
         if let Some(m) = self.fields.as_mut() {
             m.reset();
         }
         let mut ctx = Context { problem, domain_error: None };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
         call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), ctx_ptr))?;
-        call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), ctx_ptr))?;
+        call!(SNESSetJacobian(self.raw, jac.raw, pre, Some(jacobian_trampoline), ctx_ptr))?;
         let solved = call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()));
         // Never leave a pointer to this stack frame inside the SNES.
         let unset_f =
             call!(SNESSetFunction(self.raw, std::ptr::null_mut(), Some(residual_trampoline), std::ptr::null_mut()));
-        let unset_j =
-            call!(SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_trampoline), std::ptr::null_mut()));
+        let unset_j = call!(SNESSetJacobian(self.raw, jac.raw, pre, Some(jacobian_trampoline), std::ptr::null_mut()));
         solved?;
         unset_f?;
         unset_j?;
