@@ -12,7 +12,7 @@
 
 use super::pattern::Pattern;
 use super::space::NodeSpace;
-use super::step::Step;
+use super::step::{Lowered, Step};
 use crate::layout::Layout;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -59,86 +59,62 @@ impl PcMatrix {
     }
 }
 
-/// The multilinear preconditioning matrix's side of a step: each point's cell corners (2^D
-/// ghosted node numbers per point), which ghosted nodes are no point's corner on any rank (they
-/// take the diagonal blocks of the points' own bases), the pattern, and the (diagonal block,
-/// component) of every owned fixed dof in it.
-#[derive(Debug, Clone)]
-pub(super) struct Lowered<const D: usize> {
-    pub corners: Vec<u32>,
-    pub lone: Vec<bool>,
-    pub pattern: Arc<Pattern<D>>,
-    pub fixed_diagonals: Vec<(u32, usize)>,
-}
-
-impl<const D: usize> Lowered<D> {
-    /// The corners of point `k`'s cell.
-    pub fn corners_of(&self, k: usize) -> &[u32] {
-        let c = 1 << D;
-        &self.corners[k * c..(k + 1) * c]
+/// The multilinear preconditioning matrix's side of `step` ([`Lowered`]): its pattern kept (`old`) if every rank finds every pair in
+/// it, else a new one. Collective.
+pub(super) fn prepare<const D: usize, const M: usize>(
+    step: &Step<D, M>,
+    model: &Model<D>,
+    space: &mut NodeSpace<D>,
+    old: Option<Arc<Pattern<D>>>,
+    coll: &Collective,
+) -> Result<Lowered<D>, String> {
+    if step.scheme.a0 * step.scheme.w_inertia != 0.0 || model.geometry.axisymmetric() {
+        return Err(format!(
+            "{PC_MATRIX_OPTION} multilinear takes static stages in plane strain and three dimensions: \
+             its matrix has no inertia and no hoop terms (drop the option for this case)"
+        ));
     }
-
-    /// The multilinear side of `step`: its pattern kept (`old`) if every rank finds every pair in
-    /// it, else a new one. Collective.
-    pub fn of<const M: usize>(
-        step: &Step<D, M>,
-        model: &Model<D>,
-        space: &mut NodeSpace<D>,
-        old: Option<Arc<Pattern<D>>>,
-        coll: &Collective,
-    ) -> Result<Lowered<D>, String> {
-        if step.scheme.a0 * step.scheme.w_inertia != 0.0 || model.geometry.axisymmetric() {
-            return Err(format!(
-                "{PC_MATRIX_OPTION} multilinear takes static stages in plane strain and three dimensions: \
-                 its matrix has no inertia and no hoop terms (drop the option for this case)"
-            ));
-        }
-        let ps = &model.particles;
-        let c = 1usize << D;
-        let mut corners = Vec::with_capacity(step.stencils.len() * c);
-        for k in 0..step.stencils.len() {
-            let x = ps.x[k];
-            let cell = model.grid.cell_containing(x).ok_or_else(|| {
-                format!("material point {k} at {x:?} m is outside the grid: it has no cell for {PC_MATRIX_OPTION}")
+    let ps = &model.particles;
+    let c = 1usize << D;
+    let mut corners = Vec::with_capacity(step.stencils.len() * c);
+    for k in 0..step.stencils.len() {
+        let x = ps.x[k];
+        let cell = model.grid.cell_containing(x).ok_or_else(|| {
+            format!("material point {k} at {x:?} m is outside the grid: it has no cell for {PC_MATRIX_OPTION}")
+        })?;
+        for corner in 0..c {
+            let n: [usize; D] = std::array::from_fn(|d| cell[d] + (corner >> d & 1));
+            let l = space.ghost.local(n).ok_or_else(|| {
+                format!("material point {k}: a corner of its cell is not among this rank's ghosted nodes")
             })?;
-            for corner in 0..c {
-                let n: [usize; D] = std::array::from_fn(|d| cell[d] + (corner >> d & 1));
-                let l = space.ghost.local(n).ok_or_else(|| {
-                    format!("material point {k}: a corner of its cell is not among this rank's ghosted nodes")
-                })?;
-                corners.push(l as u32);
-            }
+            corners.push(l as u32);
         }
-        let nd = step.dofs.nd;
-        let mut cornered = vec![0.0; space.ghost.len() * nd];
-        for &l in &corners {
-            cornered[l as usize * nd] = 1.0;
-        }
-        space.sum_over_ranks(&mut cornered).map_err(|e| e.to_string())?;
-        let lone: Vec<bool> = cornered.iter().step_by(nd).map(|&x| x == 0.0).collect();
-        let lone_raw: Vec<Vec<u32>> = (0..step.stencils.len())
-            .map(|k| step.stencils.get(k).0.iter().copied().filter(|&a| lone[a as usize]).collect())
-            .collect();
-        let groups = |k: usize| (&corners[k * c..(k + 1) * c], &lone_raw[k][..]);
-        let covers = old.as_ref().is_some_and(|p| {
-            !p.is_empty()
-                && (0..step.stencils.len()).all(|k| {
-                    let (cs, raw) = groups(k);
-                    cs.iter().all(|&a| cs.iter().all(|&b| p.block(a, b).is_some()))
-                        && raw.iter().all(|&a| p.block(a, a).is_some())
-                })
-        });
-        let keep = old.is_some() && !coll.any(!covers)?;
-        let pattern = match old {
-            Some(old) if keep => old,
-            _ => Arc::new(Pattern::of_groups(
-                (0..step.stencils.len()).map(groups),
-                &space.owned_nodes,
-                space.ghost.count,
-            )),
-        };
-        drop(lone_raw);
-        let fixed_diagonals = pattern.fixed_diagonals(&step.dofs.owned_fixed, nd)?;
-        Ok(Lowered { corners, lone, pattern, fixed_diagonals })
     }
+    let nd = step.dofs.nd;
+    let mut cornered = vec![0.0; space.ghost.len() * nd];
+    for &l in &corners {
+        cornered[l as usize * nd] = 1.0;
+    }
+    space.sum_over_ranks(&mut cornered).map_err(|e| e.to_string())?;
+    let lone: Vec<bool> = cornered.iter().step_by(nd).map(|&x| x == 0.0).collect();
+    let lone_raw: Vec<Vec<u32>> = (0..step.stencils.len())
+        .map(|k| step.stencils.get(k).0.iter().copied().filter(|&a| lone[a as usize]).collect())
+        .collect();
+    let groups = |k: usize| (&corners[k * c..(k + 1) * c], &lone_raw[k][..]);
+    let covers = old.as_ref().is_some_and(|p| {
+        !p.is_empty()
+            && (0..step.stencils.len()).all(|k| {
+                let (cs, raw) = groups(k);
+                cs.iter().all(|&a| cs.iter().all(|&b| p.block(a, b).is_some()))
+                    && raw.iter().all(|&a| p.block(a, a).is_some())
+            })
+    });
+    let keep = old.is_some() && !coll.any(!covers)?;
+    let pattern = match old {
+        Some(old) if keep => old,
+        _ => Arc::new(Pattern::of_groups((0..step.stencils.len()).map(groups), &space.owned_nodes, space.ghost.count)),
+    };
+    drop(lone_raw);
+    let fixed_diagonals = pattern.fixed_diagonals(&step.dofs.owned_fixed, nd)?;
+    Ok(Lowered { corners, lone, pattern, fixed_diagonals })
 }

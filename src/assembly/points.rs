@@ -3,9 +3,8 @@
 //! dof or into the rows of the matrix, by bands of node layers on threads. Pure Rust: the SNES
 //! callbacks ([`super::callbacks`]) and the step's preparation, balance and explicit update call it.
 
-use super::lowered::Lowered;
 use super::stencils::Stencils;
-use super::step::{Band, Solution, Step};
+use super::step::{Band, Lowered, Solution, Step};
 use crate::kernels::{self, NodeState, StepResult};
 use crate::model::Model;
 use crate::scheme::Scheme;

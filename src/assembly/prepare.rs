@@ -20,7 +20,7 @@
 
 use super::dim::StepDim;
 use super::dofs::{self, DofMap};
-use super::lowered::{Lowered, PcMatrix};
+use super::lowered::{self, PcMatrix};
 use super::pattern::Pattern;
 use super::points::{bands, Points};
 use super::pressure;
@@ -126,7 +126,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         step.matrix_pattern(space, kept, coll)?;
         if pc_matrix.0 == PcMatrix::Multilinear {
-            step.lowered = Some(Lowered::of(&step, model, space, pc_matrix.1, coll)?);
+            step.lowered = Some(lowered::prepare(&step, model, space, pc_matrix.1, coll)?);
         }
         Ok(step)
     }

@@ -3,7 +3,6 @@
 //! what its solve found ([`Solution`]).
 
 use super::dofs::DofMap;
-use super::lowered::Lowered;
 use super::pattern::Pattern;
 use super::stencils::Stencils;
 use super::stiffness::MappedStiffness;
@@ -82,6 +81,26 @@ pub struct Step<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// The mean filled fraction of each moving boundary's nodes at the step's start (None for a
     /// boundary that prescribes no motion).
     pub boundary_fill: Vec<Option<f64>>,
+}
+
+/// The multilinear preconditioning matrix's side of a step: each point's cell corners (2^D
+/// ghosted node numbers per point), which ghosted nodes are no point's corner on any rank (they
+/// take the diagonal blocks of the points' own bases), the pattern, and the (diagonal block,
+/// component) of every owned fixed dof in it.
+#[derive(Debug, Clone)]
+pub(super) struct Lowered<const D: usize> {
+    pub corners: Vec<u32>,
+    pub lone: Vec<bool>,
+    pub pattern: Arc<Pattern<D>>,
+    pub fixed_diagonals: Vec<(u32, usize)>,
+}
+
+impl<const D: usize> Lowered<D> {
+    /// The corners of point `k`'s cell.
+    pub fn corners_of(&self, k: usize) -> &[u32] {
+        let c = 1 << D;
+        &self.corners[k * c..(k + 1) * c]
+    }
 }
 
 /// The nodal terms of an explicit step's start, this rank's shares per ghosted dof (see
