@@ -4,8 +4,9 @@
 //! preconditioner (algebraic multigrid above all) is built from a matrix that couples each node with
 //! its 3^D neighbours only, instead of the Jacobian's (2r + 1)^D of a basis of support radius r.
 //!
-//! Its pattern holds the pairs of each point's cell corners, the diagonal block of every node of
-//! each point's stencil and of every owned node; it is kept from step to step while it covers them,
+//! Its pattern holds the pairs of each point's cell corners, the diagonal block of every node of a
+//! point's stencil that is no point's corner on any rank, and of every owned node; it is kept from
+//! step to step while it covers them,
 //! as the Jacobian's is ([`super::pattern`]). Nodes whose motion is extended from well-filled
 //! masters (their dofs fixed) take nothing, as fixed dofs do: a preconditioner may leave out what
 //! such a node passes on to its masters.
