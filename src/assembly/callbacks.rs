@@ -2,11 +2,12 @@
 //! ([`Points`]) at PETSc's iterate, added into a ghosted vector (summed over ranks by PETSc) and
 //! into the matrix's blocks in place, in PETSc's scaling of the pressure unknowns.
 
+use super::pattern::Pattern;
 use super::points::{run_bands, run_parts, Points};
-use super::step::Step;
+use super::step::{Band, Step};
 use crate::model::Model;
 use petsc::snes::NonlinearProblem;
-use petsc::{BlockOps, BlockPlaces, CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
+use petsc::{BlockFill, BlockOps, BlockPlaces, CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
 use std::time::Instant;
 
 fn fatal(e: petsc::Error) -> CallbackError {
@@ -31,6 +32,19 @@ impl AssemblyTime {
         self.seconds += other.seconds;
         self.jacobian_seconds += other.jacobian_seconds;
         self.jacobians += other.jacobians;
+    }
+}
+
+/// Where the blocks of each of `bands` begin in `pattern`'s list, and where the last ends.
+fn band_cuts<const D: usize>(bands: &[Band], pattern: &Pattern<D>) -> Vec<usize> {
+    bands.iter().map(|b| pattern.row_start(b.lo)).chain([pattern.len()]).collect()
+}
+
+/// Fixed dofs: a unit diagonal at each (block, component) of `diagonals` (every other entry of
+/// their rows and columns stays zero).
+fn unit_diagonals(values: &mut BlockFill<'_>, diagonals: &[(u32, usize)]) {
+    for &(blk, c) in diagonals {
+        values.row_mut(blk as usize, c)[c] = 1.0;
     }
 }
 
@@ -157,9 +171,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         let nd = step.dofs.nd;
         let layout = step.layout;
         let ps = self.points;
-        let pattern = &step.pattern;
-        let mut cuts: Vec<usize> = step.bands.iter().map(|b| pattern.row_start(b.lo)).collect();
-        cuts.push(pattern.len());
+        let cuts = band_cuts(&step.bands, &step.pattern);
         // With a preconditioning matrix of its own ([`super::lowered`]), each point's blocks of
         // both matrices in one pass over the points.
         let lowered = match (p, step.lowered.as_ref(), self.lowered_places) {
@@ -174,15 +186,12 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                     run_parts(parts, |band, mut v| ps.tangent_band(band, &mut v, None, &xl));
                 }
                 Some((p, low, places)) => {
-                    let mut lcuts: Vec<usize> = step.bands.iter().map(|b| low.pattern.row_start(b.lo)).collect();
-                    lcuts.push(low.pattern.len());
+                    let lcuts = band_cuts(&step.bands, &low.pattern);
                     p.fill_blocks(places, |lvalues| -> Result<(), petsc::Error> {
                         let both =
                             parts.into_iter().zip(lvalues.bands(&lcuts)?).map(|((b, v), l)| (b, (v, l))).collect();
                         run_parts(both, |band, (mut v, mut l)| ps.tangent_band(band, &mut v, Some((&mut l, low)), &xl));
-                        for &(blk, c) in &low.fixed_diagonals {
-                            lvalues.row_mut(blk as usize, c)[c] = 1.0;
-                        }
+                        unit_diagonals(lvalues, &low.fixed_diagonals);
                         Ok(())
                     })??;
                 }
@@ -202,10 +211,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                 // PETSc's scaling: the continuity rows and the pressure columns times s.
                 values.scale_row_and_column(p, step.p_scale);
             }
-            // Fixed dofs: a unit diagonal (every other entry of their rows and columns stays zero).
-            for &(blk, c) in &step.fixed_diagonals {
-                values.row_mut(blk as usize, c)[c] = 1.0;
-            }
+            unit_diagonals(values, &step.fixed_diagonals);
             Ok(())
         });
         filled.and_then(|r| r).map_err(fatal)?;

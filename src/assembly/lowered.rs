@@ -6,10 +6,9 @@
 //!
 //! Its pattern holds the pairs of each point's cell corners, the diagonal block of every node of a
 //! point's stencil that is no point's corner on any rank, and of every owned node; it is kept from
-//! step to step while it covers them,
-//! as the Jacobian's is ([`super::pattern`]). Nodes whose motion is extended from well-filled
-//! masters (their dofs fixed) take nothing, as fixed dofs do: a preconditioner may leave out what
-//! such a node passes on to its masters.
+//! step to step while it covers them, as the Jacobian's is ([`super::pattern`]). Nodes whose
+//! motion is extended from well-filled masters (their dofs fixed) take nothing, as fixed dofs do:
+//! a preconditioner may leave out what such a node passes on to its masters.
 
 use super::pattern::Pattern;
 use super::space::NodeSpace;
@@ -44,8 +43,9 @@ impl PcMatrix {
             Some("multilinear") => PcMatrix::Multilinear,
             Some(other) => {
                 return Err(petsc::Error::new(format!(
-                "{PC_MATRIX_OPTION} {other}: the preconditioning matrix is `jacobian` (the default) or `multilinear`"
-            )))
+                    "{PC_MATRIX_OPTION} {other}: the preconditioning matrix is `jacobian` (the default) or \
+                     `multilinear`"
+                )))
             }
         };
         let solid = layout.p.is_none() && layout.w.is_none() && layout.jbar.is_none();
@@ -60,8 +60,8 @@ impl PcMatrix {
     }
 }
 
-/// The multilinear preconditioning matrix's side of `step` ([`Lowered`]): its pattern kept (`old`) if every rank finds every pair in
-/// it, else a new one. Collective.
+/// The multilinear preconditioning matrix's side of `step` ([`Lowered`]): its pattern kept (`old`)
+/// if every rank finds every pair in it, else a new one. Collective.
 pub(super) fn prepare<const D: usize, const M: usize>(
     step: &Step<D, M>,
     model: &Model<D>,
@@ -98,24 +98,20 @@ pub(super) fn prepare<const D: usize, const M: usize>(
     }
     space.sum_over_ranks(&mut cornered).map_err(|e| e.to_string())?;
     let lone: Vec<bool> = cornered.iter().step_by(nd).map(|&x| x == 0.0).collect();
-    let lone_raw: Vec<Vec<u32>> = (0..step.stencils.len())
-        .map(|k| step.stencils.get(k).0.iter().copied().filter(|&a| lone[a as usize]).collect())
-        .collect();
-    let groups = |k: usize| (&corners[k * c..(k + 1) * c], &lone_raw[k][..]);
+    // The cells' corner lists, and the stencil nodes of every point that are no point's corner.
+    let cells = || corners.chunks_exact(c);
+    let lone_nodes =
+        || (0..step.stencils.len()).flat_map(|k| step.stencils.get(k).0.iter().copied().filter(|&a| lone[a as usize]));
     let covers = old.as_ref().is_some_and(|p| {
         !p.is_empty()
-            && (0..step.stencils.len()).all(|k| {
-                let (cs, raw) = groups(k);
-                cs.iter().all(|&a| cs.iter().all(|&b| p.block(a, b).is_some()))
-                    && raw.iter().all(|&a| p.block(a, a).is_some())
-            })
+            && cells().all(|cs| cs.iter().all(|&a| cs.iter().all(|&b| p.block(a, b).is_some())))
+            && lone_nodes().all(|a| p.block(a, a).is_some())
     });
     let keep = old.is_some() && !coll.any(!covers)?;
     let pattern = match old {
         Some(old) if keep => old,
-        _ => Arc::new(Pattern::of_groups((0..step.stencils.len()).map(groups), &space.owned_nodes, space.ghost.count)),
+        _ => Arc::new(Pattern::of_groups(cells(), lone_nodes(), &space.owned_nodes, space.ghost.count)),
     };
-    drop(lone_raw);
     let fixed_diagonals = pattern.fixed_diagonals(&step.dofs.owned_fixed, nd)?;
     Ok(Lowered { corners, lone, pattern, fixed_diagonals })
 }

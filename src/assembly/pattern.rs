@@ -213,6 +213,15 @@ impl<const D: usize> Pattern<D> {
         v
     }
 
+    /// Inserts every pair of the `nodes` (a block of the matrix each).
+    fn insert_group(&mut self, nodes: &[u32]) {
+        for &a in nodes {
+            for &b in nodes {
+                self.insert(a, b);
+            }
+        }
+    }
+
     /// The pattern of the particles' effective stencils, the `owned` nodes' diagonal blocks and the
     /// pairs of each of the node `groups` (tied faces, pressure-projection cells), on a ghosted grid
     /// of `counts` nodes per direction.
@@ -238,30 +247,22 @@ impl<const D: usize> Pattern<D> {
             p.insert(a, a);
         }
         for k in 0..st.len() {
-            let eff = st.effective(k);
-            for &a in eff {
-                for &b in eff {
-                    p.insert(a, b);
-                }
-            }
+            p.insert_group(st.effective(k));
         }
         for g in groups {
-            for &a in g {
-                for &b in g {
-                    p.insert(a, b);
-                }
-            }
+            p.insert_group(g);
         }
         p.sort(nodes);
         p
     }
 
-    /// The pattern of the pairs within the first list of each of `groups` and the diagonal blocks
-    /// of the nodes of its second list, with the `owned` nodes' diagonal blocks, on a ghosted grid
-    /// of `counts` nodes per direction; the dense table spans neighbouring nodes (the preconditioning
-    /// matrix of [`super::lowered`], whose first lists are cells' corners).
+    /// The pattern of the pairs within each of `groups` and the diagonal blocks of the
+    /// `diagonals` and of the `owned` nodes, on a ghosted grid of `counts` nodes per direction; the
+    /// dense table spans neighbouring nodes (the preconditioning matrix of [`super::lowered`],
+    /// whose groups are cells' corners).
     pub fn of_groups<'g>(
-        groups: impl Iterator<Item = (&'g [u32], &'g [u32])>,
+        groups: impl Iterator<Item = &'g [u32]>,
+        diagonals: impl Iterator<Item = u32>,
         owned: &[u32],
         counts: [usize; D],
     ) -> Pattern<D> {
@@ -269,18 +270,11 @@ impl<const D: usize> Pattern<D> {
         let mut p = Pattern { counts, ..Pattern::default() };
         p.set_reach(1);
         p.near = vec![NONE; nodes * p.stride];
-        for &a in owned {
+        for a in owned.iter().copied().chain(diagonals) {
             p.insert(a, a);
         }
-        for (pairs, diagonals) in groups {
-            for &a in pairs {
-                for &b in pairs {
-                    p.insert(a, b);
-                }
-            }
-            for &a in diagonals {
-                p.insert(a, a);
-            }
+        for g in groups {
+            p.insert_group(g);
         }
         p.sort(nodes);
         p

@@ -480,7 +480,6 @@ impl<const D: usize, const M: usize, const N: usize> Points<'_, D, M, N> {
     /// whose rows lie in `band` to the band's part `values` of the preconditioning matrix of
     /// `lowered`: the cell block over its corners and the diagonal block of each stencil node that
     /// is no point's corner, without the rows and columns of fixed dofs. `cell` is scratch.
-    #[allow(clippy::too_many_arguments)]
     fn add_lowered(
         &self,
         k: usize,

@@ -105,8 +105,8 @@ pub struct System<
     f_local: Vector,
     snes: Snes,
     matrix: Option<Matrix<D>>,
-    /// The matrix the preconditioner is built from ([`super::lowered::PC_MATRIX_OPTION`]) and, when it is not the
-    /// Jacobian, that matrix.
+    /// The matrix the preconditioner is built from ([`super::lowered::PC_MATRIX_OPTION`]) and,
+    /// when it is not the Jacobian, that matrix.
     pc_matrix: PcMatrix,
     lowered: Option<Matrix<D>>,
     /// The rigid-body modes of the grid, attached to every Jacobian of a system whose unknowns are
