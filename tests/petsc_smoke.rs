@@ -318,6 +318,61 @@ fn a_failed_mumps_factorisation_leaves_the_next_solve_free() -> TestResult {
     Ok(())
 }
 
+/// After a solve the solver holds its matrix, and its preconditioner what it built from it;
+/// `Snes::release_operators` lets go of both for a factorisation and for GAMG (whose levels PETSc
+/// 3.18's `PCReset` would keep, with their old sizes), so that the matrix has no holder but its
+/// handle and the next solve, with a matrix and vectors of another size, builds everything anew.
+/// A field split keeps its splits and everything else: nothing is released.
+fn releasing_the_operators_frees_the_matrix_and_the_next_solve_builds_anew() -> TestResult {
+    for (pc_type, ksp_type) in [("lu", "preonly"), ("gamg", "gmres"), ("fieldsplit", "gmres")] {
+        let mut snes = Snes::new(Comm::self_()).map_err(e)?;
+        snes.set_prefix(&format!("release_{pc_type}_")).map_err(e)?;
+        {
+            let mut ksp = snes.ksp().map_err(e)?;
+            ksp.set_type(ksp_type).map_err(e)?;
+            ksp.pc().map_err(e)?.set_type(pc_type).map_err(e)?;
+        }
+        snes.set_tolerances(Some(1e-12), Some(1e-10), Some(0.0), Some(30)).map_err(e)?;
+        snes.set_from_options().map_err(e)?;
+        let sizes: &[usize] = if pc_type == "fieldsplit" { &[40] } else { &[200, 300] };
+        for &n in sizes {
+            let mut j = dense_matrix(n).map_err(e)?;
+            if pc_type == "fieldsplit" {
+                let mut ksp = snes.ksp().map_err(e)?;
+                let mut pc = ksp.pc().map_err(e)?;
+                let halves = [(0..n as i32 / 2).collect::<Vec<_>>(), (n as i32 / 2..n as i32).collect()];
+                for (name, rows) in ["a", "b"].into_iter().zip(halves) {
+                    pc.field_split_set_is(name, &IndexSet::new_general(Comm::self_(), &rows).map_err(e)?).map_err(e)?;
+                }
+            }
+            let mut p = Cubic { n, b: vec![1.0; n], calls: 0, mode: Mode::Normal };
+            let mut x = Vector::from_slice(&vec![0.5; n]).map_err(e)?;
+            let out = snes.solve(&mut x, &mut j, None, &mut p).map_err(|err| format!("{pc_type}, n = {n}: {err}"))?;
+            if !out.converged {
+                return Err(format!("{pc_type}, n = {n}: {}", out.reason_text));
+            }
+            let held = j.holders().map_err(e)?;
+            if held < 2 {
+                return Err(format!("{pc_type}: the solver does not hold its matrix after a solve ({held} holder)"));
+            }
+            let released = snes.release_operators().map_err(e)?;
+            let after = j.holders().map_err(e)?;
+            match (pc_type, released, after) {
+                ("fieldsplit", false, a) if a == held => {}
+                ("lu" | "gamg", true, 1) => {}
+                _ => {
+                    return Err(format!(
+                        "{pc_type}, n = {n}: release_operators gave {released}, the matrix has {after} holders \
+                         after it ({held} before)"
+                    ))
+                }
+            }
+            println!("    {pc_type}, n = {n}: {} Newton iterations; holders {held} → {after}", out.iterations);
+        }
+    }
+    Ok(())
+}
+
 fn hand_tangent_matches_finite_differences_and_newton_is_quadratic() -> TestResult {
     let n = 8;
     let mut p = Cubic { n, b: (0..n).map(|i| 1.0 + 0.3 * i as f64).collect(), calls: 0, mode: Mode::Normal };
@@ -598,6 +653,10 @@ const TESTS: &[(&str, TestFn)] = &[
         a_failed_mumps_factorisation_leaves_the_next_solve_free,
     ),
     ("unused_options_are_reported", unused_options_are_reported),
+    (
+        "releasing_the_operators_frees_the_matrix_and_the_next_solve_builds_anew",
+        releasing_the_operators_frees_the_matrix_and_the_next_solve_builds_anew,
+    ),
     (
         "a_three_dimensional_dmda_numbers_and_exchanges_its_nodes",
         a_three_dimensional_dmda_numbers_and_exchanges_its_nodes,

@@ -300,13 +300,15 @@ fn the_multilinear_preconditioning_matrix_leaves_the_answers_and_keeps_the_krylo
 }
 
 #[test]
-fn the_multilinear_preconditioning_matrix_is_refused_where_it_does_not_apply_and_a_misspelt_one_always() {
+fn the_multilinear_preconditioning_matrix_is_refused_where_it_does_not_apply_or_with_the_jacobian_in_the_multigrid_and_a_misspelt_one_always(
+) {
     let refused = |name: &str, case: &str, value: &str, message: &str| {
         let mut args = set_args(&["stages.consolidation.duration=0.0003", "grid.cells=[8,8]"]);
         if case.contains("footing") {
             args = set_args(&["parameters.k=1", "stages.push.duration=0.08333333333333333"]);
         }
-        args.extend(["--", "-porompm_pc_matrix", value].map(String::from));
+        args.extend(["--", "-porompm_pc_matrix"].map(String::from));
+        args.extend(value.split(' ').map(String::from));
         let r = run_case(case, &dir(name), &args);
         assert_ne!(r.output.status.code(), Some(0), "{name}: {}", r.stderr());
         assert!(r.stderr().contains(message), "{name}: `{message}` not in: {}", r.stderr());
@@ -318,5 +320,12 @@ fn the_multilinear_preconditioning_matrix_is_refused_where_it_does_not_apply_and
         "tests/cases/footing_square_3d.toml",
         "multilinar",
         "`jacobian` (the default) or `multilinear`",
+    );
+    // PETSc 3.18's multigrid would keep the first Jacobian as its finest residual's operator.
+    refused(
+        "pcm-amat",
+        "tests/cases/footing_square_3d.toml",
+        "multilinear -pc_type gamg -pc_use_amat true",
+        "-pc_use_amat true with -porompm_pc_matrix multilinear",
     );
 }

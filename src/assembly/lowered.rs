@@ -58,6 +58,31 @@ impl PcMatrix {
         }
         Ok(choice)
     }
+
+    /// The options this choice sets before the solver reads its own, under the preconditioner's
+    /// options prefix `pc_prefix`: with a multilinear matrix the preconditioner works on that
+    /// matrix alone (`-pc_use_amat false`, PETSc's default outside multigrid). PETSc 3.18's
+    /// multigrid computes its finest level's residual with the operator it met at its first
+    /// application and keeps it while its hierarchy is reused, which it is while the
+    /// preconditioning matrix keeps its pattern: with the Jacobian as that operator, the residual
+    /// would come from a Jacobian of an earlier step, held in memory beside the current one.
+    /// `-pc_use_amat true` is refused for that reason. Collective (the options database).
+    pub fn set_default_options(self, pc_prefix: &str) -> Result<(), petsc::Error> {
+        if self != PcMatrix::Multilinear {
+            return Ok(());
+        }
+        let name = format!("-{pc_prefix}pc_use_amat");
+        let options = petsc::Options::global();
+        match options.get_bool(&name)? {
+            Some(true) => Err(petsc::Error::new(format!(
+                "{name} true with {PC_MATRIX_OPTION} multilinear: the multigrid would compute its residual with the \
+                 first Jacobian it met and keep it from step to step while its hierarchy is reused (PETSc 3.18); \
+                 drop the option (the preconditioner then works on the multilinear matrix alone)"
+            ))),
+            Some(false) => Ok(()),
+            None => options.set_value(&name, Some("false")),
+        }
+    }
 }
 
 /// The multilinear preconditioning matrix's side of `step` ([`Lowered`]): its pattern kept (`old`)

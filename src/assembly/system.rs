@@ -184,6 +184,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
                 }
             }
         }
+        let pc_matrix = PcMatrix::from_options(layout)?;
+        pc_matrix.set_default_options(&snes.pc_prefix()?)?;
         snes.set_from_options()?;
         let positions = space.owned_positions(grid);
         let first_dof = x.ownership_range()?.0;
@@ -197,7 +199,6 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             snes.monitor_fields(layout.fields().into_iter().map(|(_, c)| c).collect(), test)?;
         }
         let user_atol = snes.tolerances()?.0;
-        let pc_matrix = PcMatrix::from_options(layout)?;
         let retry_with_line_search = petsc::Options::global().get_bool(LINE_SEARCH_RETRY_OPTION)?.unwrap_or(true);
         let stages = Stages {
             run_setup: LogStage::register("porompm: setup")?,
@@ -391,37 +392,46 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         Ok((solve, Solution { increments, ..Solution::default() }))
     }
 
-    /// The matrix of `step`'s pattern: the last one while the step shares its pattern, else a new
-    /// one (with the near-null space of a displacement system; the Schur preconditioner then
-    /// forgets the old matrix's blocks). Collective.
+    /// The matrices of `step`'s patterns: the last ones while the step shares their patterns, else
+    /// new ones (with the near-null space of a displacement system; the Schur preconditioner then
+    /// forgets the old matrix's blocks). Before a new matrix is allocated the solver lets go of
+    /// the one it replaces and of what its preconditioner built from it, so that the two do not
+    /// sit in memory together. Collective.
     fn matrix_for(&mut self, step: &Step<D, M>, coll: &Collective) -> Result<(), Error> {
-        self.lowered_matrix_for(step, coll)?;
-        if self.matrix.as_ref().is_some_and(|m| Arc::ptr_eq(&m.pattern, &step.pattern)) {
-            self.reused_patterns += 1;
-            return Ok(());
-        }
-        self.matrix = None;
-        let matrix = self.new_matrix(&step.pattern, coll)?;
-        if let Some(schur) = &mut self.schur {
-            schur.forget();
-        }
-        self.matrix = Some(matrix);
-        Ok(())
-    }
-
-    /// The multilinear preconditioning matrix of `step`'s pattern ([`super::lowered`]), with the
-    /// near-null space the preconditioner reads: the last one while the step shares its pattern,
-    /// else a new one; none when the preconditioner is built from the Jacobian. Collective.
-    fn lowered_matrix_for(&mut self, step: &Step<D, M>, coll: &Collective) -> Result<(), Error> {
-        let Some(lowered) = &step.lowered else {
-            self.lowered = None;
-            return Ok(());
+        let jacobian_kept = self.matrix.as_ref().is_some_and(|m| Arc::ptr_eq(&m.pattern, &step.pattern));
+        let lowered_kept = match (&step.lowered, &self.lowered) {
+            (Some(lowered), Some(m)) => Arc::ptr_eq(&m.pattern, &lowered.pattern),
+            (None, None) => true,
+            _ => false,
         };
-        if self.lowered.as_ref().is_some_and(|m| Arc::ptr_eq(&m.pattern, &lowered.pattern)) {
-            return Ok(());
+        if jacobian_kept {
+            self.reused_patterns += 1;
+            if lowered_kept {
+                return Ok(());
+            }
         }
-        self.lowered = None;
-        self.lowered = Some(self.new_matrix(&lowered.pattern, coll)?);
+        if self.matrix.is_some() {
+            match &self.lowered {
+                Some(kept) if lowered_kept => self.snes.release_jacobian(&kept.mat)?,
+                _ => {
+                    self.snes.release_operators()?;
+                }
+            }
+        }
+        if !lowered_kept {
+            self.lowered = None;
+            if let Some(lowered) = &step.lowered {
+                self.lowered = Some(self.new_matrix(&lowered.pattern, coll)?);
+            }
+        }
+        if !jacobian_kept {
+            self.matrix = None;
+            let matrix = self.new_matrix(&step.pattern, coll)?;
+            if let Some(schur) = &mut self.schur {
+                schur.forget();
+            }
+            self.matrix = Some(matrix);
+        }
         Ok(())
     }
 

@@ -162,6 +162,11 @@ impl PcRef<'_> {
         Ok(c_str(t))
     }
 
+    /// Reads the preconditioner's options from the options database (`PCSetFromOptions`).
+    pub fn set_from_options(&mut self) -> Result<()> {
+        call!(PCSetFromOptions(self.raw))
+    }
+
     /// For factorisation preconditioners: which package factorises (`"mumps"`, `"petsc"`, ...).
     pub fn set_factor_solver_type(&mut self, name: &str) -> Result<()> {
         let c = cstring(name)?;

@@ -133,6 +133,14 @@ pub trait MatOps {
         Ok(n)
     }
 
+    /// How many holders the matrix has (PETSc's reference count): 1 when only this handle holds
+    /// it, more while a solver or a preconditioner keeps it too.
+    fn holders(&self) -> Result<usize> {
+        let mut count: Int = 0;
+        call!(PetscObjectGetReference(self.raw() as sys::PetscObject, &mut count))?;
+        Ok(count.max(0) as usize)
+    }
+
     /// Whether the matrix equals its transpose within `tol`.
     fn is_symmetric(&self, tol: Real) -> Result<bool> {
         let mut flg = sys::PetscBool::PETSC_FALSE;

@@ -360,6 +360,45 @@ impl Snes {
         Ok(())
     }
 
+    /// Lets the solver let go of its matrices and of everything its preconditioner built from
+    /// them (a factorisation's factors, a multigrid's hierarchy), so that matrices of a new nonzero
+    /// pattern are not allocated while the old ones and their preconditioner still sit in memory
+    /// (the next solve's setup would free them only then). Returns whether it did: only
+    /// preconditioners whose whole state is built from the matrix are reset (`none`, `jacobi`,
+    /// `sor`, `ilu`, `icc`, `lu`, `cholesky`, `gamg`); the others keep definitions of their own
+    /// (a field split's splits, a redundant solver's inner solver), which a reset would lose, and
+    /// keep everything until the next setup replaces it. Collective.
+    pub fn release_operators(&mut self) -> Result<bool> {
+        {
+            let mut ksp = self.ksp()?;
+            let mut pc = ksp.pc()?;
+            match pc.type_name()?.as_str() {
+                "none" | "jacobi" | "sor" | "ilu" | "icc" | "lu" | "cholesky" => {}
+                // PETSc 3.18's PCReset of GAMG keeps the multigrid's levels with their old
+                // operators, whose sizes the next setup then refuses to change; setting the type
+                // anew destroys the whole hierarchy, and the options are read again.
+                "gamg" => {
+                    pc.set_type("none")?;
+                    pc.set_type("gamg")?;
+                    pc.set_from_options()?;
+                }
+                _ => return Ok(false),
+            }
+        }
+        call!(SNESReset(self.raw))?;
+        Ok(true)
+    }
+
+    /// Makes `pmat`, the matrix the preconditioner is built from, also the operator the solver
+    /// holds, so that the old Jacobian is freed before a new one (of another nonzero pattern) is
+    /// allocated, while the preconditioner keeps what it built from `pmat`. The next
+    /// [`Snes::solve`] sets the new Jacobian. Collective.
+    pub fn release_jacobian(&mut self, pmat: &Mat) -> Result<()> {
+        call!(SNESSetJacobian(self.raw, pmat.raw, pmat.raw, Some(jacobian_trampoline), std::ptr::null_mut()))?;
+        let ksp = self.ksp()?;
+        call!(KSPSetOperators(ksp.raw(), pmat.raw, pmat.raw))
+    }
+
     /// The 2-norm of each component of the SNES's residual vector (empty if it has none yet or
     /// its block size is one).
     fn residual_components(&self) -> Result<Vec<Real>> {
