@@ -577,14 +577,18 @@ fn an_interrupted_run_leaves_a_checkpoint_and_its_restart_matches_the_uninterrup
 }
 
 /// Garbage in a PETSc options file is one clear porompm error naming the file and line, never
-/// PETSc's traceback: text that is not an option, binary content, an incomplete `alias`, and a
-/// nested `-options_file` that does not exist. Every shipped options file passes the same check.
+/// PETSc's traceback: text that is not an option, a token left over after an option's value, two
+/// options on a line, binary content, an incomplete `alias`, and a nested `-options_file` that does
+/// not exist. Every shipped options file passes the same check.
 #[test]
 fn garbage_in_an_options_file_is_one_clear_error() {
     let dir = out_dir("garbage-options");
     std::fs::create_dir_all(&dir).unwrap();
-    let cases: [(&str, &[u8], &str); 4] = [
+    let cases: [(&str, &[u8], &str); 7] = [
         ("text.opts", b"# a comment\n-ksp_type preonly\nthis is not an option\n", "line 3: `this` is not an option"),
+        ("extra.opts", b"-ksp_rtol 1e-4\n-pc_use_amat false; see docs\n", "line 2: `see` is left over"),
+        ("two.opts", b"-snes_monitor -ksp_monitor\n", "line 1: two options on one line"),
+        ("quoted.opts", b"-snes_view_pre \"ascii:x.txt\" tail\n", "line 1: `tail` is left over"),
         ("binary.opts", &[0xff, 0xfe, 0x00, 0x13, 0x37, 0x80], "is not a text file"),
         ("alias.opts", b"alias -only_one\n", "line 1: `alias` needs two option names"),
         ("nested.opts", b"-options_file /nonexistent/porompm.opts\n", "/nonexistent/porompm.opts does not exist"),

@@ -379,16 +379,33 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
     }
     for (i, line) in text.lines().enumerate() {
         let content = line.split('#').next().unwrap_or("");
-        let tokens: Vec<&str> = content.split_whitespace().collect();
+        let tokens = option_tokens(content);
         let Some(&first) = tokens.first() else { continue };
-        if first.eq_ignore_ascii_case("alias") {
+        let alias = first.eq_ignore_ascii_case("alias");
+        if alias {
             if tokens.len() < 3 {
                 return Err(format!("PETSc options file {name} line {}: `alias` needs two option names", i + 1));
+            }
+            if let Some(extra) = tokens.get(3) {
+                return Err(format!("PETSc options file {name} line {}: `{extra}` is left over after `alias`", i + 1));
             }
         } else if !first.starts_with('-') || first.len() < 2 {
             let shown: String = first.chars().take(40).collect();
             return Err(format!(
                 "PETSc options file {name} line {}: `{shown}` is not an option (an option name begins with `-`; \
+                 comments begin with `#`)",
+                i + 1
+            ));
+        } else if tokens.get(1).is_some_and(|v| is_option_name(v)) {
+            return Err(format!(
+                "PETSc options file {name} line {}: two options on one line (`{first}` and `{}`): one a line",
+                i + 1,
+                tokens[1]
+            ));
+        } else if let Some(extra) = tokens.get(2) {
+            let shown: String = extra.chars().take(40).collect();
+            return Err(format!(
+                "PETSc options file {name} line {}: `{shown}` is left over (a line holds one option and its value; \
                  comments begin with `#`)",
                 i + 1
             ));
@@ -410,6 +427,30 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// The tokens of a line of a PETSc options file as PETSc reads them: separated by blanks, a token
+/// in double quotes taken whole (blanks included).
+fn option_tokens(line: &str) -> Vec<&str> {
+    let mut tokens = Vec::new();
+    let mut rest = line.trim_start();
+    while !rest.is_empty() {
+        let (token, after) = match rest.strip_prefix('"') {
+            Some(quoted) => quoted.split_once('"').unwrap_or((quoted, "")),
+            None => rest.split_once(char::is_whitespace).unwrap_or((rest, "")),
+        };
+        tokens.push(token);
+        rest = after.trim_start();
+    }
+    tokens
+}
+
+/// Whether a token is an option's name rather than a value, as PETSc tells them apart
+/// (`PetscOptionsValidKey`): one or two `-` followed by a letter, and not a number (`-inf`).
+fn is_option_name(token: &str) -> bool {
+    let Some(name) = token.strip_prefix('-') else { return false };
+    let name = name.strip_prefix('-').unwrap_or(name);
+    name.starts_with(|c: char| c.is_ascii_alphabetic()) && token.parse::<f64>().is_err()
+}
+
 /// MPI for the unit tests that write HDF5 files through MPI-I/O (a singleton run): initialised once
 /// and never finalised (the test process ends without it), with a lock so that one test at a
 /// time uses it.
@@ -429,6 +470,19 @@ pub(crate) fn test_world() -> (std::sync::MutexGuard<'static, ()>, SimpleCommuni
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_options_line_splits_as_petsc_reads_it() {
+        assert_eq!(option_tokens("  -ksp_rtol   1e-4 "), ["-ksp_rtol", "1e-4"]);
+        assert_eq!(option_tokens("-snes_view_pre \"ascii:a b.txt\" x"), ["-snes_view_pre", "ascii:a b.txt", "x"]);
+        assert!(option_tokens("   ").is_empty());
+        for name in ["-ksp_type", "-pc_use_amat", "-x"] {
+            assert!(is_option_name(name), "{name}");
+        }
+        for value in ["-1", "-2.5e-3", "-.5", "gmres", "1e-4", "-inf"] {
+            assert!(!is_option_name(value), "{value}");
+        }
+    }
 
     #[test]
     fn outputs_are_written_and_old_results_removed() {
