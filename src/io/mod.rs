@@ -387,10 +387,11 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
                 return Err(format!("PETSc options file {name} line {}: `alias` needs two option names", i + 1));
             }
             if let Some(extra) = tokens.get(3) {
-                return Err(format!("PETSc options file {name} line {}: `{extra}` is left over after `alias`", i + 1));
+                let shown = shown(extra);
+                return Err(format!("PETSc options file {name} line {}: `{shown}` is left over after `alias`", i + 1));
             }
         } else if !first.starts_with('-') || first.len() < 2 {
-            let shown: String = first.chars().take(40).collect();
+            let shown = shown(first);
             return Err(format!(
                 "PETSc options file {name} line {}: `{shown}` is not an option (an option name begins with `-`; \
                  comments begin with `#`)",
@@ -403,7 +404,7 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
                 tokens[1]
             ));
         } else if let Some(extra) = tokens.get(2) {
-            let shown: String = extra.chars().take(40).collect();
+            let shown = shown(extra);
             return Err(format!(
                 "PETSc options file {name} line {}: `{shown}` is left over (a line holds one option and its value; \
                  comments begin with `#`)",
@@ -425,6 +426,11 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A token of an options file as an error message shows it: its first 40 characters.
+fn shown(token: &str) -> String {
+    token.chars().take(40).collect()
 }
 
 /// The tokens of a line of a PETSc options file as PETSc reads them: separated by blanks, a token
