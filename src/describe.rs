@@ -52,8 +52,10 @@ pub fn describe(case: &Case, label: &str) -> String {
         let n = body.particles_per_cell;
         let _ = writeln!(
             s,
-            "body `{}`: {count} material points ({n}×{n} per cell), material `{}`",
-            body.name, body.material
+            "body `{}`: {count} material points ({n}×{n} per cell), material `{}`{}",
+            body.name,
+            body.material,
+            initial_text(body)
         );
     }
     let _ = writeln!(s, "material points: {}", model.particles.len());
@@ -263,8 +265,10 @@ fn describe_solid(case: &Case, label: &str) -> String {
         let _ = writeln!(
             s,
             "body `{}`: {count} material points ({n}×{n}×{n} per cell), volume {volume:.6e} m³, z ∈ [{z0}, {z1}] m, \
-             material `{}`",
-            body.name, body.material
+             material `{}`{}",
+            body.name,
+            body.material,
+            initial_text(body)
         );
     }
     let _ = writeln!(s, "material points: {}", ps.len());
@@ -336,6 +340,30 @@ fn stage_line<const D: usize>(case: &Case, model: &Model<D>, st: &crate::case::S
         loads.join(", "),
         boundaries.join(", "),
     )
+}
+
+/// A body's initial fields as the case gives them (`; initial velocity (0, v0 * y) m/s`), or
+/// nothing.
+fn initial_text(body: &crate::case::Body) -> String {
+    let Some(init) = &body.initial else {
+        return String::new();
+    };
+    let text = |f: &crate::case::Field| match f {
+        crate::case::Field::Value(v) => format!("{v}"),
+        crate::case::Field::Expression(e) => e.clone(),
+    };
+    let list = |fs: &[crate::case::Field]| fs.iter().map(text).collect::<Vec<_>>().join(", ");
+    let mut parts = Vec::new();
+    if let Some(v) = &init.velocity {
+        parts.push(format!("velocity ({}) m/s", list(v)));
+    }
+    if let Some(v) = &init.stress {
+        parts.push(format!("effective stress ({}) Pa", list(v)));
+    }
+    if let Some(p) = &init.pore_pressure {
+        parts.push(format!("pore pressure {} Pa", text(p)));
+    }
+    format!("; initial {}", parts.join(", "))
 }
 
 #[cfg(test)]

@@ -215,6 +215,7 @@ gold_tests!(
     terzaghi_3d,
     terzaghi_explicit,
     vertical_cut,
+    vibrating_bar,
 );
 
 #[test]

@@ -59,6 +59,8 @@ pub(crate) struct Links {
     pub boundaries: Vec<BoundaryLinks>,
     /// What each load names.
     pub loads: Vec<LoadLinks>,
+    /// Each body's initial fields, parsed.
+    pub body_initial: Vec<super::schema::InitialValues>,
 }
 
 /// What a boundary names.

@@ -8,6 +8,7 @@
 //! `materials.model`; the table `[verification]` it keeps untyped, for the checks' registry
 //! ([`crate::verification`]) to read with [`CaseFile::table_as`].
 
+pub mod expression;
 pub mod ids;
 mod names;
 pub mod overrides;
@@ -15,6 +16,7 @@ pub mod parameters;
 pub mod schema;
 mod validated;
 
+pub use expression::Expr;
 pub use ids::{BodyId, BoundaryId, LoadId, MaterialId, StageId, TimeFunctionId};
 pub use overrides::Override;
 pub use schema::*;

@@ -73,6 +73,11 @@ impl Case {
         (0..self.file.boundaries.len()).map(BoundaryId::new)
     }
 
+    /// `body`'s initial fields, parsed (empty where it gives none).
+    pub fn initial_values(&self, body: BodyId) -> &super::schema::InitialValues {
+        &self.links.body_initial[body.index()]
+    }
+
     /// The id of `body`'s material.
     pub fn material_id_of(&self, body: BodyId) -> MaterialId {
         self.links.body_materials[body.index()]

@@ -117,11 +117,12 @@ pub fn increment_factor(
     params: &std::collections::BTreeMap<String, f64>,
     at: &[f64],
 ) -> Result<f64, String> {
-    let mut vars: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.clone(), *v)).collect();
-    for (name, v) in ["x", "y", "z"].iter().zip(at) {
-        vars.push((name.to_string(), *v));
+    let params: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.clone(), *v)).collect();
+    let v = crate::case::Expr::parse(expr, &["x", "y", "z"][..at.len()], &params)?.eval(at);
+    if !v.is_finite() {
+        return Err(format!("the value {v} is not finite"));
     }
-    crate::case::parameters::eval(expr, &vars)
+    Ok(v)
 }
 
 /// The centre of a particle's `face` and the face's measure: its length in two dimensions (per

@@ -14,12 +14,19 @@ pub const BASE_BYTES: f64 = 60.0 * 1024.0 * 1024.0;
 /// (peak memory of the shipped plane cases against their points: 6–9 kB) [B].
 pub const POINT_BYTES_2D: f64 = 6.0e3;
 
-/// The same in three dimensions, with the solver's copies and hierarchies of the matrix that the
-/// estimate's entries leave out (measured: the consolidating layer of
+/// The same in three dimensions for a two-phase case, with the solver's copies and hierarchies of
+/// the matrix that the estimate's entries leave out (measured: the consolidating layer of
 /// `cases/consolidation_layer_3d.toml` at n = 29, 195 112 points under the fixed-stress field
 /// split, peaks at 1.30 GiB, 5.5 kB per point besides the libraries, matrix entries and grid
-/// vectors; the square footing at k = 6 at 4.6 kB per point besides PETSc's allocations) [B].
+/// vectors) [B].
 pub const POINT_BYTES_3D: f64 = 6.0e3;
+
+/// The same in three dimensions for a one-phase case (measured: the square footing of
+/// `tests/cases/footing_square_3d.toml` at k = 10, 262 144 points, its whole run on one rank with
+/// `petsc_options/gamg-solid-multilinear.opts`, peaks at 1.63 GiB, 3.1 kB per point besides the
+/// libraries, the estimate's matrix entries and grid vectors; the first four steps with
+/// `gamg-solid-inexact.opts` 1.30 GiB) [B].
+pub const POINT_BYTES_3D_ONE_PHASE: f64 = 4.5e3;
 
 /// Vectors of the grid's dofs a step keeps (solution, residual, local copies, predictors,
 /// projections, forces and reactions), 8 B each.
@@ -73,7 +80,11 @@ impl Estimate {
             None => 0.0,
         };
         let points = points_of(case);
-        let point_bytes = if dim == 3 { POINT_BYTES_3D } else { POINT_BYTES_2D };
+        let point_bytes = match (dim, pore_water) {
+            (3, true) => POINT_BYTES_3D,
+            (3, false) => POINT_BYTES_3D_ONE_PHASE,
+            _ => POINT_BYTES_2D,
+        };
         let needed =
             BASE_BYTES + points * point_bytes + grid_dofs * GRID_VECTORS * 8.0 + matrix_entries * MATRIX_ENTRY_BYTES;
         let fill = if dim == 3 { 50.0 } else { 10.0 };

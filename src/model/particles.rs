@@ -191,7 +191,7 @@ impl<const D: usize> Particles<D> {
     }
 
     /// Appends the point `id` of body `b` (material `mat_index`) at `x` with domain half-widths
-    /// `lp` and volume `vol`, at rest, with the body's initial stress.
+    /// `lp` and volume `vol`, with the body's initial velocity, stress and pore pressure.
     fn push_point(
         &mut self,
         case: &Case,
@@ -219,9 +219,12 @@ impl<const D: usize> Particles<D> {
         ps.volume.push(vol);
         ps.porosity.push(mat.porosity);
         ps.mass.push(mass);
-        ps.vel.push([0.0; D]);
+        let fields = case.initial_values(crate::case::BodyId::new(b));
+        let v = fields.velocity_at(x);
+        ps.vel.push(v);
         ps.acc.push([0.0; D]);
-        ps.vel_w.push([0.0; D]);
+        // A two-phase body's water starts with its skeleton's velocity.
+        ps.vel_w.push(if pore_water { v } else { [0.0; D] });
         ps.acc_w.push([0.0; D]);
         let (stress, p, grad_p) = match (&body.initial_stress, body.uniform_stress_vector()) {
             (Some(init), _) => {
@@ -229,8 +232,9 @@ impl<const D: usize> Particles<D> {
                 (crate::soils::plane(s), p, grad_p)
             }
             (None, Some(s)) => (s, 0.0, [0.0; D]),
-            (None, None) => ([0.0; 6], 0.0, [0.0; D]),
+            (None, None) => (fields.stress_at(x).unwrap_or([0.0; 6]), 0.0, [0.0; D]),
         };
+        let (p, grad_p) = fields.pore_pressure_at(x).unwrap_or((p, grad_p));
         ps.grad_p.push(grad_p);
         ps.stress.push(stress);
         ps.p.push(p);
@@ -240,8 +244,6 @@ impl<const D: usize> Particles<D> {
     }
 }
 
-/// A pseudo-random number in [0, 1) from a point's id and a stream (SplitMix64): the same point
-/// gets the same number on any rank.
 /// Calls `f(cell, id, x)` for every place body `b` of `case` may put a material point: the
 /// centres of the n^D sub-cells (n its `particles_per_cell`) of the cells its bounding box
 /// touches, moved by its `perturbation`, with the point's global id (from the body and the
@@ -302,6 +304,8 @@ pub fn for_each_point<const D: usize>(
     });
 }
 
+/// A pseudo-random number in [0, 1) from a point's id and a stream (SplitMix64): the same point
+/// gets the same number on any rank.
 fn jitter(id: u64, stream: u64) -> f64 {
     let mut z = id.wrapping_mul(2).wrapping_add(stream).wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -360,6 +364,65 @@ mod tests {
         let half = Particles::generate(&c, &g, |c| c[1] < 5);
         assert_eq!(half.len(), 20);
         assert!(half.x.iter().all(|x| x[1] < 0.5));
+    }
+
+    /// [`tests_support::MINIMAL`](crate::case::tests_support::MINIMAL) with the column's
+    /// `initial` table `initial` and the parameter v = 0.5.
+    fn with_initial(initial: &str) -> Result<Case, String> {
+        let text = crate::case::tests_support::MINIMAL.replace(
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+            &format!("shape = {{ rectangle = {{ min = [0.0, 0.0], max = [0.1, 1.0] }} }}\n        initial = {initial}"),
+        ) + "\n[parameters]\nv = 0.5\n";
+        crate::validation::load(&text, "t", &[]).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn initial_fields_are_expressions_of_the_points_position() {
+        let c = with_initial(
+            r#"{ velocity = ["2 * x", "v * sin(pi * y)"], stress = ["-1e4 * (1 - y)", -2.0, 0, "-3 * x"], pore_pressure = "9810 * (1 - y) + x^2" }"#,
+        )
+        .unwrap();
+        let g = Grid::new([0.0, 0.0], c.cell_size(), c.cells());
+        let ps = Particles::generate(&c, &g, |_| true);
+        assert_eq!(ps.len(), 40);
+        for k in 0..ps.len() {
+            let [x, y] = ps.x[k];
+            let v = [2.0 * x, 0.5 * (std::f64::consts::PI * y).sin()];
+            assert_eq!(ps.vel[k], v);
+            // The water of a two-phase body moves with its skeleton.
+            assert_eq!(ps.vel_w[k], v);
+            assert_eq!(ps.stress[k], [-1e4 * (1.0 - y), -2.0, 0.0, -3.0 * x, 0.0, 0.0]);
+            let p = 9810.0 * (1.0 - y) + x * x;
+            assert_eq!((ps.p[k], ps.p0[k]), (p, p));
+            assert_eq!(ps.grad_p[k], [2.0 * x, -9810.0]);
+        }
+        let refused = [
+            (r#"{ velocity = [0.0, 1.0, 2.0] }"#, "key `bodies[0].initial.velocity`: 2 components"),
+            (r#"{ velocity = [0.0, "z"] }"#, "key `bodies[0].initial.velocity[1]`: `z`: `z` is no coordinate"),
+            (r#"{ velocity = [0.0, "w * y"] }"#, "unknown parameter `w`"),
+            (r#"{ stress = [1.0, 2.0, 3.0] }"#, "key `bodies[0].initial.stress`: four entries"),
+            (
+                r#"{ velocity = [0.0, "ln(y - 0.5)"] }"#,
+                "key `bodies[0].initial.velocity[1]`: body `column` has the value NaN at its material point [0.025, 0.025]",
+            ),
+            (r#"{ pore_pressure = "1 / (x - 0.025)" }"#, "key `bodies[0].initial.pore_pressure`: body `column` has the value inf"),
+        ];
+        for (initial, message) in refused {
+            let e = with_initial(initial).unwrap_err();
+            assert!(e.contains(message), "{initial}: {e}");
+        }
+        let one_phase = crate::case::tests_support::MINIMAL.replace("two_phase", "one_phase").replace(
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }\n        initial = { pore_pressure = 1.0 }",
+        );
+        let e = crate::validation::load(&one_phase, "t", &[]).unwrap_err().to_string();
+        assert!(e.contains("a one_phase analysis has no pore pressure"), "{e}");
+        let twice = crate::case::tests_support::MINIMAL.replace(
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+            "shape = { rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }\n        uniform_stress = [0.0, 0.0, 0.0, 0.0]\n        initial = { stress = [0.0, 0.0, 0.0, 0.0] }",
+        );
+        let e = crate::validation::load(&twice, "t", &[]).unwrap_err().to_string();
+        assert!(e.contains("give the body's stress once"), "{e}");
     }
 
     #[test]

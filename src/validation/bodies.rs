@@ -12,6 +12,7 @@ pub(super) fn check(c: &Case) -> Checked {
         let key = format!("bodies[{i}]");
         b.check(&key)?;
         uniform_stress(&key, b, c.dimension())?;
+        initial(c, &key, b)?;
         depth(c, &key, b)?;
         let (bmin, bmax) = b.shape.bounds();
         if !bounds.contains(&bmin) || !bounds.contains(&bmax) {
@@ -38,14 +39,25 @@ fn occupancy<const D: usize>(c: &Case) -> Checked {
     let grid = crate::model::grid_of::<D>(c);
     for (i, b) in c.bodies.iter().enumerate() {
         let (mut held, mut overlaps) = (0usize, vec![0usize; i]);
+        let values = c.initial_values(crate::case::BodyId::new(i));
+        let mut not_finite = None;
         crate::model::particles::for_each_candidate(c, &grid, i, |_, _, x| {
             if c.body_holds(b, x) {
                 held += 1;
-                if let Some(e) = c.bodies[..i].iter().position(|o| c.body_holds(o, x)) {
-                    overlaps[e] += 1;
+                match c.bodies[..i].iter().position(|o| c.body_holds(o, x)) {
+                    Some(e) => overlaps[e] += 1,
+                    None if not_finite.is_none() => not_finite = values.not_finite_at(x).map(|f| (f, x)),
+                    None => {}
                 }
             }
         });
+        if let Some(((field, v), x)) = not_finite {
+            return Err(format!(
+                "key `bodies[{i}].initial.{field}`: body `{}` has the value {v} at its material point {x:?}; an \
+                 initial field must be finite at every point",
+                b.name
+            ));
+        }
         let key = format!("bodies[{i}].shape");
         let own = held - overlaps.iter().sum::<usize>();
         if held == 0 || own == 0 {
@@ -87,6 +99,49 @@ fn uniform_stress(key: &str, b: &Body, dim: usize) -> Checked {
     }
     if s.iter().any(|v| !v.is_finite()) {
         return Err(format!("key `{key}.uniform_stress`: must be finite"));
+    }
+    Ok(())
+}
+
+/// A body's initial fields: a velocity of one component per direction, a stress of four components
+/// (or six in three dimensions) instead of `initial_stress` and `uniform_stress`, a pore pressure
+/// in a two-phase case only and instead of a geostatic state's.
+fn initial(c: &Case, key: &str, b: &Body) -> Checked {
+    let Some(init) = &b.initial else {
+        return Ok(());
+    };
+    let dim = c.dimension();
+    if let Some(v) = init.velocity.as_ref().filter(|v| v.len() != dim) {
+        return Err(format!(
+            "key `{key}.initial.velocity`: {dim} components in a case of dimension {dim}, got {}",
+            v.len()
+        ));
+    }
+    if let Some(s) = &init.stress {
+        if !(s.len() == 4 || (dim == 3 && s.len() == 6)) {
+            return Err(format!(
+                "key `{key}.initial.stress`: four entries [xx, yy, xy, zz]{}, got {}",
+                if dim == 3 { " or six [xx, yy, xy, zz, yz, zx]" } else { " in a plane case" },
+                s.len()
+            ));
+        }
+        if b.initial_stress.is_some() || b.uniform_stress.is_some() {
+            return Err(format!(
+                "key `{key}.initial.stress`: give the body's stress once: `initial.stress`, `initial_stress` or \
+                 `uniform_stress`"
+            ));
+        }
+    }
+    if init.pore_pressure.is_some() {
+        if c.analysis.formulation != crate::case::Formulation::TwoPhase {
+            return Err(format!("key `{key}.initial.pore_pressure`: a one_phase analysis has no pore pressure"));
+        }
+        if b.initial_stress.is_some() {
+            return Err(format!(
+                "key `{key}.initial.pore_pressure`: the geostatic `initial_stress` gives the pore pressure; give one \
+                 or the other"
+            ));
+        }
     }
     Ok(())
 }

@@ -66,7 +66,10 @@ fn finite_strain_materials(c: &Case) -> Checked {
         };
         let stressed = c.body_ids().find(|&b| {
             let body = c.body(b);
-            c.material_id_of(b).index() == i && (body.initial_stress.is_some() || body.uniform_stress.is_some())
+            c.material_id_of(b).index() == i
+                && (body.initial_stress.is_some()
+                    || body.uniform_stress.is_some()
+                    || body.initial.as_ref().is_some_and(|i| i.stress.is_some()))
         });
         if let Some(b) = stressed {
             return Err(format!(

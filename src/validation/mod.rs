@@ -25,7 +25,7 @@ mod names;
 mod stages;
 
 use crate::case::ids::Links;
-use crate::case::{self, Case, CaseError, CaseFile, Override};
+use crate::case::{self, Case, CaseError, CaseFile, InitialValues, Override};
 use crate::check::{components, Checked};
 use names::Names;
 
@@ -61,8 +61,16 @@ fn default_steps(file: &mut CaseFile) -> Checked {
 /// Every name of the file resolved to the id of the table it names.
 fn resolve(file: &CaseFile) -> Result<Links, String> {
     let names = Names::of(file)?;
-    let links =
-        Links { body_materials: names.body_materials()?, boundaries: names.boundaries()?, loads: names.loads()? };
+    let params: Vec<(String, f64)> = file.parameters.iter().map(|(k, v)| (k.clone(), *v)).collect();
+    let body_initial = (file.bodies.iter().enumerate())
+        .map(|(i, b)| InitialValues::of(b, &format!("bodies[{i}]"), file.dimension(), &params))
+        .collect::<Result<_, _>>()?;
+    let links = Links {
+        body_materials: names.body_materials()?,
+        boundaries: names.boundaries()?,
+        loads: names.loads()?,
+        body_initial,
+    };
     names.check_stages()?;
     Ok(links)
 }

@@ -25,6 +25,7 @@ pub mod cook;
 pub mod dam_break;
 pub mod elastic_column;
 pub mod figures;
+pub mod free_vibration;
 pub mod harmonic_column;
 pub mod hollow_cylinder;
 pub mod hydrostatic;
@@ -505,6 +506,11 @@ verification_kinds! {
     Terzaghi(consolidation::TerzaghiConsolidation) = "terzaghi",
     /// Steady-state harmonic column (Zienkiewicz, Chang & Bettess 1980; [003] §4.1.2); two-phase.
     HarmonicColumn(harmonic_column::HarmonicColumn) = "harmonic_column",
+    /// The free vibration of an elastic bar fixed at its base, its sides held laterally, started by
+    /// an initial velocity of its first mode's shape v₀ sin(π (y − y_b)/(2H)): the period of its
+    /// first mode's displacement against 4H/c and the amplitude against v₀/ω, ω = π c/(2H),
+    /// c = √(M/ρ); one-phase.
+    FreeVibration(free_vibration::FreeVibration) = "free_vibration",
     /// Elastic column under its self-weight and a surcharge, at rest at the end of the run: the
     /// vertical stress is −(ρ g d + q) at depth d and the settlement ρ g H²/(2 E_c) + q H/E_c;
     /// one-phase.

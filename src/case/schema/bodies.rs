@@ -1,6 +1,7 @@
 //! `[[bodies]]`: the regions filled with material points at t = 0, their initial stress, and the
 //! planar shapes and boxes the case uses to select points and nodes.
 
+use super::super::expression::Expr;
 use crate::check::{at, finite, finite2, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
 
@@ -34,11 +35,121 @@ pub struct Body {
     /// arrangement).
     #[serde(default)]
     pub perturbation: f64,
+    /// Its initial velocity, effective stress and pore pressure as functions of position
+    /// (default: at rest, with the stress of `initial_stress` or `uniform_stress`, or none).
+    pub initial: Option<InitialFields>,
     /// Where it overlaps a body listed before it: `"refuse"` (the default: an error, since a
     /// material point belongs to one body) or `"yield"` (the earlier bodies keep their points
     /// there and this one fills the rest, e.g. a block around a wedge listed first).
     #[serde(default)]
     pub overlap: Overlap,
+}
+
+/// A body's initial fields. Each component is a number or an expression of the point's position
+/// `x`, `y` (and `z` in three dimensions; `x` is the radius in axial symmetry) [m] and the case's
+/// parameters, written without the leading `=`: it is evaluated at every material point when the
+/// points are made, e.g. `velocity = [0.0, "v0 * sin(pi * y / (2 * L))"]`, with the functions and
+/// the constant `pi` of `[parameters]`' expressions.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InitialFields {
+    /// Velocity [m/s]: two components in a plane case, three in a three-dimensional one. A
+    /// two-phase body's water starts with the same velocity (no relative flow).
+    pub velocity: Option<Vec<Field>>,
+    /// Effective stress [Pa] (tension positive): [xx, yy, xy, zz], in three dimensions also
+    /// [xx, yy, xy, zz, yz, zx]; instead of `initial_stress` and `uniform_stress`. The body's
+    /// equilibrium is the case's to give.
+    pub stress: Option<Vec<Field>>,
+    /// Pore pressure [Pa] (compression positive; two-phase), instead of a geostatic
+    /// `initial_stress`'s; its gradient, which a point carries, is the expression's exact one.
+    pub pore_pressure: Option<Field>,
+}
+
+/// A number, or an expression of position written without the leading `=`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(untagged)]
+pub enum Field {
+    /// A number, the same at every point.
+    Value(f64),
+    /// An expression of `x`, `y`, `z` and the parameters.
+    Expression(String),
+}
+
+/// A body's initial fields parsed, ready to be evaluated at a point ([`InitialFields`]); empty
+/// where the body gives none.
+#[derive(Debug, Clone, Default)]
+pub struct InitialValues {
+    /// The velocity's components.
+    pub velocity: Vec<Expr>,
+    /// The effective stress's components.
+    pub stress: Vec<Expr>,
+    /// The pore pressure.
+    pub pore_pressure: Option<Expr>,
+}
+
+/// The names of the position's coordinates in the expressions of fields.
+const COORDINATES: [&str; 3] = ["x", "y", "z"];
+
+impl InitialValues {
+    /// The fields of `body` (`key` its table, `bodies[0]`) in a case of dimension `dim` with the
+    /// parameters `params`; an error names the component and what is wrong.
+    pub fn of(body: &Body, key: &str, dim: usize, params: &[(String, f64)]) -> Result<InitialValues, String> {
+        let Some(init) = &body.initial else {
+            return Ok(InitialValues::default());
+        };
+        let vars = &COORDINATES[..dim.clamp(2, 3)];
+        let parse = |f: &Field, at: String| match f {
+            Field::Value(v) => Ok(Expr::constant(*v, vars.len())),
+            Field::Expression(t) => Expr::parse(t, vars, params).map_err(|e| format!("key `{at}`: `{t}`: {e}")),
+        };
+        let list = |fs: &Option<Vec<Field>>, name: &str| -> Result<Vec<Expr>, String> {
+            let fs = fs.as_deref().unwrap_or_default();
+            fs.iter().enumerate().map(|(i, f)| parse(f, format!("{key}.initial.{name}[{i}]"))).collect()
+        };
+        Ok(InitialValues {
+            velocity: list(&init.velocity, "velocity")?,
+            stress: list(&init.stress, "stress")?,
+            pore_pressure: init
+                .pore_pressure
+                .as_ref()
+                .map(|f| parse(f, format!("{key}.initial.pore_pressure")))
+                .transpose()?,
+        })
+    }
+
+    /// The velocity at `x` (zero in the components it does not give).
+    pub fn velocity_at<const D: usize>(&self, x: [f64; D]) -> [f64; D] {
+        std::array::from_fn(|d| self.velocity.get(d).map_or(0.0, |e| e.eval(&x)))
+    }
+
+    /// The effective stress [xx, yy, xy, zz, yz, zx] at `x`, if the body gives one.
+    pub fn stress_at<const D: usize>(&self, x: [f64; D]) -> Option<[f64; 6]> {
+        (!self.stress.is_empty()).then(|| std::array::from_fn(|c| self.stress.get(c).map_or(0.0, |e| e.eval(&x))))
+    }
+
+    /// The pore pressure and its gradient at `x`, if the body gives one.
+    pub fn pore_pressure_at<const D: usize>(&self, x: [f64; D]) -> Option<(f64, [f64; D])> {
+        self.pore_pressure.as_ref().map(|e| {
+            let (p, g) = e.gradient(&x);
+            (p, std::array::from_fn(|d| g[d]))
+        })
+    }
+
+    /// The first of the fields whose value at `x` is not finite, named (`velocity[1]`), with the
+    /// value.
+    pub fn not_finite_at<const D: usize>(&self, x: [f64; D]) -> Option<(String, f64)> {
+        let named = |name: &'static str, es: &[Expr]| {
+            es.iter().enumerate().map(move |(i, e)| (format!("{name}[{i}]"), e.eval(&x))).collect::<Vec<_>>()
+        };
+        let mut all = named("velocity", &self.velocity);
+        all.extend(named("stress", &self.stress));
+        if let Some(e) = &self.pore_pressure {
+            let (p, g) = e.gradient(&x);
+            all.push(("pore_pressure".into(), p));
+            all.extend(g[..D].iter().map(|v| ("the gradient of pore_pressure".to_string(), *v)));
+        }
+        all.into_iter().find(|(_, v)| !v.is_finite())
+    }
 }
 
 /// What a body does where it overlaps a body listed before it.

@@ -34,8 +34,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CaseFile {
-    /// Named numbers used by `"= expression"` values elsewhere in the file (arithmetic, `min`,
-    /// `max`, `sqrt`, trigonometry); `--set parameters.NAME=VALUE` changes them.
+    /// Named numbers used by `"= expression"` values elsewhere in the file (`+ - * / ^`,
+    /// parentheses, `pi` and the functions `sqrt`, `exp`, `ln`, `sin`, `cos`, `tan`, `atan`,
+    /// `atan2(y, x)`, `radians`, `degrees`, `abs`, `min`, `max`) and by the expressions of position
+    /// (a body's `initial` values, a load's `increment_factor`); `--set parameters.NAME=VALUE`
+    /// changes them. `x`, `y` and `z` name a point's position and no parameter.
     #[serde(default)]
     pub parameters: std::collections::BTreeMap<String, f64>,
     /// Physics switches that shape the discrete system.
