@@ -195,6 +195,7 @@ gold_tests!(
     footing_peer,
     footing_peer_3d,
     footing_sd,
+    footing_undrained,
     harmonic_column_zone1,
     harmonic_column_zone2,
     harmonic_column_zone3,

@@ -21,10 +21,11 @@
 //! (interpolated), the settlement d [m] at each q/c of `report_loads` and the largest q/c reached. With `stop_settlement` the run ends (completed) once
 //! d/B reaches it: a load-controlled footing beyond its limit load would otherwise run away.
 
+use super::undrained::{self, UndrainedPressure};
 use super::{
     all_positive, each_positive, load_name, plain_load, BuiltCheck, Check, CheckParameters, Findings, Metric, Table,
 };
-use crate::case::{BodyId, BoundaryId, Case, Dof, Load, LoadId};
+use crate::case::{BodyId, BoundaryId, Case, Dof, Formulation, Geometry, Load, LoadId};
 use crate::check::{at, components, positive, Checked};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
@@ -79,6 +80,10 @@ pub struct BearingCapacity {
     /// d/B [-], > 0, at which the run ends, completed (a load-controlled footing beyond its limit
     /// load runs away; default: run to the end).
     pub stop_settlement: Option<f64>,
+    /// The excess pore pressure under a rigid strip footing (`footing`) on undrained two-phase
+    /// soil at an early load level against the elastic undrained closed form (the metric
+    /// `excess_pressure_rms_rel_error`; plane strain).
+    pub undrained_pressure: Option<UndrainedPressure>,
 }
 
 serde_defaults! { default_prandtl: f64 = 2.0 + std::f64::consts::PI, default_bearing_tol: f64 = 0.03 }
@@ -131,7 +136,10 @@ impl CheckParameters for BearingCapacity {
         if self.load.is_some() == self.footing.is_some() {
             return Err(loading_refused(key));
         }
-        Ok(())
+        match &self.undrained_pressure {
+            Some(u) => u.check(&at(key, "undrained_pressure")),
+            None => Ok(()),
+        }
     }
 
     fn describe(&self) -> String {
@@ -155,6 +163,14 @@ impl CheckParameters for BearingCapacity {
             _ => return Err(loading_refused("verification")),
         };
         self.dimensions(c)?;
+        if self.undrained_pressure.is_some() {
+            let plane = c.dimension() == 2 && c.analysis.geometry != Geometry::Axisymmetric;
+            if !(plane && c.analysis.formulation == Formulation::TwoPhase && matches!(loading, Loading::Footing(_))) {
+                return Err("key `verification.undrained_pressure`: its closed form is a rigid strip footing's \
+                            (`footing`) on two-phase soil in plane strain"
+                    .into());
+            }
+        }
         match loading {
             Loading::Footing(f) => footing_boundary(c, f)?,
             Loading::Load(l) => {
@@ -239,6 +255,9 @@ pub struct BearingCheck<const D: usize = 2> {
     reaction: [f64; D],
     /// (t, d/B, q/c) per step.
     curve: Vec<[f64; 3]>,
+    /// The undrained pore pressure's comparison, and its last result at an early load level:
+    /// [RMS relative error, q/c, points compared].
+    undrained: Option<(UndrainedPressure, Option<[f64; 3]>)>,
 }
 
 enum LoadKind {
@@ -291,6 +310,7 @@ impl<const D: usize> BearingCheck<D> {
             baseline: 0.0,
             reaction: [0.0; D],
             curve: Vec::new(),
+            undrained: spec.undrained_pressure.clone().map(|u| (u, None)),
         })
     }
 
@@ -308,6 +328,20 @@ impl<const D: usize> BearingCheck<D> {
             }
             LoadKind::Reaction(_, width) => -self.reaction[1] / width,
         })
+    }
+
+    /// While the load is early (q/c at most the undrained comparison's fraction of the reference),
+    /// compares the excess pore pressure with the closed form under the load q (collective).
+    fn compare_pressure(&mut self, q: f64, model: &Model<D>, coll: &Collective) -> Result<(), String> {
+        let (limit, breadth) = (self.reference * self.cohesion, self.breadth);
+        let Some((spec, last)) = &mut self.undrained else {
+            return Ok(());
+        };
+        if q > 0.0 && q <= spec.load_fraction * limit {
+            let (error, n) = undrained::compare(spec, model, coll, q * breadth, breadth / 2.0)?;
+            *last = Some([error, q / self.cohesion, n as f64]);
+        }
+        Ok(())
     }
 
     /// d/B at the first crossing of q/c = `target` (interpolated), if reached.
@@ -367,6 +401,7 @@ impl<const D: usize> Check<D> for BearingCheck<D> {
         let row = [t, d / self.breadth, q / self.cohesion];
         if new_row {
             self.curve.push(row);
+            self.compare_pressure(q, model, coll)?;
         }
         Ok(vec![q, row[2], row[1]])
     }
@@ -400,7 +435,7 @@ impl<const D: usize> Check<D> for BearingCheck<D> {
             }
             (None, None) => None,
         };
-        let metrics = read
+        let mut metrics: Vec<(String, Metric)> = read
             .map(|(qc, detail)| {
                 let ratio = qc / self.reference;
                 let metric = Metric {
@@ -414,6 +449,24 @@ impl<const D: usize> Check<D> for BearingCheck<D> {
             })
             .into_iter()
             .collect();
+        if let Some((spec, last)) = &self.undrained {
+            let metric = match last {
+                Some([e, qc, n]) => Metric::error(
+                    *e,
+                    spec.tolerance,
+                    format!(
+                        "the excess pore pressure of {n} points at q/c = {qc:.4} against the rigid strip's undrained \
+                         elastic closed form, RMS of the difference over RMS of the closed form"
+                    ),
+                ),
+                None => Metric::error(
+                    f64::INFINITY,
+                    spec.tolerance,
+                    format!("no step had q/c in (0, {:.4}]", spec.load_fraction * self.reference),
+                ),
+            };
+            metrics.push(("excess_pressure_rms_rel_error".into(), metric));
+        }
         let table = Table {
             name: "load_settlement.csv".into(),
             header: vec!["time", "d_over_B", "q_over_c"],
@@ -429,19 +482,28 @@ impl<const D: usize> Check<D> for BearingCheck<D> {
     fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
         // [baseline, reaction (D), rows…]: the reaction of the last step is the footing's load when
         // the run restarts.
+        // With the undrained comparison, its last result [error, q/c, n] (NaN for none) follows the
+        // reaction.
+        let undrained = self.undrained.as_ref().map(|(_, last)| last.unwrap_or([f64::NAN; 3]));
         Ok(Some(
             std::iter::once(self.baseline)
                 .chain(self.reaction.iter().copied())
+                .chain(undrained.into_iter().flatten())
                 .chain(self.curve.iter().flatten().copied())
                 .collect(),
         ))
     }
 
     fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
-        if state.len() < 1 + D {
+        let extra = if self.undrained.is_some() { 3 } else { 0 };
+        if state.len() < 1 + D + extra {
             return Err("a load-settlement state without its baseline and reaction".into());
         }
-        let (baseline, reaction, rows) = (state[0], &state[1..1 + D], &state[1 + D..]);
+        let (baseline, reaction, rows) = (state[0], &state[1..1 + D], &state[1 + D + extra..]);
+        if let Some((_, last)) = &mut self.undrained {
+            let r = &state[1 + D..1 + D + 3];
+            *last = (!r[0].is_nan()).then(|| [r[0], r[1], r[2]]);
+        }
         if !rows.len().is_multiple_of(3) {
             return Err(format!("{} values do not make rows of a load-settlement curve", rows.len()));
         }

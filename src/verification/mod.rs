@@ -35,6 +35,7 @@ pub mod runout;
 pub mod shock;
 pub mod stiffness_map;
 pub mod terzaghi;
+pub mod undrained;
 pub mod vertical_cut;
 pub mod waves;
 pub mod xie_leo;
