@@ -7,7 +7,7 @@
 //! The check projects the points' vertical displacements on the mode with their masses,
 //! q(t) = Σ m φ(y₀) u_y / Σ m φ(y₀)² (y₀ a point's initial height), which filters the grid's
 //! higher modes, and compares q with the closed form q = (v₀/ω) sin ωt, where
-//! v₀ = Σ m φ v_y(0) / Σ m φ² is the projection of the run's own initial velocities (an initial
+//! v₀ = Σ m φ v_y(0) / Σ m φ² is the projection of the points' initial velocities (an initial
 //! field whose remainder v_y − v₀ φ is more than 1e-3 of it is refused: its higher modes would
 //! belong in the reference). Over the first `periods` periods: the period from the zero crossings
 //! of q (linear interpolation between steps; a least-squares line through the crossing times,
@@ -110,10 +110,14 @@ impl VibrationCheck {
         let b = body.index() as u16;
         let mode = |k: usize| (std::f64::consts::PI * (ps.x0[k][1] - base) / (2.0 * height)).sin();
         let mine = || (0..ps.len()).filter(|&k| ps.body[k] == b);
+        // The body's initial vertical velocity at each point's initial place (the same when the
+        // run restarts from a checkpoint, whose points move).
+        let fields = c.initial_values(body);
+        let start = |k: usize| fields.velocity_at(ps.x0[k])[1];
         let sums = coll.sum(&[
             mine().map(|k| ps.mass[k] * mode(k).powi(2)).sum(),
-            mine().map(|k| ps.mass[k] * mode(k) * ps.vel[k][1]).sum(),
-            mine().map(|k| ps.mass[k] * ps.vel[k][1].powi(2)).sum(),
+            mine().map(|k| ps.mass[k] * mode(k) * start(k)).sum(),
+            mine().map(|k| ps.mass[k] * start(k).powi(2)).sum(),
         ])?;
         let (modal_mass, v0) = (sums[0], sums[1] / sums[0]);
         // Σ m (v − v₀ φ)² = Σ m v² − v₀² Σ m φ² (v₀ the projection).
@@ -214,7 +218,10 @@ impl<const D: usize> Check<D> for VibrationCheck {
             })
             .sum();
         let q = coll.sum(&[local])?[0] / self.modal_mass;
-        self.history.push((t, q));
+        // A restart observes its first time again.
+        if self.history.last().is_none_or(|&(last, _)| t > last) {
+            self.history.push((t, q));
+        }
         Ok(vec![q])
     }
 
@@ -261,6 +268,19 @@ impl<const D: usize> Check<D> for VibrationCheck {
             ],
             Vec::new(),
         ))
+    }
+
+    /// The modal displacement's history so far.
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+        Ok(Some(self.history.iter().flat_map(|&(t, q)| [t, q]).collect()))
+    }
+
+    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
+        if state.len() < 2 || !state.len().is_multiple_of(2) {
+            return Err(format!("{} values are no history of (t, q) pairs", state.len()));
+        }
+        self.history = state.chunks(2).map(|r| (r[0], r[1])).collect();
+        Ok(())
     }
 
     fn results(&self) -> Vec<(String, f64)> {
