@@ -425,6 +425,50 @@ mod tests {
         assert!(e.contains("give the body's stress once"), "{e}");
     }
 
+    /// A box aligned with the cells is filled exactly; a ball and a cylinder to within the point
+    /// spacing's staircase, closer on finer grids; solids are refused in the plane and with a `z`.
+    #[test]
+    fn solid_shapes_fill_their_volume_to_the_point_spacing() {
+        let pi = std::f64::consts::PI;
+        let shapes = [
+            ("{ box = { min = [0.1, 0.2, 0.3], max = [0.7, 0.8, 0.9] } }", 0.216),
+            ("{ sphere = { center = [0.5, 0.5, 0.5], radius = 0.3 } }", 4.0 / 3.0 * pi * 0.027),
+            ("{ cylinder = { center = [0.5, 0.5, 0.5], axis = \"x\", radius = 0.3, length = 0.6 } }", pi * 0.09 * 0.6),
+        ];
+        for (shape, exact) in shapes {
+            let errors: Vec<f64> = [10, 20, 40]
+                .iter()
+                .map(|n| {
+                    let text = crate::case::tests_support::with_grid("[1.0, 1.0, 1.0]", &format!("[{n}, {n}, {n}]"))
+                        .replace("{ rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }", shape);
+                    let c = crate::validation::load(&text, "t", &[]).unwrap();
+                    let ps = Particles::<3>::generate(&c, &crate::model::grid_of(&c), |_| true);
+                    (ps.volume.iter().sum::<f64>() - exact).abs() / exact
+                })
+                .collect();
+            if shape.contains("box") {
+                // Exact but for the sum's round-off over up to 1.1e5 points.
+                assert!(errors.iter().all(|e| *e < 1e-11), "{shape}: {errors:?}");
+            } else {
+                assert!(errors[2] < 0.01 && errors[2] < errors[0], "{shape}: {errors:?}");
+            }
+        }
+        let sphere = "{ sphere = { center = [0.05, 0.5, 0.0], radius = 0.05 } }";
+        let plane = crate::case::tests_support::MINIMAL
+            .replace("{ rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }", sphere);
+        let e = crate::validation::load(&plane, "t", &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("key `bodies[0].shape`: a box, sphere or cylinder is a shape of a three-dimensional case"),
+            "{e}"
+        );
+        let with_z = crate::case::tests_support::with_grid("[1.0, 1.0, 1.0]", "[4, 4, 4]").replace(
+            "{ rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }",
+            "{ sphere = { center = [0.5, 0.5, 0.5], radius = 0.3 } }\n        z = [0.0, 1.0]",
+        );
+        let e = crate::validation::load(&with_z, "t", &[]).unwrap_err().to_string();
+        assert!(e.contains("a solid shape has its own extent along z"), "{e}");
+    }
+
     #[test]
     fn the_heap_count_covers_every_vector_and_generation_leaves_no_slack() {
         // Every field is a vector (a 24-byte header): the list the passes share names them all.

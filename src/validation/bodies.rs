@@ -146,9 +146,18 @@ fn initial(c: &Case, key: &str, b: &Body) -> Checked {
     Ok(())
 }
 
-/// A body's extent along z: only in three dimensions, ordered, inside the grid.
+/// A body's extent along z: only in three dimensions, ordered, inside the grid; a solid shape
+/// only in three dimensions, with its own extent.
 fn depth(c: &Case, key: &str, b: &Body) -> Checked {
-    match (c.dimension(), b.z) {
+    if b.shape.solid().is_some() {
+        if c.dimension() != 3 {
+            return Err(format!("key `{key}.shape`: a box, sphere or cylinder is a shape of a three-dimensional case"));
+        }
+        if b.z.is_some() {
+            return Err(format!("key `{key}.z`: a solid shape has its own extent along z; give no `z`"));
+        }
+    }
+    match (c.dimension(), b.z.or_else(|| b.shape.depth())) {
         (2, Some(_)) => Err(format!(
             "key `{key}.z`: only a three-dimensional case (three entries in `grid.size`) takes a body's extent \
              along z"
@@ -159,8 +168,9 @@ fn depth(c: &Case, key: &str, b: &Body) -> Checked {
             if z0.is_finite() && z1.is_finite() && z0 < z1 && z0 >= g0 - tol && z1 <= g0 + g1 + tol {
                 return Ok(());
             }
+            let what = if b.shape.solid().is_some() { "shape" } else { "z" };
             Err(format!(
-                "key `{key}.z`: body `{}` needs z_min < z_max inside the grid's [{g0}, {}], got [{z0}, {z1}]",
+                "key `{key}.{what}`: body `{}` needs z_min < z_max inside the grid's [{g0}, {}], got [{z0}, {z1}]",
                 b.name,
                 g0 + g1
             ))

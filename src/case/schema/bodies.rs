@@ -2,6 +2,7 @@
 //! planar shapes and boxes the case uses to select points and nodes.
 
 use super::super::expression::Expr;
+use super::solids::{Cuboid, Cylinder, Solid, Sphere};
 use crate::check::{at, finite, finite2, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
 
@@ -210,7 +211,9 @@ mod surface_word {
     }
 }
 
-/// A planar region, written `{ rectangle = { ... } }` or `{ polygon = { ... } }`.
+/// The region a body fills: a planar section, written `{ rectangle = { ... } }` or
+/// `{ polygon = { ... } }` (extruded along z over the body's `z` in three dimensions), or in three
+/// dimensions a solid, `{ box = { ... } }`, `{ sphere = { ... } }` or `{ cylinder = { ... } }`.
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Shape {
@@ -218,6 +221,13 @@ pub enum Shape {
     Rectangle(Rectangle),
     /// A simple polygon.
     Polygon(Polygon),
+    /// An axis-aligned box (three dimensions).
+    #[serde(rename = "box")]
+    Cuboid(Cuboid),
+    /// A ball (three dimensions).
+    Sphere(Sphere),
+    /// A circular cylinder along a grid axis (three dimensions).
+    Cylinder(Cylinder),
 }
 
 /// An axis-aligned rectangle of the plane.
@@ -299,12 +309,37 @@ impl Shape {
         match self {
             Shape::Rectangle(r) => r.check(&at(key, "rectangle")),
             Shape::Polygon(p) => p.check(&at(key, "polygon")),
+            Shape::Cuboid(b) => b.check(&at(key, "box")),
+            Shape::Sphere(b) => b.check(&at(key, "sphere")),
+            Shape::Cylinder(b) => b.check(&at(key, "cylinder")),
         }
     }
 
-    /// Bounding box (min, max) [m].
-    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+    /// The solid, if the shape is one.
+    pub fn solid(&self) -> Option<&dyn Solid> {
         match self {
+            Shape::Rectangle(_) | Shape::Polygon(_) => None,
+            Shape::Cuboid(b) => Some(b),
+            Shape::Sphere(b) => Some(b),
+            Shape::Cylinder(b) => Some(b),
+        }
+    }
+
+    /// A solid's extent along z [m] (none for a planar section).
+    pub fn depth(&self) -> Option<[f64; 2]> {
+        self.solid().map(|s| {
+            let (lo, hi) = s.bounds3();
+            [lo[2], hi[2]]
+        })
+    }
+
+    /// Bounding box (min, max) in x and y [m].
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let planar = |(lo, hi): ([f64; 3], [f64; 3])| ([lo[0], lo[1]], [hi[0], hi[1]]);
+        match self {
+            Shape::Cuboid(b) => planar(b.bounds3()),
+            Shape::Sphere(b) => planar(b.bounds3()),
+            Shape::Cylinder(b) => planar(b.bounds3()),
             Shape::Rectangle(r) => (r.min, r.max),
             Shape::Polygon(p) => {
                 let mut lo = [f64::INFINITY; 2];
@@ -320,10 +355,11 @@ impl Shape {
         }
     }
 
-    /// Whether point `p` lies inside (boundary points of a rectangle count as inside; polygons use
-    /// the even–odd rule).
+    /// Whether a planar section holds point `p` (boundary points of a rectangle count as inside;
+    /// polygons use the even–odd rule); a solid's section is not defined, and holds none.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         match self {
+            Shape::Cuboid(_) | Shape::Sphere(_) | Shape::Cylinder(_) => false,
             Shape::Rectangle(Rectangle { min, max }) => {
                 p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1]
             }

@@ -13,6 +13,7 @@ mod boundaries;
 mod loads;
 mod materials;
 mod output;
+mod solids;
 mod stabilisation;
 mod stages;
 mod verification;
@@ -23,6 +24,7 @@ pub use boundaries::*;
 pub use loads::*;
 pub use materials::*;
 pub use output::*;
+pub use solids::*;
 pub use stabilisation::*;
 pub use stages::*;
 pub use verification::*;
@@ -128,18 +130,22 @@ impl CaseFile {
         self.cell_size_in()
     }
 
-    /// The extent [z_min, z_max] of `body` along z in a three-dimensional case [m]: its own, or
-    /// the grid's.
+    /// The extent [z_min, z_max] of `body` along z in a three-dimensional case [m]: its own, its
+    /// solid's, or the grid's.
     pub fn body_depth(&self, body: &Body) -> [f64; 2] {
-        body.z.unwrap_or_else(|| {
+        body.z.or_else(|| body.shape.depth()).unwrap_or_else(|| {
             let z0 = self.grid.origin.get(2).copied().unwrap_or(0.0);
             [z0, z0 + self.grid.size.get(2).copied().unwrap_or(0.0)]
         })
     }
 
-    /// Whether `body` holds the point `p` of a case of dimension `D`: its section holds (x, y) and,
-    /// in three dimensions, its extent along z holds z (bounds included, as the section's).
+    /// Whether `body` holds the point `p` of a case of dimension `D`: its solid holds it, or its
+    /// section holds (x, y) and, in three dimensions, its extent along z holds z (bounds included,
+    /// as the section's).
     pub fn body_holds<const D: usize>(&self, body: &Body, p: [f64; D]) -> bool {
+        if let Some(solid) = body.shape.solid() {
+            return D == 3 && solid.holds([p[0], p[1], p[D - 1]]);
+        }
         if !body.shape.contains([p[0], p[1]]) {
             return false;
         }
