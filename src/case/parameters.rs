@@ -10,7 +10,7 @@
 //! `radians`, `degrees`, `abs`, `min`, `max`). The names `x`, `y` and `z` are a point's position in
 //! the keys that take a field of position (written without the leading `=`), and no parameter's.
 
-use super::expression::Expr;
+use super::expression::{Expr, COORDINATES};
 use toml::Value;
 
 /// Replaces every `"= expr"` string in `doc` (outside `[parameters]`) by its value. Errors name
@@ -21,7 +21,7 @@ pub fn expand(doc: &mut Value) -> Result<(), String> {
         Some(Value::Table(t)) => t
             .iter()
             .map(|(k, v)| match v {
-                _ if ["x", "y", "z"].contains(&k.as_str()) => Err(format!(
+                _ if COORDINATES.contains(&k.as_str()) => Err(format!(
                     "key `parameters.{k}`: `{k}` names a point's position in the expressions of fields; give the \
                      parameter another name"
                 )),
@@ -69,7 +69,12 @@ fn walk(v: &mut Value, path: &str, params: &[(String, f64)]) -> Result<(), Strin
 /// Evaluates an arithmetic expression ([`super::expression`]) with the given parameters; a value
 /// that is not finite is an error.
 pub fn eval(text: &str, params: &[(String, f64)]) -> Result<f64, String> {
-    let v = Expr::parse(text, &[], params)?.eval(&[]);
+    eval_at(text, params, &[])
+}
+
+/// [`eval`] with the position `at` = (x, y) or (x, y, z) [m] for the coordinates' names.
+pub fn eval_at(text: &str, params: &[(String, f64)], at: &[f64]) -> Result<f64, String> {
+    let v = Expr::parse(text, &COORDINATES[..at.len()], params)?.eval(at);
     if !v.is_finite() {
         return Err(format!("the value {v} is not finite"));
     }

@@ -387,13 +387,13 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
                 return Err(format!("PETSc options file {name} line {}: `alias` needs two option names", i + 1));
             }
             if let Some(extra) = tokens.get(3) {
-                let shown = shown(extra);
-                return Err(format!("PETSc options file {name} line {}: `{shown}` is left over after `alias`", i + 1));
+                let extra = shown(extra);
+                return Err(format!("PETSc options file {name} line {}: `{extra}` is left over after `alias`", i + 1));
             }
         } else if !first.starts_with('-') || first.len() < 2 {
-            let shown = shown(first);
+            let first = shown(first);
             return Err(format!(
-                "PETSc options file {name} line {}: `{shown}` is not an option (an option name begins with `-`; \
+                "PETSc options file {name} line {}: `{first}` is not an option (an option name begins with `-`; \
                  comments begin with `#`)",
                 i + 1
             ));
@@ -404,9 +404,9 @@ fn check_options_file_at(path: &Path, depth: usize) -> Result<(), String> {
                 tokens[1]
             ));
         } else if let Some(extra) = tokens.get(2) {
-            let shown = shown(extra);
+            let extra = shown(extra);
             return Err(format!(
-                "PETSc options file {name} line {}: `{shown}` is left over (a line holds one option and its value; \
+                "PETSc options file {name} line {}: `{extra}` is left over (a line holds one option and its value; \
                  comments begin with `#`)",
                 i + 1
             ));

@@ -118,11 +118,7 @@ pub fn increment_factor(
     at: &[f64],
 ) -> Result<f64, String> {
     let params: Vec<(String, f64)> = params.iter().map(|(k, v)| (k.clone(), *v)).collect();
-    let v = crate::case::Expr::parse(expr, &["x", "y", "z"][..at.len()], &params)?.eval(at);
-    if !v.is_finite() {
-        return Err(format!("the value {v} is not finite"));
-    }
-    Ok(v)
+    crate::case::parameters::eval_at(expr, &params, at)
 }
 
 /// The centre of a particle's `face` and the face's measure: its length in two dimensions (per

@@ -90,17 +90,22 @@ fn uniform_stress(key: &str, b: &Body, dim: usize) -> Checked {
     let Some(s) = &b.uniform_stress else {
         return Ok(());
     };
-    if !(s.len() == 4 || (dim == 3 && s.len() == 6)) {
-        return Err(format!(
-            "key `{key}.uniform_stress`: four entries [xx, yy, xy, zz]{}, got {}",
-            if dim == 3 { " or six [xx, yy, xy, zz, yz, zx]" } else { " in a plane case" },
-            s.len()
-        ));
-    }
+    stress_components(&format!("{key}.uniform_stress"), s.len(), dim)?;
     if s.iter().any(|v| !v.is_finite()) {
         return Err(format!("key `{key}.uniform_stress`: must be finite"));
     }
     Ok(())
+}
+
+/// A stress of `n` components at `key`: four [xx, yy, xy, zz], or six in three dimensions.
+fn stress_components(key: &str, n: usize, dim: usize) -> Checked {
+    if n == 4 || (dim == 3 && n == 6) {
+        return Ok(());
+    }
+    Err(format!(
+        "key `{key}`: four entries [xx, yy, xy, zz]{}, got {n}",
+        if dim == 3 { " or six [xx, yy, xy, zz, yz, zx]" } else { " in a plane case" }
+    ))
 }
 
 /// A body's initial fields: a velocity of one component per direction, a stress of four components
@@ -118,13 +123,7 @@ fn initial(c: &Case, key: &str, b: &Body) -> Checked {
         ));
     }
     if let Some(s) = &init.stress {
-        if !(s.len() == 4 || (dim == 3 && s.len() == 6)) {
-            return Err(format!(
-                "key `{key}.initial.stress`: four entries [xx, yy, xy, zz]{}, got {}",
-                if dim == 3 { " or six [xx, yy, xy, zz, yz, zx]" } else { " in a plane case" },
-                s.len()
-            ));
-        }
+        stress_components(&format!("{key}.initial.stress"), s.len(), dim)?;
         if b.initial_stress.is_some() || b.uniform_stress.is_some() {
             return Err(format!(
                 "key `{key}.initial.stress`: give the body's stress once: `initial.stress`, `initial_stress` or \

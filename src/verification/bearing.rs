@@ -480,10 +480,9 @@ impl<const D: usize> Check<D> for BearingCheck<D> {
     }
 
     fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
-        // [baseline, reaction (D), rows…]: the reaction of the last step is the footing's load when
-        // the run restarts.
-        // With the undrained comparison, its last result [error, q/c, n] (NaN for none) follows the
-        // reaction.
+        // [baseline, reaction (D), with the undrained comparison its last result [error, q/c, n]
+        // (NaN for none), rows…]: the reaction of the last step is the footing's load when the run
+        // restarts.
         let undrained = self.undrained.as_ref().map(|(_, last)| last.unwrap_or([f64::NAN; 3]));
         Ok(Some(
             std::iter::once(self.baseline)

@@ -99,16 +99,14 @@ impl VibrationCheck {
         model: &Model<D>,
         coll: &Collective,
     ) -> Result<VibrationCheck, String> {
-        let (young, nu) = elastic_body(c, body)?;
-        let mat = c.material_of(body);
-        let density = (1.0 - mat.porosity) * mat.solid_density + mat.porosity * mat.water_density;
-        let modulus = young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mat = &model.materials[c.material_id_of(body).index()];
+        let (density, modulus) = (mat.mixture_density(mat.porosity), mat.model.elastic().constrained_modulus());
         let (lo, hi) = c.body(body).shape.bounds();
         let (base, height) = (lo[1], hi[1] - lo[1]);
         let omega = std::f64::consts::PI * (modulus / density).sqrt() / (2.0 * height);
         let ps = &model.particles;
         let b = body.index() as u16;
-        let mode = |k: usize| (std::f64::consts::PI * (ps.x0[k][1] - base) / (2.0 * height)).sin();
+        let mode = |k: usize| first_mode(base, height, ps.x0[k][1]);
         let mine = || (0..ps.len()).filter(|&k| ps.body[k] == b);
         // The body's initial vertical velocity at each point's initial place (the same when the
         // run restarts from a checkpoint, whose points move).
@@ -191,6 +189,12 @@ impl VibrationCheck {
     }
 }
 
+/// The first mode's shape φ(y) = sin(π (y − y_b)/(2H)) of a bar of base `base` and height
+/// `height`.
+fn first_mode(base: f64, height: f64, y: f64) -> f64 {
+    (std::f64::consts::PI * (y - base) / (2.0 * height)).sin()
+}
+
 /// The slope of the least-squares line through (k, t_k), k = 0, 1, ….
 fn slope(t: &[f64]) -> f64 {
     let n = t.len() as f64;
@@ -212,10 +216,7 @@ impl<const D: usize> Check<D> for VibrationCheck {
         let ps = &model.particles;
         let local: f64 = (0..ps.len())
             .filter(|&k| ps.body[k] == self.body)
-            .map(|k| {
-                let phi = (std::f64::consts::PI * (ps.x0[k][1] - self.base) / (2.0 * self.height)).sin();
-                ps.mass[k] * phi * ps.disp[k][1]
-            })
+            .map(|k| ps.mass[k] * first_mode(self.base, self.height, ps.x0[k][1]) * ps.disp[k][1])
             .sum();
         let q = coll.sum(&[local])?[0] / self.modal_mass;
         // A restart observes its first time again.

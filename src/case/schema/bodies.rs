@@ -1,7 +1,7 @@
 //! `[[bodies]]`: the regions filled with material points at t = 0, their initial stress, and the
 //! planar shapes and boxes the case uses to select points and nodes.
 
-use super::super::expression::Expr;
+use super::super::expression::{Expr, COORDINATES};
 use super::solids::{Cuboid, Cylinder, Solid, Sphere};
 use crate::check::{at, finite, finite2, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
@@ -88,9 +88,6 @@ pub struct InitialValues {
     pub pore_pressure: Option<Expr>,
 }
 
-/// The names of the position's coordinates in the expressions of fields.
-const COORDINATES: [&str; 3] = ["x", "y", "z"];
-
 impl InitialValues {
     /// The fields of `body` (`key` its table, `bodies[0]`) in a case of dimension `dim` with the
     /// parameters `params`; an error names the component and what is wrong.
@@ -139,17 +136,21 @@ impl InitialValues {
     /// The first of the fields whose value at `x` is not finite, named (`velocity[1]`), with the
     /// value.
     pub fn not_finite_at<const D: usize>(&self, x: [f64; D]) -> Option<(String, f64)> {
-        let named = |name: &'static str, es: &[Expr]| {
-            es.iter().enumerate().map(move |(i, e)| (format!("{name}[{i}]"), e.eval(&x))).collect::<Vec<_>>()
+        let first = |name: &str, es: &[Expr]| {
+            es.iter()
+                .enumerate()
+                .map(|(i, e)| (i, e.eval(&x)))
+                .find(|(_, v)| !v.is_finite())
+                .map(|(i, v)| (format!("{name}[{i}]"), v))
         };
-        let mut all = named("velocity", &self.velocity);
-        all.extend(named("stress", &self.stress));
-        if let Some(e) = &self.pore_pressure {
-            let (p, g) = e.gradient(&x);
-            all.push(("pore_pressure".into(), p));
-            all.extend(g[..D].iter().map(|v| ("the gradient of pore_pressure".to_string(), *v)));
-        }
-        all.into_iter().find(|(_, v)| !v.is_finite())
+        let pressure = || {
+            let (p, g) = self.pore_pressure.as_ref()?.gradient(&x);
+            std::iter::once(("pore_pressure", p))
+                .chain(g[..D].iter().map(|&v| ("the gradient of pore_pressure", v)))
+                .find(|(_, v)| !v.is_finite())
+                .map(|(name, v)| (name.to_string(), v))
+        };
+        first("velocity", &self.velocity).or_else(|| first("stress", &self.stress)).or_else(pressure)
     }
 }
 
