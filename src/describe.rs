@@ -48,12 +48,14 @@ pub fn describe(case: &Case, label: &str) -> String {
         );
     }
     for (b, body) in case.bodies.iter().enumerate() {
-        let count = model.particles.body.iter().filter(|&&x| x as usize == b).count();
-        let n = body.particles_per_cell;
+        let ps = &model.particles;
+        let count = ps.body.iter().filter(|&&x| x as usize == b).count();
+        let volume: f64 = (0..ps.len()).filter(|&k| ps.body[k] as usize == b).map(|k| ps.volume[k]).sum();
         let _ = writeln!(
             s,
-            "body `{}`: {count} material points ({n}×{n} per cell), material `{}`{}",
+            "body `{}`: {count} material points ({}), volume {volume:.6e}, material `{}`{}",
             body.name,
+            fill_text(body, 2),
             body.material,
             initial_text(body)
         );
@@ -127,6 +129,9 @@ fn load_text(load: &Load, size: usize) -> String {
         }
         Load::NodalTraction(_) => format!("nodal traction on {size} nodes"),
         Load::LinePressure(p) => format!("pressure {} Pa on a line ({size} Gauss points)", p.pressure),
+        Load::SurfacePressure(p) => {
+            format!("pressure {} Pa on the surface of {} ({size} Gauss points)", p.pressure, p.surface.file())
+        }
         Load::BodyForce(f) => format!("body force {:?} m/s²", f.acceleration),
     }
 }
@@ -234,6 +239,25 @@ fn recovery_text(model: &Model) -> &'static str {
 
 /// The description of a three-dimensional case: its grid, bodies and material points, loads,
 /// boundaries (with the nodes each holds) and stages.
+/// How a body of a case of dimension `dim` is filled: its points per cell, its mesh's cells and
+/// quadrature, or its surface's triangles and the volume they enclose.
+fn fill_text(body: &crate::case::Body, dim: usize) -> String {
+    use crate::case::Shape;
+    let n = body.particles_per_cell;
+    match &body.shape {
+        Shape::Mesh(m) => format!("the {} cells of {}, quadrature of order {}", m.mesh().cells(), m.file, m.order),
+        Shape::Points(p) => format!("the {} rows of {}", p.cloud().len(), p.file),
+        Shape::Surface(f) => format!(
+            "{n}×{n}×{n} per cell inside the {} triangles of {}, which enclose {:.6e} m³",
+            f.surface().triangles(),
+            f.file,
+            f.surface().volume()
+        ),
+        _ if dim == 3 => format!("{n}×{n}×{n} per cell"),
+        _ => format!("{n}×{n} per cell"),
+    }
+}
+
 fn describe_solid(case: &Case, label: &str) -> String {
     let model = Model::build_solid(case, |_| true);
     let g = &model.grid;
@@ -260,13 +284,12 @@ fn describe_solid(case: &Case, label: &str) -> String {
     for (b, body) in case.bodies.iter().enumerate() {
         let count = ps.body.iter().filter(|&&x| x as usize == b).count();
         let volume: f64 = (0..ps.len()).filter(|&k| ps.body[k] as usize == b).map(|k| ps.volume[k]).sum();
-        let n = body.particles_per_cell;
         let [z0, z1] = case.body_depth(body);
         let _ = writeln!(
             s,
-            "body `{}`: {count} material points ({n}×{n}×{n} per cell), volume {volume:.6e} m³, z ∈ [{z0}, {z1}] m, \
-             material `{}`{}",
+            "body `{}`: {count} material points ({}), volume {volume:.6e} m³, z ∈ [{z0}, {z1}] m, material `{}`{}",
             body.name,
+            fill_text(body, 3),
             body.material,
             initial_text(body)
         );
@@ -280,6 +303,9 @@ fn describe_solid(case: &Case, label: &str) -> String {
             Load::NodalTraction(t) => format!("nodal traction {:?} Pa on {} nodes", t.traction, l.size()),
             Load::BodyForce(f) => format!("body force {:?} m/s²", f.acceleration),
             Load::LinePressure(_) => String::new(),
+            Load::SurfacePressure(p) => {
+                format!("pressure {} Pa on the surface of {} ({} Gauss points)", p.pressure, p.surface.file(), l.size())
+            }
         };
         let _ = writeln!(s, "load `{}`: {kind}", l.name);
     }

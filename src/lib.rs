@@ -24,6 +24,7 @@ pub mod distribution;
 pub mod driver;
 pub mod element_test;
 pub mod fields;
+pub mod geometry;
 pub mod io;
 pub mod kernels;
 pub mod layout;

@@ -176,7 +176,7 @@ fn the_hollow_cylinder_gives_the_same_answers_on_two_ranks() {
 }
 
 /// Bad axisymmetric input stops before the run with a message naming the key: a grid reaching
-/// r < 0, a boundary taking the axis's name, a plane-strain reference on an axisymmetric case, the
+/// r < 0, a boundary taking the axis's name, the plane-strain Lamé cylinder on an axisymmetric case, the
 /// hollow cylinder's reference on a plane-strain one, and [001]'s CMPM recovery with B̄ or in a
 /// two-phase case.
 #[test]
@@ -185,7 +185,11 @@ fn bad_axisymmetric_input_is_refused_with_a_clear_message() {
         (CYLINDER, &["grid.origin=[-0.1,0.0]"], "grid must start at x ≥ 0"),
         (CYLINDER, &["boundaries.0.name=axis"], "the name `axis` is taken"),
         (CYLINDER, &["analysis.geometry=plane_strain"], "needs `analysis.geometry = \"axisymmetric\"`"),
-        ("cases/lame_cylinder.toml", &["analysis.geometry=axisymmetric"], "is a plane-strain solution"),
+        (
+            "cases/lame_cylinder.toml",
+            &["analysis.geometry=axisymmetric"],
+            "a cylinder in axial symmetry is the `hollow_cylinder` check's",
+        ),
         (CYLINDER, &["stabilisation.stress_recovery=cmpm", "stabilisation.bbar=true"], "exclude each other"),
         ("cases/terzaghi.toml", &["stabilisation.stress_recovery=cmpm"], "`cmpm` is for one_phase analyses"),
     ];

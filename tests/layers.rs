@@ -19,6 +19,8 @@ const LAYERS: &[(&str, usize)] = &[
     ("parallel", 0),
     ("progress", 0),
     ("plot", 0),
+    // Regions read from files: a mesh's cells, a closed surface.
+    ("geometry", 0),
     // The case file as data; the soil models, their parameters and their laws.
     ("case", 1),
     ("soils", 1),

@@ -131,9 +131,8 @@ fn load_shares<const D: usize, const M: usize>(
                 out.push((Some(l), force, x));
             }
         }
-        LoadTarget::LinePressure { points, pressure } => {
-            // Each Gauss point on the rank owning the cell that holds it (a polyline of the plane:
-            // validation keeps line pressures out of three dimensions).
+        LoadTarget::Pressure { points, pressure } => {
+            // Each Gauss point on the rank owning the cell that holds it.
             for &(point, force) in points {
                 if !g.cell_containing(point).is_some_and(|c| space.owns_cell_in(c)) {
                     continue;

@@ -8,6 +8,7 @@
 
 pub mod checkpoint;
 pub mod fields;
+pub mod geometry;
 pub mod plot;
 
 use mpi::topology::SimpleCommunicator;

@@ -145,9 +145,10 @@ pub enum LoadTarget<const D: usize = 2> {
     NodalTraction { nodes: Vec<([usize; D], f64)>, traction: [f64; D] },
     /// Body acceleration on the particles of the listed bodies (all if None).
     BodyForce { acceleration: [f64; D], bodies: Option<Vec<u16>> },
-    /// A pressure on a fixed polyline: its Gauss points with the force per unit pressure there
-    /// (weight × length × the unit normal to the left) [m].
-    LinePressure { points: Vec<([f64; D], [f64; D])>, pressure: f64 },
+    /// A pressure on a fixed polyline (plane) or surface (three dimensions): its Gauss points
+    /// with the force per unit pressure there (weight × length × the unit normal to the left of a
+    /// line [m]; weight × area × the unit normal into the material of a surface [m²]).
+    Pressure { points: PressurePoints<D>, pressure: f64 },
 }
 
 impl<const D: usize> LoadDef<D> {
@@ -178,12 +179,18 @@ impl<const D: usize> LoadDef<D> {
                 acceleration: vector(&f.acceleration),
                 bodies: bodies.map(|bs| bs.iter().map(|b| b.index() as u16).collect()),
             },
-            // A pressure on a polyline of the plane (validation keeps it out of three dimensions).
-            case::Load::LinePressure(l) if D == 2 => LoadTarget::LinePressure {
+            // A pressure on a polyline of the plane, or on a surface in three dimensions (validation
+            // keeps each out of the other's dimension).
+            case::Load::LinePressure(l) if D == 2 => LoadTarget::Pressure {
                 points: line_gauss_points(&l.points).into_iter().map(|(x, f)| (vector(&x), vector(&f))).collect(),
                 pressure: l.pressure,
             },
-            case::Load::LinePressure(_) => return None,
+            case::Load::SurfacePressure(l) if D == 3 => LoadTarget::Pressure {
+                points: surface_pressure_points(c, l.surface.points(), grid.h)
+                    .expect("validation orients every point of a surface pressure"),
+                pressure: l.pressure,
+            },
+            case::Load::LinePressure(_) | case::Load::SurfacePressure(_) => return None,
         };
         Some(LoadDef::with_target(id, c, target))
     }
@@ -193,7 +200,7 @@ impl<const D: usize> LoadDef<D> {
         match &self.target {
             LoadTarget::ParticleTraction { particles, .. } => particles.len(),
             LoadTarget::NodalTraction { nodes, .. } => nodes.len(),
-            LoadTarget::LinePressure { points, .. } => points.len(),
+            LoadTarget::Pressure { points, .. } => points.len(),
             LoadTarget::BodyForce { .. } => 0,
         }
     }
@@ -273,6 +280,43 @@ pub fn face_is_exposed<const D: usize>(c: &case::Case, x: [f64; D], lp: [f64; D]
     let mut p = x;
     p[a] += face.sign() * e * lp[a];
     !c.bodies.iter().any(|b| c.body_holds(b, p))
+}
+
+/// A pressure's Gauss points, each with the force per unit pressure there [m, m or m²].
+pub type PressurePoints<const D: usize> = Vec<([f64; D], [f64; D])>;
+
+/// A surface's Gauss points `faces` (position, area vector) turned into the material: the force
+/// per unit pressure at each is its area vector, flipped where the material lies on the other side
+/// of its face. The side is where a body holds the point a quarter of the smallest cell size `h`
+/// away along the normal; material on both sides or on neither is an error naming the point.
+pub fn surface_pressure_points<const D: usize>(
+    c: &case::Case,
+    faces: &[([f64; 3], [f64; 3])],
+    h: [f64; D],
+) -> Result<PressurePoints<D>, String> {
+    let reach = 0.25 * h.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut out = Vec::with_capacity(faces.len());
+    for (x, a) in faces {
+        let length = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        if length == 0.0 {
+            continue;
+        }
+        let probe = |s: f64| -> [f64; D] { std::array::from_fn(|d| x[d] + s * reach * a[d] / length) };
+        let (ahead, behind) = (c.body_at(probe(1.0)).is_some(), c.body_at(probe(-1.0)).is_some());
+        let sign = match (ahead, behind) {
+            (true, false) => 1.0,
+            (false, true) => -1.0,
+            (both, _) => {
+                return Err(format!(
+                    "its surface at {x:?} has material on {} (within {reach:e} m along its normal); a pressure \
+                     pushes material that lies on one side of it",
+                    if both { "both sides" } else { "neither side" }
+                ))
+            }
+        };
+        out.push((std::array::from_fn(|d| x[d]), std::array::from_fn(|d| sign * a[d])));
+    }
+    Ok(out)
 }
 
 /// The two Gauss points of each segment of a polyline, with the force per unit pressure there:

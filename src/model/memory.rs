@@ -102,6 +102,12 @@ fn points_of(case: &Case) -> f64 {
         .bodies
         .iter()
         .map(|b| {
+            if let Some(m) = b.shape.mesh() {
+                return (m.mesh().cells() * m.mesh().points_per_cell(m.order)) as f64;
+            }
+            if let Some(p) = b.shape.points() {
+                return p.cloud().len() as f64;
+            }
             let (lo, hi) = b.shape.bounds();
             let depth = case.body_depth(b);
             let extent = [hi[0] - lo[0], hi[1] - lo[1], depth[1] - depth[0]];
@@ -122,7 +128,7 @@ fn counted<const D: usize>(case: &Case) -> f64 {
     let grid = super::grid_of::<D>(case);
     let mut n = 0usize;
     for b in 0..case.bodies.len() {
-        super::particles::for_each_point(case, &grid, b, |_, _, _| n += 1);
+        super::particles::for_each_point(case, &grid, b, |_| n += 1);
     }
     n as f64
 }

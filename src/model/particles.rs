@@ -164,25 +164,19 @@ impl<const D: usize> Particles<D> {
 }
 
 impl<const D: usize> Particles<D> {
-    /// Fills the bodies of the case with n^D points per cell (n = `particles_per_cell`), keeping
-    /// those whose cell satisfies `owned(cell)` (the cells of this rank). Points are placed at the
-    /// centres of the sub-cells (moved by the body's `perturbation`); a point belongs to the first
-    /// body that contains it (validation refuses overlaps unless the later body says
-    /// `overlap = "yield"`). Cells and their sub-cells are visited x fastest.
+    /// Fills the bodies of the case with their points ([`for_each_point`]), keeping those whose
+    /// cell satisfies `owned(cell)` (the cells of this rank); a point belongs to the first body that
+    /// contains it (validation refuses overlaps unless the later body says `overlap = "yield"`).
     pub fn generate(case: &Case, grid: &Grid<D>, owned: impl Fn([usize; D]) -> bool) -> Particles<D> {
         let mut ps = Particles::default();
         let pore_water = case.analysis.formulation == Formulation::TwoPhase;
         let geometry = super::geometry_of(case);
         for id in case.body_ids() {
-            let (b, body) = (id.index(), case.body(id));
-            let mat_index = case.material_id_of(id).index();
-            let n = body.particles_per_cell;
-            let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
-            let volume = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
-            for_each_point(case, grid, b, |cell, id, x| {
-                if owned(cell) {
-                    let vol = volume * geometry.measure(x[0]);
-                    ps.push_point(case, grid, (id, b, mat_index), (x, lp, vol), pore_water);
+            let (b, mat_index) = (id.index(), case.material_id_of(id).index());
+            for_each_point(case, grid, b, |p| {
+                if owned(p.cell) {
+                    let vol = p.measure * geometry.measure(p.x[0]);
+                    ps.push_point(case, grid, (p.id, b, mat_index), (p.x, p.lp, vol), pore_water);
                 }
             });
         }
@@ -244,19 +238,54 @@ impl<const D: usize> Particles<D> {
     }
 }
 
-/// Calls `f(cell, id, x)` for every place body `b` of `case` may put a material point: the
-/// centres of the n^D sub-cells (n its `particles_per_cell`) of the cells its bounding box
-/// touches, moved by its `perturbation`, with the point's global id (from the body and the
-/// sub-cell, the same on any number of ranks). Cells and their sub-cells are visited x fastest;
-/// whether the body holds the place is the caller's question.
-pub fn for_each_candidate<const D: usize>(
-    case: &Case,
-    grid: &Grid<D>,
-    b: usize,
-    mut f: impl FnMut([usize; D], u64, [f64; D]),
-) {
+/// A place where a body may put a material point.
+#[derive(Debug, Clone, Copy)]
+pub struct Candidate<const D: usize> {
+    /// The grid cell holding it.
+    pub cell: [usize; D],
+    /// The point's global id (the same on any number of ranks).
+    pub id: u64,
+    /// Its position [m].
+    pub x: [f64; D],
+    /// Its area (plane and axisymmetric cases, before the ring's factor) or volume [m², m³].
+    pub measure: f64,
+    /// The half-widths of its GIMP domain [m].
+    pub lp: [f64; D],
+}
+
+/// Calls `f` for every place body `b` of `case` may put a material point: for a body filled from
+/// a mesh, its cells' quadrature points, numbered by cell and point; for a particle file's, its
+/// rows, numbered in order; for any other, the centres of
+/// the n^D sub-cells (n its `particles_per_cell`) of the cells its bounding box touches, moved by
+/// its `perturbation`, numbered by sub-cell and visited x fastest. Whether the body holds the
+/// place is the caller's question.
+pub fn for_each_candidate<const D: usize>(case: &Case, grid: &Grid<D>, b: usize, mut f: impl FnMut(Candidate<D>)) {
     let body = &case.bodies[b];
+    if let Some(m) = body.shape.mesh() {
+        let mesh = m.mesh();
+        let found = mesh.for_each_point(m.order, |number, x3, w| {
+            let x: [f64; D] = std::array::from_fn(|d| x3[d]);
+            let Some(cell) = grid.cell_containing(x) else { return };
+            let side = 0.5 * w.powf(1.0 / D as f64);
+            f(Candidate { cell, id: ((b as u64) << 48) | number, x, measure: w, lp: [side; D] });
+        });
+        found.expect("validation integrates every cell of a body's mesh");
+        return;
+    }
+    if let Some(p) = body.shape.points() {
+        let cloud = p.cloud();
+        cloud.for_each(|k, x3, measure| {
+            let x: [f64; D] = std::array::from_fn(|d| x3[d]);
+            if let Some(cell) = grid.cell_containing(x) {
+                let lp = [cloud.half_width(k); D];
+                f(Candidate { cell, id: ((b as u64) << 48) | k as u64, x, measure, lp });
+            }
+        });
+        return;
+    }
     let n = body.particles_per_cell;
+    let lp: [f64; D] = std::array::from_fn(|d| grid.h[d] / (2.0 * n as f64));
+    let measure = grid.h.iter().product::<f64>() / n.pow(D as u32) as f64;
     let (lo2, hi2) = body.shape.bounds();
     let depth = case.body_depth(body);
     let (lo, hi): ([f64; D], [f64; D]) = (
@@ -278,7 +307,7 @@ pub fn for_each_candidate<const D: usize>(
                 let shake = body.perturbation * (2.0 * jitter(id, d as u64) - 1.0);
                 grid.origin[d] + (cell[d] as f64 + (sub[d] as f64 + 0.5 + shake) / n as f64) * grid.h[d]
             });
-            f(cell, id, x);
+            f(Candidate { cell, id, x, measure, lp });
             if !super::shape::next_combination(&mut sub, [n; D]) {
                 break;
             }
@@ -291,15 +320,10 @@ pub fn for_each_candidate<const D: usize>(
 
 /// [`for_each_candidate`] for the places where body `b` puts its material points: those it holds
 /// and no body listed before it holds ([`Case::body_at`]), on any rank.
-pub fn for_each_point<const D: usize>(
-    case: &Case,
-    grid: &Grid<D>,
-    b: usize,
-    mut f: impl FnMut([usize; D], u64, [f64; D]),
-) {
-    for_each_candidate(case, grid, b, |cell, id, x| {
-        if case.body_at(x).is_some_and(|at| at.index() == b) {
-            f(cell, id, x);
+pub fn for_each_point<const D: usize>(case: &Case, grid: &Grid<D>, b: usize, mut f: impl FnMut(Candidate<D>)) {
+    for_each_candidate(case, grid, b, |p| {
+        if case.body_at(p.x).is_some_and(|at| at.index() == b) {
+            f(p);
         }
     });
 }
@@ -458,7 +482,9 @@ mod tests {
             .replace("{ rectangle = { min = [0.0, 0.0], max = [0.1, 1.0] } }", sphere);
         let e = crate::validation::load(&plane, "t", &[]).unwrap_err().to_string();
         assert!(
-            e.contains("key `bodies[0].shape`: a box, sphere or cylinder is a shape of a three-dimensional case"),
+            e.contains(
+                "key `bodies[0].shape`: a box, sphere, cylinder or surface is a shape of a three-dimensional case"
+            ),
             "{e}"
         );
         let with_z = crate::case::tests_support::with_grid("[1.0, 1.0, 1.0]", "[4, 4, 4]").replace(

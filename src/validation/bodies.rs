@@ -2,8 +2,95 @@
 //! along z, and that they lie inside the grid.
 
 use super::grid::Bounds;
-use crate::case::{Body, Case};
+use crate::case::{Body, Case, CaseFile, GroupName, LoadSurface, Shape};
 use crate::check::Checked;
+use crate::geometry::{CellKind, Group, Mesh, PointCloud, Surface};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Reads the files bodies and loads are made from, relative to the case file `origin`: a body's
+/// mesh (its cells of the case's dimension, of its group, integrated once to find a cell without
+/// measure), STL surface (scaled and moved, which must be closed) or particle file; a surface
+/// pressure's faces (their Gauss points).
+pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
+    let base = Path::new(origin).parent().unwrap_or(Path::new(""));
+    let dim = if file.dimension() == 3 { 3 } else { 2 };
+    let axisymmetric = file.analysis.geometry == crate::case::Geometry::Axisymmetric;
+    for (i, b) in file.bodies.iter_mut().enumerate() {
+        let key = format!("bodies[{i}].shape");
+        match &mut b.shape {
+            Shape::Mesh(m) => {
+                let path = base.join(&m.file);
+                let content =
+                    crate::io::geometry::read_msh(&path).map_err(|e| format!("key `{key}.mesh.file`: {e}"))?;
+                let named = |e: String| format!("key `{key}.mesh`: {}: {e}", path.display());
+                let mesh = Mesh::select(&content, dim, group(&m.group)).map_err(named)?;
+                mesh.for_each_point(m.order, |_, _, _| {}).map_err(named)?;
+                m.loaded = Some(Arc::new(mesh));
+            }
+            Shape::Surface(s) => {
+                let path = base.join(&s.file);
+                let file =
+                    crate::io::geometry::read_stl(&path).map_err(|e| format!("key `{key}.surface.file`: {e}"))?;
+                let placed =
+                    file.vertices.iter().map(|v| std::array::from_fn(|d| v[d] * s.scale + s.offset[d])).collect();
+                let surface = Surface::new(placed, file.triangles)
+                    .map_err(|e| format!("key `{key}.surface`: {}: {e}", path.display()))?;
+                s.loaded = Some(Arc::new(surface));
+            }
+            Shape::Points(p) => {
+                let path = base.join(&p.file);
+                let named = |e: String| format!("key `{key}.points`: {}: {e}", path.display());
+                let (x, volume) = crate::io::geometry::read_points(&path, dim)
+                    .map_err(|e| format!("key `{key}.points.file`: {e}"))?;
+                // A plane case's volumes are per metre: areas; an axisymmetric one's are rings.
+                let ring = |k: usize| if axisymmetric { std::f64::consts::TAU * x[k][0] } else { 1.0 };
+                if let Some(k) = (0..x.len()).find(|&k| axisymmetric && x[k][0] <= 0.0) {
+                    return Err(named(format!("its point {k} is at r = {}; a ring needs r > 0", x[k][0])));
+                }
+                let measure = (0..x.len()).map(|k| volume[k] / ring(k)).collect();
+                p.loaded = Some(Arc::new(PointCloud::new(dim, x, measure).map_err(named)?));
+            }
+            _ => {}
+        }
+    }
+    for (i, l) in file.loads.iter_mut().enumerate() {
+        if let crate::case::Load::SurfacePressure(p) = l {
+            read_load_surface(&mut p.surface, base, &format!("loads[{i}].surface"))?;
+        }
+    }
+    Ok(())
+}
+
+/// Reads a loaded surface's file into its Gauss points; `key` is its table.
+fn read_load_surface(surface: &mut LoadSurface, base: &Path, key: &str) -> Checked {
+    let path = base.join(surface.file());
+    match surface {
+        LoadSurface::Mesh(m) => {
+            let content = crate::io::geometry::read_msh(&path).map_err(|e| format!("key `{key}.mesh.file`: {e}"))?;
+            let points = content
+                .face_points(group(&m.group))
+                .map_err(|e| format!("key `{key}.mesh`: {}: {e}", path.display()))?;
+            m.loaded = Some(Arc::new(points));
+        }
+        LoadSurface::Stl(s) => {
+            let file = crate::io::geometry::read_stl(&path).map_err(|e| format!("key `{key}.stl.file`: {e}"))?;
+            let placed: Vec<[f64; 3]> =
+                file.vertices.iter().map(|v| std::array::from_fn(|d| v[d] * s.scale + s.offset[d])).collect();
+            let faces = file.triangles.iter().map(|t| (CellKind::Triangle, &t[..]));
+            s.loaded = Some(Arc::new(crate::geometry::face_points(&placed, faces)));
+        }
+    }
+    Ok(())
+}
+
+/// A physical group named in a case.
+fn group(g: &Option<GroupName>) -> Option<Group<'_>> {
+    g.as_ref().map(|g| match g {
+        GroupName::Tag(t) => Group::Tag(*t),
+        GroupName::Name(n) => Group::Name(n),
+    })
+}
 
 /// Every body.
 pub(super) fn check(c: &Case) -> Checked {
@@ -11,6 +98,12 @@ pub(super) fn check(c: &Case) -> Checked {
     for (i, b) in c.bodies.iter().enumerate() {
         let key = format!("bodies[{i}]");
         b.check(&key)?;
+        if (b.shape.mesh().is_some() || b.shape.points().is_some()) && b.perturbation != 0.0 {
+            return Err(format!(
+                "key `{key}.perturbation`: moves the points of a body filled on the grid; a mesh's points are its \
+                 cells' quadrature points, a particle file's its rows"
+            ));
+        }
         uniform_stress(&key, b, c.dimension())?;
         initial(c, &key, b)?;
         depth(c, &key, b)?;
@@ -41,7 +134,8 @@ fn occupancy<const D: usize>(c: &Case) -> Checked {
         let (mut held, mut overlaps) = (0usize, vec![0usize; i]);
         let values = c.initial_values(crate::case::BodyId::new(i));
         let mut not_finite = None;
-        crate::model::particles::for_each_candidate(c, &grid, i, |_, _, x| {
+        crate::model::particles::for_each_candidate(c, &grid, i, |p| {
+            let x = p.x;
             if c.body_holds(b, x) {
                 held += 1;
                 match c.bodies[..i].iter().position(|o| c.body_holds(o, x)) {
@@ -150,7 +244,9 @@ fn initial(c: &Case, key: &str, b: &Body) -> Checked {
 fn depth(c: &Case, key: &str, b: &Body) -> Checked {
     if b.shape.solid().is_some() {
         if c.dimension() != 3 {
-            return Err(format!("key `{key}.shape`: a box, sphere or cylinder is a shape of a three-dimensional case"));
+            return Err(format!(
+                "key `{key}.shape`: a box, sphere, cylinder or surface is a shape of a three-dimensional case"
+            ));
         }
         if b.z.is_some() {
             return Err(format!("key `{key}.z`: a solid shape has its own extent along z; give no `z`"));

@@ -23,6 +23,17 @@ pub(super) fn plane_regions(c: &Case) -> Checked {
     }
 }
 
+/// A plane or axisymmetric case has no surface to press: its pressures act on lines.
+pub(super) fn plane_pressures(c: &Case) -> Checked {
+    match c.loads.iter().position(|l| matches!(l, Load::SurfacePressure(_))) {
+        Some(i) => Err(format!(
+            "key `loads[{i}].kind = \"surface_pressure\"`: a surface pressure acts in a three-dimensional case; a plane \
+             or axisymmetric one presses a `line_pressure`"
+        )),
+        None => Ok(()),
+    }
+}
+
 /// What a three-dimensional case may not ask for, and the space of its points' identifiers.
 pub(super) fn three_dimensional(c: &Case) -> Checked {
     let not_yet =

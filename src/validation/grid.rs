@@ -12,6 +12,7 @@ pub(super) fn check(c: &Case) -> Checked {
         dimensions::three_dimensional(c)?;
     } else {
         dimensions::plane_regions(c)?;
+        dimensions::plane_pressures(c)?;
     }
     dimensions::axisymmetry(c, Bounds::of(c).tol[0])
 }

@@ -1,6 +1,6 @@
 //! Loads: their vectors with a component per dimension, the layer of nodes a nodal traction
-//! loads, an increment factor that evaluates where the loaded faces start, and line pressures
-//! inside the grid.
+//! loads, an increment factor that evaluates where the loaded faces start, line pressures inside
+//! the grid, and surface pressures inside it with material on one side of every point.
 
 use super::grid::{grid_lines_in, Bounds};
 use crate::case::{Case, Load, Region};
@@ -41,6 +41,15 @@ pub(super) fn check(c: &Case) -> Checked {
                     return Err(format!("key `{key}.points[{j}]`: {p:?} is outside the grid"));
                 }
             }
+            Load::SurfacePressure(p) => {
+                let bounds = Bounds::of(c);
+                let file = p.surface.file();
+                if let Some((x, _)) = p.surface.points().iter().find(|(x, _)| !bounds.contains(&x[..])) {
+                    return Err(format!("key `{key}.surface`: {file}: its point {x:?} is outside the grid"));
+                }
+                crate::model::loads::surface_pressure_points(c, p.surface.points(), c.cell_size_in::<3>())
+                    .map_err(|e| format!("key `{key}.surface`: {file}: {e}"))?;
+            }
         }
     }
     Ok(())
@@ -56,7 +65,7 @@ fn points_in<const D: usize>(c: &Case, load: usize, region: &Region) -> bool {
         if found || bodies.is_some_and(|bs| !bs.iter().any(|id| id.index() == b)) {
             continue;
         }
-        crate::model::particles::for_each_point(c, &grid, b, |_, _, x| found = found || region.contains_in(x));
+        crate::model::particles::for_each_point(c, &grid, b, |p| found = found || region.contains_in(p.x));
     }
     found
 }

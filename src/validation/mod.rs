@@ -35,10 +35,12 @@ pub fn load(text: &str, origin: &str, overrides: &[Override]) -> Result<Case, Ca
     validate(case::parse(text, origin, overrides)?, origin)
 }
 
-/// Checks every range, combination and name of a parsed case file and resolves its names: the
-/// only way to a [`Case`]. `origin` names the file in messages.
+/// Reads the files its bodies are made from (relative to `origin`'s directory), checks every
+/// range, combination and name of a parsed case file and resolves its names: the only way to a
+/// [`Case`]. `origin` is the case file's path, and names it in messages.
 pub fn validate(mut file: CaseFile, origin: &str) -> Result<Case, CaseError> {
     let err = |e: String| CaseError::new(format!("{origin}: {e}"));
+    bodies::read_files(&mut file, origin).map_err(err)?;
     default_steps(&mut file).map_err(err)?;
     let links = resolve(&file).map_err(err)?;
     let case = Case::new(file, links);

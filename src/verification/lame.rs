@@ -1,21 +1,26 @@
-//! Lamé's thick-walled cylinder under internal pressure, plane strain: the nearly incompressible
-//! elastic benchmark with a closed-form answer (Timoshenko & Goodier, §33).
+//! Lamé's thick-walled cylinder and sphere under internal pressure: the nearly incompressible
+//! elastic benchmarks with a closed-form answer (Timoshenko & Goodier, §33 and §141).
 //!
 //! With inner radius a, outer radius b, internal pressure p, Young's modulus E and Poisson's ratio
-//! ν (plane strain, free outer surface):
+//! ν, free outer surface; the cylinder in plane strain (a plane section, or in three dimensions
+//! along z between rollers):
 //!   u_r = (1 + ν) p a² ((1 − 2ν) r + b²/r) / (E (b² − a²)),
-//!   σ_rr = p a² (1 − b²/r²)/(b² − a²),   σ_θθ = p a² (1 + b²/r²)/(b² − a²).
+//!   σ_rr = p a² (1 − b²/r²)/(b² − a²),   σ_θθ = p a² (1 + b²/r²)/(b² − a²);
+//! the sphere (in axial symmetry about an axis through its centre, or in three dimensions):
+//!   u_r = p a³ ((1 − 2ν) r + (1 + ν) b³/(2r²)) / (E (b³ − a³)),
+//!   σ_rr = p a³ (1 − b³/r³)/(b³ − a³),   σ_θθ = p a³ (1 + b³/(2r³))/(b³ − a³).
 //! Metrics: relative L2 errors over the body's points, weighted by their volumes (so that an error
 //! does not shrink because more points are counted), of u_r (the displacement along the point's
-//! initial radial direction), σ_rr and σ_θθ (the stress projected on the radial and hoop directions
-//! there), at the end of the run.
+//! initial radial direction), σ_rr and σ_θθ (the stress projected on the radial direction, and on
+//! the hoop direction of a cylinder or the mean of the two tangential normal stresses of a sphere),
+//! at the end of the run.
 
 use super::{
     all_positive, linear_elastic, load_name, radii, BodyAndLoad, BuiltCheck, Check, CheckParameters, Findings,
     FormulationNeed, Metric,
 };
-use crate::case::{Case, Formulation, Load};
-use crate::check::{at, finite2, Checked};
+use crate::case::{Case, Formulation, Geometry, Load};
+use crate::check::{at, Checked};
 use crate::model::loads::TimeFn;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -25,13 +30,19 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LameCylinder {
-    /// The name of the cylinder's body (linear elastic).
-    pub body: String,
-    /// The name of the internal pressure (a `line_pressure`; p at the run's end).
-    pub load: String,
-    /// The cylinder's axis [m] (default: the origin).
+    /// `"cylinder"` (the default; plane strain, or in three dimensions along z) or `"sphere"`
+    /// (in axial symmetry, its centre on the axis, or in three dimensions).
     #[serde(default)]
-    pub center: [f64; 2],
+    pub shape: LameShape,
+    /// The name of the shell's body (linear elastic).
+    pub body: String,
+    /// The name of the internal pressure (p at the run's end): a `line_pressure` in a plane or
+    /// axisymmetric case, a `surface_pressure` in three dimensions.
+    pub load: String,
+    /// The centre [m]: the cylinder's axis (x, y), the sphere's centre (x, y, z in three
+    /// dimensions; (0, y) in axial symmetry) (default: the origin; entries not given are 0).
+    #[serde(default)]
+    pub center: Vec<f64>,
     /// Inner radius a [m], > 0.
     pub inner_radius: f64,
     /// Outer radius b [m], > a.
@@ -46,13 +57,28 @@ pub struct LameCylinder {
 
 serde_defaults! { default_lame_tol: f64 = 0.05 }
 
+/// The shell of a `lame` check.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LameShape {
+    /// A cylinder in plane strain.
+    #[default]
+    Cylinder,
+    /// A sphere.
+    Sphere,
+}
+
 impl CheckParameters for LameCylinder {
     type Ids = BodyAndLoad;
     const FORMULATION: FormulationNeed =
         Some((Formulation::OnePhase, "the Lamé reference is for a one_phase analysis"));
+    const SOLID: bool = true;
+    const AXISYMMETRIC: bool = true;
 
     fn check(&self, key: &str) -> Checked {
-        finite2(&at(key, "center"), self.center)?;
+        if self.center.len() > 3 || self.center.iter().any(|v| !v.is_finite()) {
+            return Err(format!("key `{}`: at most three finite entries, got {:?}", at(key, "center"), self.center));
+        }
         all_positive(key, &[("inner_radius", self.inner_radius), ("outer_radius", self.outer_radius)])?;
         radii(key, self.inner_radius, self.outer_radius)?;
         let (d, s) = (self.displacement_tolerance, self.stress_tolerance);
@@ -60,20 +86,44 @@ impl CheckParameters for LameCylinder {
     }
 
     fn describe(&self) -> String {
-        format!("Lamé cylinder, a = {} m, b = {} m: u_r, σ_rr, σ_θθ", self.inner_radius, self.outer_radius)
+        let what = if self.shape == LameShape::Sphere { "sphere" } else { "cylinder" };
+        format!("Lamé {what}, a = {} m, b = {} m: u_r, σ_rr, σ_θθ", self.inner_radius, self.outer_radius)
     }
 
-    /// A linear elastic body and a line pressure.
+    /// A linear elastic body and a line pressure (a surface pressure in three dimensions); a
+    /// cylinder in plane strain or three dimensions, a sphere in axial symmetry or three dimensions.
     fn link(&self, c: &Case) -> Result<BodyAndLoad, String> {
         let ids = BodyAndLoad::named(c, &self.body, &self.load)?;
-        if !matches!(c.load(ids.load), Load::LinePressure(_)) {
-            return Err(format!("key `verification.load`: `{}` must be a line_pressure load", load_name(c, ids.load)));
+        let (solid, axisymmetric) = (c.dimension() == 3, c.analysis.geometry == Geometry::Axisymmetric);
+        match (self.shape, solid, axisymmetric) {
+            (LameShape::Cylinder, _, true) => {
+                return Err(
+                    "key `verification.shape`: a cylinder in axial symmetry is the `hollow_cylinder` check's".into()
+                )
+            }
+            (LameShape::Sphere, false, false) => {
+                return Err("key `verification.shape`: a sphere needs axial symmetry or three dimensions".into())
+            }
+            _ => {}
+        }
+        let pressed = match c.load(ids.load) {
+            Load::LinePressure(_) => !solid,
+            Load::SurfacePressure(_) => solid,
+            _ => false,
+        };
+        if !pressed {
+            let kind = if solid { "surface_pressure" } else { "line_pressure" };
+            return Err(format!("key `verification.load`: `{}` must be a {kind} load", load_name(c, ids.load)));
         }
         linear_elastic(c, ids.body, "the Lamé reference")?;
         Ok(ids)
     }
 
     fn plane(&self, c: &Case, ids: &BodyAndLoad, _model: &Model, _coll: &Collective) -> BuiltCheck {
+        Ok(Box::new(LameCheck::new(c, self, ids)?))
+    }
+
+    fn solid(&self, c: &Case, ids: &BodyAndLoad, _model: &Model<3>, _coll: &Collective) -> BuiltCheck<3> {
         Ok(Box::new(LameCheck::new(c, self, ids)?))
     }
 }
@@ -91,14 +141,23 @@ pub struct Lame {
     pub e: f64,
     /// Poisson's ratio.
     pub nu: f64,
+    /// A sphere (else a cylinder in plane strain).
+    pub sphere: bool,
 }
 
 impl Lame {
     /// (u_r, σ_rr, σ_θθ) at radius r.
     pub fn at(&self, r: f64) -> (f64, f64, f64) {
+        let nu = self.nu;
+        if self.sphere {
+            let (a3, b3) = (self.a.powi(3), self.b.powi(3));
+            let k = self.p * a3 / (b3 - a3);
+            let u = k * ((1.0 - 2.0 * nu) * r + (1.0 + nu) * b3 / (2.0 * r * r)) / self.e;
+            return (u, k * (1.0 - b3 / r.powi(3)), k * (1.0 + b3 / (2.0 * r.powi(3))));
+        }
         let (a2, b2) = (self.a * self.a, self.b * self.b);
         let k = self.p * a2 / (b2 - a2);
-        let u = (1.0 + self.nu) * k * ((1.0 - 2.0 * self.nu) * r + b2 / r) / self.e;
+        let u = (1.0 + nu) * k * ((1.0 - 2.0 * nu) * r + b2 / r) / self.e;
         (u, k * (1.0 - b2 / (r * r)), k * (1.0 + b2 / (r * r)))
     }
 }
@@ -106,7 +165,7 @@ impl Lame {
 /// The Lamé check of a case.
 pub struct LameCheck {
     body: u16,
-    center: [f64; 2],
+    center: [f64; 3],
     theory: Lame,
     time_fn: TimeFn,
     tolerances: (f64, f64),
@@ -118,36 +177,45 @@ impl LameCheck {
     /// The check of a `lame` verification `spec`, whose names resolve to `ids`.
     pub fn new(c: &Case, spec: &LameCylinder, ids: &BodyAndLoad) -> Result<LameCheck, String> {
         let (e, nu) = super::elastic_body(c, ids.body)?;
-        let Load::LinePressure(load) = c.load(ids.load) else {
-            return Err(format!("`{}` is not a line_pressure load", spec.load));
+        let p = match c.load(ids.load) {
+            Load::LinePressure(l) => l.pressure,
+            Load::SurfacePressure(l) => l.pressure,
+            _ => return Err(format!("`{}` is not a pressure", spec.load)),
         };
+        let sphere = spec.shape == LameShape::Sphere;
         Ok(LameCheck {
             body: ids.body.index() as u16,
-            center: spec.center,
-            theory: Lame { a: spec.inner_radius, b: spec.outer_radius, p: load.pressure, e, nu },
+            center: std::array::from_fn(|d| spec.center.get(d).copied().unwrap_or(0.0)),
+            theory: Lame { a: spec.inner_radius, b: spec.outer_radius, p, e, nu, sphere },
             time_fn: super::load_time_fn(c, ids.load),
             tolerances: (spec.displacement_tolerance, spec.stress_tolerance),
             last: [f64::NAN; 4],
         })
     }
 
-    fn errors(&self, t: f64, model: &Model, coll: &Collective) -> Result<[f64; 3], String> {
+    fn errors<const D: usize>(&self, t: f64, model: &Model<D>, coll: &Collective) -> Result<[f64; 3], String> {
         let ps = &model.particles;
         let theory = Lame { p: self.theory.p * self.time_fn.eval(t), ..self.theory };
         // Σ V e² and Σ V x*² for u_r, σ_rr, σ_θθ.
         let mut local = [0.0; 6];
         for k in (0..ps.len()).filter(|&k| ps.body[k] == self.body) {
-            let d = [ps.x0[k][0] - self.center[0], ps.x0[k][1] - self.center[1]];
-            let r = d[0].hypot(d[1]);
+            // The radial direction: in the section's plane for a cylinder (along z in three
+            // dimensions), from the centre for a sphere.
+            let along = D.min(if theory.sphere { 3 } else { 2 });
+            let d: [f64; 3] = std::array::from_fn(|a| if a < along { ps.x0[k][a] - self.center[a] } else { 0.0 });
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             if r == 0.0 {
                 continue;
             }
-            let (c, s) = (d[0] / r, d[1] / r);
+            let n = d.map(|v| v / r);
             let (u, srr, stt) = theory.at(r);
-            let st = ps.stress[k];
-            let ur = ps.disp[k][0] * c + ps.disp[k][1] * s;
-            let rr = st[0] * c * c + st[1] * s * s + 2.0 * st[2] * c * s;
-            let tt = st[0] * s * s + st[1] * c * c - 2.0 * st[2] * c * s;
+            let st = crate::soils::principal::tensor(&ps.stress[k]);
+            let ur: f64 = (0..D).map(|a| ps.disp[k][a] * n[a]).sum();
+            let normal = |m: [f64; 3]| (0..3).map(|a| (0..3).map(|b| m[a] * st[a][b] * m[b]).sum::<f64>()).sum::<f64>();
+            let rr = normal(n);
+            // A cylinder's hoop direction; a sphere's two tangential directions, averaged.
+            let tt =
+                if theory.sphere { 0.5 * (st[0][0] + st[1][1] + st[2][2] - rr) } else { normal([-n[1], n[0], 0.0]) };
             let v = ps.volume[k];
             for (i, (x, x_star)) in [(ur, u), (rr, srr), (tt, stt)].into_iter().enumerate() {
                 local[2 * i] += v * (x - x_star).powi(2);
@@ -159,18 +227,18 @@ impl LameCheck {
     }
 }
 
-impl Check for LameCheck {
+impl<const D: usize> Check<D> for LameCheck {
     fn columns(&self) -> Vec<String> {
         vec!["lame.u_r_error".into(), "lame.sigma_rr_error".into(), "lame.sigma_tt_error".into()]
     }
 
-    fn observe(&mut self, t: f64, _dt: f64, model: &Model, coll: &Collective) -> Result<Vec<f64>, String> {
+    fn observe(&mut self, t: f64, _dt: f64, model: &Model<D>, coll: &Collective) -> Result<Vec<f64>, String> {
         let e = self.errors(t, model, coll)?;
         self.last = [e[0], e[1], e[2], t];
         Ok(e.to_vec())
     }
 
-    fn finish(&mut self, _model: &Model, _coll: &Collective) -> Result<Findings, String> {
+    fn finish(&mut self, _model: &Model<D>, _coll: &Collective) -> Result<Findings, String> {
         let [eu, err, ett, t] = self.last;
         let l = &self.theory;
         let detail = |what: &str| {
@@ -192,11 +260,11 @@ impl Check for LameCheck {
         ))
     }
 
-    fn checkpoint_state(&self, _model: &Model, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
+    fn checkpoint_state(&self, _model: &Model<D>, _coll: &Collective) -> Result<Option<Vec<f64>>, String> {
         Ok(Some(self.last.to_vec()))
     }
 
-    fn restore_state(&mut self, state: &[f64], _model: &Model) -> Result<(), String> {
+    fn restore_state(&mut self, state: &[f64], _model: &Model<D>) -> Result<(), String> {
         self.last = state.try_into().map_err(|_| "the Lamé check's state has 4 values".to_string())?;
         Ok(())
     }
@@ -208,7 +276,7 @@ mod tests {
 
     #[test]
     fn the_closed_form_meets_its_boundary_conditions() {
-        let l = Lame { a: 1.0, b: 2.0, p: 1e3, e: 1e6, nu: 0.3 };
+        let l = Lame { a: 1.0, b: 2.0, p: 1e3, e: 1e6, nu: 0.3, sphere: false };
         let (_, srr_a, _) = l.at(1.0);
         let (_, srr_b, _) = l.at(2.0);
         assert!((srr_a + 1e3).abs() < 1e-9 && srr_b.abs() < 1e-9);
@@ -221,5 +289,20 @@ mod tests {
         let lam = l.e * l.nu / ((1.0 + l.nu) * (1.0 - 2.0 * l.nu));
         assert!(((lam + 2.0 * g) * dudr + lam * u / r - srr).abs() < 1e-6);
         assert!((lam * dudr + (lam + 2.0 * g) * u / r - stt).abs() < 1e-6);
+    }
+
+    /// The sphere's closed form: σ_rr(a) = −p, σ_rr(b) = 0, and Hooke's law with ε_rr = du/dr
+    /// and the two hoop strains u/r.
+    #[test]
+    fn the_sphere_s_closed_form_meets_its_boundary_conditions() {
+        let l = Lame { a: 1.0, b: 2.0, p: 1e3, e: 1e6, nu: 0.3, sphere: true };
+        assert!((l.at(1.0).1 + 1e3).abs() < 1e-9 && l.at(2.0).1.abs() < 1e-9);
+        let (r, h) = (1.4, 1e-6);
+        let (u, srr, stt) = l.at(r);
+        let dudr = (l.at(r + h).0 - l.at(r - h).0) / (2.0 * h);
+        let g = l.e / (2.0 * (1.0 + l.nu));
+        let lam = l.e * l.nu / ((1.0 + l.nu) * (1.0 - 2.0 * l.nu));
+        assert!(((lam + 2.0 * g) * dudr + 2.0 * lam * u / r - srr).abs() < 1e-6);
+        assert!((lam * dudr + 2.0 * (lam + g) * u / r - stt).abs() < 1e-6);
     }
 }

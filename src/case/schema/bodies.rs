@@ -2,6 +2,7 @@
 //! planar shapes and boxes the case uses to select points and nodes.
 
 use super::super::expression::{Expr, COORDINATES};
+use super::from_files::{MeshRegion, PointsRegion, SurfaceRegion};
 use super::solids::{Cuboid, Cylinder, Solid, Sphere};
 use crate::check::{at, finite, finite2, finite_points, positive, Checked};
 use serde::{Deserialize, Serialize};
@@ -213,8 +214,11 @@ mod surface_word {
 }
 
 /// The region a body fills: a planar section, written `{ rectangle = { ... } }` or
-/// `{ polygon = { ... } }` (extruded along z over the body's `z` in three dimensions), or in three
-/// dimensions a solid, `{ box = { ... } }`, `{ sphere = { ... } }` or `{ cylinder = { ... } }`.
+/// `{ polygon = { ... } }` (extruded along z over the body's `z` in three dimensions), in three
+/// dimensions a solid, `{ box = { ... } }`, `{ sphere = { ... } }`, `{ cylinder = { ... } }` or
+/// `{ surface = { file = "dam.stl" } }`, or in any dimension the cells of a Gmsh mesh,
+/// `{ mesh = { file = "slope.msh", group = "soil" } }`, or the points of a particle file,
+/// `{ points = { file = "points.csv" } }`.
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Shape {
@@ -229,6 +233,12 @@ pub enum Shape {
     Sphere(Sphere),
     /// A circular cylinder along a grid axis (three dimensions).
     Cylinder(Cylinder),
+    /// The inside of a closed STL surface (three dimensions).
+    Surface(SurfaceRegion),
+    /// The cells of a Gmsh mesh, filled by their quadrature points.
+    Mesh(MeshRegion),
+    /// The points of a particle file.
+    Points(PointsRegion),
 }
 
 /// An axis-aligned rectangle of the plane.
@@ -313,6 +323,25 @@ impl Shape {
             Shape::Cuboid(b) => b.check(&at(key, "box")),
             Shape::Sphere(b) => b.check(&at(key, "sphere")),
             Shape::Cylinder(b) => b.check(&at(key, "cylinder")),
+            Shape::Surface(b) => b.check(&at(key, "surface")),
+            Shape::Mesh(m) => m.check(&at(key, "mesh")),
+            Shape::Points(_) => Ok(()),
+        }
+    }
+
+    /// The particle file's points a body is made of, if it is one.
+    pub fn points(&self) -> Option<&PointsRegion> {
+        match self {
+            Shape::Points(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The mesh a body is filled from, if it is one.
+    pub fn mesh(&self) -> Option<&MeshRegion> {
+        match self {
+            Shape::Mesh(m) => Some(m),
+            _ => None,
         }
     }
 
@@ -323,6 +352,9 @@ impl Shape {
             Shape::Cuboid(b) => Some(b),
             Shape::Sphere(b) => Some(b),
             Shape::Cylinder(b) => Some(b),
+            Shape::Surface(b) => Some(b),
+            Shape::Mesh(m) => (m.mesh().dim() == 3).then_some(m as &dyn Solid),
+            Shape::Points(p) => (p.cloud().dim() == 3).then_some(p as &dyn Solid),
         }
     }
 
@@ -341,6 +373,9 @@ impl Shape {
             Shape::Cuboid(b) => planar(b.bounds3()),
             Shape::Sphere(b) => planar(b.bounds3()),
             Shape::Cylinder(b) => planar(b.bounds3()),
+            Shape::Surface(b) => planar(b.bounds3()),
+            Shape::Mesh(m) => planar(m.mesh().bounds()),
+            Shape::Points(p) => planar(p.cloud().bounds()),
             Shape::Rectangle(r) => (r.min, r.max),
             Shape::Polygon(p) => {
                 let mut lo = [f64::INFINITY; 2];
@@ -360,7 +395,9 @@ impl Shape {
     /// polygons use the even–odd rule); a solid's section is not defined, and holds none.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         match self {
-            Shape::Cuboid(_) | Shape::Sphere(_) | Shape::Cylinder(_) => false,
+            Shape::Cuboid(_) | Shape::Sphere(_) | Shape::Cylinder(_) | Shape::Surface(_) => false,
+            Shape::Mesh(m) => m.mesh().dim() == 2 && m.mesh().holds([p[0], p[1], 0.0]),
+            Shape::Points(c) => c.cloud().dim() == 2 && c.cloud().holds([p[0], p[1], 0.0]),
             Shape::Rectangle(Rectangle { min, max }) => {
                 p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1]
             }

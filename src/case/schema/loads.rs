@@ -29,6 +29,13 @@ pub enum Load {
     /// functions of the cell holding each point (nodes the material does not fill pass their share
     /// to filled ones). Fixed in space: for small deformations.
     LinePressure(LinePressure),
+    /// A pressure [Pa] on a surface fixed in space (three-dimensional cases only): a Gmsh mesh's
+    /// physical surface or an STL file's triangles (e.g. the inside of a cavity, a loaded slab),
+    /// pushing the material on the side of the surface it fills: the force on each Gauss point (of
+    /// order 2) of its cells is p times its share of the area along the normal into the material,
+    /// which must lie on one side only, within a quarter cell. Distributed as a `line_pressure`'s;
+    /// fixed in space: for small deformations.
+    SurfacePressure(SurfacePressure),
     /// A body acceleration [m/s²] on every particle (gravity: [0, -9.81], or [0, -9.81, 0] in three
     /// dimensions), acting on both phases.
     BodyForce(BodyForce),
@@ -91,6 +98,21 @@ pub struct LinePressure {
     pub time_function: Option<String>,
 }
 
+/// The parameters of `kind = "surface_pressure"`.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SurfacePressure {
+    /// The name stages and the verification give to use it.
+    pub name: String,
+    /// The surface: `{ mesh = { file = "dam.msh", group = "upstream_face" } }` or
+    /// `{ stl = { file = "slab.stl" } }`.
+    pub surface: super::from_files::LoadSurface,
+    /// The pressure p [Pa].
+    pub pressure: f64,
+    /// The name of the time function scaling it (default: a constant 1).
+    pub time_function: Option<String>,
+}
+
 /// The parameters of `kind = "body_force"`.
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -114,6 +136,7 @@ impl Load {
             Load::ParticleTraction(_) => "particle_traction",
             Load::NodalTraction(_) => "nodal_traction",
             Load::LinePressure(_) => "line_pressure",
+            Load::SurfacePressure(_) => "surface_pressure",
             Load::BodyForce(_) => "body_force",
         }
     }
@@ -124,6 +147,7 @@ impl Load {
             Load::ParticleTraction(l) => (&l.name, l.time_function.as_deref()),
             Load::NodalTraction(l) => (&l.name, l.time_function.as_deref()),
             Load::LinePressure(l) => (&l.name, l.time_function.as_deref()),
+            Load::SurfacePressure(l) => (&l.name, l.time_function.as_deref()),
             Load::BodyForce(l) => (&l.name, l.time_function.as_deref()),
         }
     }
@@ -152,7 +176,7 @@ impl Load {
         match self {
             Load::ParticleTraction(l) => Some(&l.traction),
             Load::NodalTraction(l) => Some(&l.traction),
-            Load::LinePressure(_) | Load::BodyForce(_) => None,
+            Load::LinePressure(_) | Load::SurfacePressure(_) | Load::BodyForce(_) => None,
         }
     }
 
@@ -162,7 +186,7 @@ impl Load {
         match self {
             Load::ParticleTraction(l) => l.body.as_ref().map(std::slice::from_ref),
             Load::BodyForce(l) => l.bodies.as_deref(),
-            Load::NodalTraction(_) | Load::LinePressure(_) => None,
+            Load::NodalTraction(_) | Load::LinePressure(_) | Load::SurfacePressure(_) => None,
         }
     }
 
@@ -173,6 +197,10 @@ impl Load {
             Load::ParticleTraction(l) => l.region.check(&at(key, "region")),
             Load::NodalTraction(l) => l.region.check(&at(key, "region")),
             Load::LinePressure(l) => l.check(key),
+            Load::SurfacePressure(l) => {
+                l.surface.check(&at(key, "surface"))?;
+                finite(&at(key, "pressure"), l.pressure)
+            }
             Load::BodyForce(_) => Ok(()),
         }
     }

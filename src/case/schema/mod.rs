@@ -10,6 +10,7 @@
 mod analysis;
 mod bodies;
 mod boundaries;
+mod from_files;
 mod loads;
 mod materials;
 mod output;
@@ -21,6 +22,7 @@ mod verification;
 pub use analysis::*;
 pub use bodies::*;
 pub use boundaries::*;
+pub use from_files::*;
 pub use loads::*;
 pub use materials::*;
 pub use output::*;
