@@ -11,7 +11,7 @@
 # Run as root or with sudo available.
 set -euo pipefail
 
-packages=(petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev clang libclang-dev pkg-config
+packages=(petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev clang libclang-dev pkg-config xvfb
           libopenblas0-serial libfontconfig1-dev libfreetype-dev fonts-dejavu-core
           make git ca-certificates curl paraview python3-paraview python3-scipy)
 missing=()
