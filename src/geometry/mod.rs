@@ -2,7 +2,7 @@
 //! points), a closed triangulated surface (a body bounded by it) and points given one by one (a
 //! particle file's). Pure geometry: reading the
 //! files is `crate::io::geometry`'s. The tests of which side of a line or plane a point lies on are
-//! Shewchuk's exact predicates (the `robust` crate), so a point on a shared face or edge is decided
+//! Shewchuk's exact predicates (Shewchuk 1997; the `robust` crate), so a point on a shared face or edge is decided
 //! the same way by every cell and every rank.
 
 mod buckets;

@@ -1,8 +1,9 @@
 //! A closed triangulated surface (an STL file's) as a body's region: a point is inside where a
 //! ray from it crosses the surface an odd number of times. The ray runs along +z from the point
-//! moved by an infinitesimal (ε, ε², ε³) (simulation of simplicity): with the exact predicates, a
-//! ray through an edge or a vertex, or along a face, is counted once by exactly one of the triangles
-//! there, so the answer is exact for a watertight surface, wherever the point lies.
+//! moved by an infinitesimal (ε, ε², ε³) (simulation of simplicity, Edelsbrunner & Mücke 1990):
+//! with the exact predicates, a ray through an edge or a vertex, or along a face, is counted once
+//! by exactly one of the triangles there, so the answer is exact for a watertight surface, wherever
+//! the point lies.
 
 use super::buckets::Buckets;
 use super::{c2, c3};

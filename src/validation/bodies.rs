@@ -75,8 +75,7 @@ fn read_load_surface(surface: &mut LoadSurface, base: &Path, key: &str) -> Check
         }
         LoadSurface::Stl(s) => {
             let file = crate::io::geometry::read_stl(&path).map_err(|e| format!("key `{key}.stl.file`: {e}"))?;
-            let placed: Vec<[f64; 3]> =
-                file.vertices.iter().map(|v| std::array::from_fn(|d| v[d] * s.scale + s.offset[d])).collect();
+            let placed = s.placed(&file.vertices);
             let faces = file.triangles.iter().map(|t| (CellKind::Triangle, &t[..]));
             s.loaded = Some(Arc::new(crate::geometry::face_points(&placed, faces)));
         }

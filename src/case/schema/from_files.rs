@@ -78,12 +78,15 @@ pub enum GroupName {
     Name(String),
 }
 
-/// A body bounded by a closed STL surface (three dimensions).
+/// An STL file (ASCII or binary), scaled and moved into the case's frame: a body's closed surface
+/// or the triangles a surface pressure loads.
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
-pub struct SurfaceRegion {
-    /// The STL file (ASCII or binary), relative to the case file; its triangles must close the
-    /// body (every edge shared by two of them).
+#[serde(bound = "")]
+#[schemars(bound = "")]
+pub struct StlFile<T> {
+    /// The STL file, relative to the case file; a body's triangles must close it (every edge
+    /// shared by two of them).
     pub file: String,
     /// The length of the file's unit [m] (default 1; 0.001 for a file in millimetres), > 0.
     #[serde(default = "default_scale")]
@@ -91,10 +94,29 @@ pub struct SurfaceRegion {
     /// Added to every vertex after scaling [m] (default [0, 0, 0]).
     #[serde(default)]
     pub offset: [f64; 3],
-    /// The surface, read by validation.
+    /// What validation reads from it.
     #[serde(skip)]
     #[schemars(skip)]
-    pub loaded: Option<Arc<Surface>>,
+    pub loaded: Option<Arc<T>>,
+}
+
+/// A body bounded by a closed STL surface (three dimensions).
+pub type SurfaceRegion = StlFile<Surface>;
+
+impl<T> StlFile<T> {
+    /// The file's vertices [file units] scaled and moved into the case's frame [m].
+    pub fn placed(&self, vertices: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        vertices.iter().map(|v| std::array::from_fn(|d| v[d] * self.scale + self.offset[d])).collect()
+    }
+
+    /// Checks the scale and the offset; `key` is its table.
+    pub fn check_placement(&self, key: &str) -> Checked {
+        positive(&at(key, "scale"), self.scale)?;
+        for (d, v) in self.offset.iter().enumerate() {
+            finite(&format!("{}[{d}]", at(key, "offset")), *v)?;
+        }
+        Ok(())
+    }
 }
 
 serde_defaults! { default_order: usize = 2, default_scale: f64 = 1.0 }
@@ -123,11 +145,7 @@ impl SurfaceRegion {
 
 impl Solid for SurfaceRegion {
     fn check(&self, key: &str) -> Checked {
-        positive(&at(key, "scale"), self.scale)?;
-        for (d, v) in self.offset.iter().enumerate() {
-            finite(&format!("{}[{d}]", at(key, "offset")), *v)?;
-        }
-        Ok(())
+        self.check_placement(key)
     }
     fn bounds3(&self) -> ([f64; 3], [f64; 3]) {
         self.surface().bounds()
@@ -175,23 +193,8 @@ pub struct MeshFaces {
     pub loaded: Option<Arc<FacePoints>>,
 }
 
-/// The triangles of an STL file.
-#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct StlFaces {
-    /// The STL file (ASCII or binary), relative to the case file.
-    pub file: String,
-    /// The length of the file's unit [m] (default 1), > 0.
-    #[serde(default = "default_scale")]
-    pub scale: f64,
-    /// Added to every vertex after scaling [m] (default [0, 0, 0]).
-    #[serde(default)]
-    pub offset: [f64; 3],
-    /// Their Gauss points, read by validation.
-    #[serde(skip)]
-    #[schemars(skip)]
-    pub loaded: Option<Arc<FacePoints>>,
-}
+/// The triangles of an STL file (open or closed), as Gauss points with their area vectors.
+pub type StlFaces = StlFile<FacePoints>;
 
 impl LoadSurface {
     /// The file it is read from.
@@ -213,14 +216,9 @@ impl LoadSurface {
 
     /// Checks an STL file's scale and offset; `key` is its table.
     pub fn check(&self, key: &str) -> Checked {
-        let LoadSurface::Stl(s) = self else {
-            return Ok(());
-        };
-        let key = at(key, "stl");
-        positive(&at(&key, "scale"), s.scale)?;
-        for (d, v) in s.offset.iter().enumerate() {
-            finite(&format!("{}[{d}]", at(&key, "offset")), *v)?;
+        match self {
+            LoadSurface::Stl(s) => s.check_placement(&at(key, "stl")),
+            LoadSurface::Mesh(_) => Ok(()),
         }
-        Ok(())
     }
 }
