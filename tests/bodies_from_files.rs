@@ -330,3 +330,50 @@ fn a_particle_file_gives_its_points() {
     let e = bad("axis.csv", "x,y,volume\n0.0,0.5,1e-3\n", "geometry = \"axisymmetric\"");
     assert!(e.contains("its point 0 is at r = 0; a ring needs r > 0"), "{e}");
 }
+
+/// A particle file's initial fields: each point starts with its row's velocity and stress; a field
+/// the body gives too, a pore pressure in a one-phase case, a column of a group missing and a
+/// value that is not finite are refused.
+#[test]
+fn a_particle_file_gives_its_points_their_initial_fields() {
+    let dir = std::env::temp_dir().join("porompm-particle-fields");
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        format!("{{ points = {{ file = \"{}\" }} }}", file.display())
+    };
+    let rows = "x,y,volume,vy,vx,sxx,syy,sxy,szz\n0.25,0.25,0.01,-1.0,2.0,-10.0,-20.0,3.0,-15.0\n0.75,0.25,0.01,-1.5,0.5,-11.0,-21.0,4.0,-16.0\n";
+    let c = case("[1.0, 1.0]", "[10, 10]", &body("b", &write("fields.csv", rows)), "").unwrap();
+    let ps = Particles::<2>::generate(&c, &porompm::model::grid_of::<2>(&c), |_| true);
+    assert_eq!(ps.vel, vec![[2.0, -1.0], [0.5, -1.5]]);
+    assert_eq!(ps.stress[1], [-11.0, -21.0, 4.0, -16.0, 0.0, 0.0]);
+    let refused = [
+        (
+            body("b", &write("v.csv", "x,y,volume,vx,vy\n0.5,0.5,0.01,1,2\n"))
+                + "initial = { velocity = [0.0, 1.0] }\n",
+            "gives the points' velocity and the body gives it too",
+        ),
+        (
+            body("b", &write("s.csv", "x,y,volume,sxx,syy,sxy,szz\n0.5,0.5,0.01,1,2,3,4\n"))
+                + "uniform_stress = [0.0, 0.0, 0.0, 0.0]\n",
+            "gives the points' stress and the body gives it too",
+        ),
+        (
+            body("b", &write("p.csv", "x,y,volume,p\n0.5,0.5,0.01,1e3\n")),
+            "a pore pressure, which a one_phase analysis has not",
+        ),
+        (
+            body("b", &write("half.csv", "x,y,volume,vx\n0.5,0.5,0.01,1\n")),
+            "its header has no column `vy` (it needs vx, vy)",
+        ),
+        (
+            body("b", &write("nan.csv", "x,y,volume,vx,vy\n0.5,0.5,0.01,NaN,1\n")),
+            "its point 0 has the velocity [NaN, 1.0, 0.0]",
+        ),
+    ];
+    for (bodies, want) in refused {
+        let e = case("[1.0, 1.0]", "[10, 10]", &bodies, "").unwrap_err();
+        assert!(e.contains(want), "{e}\nshould say: {want}");
+    }
+}

@@ -11,7 +11,7 @@ pub mod points;
 pub mod surface;
 
 pub use mesh::{face_points, CellKind, FacePoints, FileCell, Group, Mesh, MeshFile};
-pub use points::PointCloud;
+pub use points::{PointCloud, PointFields, PointRows};
 pub use surface::{Surface, Triangles};
 
 use robust::{orient2d, orient3d, Coord, Coord3D};

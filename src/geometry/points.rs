@@ -3,12 +3,37 @@
 
 use super::buckets::Buckets;
 
+/// A particle file's rows as read: positions [m], volumes [m³] and the initial fields the file
+/// gives (each for every row, or none).
+#[derive(Debug, Clone, Default)]
+pub struct PointRows {
+    /// Positions.
+    pub x: Vec<[f64; 3]>,
+    /// Volumes.
+    pub volume: Vec<f64>,
+    /// Initial fields.
+    pub fields: PointFields,
+}
+
+/// The initial fields a particle file gives its points, each for every point or none.
+#[derive(Debug, Clone, Default)]
+pub struct PointFields {
+    /// Velocity [m/s] (z zero in the plane).
+    pub velocity: Option<Vec<[f64; 3]>>,
+    /// Effective stress [xx, yy, xy, zz, yz, zx] [Pa] (tension positive).
+    pub stress: Option<Vec<[f64; 6]>>,
+    /// Pore pressure [Pa] (compression positive).
+    pub pore_pressure: Option<Vec<f64>>,
+}
+
 /// Points of a plane (x, y) or three-dimensional region.
 #[derive(Clone)]
 pub struct PointCloud {
     dim: usize,
     x: Vec<[f64; 3]>,
     measure: Vec<f64>,
+    /// The initial fields of its points.
+    pub fields: PointFields,
     lo: [f64; 3],
     hi: [f64; 3],
     buckets: Buckets<3>,
@@ -44,8 +69,15 @@ impl PointCloud {
         if let Some(k) = (0..x.len()).find(|&k| !(measure[k] > 0.0 && measure[k].is_finite())) {
             return Err(format!("its point {k} has the measure {}, which must be positive", measure[k]));
         }
-        let mut cloud =
-            PointCloud { dim, x, measure, lo: [0.0; 3], hi: [0.0; 3], buckets: Buckets::new([0.0; 3], [0.0; 3], &[]) };
+        let mut cloud = PointCloud {
+            dim,
+            x,
+            measure,
+            fields: PointFields::default(),
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            buckets: Buckets::new([0.0; 3], [0.0; 3], &[]),
+        };
         let boxes: Vec<([f64; 3], [f64; 3])> = (0..cloud.x.len()).map(|k| cloud.domain(k)).collect();
         cloud.lo = std::array::from_fn(|d| boxes.iter().map(|b| b.0[d]).fold(f64::INFINITY, f64::min));
         cloud.hi = std::array::from_fn(|d| boxes.iter().map(|b| b.1[d]).fold(f64::NEG_INFINITY, f64::max));

@@ -2,7 +2,7 @@
 //! crate) and STL surfaces (ASCII or binary, by the `stl_io` crate), read into
 //! [`crate::geometry`]'s types.
 
-use crate::geometry::{CellKind, FileCell, MeshFile, Triangles};
+use crate::geometry::{CellKind, FileCell, MeshFile, PointFields, PointRows, Triangles};
 use mshio::mshfile::ElementType;
 use std::collections::HashMap;
 use std::path::Path;
@@ -113,34 +113,76 @@ pub fn read_stl(path: &Path) -> Result<Triangles, String> {
     Ok(Triangles { vertices, triangles })
 }
 
-/// The points of a particle file: a CSV table whose header names its columns, `x`, `y` (and `z`
-/// in three dimensions, `dim = 3`) [m] and `volume` [m³] in any order among others, which are
-/// skipped; lines starting with `#` and empty lines are skipped. An error names the line.
-pub fn read_points(path: &Path, dim: usize) -> Result<(Vec<[f64; 3]>, Vec<f64>), String> {
+/// The rows of a particle file: a CSV table whose header names its columns, `x`, `y` (and `z` in
+/// three dimensions, `dim = 3`) [m] and `volume` [m³], and optionally the initial velocity `vx`,
+/// `vy` (`vz`) [m/s], effective stress `sxx`, `syy`, `sxy`, `szz` (and `syz`, `szx`) [Pa] and pore
+/// pressure `p` [Pa], in any order among others, which are skipped; lines starting with `#` and
+/// empty lines are skipped. An error names the line, or the column a field lacks.
+pub fn read_points(path: &Path, dim: usize) -> Result<PointRows, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     let (_, header) = lines.next().ok_or_else(|| format!("{}: no header line", path.display()))?;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let wanted: &[&str] = if dim == 3 { &["x", "y", "z", "volume"] } else { &["x", "y", "volume"] };
-    let columns = (wanted.iter())
-        .map(|w| {
-            names.iter().position(|n| n == w).ok_or_else(|| {
-                format!("{}: its header has no column `{w}` (it needs {})", path.display(), wanted.join(", "))
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let (mut x, mut volume) = (Vec::new(), Vec::new());
+    let find = |w: &str| names.iter().position(|n| *n == w);
+    let group = |wanted: &[&str], optional: &[&str]| -> Result<Option<Vec<Option<usize>>>, String> {
+        let found: Vec<Option<usize>> = wanted.iter().map(|w| find(w)).collect();
+        if found.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        if let Some(k) = found.iter().position(Option::is_none) {
+            return Err(format!(
+                "{}: its header has no column `{}` (it needs {})",
+                path.display(),
+                wanted[k],
+                wanted.join(", ")
+            ));
+        }
+        Ok(Some(found.into_iter().chain(optional.iter().map(|w| find(w))).collect()))
+    };
+    let position: &[&str] = if dim == 3 { &["x", "y", "z", "volume"] } else { &["x", "y", "volume"] };
+    let place = group(position, &[])?.ok_or_else(|| {
+        format!("{}: its header has no column `x` (it needs {})", path.display(), position.join(", "))
+    })?;
+    let velocity = group(if dim == 3 { &["vx", "vy", "vz"] } else { &["vx", "vy"] }, &[])?;
+    let stress = group(&["sxx", "syy", "sxy", "szz"], if dim == 3 { &["syz", "szx"] } else { &[] })?;
+    let pressure = group(&["p"], &[])?;
+    let mut rows = PointRows::default();
+    let mut fields: [Vec<Vec<f64>>; 3] = Default::default();
     for (i, line) in lines {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let value = |c: usize| -> Result<f64, String> {
-            let text = fields.get(c).copied().unwrap_or("");
-            text.parse().map_err(|_| {
-                format!("{} line {}: `{text}` in column `{}` is not a number", path.display(), i + 1, names[c])
-            })
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let values = |columns: &[Option<usize>]| -> Result<Vec<f64>, String> {
+            (columns.iter())
+                .map(|c| match c {
+                    None => Ok(0.0),
+                    Some(c) => {
+                        let text = cells.get(*c).copied().unwrap_or("");
+                        text.parse().map_err(|_| {
+                            format!(
+                                "{} line {}: `{text}` in column `{}` is not a number",
+                                path.display(),
+                                i + 1,
+                                names[*c]
+                            )
+                        })
+                    }
+                })
+                .collect()
         };
-        let v: Vec<f64> = columns.iter().map(|&c| value(c)).collect::<Result<_, _>>()?;
-        x.push([v[0], v[1], if dim == 3 { v[2] } else { 0.0 }]);
-        volume.push(v[dim]);
+        let v = values(&place)?;
+        rows.x.push([v[0], v[1], if dim == 3 { v[2] } else { 0.0 }]);
+        rows.volume.push(v[dim]);
+        for (k, columns) in [&velocity, &stress, &pressure].into_iter().enumerate() {
+            if let Some(columns) = columns {
+                fields[k].push(values(columns)?);
+            }
+        }
     }
-    Ok((x, volume))
+    let [v, s, p] = fields;
+    rows.fields = PointFields {
+        velocity: velocity
+            .map(|_| v.iter().map(|r| std::array::from_fn(|d| r.get(d).copied().unwrap_or(0.0))).collect()),
+        stress: stress.map(|_| s.iter().map(|r| std::array::from_fn(|c| r.get(c).copied().unwrap_or(0.0))).collect()),
+        pore_pressure: pressure.map(|_| p.iter().map(|r| r[0]).collect()),
+    };
+    Ok(rows)
 }

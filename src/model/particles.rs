@@ -215,11 +215,6 @@ impl<const D: usize> Particles<D> {
         ps.mass.push(mass);
         let fields = case.initial_values(crate::case::BodyId::new(b));
         let v = fields.velocity_at(x);
-        ps.vel.push(v);
-        ps.acc.push([0.0; D]);
-        // A two-phase body's water starts with its skeleton's velocity.
-        ps.vel_w.push(if pore_water { v } else { [0.0; D] });
-        ps.acc_w.push([0.0; D]);
         let (stress, p, grad_p) = match (&body.initial_stress, body.uniform_stress_vector()) {
             (Some(init), _) => {
                 let (s, p, grad_p) = geostatic(case, grid, init, x, pore_water);
@@ -229,6 +224,20 @@ impl<const D: usize> Particles<D> {
             (None, None) => (fields.stress_at(x).unwrap_or([0.0; 6]), 0.0, [0.0; D]),
         };
         let (p, grad_p) = fields.pore_pressure_at(x).unwrap_or((p, grad_p));
+        // A particle file's own columns, where it gives them (its row is the id's low bits).
+        let (v, stress, p) = match body.shape.points().map(|f| (&f.cloud().fields, (id & ((1 << 48) - 1)) as usize)) {
+            Some((f, row)) => (
+                f.velocity.as_ref().map_or(v, |u| std::array::from_fn(|d| u[row][d])),
+                f.stress.as_ref().map_or(stress, |s| s[row]),
+                f.pore_pressure.as_ref().map_or(p, |q| q[row]),
+            ),
+            None => (v, stress, p),
+        };
+        ps.vel.push(v);
+        ps.acc.push([0.0; D]);
+        // A two-phase body's water starts with its skeleton's velocity.
+        ps.vel_w.push(if pore_water { v } else { [0.0; D] });
+        ps.acc_w.push([0.0; D]);
         ps.grad_p.push(grad_p);
         ps.stress.push(stress);
         ps.p.push(p);

@@ -41,15 +41,19 @@ pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
             Shape::Points(p) => {
                 let path = base.join(&p.file);
                 let named = |e: String| format!("key `{key}.points`: {}: {e}", path.display());
-                let (x, volume) = crate::io::geometry::read_points(&path, dim)
+                let rows = crate::io::geometry::read_points(&path, dim)
                     .map_err(|e| format!("key `{key}.points.file`: {e}"))?;
+                let (x, volume) = (&rows.x, &rows.volume);
                 // A plane case's volumes are per metre: areas; an axisymmetric one's are rings.
                 let ring = |k: usize| if axisymmetric { std::f64::consts::TAU * x[k][0] } else { 1.0 };
                 if let Some(k) = (0..x.len()).find(|&k| axisymmetric && x[k][0] <= 0.0) {
                     return Err(named(format!("its point {k} is at r = {}; a ring needs r > 0", x[k][0])));
                 }
                 let measure = (0..x.len()).map(|k| volume[k] / ring(k)).collect();
-                p.loaded = Some(Arc::new(PointCloud::new(dim, x, measure).map_err(named)?));
+                let mut cloud = PointCloud::new(dim, rows.x.clone(), measure).map_err(named)?;
+                point_fields(&rows.fields).map_err(named)?;
+                cloud.fields = rows.fields;
+                p.loaded = Some(Arc::new(cloud));
             }
             _ => {}
         }
@@ -60,6 +64,20 @@ pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
         }
     }
     Ok(())
+}
+
+/// A particle file's initial fields are finite.
+fn point_fields(f: &crate::geometry::PointFields) -> Checked {
+    let rows = |name: &str, values: Option<Vec<&[f64]>>| match values {
+        Some(v) => match v.iter().position(|r| r.iter().any(|x| !x.is_finite())) {
+            Some(k) => Err(format!("its point {k} has the {name} {:?}; an initial field must be finite", v[k])),
+            None => Ok(()),
+        },
+        None => Ok(()),
+    };
+    rows("velocity", f.velocity.as_ref().map(|v| v.iter().map(|r| &r[..]).collect()))?;
+    rows("stress", f.stress.as_ref().map(|v| v.iter().map(|r| &r[..]).collect()))?;
+    rows("pore pressure", f.pore_pressure.as_ref().map(|v| v.iter().map(std::slice::from_ref).collect()))
 }
 
 /// Reads a loaded surface's file into its Gauss points; `key` is its table.
@@ -203,8 +221,12 @@ fn stress_components(key: &str, n: usize, dim: usize) -> Checked {
 
 /// A body's initial fields: a velocity of one component per direction, a stress of four components
 /// (or six in three dimensions) instead of `initial_stress` and `uniform_stress`, a pore pressure
-/// in a two-phase case only and instead of a geostatic state's.
+/// in a two-phase case only and instead of a geostatic state's; a particle file's fields given
+/// once, in its columns or in the body's keys.
 fn initial(c: &Case, key: &str, b: &Body) -> Checked {
+    if let Some(p) = b.shape.points() {
+        file_fields(c, key, b, &p.cloud().fields)?;
+    }
     let Some(init) = &b.initial else {
         return Ok(());
     };
@@ -234,6 +256,30 @@ fn initial(c: &Case, key: &str, b: &Body) -> Checked {
                  or the other"
             ));
         }
+    }
+    Ok(())
+}
+
+/// A particle file's initial fields against the body's own: each given once; a pore pressure in a
+/// two-phase case only.
+fn file_fields(c: &Case, key: &str, b: &Body, f: &crate::geometry::PointFields) -> Checked {
+    let init = b.initial.clone().unwrap_or_default();
+    let twice = |what: &str, also: bool| -> Checked {
+        if also {
+            return Err(format!(
+                "key `{key}.shape.points`: its file gives the points' {what} and the body gives it too; give it once"
+            ));
+        }
+        Ok(())
+    };
+    twice("velocity", f.velocity.is_some() && init.velocity.is_some())?;
+    let body_stress = init.stress.is_some() || b.initial_stress.is_some() || b.uniform_stress.is_some();
+    twice("stress", f.stress.is_some() && body_stress)?;
+    twice("pore pressure", f.pore_pressure.is_some() && (init.pore_pressure.is_some() || b.initial_stress.is_some()))?;
+    if f.pore_pressure.is_some() && c.analysis.formulation != crate::case::Formulation::TwoPhase {
+        return Err(format!(
+            "key `{key}.shape.points`: its file gives a pore pressure, which a one_phase analysis has not"
+        ));
     }
     Ok(())
 }

@@ -39,9 +39,12 @@ pub struct PointsRegion {
     /// The particle file, relative to the case file: a CSV table whose header names its
     /// columns, `x`, `y` (and `z` in three dimensions) [m] and `volume` [m³; per metre of thickness
     /// in plane strain; the ring's 2πrA in axial symmetry, so r > 0], one row per point, in any
-    /// order among other columns (skipped); `#` starts a comment line. Each point's GIMP domain is
-    /// the square (cube) of its area (volume), and the body's region is the union of those
-    /// domains; the body's material, `initial` fields and stress apply to every point.
+    /// order among other columns (skipped); `#` starts a comment line. Optional columns give each
+    /// point its initial velocity `vx`, `vy` (`vz`) [m/s], effective stress `sxx`, `syy`, `sxy`,
+    /// `szz` (`syz`, `szx`) [Pa] and pore pressure `p` [Pa] (two-phase; its gradient starts at
+    /// zero), instead of the body's own. Each point's GIMP domain is the square (cube) of its area
+    /// (volume), and the body's region is the union of those domains; the body's material applies
+    /// to every point.
     pub file: String,
     /// The points, read by validation.
     #[serde(skip)]
