@@ -86,6 +86,7 @@ fn a_gmsh_body_has_the_mesh_s_volume_in_the_plane_and_in_axial_symmetry() {
         let c = case("[4.0, 2.0]", "[16, 8]", &bodies, "").unwrap();
         let v = volumes::<2>(&c);
         for b in 0..2 {
+            println!("plane, order {order}, body {b}: volume error {:.1e}", relative(v[b], areas[b]));
             assert!(relative(v[b], areas[b]) < 1e-12, "order {order}, body {b}: {} against {}", v[b], areas[b]);
         }
     }
@@ -95,6 +96,7 @@ fn a_gmsh_body_has_the_mesh_s_volume_in_the_plane_and_in_axial_symmetry() {
     let v = volumes::<2>(&c);
     for b in 0..2 {
         let ring = 2.0 * PI * moments[b];
+        println!("axial symmetry, body {b}: volume error {:.1e}", relative(v[b], ring));
         assert!(relative(v[b], ring) < 1e-12, "body {b}: {} against {ring}", v[b]);
     }
 }
@@ -114,6 +116,7 @@ fn a_gmsh_body_has_the_mesh_s_volume_in_three_dimensions() {
         );
         let c = case("[6.0, 2.0, 2.0]", "[12, 4, 4]", &bodies, "").unwrap();
         let v = volumes::<3>(&c);
+        println!("3D, order {order}: volume errors {:.1e}, {:.1e}", relative(v[0], 12.0), relative(v[1], 5.0));
         assert!(relative(v[0], 12.0) < 1e-12 && relative(v[1], 5.0) < 1e-12, "order {order}: {v:?}");
     }
     let file = porompm::io::geometry::read_msh(std::path::Path::new("tests/meshes/ball.msh")).unwrap();
@@ -130,6 +133,7 @@ fn a_gmsh_body_has_the_mesh_s_volume_in_three_dimensions() {
     let c = case("[1.0, 1.0, 1.0]", "[10, 10, 10]", &body("ball", "{ mesh = { file = \"meshes/ball.msh\" } }"), "")
         .unwrap();
     let v = volumes::<3>(&c)[0];
+    println!("3D ball: volume error {:.1e}", relative(v, enclosed));
     assert!(relative(v, enclosed) < 1e-12, "{v} against {enclosed}");
     // Facets of about 0.06 m on a radius of 0.3 m cut 1.4 % off the sphere.
     assert!(relative(v, 4.0 / 3.0 * PI * 0.027) < 0.02, "the faceted ball is close to the sphere: {v}");
