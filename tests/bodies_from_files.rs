@@ -208,7 +208,7 @@ fn a_body_s_file_and_what_is_wrong_with_it_are_named() {
     let plane = |shape: &str| case("[4.0, 2.0]", "[16, 8]", &body("b", shape), "").unwrap_err();
     let cases = [
         (plane("{ mesh = { file = \"meshes/none.msh\" } }"), "key `bodies[0].shape.mesh.file`: cannot read tests/meshes/none.msh"),
-        (plane("{ mesh = { file = \"meshes/ball.geo\" } }"), "tests/meshes/ball.geo is not a Gmsh MSH 4.1 file"),
+        (plane("{ mesh = { file = \"meshes/ball.geo\" } }"), "tests/meshes/ball.geo is not a Gmsh mesh: it does not start with $MeshFormat"),
         (
             plane("{ mesh = { file = \"meshes/layers_2d.msh\", group = \"clay\" } }"),
             "key `bodies[0].shape.mesh`: tests/meshes/layers_2d.msh: it has no physical group of dimension 2 named \"clay\"; it has \"rock\" (1), \"soil\" (2)",
@@ -267,9 +267,20 @@ fn a_body_s_file_and_what_is_wrong_with_it_are_named() {
     )
     .unwrap_err();
     assert!(e.contains("a surface pressure acts in a three-dimensional case"), "{e}");
-    // An STL surface with one triangle taken out.
+    // An STL surface with one triangle taken out; a mesh of Gmsh's format 2.2; a broken one.
     let dir = std::env::temp_dir().join("porompm-open-stl");
     std::fs::create_dir_all(&dir).unwrap();
+    let mesh = |name: &str, text: &str| {
+        std::fs::write(dir.join(name), text).unwrap();
+        plane(&format!("{{ mesh = {{ file = \"{}\" }} }}", dir.join(name).display()))
+    };
+    let e = mesh("old.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n");
+    assert!(
+        e.contains("is a Gmsh mesh of format 2.2; porompm reads format 4.1 (save it with `gmsh -format msh41`"),
+        "{e}"
+    );
+    let e = mesh("broken.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\nbroken\n$EndNodes\n");
+    assert!(e.contains("broken.msh is not a readable Gmsh MSH 4.1 file: ") && !e.contains("Hex dump"), "{e}");
     let text = std::fs::read_to_string("tests/meshes/ball.stl").unwrap();
     let start = text.find("facet").unwrap();
     let end = start + text[start..].find("endfacet").unwrap() + "endfacet".len();

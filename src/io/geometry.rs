@@ -11,9 +11,28 @@ use std::path::Path;
 /// groups of their entities, and the groups' names.
 pub fn read_msh(path: &Path) -> Result<MeshFile, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text = String::from_utf8_lossy(&bytes[..bytes.len().min(64)]).into_owned();
+    let version = text.strip_prefix("$MeshFormat").and_then(|r| r.split_whitespace().next());
+    match version {
+        Some("4.1") => {}
+        Some(v) => {
+            return Err(format!(
+                "{} is a Gmsh mesh of format {v}; porompm reads format 4.1 (save it with `gmsh -format msh41`, or \
+                 Mesh.MshFileVersion = 4.1)",
+                path.display()
+            ))
+        }
+        None => return Err(format!("{} is not a Gmsh mesh: it does not start with $MeshFormat", path.display())),
+    }
     let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| {
-        let first = e.to_string().lines().next().unwrap_or_default().to_string();
-        format!("{} is not a Gmsh MSH 4.1 file: {first}", path.display())
+        // mshio's chain of contexts, without the hex dump of the bytes it stopped at.
+        let text = e.to_string();
+        let why: Vec<&str> = (text.lines().map(str::trim))
+            .take_while(|l| !l.starts_with("Hex dump"))
+            .filter(|l| !l.is_empty() && *l != "During parsing...")
+            .map(|l| l.trim_end_matches(','))
+            .collect();
+        format!("{} is not a readable Gmsh MSH 4.1 file: {}", path.display(), why.join("; "))
     })?;
     let data = msh.data;
     let mut out = MeshFile { names: physical_names(&bytes), ..MeshFile::default() };
