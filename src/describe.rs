@@ -48,9 +48,7 @@ pub fn describe(case: &Case, label: &str) -> String {
         );
     }
     for (b, body) in case.bodies.iter().enumerate() {
-        let ps = &model.particles;
-        let count = ps.body.iter().filter(|&&x| x as usize == b).count();
-        let volume: f64 = (0..ps.len()).filter(|&k| ps.body[k] as usize == b).map(|k| ps.volume[k]).sum();
+        let (count, volume) = body_points(&model.particles, b);
         let _ = writeln!(
             s,
             "body `{}`: {count} material points ({}), volume {volume:.6e}, material `{}`{}",
@@ -237,8 +235,6 @@ fn recovery_text(model: &Model) -> &'static str {
     }
 }
 
-/// The description of a three-dimensional case: its grid, bodies and material points, loads,
-/// boundaries (with the nodes each holds) and stages.
 /// How a body of a case of dimension `dim` is filled: its points per cell, its mesh's cells and
 /// quadrature, or its surface's triangles and the volume they enclose.
 fn fill_text(body: &crate::case::Body, dim: usize) -> String {
@@ -258,6 +254,14 @@ fn fill_text(body: &crate::case::Body, dim: usize) -> String {
     }
 }
 
+/// The number of body `b`'s material points among `ps`, and the sum of their volumes.
+fn body_points<const D: usize>(ps: &crate::model::particles::Particles<D>, b: usize) -> (usize, f64) {
+    let mine = || (0..ps.len()).filter(|&k| ps.body[k] as usize == b);
+    (mine().count(), mine().map(|k| ps.volume[k]).sum())
+}
+
+/// The description of a three-dimensional case: its grid, bodies and material points, loads,
+/// boundaries (with the nodes each holds) and stages.
 fn describe_solid(case: &Case, label: &str) -> String {
     let model = Model::build_solid(case, |_| true);
     let g = &model.grid;
@@ -282,8 +286,7 @@ fn describe_solid(case: &Case, label: &str) -> String {
         g.node_count()
     );
     for (b, body) in case.bodies.iter().enumerate() {
-        let count = ps.body.iter().filter(|&&x| x as usize == b).count();
-        let volume: f64 = (0..ps.len()).filter(|&k| ps.body[k] as usize == b).map(|k| ps.volume[k]).sum();
+        let (count, volume) = body_points(ps, b);
         let [z0, z1] = case.body_depth(body);
         let _ = writeln!(
             s,
@@ -296,16 +299,15 @@ fn describe_solid(case: &Case, label: &str) -> String {
     }
     let _ = writeln!(s, "material points: {}", ps.len());
     for (l, id) in model.loads.iter().zip(case.load_ids()) {
-        let kind = match case.load(id) {
+        let load = case.load(id);
+        let kind = match load {
             Load::ParticleTraction(t) => {
                 format!("particle traction {:?} Pa on {} material points", t.traction, l.size())
             }
             Load::NodalTraction(t) => format!("nodal traction {:?} Pa on {} nodes", t.traction, l.size()),
             Load::BodyForce(f) => format!("body force {:?} m/s²", f.acceleration),
             Load::LinePressure(_) => String::new(),
-            Load::SurfacePressure(p) => {
-                format!("pressure {} Pa on the surface of {} ({} Gauss points)", p.pressure, p.surface.file(), l.size())
-            }
+            Load::SurfacePressure(_) => load_text(load, l.size()),
         };
         let _ = writeln!(s, "load `{}`: {kind}", l.name);
     }

@@ -181,12 +181,16 @@ impl MeshFile {
         }
     }
 
+    /// Its cells of dimension `dim` in the physical group of tag `tag` (all without one).
+    fn cells_of(&self, dim: usize, tag: Option<i32>) -> impl Iterator<Item = &FileCell> {
+        self.cells.iter().filter(move |c| c.kind.dim() == dim && tag.is_none_or(|t| c.groups.contains(&t)))
+    }
+
     /// The Gauss points of its two-dimensional cells in `group` (all without one), each with the
     /// area vector it stands for ([`face_points`]); an error if there are none.
     pub fn face_points(&self, group: Option<Group>) -> Result<FacePoints, String> {
         let tag = self.group_tag(2, group)?;
-        let faces = self.cells.iter().filter(|c| c.kind.dim() == 2 && tag.is_none_or(|t| c.groups.contains(&t)));
-        let points = face_points(&self.nodes, faces.map(|c| (c.kind, c.nodes.as_slice())));
+        let points = face_points(&self.nodes, self.cells_of(2, tag).map(|c| (c.kind, c.nodes.as_slice())));
         if points.is_empty() {
             return Err(match tag {
                 Some(t) => format!("its physical group {t} holds no triangle or quadrangle"),
@@ -264,7 +268,7 @@ impl Mesh {
         let mut cells = Vec::new();
         let mut used = vec![u32::MAX; file.nodes.len()];
         let mut nodes = Vec::new();
-        for c in file.cells.iter().filter(|c| c.kind.dim() == dim && tag.is_none_or(|t| c.groups.contains(&t))) {
+        for c in file.cells_of(dim, tag) {
             let mut local = [0u32; 8];
             for (k, &n) in c.nodes.iter().enumerate() {
                 if used[n] == u32::MAX {

@@ -24,6 +24,12 @@ fn c3(p: [f64; 3]) -> Coord3D<f64> {
     Coord3D { x: p[0], y: p[1], z: p[2] }
 }
 
+/// Half the side of the square (`dim` = 2) or cube (3) of area or volume `measure`: the GIMP
+/// half-width of a point given by its measure alone.
+pub fn half_side(measure: f64, dim: usize) -> f64 {
+    0.5 * measure.powf(1.0 / dim as f64)
+}
+
 /// The determinant of a 3 × 3 matrix.
 pub(crate) fn det3(m: &[[f64; 3]; 3]) -> f64 {
     m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])

@@ -88,7 +88,7 @@ impl PointCloud {
     /// The half-width of point `k`'s domain [m]: half the side of the square or cube of its
     /// measure.
     pub fn half_width(&self, k: usize) -> f64 {
-        0.5 * self.measure[k].powf(1.0 / self.dim as f64)
+        super::half_side(self.measure[k], self.dim)
     }
 
     /// Point `k`'s domain (its z extent zero in the plane).

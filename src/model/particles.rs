@@ -225,7 +225,7 @@ impl<const D: usize> Particles<D> {
         };
         let (p, grad_p) = fields.pore_pressure_at(x).unwrap_or((p, grad_p));
         // A particle file's own columns, where it gives them (its row is the id's low bits).
-        let (v, stress, p) = match body.shape.points().map(|f| (&f.cloud().fields, (id & ((1 << 48) - 1)) as usize)) {
+        let (v, stress, p) = match body.shape.points().map(|f| (&f.cloud().fields, id_number(id) as usize)) {
             Some((f, row)) => (
                 f.velocity.as_ref().map_or(v, |u| std::array::from_fn(|d| u[row][d])),
                 f.stress.as_ref().map_or(stress, |s| s[row]),
@@ -245,6 +245,17 @@ impl<const D: usize> Particles<D> {
         ps.eps_pd.push(0.0);
         ps.jbar.push(1.0);
     }
+}
+
+/// The global id of body `b`'s point `number` (its sub-cell, its cell's quadrature point or its
+/// particle file's row): the body in the top 16 bits, the number in the 48 below.
+fn point_id(b: usize, number: u64) -> u64 {
+    ((b as u64) << 48) | number
+}
+
+/// The number [`point_id`] packed into `id`.
+fn id_number(id: u64) -> u64 {
+    id & ((1 << 48) - 1)
 }
 
 /// A place where a body may put a material point.
@@ -275,8 +286,8 @@ pub fn for_each_candidate<const D: usize>(case: &Case, grid: &Grid<D>, b: usize,
         let found = mesh.for_each_point(m.order, |number, x3, w| {
             let x: [f64; D] = std::array::from_fn(|d| x3[d]);
             let Some(cell) = grid.cell_containing(x) else { return };
-            let side = 0.5 * w.powf(1.0 / D as f64);
-            f(Candidate { cell, id: ((b as u64) << 48) | number, x, measure: w, lp: [side; D] });
+            let lp = [crate::geometry::half_side(w, D); D];
+            f(Candidate { cell, id: point_id(b, number), x, measure: w, lp });
         });
         found.expect("validation integrates every cell of a body's mesh");
         return;
@@ -287,7 +298,7 @@ pub fn for_each_candidate<const D: usize>(case: &Case, grid: &Grid<D>, b: usize,
             let x: [f64; D] = std::array::from_fn(|d| x3[d]);
             if let Some(cell) = grid.cell_containing(x) {
                 let lp = [cloud.half_width(k); D];
-                f(Candidate { cell, id: ((b as u64) << 48) | k as u64, x, measure, lp });
+                f(Candidate { cell, id: point_id(b, k as u64), x, measure, lp });
             }
         });
         return;
@@ -311,7 +322,7 @@ pub fn for_each_candidate<const D: usize>(case: &Case, grid: &Grid<D>, b: usize,
         loop {
             let number =
                 (0..D).rev().fold(0u64, |acc, d| acc * (grid.cells[d] * 8) as u64 + (cell[d] * n + sub[d]) as u64);
-            let id = ((b as u64) << 48) | number;
+            let id = point_id(b, number);
             let x: [f64; D] = std::array::from_fn(|d| {
                 let shake = body.perturbation * (2.0 * jitter(id, d as u64) - 1.0);
                 grid.origin[d] + (cell[d] as f64 + (sub[d] as f64 + 0.5 + shake) / n as f64) * grid.h[d]

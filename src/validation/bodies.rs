@@ -32,9 +32,7 @@ pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
                 let path = base.join(&s.file);
                 let file =
                     crate::io::geometry::read_stl(&path).map_err(|e| format!("key `{key}.surface.file`: {e}"))?;
-                let placed =
-                    file.vertices.iter().map(|v| std::array::from_fn(|d| v[d] * s.scale + s.offset[d])).collect();
-                let surface = Surface::new(placed, file.triangles)
+                let surface = Surface::new(s.placed(&file.vertices), file.triangles)
                     .map_err(|e| format!("key `{key}.surface`: {}: {e}", path.display()))?;
                 s.loaded = Some(Arc::new(surface));
             }
@@ -263,7 +261,7 @@ fn initial(c: &Case, key: &str, b: &Body) -> Checked {
 /// A particle file's initial fields against the body's own: each given once; a pore pressure in a
 /// two-phase case only.
 fn file_fields(c: &Case, key: &str, b: &Body, f: &crate::geometry::PointFields) -> Checked {
-    let init = b.initial.clone().unwrap_or_default();
+    let given = |f: fn(&crate::case::InitialFields) -> bool| b.initial.as_ref().is_some_and(f);
     let twice = |what: &str, also: bool| -> Checked {
         if also {
             return Err(format!(
@@ -272,10 +270,13 @@ fn file_fields(c: &Case, key: &str, b: &Body, f: &crate::geometry::PointFields) 
         }
         Ok(())
     };
-    twice("velocity", f.velocity.is_some() && init.velocity.is_some())?;
-    let body_stress = init.stress.is_some() || b.initial_stress.is_some() || b.uniform_stress.is_some();
+    twice("velocity", f.velocity.is_some() && given(|i| i.velocity.is_some()))?;
+    let body_stress = given(|i| i.stress.is_some()) || b.initial_stress.is_some() || b.uniform_stress.is_some();
     twice("stress", f.stress.is_some() && body_stress)?;
-    twice("pore pressure", f.pore_pressure.is_some() && (init.pore_pressure.is_some() || b.initial_stress.is_some()))?;
+    twice(
+        "pore pressure",
+        f.pore_pressure.is_some() && (given(|i| i.pore_pressure.is_some()) || b.initial_stress.is_some()),
+    )?;
     if f.pore_pressure.is_some() && c.analysis.formulation != crate::case::Formulation::TwoPhase {
         return Err(format!(
             "key `{key}.shape.points`: its file gives a pore pressure, which a one_phase analysis has not"
