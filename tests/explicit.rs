@@ -462,11 +462,12 @@ fn bad_explicit_settings_are_named() {
         "`stabilisation.fbar` and `stabilisation.bbar` exclude each other",
     );
     let neo = "materials.soil.model={type=\"neo_hookean\",young_modulus=1.0e8,poisson_ratio=0.3}";
+    let fluid = "materials.soil.model={type=\"newtonian_fluid\",bulk_modulus=2.0e9,viscosity=1.0e-3}";
     assert_refused(
         "cases/elastic_column.toml",
         &dir,
-        &[neo, "stages.0.analysis=dynamic_explicit"],
-        "`neo_hookean` runs in dynamic_explicit stages only",
+        &[fluid, "stages.0.analysis=dynamic_explicit"],
+        "`newtonian_fluid` runs in dynamic_explicit stages only",
     );
     assert_refused(
         "cases/elastic_column.toml",
@@ -479,12 +480,25 @@ fn bad_explicit_settings_are_named() {
         ],
         "a neo_hookean body takes no initial stress",
     );
-    let hencky = "materials.soil.model={type=\"hencky_j2\",young_modulus=1.0e8,poisson_ratio=0.3,cohesion=1.0e4}";
+    let patch_neo = "materials.solid.model={type=\"neo_hookean\",young_modulus=1.0e6,poisson_ratio=0.3}";
     assert_refused(
-        "cases/elastic_column.toml",
+        "cases/patch_test.toml",
         &dir,
-        &[hencky, "stages.0.analysis=dynamic_explicit"],
-        "`hencky_j2` runs in dynamic_explicit stages only",
+        &[patch_neo, "stages.0.analysis=static", "analysis.kinematics=\"linear_increments\""],
+        "`neo_hookean` follows the total deformation, and `analysis.kinematics = \"linear_increments\"`",
+    );
+    let hencky = "materials.solid.model={type=\"hencky_j2\",young_modulus=1.0e6,poisson_ratio=0.3,cohesion=1.0e4}";
+    assert_refused(
+        "cases/patch_test.toml",
+        &dir,
+        &[hencky, "stages.0.analysis=static", "stabilisation.bbar=false", "stabilisation.fbar=true"],
+        "`hencky_j2` in the implicit stage `stretch` does not take the implicit F̄ projection",
+    );
+    assert_refused(
+        "cases/footing_fbar.toml",
+        &dir,
+        &["stabilisation={stress_recovery=\"cmpm\"}"],
+        "a `hencky_j2` point recovers its elastic strain b^e from its stress and its volume ratio",
     );
     assert_refused(
         "cases/footing_fbar.toml",

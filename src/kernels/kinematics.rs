@@ -451,7 +451,13 @@ impl<const D: usize> Kinematics<D> {
     /// axial symmetry its in-plane determinant is J_v/F_θθ, the area change of a ring whose
     /// radius grew by F_θθ).
     pub fn f_bar(&self) -> Mat<D> {
-        let s = if self.j > 0.0 && self.jv > 0.0 {
+        let s = self.volume_scale();
+        self.f.map(|r| r.map(|v| v * s))
+    }
+
+    /// The scale s = (J_v/J)^{1/D} of [`Kinematics::f_bar`] (1 where J or J_v is not positive).
+    pub fn volume_scale(&self) -> f64 {
+        if self.j > 0.0 && self.jv > 0.0 {
             let ratio = self.jv / self.j;
             if D == 2 {
                 ratio.sqrt()
@@ -460,8 +466,7 @@ impl<const D: usize> Kinematics<D> {
             }
         } else {
             1.0
-        };
-        self.f.map(|r| r.map(|v| v * s))
+        }
     }
 }
 

@@ -326,6 +326,8 @@ pub fn interpolate<const D: usize, const N: usize>(
 /// three-dimensional stencil.
 #[derive(Debug, Clone)]
 pub struct Point<'a, const D: usize = 2, const M: usize = MAX_NODES> {
+    /// The soil model the stress was updated by (`None` at a step's start, [`Point::at_start`]).
+    pub model: Option<Constitutive>,
     /// The stencil's basis on x_n.
     pub basis: &'a [NodeBasis<D>],
     /// The particle at t_n.
@@ -404,6 +406,21 @@ fn on_new_configuration<const D: usize>(
     }
 }
 
+/// What a finite-strain model's stress sees of a step ([`soils::SoilLaw::finite`]), as 3 × 3
+/// matrices (a plane point's with F_zz = 1): the step's ΔF̄ = c F̄ with F̄ the kinematics `sk`'s
+/// (B̄'s volume-scaled [`Kinematics::f_bar`]) and c the explicit F̄ projection's scale of the step,
+/// and the total F_{n+1} = s F̄ F_n with s that of the point's total deformation (c = s = 1
+/// without F̄).
+fn finite_gradients<const D: usize>(
+    sk: &Kinematics<D>,
+    part: &ParticleInput<D>,
+) -> (finite_strain::M3, finite_strain::M3) {
+    let f_bar = sk.f_bar();
+    let df = f_bar.map(|r| r.map(|v| v * part.fbar));
+    let f_new = crate::algebra::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
+    (finite_strain::embed(&df), finite_strain::embed(&f_new))
+}
+
 /// Largest number of drained faces of one particle (all sides of its domain: four in two
 /// dimensions, six in three).
 pub const MAX_FACES: usize = 6;
@@ -480,14 +497,13 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         let rotated = sk.rotate(&part.stress);
         // A finite-strain model takes the step's ΔF̄ = c ΔF and the total deformation
         // F̄_{n+1} = s ΔF F_n (c and s the F̄ scales, 1 without); the others the objective increment.
-        let f_bar = sk.f_bar();
-        let df = f_bar.map(|r| r.map(|v| v * part.fbar));
-        let f_new = crate::algebra::product(&f_bar, &part.def_grad).map(|r| r.map(|v| v * part.fbar_total));
+        let (df, f_new) = finite_gradients(sk, part);
         let upd = model
-            .finite(&finite_strain::embed(&df), &finite_strain::embed(&f_new), &part.stress, part.eps_pd, part.dt)
+            .finite(&df, &f_new, &part.stress, part.eps_pd, part.dt)
             .unwrap_or_else(|| model.update(&rotated, part.eps_pd, &sk.deps));
         let mut pt =
             Point::of_parts(buffers, basis, strain, part, layout, interp, (kin, recovered_kin), (rotated, upd));
+        pt.model = Some(*model);
         if let Some(j) = layout.jbar {
             for (t, st) in pt.jbar_nodes.iter_mut().zip(states) {
                 *t = st.d[j];
@@ -560,6 +576,7 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
         jbar_nodes.clear();
         jbar_nodes.resize(basis.len(), 0.0);
         let mut pt = Point {
+            model: None,
             basis,
             part,
             layout,
@@ -640,6 +657,14 @@ impl<'a, const D: usize, const M: usize> Point<'a, D, M> {
             Some(m) => (&m.0, &m.1),
             None => (&self.spatial, &self.hoop),
         }
+    }
+
+    /// The consistent tangent ∂σ'/∂ΔF̄ of a finite-strain model's stress at this point
+    /// ([`soils::SoilLaw::finite_tangent`]; `None` for the incremental models).
+    pub fn finite_tangent(&self) -> Option<finite_strain::FiniteTangent> {
+        let model = self.model.filter(Constitutive::is_finite_strain)?;
+        let (df, f_new) = finite_gradients(self.strain_kin(), self.part);
+        model.finite_tangent(&df, &f_new, &self.part.stress, self.part.eps_pd, self.part.dt)
     }
 
     /// The kinematics the stress sees: the recovered strain's ([`Point::with_recovery`]) or the

@@ -16,6 +16,9 @@
 //! * geometric: from ∂∇'S_i/∂Δu_l,d = −∇'S_l (∇'S_i)_d (and the same for ∇̄'):
 //!   −V_{n+1} [(dev σ' ∇'S_l)_c (∇'S_i)_d + σ'_m (∇̄'S_l)_c (∇̄'S_i)_d].
 //!
+//! A finite-strain solid (neo-Hookean, Hencky–J2) has no strain increment or rotation: its
+//! A_l = ∂σ'/∂ΔF̄ : ∂ΔF̄/∂Δu_l ([`FiniteChain`], the law's [`crate::soils::SoilLaw::finite_tangent`]).
+//!
 //! The material part's derivatives with respect to Δu_l go through node l's strain operators
 //! ([`super::Point::strain`] with [`super::Point::strain_kin`]): the basis itself, or [001]'s CMPM
 //! patch functions, which recover the strain the stress sees; the volume and geometric parts go
@@ -152,6 +155,30 @@ struct StressResponse<'p, const R: usize> {
     d_alg: &'p [[f64; NS]; NS],
     t_drot: [f64; R],
     material: f64,
+    /// A finite-strain model's ∂σ'/∂ΔF̄ ([`super::Point::finite_tangent`]) with what its chain
+    /// rule takes; `None` for the incremental models.
+    finite: Option<FiniteChain<R>>,
+}
+
+/// The chain rule of a finite-strain model's stress σ'(ΔF̄), ΔF̄ = c s F with F = I + Σ Δu_l ⊗ ∇S_l
+/// (the strain operators on x_n), s = (J_v/J)^{1/D} B̄'s volume scale and c the explicit F̄ scale
+/// (a constant, and 1 in every step that builds a tangent: explicit steps build none, and the
+/// implicit F̄ is refused for these models):
+/// ∂ΔF̄_ab/∂Δu_l,d = c (s δ_ad (∇S_l)_b + F_ab ∂s/∂Δu_l,d) with
+/// ∂s/∂Δu_l,d = (s/D) ((F_v⁻ᵀ∇̄S_l)_d − (F⁻ᵀ∇S_l)_d), so
+/// ∂σ'_r/∂Δu_l,d = c (s Σ_b T_r,db (∇S_l)_b + (T_r : F) ∂s/∂Δu_l,d) with T = ∂σ'/∂ΔF̄. Where J or
+/// J_v is not positive, s is held at 1 ([`kinematics::Kinematics::volume_scale`]) and ∂s is zero.
+struct FiniteChain<const R: usize> {
+    /// T_r,ab = ∂σ'_r/∂ΔF̄_ab.
+    t: crate::soils::finite_strain::FiniteTangent,
+    /// T_r : F over the point's D × D block.
+    t_f: [f64; R],
+    /// B̄'s volume scale s.
+    s: f64,
+    /// Whether s follows the motion (J and J_v positive; otherwise it is held at 1).
+    s_varies: bool,
+    /// The explicit F̄ scale c of the step.
+    c: f64,
 }
 
 impl<'p, const R: usize> StressResponse<'p, R> {
@@ -161,7 +188,16 @@ impl<'p, const R: usize> StressResponse<'p, R> {
         let drot = kinematics::rotate_derivative(&pt.rotated);
         let t_drot = std::array::from_fn(|r| (0..R).map(|q| t_mat[r][q] * drot[q]).sum());
         let t_identity = *t_mat == crate::soils::IDENTITY6;
-        StressResponse { t_mat, t_identity, d_alg, t_drot, material }
+        let finite = pt.finite_tangent().map(|t| {
+            let f = &pt.strain_kin().f;
+            let t_f = std::array::from_fn(|r| {
+                (0..D).flat_map(|a| (0..D).map(move |b| (a, b))).map(|(a, b)| t[r][a][b] * f[a][b]).sum()
+            });
+            let sk = pt.strain_kin();
+            debug_assert_eq!(pt.part.fbar, 1.0, "a tangent of an explicit F̄ step");
+            FiniteChain { t, t_f, s: sk.volume_scale(), s_varies: sk.j > 0.0 && sk.jv > 0.0, c: pt.part.fbar }
+        });
+        StressResponse { t_mat, t_identity, d_alg, t_drot, material, finite }
     }
 
     /// A_l = ∂σ'/∂Δu_l (strain rows × D) through the operators `bl` and the kinematics `sk`.
@@ -172,6 +208,17 @@ impl<'p, const R: usize> StressResponse<'p, R> {
         sk: &kinematics::Kinematics<D>,
         bl: &super::NodeBasis<D>,
     ) -> [[f64; D]; R] {
+        if let Some(fc) = &self.finite {
+            let (gs, gvs) = sk.spatial(bl);
+            let scale = self.material * fc.c;
+            return std::array::from_fn(|r| {
+                std::array::from_fn(|d| {
+                    let ds = if fc.s_varies { fc.s / D as f64 * (gvs[d] - gs[d]) } else { 0.0 };
+                    let direct: f64 = (0..D).map(|b| fc.t[r][d][b] * bl.g[b]).sum();
+                    scale * (fc.s * direct + fc.t_f[r] * ds)
+                })
+            });
+        }
         let de = sk.deps_derivative(bl);
         let material_part =
             |r: usize, d: usize| self.material * (0..R).map(|q| self.d_alg[r][q] * de[q][d]).sum::<f64>();

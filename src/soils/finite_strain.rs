@@ -6,8 +6,9 @@
 //! 6-vectors [xx, yy, xy, zz, yz, zx] of [`super::stress`] (Cauchy, tension positive).
 //!
 //! They are total (hyperelastic) or multiplicative forms driven by the deformation gradient (with
-//! [002]'s F̄, by F̄); they are used by the explicit integrator, which needs
-//! no tangent. Each is objective by construction: the neo-Hookean and Hencky
+//! [002]'s F̄, by F̄). The explicit integrator needs no tangent; the implicit stages take the
+//! solids' consistent tangent ∂σ/∂ΔF ([`FiniteTangent`], [`left_tangent`]; the fluid stays
+//! explicit). Each is objective by construction: the neo-Hookean and Hencky
 //! stresses are isotropic functions of b = F Fᵀ (or b^e), so a rotation R of the deformation turns
 //! the stress into R σ Rᵀ.
 
@@ -92,6 +93,42 @@ pub(super) fn finite_update(
         eps_pd,
         region,
     }
+}
+
+/// ∂σ/∂ΔF of a finite-strain model's Cauchy stress after a step at fixed F_n and σ_n
+/// ([`super::SoilLaw::finite_tangent`]): `t[r][a][b]` = ∂σ_r/∂ΔF_ab for the stress-vector
+/// component r.
+pub type FiniteTangent = [M3; NS];
+
+/// ∂σ/∂ΔF of a Cauchy stress σ = τ(b)/J whose Kirchhoff stress is a function of the left
+/// Cauchy–Green tensor b = ΔF b_n ΔFᵀ (b^e_trial for an elastoplastic model) and J = det ΔF J_n,
+/// at fixed b_n and J_n. A change δΔF has ℓ = δΔF ΔF⁻¹, δb = ℓ b + b ℓᵀ and δJ/J = tr ℓ, so
+/// δσ = δτ/J − σ tr ℓ with δτ = `dtau`(δb, tr ℓ) (δb a stress vector, tensor shears). For the
+/// unit change of ΔF_ab, ℓ = e_a ⊗ w with w the row b of ΔF⁻¹: δb = e_a ⊗ bw + bw ⊗ e_a and
+/// tr ℓ = w_a. `b` is b after the step, `sigma` σ and `j` J after it.
+pub(super) fn left_tangent(
+    df: &M3,
+    b: &Stress,
+    sigma: &Stress,
+    j: f64,
+    dtau: impl Fn(&Stress, f64) -> Stress,
+) -> FiniteTangent {
+    let inv = crate::algebra::inverse(df);
+    let bm = principal::tensor(b);
+    let mut out = [[[0.0; 3]; 3]; NS];
+    for a in 0..3 {
+        for (k, w) in inv.iter().enumerate() {
+            let bw: [f64; 3] = std::array::from_fn(|i| bm[i][0] * w[0] + bm[i][1] * w[1] + bm[i][2] * w[2]);
+            let delta = |i: usize, m: usize| if i == m { 1.0 } else { 0.0 };
+            let db: Stress = principal::TENSOR_INDEX.map(|(i, m)| delta(i, a) * bw[m] + bw[i] * delta(m, a));
+            let tr = w[a];
+            let dt = dtau(&db, tr);
+            for r in 0..NS {
+                out[r][a][k] = dt[r] / j - sigma[r] * tr;
+            }
+        }
+    }
+    out
 }
 
 /// The rate of deformation of a step of deformation gradient ΔF over Δt [1/s]:
@@ -437,5 +474,63 @@ mod tests {
         let d = rate_of_deformation(grow, dt);
         assert!((0..3).all(|k| d[k][k].abs() < 1e-3), "{d:?}");
         assert!((d[1][2] - 0.5 / 1.01).abs() < 1e-3, "{d:?}");
+    }
+
+    /// The consistent tangent ∂σ/∂ΔF of the finite-strain laws against central differences of
+    /// their stress, at fixed F_n and σ_n: neo-Hookean in three dimensions and in plane strain,
+    /// Hencky–J2 elastic, plastic with softening, and plastic from a state with history.
+    #[test]
+    fn the_finite_strain_tangents_match_central_differences() {
+        let neo = Constitutive::NeoHookean(NeoHookeanLaw::new(2e7, 0.45));
+        let hencky = Constitutive::HenckyJ2(HenckyJ2Law::new(25e6, 0.3, 40e3, 2.45e3, 5.0));
+        let f_n = mul(tilt(0.4), [[1.05, 0.02, -0.03], [0.01, 0.96, 0.04], [-0.02, 0.03, 1.02]]);
+        let f_plane = plane([[1.04, 0.05], [-0.03, 0.97]]);
+        // A Hencky–J2 stress with plastic history: a plastic shearing step from rest.
+        let first = HenckyJ2Law::new(25e6, 0.3, 40e3, 2.45e3, 5.0)
+            .step(plane([[1.0, 0.008], [0.0, 1.0]]), &PlasticState::default(), 1.0)
+            .unwrap();
+        assert!(first.plastic);
+        let small = [[1.0004, 0.0003, -0.0002], [0.0001, 0.9997, 0.0005], [0.0002, -0.0003, 1.0001]];
+        let shear = [[1.0, 0.006, 0.001], [0.0, 1.0, 0.002], [0.0, 0.0, 1.0]];
+        let cases: [(&str, Constitutive, M3, M3, Stress, f64, bool); 6] = [
+            (
+                "neo-Hookean 3D",
+                neo,
+                mul(tilt(-0.2), [[1.1, 0.05, 0.0], [0.02, 0.9, 0.03], [0.0, -0.04, 1.05]]),
+                f_n,
+                [0.0; NS],
+                0.0,
+                false,
+            ),
+            ("neo-Hookean plane", neo, plane([[1.08, -0.04], [0.06, 0.93]]), f_plane, [0.0; NS], 0.0, false),
+            ("Hencky-J2 elastic", hencky, small, I3, [0.0; NS], 0.0, false),
+            ("Hencky-J2 plastic", hencky, shear, I3, [0.0; NS], 0.0, true),
+            ("Hencky-J2 history", hencky, mul(rot(0.1), shear), I3, first.stress, first.state.eps, true),
+            ("Hencky-J2 plane", hencky, plane([[1.0, 0.006], [0.001, 1.0]]), I3, first.stress, first.state.eps, true),
+        ];
+        for (name, law, df, f_n, stress, eps, plastic) in cases {
+            let sigma = |df: M3| law.finite(&df, &mul(df, f_n), &stress, eps, 1e-3).unwrap();
+            let t = law.finite_tangent(&df, &mul(df, f_n), &stress, eps, 1e-3).unwrap();
+            let upd = sigma(df);
+            assert_eq!(upd.region != Region::Elastic, plastic, "{name}: {:?}", upd.region);
+            let scale = upd.stress.iter().chain(&law.elastic().d[0]).fold(0.0f64, |m, v| m.max(v.abs()));
+            let h = 1e-6;
+            for a in 0..3 {
+                for b in 0..3 {
+                    let (mut up, mut down) = (df, df);
+                    up[a][b] += h;
+                    down[a][b] -= h;
+                    let (sp, sm) = (sigma(up).stress, sigma(down).stress);
+                    for r in 0..NS {
+                        let fd = (sp[r] - sm[r]) / (2.0 * h);
+                        assert!(
+                            (t[r][a][b] - fd).abs() <= 1e-6 * scale,
+                            "{name}: dσ_{r}/dΔF_{a}{b} = {:e} against {fd:e}",
+                            t[r][a][b]
+                        );
+                    }
+                }
+            }
+        }
     }
 }

@@ -4,9 +4,9 @@
 //! ([`HenckyJ2Law`]).
 
 use super::elasticity::check_elastic;
-use super::finite_strain::{det, finite_update, push, M3, UNIT};
+use super::finite_strain::{det, finite_update, left_tangent, push, FiniteTangent, M3, UNIT};
 use super::principal::Principal;
-use super::{reduced_strength, LinearElastic, Region, SoilLaw, SoilParameters, Stress, StressUpdate, VonMisesLaw};
+use super::{reduced_strength, LinearElastic, Region, SoilLaw, SoilParameters, Stress, StressUpdate, VonMisesLaw, NS};
 use crate::check::{at, non_negative, strength, Checked};
 use serde::{Deserialize, Serialize};
 
@@ -182,9 +182,21 @@ impl HenckyJ2Law {
         frame.compose(&tau.map(|t| (2.0 * ((t - mean) / mu2 + mean / k3)).exp()))
     }
 
-    /// One step: the increment `df` of the deformation gradient from `state`, with `j` the volume ratio det F of the point after the step (with F̄, J̄) by which
-    /// the Kirchhoff stress is divided. `None` when b^e or J is not positive definite.
+    /// One step: the increment `df` of the deformation gradient from `state`, with `j` the volume
+    /// ratio det F of the point after the step (with F̄, J̄) by which the Kirchhoff stress is
+    /// divided. `None` when b^e or J is not positive definite.
     pub fn step(&self, df: M3, state: &PlasticState, j: f64) -> Option<HenckyUpdate> {
+        let r = self.returned(df, state, j)?;
+        let e = r.dev.map(|d| r.factor * d + r.tr / 3.0);
+        let be = r.frame.compose(&std::array::from_fn(|k| (2.0 * e[k]).exp()));
+        let state = PlasticState { be, eps: state.eps + r.flow };
+        Some(HenckyUpdate { stress: r.frame.compose(&r.tau.map(|t| t / j)), state, plastic: r.flow > 0.0 })
+    }
+
+    /// The return of one step ([`HenckyJ2Law::step`]): b^e_trial = ΔF b^e_n ΔFᵀ, its principal
+    /// logarithmic strains, the radial return of the trial deviator and the principal Kirchhoff
+    /// stresses. `None` when b^e or J is not positive definite.
+    fn returned(&self, df: M3, state: &PlasticState, j: f64) -> Option<Return> {
         if j <= 0.0 {
             return None;
         }
@@ -204,10 +216,8 @@ impl HenckyJ2Law {
         let q_trial = (1.5 * (s_trial[0].powi(2) + s_trial[1].powi(2) + s_trial[2].powi(2))).sqrt();
         let r3 = 3f64.sqrt();
         let (c_n, _) = self.cohesion_at(state.eps);
-        let mut out_eps = state.eps;
-        let mut factor = 1.0;
-        let plastic = q_trial - r3 * c_n > 1e-12 * (q_trial + c_n);
-        if plastic {
+        let (mut flow, mut factor) = (0.0, 1.0);
+        if q_trial - r3 * c_n > 1e-12 * (q_trial + c_n) {
             // g(Δ) = q_trial − 3μΔ − √3 c(ε̄_n + Δ) = 0 on [0, q_trial/3μ], where g(0) > 0 and the
             // upper end gives −√3 c < 0: Newton kept inside the bracket, bisection otherwise.
             let g3 = 3.0 * self.shear;
@@ -231,14 +241,59 @@ impl HenckyJ2Law {
                 d = if dr < 0.0 && next > lo && next < hi { next } else { 0.5 * (lo + hi) };
             }
             factor = 1.0 - g3 * d / q_trial;
-            out_eps += d;
+            flow = d;
         }
         // The returned deviator is the trial one scaled (radial return); the volume is elastic.
-        let e = [factor * dev[0] + tr / 3.0, factor * dev[1] + tr / 3.0, factor * dev[2] + tr / 3.0];
-        let tau = frame.compose(&std::array::from_fn(|k| (self.bulk * tr + factor * s_trial[k]) / j));
-        let be = frame.compose(&std::array::from_fn(|k| (2.0 * e[k]).exp()));
-        Some(HenckyUpdate { stress: tau, state: PlasticState { be, eps: out_eps }, plastic })
+        let tau = std::array::from_fn(|k| self.bulk * tr + factor * s_trial[k]);
+        Some(Return { frame, tr, dev, s_trial, q_trial, factor, flow, eps_n: state.eps, tau })
     }
+
+    /// ∂τ_i/∂λ_j of a return: the principal Kirchhoff stresses' derivatives with respect to the
+    /// principal values λ_j of b^e_trial (ε_j = ½ ln λ_j). τ_i = K tr ε + f s_i with the trial
+    /// deviator s_i = 2μ dev ε_i and the radial factor f = 1 − 3μΔ/q (1 when elastic), whose
+    /// derivative follows from the return equation q − 3μΔ − √3 c(ε̄_n + Δ) = 0:
+    /// dΔ/dq = 1/(3μ + √3 c'), ∂f/∂q = −3μ (q dΔ/dq − Δ)/q², ∂q/∂ε_k = 3μ s_k/q.
+    fn principal_tangent(&self, r: &Return) -> [[f64; 3]; 3] {
+        let mu2 = 2.0 * self.shear;
+        let df_de: [f64; 3] = if r.flow > 0.0 {
+            let g3 = 3.0 * self.shear;
+            let (_, dc) = self.cohesion_at(r.eps_n + r.flow);
+            let dd_dq = 1.0 / (g3 + 3f64.sqrt() * dc);
+            let df_dq = -g3 * (r.q_trial * dd_dq - r.flow) / (r.q_trial * r.q_trial);
+            r.s_trial.map(|s| df_dq * g3 * s / r.q_trial)
+        } else {
+            [0.0; 3]
+        };
+        let lam = r.frame.values;
+        std::array::from_fn(|i| {
+            std::array::from_fn(|k| {
+                let dev = if i == k { 2.0 / 3.0 } else { -1.0 / 3.0 };
+                (self.bulk + r.factor * mu2 * dev + r.s_trial[i] * df_de[k]) / (2.0 * lam[k])
+            })
+        })
+    }
+}
+
+/// A Hencky–J2 step's return ([`HenckyJ2Law::returned`]).
+struct Return {
+    /// The principal frame and values of b^e_trial.
+    frame: Principal,
+    /// tr ε^e (elastic, so the trial's).
+    tr: f64,
+    /// The trial's principal deviatoric logarithmic strains.
+    dev: [f64; 3],
+    /// The trial's principal deviatoric Kirchhoff stresses 2μ dev ε.
+    s_trial: [f64; 3],
+    /// The trial's q.
+    q_trial: f64,
+    /// The radial return's factor of the deviator (1 when elastic).
+    factor: f64,
+    /// The step's plastic strain Δ (0 when elastic).
+    flow: f64,
+    /// ε̄ at the step's start.
+    eps_n: f64,
+    /// The principal Kirchhoff stresses after the return.
+    tau: [f64; 3],
 }
 
 impl SoilLaw for HenckyJ2Law {
@@ -258,6 +313,21 @@ impl SoilLaw for HenckyJ2Law {
             ),
             None => finite_update(&self.elastic, None, eps_pd, Region::Elastic),
         })
+    }
+
+    /// ∂σ/∂ΔF at fixed b^e_n (recovered from σ_n as [`SoilLaw::finite`] does) and J_n: δτ is the
+    /// isotropic map's derivative ([`Principal::derivative`] with [`HenckyJ2Law::principal_tangent`])
+    /// in the direction δb^e_trial ([`left_tangent`]). `None` for an inadmissible step.
+    fn finite_tangent(&self, df: &M3, f: &M3, stress: &Stress, eps_pd: f64, _dt: f64) -> Option<FiniteTangent> {
+        let (j_new, dj) = (det(*f), det(*df));
+        let state = PlasticState { be: self.elastic_left_cauchy_green(stress, j_new / dj), eps: eps_pd };
+        let r = self.returned(*df, &state, j_new)?;
+        let dtau_db = r.frame.derivative(&r.tau, &self.principal_tangent(&r));
+        let trial = push(*df, &state.be);
+        let sigma = r.frame.compose(&r.tau.map(|t| t / j_new));
+        let dtau =
+            |db: &Stress, _: f64| -> Stress { std::array::from_fn(|i| (0..NS).map(|c| dtau_db[i][c] * db[c]).sum()) };
+        Some(left_tangent(df, &trial, &sigma, j_new, dtau))
     }
 
     /// Hencky–J2's small-strain limit, von Mises of the same strength with the exponential

@@ -45,7 +45,7 @@ pub use stress::{invariants, plane, plane_block, Mat6, Stress, IDENTITY6, NS, NS
 pub use von_mises::{VonMises, VonMisesLaw};
 
 use crate::check::Checked;
-use finite_strain::M3;
+use finite_strain::{FiniteTangent, M3};
 use principal::Principal;
 use serde::{Deserialize, Serialize};
 
@@ -121,6 +121,10 @@ pub trait SoilParameters: Clone {
     /// whose stress is their state.
     const STRESS_FUNCTION_OF: Option<&'static str> = None;
 
+    /// Whether the model runs in the implicit stages: every incremental model, and a
+    /// finite-strain one whose law has its consistent tangent ([`SoilLaw::finite_tangent`]).
+    const IMPLICIT: bool = true;
+
     /// The model as the solver runs it.
     type Law: SoilLaw;
 
@@ -164,11 +168,20 @@ pub trait SoilLaw: Copy + std::fmt::Debug + PartialEq {
 
     /// A finite-strain model's stress after a step (`None` for the incremental models, whose
     /// stress follows [`SoilLaw::update`]), with the small-strain elasticity of its moduli as the
-    /// tangent (no consistent tangent: explicit stages only). `df` is the step's deformation
+    /// update's `tangent` (what the estimates take; Newton's consistent tangent is
+    /// [`SoilLaw::finite_tangent`]). `df` is the step's deformation
     /// gradient ΔF (with F̄, ΔF̄; a plane-strain point's has F_zz = 1), `f` the total one after the
     /// step (F_{n+1}, or F̄_{n+1}), `stress` the Cauchy stress the point starts from, unrotated,
     /// `dt` the step [s]. The stress is NaN when the step is inadmissible (det F ≤ 0).
     fn finite(&self, _df: &M3, _f: &M3, _stress: &Stress, _eps_pd: f64, _dt: f64) -> Option<StressUpdate> {
+        None
+    }
+
+    /// The consistent tangent of [`SoilLaw::finite`]'s stress, ∂σ_{n+1}/∂ΔF at fixed F_n and
+    /// σ_n (the same arguments), which the implicit stages' Newton method takes; `None` for the
+    /// incremental models and for a finite-strain model that runs in explicit stages only
+    /// ([`SoilParameters::IMPLICIT`]), or when the step is inadmissible.
+    fn finite_tangent(&self, _df: &M3, _f: &M3, _stress: &Stress, _eps_pd: f64, _dt: f64) -> Option<FiniteTangent> {
         None
     }
 
@@ -215,6 +228,14 @@ macro_rules! laws {
                 }
             }
 
+            /// See [`SoilLaw::finite_tangent`].
+            #[inline]
+            pub fn finite_tangent(&self, df: &M3, f: &M3, stress: &Stress, eps_pd: f64, dt: f64) -> Option<FiniteTangent> {
+                match self {
+                    $(Constitutive::$variant(m) => SoilLaw::finite_tangent(m, df, f, stress, eps_pd, dt),)*
+                }
+            }
+
             /// See [`SoilLaw::fluid_volume_ratio`].
             #[inline]
             pub fn fluid_volume_ratio(&self, f: M3, jbar: Option<f64>) -> Option<f64> {
@@ -228,6 +249,14 @@ macro_rules! laws {
             pub fn elastic(&self) -> &LinearElastic {
                 match self {
                     $(Constitutive::$variant(m) => SoilLaw::elastic(m),)*
+                }
+            }
+
+            /// Whether the law follows the total deformation gradient ([`SoilParameters::FINITE_STRAIN`]).
+            #[inline]
+            pub fn is_finite_strain(&self) -> bool {
+                match self {
+                    $(Constitutive::$variant(_) => <$params as SoilParameters>::FINITE_STRAIN,)*
                 }
             }
 
@@ -309,6 +338,13 @@ macro_rules! soil_models {
                 }
             }
 
+            /// Whether the model runs in the implicit stages ([`SoilParameters::IMPLICIT`]).
+            pub fn runs_implicit(&self) -> bool {
+                match self {
+                    $(SoilModel::$variant(_) => <$params as SoilParameters>::IMPLICIT,)*
+                }
+            }
+
             /// What the stress is a function of, for a model whose stress is not a state its point
             /// carries (so a body of it takes no initial stress): see
             /// [`SoilParameters::STRESS_FUNCTION_OF`].
@@ -352,9 +388,8 @@ soil_models! {
     /// Von Mises with linear softening ([001] §3.2): q ≤ √3 c(ε̄), c = max(c_p + H_s ε̄, c_r).
     VonMises(von_mises::VonMises) = "von_mises",
     /// Compressible neo-Hookean hyperelasticity ([002] §4.1, Cook's membrane): Kirchhoff stress
-    /// τ = μ(b − 1) + λ ln J 1 of the point's total deformation gradient, σ = τ/J. Only in
-    /// `dynamic_explicit` stages (the implicit stages need its consistent tangent, which is not
-    /// built), without an initial stress.
+    /// τ = μ(b − 1) + λ ln J 1 of the point's total deformation gradient, σ = τ/J. In every
+    /// stage (the implicit ones with its consistent tangent), without an initial stress.
     NeoHookean(neo_hookean::NeoHookeanParameters) = "neo_hookean",
     /// Hencky elasticity with J2 (von Mises) plasticity and exponential softening ([002] §4.2 and
     /// §4.4, the strip footing and the landslide): multiplicative plasticity in principal
@@ -362,8 +397,8 @@ soil_models! {
     /// dev τ onto q = √3 c(ε̄), c(ε̄) = c_r + (c_p − c_r) exp(−η ε̄), σ = τ/J (with F̄, J̄). c is
     /// the plane-strain shear strength (the undrained strength s_u). The point's b^e is not
     /// stored: it is recovered from its stress and J, which determine it (so an initial stress is
-    /// an initial elastic strain). Only in `dynamic_explicit` stages (no consistent tangent for the
-    /// implicit ones), in plane strain.
+    /// an initial elastic strain). In every stage (the implicit ones with its consistent
+    /// tangent), in plane strain and 3D.
     HenckyJ2(hencky_j2::HenckyJ2) = "hencky_j2",
     /// A weakly compressible Newtonian fluid ([002] §4.3, the dam break): σ = −p 1 + 2μ_v dev d
     /// with the pressure of the equation of state p = K(1 − J) (with F̄, J̄) and d the step's rate

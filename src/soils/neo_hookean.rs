@@ -1,7 +1,7 @@
 //! Compressible neo-Hookean hyperelasticity, `type = "neo_hookean"` (Cook's membrane, [002] §4.1):
 //! its parameters, E and ν, and its law, the stress of the point's total deformation gradient.
 
-use super::finite_strain::{det, finite_update, normal, push, M3, UNIT};
+use super::finite_strain::{det, finite_update, left_tangent, normal, push, FiniteTangent, M3, UNIT};
 use super::{Elasticity, LinearElastic, Region, SoilLaw, SoilParameters, Stress, StressUpdate};
 use crate::check::Checked;
 use serde::{Deserialize, Serialize};
@@ -76,9 +76,19 @@ impl SoilLaw for NeoHookeanLaw {
         Some(finite_update(&self.elastic, self.stress(*f), eps_pd, Region::Elastic))
     }
 
+    /// δτ = μ δb + λ (δJ/J) 1 with b = F Fᵀ = ΔF (F_n F_nᵀ) ΔFᵀ ([`left_tangent`]).
+    fn finite_tangent(&self, df: &M3, f: &M3, _stress: &Stress, _eps_pd: f64, _dt: f64) -> Option<FiniteTangent> {
+        let sigma = self.stress(*f)?;
+        let (mu, lame) = (self.shear, self.lame);
+        let dtau = |db: &Stress, tr: f64| -> Stress {
+            std::array::from_fn(|c| mu * db[c] + if normal(c) { lame * tr } else { 0.0 })
+        };
+        Some(left_tangent(df, &push(*f, &UNIT), &sigma, det(*f), dtau))
+    }
+
     /// A hyperelastic model's stress comes from the total deformation ([`SoilLaw::finite`]); its
     /// increment here is the small-strain one of the same moduli, with their tangent (the
-    /// kernels' tests use it; a case runs it in explicit stages only, through `finite`).
+    /// kernels' tests use it; a case runs it through `finite` and `finite_tangent`).
     fn update(&self, stress: &Stress, eps_pd: f64, deps: &Stress) -> StressUpdate {
         self.elastic.update(stress, eps_pd, deps)
     }

@@ -26,6 +26,7 @@ pub struct NewtonianFluid {
 
 impl SoilParameters for NewtonianFluid {
     const FINITE_STRAIN: bool = true;
+    const IMPLICIT: bool = false;
     const STRESS_FUNCTION_OF: Option<&'static str> = Some("its deformation and its rate");
 
     type Law = NewtonianFluidLaw;

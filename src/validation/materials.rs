@@ -2,7 +2,7 @@
 //! ranges, whether a softening model has a unique return, and where the finite-strain models may
 //! be used.
 
-use crate::case::{AnalysisType, Case, Formulation, Geometry, Material};
+use crate::case::{AnalysisType, Case, Formulation, Geometry, KinematicsKind, Material, StressRecovery};
 use crate::check::{at, in_closed_open, in_open, magnitude, modulus, positive_or_inf, Checked, MAX_CONDUCTIVITY};
 
 /// Every material, then where its model may be used.
@@ -40,20 +40,48 @@ fn material(key: &str, m: &Material, pore_water: bool) -> Checked {
     }
 }
 
-/// Where a finite-strain material (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) may be used: in
-/// explicit stages only (the implicit stages need its consistent tangent, not built), in plane
-/// strain (its kinematics have F_zz = 1), and, for the hyperelastic neo-Hookean and the fluid,
-/// without an initial stress (their stress is a function of the deformation and rate alone; a
-/// Hencky–J2 point's initial stress is its initial elastic strain).
+/// Where a finite-strain material (`neo_hookean`, `hencky_j2`, `newtonian_fluid`) may be used: the
+/// solids in every stage, the fluid in explicit stages only (its viscous stress has no consistent
+/// tangent); in an implicit stage on the step's end configuration (not with
+/// `linear_increments`, whose forces stay on x_n while the stress follows the total deformation)
+/// and without the implicit F̄ projection (whose J̄_{n+1} the total deformation the stress sees
+/// does not carry); in plane strain (its kinematics have F_zz = 1); and, for the hyperelastic
+/// neo-Hookean and the fluid, without an initial stress (their stress is a function of the
+/// deformation and rate alone; a Hencky–J2 point's initial stress is its initial elastic strain).
 fn finite_strain_materials(c: &Case) -> Checked {
     for (i, m) in c.materials.iter().enumerate().filter(|(_, m)| m.model.is_finite_strain()) {
         let name = m.model.kind();
         if let Some(s) = c.stages.iter().find(|s| s.analysis != AnalysisType::DynamicExplicit) {
-            return Err(format!(
-                "key `materials[{i}].model`: `{name}` runs in dynamic_explicit stages only (its consistent \
-                 tangent for the implicit stages is not built), and stage `{}` is not one",
-                s.name
-            ));
+            if !m.model.runs_implicit() {
+                return Err(format!(
+                    "key `materials[{i}].model`: `{name}` runs in dynamic_explicit stages only (its viscous \
+                     stress has no consistent tangent for the implicit stages), and stage `{}` is not one",
+                    s.name
+                ));
+            }
+            if c.analysis.kinematics == KinematicsKind::LinearIncrements {
+                return Err(format!(
+                    "key `materials[{i}].model`: `{name}` follows the total deformation, and \
+                     `analysis.kinematics = \"linear_increments\"` keeps the forces on the step's start \
+                     (stage `{}` is implicit); use `finite_strain`",
+                    s.name
+                ));
+            }
+            if c.stabilisation.fbar {
+                return Err(format!(
+                    "key `materials[{i}].model`: `{name}` in the implicit stage `{}` does not take the \
+                     implicit F̄ projection (`stabilisation.fbar`); use B̄ (`stabilisation.bbar`) there",
+                    s.name
+                ));
+            }
+        }
+        if m.model.kind() == "hencky_j2" && c.stabilisation.stress_recovery != StressRecovery::Basis {
+            return Err(
+                "key `stabilisation.stress_recovery`: a `hencky_j2` point recovers its elastic strain b^e from \
+                 its stress and its volume ratio J_n, which are the motion's, while a recovered strain \
+                 would give the stress another J: use `basis`"
+                    .into(),
+            );
         }
         if c.analysis.geometry == Geometry::Axisymmetric {
             return Err(format!(
