@@ -213,7 +213,8 @@ fn a_body_s_file_and_what_is_wrong_with_it_are_named() {
             plane("{ mesh = { file = \"meshes/layers_2d.msh\", group = \"clay\" } }"),
             "key `bodies[0].shape.mesh`: tests/meshes/layers_2d.msh: it has no physical group of dimension 2 named \"clay\"; it has \"rock\" (1), \"soil\" (2)",
         ),
-        (plane("{ mesh = { file = \"meshes/embankment.msh\" } }"), "it holds no cell of dimension 2"),
+        (plane("{ mesh = { file = \"meshes/embankment.msh\" } }"), "its cell 0 of dimension 2 lies off the plane z = 0"),
+        (plane("{ mesh = { file = \"meshes/embankment.msh\", group = \"fill\" } }"), "no physical group of dimension 2 named \"fill\"; it has \"bottom\" (3)"),
         (plane("{ mesh = { file = \"meshes/layers_2d.msh\", order = 3 } }"), "key `bodies[0].shape.mesh.order`: 1 or 2, got 3"),
         (plane("{ surface = { file = \"meshes/ball.stl\" } }"), "a box, sphere, cylinder or surface is a shape of a three-dimensional case"),
         (
@@ -391,4 +392,54 @@ fn a_particle_file_gives_its_points_their_initial_fields() {
         let e = case("[1.0, 1.0]", "[10, 10]", &bodies, "").unwrap_err();
         assert!(e.contains(want), "{e}\nshould say: {want}");
     }
+}
+
+/// A boundary from a mesh's physical group holds the grid nodes on its lines (plane) or faces
+/// (3D): the slope's base line (y = 0, x from 0 to 4) the 17 nodes of the grid line under it; its
+/// crest (a horizontal line at y = 1 from x = 2.6 to 4 and two lines off the grid's lines) the six
+/// nodes of the horizontal part only; the embankment's base face (y = 0, 6 m × 2 m) the 13 × 5 nodes
+/// on it. A group that misses the grid's lines is refused, naming them.
+#[test]
+fn a_boundary_from_a_mesh_group_holds_the_nodes_on_its_lines_and_faces() {
+    use porompm::model::loads::mesh_nodes;
+    let boundary = |group: &str, fix: &str| {
+        format!("[[boundaries]]\nname = \"b\"\nmesh = {{ file = \"{group}\" }}\nfix = {fix}\n")
+    };
+    let slope = body("soil", "{ mesh = { file = \"meshes/layers_2d.msh\", group = \"soil\" } }");
+    let nodes = |c: &Case| mesh_nodes(&porompm::model::grid_of::<2>(c), c.boundaries[0].mesh.as_ref().unwrap());
+    let base = slope.clone() + &boundary("meshes/layers_2d.msh\", group = \"base", "[\"ux\", \"uy\"]");
+    let c = case("[4.0, 2.0]", "[16, 8]", &base, "").unwrap();
+    assert_eq!(nodes(&c), (0..17).map(|i| [i, 0]).collect::<Vec<_>>());
+    let crest = slope.clone() + &boundary("meshes/layers_2d.msh\", group = \"crest", "[\"uy\"]");
+    let c = case("[4.0, 2.0]", "[16, 8]", &crest, "").unwrap();
+    assert_eq!(nodes(&c), (11..17).map(|i| [i, 4]).collect::<Vec<_>>());
+    // A grid whose lines miss the crest's horizontal part (y = 1 lies between them).
+    let e = case("[4.0, 2.1]", "[16, 6]", &crest, "").unwrap_err();
+    assert!(e.contains("key `boundaries[0].mesh`: its lines hold no grid node"), "{e}");
+    let e =
+        case("[4.0, 2.0]", "[16, 8]", &(slope + &boundary("meshes/layers_2d.msh\", group = \"toe", "[\"uy\"]")), "")
+            .unwrap_err();
+    assert!(e.contains("no physical group of dimension 1 named \"toe\"") && e.contains("\"base\""), "{e}");
+    let fill = body("fill", "{ mesh = { file = \"meshes/embankment.msh\", group = \"fill\" } }")
+        + &boundary("meshes/embankment.msh\", group = \"bottom", "[\"ux\", \"uy\", \"uz\"]");
+    let c = case("[7.0, 3.0, 2.0]", "[14, 6, 4]", &fill, "").unwrap();
+    let on = mesh_nodes(&porompm::model::grid_of::<3>(&c), c.boundaries[0].mesh.as_ref().unwrap());
+    assert_eq!(on.len(), 13 * 5, "{on:?}");
+    assert!(on.iter().all(|n| n[1] == 0 && n[0] <= 12 && n[2] <= 4), "{on:?}");
+}
+
+/// The embankment with its base fixed by the mesh's "bottom" face gives the history of the same
+/// base given as a box of nodes (y = 0, 0 ≤ x ≤ 6), exactly.
+#[test]
+fn a_mesh_boundary_fixes_what_the_same_box_fixes() {
+    let run = |label: &str, base: &str| {
+        let dir = std::env::temp_dir().join(format!("porompm-embankment-base-{label}"));
+        let set = format!("boundaries.base={{name=\"base\",{base},fix=[\"ux\",\"uy\",\"uz\"]}}");
+        let r = common::run_case("tests/cases/embankment_mesh_3d.toml", &dir, &common::set_args(&[&set]));
+        assert!(r.completed(), "{label}: {}", r.stderr());
+        r.rows
+    };
+    let mesh = run("mesh", "mesh={file=\"../meshes/embankment.msh\",group=\"bottom\"}");
+    let region = run("region", "region={min=[0.0,0.0],max=[6.0,0.0],z=[0.0,2.0]}");
+    assert_eq!(mesh, region);
 }

@@ -7,6 +7,8 @@ use super::buckets::Buckets;
 /// A first-order cell, with Gmsh's numbering of its nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CellKind {
+    /// A two-node line (a plane case's boundary curve).
+    Line,
     /// A three-node triangle.
     Triangle,
     /// A four-node quadrangle.
@@ -23,6 +25,7 @@ impl CellKind {
     /// Its dimension.
     pub fn dim(self) -> usize {
         match self {
+            CellKind::Line => 1,
             CellKind::Triangle | CellKind::Quadrangle => 2,
             _ => 3,
         }
@@ -31,6 +34,7 @@ impl CellKind {
     /// Its number of nodes.
     pub fn nodes(self) -> usize {
         match self {
+            CellKind::Line => 2,
             CellKind::Triangle => 3,
             CellKind::Quadrangle | CellKind::Tetrahedron => 4,
             CellKind::Hexahedron => 8,
@@ -55,6 +59,7 @@ impl CellKind {
             ]
         };
         match self {
+            CellKind::Line => line.iter().map(|&(a, w)| ([a, 0.0, 0.0], w)).collect(),
             CellKind::Triangle => triangle.iter().map(|&([a, b], w)| ([a, b, 0.0], w)).collect(),
             CellKind::Quadrangle => {
                 line.iter().flat_map(|&(b, wb)| line.iter().map(move |&(a, wa)| ([a, b, 0.0], wa * wb))).collect()
@@ -89,7 +94,7 @@ impl CellKind {
                 n[..4].copy_from_slice(&[1.0 - a - b - c, a, b, c]);
                 dn[..4].copy_from_slice(&[[-1.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
             }
-            CellKind::Quadrangle | CellKind::Hexahedron => {
+            CellKind::Line | CellKind::Quadrangle | CellKind::Hexahedron => {
                 let corners = [[-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0]];
                 let dims = self.dim();
                 for i in 0..self.nodes() {
@@ -120,6 +125,7 @@ impl CellKind {
     /// for cells with plane faces (Gmsh's first-order cells of a straight-sided geometry).
     fn simplices(self) -> &'static [[usize; 4]] {
         match self {
+            CellKind::Line => &[[0, 1, 1, 0]],
             CellKind::Triangle => &[[0, 1, 2, 0]],
             CellKind::Quadrangle => &[[0, 1, 2, 0], [0, 2, 3, 0]],
             CellKind::Tetrahedron => &[[0, 1, 2, 3]],
@@ -148,11 +154,11 @@ pub struct FileCell {
 pub struct MeshFile {
     /// Node coordinates [m].
     pub nodes: Vec<[f64; 3]>,
-    /// The first-order cells of dimension 2 and 3.
+    /// The first-order cells of dimension 1 to 3.
     pub cells: Vec<FileCell>,
     /// The physical groups' names: (dimension, tag, name).
     pub names: Vec<(usize, i32, String)>,
-    /// Cells of dimension 2 or 3 of a kind no body is filled from: (dimension, kind, count).
+    /// Cells of dimension 1 to 3 of a kind no body or boundary is made from: (dimension, kind, count).
     pub other_cells: Vec<(usize, String, usize)>,
 }
 
@@ -184,6 +190,23 @@ impl MeshFile {
     /// Its cells of dimension `dim` in the physical group of tag `tag` (all without one).
     fn cells_of(&self, dim: usize, tag: Option<i32>) -> impl Iterator<Item = &FileCell> {
         self.cells.iter().filter(move |c| c.kind.dim() == dim && tag.is_none_or(|t| c.groups.contains(&t)))
+    }
+
+    /// The cells of dimension `dim` in `group` (all without one) as the positions of their
+    /// corners: segments, triangles and quadrangles (a boundary's curves or faces); an error if
+    /// there are none.
+    pub fn polygons(&self, dim: usize, group: Option<Group>) -> Result<Vec<Vec<[f64; 3]>>, String> {
+        let tag = self.group_tag(dim, group)?;
+        let out: Vec<Vec<[f64; 3]>> =
+            self.cells_of(dim, tag).map(|c| c.nodes.iter().map(|&n| self.nodes[n]).collect()).collect();
+        if out.is_empty() {
+            let what = if dim == 1 { "line" } else { "triangle or quadrangle" };
+            return Err(match tag {
+                Some(t) => format!("its physical group {t} of dimension {dim} holds no {what}"),
+                None => format!("it holds no {what}"),
+            });
+        }
+        Ok(out)
     }
 
     /// The Gauss points of its two-dimensional cells in `group` (all without one), each with the
@@ -268,16 +291,19 @@ impl Mesh {
         let mut cells = Vec::new();
         let mut used = vec![u32::MAX; file.nodes.len()];
         let mut nodes = Vec::new();
-        for c in file.cells_of(dim, tag) {
+        for (i, c) in file.cells_of(dim, tag).enumerate() {
             let mut local = [0u32; 8];
             for (k, &n) in c.nodes.iter().enumerate() {
+                if dim == 2 && file.nodes[n][2] != 0.0 {
+                    return Err(format!(
+                        "its cell {i} of dimension 2 lies off the plane z = 0 (a node at z = {}): a plane case \
+                         takes a mesh drawn in the (x, y) plane",
+                        file.nodes[n][2]
+                    ));
+                }
                 if used[n] == u32::MAX {
                     used[n] = nodes.len() as u32;
-                    let mut x = file.nodes[n];
-                    if dim == 2 {
-                        x[2] = 0.0;
-                    }
-                    nodes.push(x);
+                    nodes.push(file.nodes[n]);
                 }
                 local[k] = used[n];
             }

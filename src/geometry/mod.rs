@@ -7,10 +7,12 @@
 
 mod buckets;
 pub mod mesh;
+pub mod on_faces;
 pub mod points;
 pub mod surface;
 
 pub use mesh::{face_points, CellKind, FacePoints, FileCell, Group, Mesh, MeshFile};
+pub use on_faces::NodeLattice;
 pub use points::{PointCloud, PointFields, PointRows};
 pub use surface::{Surface, Triangles};
 

@@ -61,16 +61,18 @@ pub fn read_msh(path: &Path) -> Result<MeshFile, String> {
     }
     let mut groups: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
     if let Some(e) = &data.entities {
+        groups.extend(e.curves.iter().map(|c| ((1, c.tag), c.physical_tags.clone())));
         groups.extend(e.surfaces.iter().map(|s| ((2, s.tag), s.physical_tags.clone())));
         groups.extend(e.volumes.iter().map(|v| ((3, v.tag), v.physical_tags.clone())));
     }
     let mut other: HashMap<(usize, String), usize> = HashMap::new();
     for block in data.elements.iter().flat_map(|e| &e.element_blocks) {
         let dim = block.entity_dim as usize;
-        if dim < 2 {
+        if dim < 1 {
             continue;
         }
         let kind = match block.element_type {
+            ElementType::Lin2 => CellKind::Line,
             ElementType::Tri3 => CellKind::Triangle,
             ElementType::Qua4 => CellKind::Quadrangle,
             ElementType::Tet4 => CellKind::Tetrahedron,

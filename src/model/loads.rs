@@ -3,6 +3,7 @@
 use super::grid::Grid;
 use super::particles::Particles;
 use crate::case::{self, BoundaryId, Dof, LoadId, Region, Side, TimeFunction};
+use std::sync::Arc;
 
 /// A scalar function of time.
 #[derive(Debug, Clone)]
@@ -457,10 +458,29 @@ pub struct BoundaryDef<const D: usize = 2> {
     /// dimensions) are fixed, so that a footing's edge stays where the region puts it when the
     /// points next to the edge move.
     pub surface_span: Option<Region>,
+    /// Or the nodes on a mesh's boundary curves or faces, in the order of [`mesh_nodes`].
+    pub mesh_nodes: Option<Arc<Vec<[usize; D]>>>,
     /// Components fixed.
     pub fix: Vec<Dof>,
     /// Their prescribed motion (none: fixed to zero).
     pub motion: Option<Motion<D>>,
+}
+
+/// The grid nodes on a boundary's mesh curves or faces ([`case::MeshBoundary`]): those within
+/// 1e-6 of the smallest cell side of one of them, sorted by (z, y, x) index.
+pub fn mesh_nodes<const D: usize>(grid: &Grid<D>, m: &case::MeshBoundary) -> Vec<[usize; D]> {
+    let lattice = crate::geometry::NodeLattice {
+        origin: std::array::from_fn(|d| if d < D { grid.origin[d] } else { 0.0 }),
+        h: std::array::from_fn(|d| if d < D { grid.h[d] } else { 1.0 }),
+        counts: std::array::from_fn(|d| if d < D { grid.cells[d] + 1 } else { 1 }),
+    };
+    let on = lattice.nodes_on(m.polygons(), 1e-6 * grid.h_min());
+    on.into_iter().map(|n| std::array::from_fn(|d| n[d])).collect()
+}
+
+/// The (z, y, x) order of a node's indices that [`mesh_nodes`] sorts by.
+fn mesh_order<const D: usize>(n: &[usize; D]) -> [usize; 3] {
+    [if D == 3 { n[2] } else { 0 }, n[1], n[0]]
 }
 
 impl BoundaryDef {
@@ -481,6 +501,7 @@ impl<const D: usize> BoundaryDef<D> {
             region: None,
             surface: None,
             surface_span: None,
+            mesh_nodes: None,
             fix: vec![Dof::Ux, Dof::WUx],
             motion: None,
         }
@@ -541,6 +562,7 @@ impl<const D: usize> BoundaryDef<D> {
             region: b.region,
             surface,
             surface_span: b.surface.as_ref().and_then(|sf| sf.region),
+            mesh_nodes: b.mesh.as_ref().map(|m| Arc::new(mesh_nodes(&super::grid_of(c), m))),
             fix: b.fix.clone(),
             motion,
         }
@@ -553,6 +575,9 @@ impl<const D: usize> BoundaryDef<D> {
             let axis = side.axis();
             // (A z side in a plane case is refused by validation: it holds no node.)
             return axis < D && n[axis] == if side.sign() < 0.0 { 0 } else { grid.cells[axis] };
+        }
+        if let Some(nodes) = &self.mesh_nodes {
+            return nodes.binary_search_by_key(&mesh_order(&n), mesh_order).is_ok();
         }
         self.region.is_some_and(|r| r.holds_node_in(grid.position(n), grid.h))
     }

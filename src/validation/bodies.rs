@@ -8,10 +8,11 @@ use crate::geometry::{CellKind, Group, Mesh, PointCloud, Surface};
 use std::path::Path;
 use std::sync::Arc;
 
-/// Reads the files bodies and loads are made from, relative to the case file `origin`: a body's
-/// mesh (its cells of the case's dimension, of its group, integrated once to find a cell without
-/// measure), STL surface (scaled and moved, which must be closed) or particle file; a surface
-/// pressure's faces (their Gauss points).
+/// Reads the files bodies, loads and boundaries are made from, relative to the case file `origin`:
+/// a body's mesh (its cells of the case's dimension, of its group, integrated once to find a cell
+/// without measure), STL surface (scaled and moved, which must be closed) or particle file; a
+/// surface pressure's faces (their Gauss points); a boundary's mesh curves or faces (their
+/// corners).
 pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
     let base = Path::new(origin).parent().unwrap_or(Path::new(""));
     let dim = if file.dimension() == 3 { 3 } else { 2 };
@@ -59,6 +60,17 @@ pub(super) fn read_files(file: &mut CaseFile, origin: &str) -> Checked {
     for (i, l) in file.loads.iter_mut().enumerate() {
         if let crate::case::Load::SurfacePressure(p) = l {
             read_load_surface(&mut p.surface, base, &format!("loads[{i}].surface"))?;
+        }
+    }
+    for (i, b) in file.boundaries.iter_mut().enumerate() {
+        if let Some(m) = &mut b.mesh {
+            let key = format!("boundaries[{i}].mesh");
+            let path = base.join(&m.file);
+            let content = crate::io::geometry::read_msh(&path).map_err(|e| format!("key `{key}.file`: {e}"))?;
+            let polygons = content
+                .polygons(dim - 1, group(&m.group))
+                .map_err(|e| format!("key `{key}`: {}: {e}", path.display()))?;
+            m.loaded = Some(Arc::new(polygons));
         }
     }
     Ok(())

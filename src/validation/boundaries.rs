@@ -1,4 +1,5 @@
-//! Boundaries: what of them belongs to three dimensions only, that a region holds grid nodes, and
+//! Boundaries: what of them belongs to three dimensions only, that a region or a mesh's boundary
+//! holds grid nodes, and
 //! that a motion has a component per dimension and moves only what the boundary fixes. In a
 //! one_phase analysis the water-phase components (p, Ux, Uy) have no dofs and are ignored, so that
 //! one case file can switch formulation with `--set analysis.formulation`.
@@ -27,7 +28,33 @@ pub(super) fn check(c: &Case) -> Checked {
                 ));
             }
         }
+        if let Some(m) = &b.mesh {
+            mesh_nodes(c, &format!("{key}.mesh"), m)?;
+        }
         motion(&key, b, dim)?;
+    }
+    Ok(())
+}
+
+/// A boundary's mesh curves or faces hold at least one grid node (a mesh whose boundary misses the
+/// grid's lines would fix nothing).
+fn mesh_nodes(c: &Case, key: &str, m: &crate::case::MeshBoundary) -> Checked {
+    let count = if c.dimension() == 3 {
+        crate::model::loads::mesh_nodes(&crate::model::grid_of::<3>(c), m).len()
+    } else {
+        crate::model::loads::mesh_nodes(&crate::model::grid_of::<2>(c), m).len()
+    };
+    if count == 0 {
+        let Bounds { lo, h, .. } = Bounds::of(c);
+        return Err(format!(
+            "key `{key}`: its {} hold no grid node (the grid lines lie at x = {} + i·{}, y = {} + j·{} m); put \
+             the mesh's boundary on them or change the grid",
+            if c.dimension() == 3 { "faces" } else { "lines" },
+            lo[0],
+            h[0],
+            lo[1],
+            h[1]
+        ));
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 // An embankment on a foundation, extruded along z, for the tests of bodies made from a Gmsh mesh:
-// the foundation's prisms (physical volume "foundation") under the fill's hexahedra ("fill").
+// the foundation's prisms (physical volume "foundation") under the fill's hexahedra ("fill"),
+// with the foundation's base (y = 0) as the physical surface "bottom".
 // gmsh -3 -format msh41 embankment.geo -o embankment.msh
 h = 0.5;
 Point(1) = {0, 0, 0, h}; Point(2) = {6, 0, 0, h}; Point(3) = {6, 1, 0, h}; Point(4) = {0, 1, 0, h};
@@ -14,3 +15,4 @@ ground[] = Extrude {0, 0, 2} { Surface{1}; Layers{4}; Recombine; };
 fill[] = Extrude {0, 0, 2} { Surface{2}; Layers{4}; Recombine; };
 Physical Volume("foundation") = {ground[1]};
 Physical Volume("fill") = {fill[1]};
+Physical Surface("bottom") = {ground[2]};

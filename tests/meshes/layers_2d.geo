@@ -1,5 +1,6 @@
 // A plane slope on a layer of rock, for the tests of bodies made from a Gmsh mesh:
-// the rock's quadrangles (physical surface "rock") under the slope's triangles ("soil").
+// the rock's quadrangles (physical surface "rock") under the slope's triangles ("soil"), with
+// its base ("base", y = 0) and crest ("crest") as physical curves.
 // gmsh -2 -format msh41 layers_2d.geo -o layers_2d.msh
 h = 0.25;
 Point(1) = {0, 0, 0, h};  Point(2) = {4, 0, 0, h};  Point(3) = {4, 0.5, 0, h};
@@ -14,3 +15,4 @@ Transfinite Surface{1}; Recombine Surface{1};
 Physical Surface("rock") = {1};
 Physical Surface("soil") = {2};
 Physical Curve("crest") = {6, 7, 8};
+Physical Curve("base") = {1};

@@ -2,6 +2,7 @@
 //! degrees of freedom they name.
 
 use super::bodies::Region;
+use super::from_files::MeshBoundary;
 use crate::check::{at, Checked};
 use serde::{Deserialize, Serialize};
 
@@ -14,11 +15,14 @@ use serde::{Deserialize, Serialize};
 pub struct Boundary {
     /// The name stages and the verification give to use it.
     pub name: String,
-    /// A side of the grid (give exactly one of `side`, `region` and `surface`).
+    /// A side of the grid (give exactly one of `side`, `region`, `surface` and `mesh`).
     pub side: Option<Side>,
-    /// The nodes inside this box, at least one (give exactly one of `side`, `region` and
-    /// `surface`).
+    /// The nodes inside this box, at least one (give exactly one of `side`, `region`, `surface`
+    /// and `mesh`).
     pub region: Option<Region>,
+    /// The nodes on a physical group of a Gmsh mesh's boundary, at least one: `{ file, group }`
+    /// (give exactly one of `side`, `region`, `surface` and `mesh`).
+    pub mesh: Option<MeshBoundary>,
     /// The moving surface of a body: the nodes on or beyond the exposed faces of its boundary
     /// particles, found again every step (a drained free surface: `fix = ["p"]`; in the
     /// quasi-static u–p system p = 0 is imposed on the faces themselves, by Nitsche's method).
@@ -156,8 +160,9 @@ impl Boundary {
     /// (`boundaries[0]`). What depends on the case's dimension and grid, and its names, validation
     /// checks.
     pub fn check(&self, key: &str) -> Checked {
-        if [self.side.is_some(), self.region.is_some(), self.surface.is_some()].iter().filter(|&&x| x).count() != 1 {
-            return Err(format!("key `{key}`: give exactly one of `side`, `region` and `surface`"));
+        let given = [self.side.is_some(), self.region.is_some(), self.surface.is_some(), self.mesh.is_some()];
+        if given.iter().filter(|&&x| x).count() != 1 {
+            return Err(format!("key `{key}`: give exactly one of `side`, `region`, `surface` and `mesh`"));
         }
         if self.surface.as_ref().is_some_and(|sf| sf.faces.is_empty()) {
             return Err(format!("key `{key}.surface.faces`: list at least one face"));

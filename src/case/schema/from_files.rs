@@ -199,6 +199,32 @@ pub struct MeshFaces {
 /// The triangles of an STL file (open or closed), as Gauss points with their area vectors.
 pub type StlFaces = StlFile<FacePoints>;
 
+/// A boundary's grid nodes from a Gmsh mesh: those on the cells of one physical group of the
+/// boundary's dimension (its lines in a plane case, its triangles and quadrangles in three
+/// dimensions), within 1e-6 of the smallest cell side of a line or face. The mesh's boundary must
+/// lie on grid lines (planes) where it is to hold nodes: a node next to a slanted or curved face is
+/// not on it.
+#[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MeshBoundary {
+    /// The mesh file, Gmsh's MSH 4.1, relative to the case file.
+    pub file: String,
+    /// The physical curve (plane case) or surface (three dimensions), by name or tag (default:
+    /// every line or every triangle and quadrangle of the mesh).
+    pub group: Option<GroupName>,
+    /// Its cells' corners, read by validation.
+    #[serde(skip)]
+    #[schemars(skip)]
+    pub loaded: Option<Arc<Vec<Vec<[f64; 3]>>>>,
+}
+
+impl MeshBoundary {
+    /// The cells' corners (validation has read them).
+    pub fn polygons(&self) -> &[Vec<[f64; 3]>] {
+        self.loaded.as_deref().map_or(&[], |v| v.as_slice())
+    }
+}
+
 impl LoadSurface {
     /// The file it is read from.
     pub fn file(&self) -> &str {
