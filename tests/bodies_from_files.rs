@@ -443,3 +443,24 @@ fn a_mesh_boundary_fixes_what_the_same_box_fixes() {
     let region = run("region", "region={min=[0.0,0.0],max=[6.0,0.0],z=[0.0,2.0]}");
     assert_eq!(mesh, region);
 }
+
+/// A surface pressure pushes into the material whichever way its faces are numbered: on the top
+/// of a box, a face whose area vector points up (away from the material) and one whose vector points
+/// down (into it) both press down with their area; a face inside the box or in the empty grid is
+/// refused, naming the side.
+#[test]
+fn a_surface_pressure_pushes_into_the_material_whichever_way_its_faces_turn() {
+    use porompm::model::loads::surface_pressure_points;
+    let boxed = body("b", "{ rectangle = { min = [0.0, 0.0], max = [1.0, 1.0] } }") + "z = [0.0, 1.0]\n";
+    let c = case("[2.0, 2.0, 2.0]", "[8, 8, 8]", &boxed, "").unwrap();
+    let h = [0.25; 3];
+    let top = [0.5, 1.0, 0.5];
+    for area in [[0.0, 0.2, 0.0], [0.0, -0.2, 0.0]] {
+        let points = surface_pressure_points::<3>(&c, &[(top, area)], h).unwrap();
+        assert_eq!(points, vec![(top, [0.0, -0.2, 0.0])], "area vector {area:?}");
+    }
+    let inside = surface_pressure_points::<3>(&c, &[([0.5, 0.5, 0.5], [0.0, 0.2, 0.0])], h).unwrap_err();
+    assert!(inside.contains("has material on both sides"), "{inside}");
+    let outside = surface_pressure_points::<3>(&c, &[([1.5, 1.5, 1.5], [0.0, 0.2, 0.0])], h).unwrap_err();
+    assert!(outside.contains("has material on neither side"), "{outside}");
+}
