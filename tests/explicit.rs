@@ -461,6 +461,12 @@ fn bad_explicit_settings_are_named() {
         &["stabilisation.fbar=true", "stages.0.analysis=dynamic_explicit"],
         "`stabilisation.fbar` and `stabilisation.bbar` exclude each other",
     );
+    assert_refused(
+        "tests/cases/lame_sphere_axisymmetric.toml",
+        &dir,
+        &["analysis.kinematics=\"finite_strain\"", "stabilisation.bbar=false", "stabilisation.fbar=true"],
+        "key `stabilisation.fbar`: plane strain only (in axial symmetry the projected J would need each point's hoop",
+    );
     let neo = "materials.soil.model={type=\"neo_hookean\",young_modulus=1.0e8,poisson_ratio=0.3}";
     let fluid = "materials.soil.model={type=\"newtonian_fluid\",bulk_modulus=2.0e9,viscosity=1.0e-3}";
     assert_refused(

@@ -123,7 +123,10 @@ fn fbar(c: &Case) -> Checked {
             .into());
     }
     if c.analysis.geometry == Geometry::Axisymmetric {
-        return Err("key `stabilisation.fbar`: plane strain only for now (axial symmetry scales three axes)".into());
+        return Err("key `stabilisation.fbar`: plane strain only (in axial symmetry the projected J would need each \
+                    point's hoop stretch, which its in-plane F does not carry); use B̄ (`stabilisation.bbar = true`), \
+                    which relieves the locking there in implicit and explicit stages"
+            .into());
     }
     Ok(())
 }
