@@ -331,6 +331,7 @@ fn a_particle_file_gives_its_points() {
         let e = case("[1.0, 1.0]", "[10, 10]", &over, geometry).unwrap_err();
         assert!(e.contains("body `cap` overlaps body `block`"), "{e}");
     }
+    hdf5_particle_file(&dir);
     let bad = |name: &str, text: &str, geometry: &str| {
         let file = dir.join(name);
         std::fs::write(&file, text).unwrap();
@@ -345,6 +346,49 @@ fn a_particle_file_gives_its_points() {
     assert!(e.contains("its point 0 has the measure -0.001, which must be positive"), "{e}");
     let e = bad("axis.csv", "x,y,volume\n0.0,0.5,1e-3\n", "geometry = \"axisymmetric\"");
     assert!(e.contains("its point 0 is at r = 0; a ring needs r > 0"), "{e}");
+}
+
+/// An HDF5 particle file (one-dimensional datasets in the root group named as a CSV's columns, here
+/// the positions and volumes in double precision and the initial velocity in single) gives the
+/// points the same numbers give from a CSV file; a dataset of another length and a missing one are
+/// refused, naming them.
+fn hdf5_particle_file(dir: &std::path::Path) {
+    use hdf5_metno as h5;
+    let block = body("block", "{ rectangle = { min = [0.2, 0.1], max = [0.8, 0.7] } }");
+    let c = case("[1.0, 1.0]", "[10, 10]", &block, "").unwrap();
+    let ps = Particles::<2>::generate(&c, &porompm::model::grid_of::<2>(&c), |_| true);
+    let column = |f: fn(&Particles<2>, usize) -> f64| (0..ps.len()).map(|k| f(&ps, k)).collect::<Vec<f64>>();
+    let (x, y, volume) = (column(|p, k| p.x[k][0]), column(|p, k| p.x[k][1]), column(|p, k| p.volume[k]));
+    let vy: Vec<f32> = x.iter().map(|&x| (0.1 * x) as f32).collect();
+    let write = |name: &str, with_volume: bool, short: bool| {
+        let path = dir.join(name);
+        let file = h5::File::create(&path).unwrap();
+        let put = |name: &str, v: &[f64]| file.new_dataset_builder().with_data(v).create(name).unwrap();
+        put("x", &x);
+        put("y", if short { &y[1..] } else { &y });
+        if with_volume {
+            put("volume", &volume);
+        }
+        file.new_dataset_builder().with_data(&vy).create("vy").unwrap();
+        file.new_dataset_builder().with_data(&vec![0.0f32; x.len()]).create("vx").unwrap();
+        path
+    };
+    let read = |path: &std::path::Path| {
+        let shape = format!("{{ points = {{ file = \"{}\" }} }}", path.display());
+        case("[1.0, 1.0]", "[10, 10]", &body("block", &shape), "")
+    };
+    let from_file = read(&write("block.h5", true, false)).unwrap();
+    let qs = Particles::<2>::generate(&from_file, &porompm::model::grid_of::<2>(&from_file), |_| true);
+    assert_eq!(qs.len(), ps.len());
+    for (k, v) in vy.iter().enumerate() {
+        assert_eq!(qs.x[k], ps.x[k]);
+        assert_eq!(qs.volume[k], ps.volume[k]);
+        assert_eq!(qs.vel[k], [0.0, f64::from(*v)], "point {k}");
+    }
+    let e = read(&write("short.h5", true, true)).unwrap_err();
+    assert!(e.contains("its datasets are of"), "{e}");
+    let e = read(&write("no_volume.h5", false, false)).unwrap_err();
+    assert!(e.contains("it has no dataset `volume` (it needs x, y, volume)"), "{e}");
 }
 
 /// A particle file's initial fields: each point starts with its row's velocity and stress; a field

@@ -3,6 +3,7 @@
 //! [`crate::geometry`]'s types.
 
 use crate::geometry::{CellKind, FileCell, MeshFile, PointFields, PointRows, Triangles};
+use hdf5_metno as h5;
 use mshio::mshfile::ElementType;
 use std::collections::HashMap;
 use std::path::Path;
@@ -134,76 +135,128 @@ pub fn read_stl(path: &Path) -> Result<Triangles, String> {
     Ok(Triangles { vertices, triangles })
 }
 
-/// The rows of a particle file: a CSV table whose header names its columns, `x`, `y` (and `z` in
-/// three dimensions, `dim = 3`) [m] and `volume` [m³], and optionally the initial velocity `vx`,
-/// `vy` (`vz`) [m/s], effective stress `sxx`, `syy`, `sxy`, `szz` (and `syz`, `szx`) [Pa] and pore
-/// pressure `p` [Pa], in any order among others, which are skipped; lines starting with `#` and
-/// empty lines are skipped. An error names the line, or the column a field lacks.
+/// The rows of a particle file: a CSV table whose header names its columns, or an HDF5 file
+/// (told by its signature) whose root group holds one-dimensional datasets of numbers named as the
+/// CSV's columns, all of one length. The columns: `x`, `y` (and `z` in three dimensions, `dim = 3`)
+/// [m] and `volume` [m³], and optionally the initial velocity `vx`, `vy` (`vz`) [m/s], effective
+/// stress `sxx`, `syy`, `sxy`, `szz` (and `syz`, `szx`) [Pa] and pore pressure `p` [Pa], in any
+/// order among others, which are skipped; in a CSV file lines starting with `#` and empty lines
+/// are skipped. An error names the line, or the column a field lacks.
 pub fn read_points(path: &Path, dim: usize) -> Result<PointRows, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let (_, header) = lines.next().ok_or_else(|| format!("{}: no header line", path.display()))?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |w: &str| names.iter().position(|n| *n == w);
-    let group = |wanted: &[&str], optional: &[&str]| -> Result<Option<Vec<Option<usize>>>, String> {
-        let found: Vec<Option<usize>> = wanted.iter().map(|w| find(w)).collect();
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    if bytes.starts_with(b"\x89HDF\r\n\x1a\n") {
+        let file = h5::File::open(path).map_err(|e| format!("cannot read {} as HDF5: {e}", path.display()))?;
+        rows_of(path, dim, "dataset", |name| hdf5_column(&file, name).map_err(|e| format!("{}: {e}", path.display())))
+    } else {
+        let text = String::from_utf8(bytes)
+            .map_err(|_| format!("{}: neither a CSV (UTF-8) nor an HDF5 file", path.display()))?;
+        let table = CsvTable::new(&text).ok_or_else(|| format!("{}: no header line", path.display()))?;
+        rows_of(path, dim, "column", |name| table.column(name).map_err(|e| format!("{} {e}", path.display())))
+    }
+}
+
+/// The particle file's rows from its columns, which `column` gives by name (`None` where the file
+/// has none of that name); `kind` is what the file calls a column.
+fn rows_of(
+    path: &Path,
+    dim: usize,
+    kind: &str,
+    column: impl Fn(&str) -> Result<Option<Vec<f64>>, String>,
+) -> Result<PointRows, String> {
+    // The columns of a group: all of `wanted` or none; `optional` ones are zero where missing.
+    let group = |wanted: &[&str], optional: &[&str]| -> Result<Option<Vec<Vec<f64>>>, String> {
+        let found = wanted.iter().map(|w| column(w)).collect::<Result<Vec<_>, _>>()?;
         if found.iter().all(Option::is_none) {
             return Ok(None);
         }
         if let Some(k) = found.iter().position(Option::is_none) {
+            let (head, what) = if kind == "column" { ("its header", "column") } else { ("it", "dataset") };
             return Err(format!(
-                "{}: its header has no column `{}` (it needs {})",
+                "{}: {head} has no {what} `{}` (it needs {})",
                 path.display(),
                 wanted[k],
                 wanted.join(", ")
             ));
         }
-        Ok(Some(found.into_iter().chain(optional.iter().map(|w| find(w))).collect()))
+        let mut out: Vec<Vec<f64>> = found.into_iter().flatten().collect();
+        for w in optional {
+            let n = out[0].len();
+            out.push(column(w)?.unwrap_or_else(|| vec![0.0; n]));
+        }
+        Ok(Some(out))
     };
     let position: &[&str] = if dim == 3 { &["x", "y", "z", "volume"] } else { &["x", "y", "volume"] };
     let place = group(position, &[])?.ok_or_else(|| {
-        format!("{}: its header has no column `x` (it needs {})", path.display(), position.join(", "))
+        let head = if kind == "column" { "its header has no column" } else { "it has no dataset" };
+        format!("{}: {head} `x` (it needs {})", path.display(), position.join(", "))
     })?;
     let velocity = group(if dim == 3 { &["vx", "vy", "vz"] } else { &["vx", "vy"] }, &[])?;
     let stress = group(&["sxx", "syy", "sxy", "szz"], if dim == 3 { &["syz", "szx"] } else { &[] })?;
     let pressure = group(&["p"], &[])?;
-    let mut rows = PointRows::default();
-    let mut fields: [Vec<Vec<f64>>; 3] = Default::default();
-    for (i, line) in lines {
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let values = |columns: &[Option<usize>]| -> Result<Vec<f64>, String> {
-            (columns.iter())
-                .map(|c| match c {
-                    None => Ok(0.0),
-                    Some(c) => {
-                        let text = cells.get(*c).copied().unwrap_or("");
-                        text.parse().map_err(|_| {
-                            format!(
-                                "{} line {}: `{text}` in column `{}` is not a number",
-                                path.display(),
-                                i + 1,
-                                names[*c]
-                            )
-                        })
-                    }
-                })
-                .collect()
-        };
-        let v = values(&place)?;
-        rows.x.push([v[0], v[1], if dim == 3 { v[2] } else { 0.0 }]);
-        rows.volume.push(v[dim]);
-        for (k, columns) in [&velocity, &stress, &pressure].into_iter().enumerate() {
-            if let Some(columns) = columns {
-                fields[k].push(values(columns)?);
-            }
-        }
+    let n = place[0].len();
+    let all = [&place].into_iter().chain([&velocity, &stress, &pressure].into_iter().flatten());
+    if let Some(c) = all.flatten().find(|c| c.len() != n) {
+        return Err(format!(
+            "{}: its {kind}s are of {n} and {} values; give each point a value in each",
+            path.display(),
+            c.len()
+        ));
     }
-    let [v, s, p] = fields;
+    let row = |cols: &Vec<Vec<f64>>, k: usize| -> Vec<f64> { cols.iter().map(|c| c[k]).collect() };
+    let mut rows = PointRows {
+        x: (0..n).map(|k| [place[0][k], place[1][k], if dim == 3 { place[2][k] } else { 0.0 }]).collect(),
+        volume: place[dim].clone(),
+        ..PointRows::default()
+    };
     rows.fields = PointFields {
         velocity: velocity
-            .map(|_| v.iter().map(|r| std::array::from_fn(|d| r.get(d).copied().unwrap_or(0.0))).collect()),
-        stress: stress.map(|_| s.iter().map(|r| std::array::from_fn(|c| r.get(c).copied().unwrap_or(0.0))).collect()),
-        pore_pressure: pressure.map(|_| p.iter().map(|r| r[0]).collect()),
+            .map(|v| (0..n).map(|k| std::array::from_fn(|d| row(&v, k).get(d).copied().unwrap_or(0.0))).collect()),
+        stress: stress
+            .map(|s| (0..n).map(|k| std::array::from_fn(|c| row(&s, k).get(c).copied().unwrap_or(0.0))).collect()),
+        pore_pressure: pressure.map(|p| p[0].clone()),
     };
     Ok(rows)
+}
+
+/// A CSV file's lines (without comments and empty lines, numbered from 1) under its header.
+struct CsvTable<'a> {
+    names: Vec<&'a str>,
+    lines: Vec<(usize, Vec<&'a str>)>,
+}
+
+impl<'a> CsvTable<'a> {
+    /// The table of `text`; `None` without a header line.
+    fn new(text: &'a str) -> Option<CsvTable<'a>> {
+        let mut lines = (text.lines().enumerate())
+            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+            .map(|(i, l)| (i + 1, l.split(',').map(str::trim).collect::<Vec<_>>()));
+        let (_, names) = lines.next()?;
+        Some(CsvTable { names, lines: lines.collect() })
+    }
+
+    /// The numbers of column `name` (`None` if the header has no such column); an error names
+    /// the line of a cell that is not a number.
+    fn column(&self, name: &str) -> Result<Option<Vec<f64>>, String> {
+        let Some(c) = self.names.iter().position(|n| *n == name) else { return Ok(None) };
+        (self.lines.iter())
+            .map(|(i, cells)| {
+                let text = cells.get(c).copied().unwrap_or("");
+                text.parse().map_err(|_| format!("line {i}: `{text}` in column `{name}` is not a number"))
+            })
+            .collect::<Result<Vec<f64>, String>>()
+            .map(Some)
+    }
+}
+
+/// The numbers of the one-dimensional dataset `name` in the root group of `file` (`None` if it has
+/// none of that name), converted to f64.
+fn hdf5_column(file: &h5::File, name: &str) -> Result<Option<Vec<f64>>, String> {
+    if !file.link_exists(name) {
+        return Ok(None);
+    }
+    let ds = file.dataset(name).map_err(|e| format!("`{name}` is not a dataset: {e}"))?;
+    if ds.ndim() != 1 {
+        return Err(format!("its dataset `{name}` has {} dimensions; a column has one", ds.ndim()));
+    }
+    ds.read_raw::<f64>().map(Some).map_err(|e| format!("its dataset `{name}` is not of numbers: {e}"))
 }

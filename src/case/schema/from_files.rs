@@ -44,7 +44,8 @@ pub struct PointsRegion {
     /// `szz` (`syz`, `szx`) [Pa] and pore pressure `p` [Pa] (two-phase; its gradient starts at
     /// zero), instead of the body's own. Each point's GIMP domain is the square (cube) of its area
     /// (volume), and the body's region is the union of those domains; the body's material applies
-    /// to every point.
+    /// to every point. An HDF5 file (told by its signature) gives the same columns as
+    /// one-dimensional datasets of numbers in its root group, all of one length.
     pub file: String,
     /// The points, read by validation.
     #[serde(skip)]
