@@ -474,31 +474,18 @@ fn the_three_dimensional_tangents_match_finite_differences_block_by_block() {
         "--set",
         "stages.0.boundaries=[\"base\",\"left\",\"back\",\"drained_top\"]",
     ];
-    assert_tangent_checked(&prism, 49, "p,ux");
+    common::assert_tangent_checked(&prism, 49, "p,ux");
 
     let coarse = ["tests/cases/footing_square_3d.toml", "--set", "parameters.k=1"];
-    let text = assert_tangent_checked(&[&coarse[..], &["--steps", "6"]].concat(), 9, "uy,ux");
-    let yielded: usize = text
-        .lines()
-        .find_map(|l| l.strip_prefix("material points that have yielded: "))
-        .and_then(|n| n.trim().parse().ok())
-        .expect("the count of yielded points");
+    let text = common::assert_tangent_checked(&[&coarse[..], &["--steps", "6"]].concat(), 9, "uy,ux");
+    let yielded = common::yielded_points(&text);
     assert!(yielded > 0, "the plastic tangent takes part: {text}");
 
     // After nine steps (269 points yielded): after three the u–Jbar columns differ from the central
     // differences by 1.2e-6 of their scale, after six by 1.3e-6, where the differences' own noise
     // is (the elastic soil's u–Jbar columns: 4e-7; the plane F̄'s: 2.5e-7).
     let fbar = [&coarse[..], &["--steps", "9", "--set", "stabilisation={fbar=true}"]].concat();
-    assert_tangent_checked(&fbar, 16, "Jbar,uz");
-}
-
-/// Checks that `porompm test-jacobian ARGS` passes with `n_blocks` blocks within 1e-6 and fails with
-/// the block `flip` (ROW,COL) negated; returns the passing run's output.
-fn assert_tangent_checked(args: &[&str], n_blocks: usize, flip: &str) -> String {
-    let text = common::assert_tangent_agrees(args, n_blocks);
-    let (code, flipped, err) = common::test_jacobian(&[args, &["--flip-block", flip]].concat());
-    assert_eq!(code, Some(1), "the flipped {flip} block: {flipped}\n{err}");
-    text
+    common::assert_tangent_checked(&fbar, 16, "Jbar,uz");
 }
 
 /// [002]'s landslide (cases/landslide_3d.toml) on a prism one 0.5 m cell wide: the first 0.1 s of

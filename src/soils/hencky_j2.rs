@@ -245,7 +245,7 @@ impl HenckyJ2Law {
         }
         // The returned deviator is the trial one scaled (radial return); the volume is elastic.
         let tau = std::array::from_fn(|k| self.bulk * tr + factor * s_trial[k]);
-        Some(Return { frame, tr, dev, s_trial, q_trial, factor, flow, eps_n: state.eps, tau })
+        Some(Return { trial, frame, tr, dev, s_trial, q_trial, factor, flow, eps_n: state.eps, tau })
     }
 
     /// ∂τ_i/∂λ_j of a return: the principal Kirchhoff stresses' derivatives with respect to the
@@ -276,6 +276,8 @@ impl HenckyJ2Law {
 
 /// A Hencky–J2 step's return ([`HenckyJ2Law::returned`]).
 struct Return {
+    /// b^e_trial = ΔF b^e_n ΔFᵀ.
+    trial: Stress,
     /// The principal frame and values of b^e_trial.
     frame: Principal,
     /// tr ε^e (elastic, so the trial's).
@@ -323,11 +325,10 @@ impl SoilLaw for HenckyJ2Law {
         let state = PlasticState { be: self.elastic_left_cauchy_green(stress, j_new / dj), eps: eps_pd };
         let r = self.returned(*df, &state, j_new)?;
         let dtau_db = r.frame.derivative(&r.tau, &self.principal_tangent(&r));
-        let trial = push(*df, &state.be);
         let sigma = r.frame.compose(&r.tau.map(|t| t / j_new));
         let dtau =
             |db: &Stress, _: f64| -> Stress { std::array::from_fn(|i| (0..NS).map(|c| dtau_db[i][c] * db[c]).sum()) };
-        Some(left_tangent(df, &trial, &sigma, j_new, dtau))
+        Some(left_tangent(df, &r.trial, &sigma, j_new, dtau))
     }
 
     /// Hencky–J2's small-strain limit, von Mises of the same strength with the exponential

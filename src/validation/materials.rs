@@ -2,7 +2,7 @@
 //! ranges, whether a softening model has a unique return, and where the finite-strain models may
 //! be used.
 
-use crate::case::{AnalysisType, Case, Formulation, Geometry, KinematicsKind, Material, StressRecovery};
+use crate::case::{AnalysisType, Case, Formulation, Geometry, KinematicsKind, Material, SoilModel, StressRecovery};
 use crate::check::{at, in_closed_open, in_open, magnitude, modulus, positive_or_inf, Checked, MAX_CONDUCTIVITY};
 
 /// Every material, then where its model may be used.
@@ -75,7 +75,7 @@ fn finite_strain_materials(c: &Case) -> Checked {
                 ));
             }
         }
-        if m.model.kind() == "hencky_j2" && c.stabilisation.stress_recovery != StressRecovery::Basis {
+        if matches!(m.model, SoilModel::HenckyJ2(_)) && c.stabilisation.stress_recovery != StressRecovery::Basis {
             return Err(
                 "key `stabilisation.stress_recovery`: a `hencky_j2` point recovers its elastic strain b^e from \
                  its stress and its volume ratio J_n, which are the motion's, while a recovered strain \

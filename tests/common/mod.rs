@@ -269,6 +269,23 @@ pub fn test_jacobian(args: &[&str]) -> (Option<i32>, String, String) {
     (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
 
+/// Checks that `porompm test-jacobian ARGS` passes with `n_blocks` blocks within 1e-6 and fails
+/// with the block `flip` (ROW,COL) negated; returns the passing run's output.
+pub fn assert_tangent_checked(args: &[&str], n_blocks: usize, flip: &str) -> String {
+    let text = assert_tangent_agrees(args, n_blocks);
+    let (code, flipped, err) = test_jacobian(&[args, &["--flip-block", flip]].concat());
+    assert_eq!(code, Some(1), "the flipped {flip} block: {flipped}\n{err}");
+    text
+}
+
+/// The number of material points that have yielded, as `porompm test-jacobian` reports it.
+pub fn yielded_points(text: &str) -> usize {
+    text.lines()
+        .find_map(|l| l.strip_prefix("material points that have yielded: "))
+        .and_then(|n| n.trim().parse().ok())
+        .expect("the count of yielded points")
+}
+
 /// Checks that `porompm test-jacobian ARGS` passes with a table of `n_blocks` field-pair blocks,
 /// every one within 1e-6 of central differences; returns its standard output.
 pub fn assert_tangent_agrees(args: &[&str], n_blocks: usize) -> String {
