@@ -195,6 +195,7 @@ gold_tests!(
     footing_near_slope,
     footing_peer,
     footing_peer_3d,
+    footing_rigid,
     footing_sd,
     footing_stl_3d,
     footing_undrained,

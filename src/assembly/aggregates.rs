@@ -179,6 +179,7 @@ mod tests {
             boundary: vec![crate::assembly::dofs::NO_BOUNDARY; n],
             owned_fixed: Vec::new(),
             free_dofs: 0,
+            ..DofMap::default()
         };
         (ghost, dofs, (0..(nx * ny) as u32).collect())
     }

@@ -5,7 +5,9 @@
 use super::pattern::Pattern;
 use super::points::{run_bands, run_parts, Points};
 use super::step::{Band, Step};
+use super::ties;
 use crate::model::Model;
+use crate::parallel::Collective;
 use petsc::snes::NonlinearProblem;
 use petsc::{BlockFill, BlockOps, BlockPlaces, CallbackError, DmDa, LogStage, MatRef, VecOps, VecRef, Vector};
 use std::time::Instant;
@@ -69,6 +71,8 @@ pub(super) struct Callbacks<'a, const D: usize, const M: usize, const N: usize> 
     /// The first material point whose residual block was not finite in this solve (on this
     /// rank), with the quantity that was not.
     pub(super) nonfinite: Option<String>,
+    /// The run's ranks (a rigid body's balance sums over them).
+    coll: &'a Collective,
 }
 
 /// What the callbacks borrow from the solver: the node space's DMDA, the local work vectors, the
@@ -83,12 +87,13 @@ pub(super) struct Workspace<'a, const D: usize> {
     /// Where the pattern's blocks sit in the Jacobian and, if the preconditioner has a matrix of
     /// its own, in that one.
     pub places: (&'a BlockPlaces, Option<&'a BlockPlaces>),
+    pub coll: &'a Collective,
 }
 
 impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> {
     /// The callbacks of `step` of `model` on the solver's `work`.
     pub(super) fn new(model: &'a Model<D>, step: &'a Step<D, M>, work: Workspace<'a, D>) -> Callbacks<'a, D, M, N> {
-        let Workspace { dm, x_local, f_local, stage, schur, places: (places, lowered_places) } = work;
+        let Workspace { dm, x_local, f_local, stage, schur, places: (places, lowered_places), coll } = work;
         Callbacks {
             points: Points::new(model, step),
             step,
@@ -101,6 +106,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Callbacks<'a, D, M, N> 
             places,
             lowered_places,
             nonfinite: None,
+            coll,
         }
     }
 
@@ -148,6 +154,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
         self.points.add_projection(&xl, &mut fl);
         // The continuity rows in PETSc's scaling (see [`super::pressure::scale`]).
         self.for_pressures(&mut fl, |v, s| *v *= s);
+        let tied = ties::gather_residual(&self.step.dofs, &mut fl);
         self.f_local.write().map_err(fatal)?.copy_from_slice(&fl);
         f.set_all(0.0).map_err(fatal)?;
         self.dm.local_to_global_add(self.f_local, f).map_err(fatal)?;
@@ -158,6 +165,8 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
             for &(o, q) in &self.step.dofs.owned_fixed {
                 fo[o] = xo[o] - self.step.dofs.value[q] / self.step.unit(q);
             }
+            // Rigid bodies: their balance at the masters, x_s − x_m at the other tied dofs.
+            ties::finish_residual(&self.step.dofs, tied, &xo, &mut fo, self.coll).map_err(CallbackError::Fatal)?;
         }
         self.time.seconds += t0.elapsed().as_secs_f64();
         Ok(())
@@ -196,6 +205,8 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                     })??;
                 }
             }
+            // Rigid bodies: tied rows moved into their masters', before the pressures' scaling.
+            step.tied_rows.apply(values, &step.pattern, nd);
             if let Some(p) = layout.p {
                 for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
                     let c = cell.nodes.len();

@@ -7,6 +7,10 @@
 //! pressure is the drained value zero (its projected volume ratio in an implicit F̄ step stays
 //! free wherever a point reaches the node, `kernels::fbar`). Fixed dofs keep their rows in the global vector (residual
 //! x − value, unit diagonal, no column entries), so the layout never changes.
+//!
+//! A dof of a rigid body's node (a boundary under a `force`) is *tied*: it stays an unknown, and
+//! [`super::ties`] makes it equal to its direction's master dof and moves its equation into the
+//! master's, the body's balance.
 
 use crate::layout::Layout;
 use crate::model::{Active, Model};
@@ -14,6 +18,28 @@ use petsc::GhostedRange;
 
 /// No boundary fixes the dof.
 pub const NO_BOUNDARY: u16 = u16::MAX;
+
+/// No rigid body ties the dof.
+pub const NO_TIE: u32 = u32::MAX;
+
+/// One direction of a rigid body: the dofs of its nodes in that direction (the solid's, and the
+/// water's where the boundary fixes it) move as its master dof, the solid's of the tied node with
+/// the smallest global number (the same on every rank).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tie {
+    /// The boundary (index into `Model::boundaries`).
+    pub boundary: usize,
+    /// The direction (0: x, 1: y, 2: z), also the master's component.
+    pub dir: usize,
+    /// The master's global node number (none before [`super::ties::resolve`]).
+    pub master_node: Option<i64>,
+    /// The master's ghosted dof on this rank, if this rank ghosts its node.
+    pub master_local: Option<usize>,
+    /// The master's offset in the owned part of global vectors, if this rank owns it.
+    pub master_owned: Option<usize>,
+    /// The force in this direction at t_{n+1} and at t_n [N/m, N].
+    pub force: [f64; 2],
+}
 
 /// The dof map of a step.
 #[derive(Debug, Clone, Default)]
@@ -32,13 +58,44 @@ pub struct DofMap {
     pub owned_fixed: Vec<(usize, usize)>,
     /// Unknowns (free dofs) over all ranks.
     pub free_dofs: usize,
+    /// The rigid-body direction (index into `ties`) tying each ghosted dof, or [`NO_TIE`].
+    pub tie: Vec<u32>,
+    /// The step's rigid-body directions, in the order of the active boundaries.
+    pub ties: Vec<Tie>,
+    /// Offsets of the owned tied dofs in the owned part of global vectors, with their ghosted
+    /// index (the masters left out once resolved).
+    pub owned_tied: Vec<(usize, usize)>,
+    /// The ghosted water dofs of an impermeable surface, each with the solid dof of its node and
+    /// direction that it follows (U_d = u_d), in increasing order.
+    pub follows: Vec<(u32, u32)>,
+    /// Offsets of the owned following dofs in the owned part of global vectors, with the offset
+    /// of the solid dof each follows and its ghosted index.
+    pub owned_follows: Vec<(usize, usize, usize)>,
 }
 
 impl DofMap {
     /// The bytes the map holds on the heap.
     pub fn heap_bytes(&self) -> usize {
         use crate::algebra::heap::capacity as c;
-        c(&self.well) + c(&self.fixed) + c(&self.value) + c(&self.boundary) + c(&self.owned_fixed)
+        c(&self.well)
+            + c(&self.fixed)
+            + c(&self.value)
+            + c(&self.boundary)
+            + c(&self.owned_fixed)
+            + c(&self.tie)
+            + c(&self.ties)
+            + c(&self.owned_tied)
+            + c(&self.follows)
+            + c(&self.owned_follows)
+    }
+
+    /// Whether ghosted dof `q` is held by a boundary or barely filled (fixed), tied to a rigid
+    /// body or follows the solid on an impermeable surface: its residual entry is a reaction
+    /// rather than an equation of its own.
+    pub fn held(&self, q: usize) -> bool {
+        self.fixed[q]
+            || self.tie.get(q).is_some_and(|&t| t != NO_TIE)
+            || self.follows.binary_search_by_key(&(q as u32), |f| f.0).is_ok()
     }
 
     /// Whether a node's motion component `c` is fixed by a boundary (not merely by being barely
@@ -91,6 +148,11 @@ pub fn build<const D: usize>(
         boundary: vec![NO_BOUNDARY; n * nd],
         owned_fixed: Vec::new(),
         free_dofs: 0,
+        tie: vec![NO_TIE; n * nd],
+        ties: ties_of(model, active, (t0, t1)),
+        owned_tied: Vec::new(),
+        follows: Vec::new(),
+        owned_follows: Vec::new(),
     };
     for (l, reached) in phi.iter().enumerate() {
         let node = ghost.indices(l);
@@ -98,14 +160,33 @@ pub fn build<const D: usize>(
         for c in 0..nd {
             let (q, by_c) = (l * nd + c, layout.canonical(c).and_then(|k| by[k]));
             let b = by_c.or_else(|| (surface[q] > 0.5).then(|| surface[q].round() as usize - 1));
+            let dir = if c < D { Some(c) } else { layout.w.and_then(|w| (c >= w).then(|| c - w)) };
+            let dir = dir.filter(|&d| d < D);
             if let Some(b) = b {
                 m.boundary[q] = b as u16;
                 // A moving boundary: its solid components and the water's move by its increment.
-                if let Some(motion) = &model.boundaries[b].motion {
-                    let dir = if c < D { Some(c) } else { layout.w.and_then(|w| (c >= w).then(|| c - w)) };
-                    if let Some(d) = dir.filter(|&d| d < D) {
-                        m.value[q] = motion.increment_at(model.grid.position(node), t0, t1)[d];
+                if let (Some(motion), Some(d)) = (&model.boundaries[b].motion, dir) {
+                    m.value[q] = motion.increment_at(model.grid.position(node), t0, t1)[d];
+                }
+                // A rigid body: its components stay unknowns, tied to their direction's master.
+                if let Some(g) = dir.and_then(|d| m.ties.iter().position(|t| t.boundary == b && t.dir == d)) {
+                    m.tie[q] = g as u32;
+                    continue;
+                }
+                // An impermeable surface: the water follows the solid where the solid is an
+                // unknown, moves with it where a boundary holds it, and where the node is barely
+                // filled (its solid extended) is treated as the solid is.
+                if layout.canonical(c).is_some_and(|k| follows(model, b, k)) {
+                    let solid = l * nd + dir.expect("a followed component is the water's");
+                    if !m.fixed[solid] {
+                        m.follows.push((q as u32, solid as u32));
+                    } else if m.boundary[solid] != NO_BOUNDARY {
+                        (m.fixed[q], m.value[q]) = (true, m.value[solid]);
+                    } else {
+                        m.boundary[q] = NO_BOUNDARY;
+                        m.fixed[q] = !carries_unknown(layout, c, *reached, well_fraction);
                     }
+                    continue;
                 }
             }
             m.fixed[q] = b.is_some() || !carries_unknown(layout, c, *reached, well_fraction);
@@ -123,10 +204,40 @@ pub fn build<const D: usize>(
             } else {
                 m.free_dofs += 1;
             }
+            if m.tie[l * nd + c] != NO_TIE {
+                m.owned_tied.push((o, l * nd + c));
+            }
+            if let Ok(f) = m.follows.binary_search_by_key(&((l * nd + c) as u32), |f| f.0) {
+                let solid = m.follows[f].1 as usize % nd;
+                m.owned_follows.push((o, o - c + solid, l * nd + c));
+            }
         }
         crate::model::shape::next_combination(&mut at, owned_count);
     }
     m
+}
+
+/// Whether boundary `b` makes the water component of canonical index `k` follow the solid's.
+fn follows<const D: usize>(model: &Model<D>, b: usize, k: usize) -> bool {
+    model.boundaries[b].impermeable.iter().any(|&d| crate::model::dof_index_in::<D>(d) == Some(k))
+}
+
+/// The rigid-body directions of the active boundaries under a force over `(t0, t1)`: one per
+/// direction whose solid component the boundary fixes, in the order of the active boundaries.
+fn ties_of<const D: usize>(model: &Model<D>, active: &Active, (t0, t1): (f64, f64)) -> Vec<Tie> {
+    use crate::case::Dof;
+    let solid = [Dof::Ux, Dof::Uy, Dof::Uz];
+    let mut ties = Vec::new();
+    for &b in &active.boundaries {
+        let def = &model.boundaries[b];
+        let Some(force) = &def.force else { continue };
+        let (f1, f0) = (force.at(t1), force.at(t0));
+        for dir in (0..D).filter(|&d| def.fix.contains(&solid[d])) {
+            let force = [f1[dir], f0[dir]];
+            ties.push(Tie { boundary: b, dir, master_node: None, master_local: None, master_owned: None, force });
+        }
+    }
+    ties
 }
 
 #[cfg(test)]

@@ -26,6 +26,9 @@ pub struct StepForces<const D: usize = 2> {
     pub reactions: Vec<[f64; D]>,
     /// The reactions per ghosted dof, for the work of the next step on the same node space.
     pub reactions_by_dof: Vec<f64>,
+    /// The displacement of each rigid body over the step (a boundary under a force; zero in the
+    /// directions it does not tie and for the other boundaries) [m].
+    pub rigid_motion: Vec<[f64; D]>,
     /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
     /// (trapezoidal; the reactions at t_n are the last step's, none after a new node space; at
@@ -52,6 +55,7 @@ impl<const D: usize> Default for StepForces<D> {
             origin: [0.0; D],
             reactions: Vec::new(),
             reactions_by_dof: Vec::new(),
+            rigid_motion: Vec::new(),
             work: 0.0,
             field_scales: Vec::new(),
             at_start: false,
@@ -99,6 +103,8 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         let walls = points.wall_shares(&xl, at_start);
         let mut fext = step.fext.clone();
         let mut fext_old = step.fext_old.clone();
+        // A rigid body's force acts on the material through the body's reactions.
+        super::ties::remove_forces(&step.dofs, &mut fext, &mut fext_old);
         for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
             space.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }
@@ -119,7 +125,12 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
         // boundary (D nb)]
         let dd = D * D;
-        let mut local = vec![0.0; 4 * dd + 1 + D * nb];
+        let mut local = vec![0.0; 4 * dd + 1 + 2 * D * nb];
+        // Each rigid body's motion over the step: its masters' increments.
+        for tie in step.dofs.ties.iter().filter(|t| t.master_owned.is_some()) {
+            let q = tie.master_local.expect("an owned master is ghosted");
+            local[4 * dd + 1 + D * nb + D * tie.boundary + tie.dir] = solution.increments[q];
+        }
         let mut reactions = vec![0.0; ng];
         // (dof component, in-plane direction) of the solid and water motion.
         let motion: Vec<(usize, usize)> =
@@ -160,6 +171,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             scale: norm(&s[dd..2 * dd]).max(norm(&s[2 * dd..3 * dd])).max(norm(&s[3 * dd..4 * dd])),
             origin,
             reactions: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * b + d])).collect(),
+            rigid_motion: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * (nb + b) + d])).collect(),
             reactions_by_dof: reactions,
             work: s[4 * dd],
             field_scales,

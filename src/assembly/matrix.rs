@@ -24,7 +24,13 @@ impl<const D: usize> Matrix<D> {
     /// The matrix of `pattern` on `space`. Collective.
     pub fn of(pattern: &Arc<Pattern<D>>, space: &NodeSpace<D>, coll: &Collective) -> Result<Matrix<D>, String> {
         let nd = space.layout.nd;
-        let node = |a: u32| (space.l2g[a as usize * nd] / nd as i32) as Int;
+        // A rigid body's master that this rank does not ghost has a virtual index past the ghosted
+        // nodes (`super::ties`).
+        let ghosted = space.ghost.len();
+        let node = |a: u32| match (a as usize).checked_sub(ghosted) {
+            None => (space.l2g[a as usize * nd] / nd as i32) as Int,
+            Some(k) => pattern.ties.extra[k] as Int,
+        };
         let owned = space.owned_nodes.len();
         let counts = coll.gather(&[owned as f64])?;
         let mut starts = vec![0 as Int; counts.len() + 1];

@@ -33,6 +33,7 @@ pub mod stencils;
 mod step;
 mod stiffness;
 mod system;
+mod ties;
 
 pub use check::BlockCheck;
 pub use dim::StepDim;

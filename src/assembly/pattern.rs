@@ -30,6 +30,18 @@ const NONE: u32 = u32::MAX;
 /// ones in a map.
 const REACH: i64 = 3;
 
+/// The rigid-body ties of a pattern on this rank ([`super::ties::pattern_ties`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PatternTies {
+    /// (tied node, master node) for every ghosted node with a tied dof, sorted.
+    pub pairs: Vec<(u32, u32)>,
+    /// The global node numbers of the virtual masters, in order of their indices.
+    pub extra: Vec<i32>,
+    /// Each direction's master node: its ghosted index, or where this rank does not ghost it a
+    /// virtual index past the ghosted nodes.
+    pub masters: Vec<u32>,
+}
+
 /// The node-pair blocks of the matrix, on a ghosted grid of dimension `D`.
 #[derive(Debug, Clone)]
 pub struct Pattern<const D: usize = 2> {
@@ -49,6 +61,9 @@ pub struct Pattern<const D: usize = 2> {
     /// The blocks of row node a are `row_start[a]..row_start[a + 1]` (the list is sorted by
     /// (a, b), so that the blocks of a range of row nodes are one range of the list).
     row_start: Vec<u32>,
+    /// The rigid-body ties it was built for ([`Pattern::tie`]): the master nodes past the
+    /// ghosted ones are virtual, named by their global numbers (`ties.extra`).
+    pub ties: PatternTies,
 }
 
 impl<const D: usize> Default for Pattern<D> {
@@ -62,6 +77,7 @@ impl<const D: usize> Default for Pattern<D> {
             far: HashMap::new(),
             counts: [0; D],
             row_start: Vec::new(),
+            ties: Default::default(),
         };
         p.set_reach(REACH);
         p
@@ -117,7 +133,36 @@ impl<const D: usize> Pattern<D> {
     }
 
     fn offset(&self, a: u32, b: u32) -> Option<usize> {
+        // A virtual master node ([`Pattern::tie`]) has no place on the grid: its pairs are kept in
+        // the map.
+        let ghosted = self.ghosted();
+        if a as usize >= ghosted || b as usize >= ghosted {
+            return None;
+        }
         self.near_index(a, self.indices(a), self.indices(b))
+    }
+
+    /// The ghosted nodes of the grid.
+    fn ghosted(&self) -> usize {
+        self.counts.iter().product()
+    }
+
+    /// Adds the rigid bodies' pairs ([`super::ties`]): for each (tied node s, master m) of `ties`,
+    /// (m, b) for every block (s, b) of the pattern, (s, m) and (m, m), so that a tied row can be
+    /// moved into its master's and hold its constraint.
+    pub fn tie(&mut self, ties: PatternTies) {
+        let mut add = Vec::new();
+        for &(s, m) in &ties.pairs {
+            add.extend(self.pairs[self.row_start(s)..self.row_start(s + 1)].iter().map(|&(_, b)| (m, b)));
+            // The tied row's own block in the master's column moves into (m, m).
+            add.extend([(s, m), (m, m)]);
+        }
+        for (a, b) in add {
+            self.insert(a, b);
+        }
+        let nodes = self.ghosted() + ties.extra.len();
+        self.ties = ties;
+        self.sort(nodes);
     }
 
     /// The grid indices of ghosted node `a` (x fastest).
@@ -344,12 +389,14 @@ impl<const D: usize> Pattern<D> {
         self.row_start[a as usize] as usize
     }
 
-    /// Whether the pattern holds every pair of every particle's effective nodes.
-    pub fn covers(&self, st: &Stencils<D>) -> bool {
-        (0..st.len()).all(|k| {
-            let eff = st.effective(k);
-            eff.iter().all(|&a| eff.iter().all(|&b| self.block(a, b).is_some()))
-        })
+    /// Whether the pattern holds every pair of every particle's effective nodes, and was tied as
+    /// `ties` says.
+    pub fn covers(&self, st: &Stencils<D>, ties: &PatternTies) -> bool {
+        self.ties == *ties
+            && (0..st.len()).all(|k| {
+                let eff = st.effective(k);
+                eff.iter().all(|&a| eff.iter().all(|&b| self.block(a, b).is_some()))
+            })
     }
 
     /// Number of blocks.
@@ -396,6 +443,32 @@ mod tests {
         st
     }
 
+    /// Ties to a master this rank ghosts (node 12) and to a virtual one (index 100, past the 10 × 10
+    /// ghosted nodes): every block (s, b) of a tied row finds (m, b), and (s, m) and (m, m) exist;
+    /// the virtual row's blocks are the last rows of the list.
+    #[test]
+    fn a_tied_row_finds_its_blocks_in_the_master_row() {
+        let st = stencils(&[&[11, 12, 21, 22], &[12, 13, 22, 23], &[55, 56, 65, 66]]);
+        let mut p = Pattern::build(&st, &[11, 55], &[], 10, 10);
+        let ties = super::PatternTies {
+            pairs: vec![(13, 12), (23, 12), (56, 100), (66, 100)],
+            extra: vec![4711],
+            masters: vec![12, 100],
+        };
+        p.tie(ties.clone());
+        for &(s, m) in &ties.pairs {
+            let row: Vec<u32> = p.pairs[p.row_start(s)..p.row_start(s + 1)].iter().map(|&(_, b)| b).collect();
+            assert!(row.contains(&m), "({s}, {m})");
+            for b in row {
+                assert!(p.block(m, b).is_some(), "({m}, {b}) for the tied row {s}");
+            }
+        }
+        assert!(p.pairs.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(p.row_start(101), p.len());
+        assert_eq!(p.row_start(100), p.len() - (p.row_start(101) - p.row_start(100)));
+        assert!(p.covers(&st, &ties) && !p.covers(&st, &Default::default()));
+    }
+
     #[test]
     fn pairs_are_listed_once_and_every_particle_finds_its_blocks() {
         // A 10 × 10 ghosted grid; two particles sharing nodes, one reaching 5 columns (a far pair).
@@ -403,7 +476,7 @@ mod tests {
         let p = Pattern::build(&st, &[11], &[], 10, 10);
         // 16 + 16 − 4 shared + 4 for the far particle; (11, 11) is already a particle pair.
         assert_eq!(p.len(), 16 + 16 - 4 + 4);
-        assert!(p.covers(&st));
+        assert!(p.covers(&st, &Default::default()));
         // Sorted by (a, b), with the rows' ranges.
         assert!(p.pairs.windows(2).all(|w| w[0] < w[1]));
         assert_eq!(p.row_start(12) - p.row_start(11), 4);
@@ -416,7 +489,7 @@ mod tests {
         assert_eq!(p.block_at(30, p.ij(30), 36, p.ij(36)), NONE);
         // A particle needing a pair the pattern lacks.
         let other = stencils(&[&[11, 44]]);
-        assert!(!p.covers(&other));
+        assert!(!p.covers(&other, &Default::default()));
         let (rows, cols) = p.coo(2, &(0..200).collect::<Vec<i32>>());
         assert_eq!(rows.len(), p.len() * 4);
         assert_eq!((rows[1], cols[1]), (22, 23));
@@ -453,7 +526,7 @@ mod tests {
         let p = Pattern::build_in(&st, &[node(5, 0, 0)], &[], counts);
         // The overlap of the two cubes: i, j ∈ {1, 2}, k = 2: 4 nodes, 16 pairs.
         assert_eq!(p.len(), 27 * 27 + 27 * 27 - 16 + 3 + 1);
-        assert!(p.covers(&st));
+        assert!(p.covers(&st, &Default::default()));
         assert!(p.pairs.windows(2).all(|w| w[0] < w[1]));
         for &(x, y) in &p.pairs {
             let v = p.block(x, y).unwrap();
@@ -475,9 +548,9 @@ mod tests {
         };
         let q = Pattern::build_in(&two, &[], &[], counts);
         assert_eq!((q.reach, q.near.len(), q.far.len(), q.len()), (2, 210 * 125, 0, 27 * 27 * 2 - 16));
-        assert!(q.covers(&two));
+        assert!(q.covers(&two, &Default::default()));
         assert!(q.pairs.iter().all(|&(x, y)| q.pairs[q.block(x, y).unwrap() as usize] == (x, y)));
-        assert!(!q.covers(&st));
+        assert!(!q.covers(&st, &Default::default()));
         // A master beyond the raw stencil (three nodes from its first): the table keeps its raw
         // reach, the master's pairs three apart are in the map and found.
         let extended = Stencils::<3> {
@@ -490,7 +563,7 @@ mod tests {
         let e = Pattern::build_in(&extended, &[], &[], counts);
         assert_eq!((e.reach, e.len()), (2, 28 * 28));
         assert_eq!(e.far.len(), 2 * 9);
-        assert!(e.covers(&extended));
+        assert!(e.covers(&extended, &Default::default()));
         assert_eq!(e.pairs[e.block(node(0, 1, 2), node(3, 0, 0)).unwrap() as usize], (node(0, 1, 2), node(3, 0, 0)));
     }
 }

@@ -638,8 +638,8 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
     }
 
     /// The kernel terms of the converged step summed per ghosted dof (this rank's particles), as
-    /// a balance at t_{n+1}. `all` holds the residual without the external loads: at a fixed dof
-    /// the terms at t_{n+1} unweighted (so that `all − f_ext` is the reaction at t_{n+1}); at a
+    /// a balance at t_{n+1}. `all` holds the residual without the external loads: at a fixed or
+    /// tied dof the terms at t_{n+1} unweighted (so that `all − f_ext` is the reaction at t_{n+1}); at a
     /// free dof the scheme's weighted residual with its history divided by the weight 1 − α_f of
     /// the forces at t_{n+1} (equal to f_ext,n+1 at convergence). `inertia` holds `all` minus the
     /// internal forces at t_{n+1} (stress, pore pressure, porosity gradient, drag): the inertia
@@ -700,7 +700,7 @@ impl<'a, const D: usize, const M: usize, const N: usize> Points<'a, D, M, N> {
         }
         for (q, ((a, i), f)) in all.iter_mut().zip(inertia.iter_mut()).zip(&forces).enumerate() {
             if weighted {
-                *a = if step.dofs.fixed[q] { unweighted[q] } else { *a / nm.w_force };
+                *a = if step.dofs.held(q) { unweighted[q] } else { *a / nm.w_force };
             }
             *i = *a - f;
         }

@@ -29,7 +29,7 @@ use super::splits::SchurNeeds;
 use super::stencils::{self, Crossing, Stencils, WELL_FILLED_FRACTION};
 use super::step::{StartTerms, Step};
 use super::stiffness::MappedStiffness;
-use super::{aggregates, loads, Error};
+use super::{aggregates, loads, ties, Error};
 use crate::layout::{Dim, Layout};
 use crate::model::{Active, Model};
 use crate::parallel::Collective;
@@ -126,6 +126,13 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         step.matrix_pattern(space, kept, coll)?;
         if pc_matrix.0 == PcMatrix::Multilinear {
+            if !step.dofs.ties.is_empty() {
+                return Err(format!(
+                    "boundary `{}` drives a rigid body, whose tied rows the multilinear preconditioning matrix \
+                     (-porompm_pc_matrix multilinear) does not carry; precondition with the Jacobian itself",
+                    model.boundaries[step.dofs.ties[0].boundary].name
+                ));
+            }
             step.lowered = Some(lowered::prepare(&step, model, space, pc_matrix.1, coll)?);
         }
         Ok(step)
@@ -210,8 +217,11 @@ impl<const D: usize, const M: usize> Step<D, M> {
             drained: Vec::new(),
             boundary_fill: Vec::new(),
             lowered: None,
+            tied_rows: Default::default(),
         };
         loads::check_loads(space, &step, &applied, t_new, coll)?;
+        let mut fext_old = fext_old;
+        ties::add_forces(&step.dofs, &mut step.fext, &mut fext_old);
         if model.linear_increments {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
@@ -256,16 +266,22 @@ impl<const D: usize, const M: usize> Step<D, M> {
         coll: &Collective,
     ) -> Result<(), String> {
         let nd = self.layout.nd;
-        let covers = old.as_ref().is_some_and(|p| !p.is_empty() && p.covers(&self.stencils));
+        let ties = ties::pattern_ties(&self.dofs, space.ghost.len());
+        let covers = old.as_ref().is_some_and(|p| !p.is_empty() && p.covers(&self.stencils, &ties));
         // Whether a matrix exists is the same on every rank: the reduction is collective.
         let keep = old.is_some() && !coll.any(!covers)?;
         let pattern = match old {
             Some(old) if keep => old,
             _ => {
                 let groups: Vec<Vec<u32>> = self.projection.iter().map(|c| c.nodes.clone()).collect();
-                Arc::new(Pattern::build_in(&self.stencils, &space.owned_nodes, &groups, space.ghost.count))
+                let mut p = Pattern::build_in(&self.stencils, &space.owned_nodes, &groups, space.ghost.count);
+                if !ties.pairs.is_empty() {
+                    p.tie(ties);
+                }
+                Arc::new(p)
             }
         };
+        self.tied_rows = ties::TiedRows::of(&self.dofs, &pattern, space.ghost.len())?;
         let projection_blocks: Option<Vec<Vec<u32>>> = self
             .projection
             .iter()
@@ -393,12 +409,13 @@ fn dof_map<const D: usize>(
         space.layout,
     );
     dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
+    ties::resolve(&mut dofs, &space.l2g, |b| model.boundaries[b].name.clone(), coll)?;
     Ok(dofs)
 }
 
-/// The mean filled fraction φ of the nodes of each boundary that prescribes a motion (None for
-/// the others, and for a boundary without nodes): how much material the nodes that carry the
-/// motion reach at the step's start (collective). A boundary on grid nodes stays where the grid
+/// The mean filled fraction φ of the nodes of each boundary that prescribes a motion or ties a
+/// rigid body (None for the others, and for a boundary without nodes): how much material the
+/// nodes that carry the motion reach at the step's start (collective). A boundary on grid nodes stays where the grid
 /// is, while the material it pushes moves on: once the material has moved by about half a cell,
 /// the nodes reach only the points at the edge of their support, and the motion no longer acts on
 /// the material as the boundary means it to (the driver warns).
@@ -413,7 +430,10 @@ fn moving_boundary_fill<const D: usize>(
     let moving: Vec<bool> = model
         .boundaries
         .iter()
-        .map(|b| b.motion.as_ref().is_some_and(|m| m.gradient.is_some() || m.vector.iter().any(|&v| v != 0.0)))
+        .map(|b| {
+            b.force.is_some()
+                || b.motion.as_ref().is_some_and(|m| m.gradient.is_some() || m.vector.iter().any(|&v| v != 0.0))
+        })
         .collect();
     if !moving.contains(&true) {
         // No boundary moves (every rank has the same boundaries): nothing to reduce.
@@ -496,11 +516,13 @@ fn predictors<const D: usize>(
 
 /// A nodal value of a step's start at ghosted dof `q`, the lumped sum `of` over the lumped
 /// `mass` (a velocity or an acceleration): zero where a boundary holds the component still (fixed
-/// without a prescribed motion) or where no point gives the node mass. The Newmark predictors and
+/// without a prescribed motion; a rigid body's tied dofs and an impermeable surface's water are
+/// unknowns, not fixed) or where no point gives the node mass. The Newmark predictors and
 /// an explicit step's FLIP update take their nodal values alike (each from its own lumping).
 pub(super) fn start_value<const D: usize>(model: &Model<D>, dofs: &DofMap, q: usize, mass: &[f64], of: &[f64]) -> f64 {
     let (l, c) = (q / dofs.nd, q % dofs.nd);
-    let still = dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
+    let still =
+        dofs.fixed[q] && dofs.boundary_fixed(l, c) && model.boundaries[dofs.boundary[q] as usize].motion.is_none();
     if still || mass[q] <= 0.0 {
         0.0
     } else {

@@ -81,6 +81,8 @@ pub struct Step<const D: usize = 2, const M: usize = { kernels::MAX_NODES }> {
     /// The mean filled fraction of each moving boundary's nodes at the step's start (None for a
     /// boundary that prescribes no motion).
     pub boundary_fill: Vec<Option<f64>>,
+    /// The Jacobian rows that rigid bodies' ties rewrite ([`super::ties`]).
+    pub(super) tied_rows: super::ties::TiedRows,
 }
 
 /// The multilinear preconditioning matrix's side of a step: each point's cell corners (2^D

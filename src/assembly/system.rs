@@ -313,7 +313,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         self.snes.set_tolerances(Some(atol), None, None, None)?;
         let t0 = Instant::now();
         self.initial_guess(step, model)?;
-        let (mut out, mut nonfinite, mut assembly) = self.newton(step, model)?;
+        let (mut out, mut nonfinite, mut assembly) = self.newton(step, model, coll)?;
         let mut line_search_retry = false;
         if !out.converged
             && super::DIVERGED_BY_FULL_STEPS.contains(&out.reason_text.as_str())
@@ -324,7 +324,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             line_search_retry = true;
             self.initial_guess(step, model)?;
             self.snes.set_line_search(LINE_SEARCH_RETRY)?;
-            let retry = self.newton(step, model);
+            let retry = self.newton(step, model, coll);
             self.snes.set_line_search("basic")?;
             let (second, second_nonfinite, time) = retry?;
             assembly.add(time);
@@ -338,7 +338,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             let icntl14 = self.enlarge_mumps_workspace(before.icntl14)?;
             workspace_retry = Some(format!("{}; factorised again with ICNTL(14) = {icntl14}", before.cause()));
             self.initial_guess(step, model)?;
-            let (second, second_nonfinite, time) = self.newton(step, model)?;
+            let (second, second_nonfinite, time) = self.newton(step, model, coll)?;
             assembly.add(time);
             nonfinite = if second.converged { None } else { nonfinite.or(second_nonfinite) };
             out = SolveOutcome {
@@ -465,6 +465,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         &mut self,
         step: &Step<D, M>,
         model: &Model<D>,
+        coll: &Collective,
     ) -> Result<(SolveOutcome, Option<String>, AssemblyTime), Error> {
         let System { space, x, x_local, f_local, snes, matrix, lowered, schur, stages, .. } = self;
         let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
@@ -474,7 +475,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         };
         let places = (&*places, pc_places);
         let work =
-            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
+            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places, coll };
         let mut callbacks = Callbacks::<D, M, N>::new(model, step, work);
         let out = snes.solve(x, jac, pmat, &mut callbacks)?;
         Ok((out, callbacks.nonfinite.take(), callbacks.time))
@@ -589,14 +590,14 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         &'a mut self,
         step: &'a Step<D, M>,
         model: &'a Model<D>,
-        coll: &Collective,
+        coll: &'a Collective,
     ) -> Result<(&'a mut Vector, &'a mut Mat, Callbacks<'a, D, M, N>), Error> {
         self.matrix_for(step, coll)?;
         let System { space, x, x_local, f_local, matrix, schur, stages, .. } = self;
         let Matrix { mat: jac, places, .. } = matrix.as_mut().ok_or_else(|| Error::new("the step has no matrix"))?;
         let places = (&*places, None);
         let work =
-            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places };
+            Workspace { dm: &space.dm, x_local, f_local, stage: &stages.assembly, schur: schur.as_mut(), places, coll };
         Ok((x, jac, Callbacks::new(model, step, work)))
     }
 }

@@ -249,7 +249,7 @@ where
                 warnings.push(Warning {
                     kind: "boundary_detached".into(),
                     message: format!(
-                        "boundary `{}` prescribes a motion on grid nodes that the material has moved away from: their \
+                        "boundary `{}` moves grid nodes (a prescribed motion or a rigid body) that the material has moved away from: their \
                          mean filled fraction is {f:.3}, {:.0} % of the {start:.3} it was at first; the motion now \
                          reaches the material only through the points at the edge of the nodes' support, and the \
                          reactions past this time are not those of the boundary the case means (move it by less than \

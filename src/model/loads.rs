@@ -462,8 +462,30 @@ pub struct BoundaryDef<const D: usize = 2> {
     pub mesh_nodes: Option<Arc<Vec<[usize; D]>>>,
     /// Components fixed.
     pub fix: Vec<Dof>,
-    /// Their prescribed motion (none: fixed to zero).
+    /// Water components that follow the solid's at its nodes (an impermeable moving surface).
+    pub impermeable: Vec<Dof>,
+    /// Their prescribed motion (none: fixed to zero, or tied to a rigid body under `force`).
     pub motion: Option<Motion<D>>,
+    /// The load of a rigid body: the fixed displacement components (and the water's) of its nodes
+    /// move together, by one unknown per direction that this force drives.
+    pub force: Option<RigidForce<D>>,
+}
+
+/// The load driving a rigid body ([`BoundaryDef::force`]), in `D` dimensions.
+#[derive(Debug, Clone)]
+pub struct RigidForce<const D: usize = 2> {
+    /// The force at time-function value 1 [N per metre, on the full ring, or N].
+    pub vector: [f64; D],
+    /// The time function.
+    pub time_fn: TimeFn,
+}
+
+impl<const D: usize> RigidForce<D> {
+    /// The force at time `t`.
+    pub fn at(&self, t: f64) -> [f64; D] {
+        let f = self.time_fn.eval(t);
+        self.vector.map(|v| v * f)
+    }
 }
 
 /// The grid nodes on a boundary's mesh curves or faces ([`case::MeshBoundary`]): those within
@@ -492,6 +514,12 @@ impl BoundaryDef {
 }
 
 impl<const D: usize> BoundaryDef<D> {
+    /// The components it holds at its nodes: those it fixes and the water's it makes follow the
+    /// solid's.
+    pub fn held(&self) -> impl Iterator<Item = Dof> + '_ {
+        self.fix.iter().chain(&self.impermeable).copied()
+    }
+
     /// The axis of an axisymmetric model: u_r = 0 and U_r = 0 on the grid side r = 0 (named
     /// [`super::AXIS`]; it is not a case boundary and holds in every stage).
     pub fn axis() -> BoundaryDef<D> {
@@ -503,7 +531,9 @@ impl<const D: usize> BoundaryDef<D> {
             surface_span: None,
             mesh_nodes: None,
             fix: vec![Dof::Ux, Dof::WUx],
+            impermeable: Vec::new(),
             motion: None,
+            force: None,
         }
     }
 
@@ -564,7 +594,9 @@ impl<const D: usize> BoundaryDef<D> {
             surface_span: b.surface.as_ref().and_then(|sf| sf.region),
             mesh_nodes: b.mesh.as_ref().map(|m| Arc::new(mesh_nodes(&super::grid_of(c), m))),
             fix: b.fix.clone(),
+            impermeable: b.impermeable.clone(),
             motion,
+            force: b.force.as_ref().map(|f| RigidForce { vector: vector(f), time_fn: time_fn() }),
         }
     }
 

@@ -245,7 +245,7 @@ impl<const D: usize> Model<D> {
             let b = &self.boundaries[bi];
             let Some(list) = &b.surface else { continue };
             let mut comps = [false; SURFACE_COMPONENTS];
-            for c in b.fix.iter().filter_map(|d| dof_index_in::<D>(*d)) {
+            for c in b.held().filter_map(dof_index_in::<D>) {
                 comps[c] = true;
             }
             comps[p] &= !weak_drainage;
@@ -369,7 +369,7 @@ impl<const D: usize> Model<D> {
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
             if b.surface.is_none() && b.holds_node(&self.grid, n) {
-                for c in b.fix.iter().filter_map(|d| dof_index_in::<D>(*d)) {
+                for c in b.held().filter_map(dof_index_in::<D>) {
                     by[c] = by[c].or(Some(bi));
                 }
             }

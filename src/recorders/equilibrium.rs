@@ -1,6 +1,8 @@
 //! The equilibrium identity of every converged step and the boundaries' reactions
-//! (`equilibrium_error`, `<boundary>.reaction_*` and, for a boundary with prescribed motion,
-//! `<boundary>.displacement_*` in `history.csv`; the worst error in `summary.json`).
+//! (`equilibrium_error`, `<boundary>.reaction_*` and, for a boundary with prescribed motion or a
+//! rigid body under a force, `<boundary>.displacement_*` in `history.csv`; the worst error in
+//! `summary.json`). A rigid body's displacement is the sum of its steps' motions, kept in
+//! checkpoints.
 //!
 //! The identity: the volume integral of the total Cauchy stress over the updated material points,
 //! ∫σ dV = Σ_p (σ' − p m) V_p, against the first moment of the external forces, the reactions and
@@ -14,7 +16,7 @@
 //! before their update, and the identity holds at t_n on x_n with the lumped inertia of the nodal
 //! update.
 
-use super::{Converged, Moment, Recorder, Sink};
+use super::{Converged, FromCheckpoint, Moment, Recorder, Restored, Sink};
 use crate::assembly::StepForces;
 use crate::model::Model;
 
@@ -30,6 +32,8 @@ pub struct Equilibrium<const D: usize> {
     /// The last accepted step's error and reactions.
     error: f64,
     reactions: Vec<[f64; D]>,
+    /// Each rigid body's displacement so far (per boundary; zero for the others) [m].
+    rigid: Vec<[f64; D]>,
 }
 
 impl<const D: usize> Equilibrium<D> {
@@ -37,10 +41,16 @@ impl<const D: usize> Equilibrium<D> {
     pub fn new(model: &Model<D>) -> Equilibrium<D> {
         Equilibrium {
             names: model.boundaries.iter().map(|b| b.name.clone()).collect(),
-            moving: model.boundaries.iter().filter(|b| b.motion.is_some()).map(|b| b.name.clone()).collect(),
+            moving: model
+                .boundaries
+                .iter()
+                .filter(|b| b.motion.is_some() || b.force.is_some())
+                .map(|b| b.name.clone())
+                .collect(),
             last: None,
             error: 0.0,
             reactions: vec![[0.0; D]; model.boundaries.len()],
+            rigid: vec![[0.0; D]; model.boundaries.len()],
         }
     }
 }
@@ -103,6 +113,9 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
             let scale = norm(&lhs).max(forces.scale);
             self.error = if scale > 0.0 { norm(&diff) / scale } else { 0.0 };
             self.reactions = forces.reactions;
+            for (total, step) in self.rigid.iter_mut().zip(&forces.rigid_motion) {
+                total.iter_mut().zip(step).for_each(|(t, s)| *t += s);
+            }
             let error = self.error;
             let worst =
                 sink.summary.equilibrium_error.map_or(error, |w| if error.is_nan() { error } else { w.max(error) });
@@ -115,9 +128,33 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
         for r in &self.reactions {
             values.extend(r);
         }
-        for m in at.model.boundaries.iter().filter_map(|b| b.motion.as_ref()) {
-            values.extend(m.displacement_at(at.t));
+        for (b, rigid) in at.model.boundaries.iter().zip(&self.rigid) {
+            match (&b.motion, &b.force) {
+                (Some(m), _) => values.extend(m.displacement_at(at.t)),
+                (None, Some(_)) => values.extend(rigid),
+                (None, None) => {}
+            }
         }
         Ok(values)
+    }
+
+    fn state(&self, at: &Moment<D>) -> Result<Option<Vec<f64>>, String> {
+        let rigid = at.model.boundaries.iter().any(|b| b.force.is_some());
+        Ok(rigid.then(|| self.rigid.iter().flatten().copied().collect()))
+    }
+
+    fn restore(&mut self, FromCheckpoint { state, .. }: FromCheckpoint<D>) -> Restored {
+        let Some(state) = state else { return Ok(None) };
+        if state.len() != self.rigid.len() * D {
+            return Err(format!(
+                "it holds {} rigid-body displacement components, this case has {}",
+                state.len(),
+                self.rigid.len() * D
+            ));
+        }
+        for (r, s) in self.rigid.iter_mut().zip(state.chunks_exact(D)) {
+            r.copy_from_slice(s);
+        }
+        Ok(None)
     }
 }

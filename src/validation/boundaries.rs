@@ -112,10 +112,11 @@ fn motion(key: &str, b: &Boundary, dim: usize) -> Checked {
     if let Some(cn) = b.center.as_ref().filter(|cn| cn.len() != dim || cn.iter().any(|v| !v.is_finite())) {
         return Err(format!("key `{key}.center`: {dim} finite coordinates in a case of {dim} dimensions, got {cn:?}"));
     }
-    let (field, vector) = match (&b.displacement, &b.velocity) {
-        (Some(d), _) => ("displacement", d),
-        (None, Some(v)) => ("velocity", v),
-        (None, None) => return Ok(()),
+    let (field, vector) = match (&b.displacement, &b.velocity, &b.force) {
+        (Some(d), _, _) => ("displacement", d),
+        (None, Some(v), _) => ("velocity", v),
+        (None, None, Some(f)) => ("force", f),
+        (None, None, None) => return Ok(()),
     };
     if vector.len() != dim {
         return Err(format!(
@@ -129,6 +130,15 @@ fn motion(key: &str, b: &Boundary, dim: usize) -> Checked {
     for (c, dof) in moved.into_iter().enumerate().take(dim) {
         if vector[c] != 0.0 && !b.fix.contains(&dof) {
             return Err(format!("key `{key}.{field}`: component {c} moves `{dof}`, which `fix` does not list"));
+        }
+    }
+    if b.force.is_some() {
+        // The water moves with a rigid body where it is tied: its component needs the solid's.
+        let water = [(Dof::WUx, Dof::Ux), (Dof::WUy, Dof::Uy), (Dof::WUz, Dof::Uz)];
+        if let Some((w, u)) = water.into_iter().find(|(w, u)| b.fix.contains(w) && !b.fix.contains(u)) {
+            return Err(format!(
+                "key `{key}.fix`: a rigid body's water component `{w}` moves with its solid one; list `{u}` too"
+            ));
         }
     }
     Ok(())

@@ -40,6 +40,23 @@ fn analysis_type(c: &Case, s: &Stage, pore_water: bool) -> Checked {
     if s.analysis != AnalysisType::DynamicExplicit {
         return Ok(());
     }
+    let active = |name: &str| s.boundaries.as_ref().is_none_or(|list| list.iter().any(|n| n == name));
+    if let Some(b) = c.boundaries.iter().find(|b| b.force.is_some() && active(&b.name)) {
+        return Err(format!(
+            "key `boundaries` (`{}`): stage `{}` is explicit, and a rigid body under a `force` has its motion as an \
+             unknown of an implicit step's Newton solve; run the stage implicitly (`dynamic`, `static`, \
+             `quasi_static`) or leave the boundary out of the stage's `boundaries`",
+            b.name, s.name
+        ));
+    }
+    if let Some(b) = c.boundaries.iter().find(|b| !b.impermeable.is_empty() && active(&b.name)) {
+        return Err(format!(
+            "key `boundaries` (`{}`): stage `{}` is explicit, and an impermeable surface's water follows the solid \
+             through the rows of an implicit step's Newton solve; run the stage implicitly or leave the boundary \
+             out of the stage's `boundaries`",
+            b.name, s.name
+        ));
+    }
     let e = s.explicit.unwrap_or_default();
     if pore_water {
         explicit_with_pore_water(c, s, &e)

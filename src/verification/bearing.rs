@@ -6,8 +6,9 @@
 //!   a footing body ([000] §4.1.2: a footing of increasing unit weight), the weight of that body's
 //!   material points over the loaded width, Σ m_p |b_y| f(t) / w (the contact force at rest), or,
 //!   for a rigid footing pushed in under displacement control (a boundary moving its nodes,
-//!   [002] §4.2), the boundary's downward reaction on the soil over the loaded width, −R_y / w
-//!   (over the loaded area w × `loaded_depth` in three dimensions);
+//!   [002] §4.2) or driven by a force (a boundary under a `force`, its nodes tied), the boundary's
+//!   downward reaction on the soil over the loaded width, −R_y / w (over the loaded area w ×
+//!   `loaded_depth` in three dimensions);
 //! * d is the downward displacement of the material point nearest to `settlement_point` at t = 0,
 //!   counted from the last observation before the load starts (q = 0), so that a gravity stage
 //!   before the loading does not count as settlement.
@@ -41,9 +42,10 @@ pub struct BearingCapacity {
     /// The name of the load: a traction (its pressure), or a body force on the footing body (its
     /// weight over `loaded_width`; the body force must name its bodies). Give `load` or `footing`.
     pub load: Option<String>,
-    /// The name of a rigid footing pushed into the soil under displacement control: a boundary
-    /// that fixes `uy` and moves it vertically (`velocity` or `displacement`); the pressure is its
-    /// vertical reaction on the soil over `loaded_width` ([002] §4.2). Give `load` or `footing`.
+    /// The name of a rigid footing: a boundary that fixes `uy` and pushes it into the soil under
+    /// displacement control (a vertical `velocity` or `displacement`, [002] §4.2) or drives it by a
+    /// vertical `force`; the pressure is its vertical reaction on the soil over `loaded_width`.
+    /// Give `load` or `footing`.
     pub footing: Option<String>,
     /// Width carrying the load in the model [m], > 0 (the half-width in a half model).
     pub loaded_width: f64,
@@ -221,14 +223,15 @@ fn loading_refused(key: &str) -> String {
     format!("key `{key}`: a bearing_capacity check takes either `load` (load control) or `footing` (a moving boundary)")
 }
 
-/// A footing's boundary: it fixes `uy` and moves it vertically, so that its reaction is the load.
+/// A footing's boundary: it fixes `uy` and moves it vertically or drives it by a vertical force, so
+/// that its reaction is the load.
 fn footing_boundary(c: &Case, f: BoundaryId) -> Checked {
     let b = c.boundary(f);
     let vertical = |v: &Option<Vec<f64>>| v.as_ref().is_some_and(|v| v.get(1).is_some_and(|&y| y != 0.0));
-    if !b.fix.contains(&Dof::Uy) || !(vertical(&b.velocity) || vertical(&b.displacement)) {
+    if !b.fix.contains(&Dof::Uy) || !(vertical(&b.velocity) || vertical(&b.displacement) || vertical(&b.force)) {
         return Err(format!(
             "key `verification.footing`: the boundary `{}` must fix `uy` and move it vertically (`velocity` or \
-             `displacement`): its reaction is the footing's load",
+             `displacement`) or drive it by a vertical `force` (a rigid footing): its reaction is the footing's load",
             b.name
         ));
     }

@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 /// Dirichlet conditions on the grid nodes of a side, of a box or of a body's moving surface: the
 /// listed components are fixed, to zero (drained p = 0, a fixed or sliding wall), or moving with a
 /// prescribed displacement or velocity (a loading platen, a displacement-driven rigid footing: all
-/// its nodes move together, and the boundary's reaction is the force that drives it).
+/// its nodes move together, and the boundary's reaction is the force that drives it), or tied to
+/// one unknown displacement per direction that a prescribed `force` drives (a rigid plate or
+/// footing under a load).
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Boundary {
@@ -27,10 +29,18 @@ pub struct Boundary {
     /// particles, found again every step (a drained free surface: `fix = ["p"]`; in the
     /// quasi-static u–p system p = 0 is imposed on the faces themselves, by Nitsche's method).
     pub surface: Option<Surface>,
-    /// Components fixed, at least one: `ux`, `uy`, `uz`, `Ux`, `Uy`, `Uz` and `p` (drained). In a
-    /// one_phase analysis the water-phase components have no dofs and are ignored. Fixed to zero
-    /// unless `displacement` or `velocity` moves them.
+    /// Components fixed: `ux`, `uy`, `uz`, `Ux`, `Uy`, `Uz` and `p` (drained), at least one unless
+    /// `impermeable` lists some. In a one_phase analysis the water-phase components have no dofs
+    /// and are ignored. Fixed to zero unless `displacement` or `velocity` moves them.
+    #[serde(default)]
     pub fix: Vec<Dof>,
+    /// Water components (`Ux`, `Uy`, `Uz`) that follow the solid's at the boundary's nodes, U_d =
+    /// u_d, with the solid free: a surface that moves with the material and lets no water across
+    /// it in those directions (U·n = u·n on a face normal to d). Used by the u–p–U system (a u–p
+    /// system's surfaces are impermeable unless drained; a one_phase analysis has no water); not a
+    /// component `fix` lists.
+    #[serde(default)]
+    pub impermeable: Vec<Dof>,
     /// Prescribed displacement [m] of the fixed displacement components: at time t the nodes have
     /// moved by `displacement` × f(t) (f the time function; constant 1 without one). Fixed water
     /// components move with the solid (the boundary is impermeable to flow across it).
@@ -50,8 +60,16 @@ pub struct Boundary {
     /// Centre c of the `velocity_gradient`'s flow [m] (default: the origin); one coordinate per
     /// dimension.
     pub center: Option<Vec<f64>>,
-    /// The name of the time function scaling `displacement`, `velocity` or `velocity_gradient`
-    /// (default: a constant 1).
+    /// A rigid body's load [N per metre of thickness in plane strain, N on the full ring in
+    /// axial symmetry, N in three dimensions], scaled by the time function: the nodes' listed
+    /// displacement components move together by one unknown per direction (a rigid plate or
+    /// footing in translation; listed water components move with them, so the body is impermeable),
+    /// and the boundary's reaction on the material is this force. One component per dimension;
+    /// each non-zero one along a direction `fix` lists; not with `displacement`, `velocity` or
+    /// `velocity_gradient`; implicit stages only.
+    pub force: Option<Vec<f64>>,
+    /// The name of the time function scaling `displacement`, `velocity`, `velocity_gradient` or
+    /// `force` (default: a constant 1).
     pub time_function: Option<String>,
 }
 
@@ -167,8 +185,19 @@ impl Boundary {
         if self.surface.as_ref().is_some_and(|sf| sf.faces.is_empty()) {
             return Err(format!("key `{key}.surface.faces`: list at least one face"));
         }
-        if self.fix.is_empty() {
-            return Err(format!("key `{}`: list at least one component", at(key, "fix")));
+        if self.fix.is_empty() && self.impermeable.is_empty() {
+            return Err(format!("key `{}`: list at least one component (or an `impermeable` one)", at(key, "fix")));
+        }
+        if let Some(d) = self.impermeable.iter().find(|d| !matches!(d, Dof::WUx | Dof::WUy | Dof::WUz)) {
+            return Err(format!(
+                "key `{key}.impermeable`: lists water components (`Ux`, `Uy`, `Uz`), which follow the solid's; got `{d}`"
+            ));
+        }
+        if let Some(d) = self.impermeable.iter().find(|d| self.fix.contains(d)) {
+            return Err(format!(
+                "key `{key}.impermeable`: `{d}` is also in `fix`; a fixed water component is held (or moves with a \
+                 prescribed motion), an impermeable one follows the free solid"
+            ));
         }
         if self.displacement.is_some() && self.velocity.is_some() {
             return Err(format!("key `{key}`: give `displacement` or `velocity`, not both"));
@@ -184,8 +213,16 @@ impl Boundary {
         if self.center.is_some() && self.velocity_gradient.is_none() {
             return Err(format!("key `{key}.center`: is the centre of a `velocity_gradient`, not given"));
         }
-        if self.time_function.is_some() && !self.moves() {
-            return Err(format!("key `{key}.time_function`: only a `displacement` or `velocity` has a time function"));
+        if self.force.is_some() && self.moves() {
+            return Err(format!(
+                "key `{key}.force`: drives a rigid body whose motion is unknown; not with a prescribed \
+                 `displacement`, `velocity` or `velocity_gradient`"
+            ));
+        }
+        if self.time_function.is_some() && !self.moves() && self.force.is_none() {
+            return Err(format!(
+                "key `{key}.time_function`: only a `displacement`, `velocity` or `force` has a time function"
+            ));
         }
         Ok(())
     }
