@@ -132,7 +132,8 @@ fn a_dynamic_rigid_plate_keeps_its_energy_balance() {
 }
 
 /// What a rigid body cannot be: driven in an explicit stage, given a force and a prescribed motion,
-/// tying the water without the solid, or preconditioned by the multilinear matrix; and what an
+/// tying the water without the solid, holding a component another boundary holds at one of its
+/// nodes, tying no solid component, or preconditioned by the multilinear matrix; and what an
 /// impermeable surface cannot list: a solid component, a component it also fixes; nor can it be
 /// in an explicit stage.
 #[test]
@@ -158,7 +159,7 @@ fn what_a_rigid_body_cannot_be_is_refused() {
             "materials[0].water_bulk_modulus=2.2e9",
             "materials[0].hydraulic_conductivity=1e-3",
             "materials[0].solid_bulk_modulus=inf",
-            &format!("{plate}.fix=[\"Uy\"]"),
+            &format!("{plate}.fix=[\"ux\", \"Uy\"]"),
             &format!("{plate}.force=[0.0, 0.0]"),
         ],
         "a rigid body's water component `Uy` moves with its solid one; list `uy` too",
@@ -188,6 +189,17 @@ fn what_a_rigid_body_cannot_be_is_refused() {
         &out_dir("impermeable-explicit"),
         &[&top("impermeable=[\"Uy\"]"), "stages.0={name=\"c\",duration=0.1,analysis=\"dynamic_explicit\"}"],
         "an impermeable surface's water follows the solid through the rows of an implicit step",
+    );
+    // Found when the step's dofs are laid out (a run that stops at its first step, exit 1).
+    let r = run_case(PLATE, &out_dir("shared-component"), &set_args(&[&format!("{plate}.fix=[\"ux\", \"uy\"]")]));
+    assert_eq!(r.output.status.code(), Some(1), "{}", r.stderr());
+    let both = "boundary `plate` (a rigid body under a force) and boundary `sides` both hold `ux`";
+    assert!(r.stderr().contains(both), "{}", r.stderr());
+    assert_refused(
+        PLATE,
+        &out_dir("no-solid-component"),
+        &[&format!("{plate}.fix=[\"p\"]"), &format!("{plate}.force=[0.0, 0.0]")],
+        "a rigid body under a `force` moves by the displacement components it lists",
     );
     let r = run_case(PLATE, &out_dir("multilinear"), &["--".into(), "-porompm_pc_matrix".into(), "multilinear".into()]);
     assert!(!r.completed());
@@ -319,9 +331,39 @@ fn an_impermeable_top_moves_with_the_column_and_lets_no_water_out() {
     assert!(sealed.completed(), "{}", sealed.stderr());
     let error = common::metric(&sealed.summary, "settlement_rel_error_Tv0.5");
     assert!(error < 1e-3, "settlement error {error} at T_v = 0.5");
+    // The surface's forces on the two phases cancel (it only ties their motion), so it carries no
+    // net reaction (beyond the generalized-α weighting of the load's first jolt: 0.1 % of the
+    // 100 N/m load in the first steps, under 1e-4 of it from step 50), and the equilibrium identity
+    // holds; booked on the water alone, the reaction was the water's share of the load.
+    let (reaction, equilibrium) = (sealed.column("drained_top.reaction_y"), sealed.column("equilibrium_error"));
+    assert!(reaction[50..].iter().all(|r| r.abs() < 1e-2), "the sealed top's reaction: {:?}", &reaction[..60]);
+    assert!(equilibrium[50..].iter().all(|&e| e < 1e-8), "equilibrium error {:?}", &equilibrium[..60]);
     let open = [mirrored[0], "boundaries.drained_top={name=\"drained_top\",side=\"y_max\",fix=[\"ux\"]}"];
     let free = run_case(case, &out_dir("free-top"), &set_args(&open));
     assert!(free.completed(), "{}", free.stderr());
     let error = common::metric(&free.summary, "settlement_rel_error_Tv0.5");
     assert!(error > 0.1, "a top that drains settles faster: error {error}");
+}
+
+/// Two rigid bodies sharing nodes (tests/cases/rigid_strip_two_bodies.toml: the footing ties uy
+/// over x ∈ [1, 3] m, a pusher ties ux over x ∈ [2, 3.5] m): nodes with one master per direction
+/// on different nodes, the pusher's master itself tied to the footing's. Each body's reaction is
+/// its force, one and two ranks agree, and the tangent passes the finite-difference check.
+#[test]
+fn two_rigid_bodies_sharing_nodes_keep_their_own_balances() {
+    let case = "tests/cases/rigid_strip_two_bodies.toml";
+    let one = run_case_on(1, case, &out_dir("two-bodies-1"), &[]);
+    let two = run_case_on(2, case, &out_dir("two-bodies-2"), &[]);
+    assert!(one.completed() && two.completed(), "{}\n{}", one.stderr(), two.stderr());
+    for r in [&one, &two] {
+        let (t, fy, fx) = (r.column("time"), r.column("footing.reaction_y"), r.column("pusher.reaction_x"));
+        for k in 1..t.len() {
+            assert!((fy[k] + 2.0e4 * t[k]).abs() < 1e-9 * 2.0e4, "footing {}", fy[k]);
+            assert!((fx[k] - 500.0 * t[k]).abs() < 1e-9 * 2.0e4, "pusher {}", fx[k]);
+        }
+    }
+    let (a, b) = (one.column("pusher.displacement_x"), two.column("pusher.displacement_x"));
+    assert!(a.last().unwrap() > &0.0, "the pusher moves along its force: {a:?}");
+    assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= 1e-12 * a.last().unwrap()), "{a:?} vs {b:?}");
+    assert_tangent_checked(&[case, "--steps", "2"], 4, "ux,uy");
 }

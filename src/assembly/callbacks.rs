@@ -206,7 +206,7 @@ impl<const D: usize, const M: usize, const N: usize> NonlinearProblem for Callba
                 }
             }
             // Rigid bodies: tied rows moved into their masters', before the pressures' scaling.
-            step.tied_rows.apply(values, &step.pattern, nd);
+            step.tied_rows.apply(values, nd);
             if let Some(p) = layout.p {
                 for (cell, blocks) in step.projection.iter().zip(&step.projection_blocks) {
                     let c = cell.nodes.len();

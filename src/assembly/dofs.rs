@@ -71,6 +71,9 @@ pub struct DofMap {
     /// Offsets of the owned following dofs in the owned part of global vectors, with the offset
     /// of the solid dof each follows and its ghosted index.
     pub owned_follows: Vec<(usize, usize, usize)>,
+    /// Why the ties cannot be made: a node that a rigid body and another boundary both hold in a
+    /// component.
+    pub conflict: Option<String>,
 }
 
 impl DofMap {
@@ -90,12 +93,10 @@ impl DofMap {
     }
 
     /// Whether ghosted dof `q` is held by a boundary or barely filled (fixed), tied to a rigid
-    /// body or follows the solid on an impermeable surface: its residual entry is a reaction
-    /// rather than an equation of its own.
+    /// body, or one of an impermeable surface's pairs (the water and the solid it follows): its
+    /// residual entry is a reaction rather than an equation of its own (a pair's two sum to zero).
     pub fn held(&self, q: usize) -> bool {
-        self.fixed[q]
-            || self.tie.get(q).is_some_and(|&t| t != NO_TIE)
-            || self.follows.binary_search_by_key(&(q as u32), |f| f.0).is_ok()
+        self.fixed[q] || self.boundary[q] != NO_BOUNDARY
     }
 
     /// Whether a node's motion component `c` is fixed by a boundary (not merely by being barely
@@ -153,9 +154,13 @@ pub fn build<const D: usize>(
         owned_tied: Vec::new(),
         follows: Vec::new(),
         owned_follows: Vec::new(),
+        conflict: None,
     };
     for (l, reached) in phi.iter().enumerate() {
         let node = ghost.indices(l);
+        if let Some((rigid, other, k)) = (!m.ties.is_empty()).then(|| model.rigid_conflict(active, node)).flatten() {
+            m.conflict.get_or_insert_with(|| conflict(model, (rigid, other, k), node));
+        }
         let by = model.fixing_boundaries(active, node);
         for c in 0..nd {
             let (q, by_c) = (l * nd + c, layout.canonical(c).and_then(|k| by[k]));
@@ -180,6 +185,11 @@ pub fn build<const D: usize>(
                     let solid = l * nd + dir.expect("a followed component is the water's");
                     if !m.fixed[solid] {
                         m.follows.push((q as u32, solid as u32));
+                        // The pair's two entries are the surface's forces on each phase (their sum is
+                        // zero): both booked to it.
+                        if m.boundary[solid] == NO_BOUNDARY {
+                            m.boundary[solid] = b as u16;
+                        }
                     } else if m.boundary[solid] != NO_BOUNDARY {
                         (m.fixed[q], m.value[q]) = (true, m.value[solid]);
                     } else {
@@ -215,6 +225,23 @@ pub fn build<const D: usize>(
         crate::model::shape::next_combination(&mut at, owned_count);
     }
     m
+}
+
+/// The message of a node that rigid body `rigid` and boundary `other` both hold in the component of
+/// canonical index `k`.
+fn conflict<const D: usize>(model: &Model<D>, (rigid, other, k): (usize, usize, usize), node: [usize; D]) -> String {
+    use crate::case::Dof;
+    let all = [Dof::Ux, Dof::Uy, Dof::Uz, Dof::P, Dof::WUx, Dof::WUy, Dof::WUz];
+    let name =
+        all.into_iter().find(|&d| crate::model::dof_index_in::<D>(d) == Some(k)).map_or("?".into(), |d| d.to_string());
+    format!(
+        "boundary `{}` (a rigid body under a force) and boundary `{}` both hold `{name}` at the grid node at {} m: a \
+         rigid body's nodes are held by it alone in its components (for a rough footing in a half model, fix `ux` \
+         on the footing's nodes in a boundary of its own and let the force tie `uy` alone)",
+        model.boundaries[rigid].name,
+        model.boundaries[other].name,
+        crate::model::position_text(&model.grid.position(node))
+    )
 }
 
 /// Whether boundary `b` makes the water component of canonical index `k` follow the solid's.

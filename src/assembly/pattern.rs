@@ -148,21 +148,32 @@ impl<const D: usize> Pattern<D> {
     }
 
     /// Adds the rigid bodies' pairs ([`super::ties`]): for each (tied node s, master m) of `ties`,
-    /// (m, b) for every block (s, b) of the pattern, (s, m) and (m, m), so that a tied row can be
-    /// moved into its master's and hold its constraint.
+    /// (s, m), then (m, b) for every block (s, b) of the row so completed (its own masters' columns
+    /// included, (m, m) among them, and repeated while rows grow), so that a tied row can be moved
+    /// into each of its masters' and hold its constraint.
     pub fn tie(&mut self, ties: PatternTies) {
-        let mut add = Vec::new();
-        for &(s, m) in &ties.pairs {
-            add.extend(self.pairs[self.row_start(s)..self.row_start(s + 1)].iter().map(|&(_, b)| (m, b)));
-            // The tied row's own block in the master's column moves into (m, m).
-            add.extend([(s, m), (m, m)]);
-        }
-        for (a, b) in add {
-            self.insert(a, b);
-        }
         let nodes = self.ghosted() + ties.extra.len();
-        self.ties = ties;
+        for &(s, m) in &ties.pairs {
+            self.insert(s, m);
+        }
         self.sort(nodes);
+        // Until no pair is new: a master's row grows by its slaves' blocks, and a master that is
+        // itself tied in another direction moves that grown row on.
+        loop {
+            let before = self.pairs.len();
+            let mut add = Vec::new();
+            for &(s, m) in &ties.pairs {
+                add.extend(self.pairs[self.row_start(s)..self.row_start(s + 1)].iter().map(|&(_, b)| (m, b)));
+            }
+            for (a, b) in add {
+                self.insert(a, b);
+            }
+            self.sort(nodes);
+            if self.pairs.len() == before {
+                break;
+            }
+        }
+        self.ties = ties;
     }
 
     /// The grid indices of ghosted node `a` (x fastest).

@@ -126,13 +126,17 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         step.matrix_pattern(space, kept, coll)?;
         if pc_matrix.0 == PcMatrix::Multilinear {
-            if !step.dofs.ties.is_empty() {
-                return Err(format!(
-                    "boundary `{}` drives a rigid body, whose tied rows the multilinear preconditioning matrix \
-                     (-porompm_pc_matrix multilinear) does not carry; precondition with the Jacobian itself",
-                    model.boundaries[step.dofs.ties[0].boundary].name
-                ));
-            }
+            let tied = step.dofs.ties.first().map(|t| t.boundary);
+            let followed = step.dofs.follows.first().map(|&(q, _)| step.dofs.boundary[q as usize] as usize);
+            // The rank that finds one tells every rank (its impermeable nodes may be on it alone).
+            coll.agree(tied.or(followed).map_or(Ok(()), |b| {
+                Err(format!(
+                    "boundary `{}` ties rows (a rigid body or an impermeable surface) that the multilinear \
+                     preconditioning matrix (-porompm_pc_matrix multilinear) does not carry; precondition with the \
+                     Jacobian itself",
+                    model.boundaries[b].name
+                ))
+            }))?;
             step.lowered = Some(lowered::prepare(&step, model, space, pc_matrix.1, coll)?);
         }
         Ok(step)
@@ -275,13 +279,15 @@ impl<const D: usize, const M: usize> Step<D, M> {
             _ => {
                 let groups: Vec<Vec<u32>> = self.projection.iter().map(|c| c.nodes.clone()).collect();
                 let mut p = Pattern::build_in(&self.stencils, &space.owned_nodes, &groups, space.ghost.count);
-                if !ties.pairs.is_empty() {
+                // Also on a rank without tied nodes (its virtual masters are in `ties`), so that
+                // every rank finds the same ties in the pattern it keeps.
+                if ties != Default::default() {
                     p.tie(ties);
                 }
                 Arc::new(p)
             }
         };
-        self.tied_rows = ties::TiedRows::of(&self.dofs, &pattern, space.ghost.len())?;
+        self.tied_rows = coll.agree(ties::TiedRows::of(&self.dofs, &pattern, space.ghost.len()))?;
         let projection_blocks: Option<Vec<Vec<u32>>> = self
             .projection
             .iter()
@@ -409,6 +415,7 @@ fn dof_map<const D: usize>(
         space.layout,
     );
     dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
+    coll.agree(dofs.conflict.take().map_or(Ok(()), Err))?;
     ties::resolve(&mut dofs, &space.l2g, |b| model.boundaries[b].name.clone(), coll)?;
     Ok(dofs)
 }

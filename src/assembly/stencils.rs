@@ -505,7 +505,7 @@ fn beyond_the_grid<const D: usize, const M: usize>(
 /// The grid's edge. A support that reaches past a side of the grid loses the part of its basis
 /// beyond it (the partition of unity, and with it part of the particle's internal force and load).
 /// Where the particle's nodes on that side are held in the side's normal direction by a boundary
-/// (a wall: rollers, a fixed base), the material beyond is the rigid wall, which carries that part
+/// (a wall: rollers, a fixed base; not a rigid body's tied nodes, which move), the material beyond is the rigid wall, which carries that part
 /// as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must
 /// stop, naming the particle, its body, the time and the side. (Linear MPM and B-splines: a centre
 /// outside the grid always stops the run.)
@@ -527,7 +527,9 @@ pub fn check_edges<const D: usize>(
         let on_side = |l: u32| ghost.indices(l as usize)[normal] == edge;
         let wall = model.basis == Basis::Gimp && {
             let side_nodes: Vec<u32> = nodes.iter().copied().filter(|&l| on_side(l)).collect();
-            !side_nodes.is_empty() && side_nodes.iter().all(|&l| dofs.boundary_fixed(l as usize, normal))
+            // Held still or moved by a boundary: a rigid body's tied nodes are unknowns, not a wall.
+            let held = |l: u32| dofs.boundary_fixed(l as usize, normal) && dofs.fixed[l as usize * dofs.nd + normal];
+            !side_nodes.is_empty() && side_nodes.iter().all(|&l| held(l))
         };
         if !wall {
             let body = body_names.get(ps.body[c.k] as usize).map_or("?", |s| s.as_str());

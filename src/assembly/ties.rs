@@ -1,15 +1,15 @@
 //! Rigid bodies under a force: the dofs of a body's nodes tied to one master dof per direction.
 //!
-//! A boundary with a `force` ties the displacement components it fixes (and the water's, which
-//! then moves with the body: it is impermeable) to one unknown per direction, the master: the
+//! A boundary with a `force` ties the displacement components it lists (and the water's it lists,
+//! which then move with the body: impermeable there) to one unknown per direction, the master: the
 //! solid dof in that direction of the tied node with the smallest global number, the same on every
 //! rank. The global vector keeps its layout (one block of dofs per node): every tied dof stays an
 //! unknown, and the equations are rewritten by rows, the master-slave elimination written without
 //! renumbering:
 //! * the master's row is the body's balance: the sum over all tied dofs of the direction, on every
 //!   rank, of their residual rows (internal, inertia and external forces), minus the body's force
-//!   (which [`super::loads`] puts at the master as an external load, so that schemes with a
-//!   history of t_n weigh it as every other load);
+//!   (which [`add_forces`] puts at the master as an external load, so that schemes with a history
+//!   of t_n weigh it as every other load);
 //! * each other tied dof's row is x_s − x_m = 0 (unit diagonal, −1 in the master's column).
 //!
 //! An impermeable moving surface (a boundary's `impermeable` water components) is the same
@@ -100,34 +100,44 @@ pub(super) fn pattern_ties(dofs: &DofMap, ghosted: usize) -> PatternTies {
     PatternTies { pairs, extra, masters }
 }
 
-/// The rows of a Jacobian that a step's ties rewrite: each non-master tied ghosted dof's row moved
-/// into its master's (block by block), and each owned one's constraint entries.
+/// The rows of a Jacobian that a step's ties rewrite: each moved row's blocks with their targets,
+/// and each owned tied dof's constraint entries.
 #[derive(Debug, Clone, Default)]
 pub(super) struct TiedRows {
-    /// (ghosted tied dof, master node's index in the pattern, master component), masters left out.
-    pub moved: Vec<(u32, u32, u8)>,
-    /// (block (s, s), block (s, m), component, master component) of every owned non-master tied
-    /// dof: its row is x_s − x_m.
+    /// (block (s, b), target block, component, target component) of every block of every moved
+    /// row, in order: an impermeable surface's water rows into their own node's solid rows
+    /// (block (s, b) itself), then each non-master rigid-body dof's row into its master's
+    /// (block (m, b)), so that a followed solid row carries its water's on to a master.
+    pub moves: Vec<(u32, u32, u8, u8)>,
+    /// (block (s, s), block (s, m), component, master component) of every owned tied dof that is
+    /// not a master (m = s for an impermeable surface's water): its row is x_s − x_m.
     pub constraints: Vec<(u32, u32, u8, u8)>,
 }
 
 impl TiedRows {
-    /// The rows of `dofs`' ties in `pattern` (built with [`pattern_ties`]).
+    /// The rows of `dofs`' ties in `pattern` (built with [`pattern_ties`]); an error if the
+    /// pattern lacks a block they need.
     pub fn of<const D: usize>(dofs: &DofMap, pattern: &Pattern<D>, ghosted: usize) -> Result<TiedRows, String> {
         let nd = dofs.nd;
         let masters = pattern_ties(dofs, ghosted).masters;
+        let missing = || "a tied row's block is not in the matrix pattern".to_string();
         let mut rows = TiedRows::default();
-        // An impermeable surface's water rows first, into their own node's solid rows (which a
-        // rigid body may then move on into its master's).
+        let mut move_row = |q: usize, m: u32, cm: usize| -> Result<(), String> {
+            let s = (q / nd) as u32;
+            for k in pattern.row_start(s)..pattern.row_start(s + 1) {
+                let target = pattern.block(m, pattern.pairs[k].1).ok_or_else(missing)?;
+                rows.moves.push((k as u32, target, (q % nd) as u8, cm as u8));
+            }
+            Ok(())
+        };
         for &(q, solid) in &dofs.follows {
-            rows.moved.push((q, q / nd as u32, (solid as usize % nd) as u8));
+            move_row(q as usize, q / nd as u32, solid as usize % nd)?;
         }
         for (q, &g) in dofs.tie.iter().enumerate() {
             let tie = &dofs.ties.get(g as usize);
             let Some(tie) = tie.filter(|t| Some(q) != t.master_local) else { continue };
-            rows.moved.push((q as u32, masters[g as usize], tie.dir as u8));
+            move_row(q, masters[g as usize], tie.dir)?;
         }
-        let missing = || "a tied node's block is not in the pattern".to_string();
         for &(_, solid, q) in &dofs.owned_follows {
             let s = (q / nd) as u32;
             let ss = pattern.block(s, s).ok_or_else(missing)?;
@@ -142,21 +152,16 @@ impl TiedRows {
         Ok(rows)
     }
 
-    /// Rewrites the Jacobian's rows: moves each tied row into its master's and writes the
+    /// Rewrites the Jacobian's rows: moves each tied row into its target's and writes the
     /// constraints' entries (before PETSc's scaling of the pressure columns, which the moved rows
-    /// then share with the master's).
-    pub fn apply<const D: usize>(&self, values: &mut BlockFill<'_>, pattern: &Pattern<D>, nd: usize) {
+    /// then share with their targets).
+    pub fn apply(&self, values: &mut BlockFill<'_>, nd: usize) {
         let mut row = [0.0; petsc::MAX_BS];
-        for &(q, m, cm) in &self.moved {
-            let (s, c) = (q as usize / nd, q as usize % nd);
-            for k in pattern.row_start(s as u32)..pattern.row_start(s as u32 + 1) {
-                let b = pattern.pairs[k].1;
-                let target = pattern.block(m, b).expect("the pattern ties every block of a tied row") as usize;
-                let from = values.row_mut(k, c);
-                row[..nd].copy_from_slice(from);
-                from.fill(0.0);
-                values.row_mut(target, cm as usize).iter_mut().zip(&row[..nd]).for_each(|(v, r)| *v += r);
-            }
+        for &(k, target, c, cm) in &self.moves {
+            let from = values.row_mut(k as usize, c as usize);
+            row[..nd].copy_from_slice(from);
+            from.fill(0.0);
+            values.row_mut(target as usize, cm as usize).iter_mut().zip(&row[..nd]).for_each(|(v, r)| *v += r);
         }
         for &(ss, sm, c, cm) in &self.constraints {
             values.row_mut(ss as usize, c as usize)[c as usize] = 1.0;

@@ -377,6 +377,23 @@ impl<const D: usize> Model<D> {
         by
     }
 
+    /// A component that a rigid body (a boundary under a force) and another boundary both hold at
+    /// the grid node with indices `n`: (the body, the other, the component's [`dof_index_in`]
+    /// index), if any (side, region and mesh boundaries; the first such component).
+    pub fn rigid_conflict(&self, active: &Active, n: [usize; D]) -> Option<(usize, usize, usize)> {
+        let (mut rigid, mut other) = ([None; crate::layout::MAX_DOF_3D], [None; crate::layout::MAX_DOF_3D]);
+        for &bi in &active.boundaries {
+            let b = &self.boundaries[bi];
+            if b.surface.is_none() && b.holds_node(&self.grid, n) {
+                let first = if b.force.is_some() { &mut rigid } else { &mut other };
+                for c in b.held().filter_map(dof_index_in::<D>) {
+                    first[c] = first[c].or(Some(bi));
+                }
+            }
+        }
+        (0..crate::layout::MAX_DOF_3D).find_map(|c| Some((rigid[c]?, other[c]?, c)))
+    }
+
     /// Takes the materials of `stage`: the case's, with the stage's strength reduction factor
     /// (`strength_reduction`, default 1) applied to their peak strengths.
     pub fn take_stage_materials(&mut self, case: &Case, stage: &crate::case::Stage) {

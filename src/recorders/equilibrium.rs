@@ -143,8 +143,13 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
         Ok(rigid.then(|| self.rigid.iter().flatten().copied().collect()))
     }
 
-    fn restore(&mut self, FromCheckpoint { state, .. }: FromCheckpoint<D>) -> Restored {
-        let Some(state) = state else { return Ok(None) };
+    fn restore(&mut self, from: FromCheckpoint<D>) -> Restored {
+        let Some(state) = from.state else {
+            let rigid = from.at.model.boundaries.iter().any(|b| b.force.is_some());
+            return Ok(rigid.then(|| {
+                format!("the checkpoint holds no rigid-body displacements: they count from t = {:.6e} s", from.at.t)
+            }));
+        };
         if state.len() != self.rigid.len() * D {
             return Err(format!(
                 "it holds {} rigid-body displacement components, this case has {}",

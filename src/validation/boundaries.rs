@@ -67,6 +67,7 @@ fn dimension(key: &str, b: &Boundary, dim: usize) -> Checked {
         let z_parts = [
             (b.side.is_some_and(|s| s.axis() == 2), "side"),
             (b.fix.iter().any(|d| matches!(d, Dof::Uz | Dof::WUz)), "fix"),
+            (b.impermeable.contains(&Dof::WUz), "impermeable"),
             (b.region.is_some_and(|r| r.z.is_some()), "region.z"),
             (b.surface.as_ref().is_some_and(|sf| sf.faces.iter().any(|f| f.axis() == 2)), "surface.faces"),
             (surface_region.is_some_and(|r| r.z.is_some()), "surface.region.z"),
@@ -133,6 +134,13 @@ fn motion(key: &str, b: &Boundary, dim: usize) -> Checked {
         }
     }
     if b.force.is_some() {
+        if !moved[..dim].iter().any(|d| b.fix.contains(d)) {
+            return Err(format!(
+                "key `{key}.fix`: a rigid body under a `force` moves by the displacement components it lists; list \
+                 at least one of {}",
+                moved[..dim].iter().map(|d| format!("`{d}`")).collect::<Vec<_>>().join(", ")
+            ));
+        }
         // The water moves with a rigid body where it is tied: its component needs the solid's.
         let water = [(Dof::WUx, Dof::Ux), (Dof::WUy, Dof::Uy), (Dof::WUz, Dof::Uz)];
         if let Some((w, u)) = water.into_iter().find(|(w, u)| b.fix.contains(w) && !b.fix.contains(u)) {
