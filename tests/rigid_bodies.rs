@@ -250,32 +250,24 @@ fn a_rigid_plate_consolidates_a_saturated_layer_to_the_drained_settlement() {
 /// the free solid.
 #[test]
 fn the_tied_two_phase_tangents_pass_the_finite_difference_check() {
-    let mut up = vec![PLATE, "--steps", "1"];
+    let check = |case: &str, steps: &str, sets: &[&str], blocks: usize, flip: &str| {
+        let args = [vec![case.to_string(), "--steps".into(), steps.into()], set_args(sets)].concat();
+        assert_tangent_checked(&args.iter().map(String::as_str).collect::<Vec<_>>(), blocks, flip);
+    };
     let stage = "stages=[{name=\"load\",duration=1.0,analysis=\"quasi_static\"}]";
-    let sets: Vec<String> = TWO_PHASE.iter().chain([&stage]).flat_map(|s| ["--set".into(), s.to_string()]).collect();
-    up.extend(sets.iter().map(String::as_str));
-    assert_tangent_checked(&up, 9, "uy,p");
+    check(PLATE, "1", &[&TWO_PHASE[..], &[stage]].concat(), 9, "uy,p");
     let dynamic = [
         "stages=[{name=\"load\",duration=1.0,analysis=\"dynamic\"}]",
         "boundaries[0].fix=[\"ux\", \"uy\", \"p\", \"Ux\", \"Uy\"]",
         "boundaries[3].fix=[\"uy\", \"Uy\"]",
     ];
-    let sets: Vec<String> =
-        TWO_PHASE[..4].iter().chain(dynamic.iter()).flat_map(|s| ["--set".into(), s.to_string()]).collect();
-    let mut upu = vec![PLATE, "--steps", "2"];
-    upu.extend(sets.iter().map(String::as_str));
-    assert_tangent_checked(&upu, 25, "Uy,uy");
+    check(PLATE, "2", &[&TWO_PHASE[..4], &dynamic[..]].concat(), 25, "Uy,uy");
     // An impermeable top whose water follows the free solid (u–p–U, Terzaghi's column).
     let sealed = [
-        "cases/terzaghi.toml",
-        "--steps",
-        "3",
-        "--set",
         "boundaries.base.fix=[\"ux\", \"uy\", \"p\"]",
-        "--set",
         "boundaries.drained_top={name=\"drained_top\",side=\"y_max\",impermeable=[\"Uy\"]}",
     ];
-    assert_tangent_checked(&sealed, 25, "Uy,uy");
+    check("cases/terzaghi.toml", "3", &sealed, 25, "Uy,uy");
 }
 
 /// The rigid plate in three dimensions (a 1 m × 2 m × 1 m column on rollers at its four sides):

@@ -58,7 +58,8 @@ pub struct DofMap {
     pub owned_fixed: Vec<(usize, usize)>,
     /// Unknowns (free dofs) over all ranks.
     pub free_dofs: usize,
-    /// The rigid-body direction (index into `ties`) tying each ghosted dof, or [`NO_TIE`].
+    /// The rigid-body direction (index into `ties`) tying each ghosted dof, or [`NO_TIE`] (empty
+    /// without rigid bodies).
     pub tie: Vec<u32>,
     /// The step's rigid-body directions, in the order of the active boundaries.
     pub ties: Vec<Tie>,
@@ -71,9 +72,6 @@ pub struct DofMap {
     /// Offsets of the owned following dofs in the owned part of global vectors, with the offset
     /// of the solid dof each follows and its ghosted index.
     pub owned_follows: Vec<(usize, usize, usize)>,
-    /// Why the ties cannot be made: a node that a rigid body and another boundary both hold in a
-    /// component.
-    pub conflict: Option<String>,
 }
 
 impl DofMap {
@@ -125,7 +123,8 @@ pub fn carries_unknown(layout: Layout, c: usize, fill: f64, well_fraction: f64) 
 
 /// Builds the dof map from the filled fractions `phi` (per ghosted node, summed over ranks) and the
 /// moving-surface fixes `surface` (per ghosted dof, the boundary index + 1 or 0, maximum over ranks),
-/// in any dimension.
+/// in any dimension; an error where a rigid body and another boundary hold the same component of
+/// a node.
 #[allow(clippy::too_many_arguments)]
 pub fn build<const D: usize>(
     model: &Model<D>,
@@ -139,8 +138,9 @@ pub fn build<const D: usize>(
     surface: &[f64],
     well_fraction: f64,
     layout: Layout,
-) -> DofMap {
+) -> Result<DofMap, String> {
     let n = ghost.len();
+    let ties = ties_of(model, active, (t0, t1));
     let mut m = DofMap {
         nd,
         well: phi.iter().map(|&f| f > well_fraction).collect(),
@@ -149,17 +149,16 @@ pub fn build<const D: usize>(
         boundary: vec![NO_BOUNDARY; n * nd],
         owned_fixed: Vec::new(),
         free_dofs: 0,
-        tie: vec![NO_TIE; n * nd],
-        ties: ties_of(model, active, (t0, t1)),
+        tie: if ties.is_empty() { Vec::new() } else { vec![NO_TIE; n * nd] },
+        ties,
         owned_tied: Vec::new(),
         follows: Vec::new(),
         owned_follows: Vec::new(),
-        conflict: None,
     };
     for (l, reached) in phi.iter().enumerate() {
         let node = ghost.indices(l);
-        if let Some((rigid, other, k)) = (!m.ties.is_empty()).then(|| model.rigid_conflict(active, node)).flatten() {
-            m.conflict.get_or_insert_with(|| conflict(model, (rigid, other, k), node));
+        if let Some(both) = (!m.ties.is_empty()).then(|| model.rigid_conflict(active, node)).flatten() {
+            return Err(conflict(model, both, node));
         }
         let by = model.fixing_boundaries(active, node);
         for c in 0..nd {
@@ -214,7 +213,7 @@ pub fn build<const D: usize>(
             } else {
                 m.free_dofs += 1;
             }
-            if m.tie[l * nd + c] != NO_TIE {
+            if m.tie.get(l * nd + c).is_some_and(|&g| g != NO_TIE) {
                 m.owned_tied.push((o, l * nd + c));
             }
             if let Ok(f) = m.follows.binary_search_by_key(&((l * nd + c) as u32), |f| f.0) {
@@ -224,7 +223,7 @@ pub fn build<const D: usize>(
         }
         crate::model::shape::next_combination(&mut at, owned_count);
     }
-    m
+    Ok(m)
 }
 
 /// The message of a node that rigid body `rigid` and boundary `other` both hold in the component of
@@ -288,7 +287,8 @@ mod tests {
         // Every node well filled but one.
         let lonely = ghost.local([2, 5, 3]).unwrap();
         let phi: Vec<f64> = (0..n).map(|l| if l == lonely { 0.1 } else { 1.0 }).collect();
-        let map = build(&m, &active, (0.0, 0.5), &ghost, [0; 3], nodes, nd, &phi, &vec![0.0; n * nd], 0.5, layout);
+        let map =
+            build(&m, &active, (0.0, 0.5), &ghost, [0; 3], nodes, nd, &phi, &vec![0.0; n * nd], 0.5, layout).unwrap();
         let base = (nodes[0] * nodes[2]) * 3;
         let back = nodes[0] * nodes[1] - nodes[0];
         // The top region: x ∈ {0, 0.1}, z ∈ {0.1, 0.2} at y = 1: four nodes, four components each.

@@ -104,7 +104,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         let mut fext = step.fext.clone();
         let mut fext_old = step.fext_old.clone();
         // A rigid body's force acts on the material through the body's reactions.
-        super::ties::remove_forces(&step.dofs, &mut fext, &mut fext_old);
+        super::ties::add_forces(&step.dofs, -1.0, &mut fext, &mut fext_old);
         for v in [&mut all, &mut inertia, &mut fext, &mut fext_old, &mut magnitude] {
             space.sum_over_ranks(v).map_err(|e| e.to_string())?;
         }

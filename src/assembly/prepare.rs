@@ -225,7 +225,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
         };
         loads::check_loads(space, &step, &applied, t_new, coll)?;
         let mut fext_old = fext_old;
-        ties::add_forces(&step.dofs, &mut step.fext, &mut fext_old);
+        ties::add_forces(&step.dofs, 1.0, &mut step.fext, &mut fext_old);
         if model.linear_increments {
             // A geometrically linear step solves for the increments alone ([001]'s K Δu = ΔF):
             // the residual of the step's start on x_n is taken off (validation keeps these stages
@@ -287,7 +287,10 @@ impl<const D: usize, const M: usize> Step<D, M> {
                 Arc::new(p)
             }
         };
-        self.tied_rows = coll.agree(ties::TiedRows::of(&self.dofs, &pattern, space.ghost.len()))?;
+        // Only a rigid body's rows can miss a block (an impermeable surface's stay in their own
+        // node's blocks); the bodies are the same on every rank, so only then is it agreed.
+        let rows = ties::TiedRows::of(&self.dofs, &pattern);
+        self.tied_rows = if self.dofs.ties.is_empty() { rows? } else { coll.agree(rows)? };
         let projection_blocks: Option<Vec<Vec<u32>>> = self
             .projection
             .iter()
@@ -401,7 +404,9 @@ fn dof_map<const D: usize>(
             }
         }
     }
-    let mut dofs = dofs::build(
+    // Only a rigid body conflicts with another boundary, and the bodies are the same on every
+    // rank: only then is the outcome agreed.
+    let built = dofs::build(
         model,
         active,
         times,
@@ -414,18 +419,18 @@ fn dof_map<const D: usize>(
         WELL_FILLED_FRACTION,
         space.layout,
     );
+    let mut dofs = if model.boundaries.iter().any(|b| b.force.is_some()) { coll.agree(built)? } else { built? };
     dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
-    coll.agree(dofs.conflict.take().map_or(Ok(()), Err))?;
     ties::resolve(&mut dofs, &space.l2g, |b| model.boundaries[b].name.clone(), coll)?;
     Ok(dofs)
 }
 
 /// The mean filled fraction φ of the nodes of each boundary that prescribes a motion or ties a
 /// rigid body (None for the others, and for a boundary without nodes): how much material the
-/// nodes that carry the motion reach at the step's start (collective). A boundary on grid nodes stays where the grid
-/// is, while the material it pushes moves on: once the material has moved by about half a cell,
-/// the nodes reach only the points at the edge of their support, and the motion no longer acts on
-/// the material as the boundary means it to (the driver warns).
+/// nodes that carry the motion reach at the step's start (collective). A boundary on grid nodes
+/// stays where the grid is, while the material it pushes moves on: once the material has moved by
+/// about half a cell, the nodes reach only the points at the edge of their support, and the motion
+/// no longer acts on the material as the boundary means it to (the driver warns).
 fn moving_boundary_fill<const D: usize>(
     space: &NodeSpace<D>,
     model: &Model<D>,

@@ -505,8 +505,8 @@ fn beyond_the_grid<const D: usize, const M: usize>(
 /// The grid's edge. A support that reaches past a side of the grid loses the part of its basis
 /// beyond it (the partition of unity, and with it part of the particle's internal force and load).
 /// Where the particle's nodes on that side are held in the side's normal direction by a boundary
-/// (a wall: rollers, a fixed base; not a rigid body's tied nodes, which move), the material beyond is the rigid wall, which carries that part
-/// as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must
+/// (a wall: rollers, a fixed base; not a rigid body's tied nodes, which move), the material beyond
+/// is the rigid wall, which carries that part as its reaction (the held slots beyond the grid, [`WallSlot`]); on any other side the run must
 /// stop, naming the particle, its body, the time and the side. (Linear MPM and B-splines: a centre
 /// outside the grid always stops the run.)
 pub fn check_edges<const D: usize>(

@@ -29,9 +29,9 @@ use crate::parallel::Collective;
 use petsc::BlockFill;
 
 /// Finds each rigid-body direction's master (the tied solid dof of the smallest global node
-/// number over all ranks, `l2g` the global index of every ghosted dof), where this rank ghosts and owns it, and leaves the masters out of the
-/// owned tied dofs. A direction of an active rigid body that ties no node is an error naming it.
-/// Collective.
+/// number over all ranks; `l2g` is the global index of every ghosted dof), where this rank ghosts
+/// and owns it, and leaves the masters out of the owned tied dofs. A direction of an active rigid
+/// body that ties no node is an error naming it. Collective.
 pub(super) fn resolve(
     dofs: &mut DofMap,
     l2g: &[i32],
@@ -42,15 +42,18 @@ pub(super) fn resolve(
         return Ok(());
     }
     let nd = dofs.nd;
-    let mut lowest = vec![f64::INFINITY; dofs.ties.len()];
+    // Per direction, this rank's lowest tied node and its ghosted solid dof.
+    let mut lowest = vec![(f64::INFINITY, 0); dofs.ties.len()];
     for (q, &g) in dofs.tie.iter().enumerate() {
         if g != NO_TIE && q % nd == dofs.ties[g as usize].dir {
             let node = (l2g[q] as usize / nd) as f64;
-            lowest[g as usize] = lowest[g as usize].min(node);
+            if node < lowest[g as usize].0 {
+                lowest[g as usize] = (node, q);
+            }
         }
     }
-    let lowest = coll.min(&lowest)?;
-    for (g, (tie, &node)) in dofs.ties.iter_mut().zip(&lowest).enumerate() {
+    let global = coll.min(&lowest.iter().map(|l| l.0).collect::<Vec<_>>())?;
+    for ((tie, &node), &(mine, q)) in dofs.ties.iter_mut().zip(&global).zip(&lowest) {
         if !node.is_finite() {
             return Err(format!(
                 "boundary `{}` drives a rigid body under a force, but no grid node of it is tied in direction {} \
@@ -60,8 +63,7 @@ pub(super) fn resolve(
             ));
         }
         tie.master_node = Some(node as i64);
-        tie.master_local = (0..dofs.tie.len())
-            .find(|&q| dofs.tie[q] == g as u32 && q % nd == tie.dir && (l2g[q] as usize / nd) as f64 == node);
+        tie.master_local = (mine == node).then_some(q);
         tie.master_owned = dofs.owned_tied.iter().find(|&&(_, q)| Some(q) == tie.master_local).map(|&(o, _)| o);
     }
     let masters: Vec<usize> = dofs.ties.iter().filter_map(|t| t.master_local).collect();
@@ -115,11 +117,11 @@ pub(super) struct TiedRows {
 }
 
 impl TiedRows {
-    /// The rows of `dofs`' ties in `pattern` (built with [`pattern_ties`]); an error if the
-    /// pattern lacks a block they need.
-    pub fn of<const D: usize>(dofs: &DofMap, pattern: &Pattern<D>, ghosted: usize) -> Result<TiedRows, String> {
+    /// The rows of `dofs`' ties in `pattern` (tied as [`pattern_ties`] says, its masters'
+    /// indices); an error if the pattern lacks a block they need.
+    pub fn of<const D: usize>(dofs: &DofMap, pattern: &Pattern<D>) -> Result<TiedRows, String> {
         let nd = dofs.nd;
-        let masters = pattern_ties(dofs, ghosted).masters;
+        let masters = &pattern.ties.masters;
         let missing = || "a tied row's block is not in the matrix pattern".to_string();
         let mut rows = TiedRows::default();
         let mut move_row = |q: usize, m: u32, cm: usize| -> Result<(), String> {
@@ -170,24 +172,15 @@ impl TiedRows {
     }
 }
 
-/// Puts each rigid body's force at its master, on the rank that owns it: into `fext` (t_{n+1})
-/// and `fext_old` (t_n), per ghosted dof, as an external load that the body's balance (the
-/// master's row) carries.
-pub(super) fn add_forces(dofs: &DofMap, fext: &mut [f64], fext_old: &mut [f64]) {
+/// Adds `sign` times each rigid body's force at its master, on the rank that owns it, to `fext`
+/// (t_{n+1}) and `fext_old` (t_n), per ghosted dof: with +1 an external load that the body's
+/// balance (the master's row) carries; with −1 it is taken out again, since what acts on the
+/// material there is the body's reaction.
+pub(super) fn add_forces(dofs: &DofMap, sign: f64, fext: &mut [f64], fext_old: &mut [f64]) {
     for tie in dofs.ties.iter().filter(|t| t.master_owned.is_some()) {
         let q = tie.master_local.expect("an owned master is ghosted");
-        fext[q] += tie.force[0];
-        fext_old[q] += tie.force[1];
-    }
-}
-
-/// Takes the rigid bodies' forces of [`add_forces`] out of `fext` and `fext_old` again (this
-/// rank's shares): what acts on the material there is the body's reaction.
-pub(super) fn remove_forces(dofs: &DofMap, fext: &mut [f64], fext_old: &mut [f64]) {
-    for tie in dofs.ties.iter().filter(|t| t.master_owned.is_some()) {
-        let q = tie.master_local.expect("an owned master is ghosted");
-        fext[q] -= tie.force[0];
-        fext_old[q] -= tie.force[1];
+        fext[q] += sign * tie.force[0];
+        fext_old[q] += sign * tie.force[1];
     }
 }
 

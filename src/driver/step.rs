@@ -249,11 +249,11 @@ where
                 warnings.push(Warning {
                     kind: "boundary_detached".into(),
                     message: format!(
-                        "boundary `{}` moves grid nodes (a prescribed motion or a rigid body) that the material has moved away from: their \
-                         mean filled fraction is {f:.3}, {:.0} % of the {start:.3} it was at first; the motion now \
-                         reaches the material only through the points at the edge of the nodes' support, and the \
-                         reactions past this time are not those of the boundary the case means (move it by less than \
-                         half a cell, or model the pushing body with material points)",
+                        "boundary `{}` moves grid nodes (a prescribed motion or a rigid body) that the material has \
+                         moved away from: their mean filled fraction is {f:.3}, {:.0} % of the {start:.3} it was at \
+                         first; the motion now reaches the material only through the points at the edge of the \
+                         nodes' support, and the reactions past this time are not those of the boundary the case \
+                         means (move it by less than half a cell, or model the pushing body with material points)",
                         self.model.boundaries[b].name,
                         100.0 * f / start
                     ),

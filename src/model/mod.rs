@@ -365,10 +365,21 @@ impl<const D: usize> Model<D> {
     /// region boundary (index into `boundaries`, in case order) that fixes it. Moving surfaces are
     /// in [`Model::surface_fixes`].
     pub fn fixing_boundaries(&self, active: &Active, n: [usize; D]) -> [Option<usize>; crate::layout::MAX_DOF_3D] {
+        self.first_holders(active, n, |_| true)
+    }
+
+    /// For each dof component at the grid node with indices `n` (as [`Model::fixing_boundaries`]),
+    /// the first active side, region or mesh boundary that holds it among those `which` selects.
+    fn first_holders(
+        &self,
+        active: &Active,
+        n: [usize; D],
+        which: impl Fn(&BoundaryDef<D>) -> bool,
+    ) -> [Option<usize>; crate::layout::MAX_DOF_3D] {
         let mut by = [None; crate::layout::MAX_DOF_3D];
         for &bi in &active.boundaries {
             let b = &self.boundaries[bi];
-            if b.surface.is_none() && b.holds_node(&self.grid, n) {
+            if which(b) && b.surface.is_none() && b.holds_node(&self.grid, n) {
                 for c in b.held().filter_map(dof_index_in::<D>) {
                     by[c] = by[c].or(Some(bi));
                 }
@@ -381,16 +392,8 @@ impl<const D: usize> Model<D> {
     /// the grid node with indices `n`: (the body, the other, the component's [`dof_index_in`]
     /// index), if any (side, region and mesh boundaries; the first such component).
     pub fn rigid_conflict(&self, active: &Active, n: [usize; D]) -> Option<(usize, usize, usize)> {
-        let (mut rigid, mut other) = ([None; crate::layout::MAX_DOF_3D], [None; crate::layout::MAX_DOF_3D]);
-        for &bi in &active.boundaries {
-            let b = &self.boundaries[bi];
-            if b.surface.is_none() && b.holds_node(&self.grid, n) {
-                let first = if b.force.is_some() { &mut rigid } else { &mut other };
-                for c in b.held().filter_map(dof_index_in::<D>) {
-                    first[c] = first[c].or(Some(bi));
-                }
-            }
-        }
+        let rigid = self.first_holders(active, n, |b| b.force.is_some());
+        let other = self.first_holders(active, n, |b| b.force.is_none());
         (0..crate::layout::MAX_DOF_3D).find_map(|c| Some((rigid[c]?, other[c]?, c)))
     }
 
