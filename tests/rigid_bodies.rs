@@ -359,3 +359,133 @@ fn two_rigid_bodies_sharing_nodes_keep_their_own_balances() {
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= 1e-12 * a.last().unwrap()), "{a:?} vs {b:?}");
     assert_tangent_checked(&[case, "--steps", "2"], 4, "ux,uy");
 }
+
+const COLUMN: &str = "tests/cases/rigid_column_eccentric.toml";
+const COLUMN_3D: &str = "tests/cases/rigid_column_eccentric_3d.toml";
+
+/// The closed form of tests/cases/rigid_column_eccentric.toml (plane strain): the tilt θ =
+/// −12 (1 − ν²) P e H/(E w³) and the settlement of the force's point, the centre's (1 − ν²) P H/(E
+/// w) plus θ e.
+fn column_tilt_and_settlement(e: f64) -> (f64, f64) {
+    let (young, nu, p, h, w) = (1.0e7f64, 0.3f64, 1.0e4f64, 2.0f64, 1.0f64);
+    let theta = -12.0 * (1.0 - nu * nu) * p * e * h / (young * w.powi(3));
+    (theta, -(1.0 - nu * nu) * p * h / (young * w) + theta * e)
+}
+
+/// A short column under an eccentric force through a smooth rigid plate that may rotate: the plate
+/// tilts and settles as plane elasticity says (its linear σ_yy keeps the top straight), the errors
+/// falling at the second order under h-refinement (1.1e-2 and 2.8e-3 of the tilt at h = 0.25 and
+/// 0.125 m, one load step); at every step of the two-step ramp the reactions carry the force and
+/// their moment about the origin is x_F F_y (x_F F_y − y_F F_x for a rough plate under an inclined
+/// force); a centric force does not tilt it.
+#[test]
+fn an_eccentric_force_tilts_a_rigid_plate_as_plane_elasticity_says() {
+    let (theta, settlement) = column_tilt_and_settlement(0.1);
+    let mut errors = Vec::new();
+    for cells in ["[8,10]", "[16,20]"] {
+        let sets = [format!("grid.cells={cells}"), "time.dt=1.0".into()];
+        let r = run_case(COLUMN, &out_dir(&format!("column-{cells}")), &set_args(&[&sets[0], &sets[1]]));
+        assert!(r.completed(), "{cells}: {}", r.stderr());
+        let tilt = r.column("plate.rotation_z").last().copied().unwrap();
+        let settled = r.column("plate.displacement_y").last().copied().unwrap();
+        assert!((settled - settlement).abs() < 2e-3 * settlement.abs(), "{cells}: {settled} vs {settlement}");
+        errors.push((tilt - theta).abs() / theta.abs());
+    }
+    let order = (errors[0] / errors[1]).log2();
+    assert!(errors[0] < 1.3e-2 && errors[1] < 3.2e-3 && (1.8..2.2).contains(&order), "{errors:?}, order {order}");
+    let r = run_case(COLUMN, &out_dir("column-ramp"), &[]);
+    assert!(r.completed(), "{}", r.stderr());
+    let (t, fy, m) = (r.column("time"), r.column("plate.reaction_y"), r.column("plate.reaction_moment_z"));
+    for k in 1..t.len() {
+        let force = -1.0e4 * t[k];
+        assert!((fy[k] - force).abs() <= 1e-10 * force.abs(), "t = {}: reaction {}", t[k], fy[k]);
+        assert!((m[k] - 0.6 * force).abs() <= 1e-10 * force.abs(), "t = {}: moment {} vs {}", t[k], m[k], 0.6 * force);
+    }
+    // A rough plate (u_x tied too) under an inclined force: the moment has both arms.
+    let sets = ["boundaries.plate.fix=[\"ux\", \"uy\"]", "boundaries.plate.force=[1.0e3, -1.0e4]"];
+    let r = run_case(COLUMN, &out_dir("column-inclined"), &set_args(&sets));
+    assert!(r.completed(), "{}", r.stderr());
+    let (t, fx, m) = (r.column("time"), r.column("plate.reaction_x"), r.column("plate.reaction_moment_z"));
+    for k in 1..t.len() {
+        let moment = (0.6 * -1.0e4 - 2.0 * 1.0e3) * t[k];
+        assert!((fx[k] - 1.0e3 * t[k]).abs() <= 1e-9 * 1.0e4, "t = {}: reaction {}", t[k], fx[k]);
+        assert!((m[k] - moment).abs() <= 1e-9 * 1.0e4, "t = {}: moment {} vs {moment}", t[k], m[k]);
+    }
+    let r = run_case(COLUMN, &out_dir("column-centric"), &set_args(&["boundaries.plate.force_point=[0.5, 2.0]"]));
+    assert!(r.completed(), "{}", r.stderr());
+    let tilt = r.column("plate.rotation_z").last().copied().unwrap();
+    assert!(tilt.abs() < 1e-12 * theta.abs(), "a centric force tilts the plate by {tilt}");
+    let settled = r.column("plate.displacement_y").last().copied().unwrap();
+    let (_, centre) = column_tilt_and_settlement(0.0);
+    assert!((settled - centre).abs() < 2e-3 * centre.abs(), "{settled} vs {centre}");
+}
+
+/// The column in three dimensions: the plate tilts about z as elasticity says (θ_z = −12 P e
+/// H/(E w³ d), within 1.1e-2 at h = 0.25 m), not about x (the force lies in the column's plane of
+/// symmetry), and cannot twist about y (its tied u_y does not see a twist: no such column is
+/// carried); the reactions' moment about the origin is x_F × F in every component, and two ranks
+/// give one rank's answers.
+#[test]
+fn an_eccentric_force_tilts_a_rigid_plate_in_three_dimensions() {
+    let (p, e, h, young, w, d) = (5.0e3f64, 0.1f64, 2.0f64, 1.0e7f64, 1.0f64, 0.5f64);
+    let theta = -12.0 * p * e * h / (young * w.powi(3) * d);
+    let one = run_case_on(1, COLUMN_3D, &out_dir("column-3d-1"), &[]);
+    let two = run_case_on(2, COLUMN_3D, &out_dir("column-3d-2"), &[]);
+    assert!(one.completed() && two.completed(), "{}\n{}", one.stderr(), two.stderr());
+    let last = |r: &common::Run, name: &str| r.column(name).last().copied().unwrap();
+    let tilt = last(&one, "plate.rotation_z");
+    assert!((tilt - theta).abs() < 1.1e-2 * theta.abs(), "tilt {tilt} vs {theta}");
+    assert!(last(&one, "plate.rotation_x").abs() < 1e-12 * theta.abs());
+    assert_eq!(last(&one, "plate.rotation_y"), 0.0);
+    let moment = [2.0 * 0.0 - 0.25 * -p, 0.0, 0.6 * -p];
+    for (a, m) in ["x", "y", "z"].into_iter().zip(moment) {
+        let got = last(&one, &format!("plate.reaction_moment_{a}"));
+        assert!((got - m).abs() <= 1e-10 * p, "moment about {a}: {got} vs {m}");
+    }
+    for name in ["plate.rotation_z", "plate.displacement_y", "plate.reaction_moment_z"] {
+        let (a, b) = (last(&one, name), last(&two, name));
+        assert!((a - b).abs() <= 1e-10 * a.abs(), "{name}: {a} on one rank, {b} on two");
+    }
+}
+
+/// The tangent of a rotating plate's rows (each tied row moved into its two or three masters'
+/// rows with its weights, the constraints x_s − Σ w x_m) against central differences, in the
+/// plane and in three dimensions; a flipped block fails.
+#[test]
+fn the_rotating_plate_tangent_passes_the_finite_difference_check() {
+    assert_tangent_checked(&[COLUMN, "--steps", "1"], 4, "uy,uy");
+    assert_tangent_checked(&[COLUMN_3D, "--steps", "1"], 9, "uy,uy");
+}
+
+/// What a rotating body cannot be: a point without a force, a point of the wrong dimension, a
+/// rotating body in axial symmetry; and a force whose moment about its tied nodes nothing resists
+/// (a strip of nodes on one vertical line tying u_y, loaded off that line), found at the first
+/// step.
+#[test]
+fn what_a_rotating_body_cannot_be_is_refused() {
+    assert_refused(
+        COLUMN,
+        &out_dir("point-alone"),
+        &["boundaries.pin.force_point=[0.5, 0.0]"],
+        "is where a `force` acts, and no `force` is given",
+    );
+    assert_refused(
+        COLUMN,
+        &out_dir("point-3"),
+        &["boundaries.plate.force_point=[0.5, 2.0, 0.0]"],
+        "2 coordinates in a case of 2 dimensions",
+    );
+    assert_refused(
+        PLATE,
+        &out_dir("point-axisymmetric"),
+        &["analysis.geometry=axisymmetric", "boundaries.plate.force_point=[0.5, 2.0]"],
+        "moves along the axis and does not rotate",
+    );
+    let r = run_case(
+        COLUMN,
+        &out_dir("unresisted"),
+        &set_args(&["boundaries.plate.region={min=[0.0, 1.0], max=[0.0, 2.0]}"]),
+    );
+    assert_eq!(r.output.status.code(), Some(1), "{}", r.stderr());
+    assert!(r.stderr().contains("boundary `plate`: its force turns the body about z"), "{}", r.stderr());
+}

@@ -9,9 +9,10 @@
 //! x − value, unit diagonal, no column entries), so the layout never changes.
 //!
 //! A dof of a rigid body's node (a boundary under a `force`) is *tied*: it stays an unknown, and
-//! [`super::ties`] makes it equal to its direction's master dof and moves its equation into the
-//! master's, the body's balance.
+//! [`super::ties`] makes it the weighted sum of the body's master dofs that its motion gives and
+//! moves its equation, weighted, into the masters', the body's balance.
 
+use super::ties::rigid::{Param, Selection, MAX_PARAMS};
 use crate::layout::Layout;
 use crate::model::{Active, Model};
 use petsc::GhostedRange;
@@ -19,26 +20,57 @@ use petsc::GhostedRange;
 /// No boundary fixes the dof.
 pub const NO_BOUNDARY: u16 = u16::MAX;
 
-/// No rigid body ties the dof.
-pub const NO_TIE: u32 = u32::MAX;
-
-/// One direction of a rigid body: the dofs of its nodes in that direction (the solid's, and the
-/// water's where the boundary fixes it) move as its master dof, the solid's of the tied node with
-/// the smallest global number (the same on every rank).
+/// One master of a rigid body: a tied solid dof whose value, with the body's other masters',
+/// fixes the body's motion ([`super::ties`]), the same on every rank.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tie {
-    /// The boundary (index into `Model::boundaries`).
-    pub boundary: usize,
-    /// The direction (0: x, 1: y, 2: z), also the master's component.
+    /// The body (index into `DofMap::bodies`).
+    pub body: usize,
+    /// The master's component (its direction: 0: x, 1: y, 2: z).
     pub dir: usize,
-    /// The master's global node number (none before [`super::ties::resolve`]).
-    pub master_node: Option<i64>,
+    /// The master's global node number.
+    pub master_node: i64,
     /// The master's ghosted dof on this rank, if this rank ghosts its node.
     pub master_local: Option<usize>,
     /// The master's offset in the owned part of global vectors, if this rank owns it.
     pub master_owned: Option<usize>,
-    /// The force in this direction at t_{n+1} and at t_n [N/m, N].
+    /// The body's load carried at this master (its generalized force) at t_{n+1} and at t_n [N/m, N].
     pub force: [f64; 2],
+}
+
+/// A rigid body of a step: a boundary under a force whose tied dofs move together, in translation
+/// along the directions it ties and, where its force has a point of application, in rotation about
+/// that point ([`super::ties::rigid`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// The boundary (index into `Model::boundaries`).
+    pub boundary: usize,
+    /// The parameters of its motion: the translations along the directions it ties, then the
+    /// rotations if it rotates.
+    pub params: Vec<Param>,
+    /// Where its force acts, the centre of its rotations [m] (zero if it does not rotate).
+    pub point: [f64; 3],
+    /// Its force at t_{n+1} and at t_n [N/m, N].
+    pub force: [[f64; 3]; 2],
+    /// Its masters (a range of `DofMap::ties`, filled by [`super::ties::resolve`]).
+    pub masters: std::ops::Range<usize>,
+    /// How its motion follows from its masters'.
+    pub selection: Selection,
+}
+
+/// A tied dof: one of a rigid body's, moving as the weighted sum of the body's masters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tied {
+    /// The ghosted dof.
+    pub q: u32,
+    /// The body (index into `DofMap::bodies`).
+    pub body: u32,
+    /// Its direction.
+    pub dir: u8,
+    /// Whether it is the solid's (a candidate master) rather than the water's.
+    pub solid: bool,
+    /// Its weights on the body's masters, u_q = Σ_k w_k u_{m_k} (filled by [`super::ties::resolve`]).
+    pub w: [f64; MAX_PARAMS],
 }
 
 /// The dof map of a step.
@@ -58,13 +90,14 @@ pub struct DofMap {
     pub owned_fixed: Vec<(usize, usize)>,
     /// Unknowns (free dofs) over all ranks.
     pub free_dofs: usize,
-    /// The rigid-body direction (index into `ties`) tying each ghosted dof, or [`NO_TIE`] (empty
-    /// without rigid bodies).
-    pub tie: Vec<u32>,
-    /// The step's rigid-body directions, in the order of the active boundaries.
+    /// The step's rigid bodies, in the order of the active boundaries.
+    pub bodies: Vec<Body>,
+    /// The rigid bodies' masters, body by body.
     pub ties: Vec<Tie>,
-    /// Offsets of the owned tied dofs in the owned part of global vectors, with their ghosted
-    /// index (the masters left out once resolved).
+    /// The tied ghosted dofs, in increasing order.
+    pub tied: Vec<Tied>,
+    /// Offsets of the owned tied dofs in the owned part of global vectors, with their index in
+    /// `tied` (the masters left out once resolved).
     pub owned_tied: Vec<(usize, usize)>,
     /// The ghosted water dofs of an impermeable surface, each with the solid dof of its node and
     /// direction that it follows (U_d = u_d), in increasing order.
@@ -83,8 +116,9 @@ impl DofMap {
             + c(&self.value)
             + c(&self.boundary)
             + c(&self.owned_fixed)
-            + c(&self.tie)
+            + c(&self.bodies)
             + c(&self.ties)
+            + c(&self.tied)
             + c(&self.owned_tied)
             + c(&self.follows)
             + c(&self.owned_follows)
@@ -140,7 +174,7 @@ pub fn build<const D: usize>(
     layout: Layout,
 ) -> Result<DofMap, String> {
     let n = ghost.len();
-    let ties = ties_of(model, active, (t0, t1));
+    let bodies = bodies_of(model, active, (t0, t1));
     let mut m = DofMap {
         nd,
         well: phi.iter().map(|&f| f > well_fraction).collect(),
@@ -149,15 +183,16 @@ pub fn build<const D: usize>(
         boundary: vec![NO_BOUNDARY; n * nd],
         owned_fixed: Vec::new(),
         free_dofs: 0,
-        tie: if ties.is_empty() { Vec::new() } else { vec![NO_TIE; n * nd] },
-        ties,
+        bodies,
+        ties: Vec::new(),
+        tied: Vec::new(),
         owned_tied: Vec::new(),
         follows: Vec::new(),
         owned_follows: Vec::new(),
     };
     for (l, reached) in phi.iter().enumerate() {
         let node = ghost.indices(l);
-        if let Some(both) = (!m.ties.is_empty()).then(|| model.rigid_conflict(active, node)).flatten() {
+        if let Some(both) = (!m.bodies.is_empty()).then(|| model.rigid_conflict(active, node)).flatten() {
             return Err(conflict(model, both, node));
         }
         let by = model.fixing_boundaries(active, node);
@@ -172,9 +207,11 @@ pub fn build<const D: usize>(
                 if let (Some(motion), Some(d)) = (&model.boundaries[b].motion, dir) {
                     m.value[q] = motion.increment_at(model.grid.position(node), t0, t1)[d];
                 }
-                // A rigid body: its components stay unknowns, tied to their direction's master.
-                if let Some(g) = dir.and_then(|d| m.ties.iter().position(|t| t.boundary == b && t.dir == d)) {
-                    m.tie[q] = g as u32;
+                // A rigid body: its components stay unknowns, tied to its masters.
+                let body = |d: usize| m.bodies.iter().position(|t| t.boundary == b && t.ties(d));
+                if let Some((d, g)) = dir.and_then(|d| Some((d, body(d)?))) {
+                    let (body, dir, solid) = (g as u32, d as u8, c < D);
+                    m.tied.push(Tied { q: q as u32, body, dir, solid, w: [0.0; MAX_PARAMS] });
                     continue;
                 }
                 // An impermeable surface: the water follows the solid where the solid is an
@@ -213,8 +250,8 @@ pub fn build<const D: usize>(
             } else {
                 m.free_dofs += 1;
             }
-            if m.tie.get(l * nd + c).is_some_and(|&g| g != NO_TIE) {
-                m.owned_tied.push((o, l * nd + c));
+            if let Ok(i) = m.tied.binary_search_by_key(&((l * nd + c) as u32), |t| t.q) {
+                m.owned_tied.push((o, i));
             }
             if let Ok(f) = m.follows.binary_search_by_key(&((l * nd + c) as u32), |f| f.0) {
                 let solid = m.follows[f].1 as usize % nd;
@@ -248,22 +285,39 @@ fn follows<const D: usize>(model: &Model<D>, b: usize, k: usize) -> bool {
     model.boundaries[b].impermeable.iter().any(|&d| crate::model::dof_index_in::<D>(d) == Some(k))
 }
 
-/// The rigid-body directions of the active boundaries under a force over `(t0, t1)`: one per
-/// direction whose solid component the boundary fixes, in the order of the active boundaries.
-fn ties_of<const D: usize>(model: &Model<D>, active: &Active, (t0, t1): (f64, f64)) -> Vec<Tie> {
+/// The rigid bodies of the active boundaries under a force over `(t0, t1)`, in the order of the
+/// active boundaries: translations along the directions whose solid component the boundary fixes,
+/// and rotations where its force has a point of application (about z in the plane; about x, y
+/// and z in three dimensions).
+fn bodies_of<const D: usize>(model: &Model<D>, active: &Active, (t0, t1): (f64, f64)) -> Vec<Body> {
     use crate::case::Dof;
     let solid = [Dof::Ux, Dof::Uy, Dof::Uz];
-    let mut ties = Vec::new();
+    let mut bodies = Vec::new();
     for &b in &active.boundaries {
         let def = &model.boundaries[b];
         let Some(force) = &def.force else { continue };
-        let (f1, f0) = (force.at(t1), force.at(t0));
-        for dir in (0..D).filter(|&d| def.fix.contains(&solid[d])) {
-            let force = [f1[dir], f0[dir]];
-            ties.push(Tie { boundary: b, dir, master_node: None, master_local: None, master_owned: None, force });
+        let pad = |v: [f64; D]| std::array::from_fn(|d| if d < D { v[d] } else { 0.0 });
+        let mut params: Vec<Param> = (0..D).filter(|&d| def.fix.contains(&solid[d])).map(Param::Translation).collect();
+        if force.point.is_some() {
+            params.extend(if D == 2 { vec![Param::Rotation(2)] } else { (0..3).map(Param::Rotation).collect() });
         }
+        bodies.push(Body {
+            boundary: b,
+            params,
+            point: pad(force.point.unwrap_or([0.0; D])),
+            force: [pad(force.at(t1)), pad(force.at(t0))],
+            masters: 0..0,
+            selection: Selection::default(),
+        });
     }
-    ties
+    bodies
+}
+
+impl Body {
+    /// Whether it ties the components of direction `d`.
+    pub fn ties(&self, d: usize) -> bool {
+        self.params.contains(&Param::Translation(d))
+    }
 }
 
 #[cfg(test)]

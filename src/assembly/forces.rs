@@ -26,9 +26,15 @@ pub struct StepForces<const D: usize = 2> {
     pub reactions: Vec<[f64; D]>,
     /// The reactions per ghosted dof, for the work of the next step on the same node space.
     pub reactions_by_dof: Vec<f64>,
-    /// The displacement of each rigid body over the step (a boundary under a force; zero in the
-    /// directions it does not tie and for the other boundaries) [m].
-    pub rigid_motion: Vec<[f64; D]>,
+    /// The motion of each rigid body over the step (a boundary under a force; zero for the other
+    /// boundaries): the displacement of its force's point along x, y, z [m] (zero in the
+    /// directions it does not tie), then its rotation about x, y, z [rad] (zero unless it rotates;
+    /// in the plane about z alone).
+    pub rigid_motion: Vec<[f64; 6]>,
+    /// The moment about the origin of each boundary's reactions, Σ x_i × R_i over its nodes at
+    /// their grid positions [N m per m in the plane (about z), N m in three dimensions]: for a
+    /// rigid body that rotates, the moment of its force about the origin when it is in balance.
+    pub reaction_moments: Vec<[f64; 3]>,
     /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}
     /// (trapezoidal; the reactions at t_n are the last step's, none after a new node space; at
@@ -56,6 +62,7 @@ impl<const D: usize> Default for StepForces<D> {
             reactions: Vec::new(),
             reactions_by_dof: Vec::new(),
             rigid_motion: Vec::new(),
+            reaction_moments: Vec::new(),
             work: 0.0,
             field_scales: Vec::new(),
             at_start: false,
@@ -123,13 +130,13 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         }
         let nb = model.boundaries.len();
         // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
-        // boundary (D nb)]
+        // boundary (D nb), rigid motions per boundary (6 nb), reaction moments per boundary (3 nb)]
         let dd = D * D;
-        let mut local = vec![0.0; 4 * dd + 1 + 2 * D * nb];
-        // Each rigid body's motion over the step: its masters' increments.
-        for tie in step.dofs.ties.iter().filter(|t| t.master_owned.is_some()) {
-            let q = tie.master_local.expect("an owned master is ghosted");
-            local[4 * dd + 1 + D * nb + D * tie.boundary + tie.dir] = solution.increments[q];
+        let (motions_at, moments_at) = (4 * dd + 1 + D * nb, 4 * dd + 1 + (D + 6) * nb);
+        let mut local = vec![0.0; 4 * dd + 1 + (D + 9) * nb];
+        // Each rigid body's motion over the step, from its masters' increments.
+        for (b, slots) in super::ties::motions(&step.dofs, &solution.increments) {
+            local[motions_at + 6 * b..motions_at + 6 * b + 6].copy_from_slice(&slots);
         }
         let mut reactions = vec![0.0; ng];
         // (dof component, in-plane direction) of the solid and water motion.
@@ -152,6 +159,10 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
                 local[4 * dd] +=
                     0.5 * (fext_old[q] + start + fext[q] + reaction_old + reaction) * solution.increments[q];
                 book_node_forces(&mut local, nb, b as usize, &xr, dir, [fext[q], reaction, inertia[q]]);
+                if (b as usize) < nb {
+                    let m = &mut local[moments_at + 3 * b as usize..moments_at + 3 * b as usize + 3];
+                    add_moment(m, &p, dir, reaction);
+                }
             }
         }
         // The held nodes beyond the grid that GIMP supports reach past a wall (this rank's
@@ -171,13 +182,28 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             scale: norm(&s[dd..2 * dd]).max(norm(&s[2 * dd..3 * dd])).max(norm(&s[3 * dd..4 * dd])),
             origin,
             reactions: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * b + d])).collect(),
-            rigid_motion: (0..nb).map(|b| std::array::from_fn(|d| s[4 * dd + 1 + D * (nb + b) + d])).collect(),
+            rigid_motion: (0..nb).map(|b| std::array::from_fn(|d| s[motions_at + 6 * b + d])).collect(),
+            reaction_moments: (0..nb).map(|b| std::array::from_fn(|d| s[moments_at + 3 * b + d])).collect(),
             reactions_by_dof: reactions,
             work: s[4 * dd],
             field_scales,
             at_start,
             node_diagnostics,
         })
+    }
+}
+
+/// Adds the moment x × f of a force `f` along direction `dir` at `x` to `m` (about x, y, z).
+fn add_moment<const D: usize>(m: &mut [f64], x: &[f64; D], dir: usize, f: f64) {
+    let x: [f64; 3] = std::array::from_fn(|d| if d < D { x[d] } else { 0.0 });
+    // x × (f e_dir): its component a is x_b f δ_{c,dir} − x_c f δ_{b,dir} with (a, b, c) cyclic.
+    for (a, m) in m.iter_mut().enumerate().take(3) {
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        if dir == c {
+            *m += x[b] * f;
+        } else if dir == b {
+            *m -= x[c] * f;
+        }
     }
 }
 

@@ -126,7 +126,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
         }
         step.matrix_pattern(space, kept, coll)?;
         if pc_matrix.0 == PcMatrix::Multilinear {
-            let tied = step.dofs.ties.first().map(|t| t.boundary);
+            let tied = step.dofs.bodies.first().map(|b| b.boundary);
             let followed = step.dofs.follows.first().map(|&(q, _)| step.dofs.boundary[q as usize] as usize);
             // The rank that finds one tells every rank (its impermeable nodes may be on it alone).
             coll.agree(tied.or(followed).map_or(Ok(()), |b| {
@@ -290,7 +290,7 @@ impl<const D: usize, const M: usize> Step<D, M> {
         // Only a rigid body's rows can miss a block (an impermeable surface's stay in their own
         // node's blocks); the bodies are the same on every rank, so only then is it agreed.
         let rows = ties::TiedRows::of(&self.dofs, &pattern);
-        self.tied_rows = if self.dofs.ties.is_empty() { rows? } else { coll.agree(rows)? };
+        self.tied_rows = if self.dofs.bodies.is_empty() { rows? } else { coll.agree(rows)? };
         let projection_blocks: Option<Vec<Vec<u32>>> = self
             .projection
             .iter()
@@ -421,7 +421,11 @@ fn dof_map<const D: usize>(
     );
     let mut dofs = if model.boundaries.iter().any(|b| b.force.is_some()) { coll.agree(built)? } else { built? };
     dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
-    ties::resolve(&mut dofs, &space.l2g, |b| model.boundaries[b].name.clone(), coll)?;
+    let position = |l: usize| {
+        let x = model.grid.position(space.ghost.indices(l));
+        std::array::from_fn(|d| if d < D { x[d] } else { 0.0 })
+    };
+    ties::resolve(&mut dofs, &space.l2g, position, |b| model.boundaries[b].name.clone(), coll)?;
     Ok(dofs)
 }
 

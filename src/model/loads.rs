@@ -467,7 +467,8 @@ pub struct BoundaryDef<const D: usize = 2> {
     /// Their prescribed motion (none: fixed to zero, or tied to a rigid body under `force`).
     pub motion: Option<Motion<D>>,
     /// The load of a rigid body: the fixed displacement components (and the water's) of its nodes
-    /// move together, by one unknown per direction that this force drives.
+    /// move together, by one unknown per direction that this force drives (and, with a point of
+    /// application, by a small rotation about it).
     pub force: Option<RigidForce<D>>,
 }
 
@@ -476,6 +477,8 @@ pub struct BoundaryDef<const D: usize = 2> {
 pub struct RigidForce<const D: usize = 2> {
     /// The force at time-function value 1 [N per metre, on the full ring, or N].
     pub vector: [f64; D],
+    /// Where it acts, if the body rotates about that point [m].
+    pub point: Option<[f64; D]>,
     /// The time function.
     pub time_fn: TimeFn,
 }
@@ -596,7 +599,11 @@ impl<const D: usize> BoundaryDef<D> {
             fix: b.fix.clone(),
             impermeable: b.impermeable.clone(),
             motion,
-            force: b.force.as_ref().map(|f| RigidForce { vector: vector(f), time_fn: time_fn() }),
+            force: b.force.as_ref().map(|f| RigidForce {
+                vector: vector(f),
+                point: b.force_point.as_ref().map(vector),
+                time_fn: time_fn(),
+            }),
         }
     }
 

@@ -1,8 +1,9 @@
 //! The equilibrium identity of every converged step and the boundaries' reactions
 //! (`equilibrium_error`, `<boundary>.reaction_*` and, for a boundary with prescribed motion or a
-//! rigid body under a force, `<boundary>.displacement_*` in `history.csv`; the worst error in
-//! `summary.json`). A rigid body's displacement is the sum of its steps' motions, kept in
-//! checkpoints.
+//! rigid body under a force, `<boundary>.displacement_*` in `history.csv`, and for a rigid body
+//! that rotates `<boundary>.rotation_*` and `<boundary>.reaction_moment_*`; the worst error in
+//! `summary.json`). A rigid body's displacement (of its force's point) and rotation are the sums
+//! of its steps' motions, kept in checkpoints.
 //!
 //! The identity: the volume integral of the total Cauchy stress over the updated material points,
 //! ∫σ dV = Σ_p (σ' − p m) V_p, against the first moment of the external forces, the reactions and
@@ -26,14 +27,28 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 pub struct Equilibrium<const D: usize> {
     names: Vec<String>,
     moving: Vec<String>,
+    /// The rigid bodies that rotate.
+    rotating: Vec<String>,
     /// The last converged step's forces, and ∫σ dV of its points before their update (an explicit
     /// step's).
     last: Option<(StepForces<D>, Option<Vec<f64>>)>,
     /// The last accepted step's error and reactions.
     error: f64,
     reactions: Vec<[f64; D]>,
-    /// Each rigid body's displacement so far (per boundary; zero for the others) [m].
-    rigid: Vec<[f64; D]>,
+    /// The moments of the last accepted step's reactions about the origin.
+    moments: Vec<[f64; 3]>,
+    /// Each rigid body's displacement [m] and rotation [rad] so far (per boundary; zero for the
+    /// others), in the slots of [`StepForces::rigid_motion`].
+    rigid: Vec<[f64; 6]>,
+}
+
+/// The rotations a body has: about z in the plane, about x, y and z in three dimensions.
+const fn rotations(d: usize) -> std::ops::Range<usize> {
+    if d == 2 {
+        2..3
+    } else {
+        0..3
+    }
 }
 
 impl<const D: usize> Equilibrium<D> {
@@ -47,10 +62,17 @@ impl<const D: usize> Equilibrium<D> {
                 .filter(|b| b.motion.is_some() || b.force.is_some())
                 .map(|b| b.name.clone())
                 .collect(),
+            rotating: model
+                .boundaries
+                .iter()
+                .filter(|b| b.force.as_ref().is_some_and(|f| f.point.is_some()))
+                .map(|b| b.name.clone())
+                .collect(),
             last: None,
             error: 0.0,
             reactions: vec![[0.0; D]; model.boundaries.len()],
-            rigid: vec![[0.0; D]; model.boundaries.len()],
+            moments: vec![[0.0; 3]; model.boundaries.len()],
+            rigid: vec![[0.0; 6]; model.boundaries.len()],
         }
     }
 }
@@ -94,6 +116,10 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
         for b in &self.moving {
             c.extend(AXES[..D].iter().map(|a| format!("{b}.displacement_{a}")));
         }
+        for b in &self.rotating {
+            c.extend(AXES[rotations(D)].iter().map(|a| format!("{b}.rotation_{a}")));
+            c.extend(AXES[rotations(D)].iter().map(|a| format!("{b}.reaction_moment_{a}")));
+        }
         c
     }
 
@@ -113,6 +139,7 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
             let scale = norm(&lhs).max(forces.scale);
             self.error = if scale > 0.0 { norm(&diff) / scale } else { 0.0 };
             self.reactions = forces.reactions;
+            self.moments = forces.reaction_moments;
             for (total, step) in self.rigid.iter_mut().zip(&forces.rigid_motion) {
                 total.iter_mut().zip(step).for_each(|(t, s)| *t += s);
             }
@@ -131,9 +158,15 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
         for (b, rigid) in at.model.boundaries.iter().zip(&self.rigid) {
             match (&b.motion, &b.force) {
                 (Some(m), _) => values.extend(m.displacement_at(at.t)),
-                (None, Some(_)) => values.extend(rigid),
+                (None, Some(_)) => values.extend(&rigid[..D]),
                 (None, None) => {}
             }
+        }
+        let rotating =
+            at.model.boundaries.iter().enumerate().filter(|(_, b)| b.force.as_ref().is_some_and(|f| f.point.is_some()));
+        for (i, _) in rotating {
+            values.extend(rotations(D).map(|a| self.rigid[i][3 + a]));
+            values.extend(rotations(D).map(|a| self.moments[i][a]));
         }
         Ok(values)
     }
@@ -150,14 +183,14 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
                 format!("the checkpoint holds no rigid-body displacements: they count from t = {:.6e} s", from.at.t)
             }));
         };
-        if state.len() != self.rigid.len() * D {
+        if state.len() != self.rigid.len() * 6 {
             return Err(format!(
-                "it holds {} rigid-body displacement components, this case has {}",
+                "it holds {} rigid-body motion components, this case has {}",
                 state.len(),
-                self.rigid.len() * D
+                self.rigid.len() * 6
             ));
         }
-        for (r, s) in self.rigid.iter_mut().zip(state.chunks_exact(D)) {
+        for (r, s) in self.rigid.iter_mut().zip(state.chunks_exact(6)) {
             r.copy_from_slice(s);
         }
         Ok(None)

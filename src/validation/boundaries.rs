@@ -32,6 +32,20 @@ pub(super) fn check(c: &Case) -> Checked {
             mesh_nodes(c, &format!("{key}.mesh"), m)?;
         }
         motion(&key, b, dim)?;
+        if let Some(x) = &b.force_point {
+            if x.len() != dim {
+                return Err(format!(
+                    "key `{key}.force_point`: {dim} coordinates in a case of {dim} dimensions, got {}",
+                    x.len()
+                ));
+            }
+            if c.analysis.geometry == crate::case::Geometry::Axisymmetric {
+                return Err(format!(
+                    "key `{key}.force_point`: a rigid body in axial symmetry is a ring or a disc on the axis, which \
+                     moves along the axis and does not rotate; leave the point out"
+                ));
+            }
+        }
     }
     Ok(())
 }

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 /// prescribed displacement or velocity (a loading platen, a displacement-driven rigid footing: all
 /// its nodes move together, and the boundary's reaction is the force that drives it), or tied to
 /// one unknown displacement per direction that a prescribed `force` drives (a rigid plate or
-/// footing under a load).
+/// footing under a load; with `force_point`, also to its rotation about that point).
 #[derive(Debug, Clone, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Boundary {
@@ -63,11 +63,17 @@ pub struct Boundary {
     /// A rigid body's load [N per metre of thickness in plane strain, N on the full ring in
     /// axial symmetry, N in three dimensions], scaled by the time function: the nodes' listed
     /// displacement components move together by one unknown per direction (a rigid plate or
-    /// footing in translation; listed water components move with them, so the body is impermeable),
+    /// footing in translation; with `force_point` also in rotation; listed water components move with them, so the body is impermeable),
     /// and the boundary's reaction on the material is this force. One component per dimension;
     /// each non-zero one along a direction `fix` lists; not with `displacement`, `velocity` or
     /// `velocity_gradient`; implicit stages only.
     pub force: Option<Vec<f64>>,
+    /// Where the `force` acts [m], one coordinate per dimension: given, the rigid body also
+    /// rotates, by a small rotation about this point (about z in plane strain; about x, y and z in
+    /// three dimensions, as far as the tied components see it: a plate tying only its normal
+    /// component tilts but does not twist), so that an eccentric load tilts a footing;
+    /// `<name>.rotation_*` and `<name>.reaction_moment_*` in history.csv. Not in axial symmetry.
+    pub force_point: Option<Vec<f64>>,
     /// The name of the time function scaling `displacement`, `velocity`, `velocity_gradient` or
     /// `force` (default: a constant 1).
     pub time_function: Option<String>,
@@ -218,6 +224,12 @@ impl Boundary {
                 "key `{key}.force`: drives a rigid body whose motion is unknown; not with a prescribed \
                  `displacement`, `velocity` or `velocity_gradient`"
             ));
+        }
+        if self.force_point.is_some() && self.force.is_none() {
+            return Err(format!("key `{key}.force_point`: is where a `force` acts, and no `force` is given"));
+        }
+        if self.force_point.as_ref().is_some_and(|x| x.iter().any(|v| !v.is_finite())) {
+            return Err(format!("key `{key}.force_point`: must be finite"));
         }
         if self.time_function.is_some() && !self.moves() && self.force.is_none() {
             return Err(format!(
