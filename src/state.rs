@@ -18,7 +18,7 @@ use crate::case::Case;
 use crate::model::particles::Particles;
 
 /// Version of the checkpoint layout; a file of another version is refused.
-pub const FORMAT_VERSION: u64 = 9;
+pub const FORMAT_VERSION: u64 = 10;
 
 /// The particle arrays of a checkpoint of points in `dim` dimensions: (name, components), in the
 /// order of [`write_record`]: `dim` components per vector, dim² for F (row by row), six stresses.

@@ -245,6 +245,7 @@ mod tests {
             geometry: shape::Geometry::Solid,
             stiffness: m.stiffness,
             stress_recovery: m.stress_recovery,
+            filtered_mode_control: m.filtered_mode_control,
             internal_force: m.internal_force,
             linear_increments: m.linear_increments,
             stiffness_in_jacobian: m.stiffness_in_jacobian,

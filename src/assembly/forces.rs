@@ -31,9 +31,10 @@ pub struct StepForces<const D: usize = 2> {
     /// directions it does not tie), then its rotation about x, y, z [rad] (zero unless it rotates;
     /// in the plane about z alone).
     pub rigid_motion: Vec<[f64; 6]>,
-    /// The moment about the origin of each boundary's reactions, Σ x_i × R_i over its nodes at
+    /// The moment about the origin of each boundary's reactions at its grid nodes, Σ x_i × R_i at
     /// their grid positions [N m per m in the plane (about z), N m in three dimensions]: for a
-    /// rigid body that rotates, the moment of its force about the origin when it is in balance.
+    /// rigid body that rotates, the moment of its force about the origin when it is in balance
+    /// (the shares of the held slots beyond a wall, which only walls have, are left out).
     pub reaction_moments: Vec<[f64; 3]>,
     /// The work of the external forces and the reactions over the step, Σ_i F̄_i · Δd_i over the
     /// displacement dofs of both phases, with F̄ the mean of the forces at t_n and t_{n+1}

@@ -37,8 +37,8 @@ pub struct PatternTies {
     pub pairs: Vec<(u32, u32)>,
     /// The global node numbers of the virtual masters, in order of their indices.
     pub extra: Vec<i32>,
-    /// Each direction's master node: its ghosted index, or where this rank does not ghost it a
-    /// virtual index past the ghosted nodes.
+    /// Each master's node (in the order of `DofMap::ties`): its ghosted index, or where this rank
+    /// does not ghost it a virtual index past the ghosted nodes.
     pub masters: Vec<u32>,
 }
 

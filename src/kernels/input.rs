@@ -61,6 +61,9 @@ pub struct ParticleInput<const D: usize = 2> {
     pub jbar: f64,
     /// The scale κ [Pa/m] of an implicit F̄ step's projection rows ([`fbar`]; 0 otherwise).
     pub fbar_rows: f64,
+    /// The factor α of the control of the modes a recovered strain filters
+    /// ([`super::control`]; 0: none).
+    pub control: f64,
 }
 
 #[cfg(test)]
@@ -91,6 +94,7 @@ impl<const D: usize> ParticleInput<D> {
             dt: 0.0,
             jbar: 1.0,
             fbar_rows: 0.0,
+            control: 0.0,
         }
     }
 }
@@ -133,6 +137,7 @@ impl<const D: usize> ParticleInput<D> {
             dt: 0.0,
             jbar: ps.jbar[idx],
             fbar_rows: 0.0,
+            control: model.filtered_mode_control,
         }
     }
 }

@@ -51,6 +51,7 @@
 //! ([`fbar`], [`kinematics::Kinematics::with_projected_volume`]).
 
 pub mod cell;
+pub mod control;
 pub mod fbar;
 pub mod flow;
 pub mod inertia;
@@ -721,6 +722,7 @@ pub fn residual_terms<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Sch
         inertia::residual(pt, nm, out);
     }
     stress::residual(pt, nm, out);
+    control::residual(pt, nm, out);
     stress::pore_pressure::residual(pt, nm, out);
     if pt.layout.w.is_some() {
         inertia::drag::residual(pt, nm, out);
@@ -749,6 +751,7 @@ pub fn tangent_with<const D: usize, const M: usize>(pt: &Point<D, M>, nm: &Schem
     out[..m * m].fill(0.0);
     inertia::tangent(pt, nm, out);
     stress::tangent_with(pt, nm, out, material);
+    control::tangent(pt, nm, out);
     stress::pore_pressure::tangent(pt, nm, out);
     if pt.layout.w.is_some() {
         inertia::drag::tangent(pt, nm, out);

@@ -67,6 +67,8 @@ pub struct Model<const D: usize = 2> {
     pub stiffness: crate::case::Stiffness,
     /// How a point's strain increment is recovered ([001] §5.5).
     pub stress_recovery: crate::case::StressRecovery,
+    /// The factor α of the control of the modes CMPM's recovered strain filters (0: none).
+    pub filtered_mode_control: f64,
     /// How the skeleton's internal force is integrated (at the points, or double-mapped).
     pub internal_force: crate::case::InternalForce,
     /// Geometrically linear steps (`analysis.kinematics = "linear_increments"`).
@@ -489,6 +491,7 @@ impl<const D: usize> Model<D> {
             geometry: geometry_of(case),
             stiffness: case.stabilisation.stiffness,
             stress_recovery: case.stabilisation.stress_recovery,
+            filtered_mode_control: case.stabilisation.filtered_mode_control,
             internal_force: case.stabilisation.internal_force,
             linear_increments: case.analysis.kinematics == crate::case::KinematicsKind::LinearIncrements,
             stiffness_in_jacobian: case.stabilisation.mapped_stiffness == crate::case::MappedStiffnessUse::Jacobian,

@@ -84,8 +84,10 @@ pub(super) fn resolve(
             body.params.iter().map(|p| if let Param::Translation(d) = *p { body.force[s][d] } else { 0.0 }).collect()
         });
         let loads = [&g[0], &g[1]].map(|g| sel.master_forces(g));
-        unresisted(&body.params, &sel, &candidates, &g[0], &loads[0], length)
-            .map_err(|what| format!("boundary `{}`: its force {what}", name()))?;
+        for (g, f) in g.iter().zip(&loads) {
+            unresisted(&body.params, &sel, &candidates, g, f, length)
+                .map_err(|what| format!("boundary `{}`: its force {what}", name()))?;
+        }
         let start = dofs.ties.len();
         for (k, &m) in sel.masters.iter().enumerate() {
             let c = &candidates[m];
@@ -107,9 +109,15 @@ pub(super) fn resolve(
     }
     for t in &mut dofs.tied {
         let body = &dofs.bodies[t.body as usize];
-        let x = position(t.q as usize / nd);
-        let r = std::array::from_fn(|d| x[d] - body.point[d]);
-        t.w = body.selection.weights(&body.params, t.dir as usize, r);
+        // A master moves as itself, exactly (its row stays its own in the Jacobian).
+        let own = body.masters.clone().find(|&k| dofs.ties[k].master_local == Some(t.q as usize));
+        t.w = match own {
+            Some(k) => std::array::from_fn(|i| (i == k - body.masters.start) as u8 as f64),
+            None => {
+                let x = position(t.q as usize / nd);
+                body.selection.weights(&body.params, t.dir as usize, std::array::from_fn(|d| x[d] - body.point[d]))
+            }
+        };
     }
     let masters: Vec<usize> = dofs.ties.iter().filter_map(|t| t.master_local).collect();
     let tied = &dofs.tied;
@@ -159,7 +167,7 @@ fn unresisted(
                 "turns the body about {axis} (a moment of {:.6e} N m, per metre in the plane, about its tied nodes), \
                  which its tied components do not resist: tie the components that do, or put `force_point` where the force's line of action meets the \
                  body",
-                done - g[j]
+                g[j] - done
             ));
         }
     }
@@ -200,11 +208,11 @@ pub(super) fn pattern_ties(dofs: &DofMap, ghosted: usize) -> PatternTies {
 /// and each owned tied dof's constraint entries.
 #[derive(Debug, Clone, Default)]
 pub(super) struct TiedRows {
-    /// (block (s, b), target block, component, target component, weight) of every block of every
-    /// moved row, in order: an impermeable surface's water rows into their own node's solid rows
-    /// (block (s, b) itself, weight 1), then each non-master rigid-body dof's row into each of its
-    /// masters' (block (m, b)), so that a followed solid row carries its water's on to a master. A
-    /// block's entries for its first target come first.
+    /// Every block of every moved row with each of its targets, in order: an impermeable
+    /// surface's water rows into their own node's solid rows (block (s, b) itself, weight 1), then
+    /// each non-master rigid-body dof's row into each of its masters' (block (m, b), its weight),
+    /// so that a followed solid row carries its water's on to its masters. A block's first target
+    /// reads and zeroes it; the others add the copy.
     pub moves: Vec<Move>,
     /// (block (s, s), component) of every owned tied dof that is not a master and of every
     /// following water dof: its row's unit diagonal.
@@ -217,7 +225,7 @@ pub(super) struct TiedRows {
 /// One block of a moved row and where it goes ([`TiedRows::moves`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Move {
-    /// The block of the row, and its target's.
+    /// The block of the row.
     pub from: u32,
     /// The target block.
     pub to: u32,

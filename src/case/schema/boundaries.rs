@@ -63,8 +63,9 @@ pub struct Boundary {
     /// A rigid body's load [N per metre of thickness in plane strain, N on the full ring in
     /// axial symmetry, N in three dimensions], scaled by the time function: the nodes' listed
     /// displacement components move together by one unknown per direction (a rigid plate or
-    /// footing in translation; with `force_point` also in rotation; listed water components move with them, so the body is impermeable),
-    /// and the boundary's reaction on the material is this force. One component per dimension;
+    /// footing in translation; with `force_point` also in rotation; listed water components move
+    /// with them, so the body is impermeable), and the boundary's reaction on the material is
+    /// this force. One component per dimension;
     /// each non-zero one along a direction `fix` lists; not with `displacement`, `velocity` or
     /// `velocity_gradient`; implicit stages only.
     pub force: Option<Vec<f64>>,

@@ -65,6 +65,12 @@ pub struct Stabilisation {
     /// Needs a mapped `stiffness` (`gauss_mapping`, `double_mapping` or `double_mapping_gimp`), a
     /// one-phase plane case without B-splines; the residual and its exact tangent change together.
     pub internal_force: InternalForce,
+    /// The control of the modes CMPM's recovered strain filters (`stress_recovery = "cmpm"`): a
+    /// factor α ≥ 0 [-] of a stiffness on the difference between the strain of each
+    /// step's increment by the point's basis and by its patch, α V e : C : e / 2 with C the
+    /// material's elastic stiffness (docs/stiffness.md). 0, the default, adds nothing; a field
+    /// both reproduce (every linear one) is not touched.
+    pub filtered_mode_control: f64,
 }
 
 /// How the skeleton's internal force is integrated (see [`Stabilisation::internal_force`]).
@@ -182,6 +188,19 @@ impl Stabilisation {
         }
         if self.fbar {
             self.check_fbar(key)?;
+        }
+        if !(self.filtered_mode_control >= 0.0 && self.filtered_mode_control.is_finite()) {
+            return Err(format!(
+                "key `{key}.filtered_mode_control`: a factor of the elastic stiffness, finite and not negative; got {}",
+                self.filtered_mode_control
+            ));
+        }
+        if self.filtered_mode_control > 0.0 && self.stress_recovery != StressRecovery::Cmpm {
+            return Err(format!(
+                "key `{key}.filtered_mode_control`: controls the modes CMPM's recovered strain filters; set \
+                 `{key}.stress_recovery = \"cmpm\"` (with the basis's own strain, or the mapped force's transpose, no mode \
+                 is filtered)"
+            ));
         }
         if self.stress_recovery == StressRecovery::Cmpm && self.bbar {
             return Err(format!(

@@ -221,6 +221,7 @@ fn terms_in<const D: usize, const M: usize>() -> Vec<Term<D, M>> {
         ("inertia", inertia::residual::<D, M>, inertia::tangent::<D, M>),
         ("drag", inertia::drag::residual::<D, M>, inertia::drag::tangent::<D, M>),
         ("effective stress", stress::residual::<D, M>, stress::tangent::<D, M>),
+        ("filtered-mode control", control::residual::<D, M>, control::tangent::<D, M>),
         ("pore pressure", stress::pore_pressure::residual::<D, M>, stress::pore_pressure::tangent::<D, M>),
         ("porosity gradient", flow::porosity_gradient::residual::<D, M>, flow::porosity_gradient::tangent::<D, M>),
         ("continuity", flow::continuity::residual::<D, M>, flow::continuity::tangent::<D, M>),
@@ -318,6 +319,8 @@ fn check_term(
         p.fbar_rows = 2.0e8;
     }
     let recovered = if recovery { sample_strain(6, hoop) } else { Vec::new() };
+    // The control acts where the strain is recovered (it is nothing otherwise).
+    p.control = 0.4;
     p.stress = stress;
     p.linear = linear;
     let forces = if forces { sample_forces(6, hoop) } else { Vec::new() };
@@ -762,4 +765,60 @@ fn finite_strain_solids_match_central_differences_block_by_block() {
     let st = states(&d0, 2, &Scheme::of(&Integration::Static, 1e-3, false));
     let pt = Point::<2>::with_recovery(&basis, &basis, &st, &p, &finite_strain_models()[2].1, Layout::U);
     assert_ne!(pt.upd.region, soils::Region::Elastic, "the plastic sample stays elastic");
+}
+
+/// The filtered-mode control's forces are the gradient of its energy ½ α V_n e : C : e, with e
+/// formed here from the nodal increments directly (sym Σ_i Δu_i ⊗ (∇S_i − ∇P_i), the hoop part
+/// from T_i − T^P_i), by central differences, in the plane and in axial symmetry; they vanish
+/// with α = 0 and where the strain is the basis's own.
+#[test]
+fn the_filtered_mode_control_is_the_gradient_of_its_energy() {
+    let el = LinearElastic::new(1e7, 0.3);
+    let model = Constitutive::LinearElastic(el);
+    let (g, lambda) = (el.shear_modulus(), el.bulk_modulus() - 2.0 * el.shear_modulus() / 3.0);
+    let nm = Scheme::of(&Integration::Static, 1e-3, false);
+    let layout = Layout::U;
+    for hoop in [false, true] {
+        let (basis, strain) = (sample_in(6, hoop), sample_strain(6, hoop));
+        let mut p = part();
+        p.control = 0.4;
+        let energy = |d: &[f64]| -> f64 {
+            let mut e = [[0.0; 2]; 2];
+            let mut e_hoop = 0.0;
+            for (i, (b, r)) in basis.iter().zip(&strain).enumerate() {
+                let u = [d[2 * i], d[2 * i + 1]];
+                for a in 0..2 {
+                    for c in 0..2 {
+                        let h = |k: usize| b.g[k] - r.g[k];
+                        e[a][c] += 0.5 * (u[a] * h(c) + u[c] * h(a));
+                    }
+                }
+                e_hoop += (b.t - r.t) * u[0];
+            }
+            let tr = e[0][0] + e[1][1] + e_hoop;
+            let ee = e[0][0].powi(2) + e[1][1].powi(2) + 2.0 * e[0][1].powi(2) + e_hoop * e_hoop;
+            0.5 * p.control * p.volume * (lambda * tr * tr + 2.0 * g * ee)
+        };
+        let d0 = increments(12, layout);
+        let st = states(&d0, 2, &nm);
+        let pt = Point::<2>::with_recovery(&basis, &strain, &st, &p, &model, layout);
+        let mut r = vec![0.0; 12];
+        control::residual(&pt, &nm, &mut r);
+        let scale = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0);
+        for k in 0..12 {
+            let step = 1e-7;
+            let (mut dp, mut dm) = (d0.clone(), d0.clone());
+            dp[k] += step;
+            dm[k] -= step;
+            let fd = (energy(&dp) - energy(&dm)) / (2.0 * step);
+            assert!((fd - r[k]).abs() < 1e-6 * scale, "hoop {hoop}, dof {k}: {} against {fd}", r[k]);
+        }
+        let mut none = vec![0.0; 12];
+        let own = Point::<2>::with_recovery(&basis, &basis, &st, &p, &model, layout);
+        control::residual(&own, &nm, &mut none);
+        p.control = 0.0;
+        control::residual(&Point::<2>::with_recovery(&basis, &strain, &st, &p, &model, layout), &nm, &mut none);
+        assert!(none.iter().all(|&v| v == 0.0));
+    }
 }

@@ -84,6 +84,7 @@ mod samples {
             dt: p.dt,
             jbar: p.jbar,
             fbar_rows: p.fbar_rows,
+            control: p.control,
         }
     }
 
