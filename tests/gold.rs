@@ -219,6 +219,7 @@ gold_tests!(
     terzaghi_3d,
     terzaghi_explicit,
     vertical_cut,
+    vertical_cut_dmgc,
     vibrating_bar,
 );
 
