@@ -238,29 +238,42 @@ pub fn build<const D: usize>(
             m.fixed[q] = b.is_some() || !carries_unknown(layout, c, *reached, well_fraction);
         }
     }
-    // The owned nodes, x fastest, and their place in the owned part of global vectors.
-    let owned: usize = owned_count.iter().product();
-    let mut at = [0usize; D];
-    for node in 0..owned {
-        let l = ghost.local(std::array::from_fn(|d| owned_start[d] + at[d])).expect("owned nodes are ghosted");
-        for c in 0..nd {
-            let o = node * nd + c;
-            if m.fixed[l * nd + c] {
-                m.owned_fixed.push((o, l * nd + c));
-            } else {
-                m.free_dofs += 1;
-            }
-            if let Ok(i) = m.tied.binary_search_by_key(&((l * nd + c) as u32), |t| t.q) {
-                m.owned_tied.push((o, i));
-            }
-            if let Ok(f) = m.follows.binary_search_by_key(&((l * nd + c) as u32), |f| f.0) {
-                let solid = m.follows[f].1 as usize % nd;
-                m.owned_follows.push((o, o - c + solid, l * nd + c));
-            }
-        }
-        crate::model::shape::next_combination(&mut at, owned_count);
-    }
+    m.list_owned(ghost, owned_start, owned_count);
     Ok(m)
+}
+
+impl DofMap {
+    /// Lists the owned nodes' fixed, tied and following dofs by their place in the owned part of
+    /// global vectors (the owned nodes x fastest), and counts the free ones.
+    fn list_owned<const D: usize>(
+        &mut self,
+        ghost: &GhostedRange<D>,
+        owned_start: [usize; D],
+        owned_count: [usize; D],
+    ) {
+        let nd = self.nd;
+        let owned: usize = owned_count.iter().product();
+        let mut at = [0usize; D];
+        for node in 0..owned {
+            let l = ghost.local(std::array::from_fn(|d| owned_start[d] + at[d])).expect("owned nodes are ghosted");
+            for c in 0..nd {
+                let (o, q) = (node * nd + c, l * nd + c);
+                if self.fixed[q] {
+                    self.owned_fixed.push((o, q));
+                } else {
+                    self.free_dofs += 1;
+                }
+                if let Ok(i) = self.tied.binary_search_by_key(&(q as u32), |t| t.q) {
+                    self.owned_tied.push((o, i));
+                }
+                if let Ok(f) = self.follows.binary_search_by_key(&(q as u32), |f| f.0) {
+                    let solid = self.follows[f].1 as usize % nd;
+                    self.owned_follows.push((o, o - c + solid, q));
+                }
+            }
+            crate::model::shape::next_combination(&mut at, owned_count);
+        }
+    }
 }
 
 /// The message of a node that rigid body `rigid` and boundary `other` both hold in the component of

@@ -122,13 +122,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
         }
         let field_scales = space.field_norms(step, &magnitude, coll)?;
         let g = &model.grid;
-        let hi = g.extent_max();
-        // About the grid's centre; in axial symmetry about the axis (the radial moment of the hoop
-        // stress is only defined there).
-        let mut origin: [f64; D] = std::array::from_fn(|d| 0.5 * (g.origin[d] + hi[d]));
-        if model.geometry.axisymmetric() {
-            origin[0] = 0.0;
-        }
+        let origin = moments_origin(model);
         let nb = model.boundaries.len();
         // [total moment (D²), external (D²), reaction (D²), inertia (D²), work, reactions per
         // boundary (D nb), rigid motions per boundary (6 nb), reaction moments per boundary (3 nb)]
@@ -166,16 +160,7 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
                 }
             }
         }
-        // The held nodes beyond the grid that GIMP supports reach past a wall (this rank's
-        // particles'): they do not move, and their share of the particles' forces is the wall's
-        // reaction, booked on the boundary that holds the wall node next to them.
-        for (w, share) in step.stencils.beyond.iter().zip(walls.chunks_exact(2 * nd)) {
-            let b = step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
-            let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
-            for &(c, dir) in &motion {
-                book_node_forces(&mut local, nb, b, &xr, dir, [0.0, share[c], share[c] - share[nd + c]]);
-            }
-        }
+        book_walls(&mut local, nb, step, &walls, &motion, &origin);
         let s = coll.sum(&local)?;
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         Ok(StepForces {
@@ -192,6 +177,39 @@ impl<const D: usize, const M: usize, const N: usize> System<D, M, N> {
             node_diagnostics,
         })
     }
+}
+
+/// Books the shares of the held nodes beyond the grid that GIMP supports reach past a wall (this
+/// rank's particles', `walls`, 2 nd per slot: all terms, then inertia): they do not move, and
+/// their share of the particles' forces is the wall's reaction, booked on the boundary that holds
+/// the wall node next to them (of `nb` boundaries), about `origin`.
+fn book_walls<const D: usize, const M: usize>(
+    local: &mut [f64],
+    nb: usize,
+    step: &Step<D, M>,
+    walls: &[f64],
+    motion: &[(usize, usize)],
+    origin: &[f64; D],
+) {
+    let nd = step.dofs.nd;
+    for (w, share) in step.stencils.beyond.iter().zip(walls.chunks_exact(2 * nd)) {
+        let b = step.dofs.boundary[w.wall as usize * nd + w.normal as usize] as usize;
+        let xr: [f64; D] = std::array::from_fn(|d| w.at[d] - origin[d]);
+        for &(c, dir) in motion {
+            book_node_forces(local, nb, b, &xr, dir, [0.0, share[c], share[c] - share[nd + c]]);
+        }
+    }
+}
+
+/// The point the equilibrium identity takes its moments about: the grid's centre; in axial
+/// symmetry on the axis (the radial moment of the hoop stress is only defined there).
+fn moments_origin<const D: usize>(model: &Model<D>) -> [f64; D] {
+    let (g, hi) = (&model.grid, model.grid.extent_max());
+    let mut origin: [f64; D] = std::array::from_fn(|d| 0.5 * (g.origin[d] + hi[d]));
+    if model.geometry.axisymmetric() {
+        origin[0] = 0.0;
+    }
+    origin
 }
 
 /// Adds the moment x × f of a force `f` along direction `dir` at `x` to `m` (about x, y, z).
