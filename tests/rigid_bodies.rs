@@ -422,9 +422,10 @@ fn an_eccentric_force_tilts_a_rigid_plate_as_plane_elasticity_says() {
 
 /// The column in three dimensions: the plate tilts about z as elasticity says (θ_z = −12 P e
 /// H/(E w³ d), within 1.1e-2 at h = 0.25 m), not about x (the force lies in the column's plane of
-/// symmetry), and cannot twist about y (its tied u_y does not see a twist: no such column is
-/// carried); the reactions' moment about the origin is x_F × F in every component, and two ranks
-/// give one rank's answers.
+/// symmetry), and cannot twist about y (its tied u_y does not see a twist: no master carries
+/// it); the reactions' moment about the origin is x_F × F in every component, and two ranks give
+/// one rank's answers; loaded off the centre along z as well, it tilts about x with the sign and
+/// size elasticity gives.
 #[test]
 fn an_eccentric_force_tilts_a_rigid_plate_in_three_dimensions() {
     let (p, e, h, young, w, d) = (5.0e3f64, 0.1f64, 2.0f64, 1.0e7f64, 1.0f64, 0.5f64);
@@ -446,6 +447,14 @@ fn an_eccentric_force_tilts_a_rigid_plate_in_three_dimensions() {
         let (a, b) = (last(&one, name), last(&two, name));
         assert!((a - b).abs() <= 1e-10 * a.abs(), "{name}: {a} on one rank, {b} on two");
     }
+    // Off the centre along z too (e_z = 0.05 m): the plate also tilts about x, by ω_x = 12 P e_z
+    // H/(E w d³) = 4.8e-3 rad (u_y = t_y + ω_z r_x − ω_x r_z), within 5 % on these two cells of
+    // depth (3.7 % measured).
+    let r = run_case(COLUMN_3D, &out_dir("column-3d-z"), &set_args(&["boundaries.plate.force_point=[0.6, 2.0, 0.3]"]));
+    assert!(r.completed(), "{}", r.stderr());
+    let omega_x = 12.0 * p * 0.05 * h / (young * w * d.powi(3));
+    let tilt = last(&r, "plate.rotation_x");
+    assert!((tilt - omega_x).abs() < 5e-2 * omega_x, "tilt about x {tilt} vs {omega_x}");
 }
 
 /// The tangent of a rotating plate's rows (each tied row moved into its two or three masters'
