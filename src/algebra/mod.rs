@@ -7,6 +7,11 @@ pub mod dense;
 pub mod heap;
 pub mod linalg;
 
+/// A D-vector with three components (zero beyond D).
+pub fn pad3<const D: usize>(v: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|d| if d < D { v[d] } else { 0.0 })
+}
+
 /// A 2 × 2 matrix, rows first.
 pub type M2 = [[f64; 2]; 2];
 

@@ -13,6 +13,7 @@
 //! moves its equation, weighted, into the masters', the body's balance.
 
 use super::ties::rigid::{Param, Selection, MAX_PARAMS};
+use crate::algebra::pad3;
 use crate::layout::Layout;
 use crate::model::{Active, Model};
 use petsc::GhostedRange;
@@ -309,16 +310,12 @@ fn bodies_of<const D: usize>(model: &Model<D>, active: &Active, (t0, t1): (f64, 
     for &b in &active.boundaries {
         let def = &model.boundaries[b];
         let Some(force) = &def.force else { continue };
-        let pad = |v: [f64; D]| std::array::from_fn(|d| if d < D { v[d] } else { 0.0 });
-        let mut params: Vec<Param> = (0..D).filter(|&d| def.fix.contains(&solid[d])).map(Param::Translation).collect();
-        if force.point.is_some() {
-            params.extend(if D == 2 { vec![Param::Rotation(2)] } else { (0..3).map(Param::Rotation).collect() });
-        }
+        let translations = (0..D).filter(|&d| def.fix.contains(&solid[d])).map(Param::Translation);
         bodies.push(Body {
             boundary: b,
-            params,
-            point: pad(force.point.unwrap_or([0.0; D])),
-            force: [pad(force.at(t1)), pad(force.at(t0))],
+            params: translations.chain(force.rotation_axes().map(Param::Rotation)).collect(),
+            point: pad3(force.point.unwrap_or([0.0; D])),
+            force: [pad3(force.at(t1)), pad3(force.at(t0))],
             masters: 0..0,
             selection: Selection::default(),
         });

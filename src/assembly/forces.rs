@@ -214,7 +214,7 @@ fn moments_origin<const D: usize>(model: &Model<D>) -> [f64; D] {
 
 /// Adds the moment x × f of a force `f` along direction `dir` at `x` to `m` (about x, y, z).
 fn add_moment<const D: usize>(m: &mut [f64], x: &[f64; D], dir: usize, f: f64) {
-    let x: [f64; 3] = std::array::from_fn(|d| if d < D { x[d] } else { 0.0 });
+    let x = crate::algebra::pad3(*x);
     // x × (f e_dir): its component a is x_b f δ_{c,dir} − x_c f δ_{b,dir} with (a, b, c) cyclic.
     for (a, m) in m.iter_mut().enumerate().take(3) {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);

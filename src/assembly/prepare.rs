@@ -421,10 +421,7 @@ fn dof_map<const D: usize>(
     );
     let mut dofs = if model.boundaries.iter().any(|b| b.force.is_some()) { coll.agree(built)? } else { built? };
     dofs.free_dofs = coll.sum_count(dofs.free_dofs as u64) as usize;
-    let position = |l: usize| {
-        let x = model.grid.position(space.ghost.indices(l));
-        std::array::from_fn(|d| if d < D { x[d] } else { 0.0 })
-    };
+    let position = |l: usize| crate::algebra::pad3(model.grid.position(space.ghost.indices(l)));
     ties::resolve(&mut dofs, &space.l2g, position, |b| model.boundaries[b].name.clone(), coll)?;
     Ok(dofs)
 }

@@ -5,16 +5,17 @@
 //! the smoother patch filters out (Σ_i Δu_i ⊗ ∇P_i = 0 while Σ_i Δu_i ⊗ ∇S_i ≠ 0) changes no
 //! stress, so only inertia resists it. The control is the stiffness of stabilised nodal
 //! integration and of reduced integration's hourglass control, on the difference of the two
-//! strains (Puso, Chen, Zywicz & Elmer 2008, docs/references.md): with h_i = ∇S_i − ∇P_i (and h_θ,i = T_i − T^P_i in axial symmetry) and the step's
-//! difference e = sym Σ_i Δu_i ⊗ h_i (e_θθ = Σ_i h_θ,i Δu_r,i), the point stores the energy
-//! ½ α V_n e : C : e, C the isotropic elastic stiffness of its material (λ, G), so that its
-//! forces are f_i = α V_n (s h_i + s_θθ h_θ,i e_r) with s = λ tr e I + 2 G e, and its tangent the
-//! symmetric α V_n h_i · C · h_j. The difference is taken over each step's increment, not
-//! accumulated: the control resists a filtered mode's growth in a step, not its amplitude (over a
-//! run it acts as a viscosity α C Δt). A field both operators reproduce (every linear one: the
-//! basis's partition of unity, the patch's polynomial reproduction) has e = 0, so the patch test
-//! and the solution of a smooth problem are not changed at first order; and Σ_i x_i ⊗ h_i = 0, so
-//! its forces have no moment and the equilibrium identity holds as without it.
+//! strains (Puso, Chen, Zywicz & Elmer 2008, docs/references.md): with h_i = ∇S_i − ∇P_i (and
+//! h_θ,i = T_i − T^P_i in axial symmetry) and the step's difference e = sym Σ_i Δu_i ⊗ h_i
+//! (e_θθ = Σ_i h_θ,i Δu_r,i), the point stores the energy ½ α V_n e : C : e, C the isotropic
+//! elastic stiffness of its material (λ, G), so that its forces are f_i = α V_n (s h_i + s_θθ h_θ,i
+//! e_r) with s = λ tr e I + 2 G e, and its tangent the symmetric α V_n h_i · C · h_j. The
+//! difference is taken over each step's increment, not accumulated: the control resists a
+//! filtered mode's growth in a step, not its amplitude (over a run it acts as a viscosity
+//! α C Δt). A field both operators reproduce (every linear one: the basis's partition of unity,
+//! the patch's polynomial reproduction) has e = 0, so the patch test and the solution of a smooth
+//! problem are not changed at first order; and Σ_i x_i ⊗ h_i = 0, so its forces have no moment and
+//! the equilibrium identity holds as without it.
 
 use super::{NodeBasis, Point};
 use crate::scheme::Scheme;

@@ -484,6 +484,16 @@ pub struct RigidForce<const D: usize = 2> {
 }
 
 impl<const D: usize> RigidForce<D> {
+    /// The axes it turns the body about (indices of x, y, z): none without a point of
+    /// application; z in the plane; x, y and z in three dimensions.
+    pub fn rotation_axes(&self) -> std::ops::Range<usize> {
+        match (self.point, D) {
+            (None, _) => 0..0,
+            (Some(_), 2) => 2..3,
+            (Some(_), _) => 0..3,
+        }
+    }
+
     /// The force at time `t`.
     pub fn at(&self, t: f64) -> [f64; D] {
         let f = self.time_fn.eval(t);

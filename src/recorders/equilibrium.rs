@@ -27,8 +27,8 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 pub struct Equilibrium<const D: usize> {
     names: Vec<String>,
     moving: Vec<String>,
-    /// The rigid bodies that rotate.
-    rotating: Vec<String>,
+    /// The rigid bodies that rotate, with the axes they turn about.
+    rotating: Vec<(String, std::ops::Range<usize>)>,
     /// The last converged step's forces, and ∫σ dV of its points before their update (an explicit
     /// step's).
     last: Option<(StepForces<D>, Option<Vec<f64>>)>,
@@ -40,15 +40,6 @@ pub struct Equilibrium<const D: usize> {
     /// Each rigid body's displacement [m] and rotation [rad] so far (per boundary; zero for the
     /// others), in the slots of [`StepForces::rigid_motion`].
     rigid: Vec<[f64; 6]>,
-}
-
-/// The rotations a body has: about z in the plane, about x, y and z in three dimensions.
-const fn rotations(d: usize) -> std::ops::Range<usize> {
-    if d == 2 {
-        2..3
-    } else {
-        0..3
-    }
 }
 
 impl<const D: usize> Equilibrium<D> {
@@ -65,8 +56,8 @@ impl<const D: usize> Equilibrium<D> {
             rotating: model
                 .boundaries
                 .iter()
-                .filter(|b| b.force.as_ref().is_some_and(|f| f.point.is_some()))
-                .map(|b| b.name.clone())
+                .filter_map(|b| Some((b.name.clone(), b.force.as_ref()?.rotation_axes())))
+                .filter(|(_, axes)| !axes.is_empty())
                 .collect(),
             last: None,
             error: 0.0,
@@ -116,9 +107,9 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
         for b in &self.moving {
             c.extend(AXES[..D].iter().map(|a| format!("{b}.displacement_{a}")));
         }
-        for b in &self.rotating {
-            c.extend(AXES[rotations(D)].iter().map(|a| format!("{b}.rotation_{a}")));
-            c.extend(AXES[rotations(D)].iter().map(|a| format!("{b}.reaction_moment_{a}")));
+        for (b, axes) in &self.rotating {
+            c.extend(AXES[axes.clone()].iter().map(|a| format!("{b}.rotation_{a}")));
+            c.extend(AXES[axes.clone()].iter().map(|a| format!("{b}.reaction_moment_{a}")));
         }
         c
     }
@@ -162,11 +153,10 @@ impl<const D: usize> Recorder<D> for Equilibrium<D> {
                 (None, None) => {}
             }
         }
-        let rotating =
-            at.model.boundaries.iter().enumerate().filter(|(_, b)| b.force.as_ref().is_some_and(|f| f.point.is_some()));
-        for (i, _) in rotating {
-            values.extend(rotations(D).map(|a| self.rigid[i][3 + a]));
-            values.extend(rotations(D).map(|a| self.moments[i][a]));
+        for (i, b) in at.model.boundaries.iter().enumerate() {
+            let axes = b.force.as_ref().map_or(0..0, |f| f.rotation_axes());
+            values.extend(axes.clone().map(|a| self.rigid[i][3 + a]));
+            values.extend(axes.map(|a| self.moments[i][a]));
         }
         Ok(values)
     }

@@ -12,6 +12,7 @@
 //! over all particles whose neighbourhood has enough points for the fit. A field that is locally
 //! quadratic scores 0, a smooth field O(h³ p‴/p), an alternating pattern of amplitude A about A/|p|.
 
+use crate::algebra::pad3;
 use crate::distribution::Owners;
 use crate::model::Model;
 use crate::parallel::Collective;
@@ -43,13 +44,13 @@ pub fn pressure_fit<const D: usize>(model: &Model<D>, owners: &Owners<D>, coll: 
     let ps = &model.particles;
     let g = &model.grid;
     // In the plane the third direction is one cell of unit size at z = 0.
-    let (origin, h) = (pad(g.origin), std::array::from_fn(|d| if d < D { g.h[d] } else { 1.0 }));
+    let (origin, h) = (pad3(g.origin), std::array::from_fn(|d| if d < D { g.h[d] } else { 1.0 }));
     let cells: [i64; 3] = std::array::from_fn(|d| if d < D { g.cells[d] as i64 } else { 1 });
     let owner = |c: [i64; 3]| owners.rank_of_cell_in(std::array::from_fn(|d| c[d].clamp(0, cells[d] - 1) as usize));
     let me = coll.rank();
     let mut points: Vec<FitPoint> = (0..ps.len())
         .map(|k| {
-            let x = pad(ps.x[k]);
+            let x = pad3(ps.x[k]);
             [x[0], x[1], x[2], ps.p[k], ps.body[k] as f64]
         })
         .collect();
@@ -85,11 +86,6 @@ pub fn pressure_fit<const D: usize>(model: &Model<D>, owners: &Owners<D>, coll: 
     Ok(Fit { index: if sums[1] <= 0.0 { 0.0 } else { (sums[0] / sums[1]).sqrt() }, max_deviation: worst })
 }
 
-/// A D-vector with three components (zero beyond D).
-fn pad<const D: usize>(v: [f64; D]) -> [f64; 3] {
-    std::array::from_fn(|d| if d < D { v[d] } else { 0.0 })
-}
-
 /// The cell (i, j, k) of point `p` and its body (k = 0 in the plane, whose z and origin are 0
 /// and whose `h[2]` is 1).
 fn cell_of(p: &FitPoint, origin: [f64; 3], h: [f64; 3]) -> FitCell {
@@ -101,7 +97,7 @@ fn cell_of(p: &FitPoint, origin: [f64; 3], h: [f64; 3]) -> FitCell {
 /// body's points apart.
 pub fn fit_of(points: &[[f64; 4]], origin: [f64; 2], h: [f64; 2]) -> Fit {
     let points: Vec<FitPoint> = points.iter().map(|p| [p[0], p[1], 0.0, p[2], p[3]]).collect();
-    let (r2, s2, worst) = sums_of(&points, pad(origin), [h[0], h[1], 1.0], |_| true);
+    let (r2, s2, worst) = sums_of(&points, pad3(origin), [h[0], h[1], 1.0], |_| true);
     Fit { index: if s2 <= 0.0 { 0.0 } else { (r2 / s2).sqrt() }, max_deviation: worst }
 }
 

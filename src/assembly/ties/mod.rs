@@ -19,9 +19,10 @@
 //! rewriting within one node: its water row moves into the solid's row of its direction and
 //! becomes U_d − u_d = 0, so that no water crosses the surface while it moves with the material.
 //!
-//! At convergence every tied dof moves as the master, the nodes' residual entries are the forces
-//! the body exerts on the material (its reactions, [`super::forces`]), and they sum to its force.
-//! The master may lie far from a rank's points: the ranks that do not ghost it name it by a
+//! At convergence every tied dof moves with the body, the nodes' residual entries are the forces
+//! the body exerts on the material (its reactions, [`super::forces`]), they sum to its force, and
+//! for a body that rotates their moment about the force's point is zero. A master may lie far
+//! from a rank's points: the ranks that do not ghost it name it by a
 //! *virtual* ghosted index past their ghosted nodes ([`super::pattern::Pattern::tie`]), whose rows
 //! and columns the matrix places by the master's global node number; the residual gathers the
 //! sums and the master's value over all ranks with one reduction per evaluation.
@@ -165,8 +166,8 @@ fn unresisted(
             };
             return Err(format!(
                 "turns the body about {axis} (a moment of {:.6e} N m, per metre in the plane, about its tied nodes), \
-                 which its tied components do not resist: tie the components that do, or put `force_point` where the force's line of action meets the \
-                 body",
+                 which its tied components do not resist: tie the components that do, or put `force_point` where \
+                 the force's line of action meets the body",
                 g[j] - done
             ));
         }
